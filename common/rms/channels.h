@@ -1,0 +1,12 @@
+#pragma once
+// LCM channel names. docs/protocol.md "Channels" is the one description.
+// Every name is used with the session's channel suffix appended (see
+// LcmOptions::channel_suffix), so several stations can share a lab network.
+namespace rms::channels {
+
+inline constexpr const char* kOperatorInput = "RMS_OPERATOR_INPUT";  // operator_station -> dynamics_proc
+inline constexpr const char* kDcpFrame = "RMS_DCP_FRAME";            // dynamics_proc -> scene_proc
+inline constexpr const char* kEsgFrame = "RMS_ESG_FRAME";            // scene_proc -> esg_renderer
+inline constexpr const char* kStatus = "RMS_STATUS";                 // every process -> monitors, log
+
+}  // namespace rms::channels

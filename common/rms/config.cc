@@ -1,0 +1,310 @@
+#include "rms/config.h"
+
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <toml++/toml.h>
+
+#include "rms/check.h"
+
+#ifndef RMSLAB_DEFAULT_CONFIG
+#error "RMSLAB_DEFAULT_CONFIG must be defined by the build"
+#endif
+
+namespace rms {
+
+std::string DefaultConfigPath() { return RMSLAB_DEFAULT_CONFIG; }
+
+namespace {
+
+std::string Fmt(double v) {
+  std::ostringstream os;
+  os.precision(10);
+  os << v;
+  return os.str();
+}
+
+// Reads one TOML table strictly: every key it is asked for must be present
+// and well-formed; Finish() refuses keys nobody asked for.
+class TableReader {
+ public:
+  TableReader(const toml::table* table, std::string path, const std::string* source)
+      : table_(table), path_(std::move(path)), source_(source) {}
+
+  [[noreturn]] void Fail(std::string_view key, const std::string& reason) const {
+    throw InputError(*source_ + ": key '" + Key(key) + "': " + reason);
+  }
+  std::string Key(std::string_view key) const {
+    return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
+  }
+
+  const toml::node* Get(std::string_view key) {
+    used_.insert(std::string(key));
+    const toml::node* n = table_->get(key);
+    if (n == nullptr) Fail(key, "missing (every key is required; see docs/config.md)");
+    return n;
+  }
+
+  double Number(std::string_view key, double lo, double hi, bool open_lo = false) {
+    const toml::node* n = Get(key);
+    std::optional<double> v = n->value<double>();
+    if (!v || !(n->is_integer() || n->is_floating_point())) Fail(key, "must be a number");
+    CheckRange(key, *v, lo, hi, open_lo);
+    return *v;
+  }
+
+  void CheckRange(std::string_view key, double v, double lo, double hi, bool open_lo) const {
+    if (!std::isfinite(v)) Fail(key, "must be finite, got " + Fmt(v));
+    if (open_lo ? !(v > lo) : !(v >= lo)) {
+      Fail(key, "must be " + std::string(open_lo ? "> " : ">= ") + Fmt(lo) + ", got " + Fmt(v));
+    }
+    if (!(v <= hi)) Fail(key, "must be <= " + Fmt(hi) + ", got " + Fmt(v));
+  }
+
+  double Positive(std::string_view key, double hi = 1e4) { return Number(key, 0.0, hi, true); }
+
+  std::vector<double> Numbers(std::string_view key, std::size_t count, double lo, double hi) {
+    const toml::node* n = Get(key);
+    const toml::array* a = n->as_array();
+    if (a == nullptr || a->size() != count) {
+      Fail(key, "must be an array of " + std::to_string(count) + " numbers");
+    }
+    std::vector<double> out;
+    for (const toml::node& e : *a) {
+      std::optional<double> v = e.value<double>();
+      if (!v || !(e.is_integer() || e.is_floating_point())) {
+        Fail(key, "must be an array of " + std::to_string(count) + " numbers");
+      }
+      CheckRange(key, *v, lo, hi, false);
+      out.push_back(*v);
+    }
+    return out;
+  }
+
+  Eigen::Vector3d Vec3(std::string_view key, double limit = 1e4) {
+    std::vector<double> v = Numbers(key, 3, -limit, limit);
+    return {v[0], v[1], v[2]};
+  }
+
+  std::pair<double, double> Range(std::string_view key, double lo, double hi) {
+    std::vector<double> v = Numbers(key, 2, lo, hi);
+    if (!(v[0] < v[1])) Fail(key, "must be [low, high] with low < high");
+    return {v[0], v[1]};
+  }
+
+  std::string String(std::string_view key) {
+    const toml::node* n = Get(key);
+    std::optional<std::string> v = n->value<std::string>();
+    if (!v || !n->is_string()) Fail(key, "must be a string");
+    return *v;
+  }
+
+  TableReader Sub(std::string_view key) {
+    const toml::node* n = Get(key);
+    const toml::table* t = n->as_table();
+    if (t == nullptr) Fail(key, "must be a table");
+    return TableReader(t, Key(key), source_);
+  }
+
+  const toml::array* Array(std::string_view key) {
+    const toml::node* n = Get(key);
+    const toml::array* a = n->as_array();
+    if (a == nullptr) Fail(key, "must be an array of tables ([[" + Key(key) + "]])");
+    return a;
+  }
+
+  // A rotation from two unit axes given in R (y and z); x = y cross z.
+  Eigen::Matrix3d Rotation(std::string_view y_key, std::string_view z_key) {
+    Eigen::Vector3d y = Vec3(y_key), z = Vec3(z_key);
+    if (std::abs(y.norm() - 1.0) > 1e-6) Fail(y_key, "must be a unit vector");
+    if (std::abs(z.norm() - 1.0) > 1e-6) Fail(z_key, "must be a unit vector");
+    if (std::abs(y.dot(z)) > 1e-6) Fail(z_key, "must be perpendicular to " + Key(y_key));
+    Eigen::Matrix3d r;
+    r.col(0) = y.cross(z);
+    r.col(1) = y;
+    r.col(2) = z;
+    return r;
+  }
+
+  void Finish() const {
+    for (auto&& [k, v] : *table_) {
+      if (!used_.count(std::string(k.str()))) {
+        throw InputError(*source_ + ": key '" + Key(k.str()) +
+                         "': unknown key (misspelt? see docs/config.md)");
+      }
+    }
+  }
+
+  const std::string& path() const { return path_; }
+
+ private:
+  const toml::table* table_;
+  std::string path_;
+  const std::string* source_;
+  std::set<std::string> used_;
+};
+
+CameraMount ParseMount(TableReader& r) {
+  const std::string m = r.String("mount");
+  if (m == "shuttle") return CameraMount::kShuttle;
+  if (m == "elbow") return CameraMount::kElbow;
+  if (m == "wrist") return CameraMount::kWrist;
+  if (m == "cae") return CameraMount::kCae;
+  r.Fail("mount", "must be one of \"shuttle\", \"elbow\", \"wrist\", \"cae\"; got \"" + m + "\"");
+}
+
+}  // namespace
+
+LabConfig ParseConfig(std::string_view text, const std::string& source) {
+  toml::table root;
+  try {
+    root = toml::parse(text, source);
+  } catch (const toml::parse_error& e) {
+    std::ostringstream os;
+    os << source << ":" << e.source().begin.line << ":" << e.source().begin.column
+       << ": TOML syntax error: " << e.description();
+    throw InputError(os.str());
+  }
+  LabConfig c;
+  c.source = source;
+  TableReader top(&root, "", &c.source);
+
+  {
+    TableReader r = top.Sub("session");
+    c.session.frame_rate_hz = r.Number("frame_rate_hz", 1.0, 1000.0);
+    r.Finish();
+  }
+  {
+    TableReader r = top.Sub("shuttle");
+    c.shuttle.bay_length_ft = r.Positive("bay_length_ft");
+    c.shuttle.bay_width_ft = r.Positive("bay_width_ft");
+    c.shuttle.bay_depth_ft = r.Positive("bay_depth_ft");
+    c.shuttle.door_open_deg = r.Number("door_open_deg", 0.0, 180.0);
+    r.Finish();
+  }
+  {
+    TableReader r = top.Sub("arm");
+    c.arm.p_RoB_R_ft = r.Vec3("base_position_ft");
+    c.arm.upper_boom_ft = r.Positive("upper_boom_ft");
+    c.arm.lower_boom_ft = r.Positive("lower_boom_ft");
+    c.arm.wrist_to_palm_ft = r.Positive("wrist_to_palm_ft");
+    c.arm.boom_diameter_ft = r.Positive("boom_diameter_ft");
+    r.Finish();
+  }
+  {
+    TableReader r = top.Sub("end_effector");
+    auto& e = c.end_effector;
+    e.palm_length_ft = r.Positive("palm_length_ft");
+    e.palm_half_width_ft = r.Positive("palm_half_width_ft");
+    e.palm_half_height_ft = r.Positive("palm_half_height_ft");
+    e.finger_length_ft = r.Positive("finger_length_ft");
+    e.finger_thickness_ft = r.Positive("finger_thickness_ft");
+    e.finger_gap_open_ft = r.Positive("finger_gap_open_ft");
+    e.finger_gap_closed_ft = r.Number("finger_gap_closed_ft", 0.0, 1e4);
+    if (e.finger_gap_closed_ft >= e.finger_gap_open_ft) {
+      r.Fail("finger_gap_closed_ft", "must be less than end_effector.finger_gap_open_ft");
+    }
+    if (e.finger_gap_open_ft + 2 * e.finger_thickness_ft > 2 * e.palm_half_width_ft + 1e-9) {
+      r.Fail("finger_gap_open_ft",
+             "the open fingers (gap + 2 x finger_thickness_ft) must fit within the palm's width "
+             "(2 x palm_half_width_ft)");
+    }
+    r.Finish();
+  }
+  {
+    TableReader r = top.Sub("payload");
+    auto& p = c.payload;
+    p.diameter_ft = r.Positive("diameter_ft");
+    p.length_ft = r.Positive("length_ft");
+    p.probe_diameter_ft = r.Positive("probe_diameter_ft");
+    if (p.probe_diameter_ft >= p.diameter_ft) r.Fail("probe_diameter_ft", "must be less than payload.diameter_ft");
+    p.probe_length_ft = r.Positive("probe_length_ft");
+    p.p_RoPo_R_ft = r.Vec3("position_ft");
+    p.R_RP = r.Rotation("y_axis", "z_axis");
+    p.p_PoBar_P_ft = r.Vec3("bar_center_ft");
+    p.bar_size_P_ft = r.Vec3("bar_size_ft");
+    for (int i = 0; i < 3; ++i) {
+      if (!(p.bar_size_P_ft[i] > 0)) r.Fail("bar_size_ft", "every extent must be > 0");
+    }
+    r.Finish();
+  }
+  {
+    TableReader r = top.Sub("cae");
+    auto& a = c.cae;
+    a.p_RoCo_R_ft = r.Vec3("port_position_ft");
+    a.R_RC = r.Rotation("y_axis", "z_axis");
+    a.across_flats_ft = r.Positive("across_flats_ft");
+    a.length_ft = r.Positive("length_ft");
+    a.port_diameter_ft = r.Positive("port_diameter_ft");
+    r.Finish();
+  }
+  {
+    TableReader inputs = top.Sub("inputs");
+    for (int i = 0; i < kNumAnalogInputs; ++i) {
+      TableReader r = inputs.Sub(kAnalogInputNames[i]);
+      InputCalibration& cal = c.inputs[i];
+      cal.unit = r.String("unit");
+      cal.units_per_count = r.Number("units_per_count", -1e6, 1e6);
+      if (cal.units_per_count == 0.0) r.Fail("units_per_count", "must not be zero");
+      cal.zero_count = r.Number("zero_count", -32768.0, 32767.0);
+      cal.min = r.Number("min", -1e6, 1e6);
+      cal.max = r.Number("max", -1e6, 1e6);
+      if (!(cal.min < cal.max)) r.Fail("max", "must be greater than min");
+      cal.initial = r.Number("initial", cal.min, cal.max);
+      // The range must be reachable by the 15-bit-plus-sign converter.
+      for (double v : {cal.min, cal.max}) {
+        const double counts = v / cal.units_per_count + cal.zero_count;
+        if (counts < -32768.5 || counts > 32767.5) {
+          r.Fail(v == cal.min ? "min" : "max",
+                 "value " + Fmt(v) + " needs " + Fmt(counts) +
+                     " counts, outside the ADC's [-32768, 32767]; change units_per_count");
+        }
+      }
+      r.Finish();
+    }
+    inputs.Finish();
+  }
+  {
+    const toml::array* cams = top.Array("cameras");
+    if (cams->size() != kNumCameraStations) {
+      top.Fail("cameras", "must list exactly 8 camera stations ([[cameras]] tables), got " +
+                              std::to_string(cams->size()));
+    }
+    int i = 0;
+    for (const toml::node& n : *cams) {
+      ++i;
+      const toml::table* t = n.as_table();
+      const std::string path = "cameras[" + std::to_string(i) + "]";
+      if (t == nullptr) top.Fail("cameras", "entry " + std::to_string(i) + " must be a table");
+      TableReader r(t, path, &c.source);
+      CameraStationConfig cam;
+      cam.name = r.String("name");
+      cam.mount = ParseMount(r);
+      cam.p_MoCam_M_ft = r.Vec3("position_ft");
+      cam.p_MoAim_M_ft = r.Vec3("aim_at_ft");
+      const Eigen::Vector3d look = cam.p_MoAim_M_ft - cam.p_MoCam_M_ft;
+      if (look.norm() < 1e-3) r.Fail("aim_at_ft", "must differ from position_ft");
+      if (std::abs(look.normalized().z()) > 0.999) {
+        r.Fail("aim_at_ft", "the default aim must not be along the mount's z axis (the camera's up)");
+      }
+      std::tie(cam.pan_min_deg, cam.pan_max_deg) = r.Range("pan_deg", -180.0, 180.0);
+      std::tie(cam.tilt_min_deg, cam.tilt_max_deg) = r.Range("tilt_deg", -89.0, 89.0);
+      std::tie(cam.fov_min_deg, cam.fov_max_deg) = r.Range("fov_deg", 1.0, 120.0);
+      r.Finish();
+      c.cameras.push_back(std::move(cam));
+    }
+  }
+  top.Finish();
+  return c;
+}
+
+LabConfig LoadConfig(const std::string& path) {
+  std::ifstream f(path);
+  if (!f) throw InputError(path + ": cannot read the configuration file");
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ParseConfig(ss.str(), path);
+}
+
+}  // namespace rms

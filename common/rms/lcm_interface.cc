@@ -1,0 +1,155 @@
+#include "rms/lcm_interface.h"
+
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <lcm/lcm-cpp.hpp>
+
+#include "rms/check.h"
+
+namespace rms {
+
+std::int64_t WallTimeUs() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+void ValidateChannelSuffix(std::string_view suffix) {
+  for (char ch : suffix) {
+    const bool ok = (ch >= 'A' && ch <= 'Z') || (ch >= 'a' && ch <= 'z') ||
+                    (ch >= '0' && ch <= '9') || ch == '_';
+    if (!ok) {
+      throw InputError("channel suffix '" + std::string(suffix) +
+                       "' may hold only letters, digits and '_'");
+    }
+  }
+}
+
+LcmInterface::LcmInterface(std::string suffix) : suffix_(std::move(suffix)) {
+  ValidateChannelSuffix(suffix_);
+}
+
+// ---------------------------------------------------------------- UdpLcm
+
+struct UdpLcm::Sub {
+  Handler handler;
+  static void OnMessage(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/, Sub* self) {
+    self->handler(rbuf->data, static_cast<int>(rbuf->data_size), rbuf->recv_utime);
+  }
+};
+
+UdpLcm::UdpLcm(const LcmOptions& options)
+    : LcmInterface(options.channel_suffix),
+      url_(options.url),
+      queue_capacity_(options.queue_capacity) {
+  if (queue_capacity_ < 1) throw InputError("LCM queue capacity must be >= 1");
+  lcm_ = std::make_unique<lcm::LCM>(url_);
+  if (!lcm_->good()) {
+    throw TransportError(
+        "LCM could not open '" + url_ +
+        "'. For UDP multicast this machine needs a route to 224.0.0.0/4; on a host without a "
+        "default route add one on loopback:  sudo ip route add 224.0.0.0/4 dev lo  "
+        "(scripts/lab and scripts/test add it for you). Check the URL's group, port and ttl.");
+  }
+}
+
+UdpLcm::~UdpLcm() = default;
+
+bool UdpLcm::Publish(std::string_view channel, const void* data, int size) {
+  return lcm_->publish(FullChannel(channel), data, static_cast<unsigned>(size)) == 0;
+}
+
+void UdpLcm::Subscribe(std::string_view channel, Handler handler) {
+  auto sub = std::make_unique<Sub>();
+  sub->handler = std::move(handler);
+  // LCM treats the channel as a regex; our names hold only [A-Za-z0-9_].
+  lcm::Subscription* s = lcm_->subscribeFunction(FullChannel(channel), &Sub::OnMessage, sub.get());
+  RMS_CHECK(s != nullptr);
+  s->setQueueCapacity(queue_capacity_);
+  subs_.push_back(std::move(sub));
+}
+
+int UdpLcm::HandleSubscriptions(int timeout_ms) {
+  int handled = 0;
+  errno = 0;
+  int r = lcm_->handleTimeout(timeout_ms);
+  while (r > 0) {
+    ++handled;
+    r = lcm_->handleTimeout(0);  // drain what is already queued
+  }
+  // A signal (SIGINT to stop) interrupting the wait is not a transport error.
+  if (r < 0 && errno == EINTR) return handled;
+  return r < 0 ? r : handled;
+}
+
+std::int64_t UdpLcm::NowUs() const { return WallTimeUs(); }
+
+// ---------------------------------------------------------------- LogLcm
+
+LogLcm::LogLcm(const std::string& input_path, const std::string& output_path,
+               std::string channel_suffix)
+    : LcmInterface(std::move(channel_suffix)) {
+  if (!input_path.empty()) {
+    in_ = std::make_unique<lcm::LogFile>(input_path, "r");
+    if (!in_->good()) throw InputError("cannot read LCM log '" + input_path + "'");
+    input_done_ = false;
+  }
+  if (!output_path.empty()) {
+    out_ = std::make_unique<lcm::LogFile>(output_path, "w");
+    if (!out_->good()) throw InputError("cannot write LCM log '" + output_path + "'");
+  }
+}
+
+LogLcm::~LogLcm() = default;
+
+bool LogLcm::Publish(std::string_view channel, const void* data, int size) {
+  const std::string full = FullChannel(channel);
+  if (out_) {
+    lcm::LogEvent ev{};
+    ev.timestamp = now_us_;
+    ev.channel = full;
+    ev.datalen = size;
+    ev.data = const_cast<void*>(data);
+    if (out_->writeEvent(&ev) != 0) return false;
+  }
+  Pending p{full, std::vector<std::uint8_t>(static_cast<const std::uint8_t*>(data),
+                                            static_cast<const std::uint8_t*>(data) + size)};
+  pending_.push_back(std::move(p));
+  return true;
+}
+
+void LogLcm::Subscribe(std::string_view channel, Handler handler) {
+  handlers_.emplace_back(FullChannel(channel), std::move(handler));
+}
+
+void LogLcm::Dispatch(const std::string& channel, const void* data, int size) {
+  for (auto& [name, handler] : handlers_) {
+    if (name == channel) handler(data, size, now_us_);
+  }
+}
+
+int LogLcm::HandleSubscriptions(int /*timeout_ms*/) {
+  // Messages published locally go first (they were "sent" before the next
+  // logged event is read), then one logged event.
+  int handled = 0;
+  while (!pending_.empty()) {
+    std::vector<Pending> batch;
+    batch.swap(pending_);
+    for (const Pending& p : batch) {
+      Dispatch(p.channel, p.data.data(), static_cast<int>(p.data.size()));
+      ++handled;
+    }
+  }
+  if (handled > 0 || input_done_) return handled;
+  const lcm::LogEvent* ev = in_->readNextEvent();
+  if (ev == nullptr) {
+    input_done_ = true;
+    return 0;
+  }
+  now_us_ = ev->timestamp;
+  Dispatch(ev->channel, ev->data, ev->datalen);
+  return 1;
+}
+
+}  // namespace rms

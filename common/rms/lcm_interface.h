@@ -1,0 +1,129 @@
+#pragma once
+// The LCM transport behind a small interface (after Drake's
+// lcm/drake_lcm_interface.h and drake_lcm_log.h): processes publish and
+// subscribe through LcmInterface; UdpLcm is real LCM (UDP multicast), LogLcm
+// replays / records an LCM log file deterministically, without a network.
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace lcm {
+class LCM;
+class LogFile;
+}  // namespace lcm
+
+namespace rms {
+
+// Default URL: UDP multicast on this host only (TTL 0). docs/protocol.md "Transport".
+inline constexpr const char* kDefaultLcmUrl = "udpm://239.255.76.67:7667?ttl=0";
+
+struct LcmOptions {
+  std::string url = kDefaultLcmUrl;
+  // Appended to every channel name, e.g. "_BAY2". Letters, digits, '_' only.
+  std::string channel_suffix;
+  // Per-subscription receive queue (LCM's default of 30 drops silently).
+  int queue_capacity = 1000;
+};
+
+// Throws rms::InputError when the suffix has characters other than [A-Za-z0-9_].
+void ValidateChannelSuffix(std::string_view suffix);
+
+// Raised when the transport cannot be opened; the message says how to fix it.
+class TransportError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class LcmInterface {
+ public:
+  // data/size: the raw message; recv_time_us: when it arrived (wall clock for
+  // UDP, the log's timestamp for a log).
+  using Handler = std::function<void(const void* data, int size, std::int64_t recv_time_us)>;
+
+  virtual ~LcmInterface() = default;
+  LcmInterface(const LcmInterface&) = delete;
+  LcmInterface& operator=(const LcmInterface&) = delete;
+
+  // Publishes on channel + suffix. Returns false when the transport refused.
+  virtual bool Publish(std::string_view channel, const void* data, int size) = 0;
+  // Subscribes to exactly channel + suffix.
+  virtual void Subscribe(std::string_view channel, Handler handler) = 0;
+  // Waits up to timeout_ms (0: don't wait) and dispatches what arrived; returns
+  // the number of messages dispatched (0 on timeout or end of log), <0 on error.
+  virtual int HandleSubscriptions(int timeout_ms) = 0;
+  // Time as this transport sees it, microseconds since 1970.
+  virtual std::int64_t NowUs() const = 0;
+
+  const std::string& channel_suffix() const { return suffix_; }
+  std::string FullChannel(std::string_view channel) const {
+    return std::string(channel) + suffix_;
+  }
+
+ protected:
+  explicit LcmInterface(std::string suffix);
+
+ private:
+  std::string suffix_;
+};
+
+// Real LCM. Throws TransportError when LCM is not good() (no multicast route,
+// bad URL), with the fix in the message.
+class UdpLcm final : public LcmInterface {
+ public:
+  explicit UdpLcm(const LcmOptions& options);
+  ~UdpLcm() override;
+  bool Publish(std::string_view channel, const void* data, int size) override;
+  void Subscribe(std::string_view channel, Handler handler) override;
+  int HandleSubscriptions(int timeout_ms) override;
+  std::int64_t NowUs() const override;
+  const std::string& url() const { return url_; }
+
+ private:
+  struct Sub;
+  std::string url_;
+  int queue_capacity_;
+  std::unique_ptr<lcm::LCM> lcm_;
+  std::vector<std::unique_ptr<Sub>> subs_;
+};
+
+// Log-backed LCM. Reads events from an input log (optional) in order and
+// dispatches them to subscribers, one event per HandleSubscriptions call;
+// NowUs() is the last event's timestamp. Published messages are delivered to
+// local subscribers (like multicast loopback) and appended to the output log
+// (optional) with the current log time. No network, no wall clock: runs are
+// deterministic.
+class LogLcm final : public LcmInterface {
+ public:
+  LogLcm(const std::string& input_path, const std::string& output_path,
+         std::string channel_suffix = "");
+  ~LogLcm() override;
+  bool Publish(std::string_view channel, const void* data, int size) override;
+  void Subscribe(std::string_view channel, Handler handler) override;
+  int HandleSubscriptions(int timeout_ms) override;
+  std::int64_t NowUs() const override { return now_us_; }
+  // Sets the time used for publishing when there is no input log.
+  void SetNowUs(std::int64_t t) { now_us_ = t; }
+  bool at_end() const { return input_done_ && pending_.empty(); }
+
+ private:
+  struct Pending {
+    std::string channel;
+    std::vector<std::uint8_t> data;
+  };
+  void Dispatch(const std::string& channel, const void* data, int size);
+  std::unique_ptr<lcm::LogFile> in_;
+  std::unique_ptr<lcm::LogFile> out_;
+  bool input_done_ = true;
+  std::int64_t now_us_ = 0;
+  std::vector<std::pair<std::string, Handler>> handlers_;
+  std::vector<Pending> pending_;
+};
+
+// Wall clock, microseconds since 1970 (CLOCK_REALTIME): the send_time_us of
+// every message.
+std::int64_t WallTimeUs();
+
+}  // namespace rms

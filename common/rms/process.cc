@@ -1,0 +1,132 @@
+#include "rms/process.h"
+
+#include <CLI/CLI.hpp>
+#include <csignal>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <spdlog/sinks/stdout_sinks.h>
+#include <spdlog/spdlog.h>
+#include <unistd.h>
+
+#include "rms/check.h"
+#include "rms/channels.h"
+#include "rms/config.h"
+#include "rms/message_io.h"
+#include "rms/process_status_t.hpp"
+
+namespace rms {
+
+void AddCommonOptions(CLI::App& app, CommonOptions* o) {
+  o->config_path = DefaultConfigPath();
+  app.add_option("--config", o->config_path, "Configuration file (docs/config.md)")
+      ->capture_default_str();
+  app.add_option("--lcm-url", o->lcm.url, "LCM URL (docs/protocol.md, Transport)")
+      ->capture_default_str();
+  app.add_option("--channel-suffix", o->lcm.channel_suffix,
+                 "Suffix appended to every channel name, so several stations share a network");
+  app.add_option("--queue-capacity", o->lcm.queue_capacity,
+                 "LCM receive queue per subscription, messages")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000000));
+  app.add_option("--stats", o->stats_path, "Write the final counters as JSON to this file at exit");
+  app.add_option("--ready-file", o->ready_path,
+                 "Create this file once subscribed and running (for launchers)");
+  app.add_option("--log-level", o->log_level, "trace, debug, info, warn, error")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
+}
+
+void SetUpLogging(const std::string& process, const std::string& level) {
+  auto logger = spdlog::stderr_logger_mt(process);
+  logger->set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%n] [%l] %v");
+  logger->set_level(spdlog::level::from_str(level));
+  logger->flush_on(spdlog::level::info);
+  spdlog::set_default_logger(logger);
+}
+
+namespace {
+std::atomic<bool> g_stop{false};
+extern "C" void OnStopSignal(int) { g_stop.store(true); }
+}  // namespace
+
+void InstallStopHandlers() {
+  struct sigaction sa {};
+  sa.sa_handler = OnStopSignal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  std::signal(SIGPIPE, SIG_IGN);
+}
+bool StopRequested() { return g_stop.load(); }
+void RequestStop() { g_stop.store(true); }
+
+void TouchFile(const std::string& path) {
+  std::ofstream f(path);
+  if (!f) throw InputError("cannot create '" + path + "'");
+}
+
+StatusReporter::StatusReporter(LcmInterface* lcm, std::string process)
+    : lcm_(lcm), process_(std::move(process)) {
+  char buf[256] = {};
+  gethostname(buf, sizeof buf - 1);
+  host_ = buf;
+}
+
+void StatusReporter::Tick(std::int64_t frame, const Counters& counters) {
+  const std::int64_t now = lcm_->NowUs();
+  if (now - last_us_ < 1000000) return;
+  last_us_ = now;
+  Publish(frame, counters, false);
+}
+
+void StatusReporter::Final(std::int64_t frame, const Counters& counters) {
+  Publish(frame, counters, true);
+}
+
+void StatusReporter::Publish(std::int64_t frame, const Counters& counters, bool final) {
+  process_status_t m;
+  m.send_time_us = lcm_->NowUs();
+  m.process = process_;
+  m.host = host_;
+  m.pid = static_cast<std::int32_t>(getpid());
+  m.frame = frame;
+  m.final = final;
+  for (const auto& [k, v] : counters.values()) {
+    if (m.counter_names.size() >= 32000) break;
+    m.counter_names.push_back(k);
+    m.counter_values.push_back(v);
+  }
+  m.num_counters = static_cast<std::int16_t>(m.counter_names.size());
+  PublishMessage(*lcm_, channels::kStatus, m);
+}
+
+void AddLatencyCounters(const LatencyMap& latencies, Counters* counters) {
+  for (const auto& [name, h] : latencies) {
+    const std::string p = "latency." + name + ".";
+    counters->Set(p + "count", h.count());
+    counters->Set(p + "p50_us", static_cast<std::int64_t>(h.Percentile(0.5)));
+    counters->Set(p + "p99_us", static_cast<std::int64_t>(h.Percentile(0.99)));
+    counters->Set(p + "max_us", static_cast<std::int64_t>(h.max_us()));
+  }
+}
+
+void WriteStatsJson(const std::string& path, const std::string& process, const Counters& counters,
+                    const LatencyMap& latencies) {
+  nlohmann::ordered_json j;
+  j["process"] = process;
+  j["counters"] = nlohmann::ordered_json::object();
+  for (const auto& [k, v] : counters.values()) j["counters"][k] = v;
+  j["latency_us"] = nlohmann::ordered_json::object();
+  for (const auto& [name, h] : latencies) {
+    j["latency_us"][name] = {{"count", h.count()},
+                             {"p50", h.Percentile(0.5)},
+                             {"p99", h.Percentile(0.99)},
+                             {"max", h.max_us()},
+                             {"mean", h.mean_us()}};
+  }
+  std::ofstream f(path);
+  if (!f) throw InputError("cannot write stats file '" + path + "'");
+  f << j.dump(2) << "\n";
+}
+
+}  // namespace rms

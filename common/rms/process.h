@@ -1,0 +1,69 @@
+#pragma once
+// What every rmslab process does the same way: common command-line options,
+// stop on SIGINT / SIGTERM, a once-a-second status report on RMS_STATUS, the
+// final counters written as JSON (--stats) and a ready file (--ready-file)
+// that launchers wait for.
+#include <atomic>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "rms/counters.h"
+#include "rms/lcm_interface.h"
+
+namespace CLI {
+class App;
+}
+
+namespace rms {
+
+struct CommonOptions {
+  std::string config_path;  // --config (default: DefaultConfigPath())
+  LcmOptions lcm;           // --lcm-url, --channel-suffix, --queue-capacity
+  std::string stats_path;   // --stats FILE: final counters as JSON at exit
+  std::string ready_path;   // --ready-file FILE: created once subscribed and running
+  std::string log_level = "info";  // --log-level
+};
+
+void AddCommonOptions(CLI::App& app, CommonOptions* options);
+
+// Sets up spdlog's default logger (stderr, "[time] [process] [level] msg").
+void SetUpLogging(const std::string& process, const std::string& level);
+
+// SIGINT / SIGTERM set the stop flag; the main loops poll it.
+void InstallStopHandlers();
+bool StopRequested();
+void RequestStop();
+
+// Creates the file (empty); throws rms::InputError if it cannot.
+void TouchFile(const std::string& path);
+
+// Publishes process_status_t on RMS_STATUS once a second (transport time)
+// and once at exit.
+class StatusReporter {
+ public:
+  StatusReporter(LcmInterface* lcm, std::string process);
+  void Tick(std::int64_t frame, const Counters& counters);
+  void Final(std::int64_t frame, const Counters& counters);
+
+ private:
+  void Publish(std::int64_t frame, const Counters& counters, bool final);
+  LcmInterface* lcm_;
+  std::string process_;
+  std::string host_;
+  std::int64_t last_us_ = 0;
+};
+
+// Latency histograms by link name, e.g. "input_to_dcp_us".
+using LatencyMap = std::map<std::string, LatencyHistogram>;
+
+// Adds p50 / p99 / max / count of each histogram to the counters (as
+// "latency.NAME.p50_us" ...), for status reports.
+void AddLatencyCounters(const LatencyMap& latencies, Counters* counters);
+
+// Writes {"process":..., "counters":{...}, "latency_us":{NAME:{count,p50,p99,max,mean}}}.
+void WriteStatsJson(const std::string& path, const std::string& process, const Counters& counters,
+                    const LatencyMap& latencies);
+
+}  // namespace rms

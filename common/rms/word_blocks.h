@@ -1,0 +1,107 @@
+#pragma once
+// Per-frame word blocks shared by two processes: the DCP's output block
+// (dynamics_proc -> scene_proc) and the ESG frame (scene_proc ->
+// esg_renderer). docs/protocol.md holds their word-by-word tables; this file
+// implements them. Packing saturates and counts ("saturated.FIELD"); unpacking
+// validates every word and throws rms::InputError naming the word on the first
+// problem (the caller counts the message as malformed and drops it).
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "rms/arm_kinematics.h"
+#include "rms/control_word.h"
+#include "rms/counters.h"
+#include "rms/word_codec.h"
+
+namespace rms {
+class dcp_frame_t;
+class esg_frame_t;
+}  // namespace rms
+
+namespace rms {
+
+// A separating plane in Reference coordinates: points p with n.p = d. n is a
+// unit normal pointing to the plane's TRUE side (docs/collision.md).
+struct SeparatingPlane {
+  Eigen::Vector3d n_R = Eigen::Vector3d::UnitZ();
+  double d_ft = 0.0;
+};
+
+// ---------------------------------------------------------------- DCP block
+
+// state_words layout (docs/protocol.md "RMS_DCP_FRAME").
+namespace dcp_state {
+inline constexpr int kShoulderHeight = 0;  // FT12
+inline constexpr int kFingerGap = 1;       // FT12
+inline constexpr int kCameraPan = 2;       // BAM24
+inline constexpr int kCameraTilt = 3;      // BAM24
+inline constexpr int kCameraZoom = 4;      // SC22, 0..1
+inline constexpr int kPayloadPos = 5;      // 3 x FT12
+inline constexpr int kPayloadRot = 8;      // 9 x SC22, row-major
+inline constexpr int kCount = 17;
+}  // namespace dcp_state
+
+struct DcpFrameData {
+  std::int64_t frame = 0;
+  std::int64_t send_time_us = 0;
+  std::int64_t input_frame = 0;
+  std::int64_t input_send_time_us = 0;
+  ArmSinCos arm{};                   // arm words
+  ControlWord control;               // priority bits zero
+  std::array<SeparatingPlane, 3> planes{};
+  std::uint32_t plane_valid = 0;     // bit i: plane i+1 valid
+  double shoulder_height_ft = 0.0;
+  double finger_gap_ft = 0.0;
+  double camera_pan_deg = 0.0;
+  double camera_tilt_deg = 0.0;
+  double camera_zoom = 0.0;          // 0 widest .. 1 narrowest
+  Eigen::Vector3d p_RoPo_R_ft = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d R_RP = Eigen::Matrix3d::Identity();
+};
+
+void PackDcpFrame(const DcpFrameData& in, dcp_frame_t* out, Counters* counters);
+DcpFrameData UnpackDcpFrame(const dcp_frame_t& msg);
+
+// ---------------------------------------------------------------- ESG frame
+
+inline constexpr int kEsgMaxWords = 64;  // the IEU's limit (report, Section III)
+
+// Word indices of the ESG frame (docs/protocol.md "RMS_ESG_FRAME").
+namespace esg_words {
+inline constexpr int kFrameCount = 0;     // U24, frame number mod 2^24
+inline constexpr int kControl = 1;        // control word, with priority bits
+inline constexpr int kArm = 2;            // 12 x SC22: sin t1, cos t1, ... sin t6, cos t6
+inline constexpr int kShoulderHeight = 14;  // FT12
+inline constexpr int kFingerGap = 15;     // FT12
+inline constexpr int kEye = 16;           // 3 x FT12, p_RoEye_R
+inline constexpr int kView = 19;          // 9 x SC22, R_RE row-major
+inline constexpr int kFov = 28;           // BAM24, vertical field of view
+inline constexpr int kPayloadPos = 29;    // 3 x FT12, p_RoPo_R
+inline constexpr int kPayloadRot = 32;    // 9 x SC22, R_RP row-major
+inline constexpr int kCount = 41;         // words used; the frame carries exactly these
+}  // namespace esg_words
+static_assert(esg_words::kCount <= kEsgMaxWords);
+
+struct EsgFrameData {
+  std::uint32_t frame_count = 0;
+  ControlWord control;
+  ArmSinCos arm{};
+  double shoulder_height_ft = 0.0;
+  double finger_gap_ft = 0.0;
+  Eigen::Vector3d p_RoEye_R_ft = Eigen::Vector3d::Zero();  // viewpoint
+  Eigen::Matrix3d R_RE = Eigen::Matrix3d::Identity();      // eye frame: X line of sight, Y right, Z down
+  double fov_deg = 45.0;                                   // vertical field of view
+  Eigen::Vector3d p_RoPo_R_ft = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d R_RP = Eigen::Matrix3d::Identity();
+};
+
+std::vector<std::int32_t> PackEsgWords(const EsgFrameData& in, Counters* counters);
+// Validates: count, 24-bit words, control word, arm pairs on the unit circle
+// (|norm - 1| <= 1e-3), rotations orthonormal within 1e-3, fov in (0, 180).
+EsgFrameData UnpackEsgWords(std::span<const std::int32_t> words);
+
+}  // namespace rms

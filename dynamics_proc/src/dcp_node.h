@@ -1,0 +1,40 @@
+#pragma once
+// dynamics_proc's LCM side: RMS_OPERATOR_INPUT in, RMS_DCP_FRAME out, one
+// output frame per input block, counters and latency.
+#include <string>
+
+#include "dynamic_collision_program.h"
+#include "rms/counters.h"
+#include "rms/lcm_interface.h"
+#include "rms/process.h"
+
+namespace rms::dcp {
+
+class DcpNode {
+ public:
+  DcpNode(const LabConfig& config, LcmInterface* lcm);
+  // Handles one raw RMS_OPERATOR_INPUT message: malformed ones are counted
+  // ("dropped.REASON") and dropped; a good one produces one RMS_DCP_FRAME.
+  void OnInput(const void* data, int size, std::int64_t recv_time_us);
+
+  const Counters& counters() const { return counters_; }
+  Counters& counters() { return counters_; }
+  const LatencyMap& latencies() const { return latencies_; }
+  std::int64_t last_frame() const { return next_frame_ - 1; }
+  const DynamicCollisionProgram& program() const { return dcp_; }
+
+ private:
+  const LabConfig& config_;
+  LcmInterface* lcm_;
+  DynamicCollisionProgram dcp_;
+  Counters counters_;
+  LatencyMap latencies_;
+  SequenceTracker inputs_;
+  std::int64_t next_frame_ = 0;
+};
+
+// Main loop until SIGINT / SIGTERM. Returns the exit code.
+int RunDynamicsProc(const LabConfig& config, LcmInterface& lcm, const std::string& stats_path,
+                    const std::string& ready_path);
+
+}  // namespace rms::dcp

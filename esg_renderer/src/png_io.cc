@@ -1,0 +1,61 @@
+#include "png_io.h"
+
+#include <cstdio>
+#include <memory>
+#include <png.h>
+#include <stdexcept>
+
+namespace rms::esg {
+
+namespace {
+struct FileCloser {
+  void operator()(FILE* f) const { if (f) std::fclose(f); }
+};
+}  // namespace
+
+void WritePng(const std::string& path, int width, int height, const std::uint8_t* rgba) {
+  std::unique_ptr<FILE, FileCloser> f(std::fopen(path.c_str(), "wb"));
+  if (!f) throw std::runtime_error("cannot write PNG '" + path + "'");
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  png_infop info = png ? png_create_info_struct(png) : nullptr;
+  if (!png || !info) {
+    png_destroy_write_struct(&png, &info);
+    throw std::runtime_error("libpng: out of memory");
+  }
+  if (setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    throw std::runtime_error("libpng failed writing '" + path + "'");
+  }
+  png_init_io(png, f.get());
+  png_set_compression_level(png, 1);
+  png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_SUB);
+  png_set_IHDR(png, info, width, height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+               PNG_COMPRESSION_TYPE_BASE, PNG_FILTER_TYPE_BASE);
+  png_write_info(png, info);
+  png_set_filler(png, 0, PNG_FILLER_AFTER);  // input rows are RGBA; drop A
+  for (int y = 0; y < height; ++y) {
+    png_write_row(png, const_cast<png_bytep>(rgba + static_cast<std::size_t>(y) * width * 4));
+  }
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+}
+
+Image ReadPng(const std::string& path) {
+  png_image img{};
+  img.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_file(&img, path.c_str())) {
+    throw std::runtime_error("cannot read PNG '" + path + "': " + img.message);
+  }
+  img.format = PNG_FORMAT_RGB;
+  Image out;
+  out.width = static_cast<int>(img.width);
+  out.height = static_cast<int>(img.height);
+  out.rgb.resize(PNG_IMAGE_SIZE(img));
+  if (!png_image_finish_read(&img, nullptr, out.rgb.data(), 0, nullptr)) {
+    png_image_free(&img);
+    throw std::runtime_error("cannot decode PNG '" + path + "': " + img.message);
+  }
+  return out;
+}
+
+}  // namespace rms::esg

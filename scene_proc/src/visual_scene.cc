@@ -1,0 +1,110 @@
+#include "visual_scene.h"
+
+#include <spdlog/spdlog.h>
+
+#include "rms/channels.h"
+#include "rms/check.h"
+#include "rms/dcp_frame_t.hpp"
+#include "rms/esg_frame_t.hpp"
+#include "rms/message_io.h"
+
+namespace rms::scene {
+
+EsgFrameData VisualScene::Step(const DcpFrameData& dcp, std::uint32_t frame_count,
+                               Counters* counters) {
+  const ArmPose arm = ComputeArmPose(config_.arm, dcp.arm, dcp.shoulder_height_ft);
+  const CameraView view =
+      ComputeCameraView(config_, dcp.control.camera_station, dcp.camera_pan_deg,
+                        dcp.camera_tilt_deg, dcp.camera_zoom, arm, counters);
+  EsgFrameData e;
+  e.frame_count = frame_count;
+  e.control = dcp.control;
+  // Visual priority bits (separating planes): docs/scene.md; zero until the
+  // priority design lands, and the renderer resolves visibility by depth.
+  e.control.priority_dynamic = 0;
+  e.control.priority_fixed = 0;
+  e.arm = dcp.arm;
+  e.shoulder_height_ft = dcp.shoulder_height_ft;
+  e.finger_gap_ft = dcp.finger_gap_ft;
+  e.p_RoEye_R_ft = view.p_RoEye_R_ft;
+  e.R_RE = view.R_RE;
+  e.fov_deg = view.fov_deg;
+  e.p_RoPo_R_ft = dcp.p_RoPo_R_ft;
+  e.R_RP = dcp.R_RP;
+  return e;
+}
+
+namespace {
+// dcp_frame_t is fixed-size: 8 + 4 x 8 + (12 + 1 + 12 + 1 + 17) x 4.
+constexpr int kMaxDcpSize = 8 + 32 + 43 * 4;
+}  // namespace
+
+SceneNode::SceneNode(const LabConfig& config, LcmInterface* lcm)
+    : config_(config), lcm_(lcm), scene_(config) {
+  lcm_->Subscribe(channels::kDcpFrame,
+                  [this](const void* d, int n, std::int64_t t) { OnDcpFrame(d, n, t); });
+}
+
+void SceneNode::OnDcpFrame(const void* data, int size, std::int64_t recv_time_us) {
+  counters_.Add("received");
+  dcp_frame_t msg;
+  const DecodeError err = SafeDecode(data, size, kMaxDcpSize, &msg);
+  if (err != DecodeError::kNone) {
+    counters_.Add(std::string("dropped.") + DecodeErrorName(err));
+    return;
+  }
+  DcpFrameData dcp;
+  try {
+    dcp = UnpackDcpFrame(msg);
+  } catch (const InputError& e) {
+    counters_.Add("dropped.bad_word");
+    spdlog::debug("DCP frame {} dropped: {}", msg.frame, e.what());
+    return;
+  }
+  switch (dcp_frames_.Accept(msg.frame)) {
+    case SequenceTracker::Verdict::kDuplicate: counters_.Add("dropped.duplicate"); return;
+    case SequenceTracker::Verdict::kStale: counters_.Add("dropped.stale"); return;
+    default: break;
+  }
+  counters_.Set("dcp.missing", dcp_frames_.missing());
+  latencies_["dcp_to_scene"].Add(recv_time_us - msg.send_time_us);
+
+  const std::int64_t frame = next_frame_++;
+  const EsgFrameData e = scene_.Step(dcp, static_cast<std::uint32_t>(frame & 0xFFFFFF), &counters_);
+  esg_frame_t out;
+  out.frame = frame;
+  out.dcp_frame = msg.frame;
+  out.input_frame = msg.input_frame;
+  out.input_send_time_us = msg.input_send_time_us;
+  out.words = PackEsgWords(e, &counters_);
+  RMS_CHECK(out.words.size() <= static_cast<std::size_t>(kEsgMaxWords));
+  out.num_words = static_cast<std::int16_t>(out.words.size());
+  out.send_time_us = lcm_->NowUs();
+  if (PublishMessage(*lcm_, channels::kEsgFrame, out)) counters_.Add("published");
+  else counters_.Add("publish_failed");
+}
+
+int RunSceneProc(const LabConfig& config, LcmInterface& lcm, const std::string& stats_path,
+                 const std::string& ready_path) {
+  SceneNode node(config, &lcm);
+  StatusReporter status(&lcm, "scene_proc");
+  if (!ready_path.empty()) TouchFile(ready_path);
+  spdlog::info("ready: {} -> {}", lcm.FullChannel(channels::kDcpFrame),
+               lcm.FullChannel(channels::kEsgFrame));
+  while (!StopRequested()) {
+    if (lcm.HandleSubscriptions(100) < 0) node.counters().Add("transport_errors");
+    Counters report = node.counters();
+    AddLatencyCounters(node.latencies(), &report);
+    status.Tick(node.last_frame(), report);
+  }
+  Counters report = node.counters();
+  AddLatencyCounters(node.latencies(), &report);
+  status.Final(node.last_frame(), report);
+  if (!stats_path.empty()) WriteStatsJson(stats_path, "scene_proc", node.counters(), node.latencies());
+  spdlog::info("published {} ESG frames; DCP frames missing {}, dropped {}",
+               node.counters().Get("published"), node.counters().Get("dcp.missing"),
+               node.counters().SumPrefix("dropped."));
+  return 0;
+}
+
+}  // namespace rms::scene

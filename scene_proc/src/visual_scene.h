@@ -1,0 +1,49 @@
+#pragma once
+// The VISUAL SCENE PROGRAM (the report's lost Section V; docs/scene.md): from
+// each DCP frame it computes the selected camera's view and packs the ESG
+// frame (at most 64 twenty-four-bit words).
+#include <cstdint>
+#include <string>
+
+#include "camera_stations.h"
+#include "rms/config.h"
+#include "rms/counters.h"
+#include "rms/lcm_interface.h"
+#include "rms/process.h"
+#include "rms/word_blocks.h"
+
+namespace rms::scene {
+
+class VisualScene {
+ public:
+  explicit VisualScene(const LabConfig& config) : config_(config) {}
+  // One frame: the ESG frame's content for this DCP frame.
+  EsgFrameData Step(const DcpFrameData& dcp, std::uint32_t frame_count, Counters* counters);
+
+ private:
+  const LabConfig& config_;
+};
+
+class SceneNode {
+ public:
+  SceneNode(const LabConfig& config, LcmInterface* lcm);
+  void OnDcpFrame(const void* data, int size, std::int64_t recv_time_us);
+  const Counters& counters() const { return counters_; }
+  Counters& counters() { return counters_; }
+  const LatencyMap& latencies() const { return latencies_; }
+  std::int64_t last_frame() const { return next_frame_ - 1; }
+
+ private:
+  const LabConfig& config_;
+  LcmInterface* lcm_;
+  VisualScene scene_;
+  Counters counters_;
+  LatencyMap latencies_;
+  SequenceTracker dcp_frames_;
+  std::int64_t next_frame_ = 0;
+};
+
+int RunSceneProc(const LabConfig& config, LcmInterface& lcm, const std::string& stats_path,
+                 const std::string& ready_path);
+
+}  // namespace rms::scene

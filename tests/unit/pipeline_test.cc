@@ -1,0 +1,120 @@
+// dynamics_proc's and scene_proc's libraries chained on one log-backed
+// transport: deterministic, no network. One ESG frame per input block, in
+// order, carrying the kinematics; malformed blocks are counted and dropped.
+#include <gtest/gtest.h>
+
+#include "camera_stations.h"
+#include "dcp_node.h"
+#include "rms/channels.h"
+#include "rms/config.h"
+#include "rms/esg_frame_t.hpp"
+#include "rms/message_io.h"
+#include "rms/operator_input_t.hpp"
+#include "visual_scene.h"
+
+namespace rms {
+namespace {
+
+class Pipeline : public ::testing::Test {
+ protected:
+  Pipeline() : lcm("", ""), dcp(config, &lcm), scene(config, &lcm) {
+    lcm.Subscribe(channels::kEsgFrame, [this](const void* d, int n, std::int64_t) {
+      esg_frame_t m;
+      ASSERT_EQ(SafeDecode(d, n, 1000, &m), DecodeError::kNone);
+      esg.push_back(m);
+    });
+  }
+  void Send(const operator_input_t& m) {
+    PublishMessage(lcm, channels::kOperatorInput, m);
+    while (lcm.HandleSubscriptions(0) > 0) {
+    }
+  }
+  operator_input_t Block(std::int64_t frame, const OperatorInputs& in) {
+    operator_input_t m{};
+    m.frame = frame;
+    m.send_time_us = 1000 * frame;
+    const auto w = EncodeInputs(in, config.inputs, nullptr);
+    std::copy(w.begin(), w.end(), m.words);
+    return m;
+  }
+  LabConfig config = LoadConfig(DefaultConfigPath());
+  LogLcm lcm;
+  dcp::DcpNode dcp;
+  scene::SceneNode scene;
+  std::vector<esg_frame_t> esg;
+};
+
+TEST_F(Pipeline, OneEsgFramePerInputBlockCarryingTheKinematics) {
+  OperatorInputs in = InitialInputs(config.inputs);
+  for (int f = 0; f < 30; ++f) {
+    in.value[kShoulderYaw] = f;
+    in.value[kShoulderPitch] = 2.0 * f;
+    in.value[kShoulderHeight] = 3.0 + 0.1 * f;
+    in.camera_station = 1 + f % 8;
+    Send(Block(f, in));
+  }
+  ASSERT_EQ(esg.size(), 30u);
+  for (int f = 0; f < 30; ++f) {
+    EXPECT_EQ(esg[f].frame, f);
+    EXPECT_EQ(esg[f].input_frame, f);
+    ASSERT_LE(esg[f].num_words, 64);
+    const EsgFrameData d = UnpackEsgWords(esg[f].words);
+    EXPECT_EQ(d.control.camera_station, 1 + f % 8);
+    EXPECT_EQ(d.control.mode, 1);
+    EXPECT_NEAR(std::atan2(d.arm[0].s, d.arm[0].c) * 180 / M_PI, f, 0.006);
+    EXPECT_NEAR(std::atan2(d.arm[1].s, d.arm[1].c) * 180 / M_PI, 2.0 * f, 0.006);
+    EXPECT_NEAR(d.shoulder_height_ft, 3.0 + 0.1 * f, 1e-3);
+    // The payload rests at its bay position in Mode 1.
+    EXPECT_LT((d.p_RoPo_R_ft - config.payload.p_RoPo_R_ft).norm(), 1e-3);
+  }
+  EXPECT_EQ(dcp.counters().Get("published"), 30);
+  EXPECT_EQ(scene.counters().Get("published"), 30);
+}
+
+TEST_F(Pipeline, ViewFollowsTheSelectedCameraStation) {
+  OperatorInputs in = InitialInputs(config.inputs);
+  in.camera_station = 8;
+  Send(Block(0, in));
+  ASSERT_EQ(esg.size(), 1u);
+  const EsgFrameData d = UnpackEsgWords(esg[0].words);
+  const auto& cam = config.cameras[7];
+  EXPECT_LT((d.p_RoEye_R_ft - cam.p_MoCam_M_ft).norm(), 1e-3);
+  const Eigen::Vector3d look = (cam.p_MoAim_M_ft - cam.p_MoCam_M_ft).normalized();
+  EXPECT_LT((d.R_RE.col(0) - look).norm(), 1e-5);
+  EXPECT_NEAR(d.fov_deg, cam.fov_max_deg, 1e-3);  // zoom 0: widest
+}
+
+TEST_F(Pipeline, MalformedDuplicateAndStaleBlocksAreCountedAndDropped) {
+  OperatorInputs in = InitialInputs(config.inputs);
+  Send(Block(0, in));
+  operator_input_t bad = Block(1, in);
+  bad.words[2] = 0x7000000;  // bits above 23
+  Send(bad);
+  Send(Block(1, in));
+  Send(Block(1, in));  // duplicate
+  Send(Block(0, in));  // stale
+  const char junk[5] = {1, 2, 3, 4, 5};
+  lcm.Publish(channels::kOperatorInput, junk, 5);
+  while (lcm.HandleSubscriptions(0) > 0) {
+  }
+  Send(Block(4, in));  // frames 2 and 3 lost
+  EXPECT_EQ(esg.size(), 3u);
+  EXPECT_EQ(dcp.counters().Get("dropped.bad_word"), 1);
+  EXPECT_EQ(dcp.counters().Get("dropped.duplicate"), 1);
+  EXPECT_EQ(dcp.counters().Get("dropped.stale"), 1);
+  EXPECT_EQ(dcp.counters().Get("dropped.truncated"), 1);
+  EXPECT_EQ(dcp.counters().Get("input.missing"), 2);
+}
+
+TEST_F(Pipeline, ResetReturnsToMode1AndSetsTheResetBit) {
+  OperatorInputs in = InitialInputs(config.inputs);
+  in.reset = true;
+  Send(Block(0, in));
+  ASSERT_EQ(esg.size(), 1u);
+  const EsgFrameData d = UnpackEsgWords(esg[0].words);
+  EXPECT_TRUE(d.control.reset);
+  EXPECT_EQ(d.control.mode, 1);
+}
+
+}  // namespace
+}  // namespace rms

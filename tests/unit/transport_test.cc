@@ -1,0 +1,147 @@
+// The transport interface: the log-backed implementation is deterministic and
+// network-free; the UDP one is real LCM on loopback; SafeDecode classifies
+// hostile bytes without throwing.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <lcm/lcm-cpp.hpp>
+#include <unistd.h>
+
+#include "rms/channels.h"
+#include "rms/check.h"
+#include "rms/esg_frame_t.hpp"
+#include "rms/lcm_interface.h"
+#include "rms/message_io.h"
+#include "rms/operator_input_t.hpp"
+#include "rms/process_status_t.hpp"
+
+namespace rms {
+namespace {
+
+std::string TempPath(const std::string& name) {
+  return (std::filesystem::temp_directory_path() /
+          ("rmslab_" + std::to_string(getpid()) + "_" + name)).string();
+}
+
+TEST(LogLcm, RecordsAndReplaysInOrderWithTimestampsAndSuffix) {
+  const std::string path = TempPath("a.lcmlog");
+  {
+    LogLcm out("", path, "_BAY2");
+    for (int i = 0; i < 5; ++i) {
+      out.SetNowUs(1000 + i * 33333);
+      operator_input_t m{};
+      m.frame = i;
+      ASSERT_TRUE(PublishMessage(out, channels::kOperatorInput, m));
+    }
+  }
+  {
+    lcm::LogFile raw(path, "r");
+    const lcm::LogEvent* ev = raw.readNextEvent();
+    ASSERT_NE(ev, nullptr);
+    EXPECT_EQ(ev->channel, "RMS_OPERATOR_INPUT_BAY2");
+    EXPECT_EQ(ev->timestamp, 1000);
+  }
+  LogLcm in(path, "", "_BAY2");
+  std::vector<std::pair<std::int64_t, std::int64_t>> got;  // frame, time
+  in.Subscribe(channels::kOperatorInput, [&](const void* d, int n, std::int64_t t) {
+    operator_input_t m;
+    ASSERT_EQ(SafeDecode(d, n, 1000, &m), DecodeError::kNone);
+    got.emplace_back(m.frame, t);
+  });
+  while (in.HandleSubscriptions(0) > 0) {
+  }
+  EXPECT_TRUE(in.at_end());
+  ASSERT_EQ(got.size(), 5u);
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_EQ(got[i].first, i);
+    EXPECT_EQ(got[i].second, 1000 + i * 33333);
+  }
+  std::filesystem::remove(path);
+}
+
+TEST(LogLcm, PublishedMessagesReachLocalSubscribersLikeMulticastLoopback) {
+  LogLcm lcm("", "");
+  int n = 0;
+  lcm.Subscribe(channels::kStatus, [&](const void*, int, std::int64_t) { ++n; });
+  const char bytes[3] = {1, 2, 3};
+  lcm.Publish(channels::kStatus, bytes, 3);
+  lcm.Publish(channels::kEsgFrame, bytes, 3);
+  EXPECT_EQ(lcm.HandleSubscriptions(0), 2);
+  EXPECT_EQ(n, 1);
+}
+
+TEST(ChannelSuffix, OnlyLettersDigitsAndUnderscore) {
+  EXPECT_NO_THROW(ValidateChannelSuffix("_BAY_2"));
+  EXPECT_THROW(ValidateChannelSuffix("_B.*"), InputError);
+  EXPECT_THROW(ValidateChannelSuffix("a b"), InputError);
+}
+
+TEST(UdpLcm, RealMulticastOnLoopbackDeliversToASecondInstance) {
+  LcmOptions o;
+  o.url = "udpm://239.255.76.67:" + std::to_string(7800 + getpid() % 150) + "?ttl=0";
+  o.channel_suffix = "_T";
+  UdpLcm a(o), b(o);
+  std::vector<std::int64_t> frames;
+  b.Subscribe(channels::kOperatorInput, [&](const void* d, int n, std::int64_t) {
+    operator_input_t m;
+    if (SafeDecode(d, n, 1000, &m) == DecodeError::kNone) frames.push_back(m.frame);
+  });
+  for (int i = 0; i < 50; ++i) {
+    operator_input_t m{};
+    m.frame = i;
+    ASSERT_TRUE(PublishMessage(a, channels::kOperatorInput, m));
+  }
+  for (int k = 0; k < 50 && frames.size() < 50; ++k) b.HandleSubscriptions(20);
+  ASSERT_EQ(frames.size(), 50u);
+  for (int i = 0; i < 50; ++i) EXPECT_EQ(frames[i], i);
+}
+
+TEST(UdpLcm, ABadUrlIsRefusedWithTheFix) {
+  LcmOptions o;
+  o.url = "udpm://not-an-address:99999";
+  try {
+    UdpLcm l(o);
+    FAIL();
+  } catch (const TransportError& e) {
+    EXPECT_NE(std::string(e.what()).find("ip route add 224.0.0.0/4 dev lo"), std::string::npos);
+  }
+}
+
+TEST(SafeDecode, ClassifiesHostileBytesWithoutThrowing) {
+  esg_frame_t m{};
+  m.num_words = 3;
+  m.words = {1, 2, 3};
+  std::vector<std::uint8_t> good = EncodeMessage(m);
+  esg_frame_t out;
+  EXPECT_EQ(SafeDecode(good.data(), static_cast<int>(good.size()), 400, &out), DecodeError::kNone);
+  // Wrong type: an operator input block on the ESG channel.
+  operator_input_t other{};
+  std::vector<std::uint8_t> o = EncodeMessage(other);
+  EXPECT_EQ(SafeDecode(o.data(), static_cast<int>(o.size()), 400, &out), DecodeError::kWrongType);
+  // Truncated.
+  EXPECT_EQ(SafeDecode(good.data(), static_cast<int>(good.size()) - 1, 400, &out), DecodeError::kTruncated);
+  EXPECT_EQ(SafeDecode(good.data(), 4, 400, &out), DecodeError::kTruncated);
+  // Trailing bytes.
+  std::vector<std::uint8_t> longer = good;
+  longer.push_back(0);
+  EXPECT_EQ(SafeDecode(longer.data(), static_cast<int>(longer.size()), 400, &out), DecodeError::kTrailingBytes);
+  // Too large.
+  EXPECT_EQ(SafeDecode(good.data(), static_cast<int>(good.size()), 10, &out), DecodeError::kTooLarge);
+  // A negative word count (int16 at byte 48) makes lcm-gen's decoder throw.
+  std::vector<std::uint8_t> neg = good;
+  neg[48] = 0xFF;
+  neg[49] = 0xFE;
+  EXPECT_EQ(SafeDecode(neg.data(), static_cast<int>(neg.size()), 400, &out), DecodeError::kBadCount);
+  // A string length of zero in a status report.
+  process_status_t s{};
+  s.process = "x";
+  std::vector<std::uint8_t> sb = EncodeMessage(s);
+  sb[8 + 8 + 3] = 0;  // length of "process" (4-byte big-endian at offset 16) -> 0
+  process_status_t so;
+  const DecodeError e = SafeDecode(sb.data(), static_cast<int>(sb.size()), 4000, &so);
+  EXPECT_NE(e, DecodeError::kNone);
+}
+
+}  // namespace
+}  // namespace rms
