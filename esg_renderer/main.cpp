@@ -1,10 +1,8 @@
 // esg_renderer: the Electronic Scene Generator. RMS_ESG_FRAME in, images out.
 // A thin main over esg_renderer/src; see docs/esg.md.
 #include <CLI/CLI.hpp>
-#include <spdlog/spdlog.h>
 
 #include "esg_node.h"
-#include "rms/config.h"
 #include "rms/process.h"
 
 int main(int argc, char** argv) {
@@ -13,7 +11,6 @@ int main(int argc, char** argv) {
                "and writes PNG frames on request."};
   rms::CommonOptions common;
   rms::esg::EsgOptions opt;
-  rms::AddCommonOptions(app, &common);
   app.add_option("--width", opt.width, "Image width, pixels")->capture_default_str()->check(CLI::Range(16, 8192));
   app.add_option("--height", opt.height, "Image height, pixels")->capture_default_str()->check(CLI::Range(16, 8192));
   app.add_option("--png-dir", opt.png_dir, "Directory for PNG frames (frame_NNNNNN.png)");
@@ -21,16 +18,9 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   app.add_flag("--id-colors", opt.id_colors, "Draw each object in a flat identity colour (tests)");
-  CLI11_PARSE(app, argc, argv);
-
-  rms::SetUpLogging("esg_renderer", common.log_level);
-  rms::InstallStopHandlers();
-  try {
-    const rms::LabConfig config = rms::LoadConfig(common.config_path);
-    rms::UdpLcm lcm(common.lcm);
-    return rms::esg::RunEsgRenderer(config, lcm, opt, common.stats_path, common.ready_path);
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return 2;
-  }
+  return rms::ProcessMain(app, argc, argv, "esg_renderer", &common,
+                          [&](const rms::LabConfig& config, rms::LcmInterface& lcm) {
+                            return rms::esg::RunEsgRenderer(config, lcm, opt, common.stats_path,
+                                                            common.ready_path);
+                          });
 }

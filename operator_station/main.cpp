@@ -1,11 +1,8 @@
 // operator_station: the operator's inputs (Table I) onto RMS_OPERATOR_INPUT.
 // A thin main over operator_station/src; see docs/operator.md.
 #include <CLI/CLI.hpp>
-#include <spdlog/spdlog.h>
 
 #include "operator_station.h"
-#include "rms/check.h"
-#include "rms/config.h"
 #include "rms/process.h"
 
 int main(int argc, char** argv) {
@@ -13,7 +10,6 @@ int main(int argc, char** argv) {
                "RMS_OPERATOR_INPUT at the frame rate, from a timeline file or the keyboard."};
   rms::CommonOptions common;
   rms::op::OperatorOptions opt;
-  rms::AddCommonOptions(app, &common);
   app.add_option("--timeline", opt.timeline_path, "Timeline file (docs/timeline.md)")
       ->check(CLI::ExistingFile);
   app.add_flag("--keyboard", opt.keyboard, "Fly from this terminal's keyboard");
@@ -21,16 +17,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1.0, 1000.0));
   app.add_flag("--hold", opt.hold, "Keep publishing the timeline's last inputs after it ends");
   app.add_option("--frames", opt.max_frames, "Stop after this many frames");
-  CLI11_PARSE(app, argc, argv);
-
-  rms::SetUpLogging("operator_station", common.log_level);
-  rms::InstallStopHandlers();
-  try {
-    const rms::LabConfig config = rms::LoadConfig(common.config_path);
-    rms::UdpLcm lcm(common.lcm);
-    return rms::op::RunOperatorStation(opt, config, lcm, common.stats_path, common.ready_path);
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return 2;
-  }
+  return rms::ProcessMain(app, argc, argv, "operator_station", &common,
+                          [&](const rms::LabConfig& config, rms::LcmInterface& lcm) {
+                            return rms::op::RunOperatorStation(opt, config, lcm, common.stats_path,
+                                                               common.ready_path);
+                          });
 }

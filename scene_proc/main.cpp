@@ -1,9 +1,7 @@
 // scene_proc: the Visual Scene Program. RMS_DCP_FRAME in, RMS_ESG_FRAME out.
 // A thin main over scene_proc/src; see docs/scene.md.
 #include <CLI/CLI.hpp>
-#include <spdlog/spdlog.h>
 
-#include "rms/config.h"
 #include "rms/process.h"
 #include "visual_scene.h"
 
@@ -12,17 +10,9 @@ int main(int argc, char** argv) {
                "(RMS_DCP_FRAME) into the selected camera's view and packs the ESG frame "
                "(RMS_ESG_FRAME, at most 64 twenty-four-bit words)."};
   rms::CommonOptions common;
-  rms::AddCommonOptions(app, &common);
-  CLI11_PARSE(app, argc, argv);
-
-  rms::SetUpLogging("scene_proc", common.log_level);
-  rms::InstallStopHandlers();
-  try {
-    const rms::LabConfig config = rms::LoadConfig(common.config_path);
-    rms::UdpLcm lcm(common.lcm);
-    return rms::scene::RunSceneProc(config, lcm, common.stats_path, common.ready_path);
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return 2;
-  }
+  return rms::ProcessMain(app, argc, argv, "scene_proc", &common,
+                          [&](const rms::LabConfig& config, rms::LcmInterface& lcm) {
+                            return rms::scene::RunSceneProc(config, lcm, common.stats_path,
+                                                            common.ready_path);
+                          });
 }

@@ -36,6 +36,27 @@ void AddCommonOptions(CLI::App& app, CommonOptions* o) {
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
 }
 
+int ProcessMain(CLI::App& app, int argc, char** argv, const std::string& process,
+                CommonOptions* common,
+                const std::function<int(const LabConfig&, LcmInterface&)>& body) {
+  AddCommonOptions(app, common);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  SetUpLogging(process, common->log_level);
+  InstallStopHandlers();
+  try {
+    const LabConfig config = LoadConfig(common->config_path);
+    UdpLcm lcm(common->lcm);
+    return body(config, lcm);
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return 2;
+  }
+}
+
 void SetUpLogging(const std::string& process, const std::string& level) {
   auto logger = spdlog::stderr_logger_mt(process);
   logger->set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%n] [%l] %v");
@@ -108,6 +129,24 @@ void AddLatencyCounters(const LatencyMap& latencies, Counters* counters) {
     counters->Set(p + "p99_us", static_cast<std::int64_t>(h.Percentile(0.99)));
     counters->Set(p + "max_us", static_cast<std::int64_t>(h.max_us()));
   }
+}
+
+void RunNodeLoop(LcmInterface& lcm, const std::string& process, Counters& counters,
+                 const LatencyMap& latencies, const std::function<std::int64_t()>& last_frame,
+                 const std::function<void()>& after_wait, const std::string& stats_path) {
+  StatusReporter status(&lcm, process);
+  auto report = [&] {
+    Counters r = counters;
+    AddLatencyCounters(latencies, &r);
+    return r;
+  };
+  while (!StopRequested()) {
+    if (lcm.HandleSubscriptions(100) < 0) counters.Add("transport_errors");
+    if (after_wait) after_wait();
+    status.Tick(last_frame(), report());
+  }
+  status.Final(last_frame(), report());
+  if (!stats_path.empty()) WriteStatsJson(stats_path, process, counters, latencies);
 }
 
 void WriteStatsJson(const std::string& path, const std::string& process, const Counters& counters,

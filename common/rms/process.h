@@ -5,6 +5,7 @@
 // that launchers wait for.
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -27,6 +28,16 @@ struct CommonOptions {
 };
 
 void AddCommonOptions(CLI::App& app, CommonOptions* options);
+
+struct LabConfig;
+
+// The main() every process shares: adds the common options to `app`, parses
+// the command line, sets up logging and the stop signals, loads the
+// configuration, opens LCM and runs `body`. Bad input (a config error, no
+// multicast route) is logged with its reason and exits 2.
+int ProcessMain(CLI::App& app, int argc, char** argv, const std::string& process,
+                CommonOptions* common,
+                const std::function<int(const LabConfig&, LcmInterface&)>& body);
 
 // Sets up spdlog's default logger (stderr, "[time] [process] [level] msg").
 void SetUpLogging(const std::string& process, const std::string& level);
@@ -61,6 +72,14 @@ using LatencyMap = std::map<std::string, LatencyHistogram>;
 // Adds p50 / p99 / max / count of each histogram to the counters (as
 // "latency.NAME.p50_us" ...), for status reports.
 void AddLatencyCounters(const LatencyMap& latencies, Counters* counters);
+
+// The main loop of a subscribing process: waits for messages (dispatching
+// them to its handlers), calls `after_wait` after each wait, publishes the
+// counters on RMS_STATUS once a second, and at SIGINT / SIGTERM publishes the
+// final report and writes the stats file (if stats_path is set).
+void RunNodeLoop(LcmInterface& lcm, const std::string& process, Counters& counters,
+                 const LatencyMap& latencies, const std::function<std::int64_t()>& last_frame,
+                 const std::function<void()>& after_wait, const std::string& stats_path);
 
 // Writes {"process":..., "counters":{...}, "latency_us":{NAME:{count,p50,p99,max,mean}}}.
 void WriteStatsJson(const std::string& path, const std::string& process, const Counters& counters,

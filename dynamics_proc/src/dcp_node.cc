@@ -5,6 +5,7 @@
 #include "rms/channels.h"
 #include "rms/check.h"
 #include "rms/dcp_frame_t.hpp"
+#include "rms/frame_receiver.h"
 #include "rms/message_io.h"
 #include "rms/operator_input_t.hpp"
 
@@ -23,28 +24,14 @@ DcpNode::DcpNode(const LabConfig& config, LcmInterface* lcm)
 }
 
 void DcpNode::OnInput(const void* data, int size, std::int64_t recv_time_us) {
-  counters_.Add("received");
-  operator_input_t msg;
-  const DecodeError err = SafeDecode(data, size, kMaxInputSize, &msg);
-  if (err != DecodeError::kNone) {
-    counters_.Add(std::string("dropped.") + DecodeErrorName(err));
-    return;
-  }
-  OperatorInputs in;
-  try {
-    std::array<std::int32_t, kInputWords> words{};
-    std::copy(msg.words, msg.words + kInputWords, words.begin());
-    in = DecodeInputs(words, config_.inputs, &counters_);
-  } catch (const InputError& e) {
-    counters_.Add("dropped.bad_word");
-    spdlog::debug("input frame {} dropped: {}", msg.frame, e.what());
-    return;
-  }
-  switch (inputs_.Accept(msg.frame)) {
-    case SequenceTracker::Verdict::kDuplicate: counters_.Add("dropped.duplicate"); return;
-    case SequenceTracker::Verdict::kStale: counters_.Add("dropped.stale"); return;
-    default: break;
-  }
+  auto got = ReceiveFrame<operator_input_t>(
+      data, size, kMaxInputSize, &inputs_, &counters_, [this](const operator_input_t& m) {
+        std::array<std::int32_t, kInputWords> words{};
+        std::copy(m.words, m.words + kInputWords, words.begin());
+        return DecodeInputs(words, config_.inputs, &counters_);
+      });
+  if (!got) return;
+  const auto& [msg, in] = *got;
   counters_.Set("input.missing", inputs_.missing());
   latencies_["input_to_dcp"].Add(recv_time_us - msg.send_time_us);
 
@@ -63,22 +50,11 @@ void DcpNode::OnInput(const void* data, int size, std::int64_t recv_time_us) {
 int RunDynamicsProc(const LabConfig& config, LcmInterface& lcm, const std::string& stats_path,
                     const std::string& ready_path) {
   DcpNode node(config, &lcm);
-  StatusReporter status(&lcm, "dynamics_proc");
   if (!ready_path.empty()) TouchFile(ready_path);
   spdlog::info("ready: {} -> {}", lcm.FullChannel(channels::kOperatorInput),
                lcm.FullChannel(channels::kDcpFrame));
-  while (!StopRequested()) {
-    if (lcm.HandleSubscriptions(100) < 0) {
-      node.counters().Add("transport_errors");
-    }
-    Counters report = node.counters();
-    AddLatencyCounters(node.latencies(), &report);
-    status.Tick(node.last_frame(), report);
-  }
-  Counters report = node.counters();
-  AddLatencyCounters(node.latencies(), &report);
-  status.Final(node.last_frame(), report);
-  if (!stats_path.empty()) WriteStatsJson(stats_path, "dynamics_proc", node.counters(), node.latencies());
+  RunNodeLoop(lcm, "dynamics_proc", node.counters(), node.latencies(),
+              [&] { return node.last_frame(); }, nullptr, stats_path);
   spdlog::info("published {} DCP frames; inputs missing {}, dropped {}; final mode {}",
                node.counters().Get("published"), node.counters().Get("input.missing"),
                node.counters().SumPrefix("dropped."), node.program().mode());

@@ -6,6 +6,7 @@
 
 #include "rms/channels.h"
 #include "rms/check.h"
+#include "rms/frame_receiver.h"
 #include "rms/message_io.h"
 #include "png_io.h"
 
@@ -24,34 +25,20 @@ EsgNode::EsgNode(const LabConfig& /*config*/, LcmInterface* lcm, EsgRenderer* re
 }
 
 void EsgNode::OnFrame(const void* data, int size, std::int64_t recv_time_us) {
-  counters_.Add("received");
-  esg_frame_t msg;
-  const DecodeError err = SafeDecode(data, size, kMaxEsgSize, &msg);
-  if (err != DecodeError::kNone) {
-    counters_.Add(std::string("dropped.") + DecodeErrorName(err));
-    return;
-  }
-  if (msg.num_words < 1 || msg.num_words > kEsgMaxWords) {
-    counters_.Add("dropped.word_count");
-    return;
-  }
-  EsgFrameData data_words;
-  try {
-    data_words = UnpackEsgWords(msg.words);
-  } catch (const InputError& e) {
-    counters_.Add("dropped.bad_word");
-    spdlog::debug("ESG frame {} dropped: {}", msg.frame, e.what());
-    return;
-  }
-  switch (frames_.Accept(msg.frame)) {
-    case SequenceTracker::Verdict::kDuplicate: counters_.Add("dropped.duplicate"); return;
-    case SequenceTracker::Verdict::kStale: counters_.Add("dropped.stale"); return;
-    default: break;
-  }
+  auto got = ReceiveFrame<esg_frame_t>(data, size, kMaxEsgSize, &frames_, &counters_,
+                                       [](const esg_frame_t& m) {
+                                         if (m.num_words < 1 || m.num_words > kEsgMaxWords) {
+                                           throw MalformedError("word_count",
+                                                                "ESG frame with " + std::to_string(m.num_words) + " words");
+                                         }
+                                         return UnpackEsgWords(m.words);
+                                       });
+  if (!got) return;
+  auto& [msg, data_words] = *got;
   counters_.Set("esg.missing", frames_.missing());
   latencies_["scene_to_esg"].Add(recv_time_us - msg.send_time_us);
   if (pending_) counters_.Add("superseded");
-  pending_.emplace(std::move(msg), data_words);
+  pending_.emplace(std::move(msg), std::move(data_words));
 }
 
 bool EsgNode::RenderPending() {
@@ -88,20 +75,10 @@ int RunEsgRenderer(const LabConfig& config, LcmInterface& lcm, const EsgOptions&
   spdlog::info("{}; {}x{}; {} triangles in the static models", gl->description(), options.width,
                options.height, renderer.triangle_count());
   EsgNode node(config, &lcm, &renderer, options);
-  StatusReporter status(&lcm, "esg_renderer");
   if (!ready_path.empty()) TouchFile(ready_path);
   spdlog::info("ready: {}", lcm.FullChannel(channels::kEsgFrame));
-  while (!StopRequested()) {
-    if (lcm.HandleSubscriptions(100) < 0) node.counters().Add("transport_errors");
-    node.RenderPending();
-    Counters report = node.counters();
-    AddLatencyCounters(node.latencies(), &report);
-    status.Tick(node.last_rendered(), report);
-  }
-  Counters report = node.counters();
-  AddLatencyCounters(node.latencies(), &report);
-  status.Final(node.last_rendered(), report);
-  if (!stats_path.empty()) WriteStatsJson(stats_path, "esg_renderer", node.counters(), node.latencies());
+  RunNodeLoop(lcm, "esg_renderer", node.counters(), node.latencies(),
+              [&] { return node.last_rendered(); }, [&] { node.RenderPending(); }, stats_path);
   spdlog::info("rendered {} frames ({} superseded, {} dropped, {} PNG)", node.counters().Get("rendered"),
                node.counters().Get("superseded"), node.counters().SumPrefix("dropped."),
                node.counters().Get("png_written"));

@@ -6,6 +6,7 @@
 #include "rms/check.h"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/esg_frame_t.hpp"
+#include "rms/frame_receiver.h"
 #include "rms/message_io.h"
 
 namespace rms::scene {
@@ -46,26 +47,10 @@ SceneNode::SceneNode(const LabConfig& config, LcmInterface* lcm)
 }
 
 void SceneNode::OnDcpFrame(const void* data, int size, std::int64_t recv_time_us) {
-  counters_.Add("received");
-  dcp_frame_t msg;
-  const DecodeError err = SafeDecode(data, size, kMaxDcpSize, &msg);
-  if (err != DecodeError::kNone) {
-    counters_.Add(std::string("dropped.") + DecodeErrorName(err));
-    return;
-  }
-  DcpFrameData dcp;
-  try {
-    dcp = UnpackDcpFrame(msg);
-  } catch (const InputError& e) {
-    counters_.Add("dropped.bad_word");
-    spdlog::debug("DCP frame {} dropped: {}", msg.frame, e.what());
-    return;
-  }
-  switch (dcp_frames_.Accept(msg.frame)) {
-    case SequenceTracker::Verdict::kDuplicate: counters_.Add("dropped.duplicate"); return;
-    case SequenceTracker::Verdict::kStale: counters_.Add("dropped.stale"); return;
-    default: break;
-  }
+  auto got = ReceiveFrame<dcp_frame_t>(data, size, kMaxDcpSize, &dcp_frames_, &counters_,
+                                       [](const dcp_frame_t& m) { return UnpackDcpFrame(m); });
+  if (!got) return;
+  const auto& [msg, dcp] = *got;
   counters_.Set("dcp.missing", dcp_frames_.missing());
   latencies_["dcp_to_scene"].Add(recv_time_us - msg.send_time_us);
 
@@ -87,20 +72,11 @@ void SceneNode::OnDcpFrame(const void* data, int size, std::int64_t recv_time_us
 int RunSceneProc(const LabConfig& config, LcmInterface& lcm, const std::string& stats_path,
                  const std::string& ready_path) {
   SceneNode node(config, &lcm);
-  StatusReporter status(&lcm, "scene_proc");
   if (!ready_path.empty()) TouchFile(ready_path);
   spdlog::info("ready: {} -> {}", lcm.FullChannel(channels::kDcpFrame),
                lcm.FullChannel(channels::kEsgFrame));
-  while (!StopRequested()) {
-    if (lcm.HandleSubscriptions(100) < 0) node.counters().Add("transport_errors");
-    Counters report = node.counters();
-    AddLatencyCounters(node.latencies(), &report);
-    status.Tick(node.last_frame(), report);
-  }
-  Counters report = node.counters();
-  AddLatencyCounters(node.latencies(), &report);
-  status.Final(node.last_frame(), report);
-  if (!stats_path.empty()) WriteStatsJson(stats_path, "scene_proc", node.counters(), node.latencies());
+  RunNodeLoop(lcm, "scene_proc", node.counters(), node.latencies(),
+              [&] { return node.last_frame(); }, nullptr, stats_path);
   spdlog::info("published {} ESG frames; DCP frames missing {}, dropped {}",
                node.counters().Get("published"), node.counters().Get("dcp.missing"),
                node.counters().SumPrefix("dropped."));

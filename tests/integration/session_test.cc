@@ -14,6 +14,7 @@
 #include "png_io.h"
 #include "rms/arm_kinematics.h"
 #include "rms/channels.h"
+#include "pinhole.h"
 #include "rms/config.h"
 #include "rms/esg_frame_t.hpp"
 #include "rms/lcm_interface.h"
@@ -28,15 +29,7 @@ using testing::BuildPath;
 using testing::SourcePath;
 using testing::Subprocess;
 
-// Pinhole of docs/esg.md (eye frame X forward, Y right, Z down; vertical fov).
-bool Project(const EsgFrameData& f, const Eigen::Vector3d& p_R, int w, int h, int* px, int* py) {
-  const Eigen::Vector3d e = f.R_RE.transpose() * (p_R - f.p_RoEye_R_ft);
-  if (e.x() < 1.0) return false;
-  const double focal = 0.5 * h / std::tan(0.5 * f.fov_deg * M_PI / 180.0);
-  *px = static_cast<int>(std::floor(0.5 * w + focal * e.y() / e.x()));
-  *py = static_cast<int>(std::floor(0.5 * h + focal * e.z() / e.x()));
-  return *px >= 0 && *px < w && *py >= 0 && *py < h;
-}
+using testing::Project;
 
 class Session : public ::testing::Test {
  protected:

@@ -9,21 +9,13 @@
 #include "gl_context.h"
 #include "models.h"
 #include "renderer.h"
+#include "pinhole.h"
 #include "rms/config.h"
 
 namespace rms::esg {
 namespace {
 
-// Pinhole of docs/esg.md: eye frame X forward, Y right, Z down; vertical
-// field of view; square pixels; pixel (0, 0) top left.
-bool Project(const EsgFrameData& f, const Eigen::Vector3d& p_R, int w, int h, int* px, int* py) {
-  const Eigen::Vector3d e = f.R_RE.transpose() * (p_R - f.p_RoEye_R_ft);
-  if (e.x() < 1.0) return false;
-  const double focal = 0.5 * h / std::tan(0.5 * f.fov_deg * M_PI / 180.0);
-  *px = static_cast<int>(std::floor(0.5 * w + focal * e.y() / e.x()));
-  *py = static_cast<int>(std::floor(0.5 * h + focal * e.z() / e.x()));
-  return *px >= 0 && *px < w && *py >= 0 && *py < h;
-}
+using testing::Project;
 
 class Renderer : public ::testing::Test {
  protected:

@@ -1,0 +1,66 @@
+#pragma once
+// The receive path every subscriber shares: safe decode, the block's own
+// checks, frame-number bookkeeping, and a counter for whatever is dropped
+// ("dropped.REASON", docs/protocol.md "Malformed messages"). Nothing throws out.
+#include <optional>
+#include <string>
+#include <type_traits>
+#include <utility>
+
+#include <spdlog/spdlog.h>
+
+#include "rms/check.h"
+#include "rms/counters.h"
+#include "rms/message_io.h"
+
+namespace rms {
+
+// Thrown by a block's checks to drop a message under a reason of its own
+// (plain InputError drops it as "bad_word").
+class MalformedError : public InputError {
+ public:
+  MalformedError(std::string reason, const std::string& what)
+      : InputError(what), reason_(std::move(reason)) {}
+  const std::string& reason() const { return reason_; }
+
+ private:
+  std::string reason_;
+};
+
+// Decodes one raw message of type Msg (at most max_size bytes), applies
+// `unpack` (Msg -> the block's content; throws InputError to refuse it) and
+// the frame-number checks. Returns the message and its content, or nothing
+// when the message was dropped (and counted). Counts "received" always.
+template <class Msg, class Unpack>
+auto ReceiveFrame(const void* data, int size, int max_size, SequenceTracker* seq,
+                  Counters* counters, Unpack&& unpack)
+    -> std::optional<std::pair<Msg, std::invoke_result_t<Unpack, const Msg&>>> {
+  using Content = std::invoke_result_t<Unpack, const Msg&>;
+  counters->Add("received");
+  Msg msg;
+  const DecodeError err = SafeDecode(data, size, max_size, &msg);
+  if (err != DecodeError::kNone) {
+    counters->Add(std::string("dropped.") + DecodeErrorName(err));
+    return std::nullopt;
+  }
+  std::optional<Content> content;
+  try {
+    content.emplace(unpack(msg));
+  } catch (const MalformedError& e) {
+    counters->Add("dropped." + e.reason());
+    spdlog::debug("frame {} dropped: {}", msg.frame, e.what());
+    return std::nullopt;
+  } catch (const InputError& e) {
+    counters->Add("dropped.bad_word");
+    spdlog::debug("frame {} dropped: {}", msg.frame, e.what());
+    return std::nullopt;
+  }
+  switch (seq->Accept(msg.frame)) {
+    case SequenceTracker::Verdict::kDuplicate: counters->Add("dropped.duplicate"); return std::nullopt;
+    case SequenceTracker::Verdict::kStale: counters->Add("dropped.stale"); return std::nullopt;
+    default: break;
+  }
+  return std::make_pair(std::move(msg), std::move(*content));
+}
+
+}  // namespace rms
