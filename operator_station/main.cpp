@@ -16,6 +16,9 @@ int main(int argc, char** argv) {
   app.add_option("--rate", opt.rate_hz, "Frame rate, Hz (default: config session.frame_rate_hz)")
       ->check(CLI::Range(1.0, 1000.0));
   app.add_flag("--hold", opt.hold, "Keep publishing the timeline's last inputs after it ends");
+  app.add_option("--speed", opt.speed, "Play the timeline this many times faster than real time")
+      ->capture_default_str()
+      ->check(CLI::Range(0.01, 100.0));
   app.add_option("--frames", opt.max_frames, "Stop after this many frames");
   return rms::ProcessMain(app, argc, argv, "operator_station", &common,
                           [&](const rms::LabConfig& config, rms::LcmInterface& lcm) {

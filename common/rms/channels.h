@@ -8,5 +8,6 @@ inline constexpr const char* kOperatorInput = "RMS_OPERATOR_INPUT";  // operator
 inline constexpr const char* kDcpFrame = "RMS_DCP_FRAME";            // dynamics_proc -> scene_proc
 inline constexpr const char* kEsgFrame = "RMS_ESG_FRAME";            // scene_proc -> esg_renderer
 inline constexpr const char* kStatus = "RMS_STATUS";                 // every process -> monitors, log
+inline constexpr const char* kDcpTelemetry = "RMS_DCP_TELEMETRY";    // dynamics_proc -> operator_station, monitors
 
 }  // namespace rms::channels

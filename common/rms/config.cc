@@ -240,6 +240,17 @@ LabConfig ParseConfig(std::string_view text, const std::string& source) {
     r.Finish();
   }
   {
+    TableReader r = top.Sub("dcp");
+    c.dcp.d3y_ft = r.Positive("d3y_ft");
+    c.dcp.tpob_ft = r.Positive("tpob_ft");
+    c.dcp.dock_distance_ft = r.Positive("dock_distance_ft");
+    c.dcp.dock_angle_deg = r.Number("dock_angle_deg", 0.0, 90.0, true);
+    if (c.dcp.d3y_ft <= c.end_effector.finger_gap_closed_ft) {
+      r.Fail("d3y_ft", "must be greater than end_effector.finger_gap_closed_ft, or no gap could satisfy it");
+    }
+    r.Finish();
+  }
+  {
     TableReader inputs = top.Sub("inputs");
     for (int i = 0; i < kNumAnalogInputs; ++i) {
       TableReader r = inputs.Sub(kAnalogInputNames[i]);

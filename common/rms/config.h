@@ -79,6 +79,14 @@ struct CaeConfig {
   double port_diameter_ft = 0;
 };
 
+// [dcp]: the Dynamic Collision Program's selected values (report IV.A.3).
+struct DcpConfig {
+  double d3y_ft = 0;            // D3Y: acquisition needs the finger gap below this
+  double tpob_ft = 0;           // TPOB: acquisition needs EFF HEX 1's face d within this of the BAR's face c
+  double dock_distance_ft = 0;  // docking: port centre to probe tip centre at most this
+  double dock_angle_deg = 0;    // docking: angle between the probe's and the port's y axes at most this
+};
+
 // [[cameras]]: one of the eight camera stations. docs/scene.md.
 enum class CameraMount { kShuttle, kElbow, kWrist, kCae };
 struct CameraStationConfig {
@@ -99,6 +107,7 @@ struct LabConfig {
   EndEffectorConfig end_effector;
   PayloadConfig payload;
   CaeConfig cae;
+  DcpConfig dcp;
   InputCalibrations inputs;
   std::vector<CameraStationConfig> cameras;  // exactly kNumCameraStations
 };

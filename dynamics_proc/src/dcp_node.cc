@@ -5,6 +5,7 @@
 #include "rms/channels.h"
 #include "rms/check.h"
 #include "rms/dcp_frame_t.hpp"
+#include "rms/dcp_telemetry_t.hpp"
 #include "rms/frame_receiver.h"
 #include "rms/message_io.h"
 #include "rms/operator_input_t.hpp"
@@ -44,7 +45,76 @@ void DcpNode::OnInput(const void* data, int size, std::int64_t recv_time_us) {
   PackDcpFrame(out, &wire_msg, &counters_);
   if (PublishMessage(*lcm_, channels::kDcpFrame, wire_msg)) counters_.Add("published");
   else counters_.Add("publish_failed");
-  counters_.Set("mode", dcp_.mode());
+  const dcp_telemetry_t tm = MakeTelemetry(dcp_.status(), out);
+  if (!PublishMessage(*lcm_, channels::kDcpTelemetry, tm)) counters_.Add("publish_failed");
+  Report(dcp_.status(), out.frame);
+}
+
+void DcpNode::Report(const DcpStatus& st, std::int64_t frame) {
+  counters_.Set("mode", st.mode);
+  if (st.held) counters_.Add("frames.held");
+  if (st.finger_held) counters_.Add("frames.finger_held");
+  for (int b = 0; b < collision_bits::kCount; ++b) {
+    if (st.collisions & (1u << b)) counters_.Add(std::string("collision_frames.") + CollisionName(b));
+  }
+  if (st.mode != last_mode_) {
+    if (last_mode_ != 0) counters_.Add("mode_changes");
+    last_mode_ = st.mode;
+  }
+  // Each collision as it starts and ends.
+  const std::uint32_t started = st.collisions & ~last_collisions_;
+  const std::uint32_t ended = last_collisions_ & ~st.collisions;
+  for (int b = 0; b < collision_bits::kCount; ++b) {
+    if (started & (1u << b)) {
+      counters_.Add(std::string("collisions.") + CollisionName(b));
+      spdlog::info("frame {}: collision {} (slave {})", frame, CollisionName(b), st.held ? "holds" : st.finger_held ? "holds the finger" : "follows");
+    }
+    if (ended & (1u << b)) spdlog::info("frame {}: collision {} relieved", frame, CollisionName(b));
+  }
+  last_collisions_ = st.collisions;
+}
+
+dcp_telemetry_t MakeTelemetry(const DcpStatus& st, const DcpFrameData& out) {
+  dcp_telemetry_t t{};
+  t.frame = out.frame;
+  t.send_time_us = out.send_time_us;
+  t.input_frame = out.input_frame;
+  t.input_send_time_us = out.input_send_time_us;
+  t.mode = static_cast<std::int8_t>(st.mode);
+  t.acquired = st.acquired;
+  t.docked = st.docked;
+  t.held = st.held;
+  t.finger_held = st.finger_held;
+  t.collisions = static_cast<std::int32_t>(st.collisions);
+  t.slave_collisions = static_cast<std::int32_t>(st.slave_collisions);
+  for (int i = 0; i < 6; ++i) t.acquisition_conditions[i] = st.acquisition[i];
+  t.finger_gap_ft = st.finger_gap_ft;
+  t.palm_to_bar_ft = st.palm_to_bar_ft;
+  t.probe_in_envelope = st.probe_in_envelope;
+  t.dock_distance_ft = st.dock_distance_ft;
+  t.dock_angle_deg = st.dock_angle_deg;
+  for (int k = 0; k < 3; ++k) {
+    t.plane_valid[k] = (st.plane_valid >> k) & 1;
+    for (int j = 0; j < 3; ++j) t.plane_n[3 * k + j] = st.planes[k].n_R[j];
+    t.plane_d_ft[k] = st.planes[k].d_ft;
+  }
+  for (int i = 0; i < 6; ++i) {
+    t.master_angles_deg[i] = st.master.angles_deg[i];
+    t.slave_angles_deg[i] = st.slave.angles_deg[i];
+  }
+  t.master_shoulder_height_ft = st.master.shoulder_height_ft;
+  t.slave_shoulder_height_ft = st.slave.shoulder_height_ft;
+  t.master_finger = st.master.finger;
+  t.slave_finger = st.slave.finger;
+  for (int i = 0; i < 3; ++i) {
+    t.p_RoA_R_ft[i] = st.X_RS2.translation()[i];
+    t.p_RoPo_R_ft[i] = st.X_RP.translation()[i];
+    for (int j = 0; j < 3; ++j) {
+      t.R_RS2[3 * i + j] = st.X_RS2.linear()(i, j);
+      t.R_RP[3 * i + j] = st.X_RP.linear()(i, j);
+    }
+  }
+  return t;
 }
 
 int RunDynamicsProc(const LabConfig& config, LcmInterface& lcm, const std::string& stats_path,

@@ -6,6 +6,7 @@
 #include "dynamic_collision_program.h"
 #include "rms/counters.h"
 #include "rms/lcm_interface.h"
+#include "rms/dcp_telemetry_t.hpp"
 #include "rms/process.h"
 
 namespace rms::dcp {
@@ -24,6 +25,7 @@ class DcpNode {
   const DynamicCollisionProgram& program() const { return dcp_; }
 
  private:
+  void Report(const DcpStatus& status, std::int64_t frame);
   const LabConfig& config_;
   LcmInterface* lcm_;
   DynamicCollisionProgram dcp_;
@@ -31,7 +33,12 @@ class DcpNode {
   LatencyMap latencies_;
   SequenceTracker inputs_;
   std::int64_t next_frame_ = 0;
+  int last_mode_ = 0;
+  std::uint32_t last_collisions_ = 0;
 };
+
+// The telemetry message for a frame (docs/protocol.md "RMS_DCP_TELEMETRY").
+dcp_telemetry_t MakeTelemetry(const DcpStatus& status, const DcpFrameData& frame);
 
 // Main loop until SIGINT / SIGTERM. Returns the exit code.
 int RunDynamicsProc(const LabConfig& config, LcmInterface& lcm, const std::string& stats_path,

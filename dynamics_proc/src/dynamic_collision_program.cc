@@ -1,5 +1,9 @@
 #include "dynamic_collision_program.h"
 
+#include <algorithm>
+#include <cmath>
+#include <spdlog/spdlog.h>
+
 #include "rms/word_codec.h"
 
 namespace rms::dcp {
@@ -13,16 +17,55 @@ ArmSinCos TransmittedArmWords(const std::array<double, 6>& angles_deg) {
   return sc;
 }
 
+const char* CollisionName(int bit) {
+  static const char* kNames[collision_bits::kCount] = {
+      "eff_hex_1-recpt", "eff_hex_2-recpt", "eff_hex_3-recpt", "eff_hex_1-payload",
+      "eff_hex_2-payload", "eff_hex_3-payload", "payload-bay_a", "payload-bay_b",
+      "payload-bay_c", "payload-bay_d", "payload-bay_e", "payload-bay_f", "payload-cae"};
+  return bit >= 0 && bit < collision_bits::kCount ? kNames[bit] : "?";
+}
+
+namespace {
+
+Eigen::Isometry3d Pose(const Eigen::Matrix3d& R, const Eigen::Vector3d& p) {
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = R;
+  X.translation() = p;
+  return X;
+}
+
+bool AllHave(const std::array<LocationWord, 8>& words, int face) {
+  for (LocationWord w : words) {
+    if (!(w & FaceBit(face))) return false;
+  }
+  return true;
+}
+
+std::string Names(std::uint32_t bits) {
+  std::string s;
+  for (int b = 0; b < collision_bits::kCount; ++b) {
+    if (bits & (1u << b)) s += std::string(s.empty() ? "" : ", ") + CollisionName(b);
+  }
+  return s.empty() ? "none" : s;
+}
+
+}  // namespace
+
 DynamicCollisionProgram::DynamicCollisionProgram(const LabConfig& config) : config_(config) {
-  X_RP_bay_ = Eigen::Isometry3d::Identity();
-  X_RP_bay_.linear() = config.payload.R_RP;
-  X_RP_bay_.translation() = config.payload.p_RoPo_R_ft;
+  X_RP_bay_ = Pose(config.payload.R_RP, config.payload.p_RoPo_R_ft);
+  bar_bay_ = MakeBar(config.payload, X_RP_bay_);
+  payload_bay_ = MakePayload(config.payload, X_RP_bay_);
+  bay_ = MakeCargoBay(config.shuttle);
+  cae_ = MakeCaeFrontHalf(config.cae);
   Reset();
 }
 
 void DynamicCollisionProgram::Reset() {
-  mode_ = 1;
-  X_RP_ = X_RP_bay_;
+  status_.mode = 1;
+  status_.acquired = false;
+  status_.docked = false;
+  status_.X_RP = X_RP_bay_;
+  have_slave_ = false;
 }
 
 double DynamicCollisionProgram::FingerGapFt(double lever) const {
@@ -30,35 +73,223 @@ double DynamicCollisionProgram::FingerGapFt(double lever) const {
   return e.finger_gap_open_ft - lever * (e.finger_gap_open_ft - e.finger_gap_closed_ft);
 }
 
-void DynamicCollisionProgram::UpdateModes(const OperatorInputs& /*in*/) {
-  // Section IV.A: collision detection and the Mode 1 -> 2 -> 3 transitions
-  // belong here (its own issue). Until then: Mode 1, no collisions.
+DynamicCollisionProgram::Evaluation DynamicCollisionProgram::Evaluate(const ArmCommand& cmd) const {
+  Evaluation e;
+  e.cmd = cmd;
+  e.words = TransmittedArmWords(cmd.angles_deg);
+  e.pose = ComputeArmPose(config_.arm, e.words, cmd.shoulder_height_ft);
+  e.finger_gap_ft = FingerGapFt(cmd.finger);
+  namespace cb = collision_bits;
+  switch (status_.mode) {
+    case 1: {
+      // EFF HEX 1-3 against the BAR and against the payload's body.
+      e.ee = MakeEndEffector(config_.end_effector, e.pose.X_RS2, e.finger_gap_ft);
+      e.X_RP = X_RP_bay_;
+      e.payload = payload_bay_;
+      for (int k = 0; k < 3; ++k) {
+        e.ee_bar[k] = Collide(e.ee.hex[k], bar_bay_);
+        if (e.ee_bar[k].verdict != Verdict::kSeparate) e.collisions |= cb::kEffHexRecpt << k;
+        const CollisionResult body = Collide(e.ee.hex[k], payload_bay_.body, {.want_plane = false});
+        if (body.verdict != Verdict::kSeparate) e.collisions |= cb::kEffHexPayload << k;
+      }
+      break;
+    }
+    case 2: {
+      // The payload's and probe's vertices against the bay's walls and
+      // bottom: a vertex below face c that is beyond a wall collides with it.
+      e.X_RP = e.pose.X_RS2 * X_S2P_;
+      e.payload = MakePayload(config_.payload, e.X_RP);
+      const double tau = tau_rel_ * bay_.scale;
+      for (const Eigen::Vector3d& v : e.payload.v) {
+        const LocationWord w = bay_.Word(v, tau);
+        if (!(w & FaceBit(kFaceC))) e.collisions |= static_cast<std::uint32_t>(w) << 6;
+      }
+      break;
+    }
+    default: {
+      if (status_.docked) {
+        e.X_RP = X_RP_docked_;  // captured by the CAE; the arm is free
+        e.payload = MakePayload(config_.payload, e.X_RP);
+        break;
+      }
+      // The payload's and probe's vertices against the CAE's front half.
+      e.X_RP = e.pose.X_RS2 * X_S2P_;
+      e.payload = MakePayload(config_.payload, e.X_RP);
+      const double tau = tau_rel_ * cae_.scale;
+      for (const Eigen::Vector3d& v : e.payload.v) {
+        if (cae_.Word(v, tau) == 0) e.collisions |= cb::kPayloadCae;
+      }
+      break;
+    }
+  }
+  return e;
+}
+
+void DynamicCollisionProgram::Accept(const Evaluation& e) {
+  slave_ = e;
+  have_slave_ = true;
 }
 
 DcpFrameData DynamicCollisionProgram::Step(const OperatorInputs& in) {
-  if (in.reset) Reset();
-  std::array<double, 6> angles{};
-  for (int i = 0; i < 6; ++i) angles[i] = in.value[i];
+  ArmCommand master;
+  for (int i = 0; i < 6; ++i) master.angles_deg[i] = in.value[i];
+  master.shoulder_height_ft = in.value[kShoulderHeight];
+  master.finger = in.value[kFinger];
+  if (in.reset) {
+    Reset();
+    spdlog::info("reset: Mode 1, payload in the cargo bay");
+  }
+  status_.master = master;
+  status_.held = false;
+  status_.finger_held = false;
+
+  const Evaluation cand = Evaluate(master);
+  status_.collisions = cand.collisions;
+  if (!have_slave_) {
+    // The first frame after start or reset: the slave takes the command.
+    Accept(cand);
+    if (cand.collisions) spdlog::warn("starting in collision: {}", Names(cand.collisions));
+  } else if (cand.collisions == 0) {
+    Accept(cand);
+  } else {
+    bool moved = false;
+    if (status_.mode == 1 && master.finger != slave_.cmd.finger) {
+      // The finger is what collides: let the arm follow and hold the finger.
+      ArmCommand arm_only = master;
+      arm_only.finger = slave_.cmd.finger;
+      const Evaluation e2 = Evaluate(arm_only);
+      if (e2.collisions == 0) {
+        Accept(e2);
+        status_.finger_held = true;
+        moved = true;
+      }
+    }
+    status_.held = !moved;
+  }
+  status_.slave_collisions = slave_.collisions;
+  status_.slave = slave_.cmd;
+  status_.X_RS2 = slave_.pose.X_RS2;
+  status_.X_RP = slave_.X_RP;
+  status_.finger_gap_ft = slave_.finger_gap_ft;
+
+  // The three dynamic separating planes, EFF HEX 1-3 against the BAR (Mode 1).
+  status_.plane_valid = 0;
+  if (status_.mode == 1) {
+    for (int k = 0; k < 3; ++k) {
+      const CollisionResult& r = slave_.ee_bar[k];
+      if (r.verdict == Verdict::kSeparate && r.plane_valid) {
+        status_.planes[k] = {r.n, r.d};
+        status_.plane_valid |= 1u << k;
+      }
+    }
+  }
+
+  const int mode_before = status_.mode;
+  UpdateDocking();  // distance and angle every frame; docking in Mode 3
+  if (mode_before == 1) UpdateAcquisition();
+  else if (mode_before == 2) UpdateExtraction();
+
   DcpFrameData out;
-  out.arm = TransmittedArmWords(angles);
-  const double height = in.value[kShoulderHeight];
-  pose_ = ComputeArmPose(config_.arm, out.arm, height);
-
-  UpdateModes(in);
-
+  out.arm = slave_.words;
   out.control.camera_station = in.camera_station;
   out.control.reset = in.reset;
   out.control.overlay = in.overlay;
-  out.control.mode = mode_;
-  out.shoulder_height_ft = height;
-  out.finger_gap_ft = FingerGapFt(in.value[kFinger]);
+  out.control.mode = status_.mode;
+  out.control.collision = (status_.collisions & ~collision_bits::kRecptMask) != 0;
+  out.control.receptacle_collision = (status_.collisions & collision_bits::kRecptMask) != 0;
+  out.control.acquired = status_.acquired;
+  out.control.docked = status_.docked;
+  out.shoulder_height_ft = slave_.cmd.shoulder_height_ft;
+  out.finger_gap_ft = slave_.finger_gap_ft;
   out.camera_pan_deg = in.value[kCameraPan];
   out.camera_tilt_deg = in.value[kCameraTilt];
   out.camera_zoom = in.value[kCameraZoom];
-  out.p_RoPo_R_ft = X_RP_.translation();
-  out.R_RP = X_RP_.linear();
-  out.plane_valid = 0;
+  out.p_RoPo_R_ft = status_.X_RP.translation();
+  out.R_RP = status_.X_RP.linear();
+  out.planes = status_.planes;
+  out.plane_valid = status_.plane_valid;
   return out;
+}
+
+bool AcquisitionCheck::all() const {
+  return std::all_of(holds.begin(), holds.end(), [](bool b) { return b; });
+}
+
+AcquisitionCheck CheckAcquisition(const DcpConfig& dcp, const EndEffectorModel& ee, const Hexahedron& bar,
+                                  double finger_gap_ft, double relative_tolerance) {
+  const Hexahedron& h1 = ee.hex[0];
+  const Hexahedron& h2 = ee.hex[1];
+  const Hexahedron& h3 = ee.hex[2];
+  const double tau = relative_tolerance * std::max(h1.scale, bar.scale);
+  AcquisitionCheck c;
+  c.finger_gap_ft = finger_gap_ft;
+  c.holds[0] = AllHave(h1.Words(bar, tau), kFaceD);
+  c.holds[1] = AllHave(h2.Words(bar, tau), kFaceB);
+  c.holds[2] = AllHave(h3.Words(bar, tau), kFaceE);
+  c.holds[3] = finger_gap_ft < dcp.d3y_ft;
+  Eigen::Vector3d top = Eigen::Vector3d::Zero();
+  for (int v : kFaceVertices[kFaceC]) top += bar.vertex(v);
+  top *= 0.25;
+  c.palm_to_bar_ft = h1.Beyond(kFaceD, top.x(), top.y(), top.z());
+  c.holds[4] = c.palm_to_bar_ft < dcp.tpob_ft;
+  bool between = true;
+  for (LocationWord w : bar.Words(h1, tau)) between = between && !(w & (FaceBit(kFaceA) | FaceBit(kFaceD)));
+  c.holds[5] = between;
+  return c;
+}
+
+DockingCheck CheckDocking(const DcpConfig& dcp, const CaeConfig& cae, const Hexahedron& front,
+                          const PayloadModel& p, double relative_tolerance) {
+  DockingCheck d;
+  const double tau = relative_tolerance * front.scale;
+  const LocationWord sides = FaceBit(kFaceA) | FaceBit(kFaceB) | FaceBit(kFaceD) | FaceBit(kFaceE);
+  d.in_envelope = true;
+  for (int i = kProbeFirst; i < kPayloadVertices; ++i) {
+    const LocationWord w = front.Word(p.v[i], tau);
+    d.in_envelope = d.in_envelope && (w & FaceBit(kFaceC)) && !(w & sides);
+  }
+  d.distance_ft = (p.probe_tip_centre - cae.p_RoCo_R_ft).norm();
+  const double c = std::clamp(p.probe_axis.dot(cae.R_RC.col(1)), -1.0, 1.0);
+  d.angle_deg = std::acos(c) * 180.0 / M_PI;
+  d.docked = d.in_envelope && d.distance_ft <= dcp.dock_distance_ft && d.angle_deg <= dcp.dock_angle_deg;
+  return d;
+}
+
+void DynamicCollisionProgram::UpdateAcquisition() {
+  // Report IV.A.3: the six conditions, on the slave's (collision-free) pose.
+  const AcquisitionCheck c =
+      CheckAcquisition(config_.dcp, slave_.ee, bar_bay_, slave_.finger_gap_ft, tau_rel_);
+  status_.acquisition = c.holds;
+  status_.palm_to_bar_ft = c.palm_to_bar_ft;
+  if (c.all()) {
+    status_.mode = 2;
+    status_.acquired = true;
+    X_S2P_ = slave_.pose.X_RS2.inverse() * X_RP_bay_;
+    spdlog::info("acquisition: Mode 1 -> Mode 2 (finger gap {:.3f} ft, palm to bar {:.3f} ft)",
+                 c.finger_gap_ft, c.palm_to_bar_ft);
+  }
+}
+
+void DynamicCollisionProgram::UpdateExtraction() {
+  // Report IV.A.3: all payload and probe vertices above the bay's face c.
+  const double tau = tau_rel_ * bay_.scale;
+  for (const Eigen::Vector3d& v : slave_.payload.v) {
+    if (!(bay_.Word(v, tau) & FaceBit(kFaceC))) return;
+  }
+  status_.mode = 3;
+  spdlog::info("clear of the cargo bay: Mode 2 -> Mode 3");
+}
+
+void DynamicCollisionProgram::UpdateDocking() {
+  const DockingCheck d = CheckDocking(config_.dcp, config_.cae, cae_, slave_.payload, tau_rel_);
+  status_.probe_in_envelope = d.in_envelope;
+  status_.dock_distance_ft = d.distance_ft;
+  status_.dock_angle_deg = d.angle_deg;
+  if (status_.mode == 3 && !status_.docked && d.docked) {
+    status_.docked = true;
+    X_RP_docked_ = slave_.X_RP;
+    spdlog::info("docked: distance {:.3f} ft, angle {:.3f} deg", d.distance_ft, d.angle_deg);
+  }
 }
 
 }  // namespace rms::dcp

@@ -1,17 +1,33 @@
 #pragma once
-// The DYNAMIC COLLISION PROGRAM (report, Section IV): each frame it processes
-// the operator's inputs (IV.B), computes the sines and cosines of the six arm
-// angles (the block of 12 words), the arm's pose in Reference coordinates,
-// the payload's pose, and the scene generator control word.
+// The DYNAMIC COLLISION PROGRAM (report, Section IV; docs/collision.md).
 //
-// Section IV.A (hexahedron collision detection, separating planes,
-// acquisition, extraction, docking) plugs in at UpdateModes(); until it does
-// the program stays in Mode 1 with no collisions and no separating planes,
-// and Reset returns it there.
+// Each frame it processes the operator's inputs (IV.B) as the master arm's
+// command, generates the models of the active mode in Reference coordinates
+// (IV.A.2), tests the mode's pairs with the hexahedron collision algorithm
+// (IV.A.1) and decides acquisition, extraction and docking (IV.A.3):
+//
+//  Mode 1  EFF HEX 1-3 against the BAR (RECPT) and the payload's body; the
+//          six acquisition conditions -> Mode 2, payload rigidly attached.
+//  Mode 2  the payload's and probe's vertices against the cargo bay's walls
+//          and bottom; all above face c -> Mode 3.
+//  Mode 3  the payload's and probe's vertices against the CAE's front half;
+//          all probe vertices in the docking envelope, within the distance
+//          and the angle -> docked.
+//
+// Collision response: the slave arm (what the scene shows) follows the master
+// while the master's command is collision-free; while it would collide, the
+// slave holds its last collision-free pose (in Mode 1 the arm may still
+// follow with only the finger held) and the collision bits say which pair,
+// so the operator can relieve it. A collision never shows as
+// interpenetration. The finger closing on the bar is the essential contact:
+// the finger stops on it and the acquisition conditions are met.
+#include <array>
 #include <cstdint>
 
 #include <Eigen/Geometry>
 
+#include "collision.h"
+#include "dcp_models.h"
 #include "rms/arm_kinematics.h"
 #include "rms/config.h"
 #include "rms/input_block.h"
@@ -19,33 +35,131 @@
 
 namespace rms::dcp {
 
+// Which pair collides (docs/collision.md): the collision bits of the
+// telemetry.
+namespace collision_bits {
+inline constexpr std::uint32_t kEffHexRecpt = 1u << 0;     // bits 0-2: EFF HEX 1, 2, 3 with the BAR
+inline constexpr std::uint32_t kEffHexPayload = 1u << 3;   // bits 3-5: EFF HEX 1, 2, 3 with the payload body
+inline constexpr std::uint32_t kBayFace = 1u << 6;         // bits 6-11: a payload vertex beyond bay face a..f
+inline constexpr std::uint32_t kPayloadCae = 1u << 12;     // a payload vertex inside the CAE's front half
+inline constexpr std::uint32_t kRecptMask = 0x7u;          // essential in the acquisition relationship
+inline constexpr std::uint32_t kEePayloadMask = 0x7u << 3;
+inline constexpr std::uint32_t kBayMask = 0x3Fu << 6;
+inline constexpr int kCount = 13;
+}  // namespace collision_bits
+// "eff_hex_2-recpt", "payload-bay_b", ... for logs and counters.
+const char* CollisionName(int bit);
+
+// The six acquisition conditions of report IV.A.3, in its order:
+//  0 all BAR vertices beyond face d of EFF HEX 1
+//  1 all BAR vertices beyond face b of EFF HEX 2
+//  2 all BAR vertices beyond face e of EFF HEX 3
+//  3 the distance between faces b (EFF HEX 2) and e (EFF HEX 3) below D3Y
+//  4 the distance from face d of EFF HEX 1 to the centre of the BAR's top
+//    face c below TPOB
+//  5 the end effector between the BAR's ends: no EFF HEX 1 vertex beyond
+//    the BAR's faces a or d
+struct AcquisitionCheck {
+  std::array<bool, 6> holds{};
+  double finger_gap_ft = 0.0;
+  double palm_to_bar_ft = 0.0;
+  bool all() const;
+};
+AcquisitionCheck CheckAcquisition(const DcpConfig& dcp, const EndEffectorModel& ee, const Hexahedron& bar,
+                                  double finger_gap_ft, double relative_tolerance = 1e-12);
+
+// Docking (report IV.A.3): every probe vertex (V21-V24, V31-V36) in the
+// docking envelope -- beyond CAE face c, not beyond faces a, b, d, e -- and
+// the probe's tip centre within dock_distance_ft of the port's centre, the
+// probe's y axis within dock_angle_deg of the port's.
+struct DockingCheck {
+  bool in_envelope = false;
+  double distance_ft = 0.0;
+  double angle_deg = 0.0;
+  bool docked = false;
+};
+DockingCheck CheckDocking(const DcpConfig& dcp, const CaeConfig& cae, const Hexahedron& cae_front_half,
+                          const PayloadModel& payload, double relative_tolerance = 1e-12);
+
+// The arm as commanded or as it is.
+struct ArmCommand {
+  std::array<double, 6> angles_deg{};
+  double shoulder_height_ft = 0.0;
+  double finger = 0.0;  // lever, 0 open .. 1 closed
+};
+
+// What one frame decided, for telemetry.
+struct DcpStatus {
+  int mode = 1;
+  bool acquired = false;
+  bool docked = false;
+  bool held = false;
+  bool finger_held = false;
+  std::uint32_t collisions = 0;        // of the master's command
+  std::uint32_t slave_collisions = 0;  // of the pose the slave holds
+  std::array<bool, 6> acquisition{};   // the six conditions, report order
+  double finger_gap_ft = 0.0;
+  double palm_to_bar_ft = 0.0;
+  bool probe_in_envelope = false;
+  double dock_distance_ft = 0.0;
+  double dock_angle_deg = 0.0;
+  std::array<SeparatingPlane, 3> planes{};
+  std::uint32_t plane_valid = 0;
+  ArmCommand master, slave;
+  Eigen::Isometry3d X_RS2 = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d X_RP = Eigen::Isometry3d::Identity();
+};
+
 class DynamicCollisionProgram {
  public:
   explicit DynamicCollisionProgram(const LabConfig& config);
 
-  // One frame. The returned block's frame / time fields are left for the caller.
+  // One frame. The returned block's frame / time fields are the caller's.
   DcpFrameData Step(const OperatorInputs& in);
 
-  // Back to the Acquisition Phase (Mode 1), payload in the cargo bay.
+  // Back to the Acquisition Phase (Mode 1) and the initial state: payload in
+  // the cargo bay, nothing acquired or docked; the slave takes the next
+  // command as it is.
   void Reset();
 
-  int mode() const { return mode_; }
-  // The arm pose of the last Step, computed from the transmitted arm words.
-  const ArmPose& arm_pose() const { return pose_; }
-  const Eigen::Isometry3d& X_RP() const { return X_RP_; }
-
-  // The finger gap for a finger lever value (0 open .. 1 closed), ft:
-  // the distance between face b of EFF HEX 2 and face e of EFF HEX 3.
+  int mode() const { return status_.mode; }
+  const DcpStatus& status() const { return status_; }
+  const ArmPose& arm_pose() const { return slave_.pose; }
+  const Eigen::Isometry3d& X_RP() const { return status_.X_RP; }
   double FingerGapFt(double lever) const;
 
  private:
-  void UpdateModes(const OperatorInputs& in);
+  struct Evaluation {
+    ArmCommand cmd;
+    ArmSinCos words{};
+    ArmPose pose{};
+    double finger_gap_ft = 0.0;
+    EndEffectorModel ee{};
+    std::array<CollisionResult, 3> ee_bar{};
+    Eigen::Isometry3d X_RP = Eigen::Isometry3d::Identity();
+    PayloadModel payload{};
+    std::uint32_t collisions = 0;
+  };
+  Evaluation Evaluate(const ArmCommand& cmd) const;
+  void Accept(const Evaluation& e);
+  void UpdateAcquisition();
+  void UpdateExtraction();
+  void UpdateDocking();
 
   const LabConfig& config_;
-  int mode_ = 1;
-  Eigen::Isometry3d X_RP_bay_;  // payload in the cargo bay (Mode 1)
-  Eigen::Isometry3d X_RP_;      // payload now
-  ArmPose pose_{};
+  double tau_rel_ = 1e-12;
+  // Fixed models: the payload in the bay (Mode 1), the bay, the CAE.
+  Eigen::Isometry3d X_RP_bay_;
+  Hexahedron bar_bay_;
+  PayloadModel payload_bay_;
+  Hexahedron bay_;
+  Hexahedron cae_;
+  // State.
+  bool have_slave_ = false;
+  Evaluation slave_;
+  Eigen::Isometry3d X_S2P_ = Eigen::Isometry3d::Identity();       // payload in System Two, from acquisition
+  Eigen::Isometry3d X_RP_docked_ = Eigen::Isometry3d::Identity();  // payload at the dock
+  DcpStatus status_;
 };
 
 // The arm words as transmitted: sin/cos of the angles (deg), rounded to SC22

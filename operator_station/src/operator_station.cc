@@ -57,8 +57,8 @@ int RunOperatorStation(const OperatorOptions& options, const LabConfig& config, 
   if (!options.timeline_path.empty()) {
     timeline = std::make_unique<Timeline>(Timeline::Load(options.timeline_path, config.inputs));
     for (const std::string& w : timeline->warnings()) spdlog::warn("{}", w);
-    spdlog::info("timeline {}: {:.2f} s at {:.1f} Hz", options.timeline_path,
-                 timeline->end_time(), rate);
+    spdlog::info("timeline {}: {:.2f} s at {:.1f} Hz, speed {}", options.timeline_path,
+                 timeline->end_time(), rate, options.speed);
   } else {
     keys = std::make_unique<TerminalKeys>();
     spdlog::info("{}", KeyboardHelp());
@@ -79,7 +79,7 @@ int RunOperatorStation(const OperatorOptions& options, const LabConfig& config, 
   while (!StopRequested() && !quit) {
     if (options.max_frames >= 0 && frames >= options.max_frames) break;
     // Timeline time is the frame count over the rate: jitter-free and reproducible.
-    const double t = static_cast<double>(frames) / rate;
+    const double t = options.speed * static_cast<double>(frames) / rate;
     OperatorInputs in;
     if (timeline) {
       if (t > timeline->end_time() + 1e-9 && !options.hold) break;

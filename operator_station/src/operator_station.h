@@ -17,6 +17,7 @@ struct OperatorOptions {
   bool keyboard = false;      // --keyboard
   double rate_hz = 0.0;       // --rate (0: config session.frame_rate_hz)
   bool hold = false;          // --hold: keep publishing the timeline's last inputs until stopped
+  double speed = 1.0;         // --speed: timeline seconds per wall-clock second (frames stay at the rate)
   std::int64_t max_frames = -1;  // --frames N: stop after N frames (-1: no limit)
 };
 

@@ -67,6 +67,8 @@ TEST(Config, EveryProblemNamesTheKeyAndTheReason) {
       {R"(units_per_count = 0.001)", "units_per_count = 0.0001", "inputs.shoulder_height.max", "outside the ADC"},
       {R"(initial = 3.0)", "initial = 30.0", "inputs.shoulder_height.initial", "must be <= 20"},
       {R"(\[\[cameras\]\]\nname = "external")", "[[camera]]\nname = \"external\"", "cameras", "exactly 8"},
+      {R"(d3y_ft = 0.6)", "d3y_ft = 0.3", "dcp.d3y_ft", "greater than end_effector.finger_gap_closed_ft"},
+      {R"(dock_distance_ft = 0.25)", "", "dcp.dock_distance_ft", "missing"},
   };
   for (const Case& c : cases) {
     const std::string err = ErrorOf(Edit(c.pattern, c.replacement));

@@ -134,3 +134,41 @@ TEST_F(Kinematics, RandomPosesAreRigidAndIgnoreThePairsScale) {
 
 }  // namespace
 }  // namespace rms
+
+#include "rms/arm_ik.h"
+
+namespace rms {
+namespace {
+
+TEST(ArmIk, ForwardOfInverseIsTheTargetPose) {
+  const LabConfig config = LoadConfig(DefaultConfigPath());
+  const std::uint64_t seed = 17;
+  std::printf("seed %llu\n", static_cast<unsigned long long>(seed));
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> ang(-170, 170), wy(-80, 80), h(0, 20);
+  int solved = 0;
+  for (int i = 0; i < 20000; ++i) {
+    // A reachable target: forward kinematics of random angles.
+    const std::array<double, 6> deg = {ang(rng), ang(rng), ang(rng), ang(rng), wy(rng), ang(rng)};
+    const double height = h(rng);
+    const ArmPose p = ComputeArmPose(config.arm, SinCosFromDegrees(deg), height);
+    for (Elbow elbow : {Elbow::kUp, Elbow::kDown}) {
+      const auto s = SolveArmIk(config.arm, p.X_RS2, height, elbow);
+      ASSERT_TRUE(s.has_value());
+      const ArmPose q = ComputeArmPose(config.arm, SinCosFromDegrees(s->angles_deg), height);
+      ASSERT_LT((q.X_RS2.translation() - p.X_RS2.translation()).norm(), 1e-7);
+      ASSERT_LT((q.X_RS2.linear() - p.X_RS2.linear()).norm(), 1e-7);
+      ++solved;
+    }
+  }
+  EXPECT_EQ(solved, 40000);
+}
+
+TEST(ArmIk, OutOfReachHasNoSolution) {
+  const LabConfig config = LoadConfig(DefaultConfigPath());
+  const auto X = EndEffectorPose(Eigen::Vector3d(200, 0, 0), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY());
+  EXPECT_FALSE(SolveArmIk(config.arm, X, 3.0).has_value());
+}
+
+}  // namespace
+}  // namespace rms

@@ -68,7 +68,7 @@ TEST_F(TimelineTest, OutOfRangeValuesAreAcceptedWithAWarning) {
 }
 
 TEST_F(TimelineTest, TheShippedTimelinesParse) {
-  for (const char* name : {"demo.tl", "short.tl"}) {
+  for (const char* name : {"mission.tl", "tour.tl", "short.tl"}) {
     const Timeline tl = Timeline::Load(std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/" + name, config.inputs);
     EXPECT_GT(tl.end_time(), 0.0);
     EXPECT_TRUE(tl.warnings().empty()) << name;

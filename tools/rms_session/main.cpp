@@ -38,7 +38,18 @@ int main(int argc, char** argv) {
       std::cout << "operator input to rendered frame: median " << l["p50_ms"].get<double>()
                 << " ms, p99 " << l["p99_ms"].get<double>() << " ms\n";
     }
-    std::cout << "final mode " << j["final_mode"] << "; LCM log events " << j["log"]["events"] << "\n";
+    std::cout << "modes 1";
+    for (const auto& mc : j["mode_changes"]) {
+      std::cout << " -> " << mc["to"] << " (" << mc["time_s"].get<double>() << " s)";
+    }
+    std::cout << "; acquired " << (j["acquired"].get<bool>() ? "yes" : "no") << ", docked "
+              << (j["docked"].get<bool>() ? "yes" : "no");
+    if (!j["docking"].is_null()) {
+      std::cout << " (" << j["docking"]["distance_ft"].get<double>() << " ft, "
+                << j["docking"]["angle_deg"].get<double>() << " deg)";
+    }
+    std::cout << "\ncollisions " << j["collisions"].size() << ", frames held " << j["held_frames"]
+              << "; LCM log events " << j["log"]["events"] << "\n";
     return 0;
   } catch (const std::exception& e) {
     std::cerr << "rms_session: " << e.what() << "\n";

@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <fstream>
 #include <lcm/lcm-cpp.hpp>
+#include <algorithm>
 #include <map>
 #include <set>
 
@@ -11,6 +12,7 @@
 #include "rms/control_word.h"
 #include "rms/counters.h"
 #include "rms/dcp_frame_t.hpp"
+#include "rms/dcp_telemetry_t.hpp"
 #include "rms/esg_frame_t.hpp"
 #include "rms/message_io.h"
 #include "rms/operator_input_t.hpp"
@@ -47,9 +49,17 @@ std::int64_t SumPrefix(const nlohmann::json& stats, const std::string& prefix) {
   return s;
 }
 
+// Collision bit names (docs/collision.md), as dynamics_proc logs them.
+const char* kCollisionNames[] = {"eff_hex_1-recpt",   "eff_hex_2-recpt",   "eff_hex_3-recpt",
+                                 "eff_hex_1-payload", "eff_hex_2-payload", "eff_hex_3-payload",
+                                 "payload-bay_a",     "payload-bay_b",     "payload-bay_c",
+                                 "payload-bay_d",     "payload-bay_e",     "payload-bay_f",
+                                 "payload-cae"};
+constexpr int kCollisionBits = 13;
+
 std::string StripSuffix(const std::string& channel) {
-  for (const char* base : {channels::kOperatorInput, channels::kDcpFrame, channels::kEsgFrame,
-                           channels::kStatus}) {
+  for (const char* base : {channels::kOperatorInput, channels::kDcpTelemetry, channels::kDcpFrame,
+                           channels::kEsgFrame, channels::kStatus}) {
     if (channel.rfind(base, 0) == 0) return base;
   }
   return channel;
@@ -70,6 +80,17 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
   int final_mode = 0;
   std::set<int> modes;
   std::map<std::string, bool> final_status_seen;
+  // From the DCP's telemetry: mode changes, collision runs, docking.
+  nlohmann::ordered_json mode_changes = nlohmann::ordered_json::array();
+  nlohmann::ordered_json collision_events = nlohmann::ordered_json::array();
+  std::map<std::string, std::array<double, 3>> collision_totals;  // events, frames, seconds
+  std::array<std::int64_t, kCollisionBits> run_start_us{};
+  std::array<std::int64_t, kCollisionBits> run_frames{};
+  std::uint32_t last_bits = 0;
+  int last_mode = 0;
+  bool acquired = false, docked = false;
+  std::int64_t held_frames = 0, telemetry_frames = 0, prev_us = 0;
+  nlohmann::ordered_json docking = nullptr;
   while (const lcm::LogEvent* ev = log.readNextEvent()) {
     ++events;
     if (first_us < 0) first_us = ev->timestamp;
@@ -93,6 +114,49 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
       } else {
         ++malformed;
       }
+    } else if (base == channels::kDcpTelemetry) {
+      dcp_telemetry_t m{};
+      if (SafeDecode(ev->data, ev->datalen, 4096, &m) != DecodeError::kNone) {
+        ++malformed;
+        continue;
+      }
+      ++telemetry_frames;
+      const double t_s = (ev->timestamp - first_us) * 1e-6;
+      if (m.mode != last_mode) {
+        if (last_mode != 0) {
+          mode_changes.push_back({{"frame", m.frame}, {"time_s", t_s}, {"from", last_mode}, {"to", m.mode}});
+        }
+        last_mode = m.mode;
+      }
+      acquired = acquired || m.acquired;
+      if (m.docked && !docked) {
+        docking = {{"frame", m.frame}, {"time_s", t_s}, {"distance_ft", m.dock_distance_ft},
+                   {"angle_deg", m.dock_angle_deg}};
+      }
+      docked = docked || m.docked;
+      held_frames += m.held;
+      const auto bits = static_cast<std::uint32_t>(m.collisions);
+      for (int b = 0; b < kCollisionBits; ++b) {
+        const bool on = bits & (1u << b), was = last_bits & (1u << b);
+        if (on && !was) {
+          run_start_us[b] = ev->timestamp;
+          run_frames[b] = 0;
+        }
+        if (on) ++run_frames[b];
+        if (was && !on) {
+          const double dur = (prev_us - run_start_us[b]) * 1e-6;
+          collision_events.push_back({{"kind", kCollisionNames[b]},
+                                      {"start_s", (run_start_us[b] - first_us) * 1e-6},
+                                      {"duration_s", dur},
+                                      {"frames", run_frames[b]}});
+          auto& tot = collision_totals[kCollisionNames[b]];
+          tot[0] += 1;
+          tot[1] += run_frames[b];
+          tot[2] += dur;
+        }
+      }
+      last_bits = bits;
+      prev_us = ev->timestamp;
     } else if (base == channels::kEsgFrame) {
       esg_frame_t m;
       if (SafeDecode(ev->data, ev->datalen, 1024, &m) == DecodeError::kNone) logged_esg.Accept(m.frame);
@@ -106,6 +170,22 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
       }
     }
   }
+
+  // Collisions still on at the end of the log.
+  for (int b = 0; b < kCollisionBits; ++b) {
+    if (last_bits & (1u << b)) {
+      const double dur = (prev_us - run_start_us[b]) * 1e-6;
+      collision_events.push_back({{"kind", kCollisionNames[b]}, {"start_s", (run_start_us[b] - first_us) * 1e-6},
+                                  {"duration_s", dur}, {"frames", run_frames[b]}, {"open", true}});
+      auto& tot = collision_totals[kCollisionNames[b]];
+      tot[0] += 1;
+      tot[1] += run_frames[b];
+      tot[2] += dur;
+    }
+  }
+
+  std::sort(collision_events.begin(), collision_events.end(),
+            [](const auto& a, const auto& b) { return a["start_s"].template get<double>() < b["start_s"].template get<double>(); });
 
   std::map<std::string, nlohmann::json> stats;
   for (const char* p : {"operator_station", "dynamics_proc", "scene_proc", "esg_renderer"}) {
@@ -122,6 +202,19 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
   j["duration_s"] = first_us >= 0 ? (last_us - first_us) * 1e-6 : 0.0;
   j["final_mode"] = final_mode;
   j["modes_seen"] = std::vector<int>(modes.begin(), modes.end());
+  j["acquired"] = acquired;
+  j["docked"] = docked;
+  j["docking"] = docking;
+  j["mode_changes"] = mode_changes;
+  j["collisions"] = collision_events;
+  nlohmann::ordered_json by_kind = nlohmann::ordered_json::object();
+  for (const auto& [kind, t] : collision_totals) {
+    by_kind[kind] = {{"events", static_cast<std::int64_t>(t[0])}, {"frames", static_cast<std::int64_t>(t[1])},
+                     {"duration_s", t[2]}};
+  }
+  j["collisions_by_kind"] = by_kind;
+  j["held_frames"] = held_frames;
+  j["telemetry_frames"] = telemetry_frames;
   nlohmann::ordered_json frames;
   frames["operator_published"] = Counter(op, "published");
   frames["dcp_published"] = Counter(dcp, "published");

@@ -1,0 +1,229 @@
+#include "collision.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <limits>
+
+namespace rms::dcp {
+
+namespace {
+
+constexpr std::array<FaceList, 64> MakeFaceLists() {
+  std::array<FaceList, 64> lists{};
+  for (int m = 0; m < 64; ++m) {
+    FaceList l{};
+    for (int f = 0; f < kNumFaces; ++f) {
+      if (m & (1 << f)) l.faces[l.count++] = static_cast<std::uint8_t>(f);
+    }
+    lists[m] = l;
+  }
+  return lists;
+}
+
+// The report's candidate separating plane: through a vertex of one solid and
+// a bounding edge of the other (the first non-negative triple product).
+struct PlaneCandidate {
+  bool have = false;
+  Eigen::Vector3d apex, q0, q1;
+};
+
+// Section IV.A.1's edge test for the edge (i, k) of P against the faces of Q,
+// given the two vertices' location words against Q. Returns the face of Q the
+// edge pierces, or -1.
+//
+// The exclusive-or of the two words names the faces whose planes the edge
+// crosses; fewer than two ones and the edge cannot pass through Q (it would
+// have to enter through one face and leave through another, or end inside Q,
+// which the vertex test caught). For each such face f the endpoint on f's TRUE
+// side is the apex v, V runs to the other endpoint, and the edge pierces f iff
+// V passes inside each of f's four bounding edges (b_j, b_j+1):
+//   T_j = (b_j - v) x (b_j+1 - b_j) . V <= 0   for j = 0..3
+// (the report's V_B x V_A . V_i with V_B = b_j - v, V_A = b_j+1 - v). A T_j
+// above the tolerance ends the sequence for that face.
+int EdgePiercesFace(const Hexahedron& P, int i, int k, LocationWord wi, LocationWord wk,
+                    const Hexahedron& Q, double tau, PlaneCandidate* cand, int* products) {
+  const LocationWord x = wi ^ wk;
+  if (std::popcount(static_cast<unsigned>(x)) < 2) return -1;
+  const Eigen::Vector3d vi = P.vertex(i), vk = P.vertex(k);
+  const FaceList& faces = kFacesOfMask[x];
+  for (int n = 0; n < faces.count; ++n) {
+    const int f = faces.faces[n];
+    const bool apex_is_i = (wi & FaceBit(f)) != 0;
+    const Eigen::Vector3d& apex = apex_is_i ? vi : vk;
+    const Eigen::Vector3d dir = apex_is_i ? Eigen::Vector3d(vk - vi) : Eigen::Vector3d(vi - vk);
+    const double dir_len = dir.norm();
+    if (!(dir_len > 0)) continue;
+    bool inside = true;
+    for (int j = 0; j < 4; ++j) {
+      const int b0 = kFaceVertices[f][j], b1 = kFaceVertices[f][(j + 1) % 4];
+      const Eigen::Vector3d q0 = Q.vertex(b0);
+      const Eigen::Vector3d e = Q.vertex(b1) - q0;
+      const double t = Q.handedness * (q0 - apex).cross(e).dot(dir);
+      ++*products;
+      // T_j / (|edge| |V|) is how far the edge passes outside the bounding
+      // edge (docs/collision.md); within tau it still touches.
+      if (t > tau * Q.edge_len[f][j] * dir_len) {
+        inside = false;
+        if (!cand->have) *cand = {true, apex, q0, Q.vertex(b1)};
+        break;
+      }
+    }
+    if (inside) return f;
+  }
+  return -1;
+}
+
+void SetPlane(CollisionResult* r, const Eigen::Vector3d& n, double d) {
+  r->plane_valid = true;
+  r->n = n;
+  r->d = d;
+}
+
+void ProjectionRange(const Hexahedron& h, const Eigen::Vector3d& n, double* lo, double* hi) {
+  *lo = std::numeric_limits<double>::infinity();
+  *hi = -*lo;
+  for (int i = 0; i < kNumVertices; ++i) {
+    const double p = n.x() * h.x[i] + n.y() * h.y[i] + n.z() * h.z[i];
+    *lo = std::min(*lo, p);
+    *hi = std::max(*hi, p);
+  }
+}
+
+// A separating plane when no face of either solid is one: the report's
+// candidate if it separates the whole solids, else the widest gap along the
+// cross products of A's and B's edge directions (for convex solids whose
+// faces do not separate them, one of these does).
+void FindEdgePlane(const Hexahedron& a, const Hexahedron& b, const PlaneCandidate& cand,
+                   double tau, CollisionResult* r) {
+  if (cand.have) {
+    Eigen::Vector3d n = (cand.q0 - cand.apex).cross(cand.q1 - cand.q0);
+    const double len = n.norm();
+    if (len > 0) {
+      n /= len;
+      const double d = n.dot(cand.q0);
+      if (PlaneSeparates(a, b, n, d, tau)) return SetPlane(r, n, d);
+      if (PlaneSeparates(a, b, -n, -d, tau)) return SetPlane(r, -n, -d);
+    }
+  }
+  double best_gap = -std::numeric_limits<double>::infinity();
+  Eigen::Vector3d best_n = Eigen::Vector3d::UnitZ();
+  double best_d = 0;
+  for (const auto& ea : kEdges) {
+    const Eigen::Vector3d da = a.vertex(ea[1]) - a.vertex(ea[0]);
+    for (const auto& eb : kEdges) {
+      Eigen::Vector3d n = da.cross(b.vertex(eb[1]) - b.vertex(eb[0]));
+      const double len = n.norm();
+      if (!(len > 1e-12 * da.norm() * (b.vertex(eb[1]) - b.vertex(eb[0])).norm())) continue;
+      n /= len;
+      double alo, ahi, blo, bhi;
+      ProjectionRange(a, n, &alo, &ahi);
+      ProjectionRange(b, n, &blo, &bhi);
+      if (blo - ahi > best_gap) {
+        best_gap = blo - ahi;
+        best_n = n;
+        best_d = 0.5 * (ahi + blo);
+      }
+      if (alo - bhi > best_gap) {
+        best_gap = alo - bhi;
+        best_n = -n;
+        best_d = -0.5 * (bhi + alo);
+      }
+    }
+  }
+  if (best_gap >= -tau) SetPlane(r, best_n, best_d);
+}
+
+}  // namespace
+
+const std::array<FaceList, 64> kFacesOfMask = MakeFaceLists();
+
+bool PlaneSeparates(const Hexahedron& a, const Hexahedron& b, const Eigen::Vector3d& n, double d,
+                    double tol) {
+  double alo, ahi, blo, bhi;
+  ProjectionRange(a, n, &alo, &ahi);
+  ProjectionRange(b, n, &blo, &bhi);
+  return ahi <= d + tol && blo >= d - tol;
+}
+
+CollisionResult Collide(const Hexahedron& a, const Hexahedron& b, const CollideOptions& options) {
+  CollisionResult r;
+  if (!a.valid || !b.valid) return r;  // kInvalid, kNonFinite
+  const double tau = options.relative_tolerance * std::max(a.scale, b.scale);
+
+  // 1. A's vertices against B's faces.
+  r.words_a = b.Words(a, tau);
+  LocationWord common = kAllFaces;
+  for (int i = 0; i < kNumVertices; ++i) {
+    if (r.words_a[i] == 0) {
+      r.verdict = Verdict::kCollide;
+      r.decider = Decider::kVertexOfAInB;
+      r.index = i;
+      return r;
+    }
+    common &= r.words_a[i];
+  }
+  if (common != 0) {
+    const int f = std::countr_zero(static_cast<unsigned>(common));
+    r.verdict = Verdict::kSeparate;
+    r.decider = Decider::kFaceOfBSeparates;
+    r.index = r.face = f;
+    if (options.want_plane) SetPlane(&r, -b.normal(f), -b.d[f]);
+    return r;
+  }
+
+  // 2. B's vertices against A's faces.
+  r.words_b = a.Words(b, tau);
+  r.words_b_valid = true;
+  common = kAllFaces;
+  for (int i = 0; i < kNumVertices; ++i) {
+    if (r.words_b[i] == 0) {
+      r.verdict = Verdict::kCollide;
+      r.decider = Decider::kVertexOfBInA;
+      r.index = i;
+      return r;
+    }
+    common &= r.words_b[i];
+  }
+  if (common != 0) {
+    const int f = std::countr_zero(static_cast<unsigned>(common));
+    r.verdict = Verdict::kSeparate;
+    r.decider = Decider::kFaceOfASeparates;
+    r.index = r.face = f;
+    if (options.want_plane) SetPlane(&r, a.normal(f), a.d[f]);
+    return r;
+  }
+
+  // 3. Potential edge collisions, both directions.
+  PlaneCandidate cand;
+  for (int e = 0; e < kNumEdges; ++e) {
+    const int i = kEdges[e][0], k = kEdges[e][1];
+    const int f = EdgePiercesFace(a, i, k, r.words_a[i], r.words_a[k], b, tau, &cand, &r.triple_products);
+    if (f >= 0) {
+      r.verdict = Verdict::kCollide;
+      r.decider = Decider::kEdgeOfAPiercesB;
+      r.index = e;
+      r.face = f;
+      return r;
+    }
+  }
+  for (int e = 0; e < kNumEdges; ++e) {
+    const int i = kEdges[e][0], k = kEdges[e][1];
+    const int f = EdgePiercesFace(b, i, k, r.words_b[i], r.words_b[k], a, tau, &cand, &r.triple_products);
+    if (f >= 0) {
+      r.verdict = Verdict::kCollide;
+      r.decider = Decider::kEdgeOfBPiercesA;
+      r.index = e;
+      r.face = f;
+      return r;
+    }
+  }
+
+  // 4. Separate.
+  r.verdict = Verdict::kSeparate;
+  r.decider = Decider::kNoEdgePierces;
+  if (options.want_plane) FindEdgePlane(a, b, cand, tau, &r);
+  return r;
+}
+
+}  // namespace rms::dcp

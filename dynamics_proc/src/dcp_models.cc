@@ -1,0 +1,78 @@
+#include "dcp_models.h"
+
+#include <cmath>
+
+namespace rms::dcp {
+
+EndEffectorModel MakeEndEffector(const EndEffectorConfig& ee, const Eigen::Isometry3d& X_RS2,
+                                 double gap) {
+  // The Reference coordinates of the three System-Two unit vectors.
+  const Eigen::Vector3d UX2 = X_RS2.linear().col(0), UY2 = X_RS2.linear().col(1),
+                        UZ2 = X_RS2.linear().col(2);
+  const Eigen::Vector3d A = X_RS2.translation();
+  const double L = ee.palm_length_ft, W = ee.palm_half_width_ft, H = ee.palm_half_height_ft;
+  const double fl = ee.finger_length_ft, t = ee.finger_thickness_ft;
+  EndEffectorModel m;
+  m.hex[0] = MakeBox(A, UX2, UY2, UZ2, L, W, H);
+  const Eigen::Vector3d palm_bottom = A + L * UX2;
+  m.hex[1] = MakeBox(palm_bottom + (W - 0.5 * t) * UY2, UX2, UY2, UZ2, fl, 0.5 * t, H);
+  m.hex[2] = MakeBox(palm_bottom + (W - t - gap - 0.5 * t) * UY2, UX2, UY2, UZ2, fl, 0.5 * t, H);
+  return m;
+}
+
+Hexahedron MakeBar(const PayloadConfig& p, const Eigen::Isometry3d& X_RP) {
+  const Eigen::Matrix3d& R = X_RP.linear();
+  const Eigen::Vector3d u = R.col(0), v = -R.col(1), w = -R.col(2);
+  const Eigen::Vector3d centre = X_RP * p.p_PoBar_P_ft;
+  const Eigen::Vector3d& size = p.bar_size_P_ft;
+  return MakeBox(centre - 0.5 * size.x() * u, u, v, w, size.x(), 0.5 * size.y(), 0.5 * size.z());
+}
+
+PayloadModel MakePayload(const PayloadConfig& p, const Eigen::Isometry3d& X_RP) {
+  const Eigen::Matrix3d& R = X_RP.linear();
+  const Eigen::Vector3d xP = R.col(0), yP = R.col(1), zP = R.col(2);
+  const Eigen::Vector3d centre = X_RP.translation();
+  const double half_len = 0.5 * p.length_ft, r = 0.5 * p.diameter_ft, pr = 0.5 * p.probe_diameter_ft;
+  PayloadModel m;
+  m.body = MakeBox(centre - half_len * yP, yP, xP, -zP, p.length_ft, r, r);
+  for (int i = 0; i < 8; ++i) m.v[i] = m.body.vertex(i);
+  const Eigen::Vector3d root = centre + half_len * yP;
+  const Eigen::Vector3d tip = root + p.probe_length_ft * yP;
+  int k = kProbeFirst;
+  for (double sx : {-1.0, 1.0})
+    for (double sz : {-1.0, 1.0}) m.v[k++] = root + pr * (sx * xP + sz * zP);
+  for (int j = 0; j < 6; ++j) {
+    const double a = j * M_PI / 3.0;
+    m.v[k++] = tip + pr * (std::cos(a) * xP + std::sin(a) * zP);
+  }
+  m.probe_tip_centre = tip;
+  m.probe_axis = yP;
+  return m;
+}
+
+const char* PayloadVertexName(int i) {
+  static const char* kNames[kPayloadVertices] = {"V11", "V12", "V13", "V14", "V15", "V16",
+                                                 "V17", "V18", "V21", "V22", "V23", "V24",
+                                                 "V31", "V32", "V33", "V34", "V35", "V36"};
+  return i >= 0 && i < kPayloadVertices ? kNames[i] : "?";
+}
+
+Hexahedron MakeCargoBay(const ShuttleConfig& s) {
+  const Eigen::Vector3d A(0.0, 0.0, -0.5 * s.bay_depth_ft);  // centre of face a, the forward bulkhead
+  return MakeBox(A, Eigen::Vector3d::UnitX(), -Eigen::Vector3d::UnitY(), -Eigen::Vector3d::UnitZ(),
+                 s.bay_length_ft, 0.5 * s.bay_width_ft, 0.5 * s.bay_depth_ft);
+}
+
+Hexahedron MakeCaeFrontHalf(const CaeConfig& c) {
+  const double F = c.across_flats_ft, s = F / std::sqrt(3.0), hl = 0.5 * c.length_ft;
+  // In the CAE frame (x_C, y_C, z_C); the port's face c is y_C = 0.
+  const std::array<Eigen::Vector3d, 8> v_C = {{
+      {-0.5 * s, 0, -hl}, {-s, 0.5 * F, -hl}, {-0.5 * s, 0, hl}, {s, 0.5 * F, -hl},
+      {0.5 * s, 0, -hl},  {-s, 0.5 * F, hl},  {s, 0.5 * F, hl},  {0.5 * s, 0, hl},
+  }};
+  std::array<Eigen::Vector3d, 8> v;
+  for (int i = 0; i < 8; ++i) v[i] = c.p_RoCo_R_ft + c.R_RC * v_C[i];
+  return FromVertices(v);
+}
+
+}  // namespace rms::dcp

@@ -1,0 +1,125 @@
+#include "compare.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "collision.h"
+#include "exact_hull.h"
+#include "generators.h"
+
+namespace rms::ref {
+
+namespace {
+const char* DeciderName(dcp::Decider d) {
+  switch (d) {
+    case dcp::Decider::kVertexOfAInB: return "vertex of A in B";
+    case dcp::Decider::kVertexOfBInA: return "vertex of B in A";
+    case dcp::Decider::kFaceOfBSeparates: return "face of B separates";
+    case dcp::Decider::kFaceOfASeparates: return "face of A separates";
+    case dcp::Decider::kEdgeOfAPiercesB: return "edge of A pierces B";
+    case dcp::Decider::kEdgeOfBPiercesA: return "edge of B pierces A";
+    case dcp::Decider::kNoEdgePierces: return "no edge pierces";
+    case dcp::Decider::kNonFinite: return "invalid";
+  }
+  return "?";
+}
+}  // namespace
+
+CompareStats Compare(std::uint64_t seed, long count, double band_rel, int exact_every) {
+  static const double kScales[] = {1e-3, 1e-2, 1e-1, 1.0, 10.0, 100.0, 1e3, 1e4};
+  const Topology topo = StandardTopology();
+  PairGenerator gen(seed);
+  CompareStats st;
+  using Clock = std::chrono::steady_clock;
+  for (long n = 0; n < count; ++n) {
+    const double scale = kScales[n % 8];
+    // Every third block of 8 draws from all ten kinds (three of them general
+    // hexahedra), the rest from the seven box kinds: 10% general in all.
+    const bool boxes_only = (n / 8) % 3 != 2;
+    const Pair p = gen.Next(scale, boxes_only);
+    ++st.pairs;
+    ++st.pairs_by_kind[p.kind];
+
+    auto t0 = Clock::now();
+    const dcp::CollisionResult r = dcp::Collide(p.a.hex, p.b.hex);
+    auto t1 = Clock::now();
+    bool ref_hit;
+    if (p.a.is_box && p.b.is_box) {
+      ref_hit = BoxesIntersect(p.a.box, p.b.box);
+      if (exact_every > 0 && n % exact_every == 0) {
+        ++st.exact_checked;
+        const bool exact = ExactHullsIntersect(p.a.v, p.b.v);
+        if (exact != ref_hit) ref_hit = exact;  // near contact the long double test may differ; exact wins
+      }
+    } else {
+      ++st.exact_checked;
+      ref_hit = ExactHullsIntersect(p.a.v, p.b.v);
+    }
+    auto t2 = Clock::now();
+    st.dcp_seconds += std::chrono::duration<double>(t1 - t0).count();
+    st.ref_seconds += std::chrono::duration<double>(t2 - t1).count();
+    ++st.deciders[DeciderName(r.decider)];
+    st.collide += ref_hit;
+    const double s = std::max(p.a.hex.scale, p.b.hex.scale);
+    if (r.verdict == dcp::Verdict::kInvalid) {
+      ++st.invalid;
+      continue;
+    }
+    const bool dcp_hit = r.verdict == dcp::Verdict::kCollide;
+    // The pair's separation, only when needed: distance if disjoint, minus
+    // the penetration depth if overlapping.
+    auto separation = [&] {
+      return ref_hit ? -static_cast<double>(PenetrationDepth(p.a.v, p.b.v, topo))
+                     : static_cast<double>(HullDistance(p.a.v, p.b.v, topo));
+    };
+    if (dcp_hit != ref_hit) {
+      const double sep = separation();
+      if (std::abs(sep) <= band_rel * s) {
+        ++st.disagree_in_band;
+        ++st.in_band_by_kind[p.kind];
+      } else {
+        ++st.disagree_outside;
+        if (st.examples.size() < 10) {
+          std::ostringstream os;
+          os.precision(17);
+          os << "pair " << n << " (" << p.kind << ", scale " << scale << "): dcp " << (dcp_hit ? "collide" : "separate")
+             << " by '" << DeciderName(r.decider) << "', reference " << (ref_hit ? "intersect" : "disjoint")
+             << ", separation " << sep << " = " << sep / s << " x scale";
+          st.examples.push_back(os.str());
+        }
+      }
+    } else if (!dcp_hit) {
+      // Separate: the plane must separate the solids (within the band).
+      if (!r.plane_valid) {
+        if (separation() > band_rel * s) ++st.plane_missing;
+      } else {
+        dcp::Hexahedron a = p.a.hex, b = p.b.hex;
+        if (!dcp::PlaneSeparates(a, b, r.n, r.d, band_rel * s)) ++st.plane_wrong;
+      }
+    }
+  }
+  return st;
+}
+
+std::string Describe(const CompareStats& s) {
+  std::ostringstream os;
+  os << s.pairs << " pairs (" << s.collide << " intersecting by the reference, " << s.exact_checked
+     << " checked exactly): " << s.disagree_outside << " disagreements outside the band, "
+     << s.disagree_in_band << " inside it; " << s.invalid << " invalid; separating planes missing "
+     << s.plane_missing << ", wrong " << s.plane_wrong << "\n";
+  os << "  DCP " << 1e9 * s.dcp_seconds / s.pairs << " ns/pair, reference " << 1e9 * s.ref_seconds / s.pairs
+     << " ns/pair (timed inside the test loop)\n";
+  os << "  kinds:";
+  for (const auto& [k, n] : s.pairs_by_kind) os << " " << k << " " << n << ";";
+  os << "\n  disagreements inside the band, by kind:";
+  for (const auto& [k, n] : s.in_band_by_kind) os << " " << k << " " << n << ";";
+  os << "\n  deciders:";
+  for (const auto& [k, n] : s.deciders) os << " " << k << " " << n << ";";
+  os << "\n";
+  for (const auto& e : s.examples) os << "  " << e << "\n";
+  return os.str();
+}
+
+}  // namespace rms::ref

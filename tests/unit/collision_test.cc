@@ -1,0 +1,162 @@
+// The DCP's collision algorithm (report IV.A.1): hand-made cases, then
+// agreement with the independent references on generated pairs.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "collision.h"
+#include "compare.h"
+#include "generators.h"
+
+namespace rms::dcp {
+namespace {
+
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+
+Hexahedron AxisBox(const Vector3d& lo, const Vector3d& hi) {
+  // Face a at x = lo.x (U = +X), b at y = lo.y, c at z = lo.z.
+  const Vector3d c = 0.5 * (lo + hi), h = 0.5 * (hi - lo);
+  return MakeBox(Vector3d(lo.x(), c.y(), c.z()), Vector3d::UnitX(), Vector3d::UnitY(), Vector3d::UnitZ(),
+                 2 * h.x(), h.y(), h.z());
+}
+
+TEST(Hexahedron, TheReportsVertexNumberingAndFaceLetters) {
+  // EFF HEX 1 at A = 0 with UX2, UY2, UZ2 = X, Y, Z: the report's v1..v4.
+  const Hexahedron h = MakeBox(Vector3d::Zero(), Vector3d::UnitX(), Vector3d::UnitY(), Vector3d::UnitZ(), 3.0, 1.0, 2.0);
+  EXPECT_EQ(h.vertex(0), Vector3d(0, -1, -2));  // v1 = A - W UY2 - H UZ2
+  EXPECT_EQ(h.vertex(1), Vector3d(0, -1, 2));   // v2 = A - W UY2 + H UZ2
+  EXPECT_EQ(h.vertex(2), Vector3d(3, -1, -2));  // v3 = A - W UY2 - H UZ2 + L UX2
+  EXPECT_EQ(h.vertex(3), Vector3d(0, 1, 2));    // v4 = A + W UY2 + H UZ2
+  // Face d is the far ("bottom") face along UX2; b and e the -Y and +Y faces.
+  EXPECT_EQ(h.normal(kFaceD), Vector3d::UnitX());
+  EXPECT_EQ(h.normal(kFaceB), -Vector3d::UnitY());
+  EXPECT_EQ(h.normal(kFaceE), Vector3d::UnitY());
+  EXPECT_EQ(h.normal(kFaceC), -Vector3d::UnitZ());
+  EXPECT_EQ(FaceLetter(kFaceD), 'd');
+  // Every vertex lies on its three faces.
+  for (int i = 0; i < 8; ++i)
+    for (int f : kVertexFaces[i]) EXPECT_NEAR(h.Beyond(f, h.x[i], h.y[i], h.z[i]), 0.0, 1e-12) << i << f;
+  // A general hexahedron from the same vertices has the same planes.
+  std::array<Vector3d, 8> v;
+  for (int i = 0; i < 8; ++i) v[i] = h.vertex(i);
+  const Hexahedron g = FromVertices(v);
+  ASSERT_TRUE(g.valid);
+  for (int f = 0; f < 6; ++f) {
+    EXPECT_LT((g.normal(f) - h.normal(f)).norm(), 1e-12);
+    EXPECT_NEAR(g.d[f], h.d[f], 1e-12);
+  }
+}
+
+TEST(Hexahedron, LocationWordsSayWhichFacesAPointIsBeyond) {
+  const Hexahedron h = AxisBox(Vector3d(0, 0, 0), Vector3d(1, 1, 1));
+  EXPECT_EQ(h.Word(Vector3d(0.5, 0.5, 0.5), 1e-12), 0);                  // inside: six zeros
+  EXPECT_EQ(h.Word(Vector3d(2, 0.5, 0.5), 1e-12), FaceBit(kFaceD));      // beyond x = 1
+  EXPECT_EQ(h.Word(Vector3d(-1, -1, 2), 1e-12), FaceBit(kFaceA) | FaceBit(kFaceB) | FaceBit(kFaceF));
+  EXPECT_EQ(h.Word(Vector3d(1, 0.5, 0.5), 1e-12), 0);                    // on a face: FALSE side
+}
+
+TEST(Collide, VertexInsideAndFaceSeparation) {
+  const Hexahedron a = AxisBox(Vector3d(0, 0, 0), Vector3d(1, 1, 1));
+  const Hexahedron b = AxisBox(Vector3d(0.5, 0.5, 0.5), Vector3d(2, 2, 2));
+  const CollisionResult r = Collide(a, b);
+  EXPECT_EQ(r.verdict, Verdict::kCollide);
+  EXPECT_EQ(r.decider, Decider::kVertexOfAInB);
+  EXPECT_EQ(r.index, 6);  // v7 = (1, 1, 1) is inside b
+
+  const Hexahedron c = AxisBox(Vector3d(3, 0, 0), Vector3d(4, 1, 1));
+  const CollisionResult s = Collide(a, c);
+  EXPECT_EQ(s.verdict, Verdict::kSeparate);
+  EXPECT_EQ(s.decider, Decider::kFaceOfBSeparates);
+  EXPECT_EQ(s.face, kFaceA);  // all of a lies beyond c's face a (x = 3)
+  ASSERT_TRUE(s.plane_valid);
+  EXPECT_LT((s.n - Vector3d::UnitX()).norm(), 1e-15);  // from a toward c
+  EXPECT_DOUBLE_EQ(s.d, 3.0);
+}
+
+TEST(Collide, TouchingCountsAsCollision) {
+  const Hexahedron a = AxisBox(Vector3d(0, 0, 0), Vector3d(1, 1, 1));
+  EXPECT_EQ(Collide(a, AxisBox(Vector3d(1, 0, 0), Vector3d(2, 1, 1))).verdict, Verdict::kCollide);
+  EXPECT_EQ(Collide(a, AxisBox(Vector3d(1, 1, 1), Vector3d(2, 2, 2))).verdict, Verdict::kCollide);  // a corner
+  EXPECT_EQ(Collide(a, AxisBox(Vector3d(1 + 1e-9, 0, 0), Vector3d(2, 1, 1))).verdict, Verdict::kSeparate);
+}
+
+TEST(Collide, ARodThroughASlabNeedsTheEdgeTestInBothDirections) {
+  // No vertex of either lies in the other.
+  const Hexahedron rod = AxisBox(Vector3d(-0.1, -0.1, -5), Vector3d(0.1, 0.1, 5));
+  const Hexahedron slab = AxisBox(Vector3d(-3, -3, -0.2), Vector3d(3, 3, 0.2));
+  const CollisionResult r1 = Collide(rod, slab);
+  EXPECT_EQ(r1.verdict, Verdict::kCollide);
+  EXPECT_EQ(r1.decider, Decider::kEdgeOfAPiercesB);  // the rod's long edges pierce the slab's faces
+  const CollisionResult r2 = Collide(slab, rod);
+  EXPECT_EQ(r2.verdict, Verdict::kCollide);
+  EXPECT_EQ(r2.decider, Decider::kEdgeOfBPiercesA);  // found only in the second direction
+  // Crossed beams.
+  const Hexahedron beam1 = AxisBox(Vector3d(-5, -0.2, -0.2), Vector3d(5, 0.2, 0.2));
+  const Hexahedron beam2 = AxisBox(Vector3d(-0.2, -5, -0.2), Vector3d(0.2, 5, 0.2));
+  EXPECT_EQ(Collide(beam1, beam2).verdict, Verdict::kCollide);
+}
+
+TEST(Collide, AnEdgeThatStopsShortOfTheSolidIsNotACollision) {
+  // docs/collision.md's counter-example to a ray-only test: the edge from
+  // (2, 2, 2) heads into the corner region of the unit cube and its ray
+  // would enter through face x = 1, but the edge ends at (1.12, 0.8, 0.8),
+  // 0.12 ft short. Its vertices' words differ in two bits.
+  const Hexahedron cube = AxisBox(Vector3d(0, 0, 0), Vector3d(1, 1, 1));
+  std::array<Vector3d, 8> v;
+  // A thin hexahedron along that edge: every vertex within 0.01 of it.
+  const Vector3d p0(2, 2, 2), p1(1.12, 0.8, 0.8);
+  const Vector3d u = (p1 - p0).normalized(), side = u.cross(Vector3d::UnitZ()).normalized(), up = u.cross(side);
+  const Hexahedron needle = MakeBox(p0, u, side, up, (p1 - p0).norm(), 0.005, 0.005);
+  const CollisionResult r = Collide(needle, cube);
+  EXPECT_EQ(r.verdict, Verdict::kSeparate) << static_cast<int>(r.decider);
+  EXPECT_TRUE(r.plane_valid);
+  // Longer, it reaches the cube.
+  const Hexahedron longer = MakeBox(p0, u, side, up, 1.2 * (p1 - p0).norm(), 0.005, 0.005);
+  EXPECT_EQ(Collide(longer, cube).verdict, Verdict::kCollide);
+}
+
+TEST(Collide, NonFiniteInputIsAnErrorNotAVerdict) {
+  const Hexahedron a = AxisBox(Vector3d(0, 0, 0), Vector3d(1, 1, 1));
+  for (double bad : {std::nan(""), std::numeric_limits<double>::infinity()}) {
+    const Hexahedron b = AxisBox(Vector3d(bad, 0, 0), Vector3d(2, 1, 1));
+    EXPECT_FALSE(b.valid);
+    const CollisionResult r = Collide(a, b);
+    EXPECT_EQ(r.verdict, Verdict::kInvalid);
+    EXPECT_EQ(r.decider, Decider::kNonFinite);
+    EXPECT_EQ(Collide(b, a).verdict, Verdict::kInvalid);
+  }
+}
+
+TEST(Collide, TheCompiledFaceListsCoverEveryCombination) {
+  for (int m = 0; m < 64; ++m) {
+    int bits = 0;
+    for (int i = 0; i < kFacesOfMask[m].count; ++i) bits |= 1 << kFacesOfMask[m].faces[i];
+    EXPECT_EQ(bits, m);
+  }
+}
+
+TEST(CollideVsReference, AgreesOutsideTheBandOnGeneratedPairs) {
+  // Fixed seed; the long target (rms_long_tests) runs 10^6 pairs.
+  const std::uint64_t seed = 20261122;
+  const long count = 40000;
+  std::printf("seed %llu, %ld pairs\n", static_cast<unsigned long long>(seed), count);
+  const ref::CompareStats st = ref::Compare(seed, count, 1e-9, /*exact_every=*/20);
+  std::printf("%s", ref::Describe(st).c_str());
+  EXPECT_EQ(st.disagree_outside, 0);
+  EXPECT_EQ(st.invalid, 0);
+  EXPECT_EQ(st.plane_wrong, 0);
+  EXPECT_EQ(st.plane_missing, 0);
+  // Exactly touching faces (representable coordinates) are always collisions.
+  EXPECT_EQ(st.in_band_by_kind.count("touching faces, exact"), 0u);
+  // The mix really exercises every path.
+  EXPECT_GT(st.deciders.at("edge of A pierces B") + st.deciders.at("edge of B pierces A"), 100);
+  EXPECT_GT(st.deciders.at("no edge pierces"), 100);
+  EXPECT_GT(st.collide, count / 5);
+  EXPECT_LT(st.collide, 4 * count / 5);
+}
+
+}  // namespace
+}  // namespace rms::dcp

@@ -1,0 +1,242 @@
+// The Dynamic Collision Program's phases (report IV.A.3) and its collision
+// response, frame by frame in process.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "dcp_models.h"
+#include "dynamic_collision_program.h"
+#include "mission_plan.h"
+#include "rms/arm_ik.h"
+#include "rms/config.h"
+#include "timeline.h"
+
+namespace rms::dcp {
+namespace {
+
+using Eigen::Isometry3d;
+using Eigen::Vector3d;
+
+class Dcp : public ::testing::Test {
+ protected:
+  LabConfig config = LoadConfig(DefaultConfigPath());
+  mission::MissionGeometry geo = mission::PlanGeometry(config);
+
+  Isometry3d X_RP_bay() const {
+    Isometry3d X = Isometry3d::Identity();
+    X.linear() = config.payload.R_RP;
+    X.translation() = config.payload.p_RoPo_R_ft;
+    return X;
+  }
+  OperatorInputs Inputs(const Isometry3d& X_RS2, double finger, double height = -1) const {
+    if (height < 0) height = geo.shoulder_height_ft;
+    OperatorInputs in = InitialInputs(config.inputs);
+    const auto s = SolveArmIk(config.arm, X_RS2, height);
+    EXPECT_TRUE(s.has_value());
+    for (int i = 0; i < 6; ++i) in.value[i] = s->angles_deg[i];
+    in.value[kShoulderHeight] = height;
+    in.value[kFinger] = finger;
+    return in;
+  }
+  static Isometry3d Shifted(Isometry3d X, const Vector3d& d) {
+    X.translation() += d;
+    return X;
+  }
+  // The acquisition check for System Two at X_RS2 and a finger gap.
+  AcquisitionCheck Check(const Isometry3d& X_RS2, double gap) const {
+    return CheckAcquisition(config.dcp, MakeEndEffector(config.end_effector, X_RS2, gap),
+                            MakeBar(config.payload, X_RP_bay()), gap);
+  }
+};
+
+TEST_F(Dcp, AllSixAcquisitionConditionsHoldAtTheGraspAndEachFailsAlone) {
+  const Isometry3d G = geo.X_RS2_grasp;
+  const double gap = 0.55;  // the bar is 0.4 wide; D3Y is 0.6
+  ASSERT_LT(gap, config.dcp.d3y_ft);
+  const AcquisitionCheck ok = Check(G, gap);
+  for (int i = 0; i < 6; ++i) EXPECT_TRUE(ok.holds[i]) << "condition " << i + 1;
+  ASSERT_TRUE(ok.all());
+
+  const Vector3d X2 = G.linear().col(0), Y2 = G.linear().col(1), Z2 = G.linear().col(2);
+  struct Case {
+    const char* what;
+    Isometry3d X;
+    double gap;
+    int fails;
+  };
+  const std::vector<Case> cases = {
+      {"palm down into the bar", Shifted(G, 0.3 * X2), gap, 0},
+      {"bar into the fixed finger", Shifted(G, -0.15 * Y2), gap, 1},
+      {"bar into the movable finger", Shifted(G, 0.22 * Y2), gap, 2},
+      {"finger gap not below D3Y", G, config.dcp.d3y_ft + 0.02, 3},
+      {"palm too far above the bar", Shifted(G, -0.3 * X2), gap, 4},
+      {"end effector past the bar's end", Shifted(G, 0.5 * Z2), gap, 5},
+  };
+  for (const Case& c : cases) {
+    const AcquisitionCheck r = Check(c.X, c.gap);
+    for (int i = 0; i < 6; ++i) {
+      EXPECT_EQ(r.holds[i], i != c.fails) << c.what << ": condition " << i + 1;
+    }
+    EXPECT_FALSE(r.all()) << c.what;
+  }
+}
+
+TEST_F(Dcp, DockingNeedsTheEnvelopeTheDistanceAndTheAngle) {
+  const Hexahedron front = MakeCaeFrontHalf(config.cae);
+  ASSERT_TRUE(front.valid);
+  const Vector3d yC = config.cae.R_RC.col(1);
+  auto check = [&](const Isometry3d& X_RP) {
+    return CheckDocking(config.dcp, config.cae, front, MakePayload(config.payload, X_RP));
+  };
+  const DockingCheck good = check(geo.X_RP_dock);  // tip 0.05 ft short of the port
+  EXPECT_TRUE(good.in_envelope);
+  EXPECT_NEAR(good.distance_ft, 0.05, 1e-9);
+  EXPECT_NEAR(good.angle_deg, 0.0, 1e-6);
+  EXPECT_TRUE(good.docked);
+  // 0.3 ft off to the side: in the envelope, too far.
+  const Vector3d side = config.cae.R_RC.col(0);
+  const DockingCheck off = check(Shifted(geo.X_RP_dock, 0.3 * side));
+  EXPECT_TRUE(off.in_envelope);
+  EXPECT_FALSE(off.docked);
+  // Tilted 3 deg (> 2 deg 32 min) about the tip: aligned badly.
+  Isometry3d tilted = geo.X_RP_dock;
+  const Vector3d tip = config.cae.p_RoCo_R_ft - 0.05 * yC;
+  tilted.linear() = Eigen::AngleAxisd(3.0 * M_PI / 180, side).toRotationMatrix() * tilted.linear();
+  tilted.translation() = tip + Eigen::AngleAxisd(3.0 * M_PI / 180, side).toRotationMatrix() * (geo.X_RP_dock.translation() - tip);
+  const DockingCheck tilt = check(tilted);
+  EXPECT_NEAR(tilt.angle_deg, 3.0, 1e-6);
+  EXPECT_LT(tilt.distance_ft, 0.25);
+  EXPECT_FALSE(tilt.docked);
+  // 2 deg passes.
+  Isometry3d tilted2 = geo.X_RP_dock;
+  tilted2.linear() = Eigen::AngleAxisd(2.0 * M_PI / 180, side).toRotationMatrix() * tilted2.linear();
+  tilted2.translation() = tip + Eigen::AngleAxisd(2.0 * M_PI / 180, side).toRotationMatrix() * (geo.X_RP_dock.translation() - tip);
+  EXPECT_TRUE(check(tilted2).docked);
+  // Beyond face c (the probe's tip inside the CAE): out of the envelope.
+  EXPECT_FALSE(check(Shifted(geo.X_RP_dock, 0.2 * yC)).in_envelope);
+}
+
+TEST_F(Dcp, TheShippedMissionTimelineIsThePlannersForTheDefaultConfig) {
+  std::ifstream f(std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl");
+  std::stringstream ss;
+  ss << f.rdbuf();
+  EXPECT_EQ(ss.str(), mission::FormatTimeline(mission::PlanMission(config), mission::kMissionHeader))
+      << "regenerate: build/tools/rms_mission --out scripts/timelines/mission.tl";
+}
+
+TEST_F(Dcp, TheMissionTimelineAcquiresExtractsAndDocks) {
+  const std::string text = mission::FormatTimeline(mission::PlanMission(config), "");
+  const op::Timeline tl = op::Timeline::Parse(text, "mission", config.inputs);
+  DynamicCollisionProgram dcp(config);
+  std::vector<int> modes;
+  int frames = 0;
+  for (double t = 0; t <= tl.end_time(); t += 1.0 / 30.0, ++frames) {
+    const DcpFrameData out = dcp.Step(tl.Sample(t));
+    if (modes.empty() || modes.back() != out.control.mode) modes.push_back(out.control.mode);
+    EXPECT_EQ(dcp.status().slave_collisions, 0u) << "the slave never stands in collision, t = " << t;
+    EXPECT_EQ(dcp.status().collisions, 0u) << "the planned mission never collides, t = " << t;
+  }
+  EXPECT_EQ(modes, (std::vector<int>{1, 2, 3}));
+  EXPECT_TRUE(dcp.status().docked);
+  EXPECT_LE(dcp.status().dock_distance_ft, config.dcp.dock_distance_ft);
+  EXPECT_LE(dcp.status().dock_angle_deg, config.dcp.dock_angle_deg);
+}
+
+TEST_F(Dcp, ACollisionHoldsTheSlaveAtContactAndReleasesIt) {
+  DynamicCollisionProgram dcp(config);
+  // Over the payload's body, well away from the bar, palm down.
+  const Isometry3d above = Shifted(geo.X_RS2_grasp, Vector3d(-6.0, 0, 3.0));
+  const Hexahedron body = MakePayload(config.payload, X_RP_bay()).body;
+  int held = 0;
+  double lowest = 1e9;
+  // Down 5 ft over 3 s (through the body's top), then back up.
+  for (int f = 0; f <= 180; ++f) {
+    const double down = f <= 90 ? 5.0 * f / 90 : 5.0 * (180 - f) / 90;
+    const OperatorInputs in = Inputs(Shifted(above, Vector3d(0, 0, -down)), 0.0);
+    const DcpFrameData out = dcp.Step(in);
+    const DcpStatus& st = dcp.status();
+    if (st.held) {
+      ++held;
+      EXPECT_TRUE(st.collisions & collision_bits::kEePayloadMask);
+      EXPECT_TRUE(out.control.collision);
+    }
+    // The slave's end effector never penetrates the body.
+    const EndEffectorModel ee = MakeEndEffector(config.end_effector, st.X_RS2, st.finger_gap_ft);
+    for (const Hexahedron& h : ee.hex) ASSERT_NE(Collide(h, body).verdict, Verdict::kCollide) << "frame " << f;
+    lowest = std::min(lowest, st.X_RS2.translation().z());
+  }
+  EXPECT_GT(held, 30);
+  // Contact: the fingers' tips stopped within one frame's travel of the body's top.
+  const double finger_tip = lowest - config.end_effector.palm_length_ft - config.end_effector.finger_length_ft;
+  const double body_top = config.payload.p_RoPo_R_ft.z() + 0.5 * config.payload.diameter_ft;
+  EXPECT_GT(finger_tip, body_top);
+  EXPECT_LT(finger_tip, body_top + 5.0 / 90 + 1e-6);
+  // Released: back above, the slave follows the master exactly.
+  EXPECT_FALSE(dcp.status().held);
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(dcp.status().slave.angles_deg[i], dcp.status().master.angles_deg[i]);
+}
+
+TEST_F(Dcp, TheFingerStopsOnTheBarWhileTheArmFollows) {
+  // With the bar in the middle of the jaw the movable finger meets it before
+  // the gap is below D3Y: the finger holds on the bar (the receptacle bit),
+  // no acquisition, and the arm still follows.
+  DynamicCollisionProgram dcp(config);
+  const Vector3d Y2 = geo.X_RS2_grasp.linear().col(1);
+  const Isometry3d centred = Shifted(geo.X_RS2_grasp, 0.3 * Y2);
+  bool finger_held = false;
+  for (int f = 0; f <= 90; ++f) {
+    dcp.Step(Inputs(centred, f / 90.0));
+    if (dcp.status().finger_held) {
+      finger_held = true;
+      EXPECT_TRUE(dcp.status().collisions & collision_bits::kRecptMask);
+    }
+  }
+  EXPECT_TRUE(finger_held);
+  EXPECT_EQ(dcp.mode(), 1);
+  EXPECT_GT(dcp.status().finger_gap_ft, config.dcp.d3y_ft);  // stopped on the bar, above D3Y
+  // The arm moves up 0.5 ft with the finger still commanded closed: it follows.
+  const double z0 = dcp.status().X_RS2.translation().z();
+  dcp.Step(Inputs(Shifted(centred, Vector3d(0, 0, 0.5)), 1.0));
+  EXPECT_NEAR(dcp.status().X_RS2.translation().z(), z0 + 0.5, 1e-3);
+}
+
+TEST_F(Dcp, InMode2APayloadVertexBeyondABayWallHoldsTheArm) {
+  DynamicCollisionProgram dcp(config);
+  for (int f = 0; f <= 30; ++f) dcp.Step(Inputs(geo.X_RS2_grasp, f / 30.0));
+  ASSERT_EQ(dcp.mode(), 2);
+  // Push sideways toward the starboard wall (+Y_R): the payload's side is 2.5 ft from it.
+  int held = 0;
+  for (int f = 1; f <= 60; ++f) {
+    dcp.Step(Inputs(Shifted(geo.X_RS2_grasp, Vector3d(0, 4.0 * f / 60, 0.5)), 1.0));
+    if (dcp.status().held) {
+      ++held;
+      // The starboard wall is bay face b (v = -Y_R): bit 6 + 1.
+      EXPECT_TRUE(dcp.status().collisions & (collision_bits::kBayFace << kFaceB));
+    }
+  }
+  EXPECT_GT(held, 10);
+  EXPECT_LT(dcp.status().X_RP.translation().y() + 0.5 * config.payload.diameter_ft,
+            0.5 * config.shuttle.bay_width_ft + 1e-9);
+  EXPECT_EQ(dcp.mode(), 2);
+}
+
+TEST_F(Dcp, ResetReturnsToMode1AndTheInitialState) {
+  DynamicCollisionProgram dcp(config);
+  for (int f = 0; f <= 30; ++f) dcp.Step(Inputs(geo.X_RS2_grasp, f / 30.0));
+  ASSERT_EQ(dcp.mode(), 2);
+  for (int f = 1; f <= 30; ++f) dcp.Step(Inputs(Shifted(geo.X_RS2_grasp, Vector3d(0, 0, 0.2 * f)), 1.0));
+  ASSERT_GT(dcp.X_RP().translation().z(), config.payload.p_RoPo_R_ft.z() + 5.0);
+  OperatorInputs in = Inputs(Shifted(geo.X_RS2_grasp, Vector3d(0, 0, 6)), 0.0);
+  in.reset = true;
+  const DcpFrameData out = dcp.Step(in);
+  EXPECT_EQ(dcp.mode(), 1);
+  EXPECT_EQ(out.control.mode, 1);
+  EXPECT_TRUE(out.control.reset);
+  EXPECT_FALSE(out.control.acquired);
+  EXPECT_LT((dcp.X_RP().translation() - config.payload.p_RoPo_R_ft).norm(), 1e-12);
+}
+
+}  // namespace
+}  // namespace rms::dcp
