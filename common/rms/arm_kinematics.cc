@@ -23,6 +23,13 @@ SinCos Normalized(const SinCos& a) {
 }
 }  // namespace
 
+Eigen::Isometry3d MakeIsometry(const Eigen::Matrix3d& R, const Eigen::Vector3d& p) {
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = R;
+  X.translation() = p;
+  return X;
+}
+
 Eigen::Matrix3d RotZ(const SinCos& a) {
   Eigen::Matrix3d r;
   r << a.c, -a.s, 0, a.s, a.c, 0, 0, 0, 1;
@@ -60,19 +67,13 @@ ArmPose ComputeArmPose(const ArmGeometry& arm, const ArmSinCos& raw, double shou
   p.p_RoW_R = p.p_RoE_R + arm.lower_boom_ft * R3.col(0);
   const Eigen::Vector3d p_RoA_R = p.p_RoW_R + arm.wrist_to_palm_ft * R6.col(0);
 
-  auto make = [](const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
-    Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-    X.linear() = R;
-    X.translation() = t;
-    return X;
-  };
-  p.X_RF1 = make(R1, p.p_RoS_R);
-  p.X_RF2 = make(R2, p.p_RoS_R);
-  p.X_RF3 = make(R3, p.p_RoE_R);
-  p.X_RF4 = make(R4, p.p_RoW_R);
-  p.X_RF5 = make(R5, p.p_RoW_R);
-  p.X_RF6 = make(R6, p.p_RoW_R);
-  p.X_RS2 = make(R6, p_RoA_R);
+  p.X_RF1 = MakeIsometry(R1, p.p_RoS_R);
+  p.X_RF2 = MakeIsometry(R2, p.p_RoS_R);
+  p.X_RF3 = MakeIsometry(R3, p.p_RoE_R);
+  p.X_RF4 = MakeIsometry(R4, p.p_RoW_R);
+  p.X_RF5 = MakeIsometry(R5, p.p_RoW_R);
+  p.X_RF6 = MakeIsometry(R6, p.p_RoW_R);
+  p.X_RS2 = MakeIsometry(R6, p_RoA_R);
   return p;
 }
 

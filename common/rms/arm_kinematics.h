@@ -49,6 +49,9 @@ struct ArmPose {
 // (callers validate words first).
 ArmPose ComputeArmPose(const ArmGeometry& arm, const ArmSinCos& sc, double shoulder_height_ft);
 
+// The pose with rotation R and translation p.
+Eigen::Isometry3d MakeIsometry(const Eigen::Matrix3d& R, const Eigen::Vector3d& p);
+
 // Elementary rotations from a sine and cosine.
 Eigen::Matrix3d RotZ(const SinCos& a);
 Eigen::Matrix3d RotX(const SinCos& a);

@@ -134,6 +134,34 @@ void FindEdgePlane(const Hexahedron& a, const Hexahedron& b, const PlaneCandidat
   if (best_gap >= -tau) SetPlane(r, best_n, best_d);
 }
 
+// One vertex phase: the words of one solid's vertices against `faces`' faces.
+// Returns true when it decided (r filled in).
+bool VertexPhase(const std::array<LocationWord, 8>& words, const Hexahedron& faces, bool a_in_b,
+                 bool want_plane, CollisionResult* r) {
+  LocationWord common = kAllFaces;
+  for (int i = 0; i < kNumVertices; ++i) {
+    if (words[i] == 0) {
+      r->verdict = Verdict::kCollide;
+      r->decider = a_in_b ? Decider::kVertexOfAInB : Decider::kVertexOfBInA;
+      r->index = i;
+      return true;
+    }
+    common &= words[i];
+  }
+  if (common == 0) return false;
+  const int f = std::countr_zero(static_cast<unsigned>(common));
+  r->verdict = Verdict::kSeparate;
+  r->decider = a_in_b ? Decider::kFaceOfBSeparates : Decider::kFaceOfASeparates;
+  r->index = r->face = f;
+  // The plane's normal points from A toward B: B's outward normal reversed,
+  // or A's outward normal.
+  if (want_plane) {
+    if (a_in_b) SetPlane(r, -faces.normal(f), -faces.d[f]);
+    else SetPlane(r, faces.normal(f), faces.d[f]);
+  }
+  return true;
+}
+
 }  // namespace
 
 const std::array<FaceList, 64> kFacesOfMask = MakeFaceLists();
@@ -151,48 +179,14 @@ CollisionResult Collide(const Hexahedron& a, const Hexahedron& b, const CollideO
   if (!a.valid || !b.valid) return r;  // kInvalid, kNonFinite
   const double tau = options.relative_tolerance * std::max(a.scale, b.scale);
 
-  // 1. A's vertices against B's faces.
+  // 1. A's vertices against B's faces; 2. B's against A's. Either decides
+  // and ends the algorithm when a word is all zeros (collision) or a face
+  // has a 1 in all eight words (separate).
   r.words_a = b.Words(a, tau);
-  LocationWord common = kAllFaces;
-  for (int i = 0; i < kNumVertices; ++i) {
-    if (r.words_a[i] == 0) {
-      r.verdict = Verdict::kCollide;
-      r.decider = Decider::kVertexOfAInB;
-      r.index = i;
-      return r;
-    }
-    common &= r.words_a[i];
-  }
-  if (common != 0) {
-    const int f = std::countr_zero(static_cast<unsigned>(common));
-    r.verdict = Verdict::kSeparate;
-    r.decider = Decider::kFaceOfBSeparates;
-    r.index = r.face = f;
-    if (options.want_plane) SetPlane(&r, -b.normal(f), -b.d[f]);
-    return r;
-  }
-
-  // 2. B's vertices against A's faces.
+  if (VertexPhase(r.words_a, b, /*a_in_b=*/true, options.want_plane, &r)) return r;
   r.words_b = a.Words(b, tau);
   r.words_b_valid = true;
-  common = kAllFaces;
-  for (int i = 0; i < kNumVertices; ++i) {
-    if (r.words_b[i] == 0) {
-      r.verdict = Verdict::kCollide;
-      r.decider = Decider::kVertexOfBInA;
-      r.index = i;
-      return r;
-    }
-    common &= r.words_b[i];
-  }
-  if (common != 0) {
-    const int f = std::countr_zero(static_cast<unsigned>(common));
-    r.verdict = Verdict::kSeparate;
-    r.decider = Decider::kFaceOfASeparates;
-    r.index = r.face = f;
-    if (options.want_plane) SetPlane(&r, a.normal(f), a.d[f]);
-    return r;
-  }
+  if (VertexPhase(r.words_b, a, /*a_in_b=*/false, options.want_plane, &r)) return r;
 
   // 3. Potential edge collisions, both directions.
   PlaneCandidate cand;

@@ -27,13 +27,6 @@ const char* CollisionName(int bit) {
 
 namespace {
 
-Eigen::Isometry3d Pose(const Eigen::Matrix3d& R, const Eigen::Vector3d& p) {
-  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  X.linear() = R;
-  X.translation() = p;
-  return X;
-}
-
 bool AllHave(const std::array<LocationWord, 8>& words, int face) {
   for (LocationWord w : words) {
     if (!(w & FaceBit(face))) return false;
@@ -52,7 +45,7 @@ std::string Names(std::uint32_t bits) {
 }  // namespace
 
 DynamicCollisionProgram::DynamicCollisionProgram(const LabConfig& config) : config_(config) {
-  X_RP_bay_ = Pose(config.payload.R_RP, config.payload.p_RoPo_R_ft);
+  X_RP_bay_ = MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft);
   bar_bay_ = MakeBar(config.payload, X_RP_bay_);
   payload_bay_ = MakePayload(config.payload, X_RP_bay_);
   bay_ = MakeCargoBay(config.shuttle);

@@ -12,12 +12,7 @@ Eigen::Isometry3d MountPose(CameraMount mount, const ArmPose& arm, const CaeConf
     case CameraMount::kShuttle: return Eigen::Isometry3d::Identity();
     case CameraMount::kElbow: return arm.X_RF3;
     case CameraMount::kWrist: return arm.X_RS2;
-    case CameraMount::kCae: {
-      Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-      X.linear() = cae.R_RC;
-      X.translation() = cae.p_RoCo_R_ft;
-      return X;
-    }
+    case CameraMount::kCae: return MakeIsometry(cae.R_RC, cae.p_RoCo_R_ft);
   }
   RMS_CHECK(false);
   return {};

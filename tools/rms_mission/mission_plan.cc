@@ -5,27 +5,17 @@
 #include <sstream>
 
 #include "rms/arm_ik.h"
+#include "rms/arm_kinematics.h"
 #include "rms/check.h"
 
 namespace rms::mission {
-
-namespace {
-
-Eigen::Isometry3d Pose(const Eigen::Matrix3d& R, const Eigen::Vector3d& p) {
-  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  X.linear() = R;
-  X.translation() = p;
-  return X;
-}
-
-}  // namespace
 
 MissionGeometry PlanGeometry(const LabConfig& c) {
   const auto& ee = c.end_effector;
   const auto& p = c.payload;
   MissionGeometry g;
   g.shoulder_height_ft = c.inputs[kShoulderHeight].initial;
-  const Eigen::Isometry3d X_RP_bay = Pose(p.R_RP, p.p_RoPo_R_ft);
+  const Eigen::Isometry3d X_RP_bay = MakeIsometry(p.R_RP, p.p_RoPo_R_ft);
   const Eigen::Vector3d xP = p.R_RP.col(0), yP = p.R_RP.col(1), zP = p.R_RP.col(2);
   // Grasp: approach down the payload's z axis, fingers closing along its
   // long axis, the bar just inside the fixed finger (a clearance of 40% of
@@ -51,7 +41,7 @@ MissionGeometry PlanGeometry(const LabConfig& c) {
   RD.col(1) = yD;
   RD.col(2) = zD;
   const Eigen::Vector3d tip = c.cae.p_RoCo_R_ft - 0.05 * yC;
-  g.X_RP_dock = Pose(RD, tip - (0.5 * p.length_ft + p.probe_length_ft) * yD);
+  g.X_RP_dock = MakeIsometry(RD, tip - (0.5 * p.length_ft + p.probe_length_ft) * yD);
   return g;
 }
 
