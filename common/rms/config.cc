@@ -302,6 +302,13 @@ LabConfig ParseConfig(std::string_view text, const std::string& source) {
       std::tie(cam.pan_min_deg, cam.pan_max_deg) = r.Range("pan_deg", -180.0, 180.0);
       std::tie(cam.tilt_min_deg, cam.tilt_max_deg) = r.Range("tilt_deg", -89.0, 89.0);
       std::tie(cam.fov_min_deg, cam.fov_max_deg) = r.Range("fov_deg", 1.0, 120.0);
+      const std::vector<double> rates = r.Numbers("rates", 3, 0.0, 1000.0);
+      if (!(rates[0] > 0 && rates[1] > 0 && rates[2] > 0)) {
+        r.Fail("rates", "[pan deg/s, tilt deg/s, zoom 1/s] must all be > 0");
+      }
+      cam.pan_rate_deg_s = rates[0];
+      cam.tilt_rate_deg_s = rates[1];
+      cam.zoom_rate_per_s = rates[2];
       r.Finish();
       c.cameras.push_back(std::move(cam));
     }

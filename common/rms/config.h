@@ -97,6 +97,8 @@ struct CameraStationConfig {
   double pan_min_deg = 0, pan_max_deg = 0;
   double tilt_min_deg = 0, tilt_max_deg = 0;
   double fov_min_deg = 0, fov_max_deg = 0;  // vertical field of view at zoom 1 and 0
+  double pan_rate_deg_s = 0, tilt_rate_deg_s = 0;  // the camera drive's slew rates
+  double zoom_rate_per_s = 0;                      // zoom lever travel per second
 };
 
 struct LabConfig {

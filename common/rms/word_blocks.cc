@@ -167,6 +167,10 @@ std::vector<std::int32_t> PackEsgWords(const EsgFrameData& in, Counters* c) {
   w[ew::kFov] = static_cast<std::int32_t>(wire::EncodeAngleBam(in.fov_deg));
   PutVec3(w.begin() + ew::kPayloadPos, in.p_RoPo_R_ft, "payload_pos", c);
   PutRot(w.begin() + ew::kPayloadRot, in.R_RP, "payload_rot", c);
+  for (int i = 0; i < ew::kPriorityCount; ++i) {
+    RMS_CHECK(wire::IsValidWord(in.priority_words[i]));
+    w[ew::kPriority + i] = in.priority_words[i];
+  }
   return w;
 }
 
@@ -195,6 +199,10 @@ EsgFrameData UnpackEsgWords(std::span<const std::int32_t> w) {
   if (!(d.fov_deg > 0.0 && d.fov_deg < 180.0)) r.Fail(ew::kFov, "field of view must be in (0, 180) deg");
   d.p_RoPo_R_ft = r.Vec3(ew::kPayloadPos);
   d.R_RP = r.Rot(ew::kPayloadRot);
+  for (int i = 0; i < ew::kPriorityCount; ++i) d.priority_words[i] = w[ew::kPriority + i];
+  if (static_cast<std::uint32_t>(d.priority_words.back()) & ~ew::kLastPriorityWordMask) {
+    r.Fail(ew::kPriority + ew::kPriorityCount - 1, "unused priority bits are set");
+  }
   return d;
 }
 

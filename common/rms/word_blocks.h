@@ -82,7 +82,11 @@ inline constexpr int kView = 19;          // 9 x SC22, R_RE row-major
 inline constexpr int kFov = 28;           // BAM24, vertical field of view
 inline constexpr int kPayloadPos = 29;    // 3 x FT12, p_RoPo_R
 inline constexpr int kPayloadRot = 32;    // 9 x SC22, R_RP row-major
-inline constexpr int kCount = 41;         // words used; the frame carries exactly these
+inline constexpr int kPriority = 41;      // 21 x BITS: visual-priority bits (docs/protocol.md)
+inline constexpr int kPriorityCount = 21;
+inline constexpr int kCount = 62;         // words used; the frame carries exactly these
+// Bits of the last priority word beyond the 493 - 7 pair bits: must be zero.
+inline constexpr std::uint32_t kLastPriorityWordMask = (1u << ((493 - 7) - 24 * (kPriorityCount - 1))) - 1;
 }  // namespace esg_words
 static_assert(esg_words::kCount <= kEsgMaxWords);
 
@@ -97,6 +101,8 @@ struct EsgFrameData {
   double fov_deg = 45.0;                                   // vertical field of view
   Eigen::Vector3d p_RoPo_R_ft = Eigen::Vector3d::Zero();
   Eigen::Matrix3d R_RP = Eigen::Matrix3d::Identity();
+  // Visual-priority bits beyond the control word's ten (rms/priority.h).
+  std::array<std::int32_t, esg_words::kPriorityCount> priority_words{};
 };
 
 std::vector<std::int32_t> PackEsgWords(const EsgFrameData& in, Counters* counters);

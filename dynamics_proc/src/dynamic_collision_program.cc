@@ -54,6 +54,7 @@ DynamicCollisionProgram::DynamicCollisionProgram(const LabConfig& config) : conf
 }
 
 void DynamicCollisionProgram::Reset() {
+  released_ = false;
   status_.mode = 1;
   status_.acquired = false;
   status_.docked = false;
@@ -72,6 +73,10 @@ DynamicCollisionProgram::Evaluation DynamicCollisionProgram::Evaluate(const ArmC
   e.words = TransmittedArmWords(cmd.angles_deg);
   e.pose = ComputeArmPose(config_.arm, e.words, cmd.shoulder_height_ft);
   e.finger_gap_ft = FingerGapFt(cmd.finger);
+  if (status_.mode >= 2) {
+    const double widest = status_.docked ? config_.end_effector.finger_gap_open_ft : acquisition_gap_ft_;
+    e.finger_gap_ft = std::clamp(e.finger_gap_ft, contact_gap_ft_, widest);
+  }
   namespace cb = collision_bits;
   switch (status_.mode) {
     case 1: {
@@ -136,7 +141,19 @@ DcpFrameData DynamicCollisionProgram::Step(const OperatorInputs& in) {
   status_.held = false;
   status_.finger_held = false;
 
-  const Evaluation cand = Evaluate(master);
+  // A docked payload is captured at the port: the arm that holds it keeps
+  // its pose and only the finger moves, until opening the finger releases it.
+  ArmCommand command = master;
+  if (status_.docked && !released_ && have_slave_) {
+    if (slave_.finger_gap_ft >= acquisition_gap_ft_ + kReleaseOpeningFt) {
+      released_ = true;
+      spdlog::info("released: the finger let go of the docked payload; the arm is free");
+    } else {
+      command.angles_deg = slave_.cmd.angles_deg;
+      command.shoulder_height_ft = slave_.cmd.shoulder_height_ft;
+    }
+  }
+  const Evaluation cand = Evaluate(command);
   status_.collisions = cand.collisions;
   if (!have_slave_) {
     // The first frame after start or reset: the slave takes the command.
@@ -258,6 +275,17 @@ void DynamicCollisionProgram::UpdateAcquisition() {
     status_.mode = 2;
     status_.acquired = true;
     X_S2P_ = slave_.pose.X_RS2.inverse() * X_RP_bay_;
+    // The gap at which face e of EFF HEX 3 would touch the bar: from face b
+    // of EFF HEX 2 (at Y2 = W - t) to the bar's nearest vertex along -Y2.
+    const Hexahedron& bar = bar_bay_;
+    double y_min = 1e30;
+    for (int i = 0; i < kNumVertices; ++i) {
+      y_min = std::min(y_min, slave_.pose.X_RS2.linear().col(1).dot(bar.vertex(i) - slave_.pose.X_RS2.translation()));
+    }
+    const auto& ee = config_.end_effector;
+    acquisition_gap_ft_ = slave_.finger_gap_ft;
+    contact_gap_ft_ = std::clamp(ee.palm_half_width_ft - ee.finger_thickness_ft - y_min + kFingerContactClearanceFt,
+                                 0.0, acquisition_gap_ft_);
     spdlog::info("acquisition: Mode 1 -> Mode 2 (finger gap {:.3f} ft, palm to bar {:.3f} ft)",
                  c.finger_gap_ft, c.palm_to_bar_ft);
   }

@@ -35,6 +35,12 @@
 
 namespace rms::dcp {
 
+// The finger stops this far short of touching the bar once acquired (above
+// the finger gap word's resolution, so the bar and finger never overlap).
+inline constexpr double kFingerContactClearanceFt = 0.01;
+// Opening the finger this far past the acquisition gap releases a docked payload.
+inline constexpr double kReleaseOpeningFt = 0.05;
+
 // Which pair collides (docs/collision.md): the collision bits of the
 // telemetry.
 namespace collision_bits {
@@ -158,6 +164,13 @@ class DynamicCollisionProgram {
   bool have_slave_ = false;
   Evaluation slave_;
   Eigen::Isometry3d X_S2P_ = Eigen::Isometry3d::Identity();       // payload in System Two, from acquisition
+  // Once acquired, the finger holds the bar: its gap stays between the gap at
+  // which it touches the bar and the gap at acquisition.
+  double contact_gap_ft_ = 0.0;
+  double acquisition_gap_ft_ = 0.0;
+  // Docked: the payload is captured at the port; the arm holding it keeps its
+  // pose until the finger opens past the acquisition gap (released).
+  bool released_ = false;
   Eigen::Isometry3d X_RP_docked_ = Eigen::Isometry3d::Identity();  // payload at the dock
   DcpStatus status_;
 };

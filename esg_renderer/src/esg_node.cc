@@ -1,38 +1,45 @@
 #include "esg_node.h"
 
+#include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <spdlog/spdlog.h>
 
+#include "overlay.h"
+#include "png_io.h"
 #include "rms/channels.h"
 #include "rms/check.h"
 #include "rms/frame_receiver.h"
 #include "rms/message_io.h"
-#include "png_io.h"
 
 namespace rms::esg {
 
 namespace {
 // esg_frame_t: 8 (fingerprint) + 5 x 8 + 2 + 64 x 4 at most.
 constexpr int kMaxEsgSize = 8 + 40 + 2 + 4 * kEsgMaxWords;
+
+std::int64_t MonotonicUs() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
 }  // namespace
 
-EsgNode::EsgNode(const LabConfig& /*config*/, LcmInterface* lcm, EsgRenderer* renderer,
-                 EsgOptions options)
-    : lcm_(lcm), renderer_(renderer), options_(std::move(options)) {
-  lcm_->Subscribe(channels::kEsgFrame,
-                  [this](const void* d, int n, std::int64_t t) { OnFrame(d, n, t); });
+EsgNode::EsgNode(const LabConfig& config, LcmInterface* lcm, EsgRenderer* renderer, EsgOptions options,
+                 VideoWriter* video, LiveWindow* window)
+    : config_(config), lcm_(lcm), renderer_(renderer), options_(std::move(options)), video_(video), window_(window) {
+  for (const auto& cam : config.cameras) camera_names_.push_back(cam.name);
+  lcm_->Subscribe(channels::kEsgFrame, [this](const void* d, int n, std::int64_t t) { OnFrame(d, n, t); });
 }
 
 void EsgNode::OnFrame(const void* data, int size, std::int64_t recv_time_us) {
-  auto got = ReceiveFrame<esg_frame_t>(data, size, kMaxEsgSize, &frames_, &counters_,
-                                       [](const esg_frame_t& m) {
-                                         if (m.num_words < 1 || m.num_words > kEsgMaxWords) {
-                                           throw MalformedError("word_count",
-                                                                "ESG frame with " + std::to_string(m.num_words) + " words");
-                                         }
-                                         return UnpackEsgWords(m.words);
-                                       });
+  auto got = ReceiveFrame<esg_frame_t>(data, size, kMaxEsgSize, &frames_, &counters_, [](const esg_frame_t& m) {
+    if (m.num_words < 1 || m.num_words > kEsgMaxWords) {
+      throw MalformedError("word_count", "ESG frame with " + std::to_string(m.num_words) + " words");
+    }
+    return UnpackEsgWords(m.words);
+  });
   if (!got) return;
   auto& [msg, data_words] = *got;
   counters_.Set("esg.missing", frames_.missing());
@@ -45,19 +52,50 @@ bool EsgNode::RenderPending() {
   if (!pending_) return false;
   const auto [msg, frame] = std::move(*pending_);
   pending_.reset();
-  renderer_->Render(frame);
-  const std::uint8_t* px = renderer_->pixels();
+  const int w = renderer_->width(), h = renderer_->height();
+  const std::size_t bytes = static_cast<std::size_t>(w) * h * 4;
+  // Skip what the scene doesn't need: the same words but for the frame
+  // counter (word 0) draw the same scene; only the overlay changes.
+  const bool unchanged = options_.skip_unchanged && !scene_.empty() && msg.words.size() == last_words_.size() &&
+                         std::equal(msg.words.begin() + 1, msg.words.end(), last_words_.begin() + 1);
+  const std::int64_t t0 = MonotonicUs();
+  if (unchanged) {
+    counters_.Add("skipped.unchanged");
+  } else {
+    renderer_->Render(frame);
+    const std::uint8_t* px = renderer_->pixels();
+    scene_.assign(px, px + bytes);
+    last_words_ = msg.words;
+    const RenderStats& s = renderer_->stats();
+    counters_.Add("rendered.scenes");
+    counters_.Add("clusters.drawn", s.clusters_drawn);
+    counters_.Add("clusters.culled", s.clusters_culled);
+    counters_.Add("triangles.submitted", s.triangles_submitted);
+    if (s.cycles_broken) counters_.Add("priority.cycles_broken", s.cycles_broken);
+    latencies_["render"].Add(MonotonicUs() - t0);
+  }
+  output_ = scene_;
+  if (!options_.id_colors) DrawOverlay(output_.data(), w, h, frame, camera_names_);
   const std::int64_t done = lcm_->NowUs();
   counters_.Add("rendered");
   latencies_["esg_to_render"].Add(done - msg.send_time_us);
   latencies_["input_to_render"].Add(done - msg.input_send_time_us);
+  if (video_) {
+    // One video frame per frame number: frames skipped or lost repeat the
+    // last image, so the video keeps the session's time.
+    const std::int64_t gap = last_rendered_ < 0 ? 1 : std::clamp<std::int64_t>(msg.frame - last_rendered_, 1, 300);
+    video_->Add(output_.data(), static_cast<int>(gap));
+  }
+  if (window_ && window_->open()) {
+    if (window_->Show(output_.data())) counters_.Add("window.frames");
+    else spdlog::info("the live window was closed; rendering goes on");
+  }
   last_rendered_ = msg.frame;
   if (options_.png_every > 0 && !options_.png_dir.empty() && msg.frame % options_.png_every == 0) {
     char name[64];
     std::snprintf(name, sizeof name, "frame_%06lld.png", static_cast<long long>(msg.frame));
     try {
-      WritePng((std::filesystem::path(options_.png_dir) / name).string(), renderer_->width(),
-               renderer_->height(), px);
+      WritePng((std::filesystem::path(options_.png_dir) / name).string(), w, h, output_.data());
       counters_.Add("png_written");
     } catch (const std::exception& e) {
       counters_.Add("png_failed");
@@ -70,18 +108,48 @@ bool EsgNode::RenderPending() {
 int RunEsgRenderer(const LabConfig& config, LcmInterface& lcm, const EsgOptions& options,
                    const std::string& stats_path, const std::string& ready_path) {
   if (!options.png_dir.empty()) std::filesystem::create_directories(options.png_dir);
-  std::unique_ptr<GlContext> gl = CreateOsMesaContext(options.width, options.height);
-  EsgRenderer renderer(config, gl.get(), RenderOptions{options.id_colors});
-  spdlog::info("{}; {}x{}; {} triangles in the static models", gl->description(), options.width,
-               options.height, renderer.triangle_count());
-  EsgNode node(config, &lcm, &renderer, options);
+  RenderOptions ro;
+  ro.id_colors = options.id_colors;
+  if (options.visibility == "depth") ro.visibility = Visibility::kDepth;
+  else if (options.visibility != "priority") throw InputError("--visibility must be priority or depth");
+  ro.frustum_cull = options.frustum_cull;
+  ro.backface_cull = options.backface_cull;
+  std::unique_ptr<GlContext> gl = CreateGlContext(ParseGlBackend(options.gl), options.width, options.height);
+  EsgRenderer renderer(config, gl.get(), ro);
+  spdlog::info("{}; {}x{}; {} triangles in {} clusters; visibility by {}", gl->description(), options.width,
+               options.height, renderer.triangle_count(), kNumClusters,
+               ro.visibility == Visibility::kDepth ? "depth buffer" : "priority (separating planes)");
+  std::unique_ptr<VideoWriter> video;
+  if (!options.video_path.empty()) {
+    video = std::make_unique<VideoWriter>(options.video_path, options.width, options.height,
+                                          config.session.frame_rate_hz);
+    spdlog::info("video: {}", options.video_path);
+  }
+  std::unique_ptr<LiveWindow> window;
+  if (options.window) {
+    try {
+      window = std::make_unique<LiveWindow>(options.width, options.height, "rmslab ESG");
+      spdlog::info("live window open");
+    } catch (const std::exception& e) {
+      spdlog::warn("no live window: {}; rendering headless", e.what());
+    }
+  }
+  EsgNode node(config, &lcm, &renderer, options, video.get(), window.get());
   if (!ready_path.empty()) TouchFile(ready_path);
   spdlog::info("ready: {}", lcm.FullChannel(channels::kEsgFrame));
-  RunNodeLoop(lcm, "esg_renderer", node.counters(), node.latencies(),
-              [&] { return node.last_rendered(); }, [&] { node.RenderPending(); }, stats_path);
-  spdlog::info("rendered {} frames ({} superseded, {} dropped, {} PNG)", node.counters().Get("rendered"),
-               node.counters().Get("superseded"), node.counters().SumPrefix("dropped."),
-               node.counters().Get("png_written"));
+  RunNodeLoop(lcm, "esg_renderer", node.counters(), node.latencies(), [&] { return node.last_rendered(); },
+              [&] { node.RenderPending(); }, stats_path);
+  if (video) {
+    video->Close();
+    node.counters().Set("video.frames", video->frames_written());
+    node.counters().Set("video.dropped", video->frames_dropped());
+    if (!stats_path.empty()) WriteStatsJson(stats_path, "esg_renderer", node.counters(), node.latencies());
+  }
+  spdlog::info("rendered {} frames ({} scenes drawn, {} unchanged, {} superseded, {} dropped, {} PNG{})",
+               node.counters().Get("rendered"), node.counters().Get("rendered.scenes"),
+               node.counters().Get("skipped.unchanged"), node.counters().Get("superseded"),
+               node.counters().SumPrefix("dropped."), node.counters().Get("png_written"),
+               video ? ", " + std::to_string(video->frames_written()) + " video frames" : std::string());
   return 0;
 }
 

@@ -1,10 +1,14 @@
 #pragma once
 // esg_renderer's LCM side: RMS_ESG_FRAME in; renders the newest frame (frames
-// that a newer one overtook before drawing are counted as superseded), writes
-// PNG frames on request, and measures latency.
+// that a newer one overtook before drawing are counted as superseded, never
+// drawn late), re-renders only when the frame's words changed, draws the
+// overlay, and sends the image to PNG files, the session's video and the live
+// window.
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "renderer.h"
 #include "rms/counters.h"
@@ -12,20 +16,30 @@
 #include "rms/lcm_interface.h"
 #include "rms/process.h"
 #include "rms/word_blocks.h"
+#include "video.h"
+#include "window.h"
 
 namespace rms::esg {
 
 struct EsgOptions {
   int width = 1024;
   int height = 768;
-  std::string png_dir;  // --png-dir: where PNG frames go
-  int png_every = 0;    // --png-every N: write every Nth ESG frame (by frame number); 0: none
-  bool id_colors = false;
+  std::string png_dir;      // --png-dir: where PNG frames go
+  int png_every = 0;        // --png-every N: write every Nth ESG frame (by frame number); 0: none
+  bool id_colors = false;   // --id-colors
+  std::string gl = "osmesa";         // --gl osmesa|egl
+  std::string visibility = "priority";  // --visibility priority|depth
+  std::string video_path;   // --video FILE: the session's video
+  bool window = false;      // --window: a live window on the desktop
+  bool skip_unchanged = true;   // --no-skip-unchanged turns off
+  bool frustum_cull = true;     // --no-frustum-cull turns off
+  bool backface_cull = true;    // --no-backface-cull turns off
 };
 
 class EsgNode {
  public:
-  EsgNode(const LabConfig& config, LcmInterface* lcm, EsgRenderer* renderer, EsgOptions options);
+  EsgNode(const LabConfig& config, LcmInterface* lcm, EsgRenderer* renderer, EsgOptions options,
+          VideoWriter* video, LiveWindow* window);
   void OnFrame(const void* data, int size, std::int64_t recv_time_us);
   // Renders the newest frame received since the last call, if any.
   bool RenderPending();
@@ -33,16 +47,24 @@ class EsgNode {
   Counters& counters() { return counters_; }
   const LatencyMap& latencies() const { return latencies_; }
   std::int64_t last_rendered() const { return last_rendered_; }
+  const std::vector<std::uint8_t>& output() const { return output_; }
 
  private:
+  const LabConfig& config_;
   LcmInterface* lcm_;
   EsgRenderer* renderer_;
   EsgOptions options_;
+  VideoWriter* video_;
+  LiveWindow* window_;
+  std::vector<std::string> camera_names_;
   Counters counters_;
   LatencyMap latencies_;
   SequenceTracker frames_;
   std::optional<std::pair<esg_frame_t, EsgFrameData>> pending_;
   std::int64_t last_rendered_ = -1;
+  std::vector<std::int32_t> last_words_;  // the words of the image in scene_
+  std::vector<std::uint8_t> scene_;       // the last rendered scene, before the overlay
+  std::vector<std::uint8_t> output_;      // the last output image, overlay included
 };
 
 int RunEsgRenderer(const LabConfig& config, LcmInterface& lcm, const EsgOptions& options,

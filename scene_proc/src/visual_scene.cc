@@ -1,5 +1,6 @@
 #include "visual_scene.h"
 
+#include <algorithm>
 #include <spdlog/spdlog.h>
 
 #include "rms/channels.h"
@@ -11,19 +12,39 @@
 
 namespace rms::scene {
 
-EsgFrameData VisualScene::Step(const DcpFrameData& dcp, std::uint32_t frame_count,
-                               Counters* counters) {
+VisualScene::VisualScene(const LabConfig& config)
+    : config_(config), model_(BuildSceneModel(config)), planner_(model_),
+      dt_s_(1.0 / config.session.frame_rate_hz) {}
+
+namespace {
+double Toward(double current, double target, double max_step) {
+  return current + std::clamp(target - current, -max_step, max_step);
+}
+}  // namespace
+
+EsgFrameData VisualScene::Step(const DcpFrameData& dcp, std::uint32_t frame_count, Counters* counters) {
+  const int station = dcp.control.camera_station;
+  const CameraStationConfig& cam = config_.cameras[station - 1];
+  // The selected station's drive slews toward the command, clamped to its limits.
+  double pan_cmd = dcp.camera_pan_deg, tilt_cmd = dcp.camera_tilt_deg;
+  if (pan_cmd < cam.pan_min_deg || pan_cmd > cam.pan_max_deg) {
+    if (counters) counters->Add("clamped.camera_pan");
+    pan_cmd = std::clamp(pan_cmd, cam.pan_min_deg, cam.pan_max_deg);
+  }
+  if (tilt_cmd < cam.tilt_min_deg || tilt_cmd > cam.tilt_max_deg) {
+    if (counters) counters->Add("clamped.camera_tilt");
+    tilt_cmd = std::clamp(tilt_cmd, cam.tilt_min_deg, cam.tilt_max_deg);
+  }
+  Drive& drv = drives_[station - 1];
+  drv.pan_deg = Toward(drv.pan_deg, pan_cmd, cam.pan_rate_deg_s * dt_s_);
+  drv.tilt_deg = Toward(drv.tilt_deg, tilt_cmd, cam.tilt_rate_deg_s * dt_s_);
+  drv.zoom = Toward(drv.zoom, std::clamp(dcp.camera_zoom, 0.0, 1.0), cam.zoom_rate_per_s * dt_s_);
+
   const ArmPose arm = ComputeArmPose(config_.arm, dcp.arm, dcp.shoulder_height_ft);
-  const CameraView view =
-      ComputeCameraView(config_, dcp.control.camera_station, dcp.camera_pan_deg,
-                        dcp.camera_tilt_deg, dcp.camera_zoom, arm, counters);
+  const CameraView view = ComputeCameraView(config_, station, drv.pan_deg, drv.tilt_deg, drv.zoom, arm, nullptr);
   EsgFrameData e;
   e.frame_count = frame_count;
   e.control = dcp.control;
-  // Visual priority bits (separating planes): docs/scene.md; zero until the
-  // priority design lands, and the renderer resolves visibility by depth.
-  e.control.priority_dynamic = 0;
-  e.control.priority_fixed = 0;
   e.arm = dcp.arm;
   e.shoulder_height_ft = dcp.shoulder_height_ft;
   e.finger_gap_ft = dcp.finger_gap_ft;
@@ -32,6 +53,11 @@ EsgFrameData VisualScene::Step(const DcpFrameData& dcp, std::uint32_t frame_coun
   e.fov_deg = view.fov_deg;
   e.p_RoPo_R_ft = dcp.p_RoPo_R_ft;
   e.R_RP = dcp.R_RP;
+  // Visual priority from the words as the ESG will read them.
+  const EsgFrameData sent = UnpackEsgWords(PackEsgWords(e, nullptr));
+  const ClusterPoses poses = ComputeClusterPoses(config_, sent);
+  const PriorityBits bits = planner_.Compute(poses, sent.p_RoEye_R_ft, dcp.planes, dcp.plane_valid, counters);
+  PackPriority(bits, &e.control, &e.priority_words);
   return e;
 }
 

@@ -7,6 +7,8 @@
 
 #include "camera_stations.h"
 #include "rms/config.h"
+#include "rms/priority.h"
+#include "rms/scene_model.h"
 #include "rms/counters.h"
 #include "rms/lcm_interface.h"
 #include "rms/process.h"
@@ -14,14 +16,28 @@
 
 namespace rms::scene {
 
+// The Visual Scene Program's state: each station's camera drive (pan, tilt,
+// zoom slewing toward the operator's command at the station's rates) and the
+// separating planes of visual priority.
 class VisualScene {
  public:
-  explicit VisualScene(const LabConfig& config) : config_(config) {}
-  // One frame: the ESG frame's content for this DCP frame.
+  explicit VisualScene(const LabConfig& config);
+  // One frame: the ESG frame's content for this DCP frame, priority bits
+  // included. Deterministic: the drives advance 1 / frame_rate a frame.
   EsgFrameData Step(const DcpFrameData& dcp, std::uint32_t frame_count, Counters* counters);
+
+  struct Drive {
+    double pan_deg = 0, tilt_deg = 0, zoom = 0;
+  };
+  const Drive& drive(int station) const { return drives_[station - 1]; }
+  const SceneModel& model() const { return model_; }
 
  private:
   const LabConfig& config_;
+  SceneModel model_;
+  PriorityPlanner planner_;
+  std::array<Drive, kNumCameraStations> drives_{};
+  double dt_s_;
 };
 
 class SceneNode {

@@ -10,7 +10,7 @@
 #include <fstream>
 #include <map>
 
-#include "models.h"
+#include "renderer.h"
 #include "png_io.h"
 #include "rms/arm_kinematics.h"
 #include "rms/channels.h"
@@ -118,16 +118,16 @@ TEST_F(Session, FourProcessesOverLcmRenderTheArmWhereTheKinematicsPutIt) {
     ASSERT_EQ(img.width, kW);
     ASSERT_EQ(img.height, kH);
     const ArmPose arm = ComputeArmPose(config.arm, f.arm, f.shoulder_height_ft);
-    for (const auto& [p, id] : {std::pair{0.5 * (arm.p_RoS_R + arm.p_RoE_R), esg::PartId::kUpperBoom},
-                                std::pair{0.5 * (arm.p_RoE_R + arm.p_RoW_R), esg::PartId::kLowerBoom}}) {
+    for (const auto& [p, id] : {std::pair{0.5 * (arm.p_RoS_R + arm.p_RoE_R), kUpperBoom},
+                                std::pair{0.5 * (arm.p_RoE_R + arm.p_RoW_R), kLowerBoom}}) {
       int x = 0, y = 0;
       ASSERT_TRUE(Project(f, p, kW, kH, &x, &y)) << name;
       const std::uint8_t* px = img.at(x, y);
-      const esg::Rgb want = esg::IdColor(id);
+      const Rgb want = esg::IdColor(id);
       EXPECT_TRUE(px[0] == want[0] && px[1] == want[1] && px[2] == want[2])
-          << name << ": " << esg::PartName(id) << " expected at (" << x << ", " << y << "), found rgb "
+          << name << ": " << ClusterName(id) << " expected at (" << x << ", " << y << "), found rgb "
           << int(px[0]) << "," << int(px[1]) << "," << int(px[2]);
-      if (id == esg::PartId::kLowerBoom) boom_pixels.emplace_back(x, y);
+      if (id == kLowerBoom) boom_pixels.emplace_back(x, y);
     }
     ++checked;
   }

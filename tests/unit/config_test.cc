@@ -57,7 +57,7 @@ TEST(Config, EveryProblemNamesTheKeyAndTheReason) {
       {R"(upper_boom_ft = 20.9)", "upper_boom_ft = \"long\"", "arm.upper_boom_ft", "must be a number"},
       {R"(upper_boom_ft = 20.9)", "upper_boom_ft = 20.9\nuper_boom_ft = 3", "arm.uper_boom_ft", "unknown key"},
       {R"(frame_rate_hz = 30.0)", "frame_rate_hz = 0.0", "session.frame_rate_hz", "must be >= 1"},
-      {R"(base_position_ft = \[1.5, -9.0, 0.0\])", "base_position_ft = [1.5, -9.0]", "arm.base_position_ft", "array of 3"},
+      {R"(base_position_ft = \[1.5, -8.5, 0.0\])", "base_position_ft = [1.5, -8.5]", "arm.base_position_ft", "array of 3"},
       {R"(y_axis = \[1.0, 0.0, 0.0\])", "y_axis = [1.0, 1.0, 0.0]", "payload.y_axis", "unit vector"},
       {R"(z_axis = \[0.0, 0.0, 1.0\])", "z_axis = [1.0, 0.0, 0.0]", "payload.z_axis", "perpendicular"},
       {R"(finger_gap_closed_ft = 0.35)", "finger_gap_closed_ft = 2.0", "end_effector.finger_gap_closed_ft", "less than"},

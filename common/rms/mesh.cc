@@ -1,10 +1,10 @@
-#include "mesh.h"
+#include "rms/mesh.h"
 
 #include <cmath>
 
 #include <Eigen/Geometry>
 
-namespace rms::esg {
+namespace rms {
 
 void Mesh::AddTri(Eigen::Vector3f a, Eigen::Vector3f b, Eigen::Vector3f c,
                   const Eigen::Vector3f& outward, const Rgb& rgb) {
@@ -15,7 +15,7 @@ void Mesh::AddTri(Eigen::Vector3f a, Eigen::Vector3f b, Eigen::Vector3f c,
   }
   const float len = n.norm();
   if (len <= 0) return;  // degenerate: nothing to draw
-  tris_.push_back({a, b, c, n / len, rgb});
+  tris_.push_back({a, b, c, n / len, rgb, decal_});
 }
 
 void Mesh::AddQuad(const Eigen::Vector3f& a, const Eigen::Vector3f& b, const Eigen::Vector3f& c,
@@ -80,6 +80,24 @@ void Mesh::AddCylinder(const Eigen::Vector3f& p0, const Eigen::Vector3f& p1, flo
   }
 }
 
+void Mesh::AddFrustum(const Eigen::Vector3f& p0, const Eigen::Vector3f& p1, float r0, float r1, int sides,
+                      const Rgb& rgb) {
+  const Eigen::Vector3f w = (p1 - p0).normalized();
+  const Eigen::Vector3f helper =
+      std::abs(w.x()) < 0.9f ? Eigen::Vector3f::UnitX() : Eigen::Vector3f::UnitY();
+  const Eigen::Vector3f u = w.cross(helper).normalized();
+  const Eigen::Vector3f v = w.cross(u);
+  for (int i = 0; i < sides; ++i) {
+    const float t0 = 2.0f * static_cast<float>(M_PI) * i / sides;
+    const float t1 = 2.0f * static_cast<float>(M_PI) * (i + 1) / sides;
+    const Eigen::Vector3f d0 = std::cos(t0) * u + std::sin(t0) * v, d1 = std::cos(t1) * u + std::sin(t1) * v;
+    const Eigen::Vector3f out = (d0 + d1) * (r0 + r1) * 0.5f + (r0 - r1) * w;
+    AddQuad(p0 + r0 * d0, p0 + r0 * d1, p1 + r1 * d1, p1 + r1 * d0, out, rgb);
+    AddTri(p0, p0 + r0 * d0, p0 + r0 * d1, -w, rgb);
+    AddTri(p1, p1 + r1 * d0, p1 + r1 * d1, w, rgb);
+  }
+}
+
 void Mesh::AddExtrusion(const std::vector<Eigen::Vector3f>& outline, const Eigen::Vector3f& axis,
                         const Rgb& rgb) {
   const std::size_t n = outline.size();
@@ -96,4 +114,4 @@ void Mesh::AddExtrusion(const std::vector<Eigen::Vector3f>& outline, const Eigen
   }
 }
 
-}  // namespace rms::esg
+}  // namespace rms

@@ -9,7 +9,7 @@
 
 #include <Eigen/Core>
 
-namespace rms::esg {
+namespace rms {
 
 using Rgb = std::array<std::uint8_t, 3>;
 
@@ -17,6 +17,7 @@ struct Triangle {
   Eigen::Vector3f a, b, c;
   Eigen::Vector3f n;  // unit, outward: (b - a) x (c - a) direction
   Rgb rgb;
+  bool decal = false;  // lies on another face of its cluster; drawn after the others
 };
 
 class Mesh {
@@ -40,16 +41,24 @@ class Mesh {
   // A prism of `sides` sides (a cylinder's flat-shaded stand-in) from p0 to p1.
   void AddCylinder(const Eigen::Vector3f& p0, const Eigen::Vector3f& p1, float radius, int sides,
                    const Rgb& rgb, bool caps = true, float phase_rad = 0.0f);
+  // A truncated cone of `sides` sides from p0 (radius r0) to p1 (radius r1).
+  void AddFrustum(const Eigen::Vector3f& p0, const Eigen::Vector3f& p1, float r0, float r1, int sides,
+                  const Rgb& rgb);
   // A convex polygon prism: `outline` (counter-clockwise about +axis, in the
   // plane through p0) extruded by `axis`.
   void AddExtrusion(const std::vector<Eigen::Vector3f>& outline, const Eigen::Vector3f& axis,
                     const Rgb& rgb);
+
+  // Triangles added from now on are decals (markings on a face, drawn after
+  // the faces they lie on).
+  void SetDecal(bool decal) { decal_ = decal; }
 
   const std::vector<Triangle>& triangles() const { return tris_; }
   std::size_t size() const { return tris_.size(); }
 
  private:
   std::vector<Triangle> tris_;
+  bool decal_ = false;
 };
 
-}  // namespace rms::esg
+}  // namespace rms

@@ -1,0 +1,98 @@
+#pragma once
+// The scene's static model data (docs/scene.md): 32 convex clusters, each a
+// flat-shaded mesh in its own frame, posed every frame from the ESG frame's
+// words. The Visual Scene Program (scene_proc) uses the clusters' geometry
+// to place the separating planes of visual priority; the Electronic Scene
+// Generator (esg_renderer) draws them. Convex clusters draw correctly alone
+// with back faces culled; decals (windows, the port, engine bells) lie just
+// off a face and are drawn after the faces they mark.
+#include <array>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "rms/config.h"
+#include "rms/mesh.h"
+#include "rms/word_blocks.h"
+
+namespace rms {
+
+enum ClusterId : int {
+  // The orbiter (fixed in R): the cargo bay's faces, the longerons' tops, the
+  // fuselage sides, the cabin with its nose, the aft fuselage, tail, wings, doors.
+  kFloor = 0, kWallPort, kWallStbd, kBulkheadFwd, kBulkheadAft, kSillPort, kSillStbd,
+  kSidePort, kSideStbd, kCabin, kAftFuselage, kTail, kWingPort, kWingStbd, kDoorPort, kDoorStbd,
+  // The CAE (fixed in C): the module with its docking port, the solar array.
+  kCaeModule, kCaeArray,
+  // The arm.
+  kPost, kShoulder, kUpperBoom, kElbow, kLowerBoom, kWrist, kEffHex1, kEffHex2, kEffHex3,
+  // The payload (frame P).
+  kPayloadBody, kBar, kBarPostA, kBarPostB, kProbe,
+  kNumClusters
+};
+static_assert(kNumClusters == 32);
+
+std::string_view ClusterName(int id);
+
+// The frame each cluster's mesh is given in.
+enum class ClusterFrame {
+  kReference,  // R
+  kCae,        // C
+  kPost,       // the foot B of the vertical fixed arm, scaled along Z to its length
+  kF1,         // after shoulder yaw, at S
+  kF2,         // the upper boom's frame
+  kF3,         // the lower boom's frame, at E
+  kF6,         // after wrist roll, at W
+  kSystemTwo,  // System Two, at A
+  kFinger3,    // System Two shifted along Y2 to the movable finger
+  kPayload,    // P
+};
+
+enum class ClusterGroup { kShuttle, kCae, kArm, kPayload };
+
+struct Cluster {
+  ClusterId id;
+  ClusterFrame frame;
+  ClusterGroup group;
+  Mesh mesh;
+  // For separating planes, in the cluster's frame: the vertices, the unit
+  // face normals and edge directions (each once), and for a flat cluster its
+  // edges' in-plane normals.
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector3d> normals;
+  std::vector<Eigen::Vector3d> edges;
+  bool flat = false;
+  bool is_static() const { return frame == ClusterFrame::kReference || frame == ClusterFrame::kCae; }
+};
+
+struct SceneModel {
+  std::array<Cluster, kNumClusters> clusters;
+  const Cluster& operator[](int id) const { return clusters[id]; }
+};
+
+SceneModel BuildSceneModel(const LabConfig& config);
+
+// Each cluster's pose in R for a frame (affine: the vertical fixed arm is
+// scaled to its length), and whether it exists this frame (the vertical
+// fixed arm vanishes below 0.8 ft, where the shoulder sits on the deck).
+struct ClusterPoses {
+  std::array<Eigen::Affine3d, kNumClusters> X_RC;
+  std::array<bool, kNumClusters> present;
+};
+ClusterPoses ComputeClusterPoses(const LabConfig& config, const EsgFrameData& frame);
+
+// Where EFF HEX 3 (built centred on Y2 = 0) sits along Y2 for a finger gap.
+double MovingFingerCentreY2(const EndEffectorConfig& ee, double finger_gap_ft);
+
+// The joint housings' radii (docs/scene.md): the booms end where the
+// housings begin, so no link can cut into another at any joint angle.
+inline constexpr double kShoulderRadiusFt = 0.8;
+inline constexpr double kElbowRadiusFt = 1.0;  // the booms clear each other down to a 56 deg elbow
+inline constexpr double kWristRadiusFt = 0.5;
+inline constexpr double kWristClearanceFt = 0.75;  // lower boom's end to W
+// Clusters that would touch are built this far apart (a well-formed scene
+// for visual priority: no two clusters share a surface; docs/scene.md).
+inline constexpr double kClusterClearanceFt = 0.01;
+
+}  // namespace rms

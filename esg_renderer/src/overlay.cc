@@ -1,0 +1,112 @@
+#include "overlay.h"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cstdio>
+
+namespace rms::esg {
+
+namespace {
+
+// 5 x 7 dot glyphs, one byte a row, bit 4 the left column.
+const std::uint8_t* Glyph(char ch) {
+  static const std::uint8_t kDigits[10][7] = {
+      {0x0E, 0x11, 0x13, 0x15, 0x19, 0x11, 0x0E}, {0x04, 0x0C, 0x04, 0x04, 0x04, 0x04, 0x0E},
+      {0x0E, 0x11, 0x01, 0x02, 0x04, 0x08, 0x1F}, {0x1F, 0x02, 0x04, 0x02, 0x01, 0x11, 0x0E},
+      {0x02, 0x06, 0x0A, 0x12, 0x1F, 0x02, 0x02}, {0x1F, 0x10, 0x1E, 0x01, 0x01, 0x11, 0x0E},
+      {0x06, 0x08, 0x10, 0x1E, 0x11, 0x11, 0x0E}, {0x1F, 0x01, 0x02, 0x04, 0x08, 0x08, 0x08},
+      {0x0E, 0x11, 0x11, 0x0E, 0x11, 0x11, 0x0E}, {0x0E, 0x11, 0x11, 0x0F, 0x01, 0x02, 0x0C}};
+  static const std::uint8_t kLetters[26][7] = {
+      {0x0E, 0x11, 0x11, 0x11, 0x1F, 0x11, 0x11}, {0x1E, 0x11, 0x11, 0x1E, 0x11, 0x11, 0x1E},
+      {0x0E, 0x11, 0x10, 0x10, 0x10, 0x11, 0x0E}, {0x1C, 0x12, 0x11, 0x11, 0x11, 0x12, 0x1C},
+      {0x1F, 0x10, 0x10, 0x1E, 0x10, 0x10, 0x1F}, {0x1F, 0x10, 0x10, 0x1E, 0x10, 0x10, 0x10},
+      {0x0E, 0x11, 0x10, 0x17, 0x11, 0x11, 0x0F}, {0x11, 0x11, 0x11, 0x1F, 0x11, 0x11, 0x11},
+      {0x0E, 0x04, 0x04, 0x04, 0x04, 0x04, 0x0E}, {0x07, 0x02, 0x02, 0x02, 0x02, 0x12, 0x0C},
+      {0x11, 0x12, 0x14, 0x18, 0x14, 0x12, 0x11}, {0x10, 0x10, 0x10, 0x10, 0x10, 0x10, 0x1F},
+      {0x11, 0x1B, 0x15, 0x15, 0x11, 0x11, 0x11}, {0x11, 0x11, 0x19, 0x15, 0x13, 0x11, 0x11},
+      {0x0E, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0E}, {0x1E, 0x11, 0x11, 0x1E, 0x10, 0x10, 0x10},
+      {0x0E, 0x11, 0x11, 0x11, 0x15, 0x12, 0x0D}, {0x1E, 0x11, 0x11, 0x1E, 0x14, 0x12, 0x11},
+      {0x0F, 0x10, 0x10, 0x0E, 0x01, 0x01, 0x1E}, {0x1F, 0x04, 0x04, 0x04, 0x04, 0x04, 0x04},
+      {0x11, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0E}, {0x11, 0x11, 0x11, 0x11, 0x11, 0x0A, 0x04},
+      {0x11, 0x11, 0x11, 0x15, 0x15, 0x15, 0x0A}, {0x11, 0x11, 0x0A, 0x04, 0x0A, 0x11, 0x11},
+      {0x11, 0x11, 0x11, 0x0A, 0x04, 0x04, 0x04}, {0x1F, 0x01, 0x02, 0x04, 0x08, 0x10, 0x1F}};
+  static const std::uint8_t kDash[7] = {0, 0, 0, 0x1F, 0, 0, 0};
+  static const std::uint8_t kColon[7] = {0, 0x0C, 0x0C, 0, 0x0C, 0x0C, 0};
+  static const std::uint8_t kDot[7] = {0, 0, 0, 0, 0, 0x0C, 0x0C};
+  static const std::uint8_t kSlash[7] = {0, 0x01, 0x02, 0x04, 0x08, 0x10, 0};
+  static const std::uint8_t kBlank[7] = {0, 0, 0, 0, 0, 0, 0};
+  const char c = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+  if (c >= '0' && c <= '9') return kDigits[c - '0'];
+  if (c >= 'A' && c <= 'Z') return kLetters[c - 'A'];
+  switch (c) {
+    case '-': return kDash;
+    case ':': return kColon;
+    case '.': return kDot;
+    case '/': return kSlash;
+    default: return kBlank;
+  }
+}
+
+}  // namespace
+
+void FillRect(std::uint8_t* rgba, int w, int h, int x0, int y0, int x1, int y1, const Rgb& c) {
+  x0 = std::max(x0, 0); y0 = std::max(y0, 0); x1 = std::min(x1, w); y1 = std::min(y1, h);
+  for (int y = y0; y < y1; ++y) {
+    std::uint8_t* p = rgba + (static_cast<std::size_t>(y) * w + x0) * 4;
+    for (int x = x0; x < x1; ++x, p += 4) {
+      p[0] = c[0]; p[1] = c[1]; p[2] = c[2]; p[3] = 255;
+    }
+  }
+}
+
+void DrawText(std::uint8_t* rgba, int w, int h, int x, int y, std::string_view text, const Rgb& colour, int scale) {
+  for (char ch : text) {
+    const std::uint8_t* g = Glyph(ch);
+    for (int row = 0; row < 7; ++row) {
+      for (int col = 0; col < 5; ++col) {
+        if (g[row] & (0x10 >> col)) {
+          FillRect(rgba, w, h, x + col * scale, y + row * scale, x + (col + 1) * scale, y + (row + 1) * scale, colour);
+        }
+      }
+    }
+    x += 6 * scale;
+  }
+}
+
+void DrawOverlay(std::uint8_t* rgba, int w, int h, const EsgFrameData& f, const std::vector<std::string>& names) {
+  if (!f.control.overlay) return;
+  const int s = std::max(1, h / 300);
+  const int line = 9 * s, margin = 4 * s;
+  const Rgb text{230, 230, 120}, dim{90, 90, 90}, black{0, 0, 0};
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "FRAME %06u", f.frame_count);
+  DrawText(rgba, w, h, margin, margin, buf, text, s);
+  const int st = f.control.camera_station;
+  std::string name = st >= 1 && st <= static_cast<int>(names.size()) ? names[st - 1] : "";
+  if (name.size() > 28) name.resize(28);
+  std::snprintf(buf, sizeof buf, "CAM %d %s", st, name.c_str());
+  DrawText(rgba, w, h, margin, margin + line, buf, text, s);
+  std::snprintf(buf, sizeof buf, "MODE %d", f.control.mode);
+  DrawText(rgba, w, h, margin, margin + 2 * line, buf, text, s);
+  // Indicators, right to left along the top.
+  struct Lamp {
+    const char* label;
+    bool on;
+    Rgb colour;
+  };
+  const Lamp lamps[] = {{"DOCK", f.control.docked, {60, 200, 80}},
+                        {"ACQ", f.control.acquired, {60, 200, 80}},
+                        {"RECPT", f.control.receptacle_collision, {230, 160, 30}},
+                        {"COLL", f.control.collision, {230, 50, 40}}};
+  int x = w - margin;
+  for (const Lamp& l : lamps) {
+    const int tw = static_cast<int>(std::string_view(l.label).size()) * 6 * s + 3 * s;
+    x -= tw;
+    if (l.on) FillRect(rgba, w, h, x - s, margin - s, x + tw - 2 * s, margin + 8 * s, l.colour);
+    DrawText(rgba, w, h, x + s, margin, l.label, l.on ? black : dim, s);
+    x -= 2 * s;
+  }
+}
+
+}  // namespace rms::esg

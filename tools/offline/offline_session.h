@@ -1,0 +1,45 @@
+#pragma once
+// A session without a network: the Dynamic Collision Program and the Visual
+// Scene Program run in process over a timeline, frame by frame, exactly as
+// the processes would (the same libraries, the words packed and read back).
+// One Visual Scene Program per camera station, so every frame can be seen
+// from all eight. For tools (visibility, snapshots) and benchmarks.
+#include <array>
+#include <memory>
+
+#include "dynamic_collision_program.h"
+#include "rms/config.h"
+#include "rms/word_blocks.h"
+#include "timeline.h"
+#include "visual_scene.h"
+
+namespace rms::offline {
+
+class OfflineSession {
+ public:
+  OfflineSession(const LabConfig& config, op::Timeline timeline);
+  // The next frame; false after the timeline's end.
+  bool Next();
+  double t_s() const { return t_; }
+  std::int64_t frame() const { return frame_ - 1; }
+  const OperatorInputs& inputs() const { return inputs_; }
+  const DcpFrameData& dcp() const { return dcp_; }
+  const dcp::DcpStatus& status() const { return program_.status(); }
+  // This frame's ESG frame from camera station s (1..8), as the ESG reads it.
+  const EsgFrameData& esg(int station) const { return esg_[station - 1]; }
+  // ... from the station the timeline selected.
+  const EsgFrameData& esg() const { return esg(inputs_.camera_station); }
+
+ private:
+  const LabConfig& config_;
+  op::Timeline timeline_;
+  dcp::DynamicCollisionProgram program_;
+  std::vector<std::unique_ptr<scene::VisualScene>> scenes_;
+  std::int64_t frame_ = 0;
+  double t_ = 0, prev_t_ = -1;
+  OperatorInputs inputs_;
+  DcpFrameData dcp_;
+  std::array<EsgFrameData, kNumCameraStations> esg_{};
+};
+
+}  // namespace rms::offline
