@@ -12,6 +12,11 @@ struct LiveWindow::Impl {
 
 LiveWindow::LiveWindow(int width, int height, const std::string& title)
     : impl_(std::make_unique<Impl>()), width_(width), height_(height) {
+  // The window surface must not be backed by GL: SDL would load GLX into a
+  // process whose GL is OSMesa's (or EGL's), and GLX's swrast then crashes
+  // on the first update. A plain X11 image (XShm / XPutImage) is all a
+  // blit needs.
+  SDL_SetHint(SDL_HINT_FRAMEBUFFER_ACCELERATION, "0");
   if (SDL_InitSubSystem(SDL_INIT_VIDEO) != 0) {
     throw std::runtime_error(std::string("cannot open a window: ") + SDL_GetError());
   }
@@ -40,6 +45,7 @@ bool LiveWindow::Show(const std::uint8_t* rgba) {
                                                           width_ * 4, SDL_PIXELFORMAT_RGBA32);
   SDL_Surface* target = SDL_GetWindowSurface(impl_->window);
   if (frame && target) {
+    SDL_SetSurfaceBlendMode(frame, SDL_BLENDMODE_NONE);  // copy, do not blend on alpha
     SDL_BlitSurface(frame, nullptr, target, nullptr);
     SDL_UpdateWindowSurface(impl_->window);
   }

@@ -1,6 +1,6 @@
 // scripts/lab demo as a user runs it (a short timeline): the session folder
 // holds an LCM log of every channel that lcm-logplayer plays, each process's
-// log, PNG frames and summary.json.
+// log, PNG frames, the session's video and summary.json.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 using testing::SourcePath;
 using testing::Subprocess;
 
-TEST(LabDemo, TheSessionFolderHoldsLogFramesProcessLogsAndSummary) {
+TEST(LabDemo, TheSessionFolderHoldsLogVideoFramesProcessLogsAndSummary) {
   const std::string tmp = testing::MakeTempDir("lab");
   const std::string out = tmp + "/session";
   const std::string url = testing::UniqueLcmUrl(8000);
@@ -42,6 +42,16 @@ TEST(LabDemo, TheSessionFolderHoldsLogFramesProcessLogsAndSummary) {
   for (const auto& e : fs::directory_iterator(out + "/frames")) pngs += e.path().extension() == ".png";
   EXPECT_GE(pngs, 3);
 
+  // The session's video: one frame per frame number, at the render size.
+  ASSERT_TRUE(fs::exists(out + "/session.mp4"));
+  {
+    Subprocess probe({"/usr/bin/ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0", "-show_entries",
+                      "stream=nb_read_frames,width,height", "-of", "csv=p=0", out + "/session.mp4"},
+                     tmp + "/ffprobe.log");
+    ASSERT_EQ(probe.Wait(60), 0) << testing::ReadFile(tmp + "/ffprobe.log");
+    EXPECT_EQ(testing::ReadFile(tmp + "/ffprobe.log"), "320,240,91\n");
+  }
+
   // The LCM log holds every channel.
   std::map<std::string, int> by_channel;
   {
@@ -60,6 +70,10 @@ TEST(LabDemo, TheSessionFolderHoldsLogFramesProcessLogsAndSummary) {
   EXPECT_EQ(s["frames"]["operator_published"], 91);
   EXPECT_GE(s["frames"]["rendered"].get<int>(), 85);
   EXPECT_EQ(s["frames"]["png_written"], pngs);
+  EXPECT_EQ(s["frames"]["video_frames"], 91);
+  EXPECT_EQ(s["frames"]["video_dropped"], 0);
+  EXPECT_EQ(s["frames"]["scenes_drawn"].get<int>() + s["frames"]["skipped_unchanged"].get<int>(),
+            s["frames"]["rendered"].get<int>());
   EXPECT_EQ(s["log"]["esg_frames"], by_channel[channels::kEsgFrame]);
   EXPECT_TRUE(s["frames"]["dropped"].contains("scene_to_esg"));
   EXPECT_TRUE(s["latency"].contains("input_to_render"));

@@ -9,15 +9,16 @@ LabProcesses::LabProcesses(std::string dir, std::string url, std::vector<std::st
 
 LabProcesses::~LabProcesses() = default;  // Subprocess kills what is left
 
-std::unique_ptr<Subprocess> LabProcesses::StartOne(const std::string& name, std::vector<std::string> args) {
+std::unique_ptr<Subprocess> LabProcesses::StartOne(const std::string& name, std::vector<std::string> args,
+                                                   const std::vector<std::string>& env) {
   std::vector<std::string> argv = {BuildPath(name + "/" + name), "--lcm-url", url_, "--stats",
                                    dir_ + "/" + name + ".json", "--ready-file", dir_ + "/" + name + ".ready"};
   argv.insert(argv.end(), args.begin(), args.end());
-  return std::make_unique<Subprocess>(argv, dir_ + "/" + name + ".log");
+  return std::make_unique<Subprocess>(argv, dir_ + "/" + name + ".log", env);
 }
 
 bool LabProcesses::Start(std::string* error) {
-  procs_.emplace_back("esg_renderer", StartOne("esg_renderer", esg_args_));
+  procs_.emplace_back("esg_renderer", StartOne("esg_renderer", esg_args_, esg_env_));
   procs_.emplace_back("scene_proc", StartOne("scene_proc", {}));
   procs_.emplace_back("dynamics_proc", StartOne("dynamics_proc", {}));
   for (const auto& [name, p] : procs_) {

@@ -27,13 +27,17 @@ class LabProcesses {
   // SIGINT to the three; returns true when all exit 0 (logs in `error` if not).
   bool Stop(std::string* error);
 
+  // Extra environment for esg_renderer (e.g. DISPLAY=:99); before Start.
+  void set_esg_env(std::vector<std::string> env) { esg_env_ = std::move(env); }
+
   const std::string& dir() const { return dir_; }
   const std::string& url() const { return url_; }
 
  private:
-  std::unique_ptr<Subprocess> StartOne(const std::string& name, std::vector<std::string> args);
+  std::unique_ptr<Subprocess> StartOne(const std::string& name, std::vector<std::string> args,
+                                       const std::vector<std::string>& env = {});
   std::string dir_, url_;
-  std::vector<std::string> esg_args_;
+  std::vector<std::string> esg_args_, esg_env_;
   std::vector<std::pair<std::string, std::unique_ptr<Subprocess>>> procs_;
 };
 

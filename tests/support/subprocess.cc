@@ -24,7 +24,13 @@ Subprocess::Subprocess(const std::vector<std::string>& argv, const std::string& 
   for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
   std::vector<std::string> env_store;
-  for (char** e = environ; *e; ++e) env_store.emplace_back(*e);
+  // extra_env entries ("KEY=value") replace the inherited ones of that key.
+  auto overridden = [&](const std::string& kv) {
+    const std::string key = kv.substr(0, kv.find('=') + 1);
+    for (const auto& e : extra_env) if (e.compare(0, key.size(), key) == 0) return true;
+    return false;
+  };
+  for (char** e = environ; *e; ++e) if (!overridden(*e)) env_store.emplace_back(*e);
   for (const auto& e : extra_env) env_store.push_back(e);
   std::vector<char*> env;
   for (auto& e : env_store) env.push_back(e.data());

@@ -221,7 +221,11 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
   frames["esg_published"] = Counter(scene, "published");
   frames["rendered"] = Counter(esg, "rendered");
   frames["superseded"] = Counter(esg, "superseded");
+  frames["scenes_drawn"] = Counter(esg, "rendered.scenes");
+  frames["skipped_unchanged"] = Counter(esg, "skipped.unchanged");
   frames["png_written"] = Counter(esg, "png_written");
+  frames["video_frames"] = Counter(esg, "video.frames");
+  frames["video_dropped"] = Counter(esg, "video.dropped");
   frames["late_operator_frames"] = Counter(op, "frames.late");
   frames["dropped"] = {
       {"operator_to_dcp", Counter(dcp, "input.missing")},
