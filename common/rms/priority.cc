@@ -102,6 +102,14 @@ void PackPriority(const PriorityBits& bits, ControlWord* cw,
   }
 }
 
+std::string PriorityBitPlace(int pair) {
+  const int k = DcpPairSlot(pair);
+  if (k >= 0) return "control word bit " + std::to_string(control_bits::kPriorityDynamicShift + k);
+  const int s = Layout().slot[pair];
+  if (s < 7) return "control word bit " + std::to_string(control_bits::kPriorityFixedShift + s);
+  return "ESG word " + std::to_string(esg_words::kPriority + (s - 7) / 24) + " bit " + std::to_string((s - 7) % 24);
+}
+
 PriorityBits UnpackPriority(const ControlWord& cw, std::span<const std::int32_t> words) {
   PriorityBits bits;
   for (int k = 0; k < 3; ++k) {

@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -47,6 +48,9 @@ using PriorityBits = std::bitset<kNumPairs>;
 void PackPriority(const PriorityBits& bits, ControlWord* cw,
                   std::array<std::int32_t, esg_words::kPriorityCount>* words);
 PriorityBits UnpackPriority(const ControlWord& cw, std::span<const std::int32_t> priority_words);
+// Where a pair's bit travels, for the priority table: "control word bit 14",
+// "ESG word 41 bit 0" (ESG frame word numbering, docs/protocol.md).
+std::string PriorityBitPlace(int pair);
 
 // How a pair's plane is set: the priority table of docs/scene.md.
 enum class PlaneSource : std::uint8_t {

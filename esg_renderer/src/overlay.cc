@@ -35,6 +35,7 @@ const std::uint8_t* Glyph(char ch) {
   static const std::uint8_t kColon[7] = {0, 0x0C, 0x0C, 0, 0x0C, 0x0C, 0};
   static const std::uint8_t kDot[7] = {0, 0, 0, 0, 0, 0x0C, 0x0C};
   static const std::uint8_t kSlash[7] = {0, 0x01, 0x02, 0x04, 0x08, 0x10, 0};
+  static const std::uint8_t kComma[7] = {0, 0, 0, 0, 0x0C, 0x04, 0x08};
   static const std::uint8_t kBlank[7] = {0, 0, 0, 0, 0, 0, 0};
   const char c = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
   if (c >= '0' && c <= '9') return kDigits[c - '0'];
@@ -44,6 +45,7 @@ const std::uint8_t* Glyph(char ch) {
     case ':': return kColon;
     case '.': return kDot;
     case '/': return kSlash;
+    case ',': return kComma;
     default: return kBlank;
   }
 }
@@ -84,7 +86,7 @@ void DrawOverlay(std::uint8_t* rgba, int w, int h, const EsgFrameData& f, const 
   DrawText(rgba, w, h, margin, margin, buf, text, s);
   const int st = f.control.camera_station;
   std::string name = st >= 1 && st <= static_cast<int>(names.size()) ? names[st - 1] : "";
-  if (name.size() > 28) name.resize(28);
+  if (name.size() > 34) name.resize(34);
   std::snprintf(buf, sizeof buf, "CAM %d %s", st, name.c_str());
   DrawText(rgba, w, h, margin, margin + line, buf, text, s);
   std::snprintf(buf, sizeof buf, "MODE %d", f.control.mode);

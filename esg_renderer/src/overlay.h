@@ -13,7 +13,7 @@
 
 namespace rms::esg {
 
-// Draws `text` (A-Z, 0-9, space, - : . /; others as blanks) with its top
+// Draws `text` (A-Z, 0-9, space, - : . / ,; others as blanks) with its top
 // left at (x, y), each dot `scale` pixels square, into an RGBA image.
 void DrawText(std::uint8_t* rgba, int width, int height, int x, int y, std::string_view text,
               const Rgb& colour, int scale);

@@ -29,19 +29,23 @@ Eigen::Matrix3d AimRotation(const Eigen::Vector3d& look_M) {
   return r;
 }
 
+void ClampPanTilt(const CameraStationConfig& cam, double* pan_deg, double* tilt_deg, Counters* counters) {
+  if (*pan_deg < cam.pan_min_deg || *pan_deg > cam.pan_max_deg) {
+    if (counters) counters->Add("clamped.camera_pan");
+    *pan_deg = std::clamp(*pan_deg, cam.pan_min_deg, cam.pan_max_deg);
+  }
+  if (*tilt_deg < cam.tilt_min_deg || *tilt_deg > cam.tilt_max_deg) {
+    if (counters) counters->Add("clamped.camera_tilt");
+    *tilt_deg = std::clamp(*tilt_deg, cam.tilt_min_deg, cam.tilt_max_deg);
+  }
+}
+
 CameraView ComputeCameraView(const LabConfig& config, int station, double pan_deg,
                              double tilt_deg, double zoom, const ArmPose& arm,
                              Counters* counters) {
   RMS_CHECK(station >= 1 && station <= kNumCameraStations);
   const CameraStationConfig& cam = config.cameras[station - 1];
-  if (pan_deg < cam.pan_min_deg || pan_deg > cam.pan_max_deg) {
-    if (counters) counters->Add("clamped.camera_pan");
-    pan_deg = std::clamp(pan_deg, cam.pan_min_deg, cam.pan_max_deg);
-  }
-  if (tilt_deg < cam.tilt_min_deg || tilt_deg > cam.tilt_max_deg) {
-    if (counters) counters->Add("clamped.camera_tilt");
-    tilt_deg = std::clamp(tilt_deg, cam.tilt_min_deg, cam.tilt_max_deg);
-  }
+  ClampPanTilt(cam, &pan_deg, &tilt_deg, counters);
   zoom = std::clamp(zoom, 0.0, 1.0);
   const Eigen::Isometry3d X_RM = MountPose(cam.mount, arm, config.cae);
   const Eigen::Matrix3d R_MA = AimRotation(cam.p_MoAim_M_ft - cam.p_MoCam_M_ft);

@@ -27,14 +27,7 @@ EsgFrameData VisualScene::Step(const DcpFrameData& dcp, std::uint32_t frame_coun
   const CameraStationConfig& cam = config_.cameras[station - 1];
   // The selected station's drive slews toward the command, clamped to its limits.
   double pan_cmd = dcp.camera_pan_deg, tilt_cmd = dcp.camera_tilt_deg;
-  if (pan_cmd < cam.pan_min_deg || pan_cmd > cam.pan_max_deg) {
-    if (counters) counters->Add("clamped.camera_pan");
-    pan_cmd = std::clamp(pan_cmd, cam.pan_min_deg, cam.pan_max_deg);
-  }
-  if (tilt_cmd < cam.tilt_min_deg || tilt_cmd > cam.tilt_max_deg) {
-    if (counters) counters->Add("clamped.camera_tilt");
-    tilt_cmd = std::clamp(tilt_cmd, cam.tilt_min_deg, cam.tilt_max_deg);
-  }
+  ClampPanTilt(cam, &pan_cmd, &tilt_cmd, counters);
   Drive& drv = drives_[station - 1];
   drv.pan_deg = Toward(drv.pan_deg, pan_cmd, cam.pan_rate_deg_s * dt_s_);
   drv.tilt_deg = Toward(drv.tilt_deg, tilt_cmd, cam.tilt_rate_deg_s * dt_s_);

@@ -31,6 +31,7 @@ class VisualScene {
   };
   const Drive& drive(int station) const { return drives_[station - 1]; }
   const SceneModel& model() const { return model_; }
+  const PriorityPlanner& planner() const { return planner_; }
 
  private:
   const LabConfig& config_;

@@ -7,11 +7,14 @@
 
 #include <cmath>
 #include <cstring>
+#include <fstream>
+#include <sstream>
 #include <map>
 #include <set>
 
 #include "gl_context.h"
 #include "offline_session.h"
+#include "priority_table.h"
 #include "renderer.h"
 #include "rms/config.h"
 
@@ -187,6 +190,58 @@ TEST_F(Scene, PriorityDrawsWhatTheDepthBufferDrawsOverTheMissionFromEveryStation
   EXPECT_GT(frames, 80);
   for (int st = 0; st < kNumCameraStations; ++st) EXPECT_EQ(differing[st], 0) << "station " << st + 1;
   EXPECT_EQ(cycles, 0);
+}
+
+TEST_F(Scene, APlaneSeparatesEveryPairOfClustersThroughoutTheMission) {
+  // A pair with no separating plane interpenetrates (the arm through the
+  // orbiter, say): visual priority can then not be right, and the mission
+  // flies through something solid.
+  offline::OfflineSession s(config, op::Timeline::Load(std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl",
+                                                       config.inputs));
+  long frames = 0;
+  while (s.Next()) ++frames;
+  EXPECT_EQ(frames, 1351);
+  EXPECT_EQ(s.scene_counters().Get("priority.unresolved"), 0);
+}
+
+TEST_F(Scene, NoCameraEverSitsInsideASolid) {
+  // A camera inside a convex cluster sees through it (all its faces turn
+  // away) and would see its inside if back faces were drawn: a modelling
+  // error that back-face culling hides. Every 5th frame of the mission, every
+  // station, every solid cluster.
+  const SceneModel model = BuildSceneModel(config);
+  offline::OfflineSession s(config, op::Timeline::Load(std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl",
+                                                       config.inputs));
+  long checked = 0;
+  while (s.Next()) {
+    if (s.frame() % 5) continue;
+    for (int st = 1; st <= kNumCameraStations; ++st) {
+      const EsgFrameData& f = s.esg(st);
+      const ClusterPoses poses = ComputeClusterPoses(config, f);
+      for (int c = 0; c < kNumClusters; ++c) {
+        if (!poses.present[c] || model[c].flat) continue;
+        ++checked;
+        // The eye in the cluster's frame; inside when behind every face.
+        const Eigen::Vector3f p = (poses.X_RC[c].inverse() * f.p_RoEye_R_ft).cast<float>();
+        float max_out_ft = -1e9f;
+        for (const Triangle& t : model[c].mesh.triangles()) {
+          if (!t.decal) max_out_ft = std::max(max_out_ft, t.n.dot(p - t.a));
+        }
+        EXPECT_GT(max_out_ft, 0.0f) << "station " << st << " (" << config.cameras[st - 1].name << ") is inside "
+                                    << ClusterName(c) << " at frame " << s.frame();
+      }
+    }
+  }
+  EXPECT_GT(checked, 10000);
+}
+
+TEST_F(Scene, ThePriorityTableInTheDocsIsWhatTheCodeComputes) {
+  std::ifstream in(std::string(RMSLAB_SOURCE_DIR) + "/docs/priority-table.md");
+  std::stringstream shipped;
+  shipped << in.rdbuf();
+  EXPECT_EQ(shipped.str(), offline::PriorityTableMarkdown(
+                               config, std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl"))
+      << "regenerate: build/tools/rms_priority_table > docs/priority-table.md";
 }
 
 }  // namespace

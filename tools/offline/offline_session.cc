@@ -23,7 +23,7 @@ bool OfflineSession::Next() {
   for (int s = 1; s <= kNumCameraStations; ++s) {
     DcpFrameData d = dcp_;
     d.control.camera_station = s;
-    esg_[s - 1] = UnpackEsgWords(PackEsgWords(scenes_[s - 1]->Step(d, static_cast<std::uint32_t>(frame_ & 0xFFFFFF), nullptr), nullptr));
+    esg_[s - 1] = UnpackEsgWords(PackEsgWords(scenes_[s - 1]->Step(d, static_cast<std::uint32_t>(frame_ & 0xFFFFFF), &scene_counters_), nullptr));
   }
   ++frame_;
   return true;

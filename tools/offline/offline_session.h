@@ -9,6 +9,7 @@
 
 #include "dynamic_collision_program.h"
 #include "rms/config.h"
+#include "rms/counters.h"
 #include "rms/word_blocks.h"
 #include "timeline.h"
 #include "visual_scene.h"
@@ -29,6 +30,11 @@ class OfflineSession {
   const EsgFrameData& esg(int station) const { return esg_[station - 1]; }
   // ... from the station the timeline selected.
   const EsgFrameData& esg() const { return esg(inputs_.camera_station); }
+  // The Visual Scene Program that computes station s's frames.
+  const scene::VisualScene& scene(int station) const { return *scenes_[station - 1]; }
+  // The Visual Scene Programs' counters, all eight stations summed
+  // (e.g. "priority.unresolved": pairs no plane separated, 8 a frame).
+  const Counters& scene_counters() const { return scene_counters_; }
 
  private:
   const LabConfig& config_;
@@ -40,6 +46,7 @@ class OfflineSession {
   OperatorInputs inputs_;
   DcpFrameData dcp_;
   std::array<EsgFrameData, kNumCameraStations> esg_{};
+  Counters scene_counters_;
 };
 
 }  // namespace rms::offline

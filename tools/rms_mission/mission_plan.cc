@@ -7,6 +7,8 @@
 #include "rms/arm_ik.h"
 #include "rms/arm_kinematics.h"
 #include "rms/check.h"
+#include "rms/priority.h"
+#include "rms/scene_model.h"
 
 namespace rms::mission {
 
@@ -45,18 +47,50 @@ MissionGeometry PlanGeometry(const LabConfig& c) {
   return g;
 }
 
+std::string Interpenetration(const LabConfig& c, const SceneModel& model, const std::array<double, 6>& angles_deg,
+                             double shoulder_height_ft, double finger_gap_ft, const Eigen::Isometry3d& X_RP) {
+  EsgFrameData f;
+  f.arm = SinCosFromDegrees(angles_deg);
+  f.shoulder_height_ft = shoulder_height_ft;
+  f.finger_gap_ft = finger_gap_ft;
+  f.p_RoPo_R_ft = X_RP.translation();
+  f.R_RP = X_RP.linear();
+  const ClusterPoses poses = ComputeClusterPoses(c, f);
+  for (int a = 0; a < kNumClusters; ++a) {
+    if (model[a].is_static() || !poses.present[a]) continue;
+    const PosedHull ha = PoseHull(model[a], poses.X_RC[a]);
+    for (int b = 0; b < kNumClusters; ++b) {
+      if (!model[b].is_static()) continue;
+      if (!FindSeparatingPlane(ha, PoseHull(model[b], poses.X_RC[b]), 5e-4, nullptr)) {
+        return std::string(ClusterName(a)) + " runs into " + std::string(ClusterName(b));
+      }
+    }
+  }
+  return "";
+}
+
 std::vector<Keyframe> PlanMission(const LabConfig& c) {
   const MissionGeometry g = PlanGeometry(c);
   const double h = g.shoulder_height_ft;
   std::vector<Keyframe> keys;
-  auto solve = [&](const Eigen::Isometry3d& X_RS2, const std::string& note) {
-    const auto s = SolveArmIk(c.arm, X_RS2, h);
+  const SceneModel model = BuildSceneModel(c);
+  const Eigen::Isometry3d X_RP_bay = MakeIsometry(c.payload.R_RP, c.payload.p_RoPo_R_ft);
+  // Elbow up (one branch all along, so joint interpolation between close
+  // waypoints stays smooth); a waypoint that puts the arm or the payload
+  // into the orbiter or the CAE is refused.
+  auto solve = [&](const Eigen::Isometry3d& X_RS2, double finger, const std::string& note) {
+    const double gap = c.end_effector.finger_gap_open_ft -
+                       finger * (c.end_effector.finger_gap_open_ft - c.end_effector.finger_gap_closed_ft);
+    const Eigen::Isometry3d X_RP = finger > 0.5 ? X_RS2 * g.X_S2P : X_RP_bay;
+    const auto s = SolveArmIk(c.arm, X_RS2, h, Elbow::kUp);
     if (!s) throw InputError("mission waypoint '" + note + "' is out of the arm's reach");
+    const std::string why = Interpenetration(c, model, s->angles_deg, h, gap, X_RP);
+    if (!why.empty()) throw InputError("mission waypoint '" + note + "': " + why);
     return s->angles_deg;
   };
   auto add = [&](double t, const Eigen::Isometry3d& X_RS2, double finger, int camera, const std::string& note,
                  const std::string& extra = "") {
-    keys.push_back({t, solve(X_RS2, note), h, finger, camera, note, extra});
+    keys.push_back({t, solve(X_RS2, finger, note), h, finger, camera, note, extra});
   };
   Keyframe stowed;
   stowed.shoulder_height_ft = h;

@@ -12,6 +12,7 @@
 #include <Eigen/Geometry>
 
 #include "rms/config.h"
+#include "rms/scene_model.h"
 
 namespace rms::mission {
 
@@ -34,7 +35,14 @@ struct MissionGeometry {
 
 MissionGeometry PlanGeometry(const LabConfig& config);
 
-// Throws rms::InputError naming the waypoint when one is out of reach.
+// What a pose puts into something solid: the first arm or payload cluster
+// no plane separates from a cluster of the orbiter or the CAE ("upper_boom
+// runs into cabin"), or "" when all are clear.
+std::string Interpenetration(const LabConfig& config, const SceneModel& model, const std::array<double, 6>& angles_deg,
+                             double shoulder_height_ft, double finger_gap_ft, const Eigen::Isometry3d& X_RP);
+
+// Throws rms::InputError naming the waypoint when one is out of reach, or
+// puts the arm or the payload into the orbiter or the CAE.
 std::vector<Keyframe> PlanMission(const LabConfig& config);
 
 std::string FormatTimeline(const std::vector<Keyframe>& keys, const std::string& header);

@@ -1,0 +1,194 @@
+// rms_render_bench: what each of the ESG's savings buys over a whole scripted
+// mission (docs/esg.md, "Skip what the scene doesn't need"), run time against
+// error. The mission is flown in process (OfflineSession: the real DCP and
+// Visual Scene Program, the words packed and read back); every frame of the
+// selected camera station is drawn by each renderer variant, timed from the
+// first GL call to the pixels in memory, and compared pixel by pixel with the
+// depth-buffer reference drawn with every cull on.
+//
+//   build/bench/rms_render_bench [--width 1024 --height 768] [--every 1] [--json out.json]
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <nlohmann/json.hpp>
+#include <fstream>
+
+#include "gl_context.h"
+#include "offline_session.h"
+#include "overlay.h"
+#include "png_io.h"
+#include "renderer.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double Ms(Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); }
+
+struct Variant {
+  std::string name;
+  rms::esg::RenderOptions options;
+  std::unique_ptr<rms::esg::GlContext> gl;
+  std::unique_ptr<rms::esg::EsgRenderer> renderer;
+  std::vector<double> ms;
+  long clusters = 0, triangles = 0, differing = 0, frames_differing = 0, worst = 0;
+};
+
+double Percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<std::size_t>(p * (v.size() - 1) + 0.5))];
+}
+double Mean(const std::vector<double>& v) {
+  double s = 0;
+  for (double x : v) s += x;
+  return v.empty() ? 0 : s / v.size();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"rmslab rms_render_bench: the ESG's savings (frustum cull, back-face cull, priority instead of a "
+               "depth buffer, the selected station only, unchanged frames not redrawn) measured over a mission"};
+  std::string config_path = rms::DefaultConfigPath();
+  std::string timeline = std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl";
+  int every = 1, width = 1024, height = 768;
+  std::string json_out, gl_name = "osmesa", dump_dir;
+  app.add_option("--config", config_path, "Configuration file")->capture_default_str();
+  app.add_option("--timeline", timeline, "Timeline to fly")->capture_default_str();
+  app.add_option("--every", every, "Measure every Nth frame")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--width", width, "Image width")->capture_default_str();
+  app.add_option("--height", height, "Image height")->capture_default_str();
+  app.add_option("--gl", gl_name, "GL backend: osmesa or egl")->capture_default_str();
+  app.add_option("--json", json_out, "Also write the figures as JSON to this file");
+  app.add_option("--dump", dump_dir, "Write each variant's worst frame, and the reference's, as PNG here");
+  CLI11_PARSE(app, argc, argv);
+  try {
+    using rms::esg::Visibility;
+    const rms::LabConfig config = rms::LoadConfig(config_path);
+    rms::offline::OfflineSession session(config, rms::op::Timeline::Load(timeline, config.inputs));
+    std::vector<Variant> v;
+    auto add = [&](std::string name, Visibility vis, bool frustum, bool backface) {
+      Variant x;
+      x.name = std::move(name);
+      x.options = {.visibility = vis, .id_colors = false, .frustum_cull = frustum, .backface_cull = backface};
+      v.push_back(std::move(x));
+    };
+    // v[0] is the reference the others are compared with.
+    add("depth buffer, all culls (reference)", Visibility::kDepth, true, true);
+    add("priority, all culls (the ESG default)", Visibility::kPriority, true, true);
+    add("priority, no frustum cull", Visibility::kPriority, false, true);
+    add("priority, no back-face cull", Visibility::kPriority, true, false);
+    add("depth buffer, no culls", Visibility::kDepth, false, false);
+    for (Variant& x : v) {
+      x.gl = rms::esg::CreateGlContext(rms::esg::ParseGlBackend(gl_name), width, height);
+      x.renderer = std::make_unique<rms::esg::EsgRenderer>(config, x.gl.get(), x.options);
+    }
+    const std::size_t n = static_cast<std::size_t>(width) * height;
+    std::vector<std::uint8_t> ref(n * 4), out(n * 4);
+    std::vector<std::string> names;
+    for (const auto& c : config.cameras) names.push_back(c.name);
+
+    std::vector<double> all_stations_ms, overlay_ms;
+    long frames = 0, unchanged = 0;
+    std::vector<std::int32_t> prev_words;
+    while (session.Next()) {
+      // Unchanged frames: the selected station's words but for the frame
+      // counter (word 0) equal the previous frame's, as esg_renderer tests.
+      const std::vector<std::int32_t> words = rms::PackEsgWords(session.esg(), nullptr);
+      const bool same = !prev_words.empty() && std::equal(words.begin() + 1, words.end(), prev_words.begin() + 1);
+      prev_words = words;
+      ++frames;
+      unchanged += same;
+      if (session.frame() % every) continue;
+      const rms::EsgFrameData& f = session.esg();
+      for (std::size_t k = 0; k < v.size(); ++k) {
+        Variant& x = v[k];
+        const auto t0 = Clock::now();
+        x.renderer->Render(f);
+        const std::uint8_t* px = x.renderer->pixels();
+        x.ms.push_back(Ms(Clock::now() - t0));
+        x.clusters += x.renderer->stats().clusters_drawn;
+        x.triangles += x.renderer->stats().triangles_submitted;
+        if (k == 0) {
+          std::memcpy(ref.data(), px, n * 4);
+        } else {
+          long d = 0;
+          for (std::size_t i = 0; i < n; ++i) d += std::memcmp(px + 4 * i, &ref[4 * i], 3) != 0;
+          if (d > x.worst && !dump_dir.empty()) {  // the worst frame so far
+            const std::string stem = dump_dir + "/variant" + std::to_string(k) + "_worst_";
+            rms::esg::WritePng(stem + "variant.png", width, height, px);
+            rms::esg::WritePng(stem + "reference.png", width, height, ref.data());
+            x.worst = d;
+          }
+          x.differing += d;
+          x.frames_differing += d > 0;
+        }
+      }
+      // Every station drawn each frame (what the ESG does not do) against the selected one.
+      {
+        Variant& x = v[1];
+        const auto t0 = Clock::now();
+        for (int s = 1; s <= rms::kNumCameraStations; ++s) {
+          x.renderer->Render(session.esg(s));
+          x.renderer->pixels();
+        }
+        all_stations_ms.push_back(Ms(Clock::now() - t0));
+      }
+      // An unchanged frame costs a copy of the last scene and the overlay.
+      {
+        const auto t0 = Clock::now();
+        std::memcpy(out.data(), ref.data(), n * 4);
+        rms::esg::DrawOverlay(out.data(), width, height, f, names);
+        overlay_ms.push_back(Ms(Clock::now() - t0));
+      }
+    }
+
+    const long measured = static_cast<long>(v[0].ms.size());
+    nlohmann::ordered_json j;
+    j["timeline"] = timeline;
+    j["size"] = {width, height};
+    j["gl"] = v[0].gl->description();
+    j["frames"] = frames;
+    j["frames_measured"] = measured;
+    std::printf("%s, %dx%d, %s: %ld frames, %ld measured\n\n", timeline.c_str(), width, height,
+                v[0].gl->description().c_str(), frames, measured);
+    std::printf("%-40s %9s %9s %9s %9s %10s %12s %8s\n", "variant (selected station)", "mean ms", "p50 ms", "p99 ms",
+                "clusters", "triangles", "px differ", "frames");
+    for (const Variant& x : v) {
+      const double m = Mean(x.ms);
+      std::printf("%-40s %9.3f %9.3f %9.3f %9.1f %10.1f %12ld %8ld\n", x.name.c_str(), m, Percentile(x.ms, 0.5),
+                  Percentile(x.ms, 0.99), static_cast<double>(x.clusters) / measured,
+                  static_cast<double>(x.triangles) / measured, x.differing, x.frames_differing);
+      j["variants"].push_back({{"name", x.name},
+                               {"mean_ms", m},
+                               {"p50_ms", Percentile(x.ms, 0.5)},
+                               {"p99_ms", Percentile(x.ms, 0.99)},
+                               {"clusters_drawn_mean", static_cast<double>(x.clusters) / measured},
+                               {"triangles_submitted_mean", static_cast<double>(x.triangles) / measured},
+                               {"pixels_differing_from_reference", x.differing},
+                               {"frames_differing_from_reference", x.frames_differing}});
+    }
+    const double sel = Mean(v[1].ms), all8 = Mean(all_stations_ms), ov = Mean(overlay_ms);
+    const double frac = static_cast<double>(unchanged) / frames;
+    std::printf("\nselected station only: %.3f ms a frame; all eight stations: %.3f ms (x%.1f)\n", sel, all8,
+                all8 / sel);
+    std::printf("unchanged frames (words 1.. equal the previous frame's): %ld of %ld (%.1f%%); such a frame costs "
+                "%.3f ms (copy + overlay) instead of %.3f ms\n",
+                unchanged, frames, 100 * frac, ov, sel);
+    std::printf("mission render time with skipping: %.3f ms a frame on average, without: %.3f ms (%.1f%% saved)\n",
+                (1 - frac) * sel + frac * ov, sel, 100 * frac * (sel - ov) / sel);
+    j["selected_station_ms"] = sel;
+    j["all_stations_ms"] = all8;
+    j["unchanged_frames"] = unchanged;
+    j["unchanged_fraction"] = frac;
+    j["unchanged_frame_ms"] = ov;
+    j["mean_ms_with_skipping"] = (1 - frac) * sel + frac * ov;
+    if (!json_out.empty()) std::ofstream(json_out) << j.dump(2) << "\n";
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "rms_render_bench: %s\n", e.what());
+    return 2;
+  }
+}
