@@ -30,3 +30,8 @@ rmslab_ensure_multicast_route() {
     return 1
   fi
 }
+
+# The frame rate of a configuration file (session.frame_rate_hz).
+rmslab_frame_rate() {
+  awk '/^\[/ { sec = $0 } sec == "[session]" && $1 == "frame_rate_hz" { print $3; exit }' "$1"
+}

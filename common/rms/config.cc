@@ -6,6 +6,8 @@
 #include <sstream>
 #include <toml++/toml.h>
 
+#include "rms/toml_reader.h"
+
 #include "rms/check.h"
 
 #ifndef RMSLAB_DEFAULT_CONFIG
@@ -14,136 +16,12 @@
 
 namespace rms {
 
+using TableReader = TomlReader;
+
 std::string DefaultConfigPath() { return RMSLAB_DEFAULT_CONFIG; }
 
 namespace {
 
-std::string Fmt(double v) {
-  std::ostringstream os;
-  os.precision(10);
-  os << v;
-  return os.str();
-}
-
-// Reads one TOML table strictly: every key it is asked for must be present
-// and well-formed; Finish() refuses keys nobody asked for.
-class TableReader {
- public:
-  TableReader(const toml::table* table, std::string path, const std::string* source)
-      : table_(table), path_(std::move(path)), source_(source) {}
-
-  [[noreturn]] void Fail(std::string_view key, const std::string& reason) const {
-    throw InputError(*source_ + ": key '" + Key(key) + "': " + reason);
-  }
-  std::string Key(std::string_view key) const {
-    return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
-  }
-
-  const toml::node* Get(std::string_view key) {
-    used_.insert(std::string(key));
-    const toml::node* n = table_->get(key);
-    if (n == nullptr) Fail(key, "missing (every key is required; see docs/config.md)");
-    return n;
-  }
-
-  double Number(std::string_view key, double lo, double hi, bool open_lo = false) {
-    const toml::node* n = Get(key);
-    std::optional<double> v = n->value<double>();
-    if (!v || !(n->is_integer() || n->is_floating_point())) Fail(key, "must be a number");
-    CheckRange(key, *v, lo, hi, open_lo);
-    return *v;
-  }
-
-  void CheckRange(std::string_view key, double v, double lo, double hi, bool open_lo) const {
-    if (!std::isfinite(v)) Fail(key, "must be finite, got " + Fmt(v));
-    if (open_lo ? !(v > lo) : !(v >= lo)) {
-      Fail(key, "must be " + std::string(open_lo ? "> " : ">= ") + Fmt(lo) + ", got " + Fmt(v));
-    }
-    if (!(v <= hi)) Fail(key, "must be <= " + Fmt(hi) + ", got " + Fmt(v));
-  }
-
-  double Positive(std::string_view key, double hi = 1e4) { return Number(key, 0.0, hi, true); }
-
-  std::vector<double> Numbers(std::string_view key, std::size_t count, double lo, double hi) {
-    const toml::node* n = Get(key);
-    const toml::array* a = n->as_array();
-    if (a == nullptr || a->size() != count) {
-      Fail(key, "must be an array of " + std::to_string(count) + " numbers");
-    }
-    std::vector<double> out;
-    for (const toml::node& e : *a) {
-      std::optional<double> v = e.value<double>();
-      if (!v || !(e.is_integer() || e.is_floating_point())) {
-        Fail(key, "must be an array of " + std::to_string(count) + " numbers");
-      }
-      CheckRange(key, *v, lo, hi, false);
-      out.push_back(*v);
-    }
-    return out;
-  }
-
-  Eigen::Vector3d Vec3(std::string_view key, double limit = 1e4) {
-    std::vector<double> v = Numbers(key, 3, -limit, limit);
-    return {v[0], v[1], v[2]};
-  }
-
-  std::pair<double, double> Range(std::string_view key, double lo, double hi) {
-    std::vector<double> v = Numbers(key, 2, lo, hi);
-    if (!(v[0] < v[1])) Fail(key, "must be [low, high] with low < high");
-    return {v[0], v[1]};
-  }
-
-  std::string String(std::string_view key) {
-    const toml::node* n = Get(key);
-    std::optional<std::string> v = n->value<std::string>();
-    if (!v || !n->is_string()) Fail(key, "must be a string");
-    return *v;
-  }
-
-  TableReader Sub(std::string_view key) {
-    const toml::node* n = Get(key);
-    const toml::table* t = n->as_table();
-    if (t == nullptr) Fail(key, "must be a table");
-    return TableReader(t, Key(key), source_);
-  }
-
-  const toml::array* Array(std::string_view key) {
-    const toml::node* n = Get(key);
-    const toml::array* a = n->as_array();
-    if (a == nullptr) Fail(key, "must be an array of tables ([[" + Key(key) + "]])");
-    return a;
-  }
-
-  // A rotation from two unit axes given in R (y and z); x = y cross z.
-  Eigen::Matrix3d Rotation(std::string_view y_key, std::string_view z_key) {
-    Eigen::Vector3d y = Vec3(y_key), z = Vec3(z_key);
-    if (std::abs(y.norm() - 1.0) > 1e-6) Fail(y_key, "must be a unit vector");
-    if (std::abs(z.norm() - 1.0) > 1e-6) Fail(z_key, "must be a unit vector");
-    if (std::abs(y.dot(z)) > 1e-6) Fail(z_key, "must be perpendicular to " + Key(y_key));
-    Eigen::Matrix3d r;
-    r.col(0) = y.cross(z);
-    r.col(1) = y;
-    r.col(2) = z;
-    return r;
-  }
-
-  void Finish() const {
-    for (auto&& [k, v] : *table_) {
-      if (!used_.count(std::string(k.str()))) {
-        throw InputError(*source_ + ": key '" + Key(k.str()) +
-                         "': unknown key (misspelt? see docs/config.md)");
-      }
-    }
-  }
-
-  const std::string& path() const { return path_; }
-
- private:
-  const toml::table* table_;
-  std::string path_;
-  const std::string* source_;
-  std::set<std::string> used_;
-};
 
 CameraMount ParseMount(TableReader& r) {
   const std::string m = r.String("mount");
@@ -157,15 +35,7 @@ CameraMount ParseMount(TableReader& r) {
 }  // namespace
 
 LabConfig ParseConfig(std::string_view text, const std::string& source) {
-  toml::table root;
-  try {
-    root = toml::parse(text, source);
-  } catch (const toml::parse_error& e) {
-    std::ostringstream os;
-    os << source << ":" << e.source().begin.line << ":" << e.source().begin.column
-       << ": TOML syntax error: " << e.description();
-    throw InputError(os.str());
-  }
+  toml::table root = ParseToml(text, source);
   LabConfig c;
   c.source = source;
   TableReader top(&root, "", &c.source);
@@ -268,7 +138,7 @@ LabConfig ParseConfig(std::string_view text, const std::string& source) {
         const double counts = v / cal.units_per_count + cal.zero_count;
         if (counts < -32768.5 || counts > 32767.5) {
           r.Fail(v == cal.min ? "min" : "max",
-                 "value " + Fmt(v) + " needs " + Fmt(counts) +
+                 "value " + FormatNumber(v) + " needs " + FormatNumber(counts) +
                      " counts, outside the ADC's [-32768, 32767]; change units_per_count");
         }
       }

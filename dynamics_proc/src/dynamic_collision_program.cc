@@ -17,14 +17,6 @@ ArmSinCos TransmittedArmWords(const std::array<double, 6>& angles_deg) {
   return sc;
 }
 
-const char* CollisionName(int bit) {
-  static const char* kNames[collision_bits::kCount] = {
-      "eff_hex_1-recpt", "eff_hex_2-recpt", "eff_hex_3-recpt", "eff_hex_1-payload",
-      "eff_hex_2-payload", "eff_hex_3-payload", "payload-bay_a", "payload-bay_b",
-      "payload-bay_c", "payload-bay_d", "payload-bay_e", "payload-bay_f", "payload-cae"};
-  return bit >= 0 && bit < collision_bits::kCount ? kNames[bit] : "?";
-}
-
 namespace {
 
 bool AllHave(const std::array<LocationWord, 8>& words, int face) {

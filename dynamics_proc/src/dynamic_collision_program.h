@@ -29,6 +29,7 @@
 #include "collision.h"
 #include "dcp_models.h"
 #include "rms/arm_kinematics.h"
+#include "rms/collision_bits.h"
 #include "rms/config.h"
 #include "rms/input_block.h"
 #include "rms/word_blocks.h"
@@ -41,20 +42,7 @@ inline constexpr double kFingerContactClearanceFt = 0.01;
 // Opening the finger this far past the acquisition gap releases a docked payload.
 inline constexpr double kReleaseOpeningFt = 0.05;
 
-// Which pair collides (docs/collision.md): the collision bits of the
-// telemetry.
-namespace collision_bits {
-inline constexpr std::uint32_t kEffHexRecpt = 1u << 0;     // bits 0-2: EFF HEX 1, 2, 3 with the BAR
-inline constexpr std::uint32_t kEffHexPayload = 1u << 3;   // bits 3-5: EFF HEX 1, 2, 3 with the payload body
-inline constexpr std::uint32_t kBayFace = 1u << 6;         // bits 6-11: a payload vertex beyond bay face a..f
-inline constexpr std::uint32_t kPayloadCae = 1u << 12;     // a payload vertex inside the CAE's front half
-inline constexpr std::uint32_t kRecptMask = 0x7u;          // essential in the acquisition relationship
-inline constexpr std::uint32_t kEePayloadMask = 0x7u << 3;
-inline constexpr std::uint32_t kBayMask = 0x3Fu << 6;
-inline constexpr int kCount = 13;
-}  // namespace collision_bits
-// "eff_hex_2-recpt", "payload-bay_b", ... for logs and counters.
-const char* CollisionName(int bit);
+// The collision bits of the telemetry: rms/collision_bits.h (in namespace rms).
 
 // The six acquisition conditions of report IV.A.3, in its order:
 //  0 all BAR vertices beyond face d of EFF HEX 1

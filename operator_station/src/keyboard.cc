@@ -1,6 +1,7 @@
 #include "keyboard.h"
 
-#include <algorithm>
+#include "bindings.h"
+
 #include <termios.h>
 #include <unistd.h>
 #include <fcntl.h>
@@ -8,55 +9,6 @@
 #include "rms/check.h"
 
 namespace rms::op {
-
-namespace {
-void Step(OperatorInputs* in, const InputCalibrations& cal, int idx, double delta) {
-  in->value[idx] = std::clamp(in->value[idx] + delta, cal[idx].min, cal[idx].max);
-}
-}  // namespace
-
-bool ApplyKey(int key, const InputCalibrations& cal, OperatorInputs* in, bool* quit) {
-  constexpr double kJointDeg = 2.0, kPanDeg = 3.0, kHeightFt = 0.25, kLever = 0.05;
-  switch (key) {
-    case 'q': Step(in, cal, kShoulderYaw, +kJointDeg); return true;
-    case 'a': Step(in, cal, kShoulderYaw, -kJointDeg); return true;
-    case 'w': Step(in, cal, kShoulderPitch, +kJointDeg); return true;
-    case 's': Step(in, cal, kShoulderPitch, -kJointDeg); return true;
-    case 'e': Step(in, cal, kElbowPitch, +kJointDeg); return true;
-    case 'd': Step(in, cal, kElbowPitch, -kJointDeg); return true;
-    case 'r': Step(in, cal, kWristPitch, +kJointDeg); return true;
-    case 'f': Step(in, cal, kWristPitch, -kJointDeg); return true;
-    case 't': Step(in, cal, kWristYaw, +kJointDeg); return true;
-    case 'g': Step(in, cal, kWristYaw, -kJointDeg); return true;
-    case 'y': Step(in, cal, kWristRoll, +kJointDeg); return true;
-    case 'h': Step(in, cal, kWristRoll, -kJointDeg); return true;
-    case 'u': Step(in, cal, kFinger, +kLever); return true;   // close
-    case 'j': Step(in, cal, kFinger, -kLever); return true;   // open
-    case 'i': Step(in, cal, kShoulderHeight, +kHeightFt); return true;
-    case 'k': Step(in, cal, kShoulderHeight, -kHeightFt); return true;
-    case kKeyLeft: Step(in, cal, kCameraPan, -kPanDeg); return true;
-    case kKeyRight: Step(in, cal, kCameraPan, +kPanDeg); return true;
-    case kKeyUp: Step(in, cal, kCameraTilt, +kPanDeg); return true;
-    case kKeyDown: Step(in, cal, kCameraTilt, -kPanDeg); return true;
-    case '+': case '=': Step(in, cal, kCameraZoom, +kLever); return true;
-    case '-': case '_': Step(in, cal, kCameraZoom, -kLever); return true;
-    case 'o': in->overlay = !in->overlay; return true;
-    case ' ': in->reset = true; return true;
-    case 'x': *quit = true; return true;
-    default:
-      if (key >= '1' && key <= '8') {
-        in->camera_station = key - '0';
-        return true;
-      }
-      return false;
-  }
-}
-
-std::string KeyboardHelp() {
-  return "keys: q/a shoulder yaw  w/s shoulder pitch  e/d elbow pitch  r/f wrist pitch  "
-         "t/g wrist yaw  y/h wrist roll  u/j finger close/open  i/k shoulder height  "
-         "1-8 camera  arrows pan/tilt  +/- zoom  o overlay  space reset  x quit";
-}
 
 struct TerminalKeys::Saved {
   termios tio;

@@ -38,15 +38,20 @@ struct Session {
   std::vector<dcp_frame_t> dcp_frames;
 };
 
-// Runs scripts/lab demo on a timeline; reads back the summary and the log.
-Session RunLab(const std::string& timeline, double speed, const std::string& tag) {
+// Runs scripts/lab demo (on a timeline, or the autopilot when `timeline` is
+// empty); reads back the summary and the log.
+Session RunLab(const std::string& timeline, double speed, const std::string& tag, int port_base) {
   Session s;
   s.dir = testing::MakeTempDir(tag) + "/session";
   const std::string log = s.dir + ".lab.log";
-  Subprocess lab({SourcePath("scripts/lab"), "demo", "--no-build", "--out", s.dir, "--timeline", timeline,
-                  "--speed", std::to_string(speed), "--lcm-url", testing::UniqueLcmUrl(8200 + 100 * (tag.size() % 2)),
-                  "--png-every", "0", "--width", "160", "--height", "120"},
-                 log, {std::string("RMSLAB_BUILD=") + RMSLAB_BUILD_DIR});
+  std::vector<std::string> argv = {SourcePath("scripts/lab"), "demo", "--no-build", "--out", s.dir,
+                                   "--speed", std::to_string(speed), "--lcm-url", testing::UniqueLcmUrl(port_base),
+                                   "--png-every", "0", "--width", "160", "--height", "120"};
+  if (!timeline.empty()) {
+    argv.push_back("--timeline");
+    argv.push_back(timeline);
+  }
+  Subprocess lab(argv, log, {std::string("RMSLAB_BUILD=") + RMSLAB_BUILD_DIR});
   EXPECT_EQ(lab.Wait(300), 0) << testing::ReadFile(log);
   s.summary = nlohmann::json::parse(testing::ReadFile(s.dir + "/summary.json"));
   lcm::LogFile f(s.dir + "/lcmlog", "r");
@@ -66,7 +71,7 @@ Session RunLab(const std::string& timeline, double speed, const std::string& tag
 
 TEST(DcpSession, TheMissionAcquiresExtractsAndDocks) {
   const LabConfig config = LoadConfig(DefaultConfigPath());
-  const Session s = RunLab(SourcePath("scripts/timelines/mission.tl"), 3.0, "mission");
+  const Session s = RunLab(SourcePath("scripts/timelines/mission.tl"), 3.0, "mission", 8200);
   const auto& mc = s.summary["mode_changes"];
   ASSERT_EQ(mc.size(), 2u) << s.summary.dump(2);
   EXPECT_EQ(mc[0]["from"], 1);
@@ -128,7 +133,7 @@ TEST(DcpSession, ACollisionHoldsThenReleasesAndResetReturnsToMode1) {
     ~Cleanup() { fs::remove_all(d); }
   } cleanup{tl_dir};
 
-  const Session s = RunLab(path, 2.0, "hold");
+  const Session s = RunLab(path, 2.0, "hold", 8300);
   // The collision: an end effector hexahedron against the payload's body.
   bool body_collision = false;
   for (const auto& c : s.summary["collisions"]) {
@@ -168,6 +173,38 @@ TEST(DcpSession, ACollisionHoldsThenReleasesAndResetReturnsToMode1) {
   const dcp_telemetry_t& end = s.telemetry.back();
   EXPECT_FALSE(end.acquired);
   EXPECT_NEAR(end.p_RoPo_R_ft[2], config.payload.p_RoPo_R_ft.z(), 1e-9);
+}
+
+TEST(DcpSession, TheLabDemosAutopilotAcquiresExtractsAndDocks) {
+  // scripts/lab demo as the README runs it (at 4x, small frames): the
+  // autopilot flies the task from the initial state, closing the loop on
+  // the DCP's telemetry.
+  const LabConfig config = LoadConfig(DefaultConfigPath());
+  const Session s = RunLab("", 4.0, "autopilot", 8400);
+  EXPECT_EQ(s.summary["pilot"], "autopilot");
+  ASSERT_TRUE(s.summary["docked"].get<bool>()) << s.summary.dump(2);
+  EXPECT_TRUE(s.summary["docking"]["within_tolerance"].get<bool>());
+  EXPECT_LE(s.summary["docking"]["distance_ft"].get<double>(), config.dcp.dock_distance_ft);
+  EXPECT_LE(s.summary["docking"]["angle_deg"].get<double>(), config.dcp.dock_angle_deg);
+  EXPECT_EQ(s.summary["final_mode"], 3);
+  const auto& pd = s.summary["phase_durations_s"];
+  for (const char* phase : {"acquisition", "extraction", "maneuvering", "docking"}) {
+    ASSERT_TRUE(pd[phase].is_number()) << phase << ": " << pd.dump();
+    EXPECT_GT(pd[phase].get<double>(), 0.5) << phase;
+  }
+  // Session time, not wall time: the whole task in about a minute of it
+  // (the 4x run took a quarter of that).
+  const double total = pd["acquisition"].get<double>() + pd["extraction"].get<double>() +
+                       pd["maneuvering"].get<double>() + pd["docking"].get<double>();
+  EXPECT_GT(total, 30.0);
+  EXPECT_LT(total, 180.0);
+  EXPECT_EQ(s.summary["held_frames"], 0);
+  for (const auto& [kind, c] : s.summary["collisions_by_kind"].items()) EXPECT_EQ(c["events"], 0) << kind;
+  // The telemetry agrees: the last frames say docked, and the autopilot's
+  // command is what the slave did all along.
+  ASSERT_FALSE(s.telemetry.empty());
+  EXPECT_TRUE(s.telemetry.back().docked);
+  for (const auto& t : s.telemetry) ASSERT_FALSE(t.held);
 }
 
 }  // namespace

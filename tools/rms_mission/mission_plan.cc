@@ -1,5 +1,7 @@
 #include "mission_plan.h"
 
+#include "rms/mission_geometry.h"
+
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -11,63 +13,6 @@
 #include "rms/scene_model.h"
 
 namespace rms::mission {
-
-MissionGeometry PlanGeometry(const LabConfig& c) {
-  const auto& ee = c.end_effector;
-  const auto& p = c.payload;
-  MissionGeometry g;
-  g.shoulder_height_ft = c.inputs[kShoulderHeight].initial;
-  const Eigen::Isometry3d X_RP_bay = MakeIsometry(p.R_RP, p.p_RoPo_R_ft);
-  const Eigen::Vector3d xP = p.R_RP.col(0), yP = p.R_RP.col(1), zP = p.R_RP.col(2);
-  // Grasp: approach down the payload's z axis, fingers closing along its
-  // long axis, the bar just inside the fixed finger (a clearance of 40% of
-  // D3Y's margin over the bar's width) and the palm half TPOB above the bar.
-  const Eigen::Vector3d X2 = -zP, Y2 = -yP;
-  const double bar_w = p.bar_size_P_ft.y(), bar_h = p.bar_size_P_ft.z();
-  const double clearance = 0.4 * (c.dcp.d3y_ft - bar_w);
-  const double y_bar = ee.palm_half_width_ft - ee.finger_thickness_ft - clearance - 0.5 * bar_w;
-  const Eigen::Vector3d bar = X_RP_bay * p.p_PoBar_P_ft;
-  const Eigen::Vector3d A = bar - y_bar * Y2 - (ee.palm_length_ft + 0.5 * c.dcp.tpob_ft + 0.5 * bar_h) * X2;
-  g.X_RS2_grasp = EndEffectorPose(A, X2, Y2);
-  g.X_S2P = g.X_RS2_grasp.inverse() * X_RP_bay;
-  (void)xP;
-  // Docked: the probe along the port's axis, its tip 0.05 ft short of the
-  // port's centre; the payload's z axis (the grasp side) toward the shoulder.
-  const Eigen::Vector3d yC = c.cae.R_RC.col(1);
-  const Eigen::Vector3d S = c.arm.p_RoB_R_ft + Eigen::Vector3d(0, 0, g.shoulder_height_ft);
-  Eigen::Vector3d toward = S - c.cae.p_RoCo_R_ft;
-  toward -= toward.dot(yC) * yC;
-  const Eigen::Vector3d zD = toward.normalized(), yD = yC, xD = yD.cross(zD);
-  Eigen::Matrix3d RD;
-  RD.col(0) = xD;
-  RD.col(1) = yD;
-  RD.col(2) = zD;
-  const Eigen::Vector3d tip = c.cae.p_RoCo_R_ft - 0.05 * yC;
-  g.X_RP_dock = MakeIsometry(RD, tip - (0.5 * p.length_ft + p.probe_length_ft) * yD);
-  return g;
-}
-
-std::string Interpenetration(const LabConfig& c, const SceneModel& model, const std::array<double, 6>& angles_deg,
-                             double shoulder_height_ft, double finger_gap_ft, const Eigen::Isometry3d& X_RP) {
-  EsgFrameData f;
-  f.arm = SinCosFromDegrees(angles_deg);
-  f.shoulder_height_ft = shoulder_height_ft;
-  f.finger_gap_ft = finger_gap_ft;
-  f.p_RoPo_R_ft = X_RP.translation();
-  f.R_RP = X_RP.linear();
-  const ClusterPoses poses = ComputeClusterPoses(c, f);
-  for (int a = 0; a < kNumClusters; ++a) {
-    if (model[a].is_static() || !poses.present[a]) continue;
-    const PosedHull ha = PoseHull(model[a], poses.X_RC[a]);
-    for (int b = 0; b < kNumClusters; ++b) {
-      if (!model[b].is_static()) continue;
-      if (!FindSeparatingPlane(ha, PoseHull(model[b], poses.X_RC[b]), 5e-4, nullptr)) {
-        return std::string(ClusterName(a)) + " runs into " + std::string(ClusterName(b));
-      }
-    }
-  }
-  return "";
-}
 
 std::vector<Keyframe> PlanMission(const LabConfig& c) {
   const MissionGeometry g = PlanGeometry(c);

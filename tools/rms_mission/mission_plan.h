@@ -12,7 +12,7 @@
 #include <Eigen/Geometry>
 
 #include "rms/config.h"
-#include "rms/scene_model.h"
+#include "rms/mission_geometry.h"
 
 namespace rms::mission {
 
@@ -25,21 +25,6 @@ struct Keyframe {
   std::string note;
   std::string extra;  // more timeline items, e.g. "camera_zoom=0.5"
 };
-
-struct MissionGeometry {
-  Eigen::Isometry3d X_RS2_grasp;    // System Two at the grasp
-  Eigen::Isometry3d X_S2P;          // the payload in System Two once grasped
-  Eigen::Isometry3d X_RP_dock;      // the payload docked
-  double shoulder_height_ft = 0;
-};
-
-MissionGeometry PlanGeometry(const LabConfig& config);
-
-// What a pose puts into something solid: the first arm or payload cluster
-// no plane separates from a cluster of the orbiter or the CAE ("upper_boom
-// runs into cabin"), or "" when all are clear.
-std::string Interpenetration(const LabConfig& config, const SceneModel& model, const std::array<double, 6>& angles_deg,
-                             double shoulder_height_ft, double finger_gap_ft, const Eigen::Isometry3d& X_RP);
 
 // Throws rms::InputError naming the waypoint when one is out of reach, or
 // puts the arm or the payload into the orbiter or the CAE.

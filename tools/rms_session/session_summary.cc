@@ -8,6 +8,8 @@
 #include <set>
 
 #include "rms/channels.h"
+#include "rms/config.h"
+#include "rms/collision_bits.h"
 #include "rms/check.h"
 #include "rms/control_word.h"
 #include "rms/counters.h"
@@ -49,13 +51,7 @@ std::int64_t SumPrefix(const nlohmann::json& stats, const std::string& prefix) {
   return s;
 }
 
-// Collision bit names (docs/collision.md), as dynamics_proc logs them.
-const char* kCollisionNames[] = {"eff_hex_1-recpt",   "eff_hex_2-recpt",   "eff_hex_3-recpt",
-                                 "eff_hex_1-payload", "eff_hex_2-payload", "eff_hex_3-payload",
-                                 "payload-bay_a",     "payload-bay_b",     "payload-bay_c",
-                                 "payload-bay_d",     "payload-bay_e",     "payload-bay_f",
-                                 "payload-cae"};
-constexpr int kCollisionBits = 13;
+constexpr int kCollisionBits = collision_bits::kCount;
 
 std::string StripSuffix(const std::string& channel) {
   for (const char* base : {channels::kOperatorInput, channels::kDcpTelemetry, channels::kDcpFrame,
@@ -83,7 +79,8 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
   // From the DCP's telemetry: mode changes, collision runs, docking.
   nlohmann::ordered_json mode_changes = nlohmann::ordered_json::array();
   nlohmann::ordered_json collision_events = nlohmann::ordered_json::array();
-  std::map<std::string, std::array<double, 3>> collision_totals;  // events, frames, seconds
+  std::map<std::string, std::array<double, 3>> collision_totals;  // events, frames, seconds; every kind
+  for (const char* name : kCollisionNames) collision_totals[name] = {0, 0, 0};
   std::array<std::int64_t, kCollisionBits> run_start_us{};
   std::array<std::int64_t, kCollisionBits> run_frames{};
   std::uint32_t last_bits = 0;
@@ -91,6 +88,10 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
   bool acquired = false, docked = false;
   std::int64_t held_frames = 0, telemetry_frames = 0, prev_us = 0;
   nlohmann::ordered_json docking = nullptr;
+  // Phase boundaries, DCP frame numbers (-1: not reached): the last start of
+  // Mode 1 (the session's start or a reset), acquisition (1 -> 2), clear of
+  // the bay (2 -> 3), the probe first in the docking envelope, docked.
+  std::int64_t f_start = -1, f_acquired = -1, f_clear = -1, f_envelope = -1, f_docked = -1;
   while (const lcm::LogEvent* ev = log.readNextEvent()) {
     ++events;
     if (first_us < 0) first_us = ev->timestamp;
@@ -122,6 +123,14 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
       }
       ++telemetry_frames;
       const double t_s = (ev->timestamp - first_us) * 1e-6;
+      if (f_start < 0 || (m.mode == 1 && last_mode != 1)) {
+        f_start = m.frame;
+        f_acquired = f_clear = f_envelope = f_docked = -1;
+      }
+      if (m.mode == 2 && last_mode == 1) f_acquired = m.frame;
+      if (m.mode == 3 && last_mode == 2) f_clear = m.frame;
+      if (m.mode == 3 && m.probe_in_envelope && f_envelope < 0) f_envelope = m.frame;
+      if (m.docked && f_docked < 0) f_docked = m.frame;
       if (m.mode != last_mode) {
         if (last_mode != 0) {
           mode_changes.push_back({{"frame", m.frame}, {"time_s", t_s}, {"from", last_mode}, {"to", m.mode}});
@@ -205,6 +214,35 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
   j["acquired"] = acquired;
   j["docked"] = docked;
   j["docking"] = docking;
+  // Phase durations in session time (DCP frames over the frame rate), so
+  // they do not depend on how fast the session ran.
+  double rate_hz = 30.0;
+  try {
+    rate_hz = LoadConfig((root / "config.toml").string()).session.frame_rate_hz;
+  } catch (const std::exception&) {
+  }
+  auto span = [&](std::int64_t a, std::int64_t b) -> nlohmann::ordered_json {
+    if (a < 0 || b < 0) return nullptr;
+    return static_cast<double>(b - a) / rate_hz;
+  };
+  j["phase_durations_s"] = {{"acquisition", span(f_start, f_acquired)},
+                            {"extraction", span(f_acquired, f_clear)},
+                            {"maneuvering", span(f_clear, f_envelope >= 0 ? f_envelope : f_docked)},
+                            {"docking", span(f_envelope >= 0 ? f_envelope : f_docked, f_docked)}};
+  if (docked && docking.is_object()) {
+    try {
+      const LabConfig c = LoadConfig((root / "config.toml").string());
+      docking["within_tolerance"] = docking["distance_ft"].get<double>() <= c.dcp.dock_distance_ft &&
+                                    docking["angle_deg"].get<double>() <= c.dcp.dock_angle_deg;
+      j["docking"] = docking;
+    } catch (const std::exception&) {
+    }
+  }
+  {
+    std::ifstream pilot((root / "run" / "pilot").string());
+    std::string who;
+    if (pilot >> who) j["pilot"] = who;
+  }
   j["mode_changes"] = mode_changes;
   j["collisions"] = collision_events;
   nlohmann::ordered_json by_kind = nlohmann::ordered_json::object();
