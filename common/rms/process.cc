@@ -76,6 +76,7 @@ void InstallStopHandlers() {
   sigemptyset(&sa.sa_mask);
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
+  sigaction(SIGHUP, &sa, nullptr);  // a closed terminal: stop as cleanly as on Ctrl-C
   std::signal(SIGPIPE, SIG_IGN);
 }
 bool StopRequested() { return g_stop.load(); }
