@@ -10,9 +10,11 @@ int main(int argc, char** argv) {
                "block (RMS_OPERATOR_INPUT), computes the arm words, kinematics and control word, "
                "and publishes RMS_DCP_FRAME once per input block."};
   rms::CommonOptions common;
+  std::string restore;
+  app.add_option("--restore", restore, "Start from this checkpoint (docs/sessions.md)")->check(CLI::ExistingFile);
   return rms::ProcessMain(app, argc, argv, "dynamics_proc", &common,
                           [&](const rms::LabConfig& config, rms::LcmInterface& lcm) {
                             return rms::dcp::RunDynamicsProc(config, lcm, common.stats_path,
-                                                             common.ready_path);
+                                                             common.ready_path, restore);
                           });
 }

@@ -31,6 +31,9 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::Range(0.01, 100.0));
   app.add_option("--frames", opt.max_frames, "Stop after this many frames");
+  app.add_option("--restore", opt.restore_path,
+                 "Start from a checkpoint's operator inputs (with dynamics_proc --restore; docs/sessions.md)")
+      ->check(CLI::ExistingFile);
   return rms::ProcessMain(app, argc, argv, "operator_station", &common,
                           [&](const rms::LabConfig& config, rms::LcmInterface& lcm) {
                             opt.gamepad = !no_gamepad;

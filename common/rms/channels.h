@@ -9,5 +9,6 @@ inline constexpr const char* kDcpFrame = "RMS_DCP_FRAME";            // dynamics
 inline constexpr const char* kEsgFrame = "RMS_ESG_FRAME";            // scene_proc -> esg_renderer
 inline constexpr const char* kStatus = "RMS_STATUS";                 // every process -> monitors, log
 inline constexpr const char* kDcpTelemetry = "RMS_DCP_TELEMETRY";    // dynamics_proc -> operator_station, monitors
+inline constexpr const char* kControl = "RMS_CONTROL";               // rms_control, operator_station -> every process
 
 }  // namespace rms::channels

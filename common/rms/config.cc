@@ -187,12 +187,6 @@ LabConfig ParseConfig(std::string_view text, const std::string& source) {
   return c;
 }
 
-LabConfig LoadConfig(const std::string& path) {
-  std::ifstream f(path);
-  if (!f) throw InputError(path + ": cannot read the configuration file");
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ParseConfig(ss.str(), path);
-}
+LabConfig LoadConfig(const std::string& path) { return ParseConfig(ReadTextFile(path, "the configuration file"), path); }
 
 }  // namespace rms

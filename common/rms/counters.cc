@@ -85,4 +85,9 @@ SequenceTracker::Verdict SequenceTracker::Accept(std::int64_t frame) {
   return Verdict::kGap;
 }
 
+void RecordEndToEnd(std::int64_t latency_us, double frame_rate_hz, LatencyHistogram* histogram, Counters* counters) {
+  histogram->Add(latency_us);
+  if (latency_us > static_cast<std::int64_t>(1e6 / frame_rate_hz)) counters->Add("frames.late");
+}
+
 }  // namespace rms

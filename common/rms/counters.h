@@ -28,6 +28,13 @@ class Counters {
 // Latency (or any duration) samples in microseconds, in a fixed-size
 // histogram: bounded memory for sessions of any length. 1 us bins below 1 ms,
 // 10 us bins to 100 ms, 1 ms bins to 10 s, then one overflow bin.
+// Timing health (docs/sessions.md "Timing health"): a frame is late at a
+// stage when it reaches it more than one frame period after the operator
+// sent it. Adds the end-to-end latency to `latencies[link]` and counts
+// "frames.late".
+class LatencyHistogram;
+void RecordEndToEnd(std::int64_t latency_us, double frame_rate_hz, LatencyHistogram* histogram, Counters* counters);
+
 class LatencyHistogram {
  public:
   LatencyHistogram();

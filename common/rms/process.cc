@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "rms/check.h"
+#include "rms/version.h"
 #include "rms/channels.h"
 #include "rms/config.h"
 #include "rms/message_io.h"
@@ -34,6 +35,7 @@ void AddCommonOptions(CLI::App& app, CommonOptions* o) {
   app.add_option("--log-level", o->log_level, "trace, debug, info, warn, error")
       ->capture_default_str()
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
+  app.set_version_flag("--version", VersionString(), "Print the software version and exit");
 }
 
 int ProcessMain(CLI::App& app, int argc, char** argv, const std::string& process,

@@ -5,6 +5,7 @@
 // rms::InputError naming the file, the key and the reason:
 //   "config/rmslab.toml: key 'arm.upper_boom_ft': must be > 0, got -3"
 #include <cmath>
+#include <fstream>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -153,6 +154,15 @@ class TomlReader {
   std::string doc_;
   std::set<std::string> used_;
 };
+
+// A whole text file; an InputError "cannot read WHAT 'PATH'" when it can't be read.
+inline std::string ReadTextFile(const std::string& path, const std::string& what) {
+  std::ifstream f(path);
+  if (!f) throw InputError("cannot read " + what + " '" + path + "'");
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
 
 // Parses TOML text; a syntax error is an InputError "SOURCE:LINE:COLUMN:
 // TOML syntax error: ...".

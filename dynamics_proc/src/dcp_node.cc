@@ -9,6 +9,8 @@
 #include "rms/frame_receiver.h"
 #include "rms/message_io.h"
 #include "rms/operator_input_t.hpp"
+#include "rms/session_control_t.hpp"
+#include "rms/checkpoint.h"
 
 namespace rms::dcp {
 
@@ -22,6 +24,50 @@ DcpNode::DcpNode(const LabConfig& config, LcmInterface* lcm)
   lcm_->Subscribe(channels::kOperatorInput, [this](const void* d, int n, std::int64_t t) {
     OnInput(d, n, t);
   });
+  lcm_->Subscribe(channels::kControl, [this](const void* d, int n, std::int64_t) { OnControl(d, n); });
+}
+
+void DcpNode::SaveCheckpoint(const std::string& path) const {
+  Checkpoint c;
+  c.dcp_frame = next_frame_ - 1;
+  c.input_frame = last_input_frame_;
+  c.saved_us = WallTimeUs();
+  c.config = config_.source;
+  c.inputs = last_inputs_;
+  c.dcp = dcp_.SaveState();
+  WriteCheckpoint(path, c);
+}
+
+void DcpNode::RestoreCheckpoint(const std::string& path) {
+  const Checkpoint c = ReadCheckpoint(path);
+  try {
+    dcp_.RestoreState(c.dcp);
+  } catch (const std::exception& e) {
+    throw InputError("checkpoint '" + path + "': " + e.what());
+  }
+  spdlog::info("restored the DCP's state from {} (saved at DCP frame {}): Mode {}{}{}", path, c.dcp_frame,
+               dcp_.status().mode, dcp_.status().acquired ? ", acquired" : "", dcp_.status().docked ? ", docked" : "");
+}
+
+void DcpNode::OnControl(const void* data, int size) {
+  session_control_t m;
+  if (SafeDecode(data, size, 1 << 16, &m) != DecodeError::kNone) {
+    counters_.Add("dropped.control_malformed");
+    return;
+  }
+  try {
+    if (m.command == session_control_t::CHECKPOINT) {
+      SaveCheckpoint(m.path);
+      counters_.Add("control.checkpoints");
+      spdlog::info("checkpoint: DCP frame {} saved to {}", next_frame_ - 1, m.path);
+    } else if (m.command == session_control_t::RESTORE) {
+      RestoreCheckpoint(m.path);
+      counters_.Add("control.restores");
+    }
+  } catch (const InputError& e) {
+    counters_.Add("control.errors");
+    spdlog::error("{}", e.what());
+  }
 }
 
 void DcpNode::OnInput(const void* data, int size, std::int64_t recv_time_us) {
@@ -34,8 +80,11 @@ void DcpNode::OnInput(const void* data, int size, std::int64_t recv_time_us) {
   if (!got) return;
   const auto& [msg, in] = *got;
   counters_.Set("input.missing", inputs_.missing());
-  latencies_["input_to_dcp"].Add(recv_time_us - msg.send_time_us);
+  RecordEndToEnd(recv_time_us - msg.send_time_us, config_.session.frame_rate_hz, &latencies_["input_to_dcp"],
+                 &counters_);
 
+  last_inputs_ = in;
+  last_input_frame_ = msg.frame;
   DcpFrameData out = dcp_.Step(in);
   out.frame = next_frame_++;
   out.input_frame = msg.frame;
@@ -118,16 +167,17 @@ dcp_telemetry_t MakeTelemetry(const DcpStatus& st, const DcpFrameData& out) {
 }
 
 int RunDynamicsProc(const LabConfig& config, LcmInterface& lcm, const std::string& stats_path,
-                    const std::string& ready_path) {
+                    const std::string& ready_path, const std::string& restore_path) {
   DcpNode node(config, &lcm);
+  if (!restore_path.empty()) node.RestoreCheckpoint(restore_path);
   if (!ready_path.empty()) TouchFile(ready_path);
   spdlog::info("ready: {} -> {}", lcm.FullChannel(channels::kOperatorInput),
                lcm.FullChannel(channels::kDcpFrame));
   RunNodeLoop(lcm, "dynamics_proc", node.counters(), node.latencies(),
               [&] { return node.last_frame(); }, nullptr, stats_path);
-  spdlog::info("published {} DCP frames; inputs missing {}, dropped {}; final mode {}",
+  spdlog::info("published {} DCP frames; inputs missing {}, late {}, dropped {}; final mode {}",
                node.counters().Get("published"), node.counters().Get("input.missing"),
-               node.counters().SumPrefix("dropped."), node.program().mode());
+               node.counters().Get("frames.late"), node.counters().SumPrefix("dropped."), node.program().mode());
   return 0;
 }
 

@@ -24,6 +24,15 @@ class DcpNode {
   std::int64_t last_frame() const { return next_frame_ - 1; }
   const DynamicCollisionProgram& program() const { return dcp_; }
 
+  // Checkpoints (docs/sessions.md "Freeze, run, step, checkpoint"): the
+  // DCP's state and the last operator inputs, to a file and back. Throw
+  // rms::InputError naming the file and what is wrong.
+  void SaveCheckpoint(const std::string& path) const;
+  void RestoreCheckpoint(const std::string& path);
+  // An RMS_CONTROL message: CHECKPOINT and RESTORE act (between frames);
+  // a bad one is counted and logged, never fatal.
+  void OnControl(const void* data, int size);
+
  private:
   void Report(const DcpStatus& status, std::int64_t frame);
   const LabConfig& config_;
@@ -33,6 +42,8 @@ class DcpNode {
   LatencyMap latencies_;
   SequenceTracker inputs_;
   std::int64_t next_frame_ = 0;
+  std::int64_t last_input_frame_ = -1;
+  OperatorInputs last_inputs_{};
   int last_mode_ = 0;
   std::uint32_t last_collisions_ = 0;
 };
@@ -41,7 +52,9 @@ class DcpNode {
 dcp_telemetry_t MakeTelemetry(const DcpStatus& status, const DcpFrameData& frame);
 
 // Main loop until SIGINT / SIGTERM. Returns the exit code.
+// restore_path: a checkpoint to start from ("" for the initial state).
 int RunDynamicsProc(const LabConfig& config, LcmInterface& lcm, const std::string& stats_path,
-                    const std::string& ready_path);
+                    const std::string& ready_path, const std::string& restore_path = "");
+
 
 }  // namespace rms::dcp

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <spdlog/spdlog.h>
 
+#include "rms/check.h"
+
 #include "rms/word_codec.h"
 
 namespace rms::dcp {
@@ -175,7 +177,10 @@ DcpFrameData DynamicCollisionProgram::Step(const OperatorInputs& in) {
   status_.finger_gap_ft = slave_.finger_gap_ft;
 
   // The three dynamic separating planes, EFF HEX 1-3 against the BAR (Mode 1).
+  // A plane not valid this frame is sent as the default (n = Z, d = 0), so
+  // the words depend on this frame's state alone.
   status_.plane_valid = 0;
+  status_.planes = {};
   if (status_.mode == 1) {
     for (int k = 0; k < 3; ++k) {
       const CollisionResult& r = slave_.ee_bar[k];
@@ -302,6 +307,93 @@ void DynamicCollisionProgram::UpdateDocking() {
     status_.docked = true;
     X_RP_docked_ = slave_.X_RP;
     spdlog::info("docked: distance {:.3f} ft, angle {:.3f} deg", d.distance_ft, d.angle_deg);
+  }
+}
+
+namespace {
+
+nlohmann::json PoseJson(const Eigen::Isometry3d& X) {
+  nlohmann::json j = nlohmann::json::array();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c) j.push_back(X.matrix()(r, c));
+  }
+  return j;
+}
+
+Eigen::Isometry3d PoseFrom(const nlohmann::json& j, const char* key) {
+  if (!j.is_array() || j.size() != 12) throw InputError(std::string("checkpoint: '") + key + "' must be 12 numbers");
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c) X.matrix()(r, c) = j.at(4 * r + c).get<double>();
+  }
+  return X;
+}
+
+nlohmann::json CommandJson(const ArmCommand& a) {
+  return {{"angles_deg", a.angles_deg}, {"shoulder_height_ft", a.shoulder_height_ft}, {"finger", a.finger}};
+}
+
+ArmCommand CommandFrom(const nlohmann::json& j) {
+  ArmCommand a;
+  a.angles_deg = j.at("angles_deg").get<std::array<double, 6>>();
+  a.shoulder_height_ft = j.at("shoulder_height_ft").get<double>();
+  a.finger = j.at("finger").get<double>();
+  return a;
+}
+
+constexpr const char* kCheckpointFormat = "rmslab-dcp-state-1";
+
+}  // namespace
+
+nlohmann::ordered_json DynamicCollisionProgram::SaveState() const {
+  nlohmann::ordered_json j;
+  j["format"] = kCheckpointFormat;
+  j["mode"] = status_.mode;
+  j["acquired"] = status_.acquired;
+  j["docked"] = status_.docked;
+  j["released"] = released_;
+  j["have_slave"] = have_slave_;
+  j["slave"] = CommandJson(slave_.cmd);
+  j["slave_collisions"] = slave_.collisions;
+  j["master"] = CommandJson(status_.master);
+  j["X_S2P"] = PoseJson(X_S2P_);
+  j["X_RP_docked"] = PoseJson(X_RP_docked_);
+  j["contact_gap_ft"] = contact_gap_ft_;
+  j["acquisition_gap_ft"] = acquisition_gap_ft_;
+  return j;
+}
+
+void DynamicCollisionProgram::RestoreState(const nlohmann::json& j) {
+  try {
+    if (j.at("format").get<std::string>() != kCheckpointFormat) {
+      throw InputError("checkpoint: format '" + j.at("format").get<std::string>() + "', expected '" +
+                       kCheckpointFormat + "'");
+    }
+    const int mode = j.at("mode").get<int>();
+    if (mode < 1 || mode > 3) throw InputError("checkpoint: mode must be 1, 2 or 3");
+    status_.mode = mode;
+    status_.acquired = j.at("acquired").get<bool>();
+    status_.docked = j.at("docked").get<bool>();
+    released_ = j.at("released").get<bool>();
+    X_S2P_ = PoseFrom(j.at("X_S2P"), "X_S2P");
+    X_RP_docked_ = PoseFrom(j.at("X_RP_docked"), "X_RP_docked");
+    contact_gap_ft_ = j.at("contact_gap_ft").get<double>();
+    acquisition_gap_ft_ = j.at("acquisition_gap_ft").get<double>();
+    status_.master = CommandFrom(j.at("master"));
+    have_slave_ = j.at("have_slave").get<bool>();
+    if (have_slave_) {
+      // The slave's evaluation follows from its command and the state above.
+      slave_ = Evaluate(CommandFrom(j.at("slave")));
+      slave_.collisions = j.at("slave_collisions").get<std::uint32_t>();
+      status_.slave = slave_.cmd;
+      status_.X_RS2 = slave_.pose.X_RS2;
+      status_.X_RP = slave_.X_RP;
+      status_.finger_gap_ft = slave_.finger_gap_ft;
+    } else {
+      status_.X_RP = X_RP_bay_;
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(std::string("checkpoint: ") + e.what());
   }
 }
 

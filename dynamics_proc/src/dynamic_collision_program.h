@@ -25,6 +25,7 @@
 #include <cstdint>
 
 #include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
 
 #include "collision.h"
 #include "dcp_models.h"
@@ -115,6 +116,15 @@ class DynamicCollisionProgram {
   // the cargo bay, nothing acquired or docked; the slave takes the next
   // command as it is.
   void Reset();
+
+  // A checkpoint (docs/sessions.md "Freeze, run, step, checkpoint"): the
+  // program's whole state -- mode, acquired, docked, released, the slave
+  // arm's pose, the payload's attachment and docked pose, the finger's
+  // limits -- as JSON, doubles exact. Restore() refuses a document of
+  // another format with rms::InputError naming what is wrong; after it the
+  // program continues as it would have from the saved frame.
+  nlohmann::ordered_json SaveState() const;
+  void RestoreState(const nlohmann::json& state);
 
   int mode() const { return status_.mode; }
   const DcpStatus& status() const { return status_; }

@@ -79,7 +79,8 @@ bool EsgNode::RenderPending() {
   const std::int64_t done = lcm_->NowUs();
   counters_.Add("rendered");
   latencies_["esg_to_render"].Add(done - msg.send_time_us);
-  latencies_["input_to_render"].Add(done - msg.input_send_time_us);
+  RecordEndToEnd(done - msg.input_send_time_us, config_.session.frame_rate_hz, &latencies_["input_to_render"],
+                 &counters_);
   if (video_) {
     // One video frame per frame number: frames skipped or lost repeat the
     // last image, so the video keeps the session's time.
@@ -145,9 +146,11 @@ int RunEsgRenderer(const LabConfig& config, LcmInterface& lcm, const EsgOptions&
     node.counters().Set("video.dropped", video->frames_dropped());
     if (!stats_path.empty()) WriteStatsJson(stats_path, "esg_renderer", node.counters(), node.latencies());
   }
-  spdlog::info("rendered {} frames ({} scenes drawn, {} unchanged, {} superseded, {} dropped, {} PNG{})",
+  spdlog::info("rendered {} frames ({} scenes drawn, {} unchanged, {} superseded, {} missing, {} late, {} dropped, "
+               "{} PNG{})",
                node.counters().Get("rendered"), node.counters().Get("rendered.scenes"),
                node.counters().Get("skipped.unchanged"), node.counters().Get("superseded"),
+               node.counters().Get("esg.missing"), node.counters().Get("frames.late"),
                node.counters().SumPrefix("dropped."), node.counters().Get("png_written"),
                video ? ", " + std::to_string(video->frames_written()) + " video frames" : std::string());
   return 0;

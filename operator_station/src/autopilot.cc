@@ -23,6 +23,7 @@ const char* AutopilotPhaseName(AutopilotPhase p) {
     case AutopilotPhase::kDock: return "dock";
     case AutopilotPhase::kDocked: return "docked";
     case AutopilotPhase::kRelieve: return "relieve a collision";
+    case AutopilotPhase::kResync: return "resume from a checkpoint";
     case AutopilotPhase::kFailed: return "failed";
   }
   return "?";
@@ -374,6 +375,18 @@ void Autopilot::Relieve(const dcp_telemetry_t& tm) {
   Enter(AutopilotPhase::kRelieve);
 }
 
+void Autopilot::Resync(const OperatorInputs& restored) {
+  const int camera = cmd_.camera_station;
+  cmd_ = restored;
+  cmd_.reset = false;
+  if (opt_.cameras) cmd_.camera_station = camera;
+  plan_.clear();
+  retries_ = 0;
+  relieved_at_frame_ = -1000;
+  failure_.clear();
+  Enter(AutopilotPhase::kResync);
+}
+
 OperatorInputs Autopilot::Step(const dcp_telemetry_t* tm_ptr) {
   t_s_ += dt_s_;
   cmd_.reset = false;
@@ -388,7 +401,7 @@ OperatorInputs Autopilot::Step(const dcp_telemetry_t* tm_ptr) {
   // A collision: the DCP holds the slave arm. (The finger stopping on the
   // bar while closing is the essential contact, not a collision.)
   const bool moving_phase = phase_ != AutopilotPhase::kWaitTelemetry && phase_ != AutopilotPhase::kReset &&
-                            phase_ != AutopilotPhase::kDocked;
+                            phase_ != AutopilotPhase::kDocked && phase_ != AutopilotPhase::kResync;
   if (moving_phase && tm.held && tm.frame > relieved_at_frame_ + 3) {
     Relieve(tm);
     return cmd_;
@@ -524,6 +537,21 @@ OperatorInputs Autopilot::Step(const dcp_telemetry_t* tm_ptr) {
       }
       break;
     }
+
+    case AutopilotPhase::kResync:
+      // The first telemetry that answers the restored command says where
+      // the task stands.
+      if (!Settled(tm)) break;
+      if (tm.docked) {
+        StartPhase(AutopilotPhase::kDocked, tm);
+      } else if (tm.mode == 3) {
+        StartPhase(AutopilotPhase::kTransfer, tm);
+      } else if (tm.mode == 2) {
+        StartPhase(AutopilotPhase::kLift, tm);
+      } else {
+        Enter(AutopilotPhase::kOpenFinger);
+      }
+      break;
 
     case AutopilotPhase::kFailed:
       break;

@@ -62,6 +62,7 @@ enum class AutopilotPhase {
   kDock,           // along the port's axis until the DCP says docked
   kDocked,         // hold
   kRelieve,        // backing away from a collision, then back to the phase it interrupted
+  kResync,         // after a restored checkpoint: pick up the task where the telemetry says it is
   kFailed,
 };
 const char* AutopilotPhaseName(AutopilotPhase p);
@@ -73,6 +74,10 @@ class Autopilot {
   // One frame: the inputs to publish, given the newest telemetry (nullptr
   // while there is none). Session time advances 1 / frame rate a call.
   OperatorInputs Step(const dcp_telemetry_t* telemetry);
+
+  // A checkpoint was restored (docs/sessions.md): command these inputs and,
+  // at the next telemetry, carry on with the phase the DCP's state calls for.
+  void Resync(const OperatorInputs& restored);
 
   AutopilotPhase phase() const { return phase_; }
   bool docked() const { return phase_ == AutopilotPhase::kDocked; }

@@ -23,6 +23,8 @@ Action ParseAction(std::string_view t) {
   else if (t == "reset") a.kind = ActionKind::kReset;
   else if (t == "overlay") a.kind = ActionKind::kOverlay;
   else if (t == "quit") a.kind = ActionKind::kQuit;
+  else if (t == "freeze") a.kind = ActionKind::kFreeze;
+  else if (t == "step") a.kind = ActionKind::kStep;
   else if (t.size() == 8 && t.substr(0, 7) == "camera_" && t[7] >= '1' && t[7] <= '8') {
     a.kind = ActionKind::kCamera;
     a.camera = t[7] - '0';
@@ -32,7 +34,7 @@ Action ParseAction(std::string_view t) {
   } else {
     throw InputError("unknown action \"" + std::string(t) +
                      "\" (INPUT+ / INPUT- for an analog input, camera_1..camera_8, camera_next, camera_prev, reset, "
-                     "overlay, quit)");
+                     "overlay, quit, freeze, step)");
   }
   return a;
 }
@@ -173,12 +175,6 @@ Bindings ParseBindings(std::string_view text, const std::string& source) {
   return b;
 }
 
-Bindings LoadBindings(const std::string& path) {
-  std::ifstream f(path);
-  if (!f) throw InputError("cannot read bindings file '" + path + "'");
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ParseBindings(ss.str(), path);
-}
+Bindings LoadBindings(const std::string& path) { return ParseBindings(ReadTextFile(path, "the bindings file"), path); }
 
 }  // namespace rms::op

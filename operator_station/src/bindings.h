@@ -22,6 +22,8 @@ enum class ActionKind {
   kReset,       // the reset pushbutton (one frame)
   kOverlay,     // the overlay switch (toggles)
   kQuit,        // stop the station (keyboard only)
+  kFreeze,      // freeze the session, or run it again (RMS_CONTROL)
+  kStep,        // while frozen: one frame (RMS_CONTROL)
 };
 struct Action {
   ActionKind kind = ActionKind::kQuit;
@@ -29,7 +31,8 @@ struct Action {
   int camera = 0;   // kCamera: 1..8
 };
 // "shoulder_yaw+", "finger-", "camera_3", "camera_next", "camera_prev",
-// "reset", "overlay", "quit". Throws rms::InputError naming the text.
+// "reset", "overlay", "quit", "freeze", "step". Throws rms::InputError naming
+// the text.
 Action ParseAction(std::string_view text);
 
 // Keys after escape-sequence decoding that are not plain characters.

@@ -34,9 +34,34 @@ OperatorInputs ManualControl::Step(double dt_s) {
   return Apply(cmd, dt_s);
 }
 
+void ManualControl::SetInputs(const OperatorInputs& in) {
+  target_ = in;
+  target_.reset = false;
+  out_ = target_;
+}
+
+void ManualControl::PollFrozen() {
+  freeze_requested_ = step_requested_ = false;
+  DeviceCommands cmd;
+  for (std::size_t i = 0; i < devices_.size(); ++i) {
+    if (devices_[i]->connected()) devices_[i]->Poll(&cmd);
+  }
+  bool ignored = false;
+  for (const Action& a : cmd.events) {
+    if (a.kind == ActionKind::kFreeze) freeze_requested_ = true;
+    else if (a.kind == ActionKind::kStep) step_requested_ = true;
+    else if (a.kind == ActionKind::kQuit) quit_ = true;
+    else ignored = true;
+  }
+  for (int i = 0; i < kNumAnalogInputs; ++i) ignored = ignored || cmd.step[i] != 0 || cmd.rate[i] != 0;
+  ignored = ignored || cmd.v_R_ft_s.squaredNorm() > 0 || cmd.w_S2_deg_s.squaredNorm() > 0;
+  if (ignored) counters_.Add("frozen.inputs_ignored");
+}
+
 OperatorInputs ManualControl::Apply(const DeviceCommands& cmd, double dt_s) {
   const InputCalibrations& cal = config_.inputs;
   out_.reset = false;
+  freeze_requested_ = step_requested_ = false;
   for (const Action& a : cmd.events) {
     switch (a.kind) {
       case ActionKind::kCamera: target_.camera_station = a.camera; break;
@@ -47,6 +72,8 @@ OperatorInputs ManualControl::Apply(const DeviceCommands& cmd, double dt_s) {
       case ActionKind::kReset: out_.reset = true; break;
       case ActionKind::kOverlay: target_.overlay = !target_.overlay; break;
       case ActionKind::kQuit: quit_ = true; break;
+      case ActionKind::kFreeze: freeze_requested_ = true; break;
+      case ActionKind::kStep: step_requested_ = true; break;
       default: break;
     }
   }

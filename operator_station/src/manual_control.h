@@ -35,6 +35,14 @@ class ManualControl {
   OperatorInputs Apply(const DeviceCommands& cmd, double dt_s);
 
   bool quit() const { return quit_; }
+  // Freeze / step asked for this frame (the station sends them on RMS_CONTROL).
+  bool freeze_requested() const { return freeze_requested_; }
+  bool step_requested() const { return step_requested_; }
+  // Only the session's keys (freeze, step, quit) while frozen: everything
+  // else is read and dropped, counted ("frozen.inputs_ignored").
+  void PollFrozen();
+  // Carry on from these inputs (a restored checkpoint): targets and outputs.
+  void SetInputs(const OperatorInputs& in);
   const OperatorInputs& target() const { return target_; }
   // "clamped.NAME", "resolved_rate.unreachable", "device.disconnected".
   const Counters& counters() const { return counters_; }
@@ -48,6 +56,7 @@ class ManualControl {
   std::array<bool, kNumAnalogInputs> clamping_{};
   Counters counters_;
   bool quit_ = false;
+  bool freeze_requested_ = false, step_requested_ = false;
 };
 
 }  // namespace rms::op

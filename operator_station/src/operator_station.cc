@@ -18,7 +18,9 @@
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/message_io.h"
 #include "rms/process.h"
+#include "rms/checkpoint.h"
 #include "rms/process_status_t.hpp"
+#include "rms/session_control_t.hpp"
 #include "status_screen.h"
 #include "timeline.h"
 
@@ -88,6 +90,8 @@ std::string KeyHelp(const Bindings& b) {
       case ActionKind::kReset: what = "reset"; break;
       case ActionKind::kOverlay: what = "overlay"; break;
       case ActionKind::kQuit: what = "quit"; break;
+      case ActionKind::kFreeze: what = "freeze"; break;
+      case ActionKind::kStep: what = "step"; break;
     }
     s += " " + key + "=" + what;
   }
@@ -195,6 +199,55 @@ int RunOperatorStation(const OperatorOptions& options, const LabConfig& config, 
     }
   });
 
+  // RMS_CONTROL: freeze, run, step; a restored checkpoint (docs/sessions.md).
+  // The station is the session's clock: frozen, it stops its source and
+  // publishes nothing, so every process holds its frame and nothing is lost.
+  bool frozen = false;
+  int steps_pending = 0;
+  std::optional<std::string> restored_from;
+  std::int64_t control_sequence = 0;
+  lcm.Subscribe(channels::kControl, [&](const void* data, int size, std::int64_t) {
+    session_control_t m;
+    if (SafeDecode(data, size, 1 << 16, &m) != DecodeError::kNone) {
+      counters.Add("dropped.control_malformed");
+      return;
+    }
+    switch (m.command) {
+      case session_control_t::FREEZE:
+        if (!frozen) spdlog::info("frozen");
+        frozen = true;
+        counters.Add("control.freezes");
+        break;
+      case session_control_t::RUN:
+        if (frozen) spdlog::info("running again");
+        frozen = false;
+        steps_pending = 0;
+        break;
+      case session_control_t::STEP:
+        if (frozen) ++steps_pending;
+        counters.Add("control.steps");
+        break;
+      case session_control_t::RESTORE:
+        restored_from = m.path;
+        break;
+      default:
+        break;
+    }
+  });
+  auto send_control = [&](std::int8_t command) {
+    session_control_t m;
+    m.send_time_us = lcm.NowUs();
+    m.sequence = control_sequence++;
+    m.command = command;
+    if (!PublishMessage(lcm, channels::kControl, m)) counters.Add("publish_failed");
+  };
+  if (!options.restore_path.empty()) {
+    const Checkpoint c = ReadCheckpoint(options.restore_path);
+    spdlog::info("starting from the checkpoint {} (DCP frame {})", options.restore_path, c.dcp_frame);
+    if (manual) manual->SetInputs(c.inputs);
+    if (autopilot) autopilot->Resync(c.inputs);
+  }
+
   const bool screen_on = options.status == 1 || (options.status == -1 && by_hand && isatty(STDOUT_FILENO));
   std::unique_ptr<StatusScreen> screen;
   if (screen_on) screen = std::make_unique<StatusScreen>(config);
@@ -211,6 +264,44 @@ int RunOperatorStation(const OperatorOptions& options, const LabConfig& config, 
   while (!StopRequested()) {
     if (options.max_frames >= 0 && frames >= options.max_frames) break;
     if (lcm.HandleSubscriptions(0) < 0) counters.Add("transport_errors");
+    if (restored_from) {
+      // Carry on from the checkpoint's inputs, so the first frame after it
+      // commands the arm where the DCP now has it.
+      try {
+        const Checkpoint c = ReadCheckpoint(*restored_from);
+        if (manual) manual->SetInputs(c.inputs);
+        if (autopilot) autopilot->Resync(c.inputs);
+        spdlog::info("restored checkpoint {}: carrying on from its inputs", *restored_from);
+        counters.Add("control.restores");
+      } catch (const InputError& e) {
+        counters.Add("control.errors");
+        spdlog::error("{}", e.what());
+      }
+      restored_from.reset();
+    }
+    if (frozen && steps_pending == 0) {
+      // Frozen: no clock, no frames. The session's keys still work.
+      if (manual) {
+        manual->PollFrozen();
+        if (manual->quit()) break;
+        if (manual->freeze_requested()) send_control(session_control_t::RUN);
+        if (manual->step_requested()) send_control(session_control_t::STEP);
+      }
+      if (screen) {
+        StatusSnapshot s;
+        s.source = source + " -- FROZEN (" + (bindings ? "freeze key runs, step key steps" : "rms_control run") + ")";
+        s.frame = builder.next_frame() - 1;
+        s.telemetry = telemetry;
+        s.devices = device_report;
+        s.help = help;
+        screen->Draw(std::move(s));
+      }
+      status.Tick(builder.next_frame() - 1, counters);
+      SleepUntilNs(MonotonicNs() + period_ns);
+      next_ns = MonotonicNs();
+      continue;
+    }
+    if (steps_pending > 0) --steps_pending;
     // Timeline time is the frame count over the rate: jitter-free and reproducible.
     const double t = options.speed * static_cast<double>(frames) / rate;
     OperatorInputs in;
@@ -221,6 +312,7 @@ int RunOperatorStation(const OperatorOptions& options, const LabConfig& config, 
     } else if (manual) {
       in = manual->Step(1.0 / rate);
       if (manual->quit()) break;
+      if (manual->freeze_requested()) send_control(session_control_t::FREEZE);
     } else {
       in = autopilot->Step(telemetry ? &*telemetry : nullptr);
       if (autopilot->failed()) {

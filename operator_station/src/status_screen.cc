@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "rms/collision_bits.h"
+#include "rms/text.h"
 
 namespace rms::op {
 
@@ -24,27 +25,18 @@ const char* ModeName(int m) {
   }
 }
 
-std::string Fmt(const char* f, ...) __attribute__((format(printf, 1, 2)));
-std::string Fmt(const char* f, ...) {
-  char buf[512];
-  va_list ap;
-  va_start(ap, f);
-  std::vsnprintf(buf, sizeof buf, f, ap);
-  va_end(ap);
-  return buf;
-}
 
 }  // namespace
 
 std::string RenderStatusScreen(const StatusSnapshot& s, const LabConfig& config, int width) {
   std::vector<std::string> L;
   const OperatorInputs& in = s.inputs;
-  L.push_back(Fmt("rmslab operator station -- %s", s.source.c_str()));
+  L.push_back(Sprintf("rmslab operator station -- %s", s.source.c_str()));
   L.back() += std::string(std::max<int>(1, width - 14 - static_cast<int>(L.back().size())), ' ') +
-              Fmt("frame %06lld", static_cast<long long>(s.frame));
+              Sprintf("frame %06lld", static_cast<long long>(s.frame));
   if (s.telemetry) {
     const dcp_telemetry_t& t = *s.telemetry;
-    L.push_back(Fmt("MODE %-26s acquired %-3s  docked %-3s  arm %s", ModeName(t.mode), t.acquired ? "YES" : "no",
+    L.push_back(Sprintf("MODE %-26s acquired %-3s  docked %-3s  arm %s", ModeName(t.mode), t.acquired ? "YES" : "no",
                     t.docked ? "YES" : "no",
                     t.held ? "HELD: the command collides" : t.finger_held ? "follows, finger held on the bar" : "follows"));
     std::string coll;
@@ -57,37 +49,37 @@ std::string RenderStatusScreen(const StatusSnapshot& s, const LabConfig& config,
     for (int half = 0; half < 2; ++half) {
       std::string cond = half == 0 ? "acquisition:" : "            ";
       for (int i = 3 * half; i < 3 * half + 3; ++i) {
-        cond += Fmt(" [%c] %d %-18s", t.acquisition_conditions[i] ? 'x' : ' ', i + 1, kCond[i]);
+        cond += Sprintf(" [%c] %d %-18s", t.acquisition_conditions[i] ? 'x' : ' ', i + 1, kCond[i]);
       }
       L.push_back(cond);
     }
-    L.push_back(Fmt("  finger gap %.3f ft (D3Y %.3f)   palm to BAR %.3f ft (TPOB %.3f)", t.finger_gap_ft,
+    L.push_back(Sprintf("  finger gap %.3f ft (D3Y %.3f)   palm to BAR %.3f ft (TPOB %.3f)", t.finger_gap_ft,
                     config.dcp.d3y_ft, t.palm_to_bar_ft, config.dcp.tpob_ft));
-    L.push_back(Fmt("docking: distance %.3f ft (<= %.2f)  angle %.2f deg (<= %.2f)  probe in envelope %s",
+    L.push_back(Sprintf("docking: distance %.3f ft (<= %.2f)  angle %.2f deg (<= %.2f)  probe in envelope %s",
                     t.dock_distance_ft, config.dcp.dock_distance_ft, t.dock_angle_deg, config.dcp.dock_angle_deg,
                     t.probe_in_envelope ? "yes" : "no"));
   } else {
     L.push_back("MODE ?  (no telemetry from dynamics_proc yet)");
   }
   const int st = in.camera_station;
-  L.push_back(Fmt("camera %d %-34s pan %+6.1f  tilt %+6.1f  zoom %.2f", st,
+  L.push_back(Sprintf("camera %d %-34s pan %+6.1f  tilt %+6.1f  zoom %.2f", st,
                   st >= 1 && st <= static_cast<int>(config.cameras.size()) ? config.cameras[st - 1].name.c_str() : "?",
                   in.value[kCameraPan], in.value[kCameraTilt], in.value[kCameraZoom]));
-  L.push_back(Fmt("arm, deg: yaw %+7.2f  pitch %+7.2f  elbow %+7.2f  wrist pitch %+7.2f  yaw %+7.2f  roll %+7.2f",
+  L.push_back(Sprintf("arm, deg: yaw %+7.2f  pitch %+7.2f  elbow %+7.2f  wrist pitch %+7.2f  yaw %+7.2f  roll %+7.2f",
                   in.value[0], in.value[1], in.value[2], in.value[3], in.value[4], in.value[5]));
-  L.push_back(Fmt("shoulder height %.2f ft   finger %.2f (0 open, 1 closed)   overlay %s", in.value[kShoulderHeight],
+  L.push_back(Sprintf("shoulder height %.2f ft   finger %.2f (0 open, 1 closed)   overlay %s", in.value[kShoulderHeight],
                   in.value[kFinger], in.overlay ? "on" : "off"));
-  std::string rates = Fmt("rates: published %.1f Hz   DCP %.1f Hz   rendered ", s.publish_hz, s.telemetry_hz);
-  rates += s.render_hz >= 0 ? Fmt("%.1f Hz", s.render_hz) : "? (no status from esg_renderer)";
+  std::string rates = Sprintf("rates: published %.1f Hz   DCP %.1f Hz   rendered ", s.publish_hz, s.telemetry_hz);
+  rates += s.render_hz >= 0 ? Sprintf("%.1f Hz", s.render_hz) : "? (no status from esg_renderer)";
   L.push_back(rates);
   std::string lat = "latency: input to DCP ";
-  lat += s.input_to_dcp_ms >= 0 ? Fmt("%.1f ms", s.input_to_dcp_ms) : "?";
+  lat += s.input_to_dcp_ms >= 0 ? Sprintf("%.1f ms", s.input_to_dcp_ms) : "?";
   lat += "   input to rendered frame ";
   lat += s.input_to_render_p50_ms >= 0
-             ? Fmt("p50 %.1f ms, p99 %.1f ms", s.input_to_render_p50_ms, s.input_to_render_p99_ms)
+             ? Sprintf("p50 %.1f ms, p99 %.1f ms", s.input_to_render_p50_ms, s.input_to_render_p99_ms)
              : "? (no status from esg_renderer)";
   L.push_back(lat);
-  L.push_back(Fmt("inputs clamped to their range: %ld", s.clamped_inputs));
+  L.push_back(Sprintf("inputs clamped to their range: %ld", s.clamped_inputs));
   std::string dev = "devices:";
   for (const auto& d : s.devices) dev += " " + d + ";";
   L.push_back(dev);

@@ -72,6 +72,8 @@ void SceneNode::OnDcpFrame(const void* data, int size, std::int64_t recv_time_us
   const auto& [msg, dcp] = *got;
   counters_.Set("dcp.missing", dcp_frames_.missing());
   latencies_["dcp_to_scene"].Add(recv_time_us - msg.send_time_us);
+  RecordEndToEnd(recv_time_us - msg.input_send_time_us, config_.session.frame_rate_hz, &latencies_["input_to_scene"],
+                 &counters_);
 
   const std::int64_t frame = next_frame_++;
   const EsgFrameData e = scene_.Step(dcp, static_cast<std::uint32_t>(frame & 0xFFFFFF), &counters_);
@@ -96,9 +98,9 @@ int RunSceneProc(const LabConfig& config, LcmInterface& lcm, const std::string& 
                lcm.FullChannel(channels::kEsgFrame));
   RunNodeLoop(lcm, "scene_proc", node.counters(), node.latencies(),
               [&] { return node.last_frame(); }, nullptr, stats_path);
-  spdlog::info("published {} ESG frames; DCP frames missing {}, dropped {}",
+  spdlog::info("published {} ESG frames; DCP frames missing {}, late {}, dropped {}",
                node.counters().Get("published"), node.counters().Get("dcp.missing"),
-               node.counters().SumPrefix("dropped."));
+               node.counters().Get("frames.late"), node.counters().SumPrefix("dropped."));
   return 0;
 }
 

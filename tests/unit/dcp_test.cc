@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
@@ -10,7 +11,10 @@
 #include "dynamic_collision_program.h"
 #include "mission_plan.h"
 #include "rms/arm_ik.h"
+#include "rms/check.h"
 #include "rms/config.h"
+#include "rms/dcp_frame_t.hpp"
+#include "rms/word_blocks.h"
 #include "timeline.h"
 
 namespace rms::dcp {
@@ -236,6 +240,54 @@ TEST_F(Dcp, ResetReturnsToMode1AndTheInitialState) {
   EXPECT_TRUE(out.control.reset);
   EXPECT_FALSE(out.control.acquired);
   EXPECT_LT((dcp.X_RP().translation() - config.payload.p_RoPo_R_ft).norm(), 1e-12);
+}
+
+TEST_F(Dcp, ACheckpointRestoresTheStateExactly) {
+  // At every phase of the mission: save, go on; restore into a fresh DCP and
+  // go on with the same inputs: the same outputs, word for word.
+  const std::string text = mission::FormatTimeline(mission::PlanMission(config), "");
+  const op::Timeline tl = op::Timeline::Parse(text, "mission", config.inputs);
+  std::vector<OperatorInputs> inputs;
+  for (double t = 0; t <= tl.end_time(); t += 1.0 / 30.0) inputs.push_back(tl.Sample(t));
+  for (std::size_t at : {std::size_t{100}, std::size_t{500}, std::size_t{800}, std::size_t{1300}}) {
+    DynamicCollisionProgram live(config);
+    for (std::size_t k = 0; k < at; ++k) live.Step(inputs[k]);
+    // Through the text of a file, as a checkpoint goes.
+    const nlohmann::json saved = nlohmann::json::parse(live.SaveState().dump());
+    DynamicCollisionProgram restored(config);
+    restored.RestoreState(saved);
+    EXPECT_EQ(restored.mode(), live.mode()) << "at frame " << at;
+    for (std::size_t k = at; k < inputs.size(); ++k) {
+      const DcpFrameData a = live.Step(inputs[k]), b = restored.Step(inputs[k]);
+      dcp_frame_t wa, wb;
+      PackDcpFrame(a, &wa, nullptr);
+      PackDcpFrame(b, &wb, nullptr);
+      ASSERT_EQ(std::memcmp(wa.arm_words, wb.arm_words, sizeof wa.arm_words), 0) << at << "+" << k;
+      ASSERT_EQ(wa.control_word, wb.control_word) << at << "+" << k;
+      ASSERT_EQ(std::memcmp(wa.state_words, wb.state_words, sizeof wa.state_words), 0) << at << "+" << k;
+      ASSERT_EQ(std::memcmp(wa.plane_words, wb.plane_words, sizeof wa.plane_words), 0) << at << "+" << k;
+    }
+    EXPECT_TRUE(restored.status().docked);
+  }
+}
+
+TEST_F(Dcp, ABadCheckpointIsRefusedNamingWhatIsWrong) {
+  DynamicCollisionProgram dcp(config);
+  nlohmann::json j = dcp.SaveState();
+  j["format"] = "something else";
+  EXPECT_THROW(dcp.RestoreState(j), InputError);
+  j = dcp.SaveState();
+  j["mode"] = 7;
+  try {
+    dcp.RestoreState(j);
+    ADD_FAILURE() << "mode 7 accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("mode"), std::string::npos) << e.what();
+  }
+  j = dcp.SaveState();
+  j.erase("X_S2P");
+  EXPECT_THROW(dcp.RestoreState(j), InputError);
+  EXPECT_EQ(dcp.mode(), 1);
 }
 
 }  // namespace

@@ -4,6 +4,8 @@
 #include <fstream>
 #include <iostream>
 
+#include "export_csv.h"
+#include "lab_file.h"
 #include "session_summary.h"
 
 int main(int argc, char** argv) {
@@ -16,8 +18,58 @@ int main(int argc, char** argv) {
   summary->add_option("--out", out, "Output file (default SESSION/summary.json)");
   bool brief = false;
   summary->add_flag("--brief", brief, "Print a few human-readable lines instead of the JSON");
+
+  // manifest: what a session ran, written by scripts/lab at the start.
+  CLI::App* manifest = app.add_subcommand("manifest", "Write SESSION/manifest.json: config, software, hosts, start");
+  std::string m_dir, pilot, url, suffix, config_sha, command, timeline, restore;
+  std::vector<std::string> hosts;
+  manifest->add_option("session", m_dir, "Session folder")->required()->check(CLI::ExistingDirectory);
+  manifest->add_option("--pilot", pilot, "autopilot, timeline, by-hand, replay")->required();
+  manifest->add_option("--lcm-url", url, "The session's LCM URL")->required();
+  manifest->add_option("--channel-suffix", suffix, "The session's channel suffix");
+  manifest->add_option("--config-sha256", config_sha, "SHA-256 of config.toml");
+  manifest->add_option("--timeline", timeline, "The timeline flown, if any");
+  manifest->add_option("--restore", restore, "The checkpoint the session started from, if any");
+  manifest->add_option("--host", hosts, "PROCESS=HOST, one per process (default: all on this host)");
+  manifest->add_option("--command", command, "The command line that started the session");
+
+  // compare-esg: replayed ESG frames against recorded ones.
+  CLI::App* compare = app.add_subcommand("compare-esg", "Compare a replay's ESG frames with the recorded session's");
+  std::string original, replay;
+  compare->add_option("original", original, "The recorded session")->required()->check(CLI::ExistingDirectory);
+  compare->add_option("replay", replay, "The replay's session folder")->required()->check(CLI::ExistingDirectory);
+  // export: every channel to CSV.
+  CLI::App* exporter = app.add_subcommand("export", "Every channel of SESSION's log to CSV, decoded, with units");
+  std::string e_dir, e_out;
+  exporter->add_option("session", e_dir, "Session folder")->required()->check(CLI::ExistingDirectory);
+  exporter->add_option("--out", e_out, "Folder for the CSV files (default SESSION/csv)");
+
+  // labfile: a lab's host layout, checked, as shell assignments for scripts/lab.
+  CLI::App* labfile = app.add_subcommand("labfile", "Check a lab file (docs/sessions.md) and print it for scripts/lab");
+  std::string lab_path;
+  labfile->add_option("file", lab_path, "Lab file")->required()->check(CLI::ExistingFile);
   CLI11_PARSE(app, argc, argv);
   try {
+    if (exporter->parsed()) {
+      if (e_out.empty()) e_out = e_dir + "/csv";
+      const auto files = rms::session::ExportCsv(e_dir, e_out, [](const std::string& line) { std::cerr << line << "\n"; });
+      for (const auto& [f, n] : files) std::cout << f << ": " << n << " rows\n";
+      return 0;
+    }
+    if (labfile->parsed()) {
+      std::cout << rms::session::LabFileShell(rms::session::LoadLabFile(lab_path));
+      return 0;
+    }
+    if (manifest->parsed()) {
+      const auto j = rms::session::MakeManifest(m_dir, pilot, url, suffix, config_sha, timeline, restore, hosts, command);
+      std::ofstream(m_dir + "/manifest.json") << j.dump(2) << "\n";
+      return 0;
+    }
+    if (compare->parsed()) {
+      const auto c = rms::session::CompareEsgFrames(original, replay);
+      std::cout << c.dump(2) << "\n";
+      return c["identical"] == c["recorded"] && c["missing"] == 0 ? 0 : 1;
+    }
     const auto j = rms::session::Summarize(dir);
     if (out.empty()) out = dir + "/summary.json";
     std::ofstream f(out);

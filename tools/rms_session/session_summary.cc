@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <map>
 #include <set>
+#include <ctime>
+#include <unistd.h>
 
 #include "rms/channels.h"
 #include "rms/config.h"
@@ -19,6 +21,8 @@
 #include "rms/message_io.h"
 #include "rms/operator_input_t.hpp"
 #include "rms/process_status_t.hpp"
+#include "rms/lcm_interface.h"
+#include "rms/version.h"
 
 namespace fs = std::filesystem;
 
@@ -53,15 +57,15 @@ std::int64_t SumPrefix(const nlohmann::json& stats, const std::string& prefix) {
 
 constexpr int kCollisionBits = collision_bits::kCount;
 
-std::string StripSuffix(const std::string& channel) {
+}  // namespace
+
+std::string BaseChannel(const std::string& channel) {
   for (const char* base : {channels::kOperatorInput, channels::kDcpTelemetry, channels::kDcpFrame,
-                           channels::kEsgFrame, channels::kStatus}) {
+                           channels::kEsgFrame, channels::kStatus, channels::kControl}) {
     if (channel.rfind(base, 0) == 0) return base;
   }
   return channel;
 }
-
-}  // namespace
 
 nlohmann::ordered_json Summarize(const std::string& dir) {
   const fs::path root(dir);
@@ -96,7 +100,7 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
     ++events;
     if (first_us < 0) first_us = ev->timestamp;
     last_us = ev->timestamp;
-    const std::string base = StripSuffix(ev->channel);
+    const std::string base = BaseChannel(ev->channel);
     ++by_channel[ev->channel];
     if (base == channels::kOperatorInput) {
       operator_input_t m;
@@ -288,6 +292,43 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
     }
   }
   j["latency"] = lat;
+  // Timing health, by process: frames lost on the way in (from the frame
+  // numbers), frames late (more than a frame period after the operator sent
+  // them), malformed ones dropped, and each link's latency.
+  {
+    double rate_hz = 30.0;
+    try {
+      rate_hz = LoadConfig((root / "config.toml").string()).session.frame_rate_hz;
+    } catch (const std::exception&) {
+    }
+    nlohmann::ordered_json timing;
+    timing["frame_period_ms"] = 1000.0 / rate_hz;
+    auto links = [&](const nlohmann::json& st) {
+      nlohmann::ordered_json l = nlohmann::ordered_json::object();
+      if (!st.contains("latency_us")) return l;
+      for (auto it = st["latency_us"].begin(); it != st["latency_us"].end(); ++it) {
+        l[it.key()] = {{"p50_ms", it.value()["p50"].get<double>() / 1000.0},
+                       {"p99_ms", it.value()["p99"].get<double>() / 1000.0},
+                       {"max_ms", it.value()["max"].get<double>() / 1000.0}};
+      }
+      return l;
+    };
+    timing["operator_station"] = {{"late_frames", Counter(op, "frames.late")}};
+    timing["dynamics_proc"] = {{"dropped_frames", Counter(dcp, "input.missing")},
+                               {"late_frames", Counter(dcp, "frames.late")},
+                               {"malformed", SumPrefix(dcp, "dropped.")},
+                               {"latency", links(dcp)}};
+    timing["scene_proc"] = {{"dropped_frames", Counter(scene, "dcp.missing")},
+                            {"late_frames", Counter(scene, "frames.late")},
+                            {"malformed", SumPrefix(scene, "dropped.")},
+                            {"latency", links(scene)}};
+    timing["esg_renderer"] = {{"dropped_frames", Counter(esg, "esg.missing")},
+                              {"superseded", Counter(esg, "superseded")},
+                              {"late_frames", Counter(esg, "frames.late")},
+                              {"malformed", SumPrefix(esg, "dropped.")},
+                              {"latency", links(esg)}};
+    j["timing"] = timing;
+  }
   nlohmann::ordered_json lj;
   lj["file"] = "lcmlog";
   lj["events"] = events;
@@ -300,6 +341,76 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
   lj["final_status_from"] = nlohmann::json::array();
   for (const auto& [p, seen] : final_status_seen) lj["final_status_from"].push_back(p);
   j["log"] = lj;
+  return j;
+}
+
+nlohmann::ordered_json MakeManifest(const std::string& dir, const std::string& pilot, const std::string& url,
+                                    const std::string& suffix, const std::string& config_sha256,
+                                    const std::string& timeline, const std::string& restore,
+                                    const std::vector<std::string>& hosts, const std::string& command) {
+  nlohmann::ordered_json j;
+  j["format"] = "rmslab-session-1";
+  j["session"] = fs::absolute(dir).lexically_normal().filename().string();
+  const std::int64_t now = WallTimeUs();
+  const std::time_t secs = static_cast<std::time_t>(now / 1000000);
+  char utc[32];
+  std::strftime(utc, sizeof utc, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&secs));
+  j["started_utc"] = utc;
+  j["started_us"] = now;
+  j["pilot"] = pilot;
+  if (!timeline.empty()) j["timeline"] = {{"file", "timeline.tl"}, {"source", timeline}};
+  if (!restore.empty()) j["restored_from"] = restore;
+  j["config"] = {{"file", "config.toml"}, {"sha256", config_sha256}};
+  j["software"] = {{"version", VersionString()}, {"project", Version().project}, {"describe", Version().describe},
+                   {"commit", Version().commit}, {"build_type", Version().build_type}, {"compiler", Version().compiler}};
+  char host[256] = {};
+  gethostname(host, sizeof host - 1);
+  j["lab_host"] = host;
+  j["lcm"] = {{"url", url}, {"channel_suffix", suffix}};
+  nlohmann::ordered_json layout = nlohmann::ordered_json::object();
+  for (const char* p : {"operator_station", "dynamics_proc", "scene_proc", "esg_renderer", "lcm-logger"}) layout[p] = "localhost";
+  for (const std::string& h : hosts) {
+    const auto eq = h.find('=');
+    if (eq == std::string::npos) throw InputError("--host must be PROCESS=HOST, got '" + h + "'");
+    layout[h.substr(0, eq)] = h.substr(eq + 1);
+  }
+  j["hosts"] = layout;
+  if (!command.empty()) j["command"] = command;
+  return j;
+}
+
+nlohmann::ordered_json CompareEsgFrames(const std::string& original_dir, const std::string& replay_dir) {
+  auto read = [](const fs::path& log_path) {
+    std::map<std::int64_t, esg_frame_t> by_dcp;
+    lcm::LogFile log(log_path.string(), "r");
+    if (!log.good()) throw InputError("cannot read '" + log_path.string() + "'");
+    while (const lcm::LogEvent* ev = log.readNextEvent()) {
+      if (BaseChannel(ev->channel) != channels::kEsgFrame) continue;
+      esg_frame_t m;
+      if (SafeDecode(ev->data, ev->datalen, 4096, &m) == DecodeError::kNone) by_dcp[m.dcp_frame] = m;
+    }
+    return by_dcp;
+  };
+  const auto a = read(fs::path(original_dir) / "lcmlog");
+  const auto b = read(fs::path(replay_dir) / "lcmlog");
+  std::int64_t identical = 0, missing = 0;
+  std::string first;
+  for (const auto& [dcp_frame, m] : a) {
+    const auto it = b.find(dcp_frame);
+    if (it == b.end()) {
+      ++missing;
+      if (first.empty()) first = "DCP frame " + std::to_string(dcp_frame) + ": not replayed";
+      continue;
+    }
+    if (it->second.frame == m.frame && it->second.words == m.words) ++identical;
+    else if (first.empty()) first = "DCP frame " + std::to_string(dcp_frame) + ": words differ";
+  }
+  nlohmann::ordered_json j;
+  j["recorded"] = static_cast<std::int64_t>(a.size());
+  j["replayed"] = static_cast<std::int64_t>(b.size());
+  j["identical"] = identical;
+  j["missing"] = missing;
+  j["first_difference"] = first;
   return j;
 }
 

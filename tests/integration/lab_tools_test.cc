@@ -1,0 +1,382 @@
+// Sessions as data (docs/sessions.md), the way a user runs them: a recorded
+// session re-simulates bit for bit and with another arm fares otherwise,
+// explained; it replays through the scene and the renderer to the same ESG
+// frames; it exports to CSV and reports to HTML that a browser draws; the
+// monitor shows its traffic; a frozen session holds, steps and resumes with
+// nothing lost; a checkpoint restores the DCP and a session can start from
+// one.
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <filesystem>
+#include <fstream>
+#include <lcm/lcm-cpp.hpp>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <regex>
+
+#include "lab_processes.h"
+#include "rms/channels.h"
+#include "rms/config.h"
+#include "rms/dcp_frame_t.hpp"
+#include "rms/dcp_telemetry_t.hpp"
+#include "rms/esg_frame_t.hpp"
+#include "rms/lcm_interface.h"
+#include "rms/message_io.h"
+#include "subprocess.h"
+
+namespace rms {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::ReadFile;
+using testing::SourcePath;
+using testing::Subprocess;
+
+struct ScriptRun {
+  int rc = -1;
+  std::string out;  // stdout + stderr
+};
+
+// Runs a script or tool to the end.
+ScriptRun Script(const std::vector<std::string>& argv, const std::string& log, double timeout_s = 300) {
+  Subprocess p(argv, log, {std::string("RMSLAB_BUILD=") + RMSLAB_BUILD_DIR});
+  ScriptRun r;
+  r.rc = p.Wait(timeout_s);
+  r.out = ReadFile(log);
+  return r;
+}
+
+// One recorded session (the autopilot, at 4x, small frames), shared by the
+// tests that only read it.
+class RecordedSession : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    tmp_ = new std::string(testing::MakeTempDir("recorded"));
+    dir_ = new std::string(*tmp_ + "/session");
+    const ScriptRun r = Script({SourcePath("scripts/lab"), "demo", "--no-build", "--out", *dir_, "--speed", "4", "--lcm-url",
+                          testing::UniqueLcmUrl(9100), "--png-every", "0", "--width", "160", "--height", "120"},
+                         *tmp_ + "/lab.log");
+    ASSERT_EQ(r.rc, 0) << r.out;
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*tmp_);
+    delete tmp_;
+    delete dir_;
+  }
+  static std::string* tmp_;
+  static std::string* dir_;
+};
+std::string* RecordedSession::tmp_ = nullptr;
+std::string* RecordedSession::dir_ = nullptr;
+
+TEST_F(RecordedSession, TheManifestSaysWhatRanWhereAndWhen) {
+  const auto m = nlohmann::json::parse(ReadFile(*dir_ + "/manifest.json"));
+  EXPECT_EQ(m["format"], "rmslab-session-1");
+  EXPECT_EQ(m["pilot"], "autopilot");
+  EXPECT_EQ(m["config"]["file"], "config.toml");
+  EXPECT_EQ(m["config"]["sha256"].get<std::string>().size(), 64u);
+  EXPECT_NE(m["software"]["version"].get<std::string>().find("rmslab"), std::string::npos);
+  EXPECT_EQ(m["software"]["commit"].get<std::string>().size(), 40u);  // the tests run in a git checkout
+  for (const char* p : {"operator_station", "dynamics_proc", "scene_proc", "esg_renderer", "lcm-logger"}) {
+    EXPECT_EQ(m["hosts"][p], "localhost") << p;
+  }
+  EXPECT_GT(m["started_us"].get<std::int64_t>(), 1700000000000000);
+  EXPECT_EQ(m["lcm"]["url"].get<std::string>().find("udpm://"), 0u);
+}
+
+TEST_F(RecordedSession, ItReSimulatesBitForBit) {
+  const ScriptRun r = Script({SourcePath("scripts/lab"), "resim", *dir_, "--no-build"}, *tmp_ + "/resim.log");
+  EXPECT_EQ(r.rc, 0) << r.out;
+  const auto s = nlohmann::json::parse(ReadFile(*dir_ + "/summary.json"));
+  const std::string want = std::to_string(s["frames"]["dcp_published"].get<int>()) + " of " +
+                           std::to_string(s["frames"]["dcp_published"].get<int>()) +
+                           " recorded frames identical, word for word";
+  EXPECT_NE(r.out.find(want), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("resim: 100%"), std::string::npos) << "no progress shown";
+}
+
+TEST_F(RecordedSession, ALongerArmFaresOtherwiseAndTheComparisonSaysWhy) {
+  // The same operator inputs with the upper boom a foot longer: the end
+  // effector arrives elsewhere, the grasp fails, nothing docks.
+  std::string cfg = ReadFile(*dir_ + "/config.toml");
+  const std::string from = "upper_boom_ft = 20.9";
+  ASSERT_NE(cfg.find(from), std::string::npos);
+  cfg.replace(cfg.find(from), from.size(), "upper_boom_ft = 21.9");
+  const std::string long_arm = *tmp_ + "/long_arm.toml";
+  std::ofstream(long_arm) << cfg;
+  const std::string out = *tmp_ + "/long_arm_session";
+  const ScriptRun r = Script({SourcePath("scripts/lab"), "resim", *dir_, "--no-build", "--config", long_arm, "--out", out},
+                       *tmp_ + "/resim_long.log");
+  ASSERT_EQ(r.rc, 0) << r.out;
+  const auto summary = nlohmann::json::parse(ReadFile(out + "/summary.json"));
+  EXPECT_FALSE(summary["docked"].get<bool>());
+  EXPECT_FALSE(summary["acquired"].get<bool>());
+  const auto c = nlohmann::json::parse(ReadFile(out + "/comparison.json"));
+  ASSERT_EQ(c["config_changes"].size(), 1u) << c["config_changes"].dump();
+  EXPECT_EQ(c["config_changes"][0]["key"], "arm.upper_boom_ft");
+  EXPECT_FALSE(c["recorded"]["docked"].is_null());
+  EXPECT_TRUE(c["resimulated"]["docked"].is_null());
+  EXPECT_GT(c["point_A"]["max_apart_ft"].get<double>(), 0.5);
+  std::string why;
+  for (const auto& line : c["explanation"]) why += line.get<std::string>() + "\n";
+  EXPECT_NE(why.find("No acquisition"), std::string::npos) << why;
+  EXPECT_NE(why.find("TPOB"), std::string::npos) << why;  // the palm did not come down onto the bar
+  EXPECT_NE(why.find("No docking"), std::string::npos) << why;
+  EXPECT_NE(ReadFile(out + "/comparison.md").find("arm.upper_boom_ft"), std::string::npos);
+}
+
+TEST_F(RecordedSession, ItReplaysThroughTheSceneAndTheRendererToTheSameFrames) {
+  const std::string out = *tmp_ + "/replay";
+  const ScriptRun r = Script({SourcePath("scripts/lab"), "replay", *dir_, "--no-build", "--out", out, "--speed", "4", "--width",
+                        "160", "--height", "120", "--lcm-url", testing::UniqueLcmUrl(9200)},
+                       *tmp_ + "/replay.log");
+  ASSERT_EQ(r.rc, 0) << r.out;
+  const auto c = nlohmann::json::parse(ReadFile(out + "/replay_comparison.json"));
+  EXPECT_GT(c["recorded"].get<int>(), 1000);
+  EXPECT_EQ(c["identical"], c["recorded"]);
+  EXPECT_EQ(c["missing"], 0);
+  // The replay's video: one frame per frame number.
+  Subprocess probe({"/usr/bin/ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0", "-show_entries",
+                    "stream=nb_read_frames", "-of", "csv=p=0", out + "/session.mp4"},
+                   *tmp_ + "/ffprobe.log");
+  ASSERT_EQ(probe.Wait(60), 0);
+  EXPECT_EQ(std::stoi(ReadFile(*tmp_ + "/ffprobe.log")), c["recorded"].get<int>());
+}
+
+TEST_F(RecordedSession, ItExportsEveryChannelToCsvWithUnits) {
+  const ScriptRun r = Script({SourcePath("scripts/lab"), "export", *dir_, "--out", *tmp_ + "/csv"}, *tmp_ + "/export.log");
+  ASSERT_EQ(r.rc, 0) << r.out;
+  const auto s = nlohmann::json::parse(ReadFile(*dir_ + "/summary.json"));
+  auto lines = [](const std::string& path) {
+    std::ifstream f(path);
+    std::string header, line;
+    std::getline(f, header);
+    long n = 0;
+    while (std::getline(f, line)) ++n;
+    return std::make_pair(header, n);
+  };
+  const auto [in_header, in_rows] = lines(*tmp_ + "/csv/operator_input.csv");
+  EXPECT_NE(in_header.find("shoulder_yaw [deg]"), std::string::npos);
+  EXPECT_NE(in_header.find("shoulder_height [ft]"), std::string::npos);
+  EXPECT_EQ(in_rows, s["log"]["operator_frames"].get<long>());
+  const auto [tm_header, tm_rows] = lines(*tmp_ + "/csv/dcp_telemetry.csv");
+  EXPECT_NE(tm_header.find("dock_distance [ft]"), std::string::npos);
+  EXPECT_EQ(tm_rows, s["telemetry_frames"].get<long>());
+  const auto [esg_header, esg_rows] = lines(*tmp_ + "/csv/esg_frame.csv");
+  EXPECT_NE(esg_header.find("fov [deg]"), std::string::npos);
+  EXPECT_EQ(esg_rows, s["log"]["esg_frames"].get<long>());
+  EXPECT_GT(lines(*tmp_ + "/csv/status.csv").second, 50);
+  EXPECT_NE(r.out.find("skipped (malformed): 0 rows"), std::string::npos) << r.out;
+  // The last telemetry row says docked, in the column the header names.
+  std::ifstream f(*tmp_ + "/csv/dcp_telemetry.csv");
+  std::string header, line, last;
+  std::getline(f, header);
+  while (std::getline(f, line)) last = line;
+  auto column = [](const std::string& row, int k) {
+    std::stringstream ss(row);
+    std::string cell;
+    for (int i = 0; i <= k; ++i) std::getline(ss, cell, ',');
+    return cell;
+  };
+  int docked_col = -1;
+  {
+    std::stringstream ss(header);
+    std::string cell;
+    for (int i = 0; std::getline(ss, cell, ','); ++i) {
+      if (cell == "docked") docked_col = i;
+    }
+  }
+  ASSERT_GE(docked_col, 0);
+  EXPECT_EQ(column(last, docked_col), "1");
+}
+
+TEST_F(RecordedSession, ItsReportOpensInABrowserWithPlots) {
+  const ScriptRun r = Script({SourcePath("scripts/lab"), "report", *dir_, "--out", *tmp_ + "/report.html"}, *tmp_ + "/report.log");
+  ASSERT_EQ(r.rc, 0) << r.out;
+  const std::string html = ReadFile(*tmp_ + "/report.html");
+  for (const char* want : {"Phase durations", "Collisions", "docking miss distance", "Frame times and latency",
+                           "Mode timeline", "Chart.js v3"}) {
+    EXPECT_NE(html.find(want), std::string::npos) << want;
+  }
+  EXPECT_EQ(html.find("<script src="), std::string::npos) << "not self-contained";
+  // A real browser: headless Chromium draws the four charts.
+  Subprocess chrome({"/usr/bin/chromium", "--headless=new", "--no-sandbox", "--disable-gpu", "--virtual-time-budget=5000",
+                     "--dump-dom", "file://" + *tmp_ + "/report.html"},
+                    *tmp_ + "/dom.html");
+  ASSERT_EQ(chrome.Wait(120), 0) << ReadFile(*tmp_ + "/dom.html").substr(0, 2000);
+  const std::string dom = ReadFile(*tmp_ + "/dom.html");
+  EXPECT_NE(dom.find("data-charts-rendered=\"4\""), std::string::npos)
+      << "charts not drawn: " << dom.substr(dom.find("<body"), 200);
+}
+
+// A short timeline run live (3 s), listening on LCM.
+struct Listener {
+  explicit Listener(const std::string& url) {
+    LcmOptions o;
+    o.url = url;
+    lcm = std::make_unique<UdpLcm>(o);
+    lcm->Subscribe(channels::kDcpFrame, [this](const void* d, int n, std::int64_t) {
+      dcp_frame_t m;
+      if (SafeDecode(d, n, 4096, &m) == DecodeError::kNone) dcp.push_back(m);
+    });
+    lcm->Subscribe(channels::kEsgFrame, [this](const void* d, int n, std::int64_t) {
+      esg_frame_t m;
+      if (SafeDecode(d, n, 4096, &m) == DecodeError::kNone) esg.push_back(m.frame);
+    });
+    lcm->Subscribe(channels::kDcpTelemetry, [this](const void* d, int n, std::int64_t) {
+      dcp_telemetry_t m{};
+      if (SafeDecode(d, n, 4096, &m) == DecodeError::kNone) telemetry = m;
+    });
+  }
+  void Pump(double seconds) {
+    const std::int64_t until = lcm->NowUs() + static_cast<std::int64_t>(seconds * 1e6);
+    while (lcm->NowUs() < until) lcm->HandleSubscriptions(20);
+  }
+  std::unique_ptr<UdpLcm> lcm;
+  std::vector<dcp_frame_t> dcp;
+  std::vector<std::int64_t> esg;
+  std::optional<dcp_telemetry_t> telemetry;
+};
+
+std::vector<dcp_frame_t> FlyShortTimeline(const std::string& dir, const std::string& url, bool freeze) {
+  testing::LabProcesses lab(dir, url);
+  std::string error;
+  EXPECT_TRUE(lab.Start(&error)) << error;
+  Listener l(url);
+  Subprocess op({testing::BuildPath("operator_station/operator_station"), "--lcm-url", url, "--timeline",
+                 SourcePath("scripts/timelines/short.tl")},
+                dir + "/op.log");
+  auto control = [&](std::vector<std::string> args) {
+    args.insert(args.begin(), {testing::BuildPath("tools/rms_control"), "--lcm-url", url});
+    Subprocess c(args, dir + "/control.log");
+    EXPECT_EQ(c.Wait(10), 0) << ReadFile(dir + "/control.log");
+  };
+  if (freeze) {
+    l.Pump(1.0);
+    control({"freeze"});
+    l.Pump(0.5);  // frames in flight arrive
+    const std::size_t frozen_at = l.dcp.size();
+    l.Pump(1.5);
+    EXPECT_EQ(l.dcp.size(), frozen_at) << "frames flowed while frozen";
+    control({"step", "3"});
+    l.Pump(1.0);
+    EXPECT_EQ(l.dcp.size(), frozen_at + 3) << "step 3 did not make exactly three frames";
+    control({"run"});
+  }
+  while (op.Running()) l.Pump(0.05);
+  l.Pump(0.5);
+  EXPECT_EQ(op.Wait(1), 0) << ReadFile(dir + "/op.log");
+  EXPECT_TRUE(lab.Stop(&error)) << error;
+  // Nothing lost: every frame, in order, through to the ESG.
+  for (std::size_t i = 0; i < l.dcp.size(); ++i) EXPECT_EQ(l.dcp[i].frame, static_cast<std::int64_t>(i));
+  for (std::size_t i = 0; i < l.esg.size(); ++i) EXPECT_EQ(l.esg[i], static_cast<std::int64_t>(i));
+  EXPECT_EQ(l.esg.size(), l.dcp.size());
+  return l.dcp;
+}
+
+TEST(SessionControl, AFrozenSessionHoldsStepsAndResumesWithNothingLost) {
+  const std::string dir = testing::MakeTempDir("freeze");
+  fs::create_directories(dir + "/plain");
+  fs::create_directories(dir + "/frozen");
+  const auto plain = FlyShortTimeline(dir + "/plain", testing::UniqueLcmUrl(9300), false);
+  const auto frozen = FlyShortTimeline(dir + "/frozen", testing::UniqueLcmUrl(9400), true);
+  // The same frames, word for word, as a session never frozen: the operator
+  // station's clock stopped with everything else.
+  ASSERT_EQ(plain.size(), 91u);
+  ASSERT_EQ(frozen.size(), plain.size());
+  for (std::size_t i = 0; i < plain.size(); ++i) {
+    ASSERT_EQ(frozen[i].input_frame, plain[i].input_frame) << i;
+    for (int k = 0; k < 12; ++k) ASSERT_EQ(frozen[i].arm_words[k], plain[i].arm_words[k]) << "frame " << i;
+    ASSERT_EQ(frozen[i].control_word, plain[i].control_word) << i;
+    for (int k = 0; k < 17; ++k) ASSERT_EQ(frozen[i].state_words[k], plain[i].state_words[k]) << i;
+  }
+  fs::remove_all(dir);
+}
+
+TEST(SessionControl, ACheckpointRestoresTheDcpAndASessionStartsFromOne) {
+  const std::string dir = testing::MakeTempDir("checkpoint");
+  const std::string url = testing::UniqueLcmUrl(9500);
+  const std::string cp = dir + "/before_docking.json";
+  {
+    testing::LabProcesses lab(dir, url);
+    std::string error;
+    ASSERT_TRUE(lab.Start(&error)) << error;
+    Listener l(url);
+    Subprocess op({testing::BuildPath("operator_station/operator_station"), "--lcm-url", url, "--autopilot", "--rate",
+                   "150", "--hold"},
+                  dir + "/op.log");
+    auto control = [&](std::vector<std::string> args) {
+      args.insert(args.begin(), {testing::BuildPath("tools/rms_control"), "--lcm-url", url});
+      Subprocess c(args, dir + "/control.log");
+      EXPECT_EQ(c.Wait(10), 0) << ReadFile(dir + "/control.log");
+    };
+    // In Mode 3, under way to the port: a checkpoint.
+    for (int i = 0; i < 600 && !(l.telemetry && l.telemetry->mode == 3); ++i) l.Pump(0.05);
+    ASSERT_TRUE(l.telemetry && l.telemetry->mode == 3) << ReadFile(dir + "/op.log");
+    control({"checkpoint", cp});
+    l.Pump(0.5);
+    ASSERT_TRUE(fs::exists(cp)) << ReadFile(dir + "/dynamics_proc.log");
+    const auto saved = nlohmann::json::parse(ReadFile(cp));
+    EXPECT_EQ(saved["dcp"]["mode"], 3);
+    EXPECT_FALSE(saved["dcp"]["docked"].get<bool>());
+    for (int i = 0; i < 600 && !l.telemetry->docked; ++i) l.Pump(0.05);
+    ASSERT_TRUE(l.telemetry->docked);
+    // Restore: back to Mode 3, not docked; the autopilot picks the task up
+    // where the DCP now is and docks again.
+    control({"restore", cp, "--run"});
+    bool undocked = false;
+    for (int i = 0; i < 100 && !undocked; ++i) {
+      l.Pump(0.05);
+      undocked = l.telemetry && !l.telemetry->docked && l.telemetry->mode == 3;
+    }
+    EXPECT_TRUE(undocked) << "the restore did not take the DCP back to before docking";
+    for (int i = 0; i < 600 && !l.telemetry->docked; ++i) l.Pump(0.05);
+    EXPECT_TRUE(l.telemetry->docked) << ReadFile(dir + "/op.log");
+    op.Signal(SIGINT);
+    op.Wait(10);
+    ASSERT_TRUE(lab.Stop(&error)) << error;
+    EXPECT_NE(ReadFile(dir + "/dynamics_proc.log").find("restored the DCP's state"), std::string::npos);
+  }
+  // A new session from the checkpoint: it starts in Mode 3 and docks without
+  // ever acquiring.
+  const ScriptRun r = Script({SourcePath("scripts/lab"), "demo", "--no-build", "--out", dir + "/from_checkpoint", "--restore", cp,
+                        "--speed", "4", "--lcm-url", testing::UniqueLcmUrl(9600), "--png-every", "0", "--no-video",
+                        "--width", "160", "--height", "120"},
+                       dir + "/lab.log");
+  ASSERT_EQ(r.rc, 0) << r.out;
+  const auto s = nlohmann::json::parse(ReadFile(dir + "/from_checkpoint/summary.json"));
+  EXPECT_TRUE(s["docked"].get<bool>());
+  EXPECT_EQ(s["modes_seen"], nlohmann::json::array({3}));
+  EXPECT_LT(s["docking"]["time_s"].get<double>(), 30.0);
+  fs::remove_all(dir);
+}
+
+TEST(Monitor, ShowsEveryChannelsTrafficWithRates) {
+  const std::string dir = testing::MakeTempDir("monitor");
+  const std::string url = testing::UniqueLcmUrl(9700);
+  testing::LabProcesses lab(dir, url);
+  std::string error;
+  ASSERT_TRUE(lab.Start(&error)) << error;
+  Subprocess op({testing::BuildPath("operator_station/operator_station"), "--lcm-url", url, "--timeline",
+                 SourcePath("scripts/timelines/short.tl")},
+                dir + "/op.log");
+  const ScriptRun m = Script({SourcePath("scripts/lab"), "monitor", "--lcm-url", url, "--for", "2.5"}, dir + "/monitor.log", 30);
+  EXPECT_EQ(op.Wait(10), 0);
+  ASSERT_TRUE(lab.Stop(&error)) << error;
+  ASSERT_EQ(m.rc, 0) << m.out;
+  for (const char* ch : {"RMS_OPERATOR_INPUT", "RMS_DCP_FRAME", "RMS_DCP_TELEMETRY", "RMS_ESG_FRAME"}) {
+    const std::regex row(std::string(ch) + R"(\s+(\d+)\s+([\d.]+)\s+[\d.]+\s+(\d+)\s+0\s)");
+    std::smatch mm;
+    ASSERT_TRUE(std::regex_search(m.out, mm, row)) << ch << " not shown:\n" << m.out;
+    EXPECT_GT(std::stoi(mm[1]), 40) << ch;
+    EXPECT_NEAR(std::stod(mm[2]), 30.0, 3.0) << ch << " rate";
+    EXPECT_EQ(mm[3], "0") << ch << " gaps";
+  }
+  EXPECT_NE(m.out.find("dynamics_proc"), std::string::npos) << m.out;
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rms

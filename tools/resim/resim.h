@@ -1,0 +1,39 @@
+#pragma once
+// Re-simulation (docs/sessions.md "Re-simulation"): the Dynamic Collision
+// Program run again on a session's recorded operator inputs, as fast as it
+// can (no network, no wall clock: the DCP's own node over a log-backed
+// transport). With the session's configuration its outputs must be the
+// recorded ones, word for word; with another configuration it writes a new
+// session folder showing how the same inputs fare with that design, and a
+// comparison of the two.
+#include <functional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace rms::resim {
+
+struct ResimOptions {
+  std::string session;      // the recorded session folder
+  std::string config_path;  // another configuration ("" = the session's own config.toml)
+  std::string out_dir;      // where the new session goes (with a config; default SESSION-resim)
+  // Progress (0..1) with a line to show; called every few percent.
+  std::function<void(double, const std::string&)> progress;
+};
+
+struct ResimResult {
+  long frames = 0;             // DCP frames re-simulated
+  long compared = 0;           // recorded DCP frames compared
+  long identical = 0;          // ... identical word for word (and their telemetry field for field)
+  std::string first_difference;  // where they first differ ("" if nowhere)
+  double seconds = 0.0;        // wall time of the re-simulation
+  std::string out_dir;         // the new session (with another configuration)
+  nlohmann::ordered_json comparison;  // with another configuration: comparison.json
+};
+
+// Throws rms::InputError for a folder that is no session, a log that cannot
+// be re-simulated (DCP frames missing from it with their inputs ambiguous,
+// a restored checkpoint file gone), or a bad configuration.
+ResimResult Resimulate(const ResimOptions& options);
+
+}  // namespace rms::resim

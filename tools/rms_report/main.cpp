@@ -1,0 +1,29 @@
+// rms_report: a session's report as one self-contained HTML file.
+#include <CLI/CLI.hpp>
+#include <fstream>
+#include <iostream>
+
+#include "report.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"rmslab rms_report: one self-contained HTML report of a session (phases, collisions, docking, "
+               "timing, plots)"};
+  std::string session, out, chart_js = rms::report::DefaultChartJsPath();
+  app.add_option("session", session, "Session folder")->required()->check(CLI::ExistingDirectory);
+  app.add_option("--out", out, "The HTML file (default SESSION/report.html)");
+  app.add_option("--chart-js", chart_js, "Chart.js to embed")->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  try {
+    if (out.empty()) out = session + "/report.html";
+    const std::string html =
+        rms::report::MakeReport(session, chart_js, [](const std::string& line) { std::cerr << line << "\n"; });
+    std::ofstream f(out);
+    f << html;
+    if (!f) throw std::runtime_error("cannot write " + out);
+    std::cout << out << "\n";
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "rms_report: " << e.what() << "\n";
+    return 2;
+  }
+}

@@ -1,0 +1,17 @@
+#pragma once
+// The session report (docs/sessions.md "Report"): one self-contained HTML
+// file -- outcome, phase durations, collisions by kind with their times,
+// the docking miss distance and angle, frame-time and latency statistics,
+// and plots (mode timeline, distance to the goal, latency, frame intervals)
+// drawn in the browser by Chart.js (Debian's libjs-chart.js), embedded.
+#include <functional>
+#include <string>
+
+namespace rms::report {
+
+std::string DefaultChartJsPath();
+// Throws rms::InputError for an unreadable session or a missing Chart.js.
+std::string MakeReport(const std::string& session_dir, const std::string& chart_js_path,
+                       const std::function<void(const std::string&)>& progress = {});
+
+}  // namespace rms::report

@@ -1,0 +1,80 @@
+#include "lab_file.h"
+
+#include <fstream>
+#include <sstream>
+
+#include "rms/check.h"
+#include "rms/toml_reader.h"
+
+namespace rms::session {
+
+namespace {
+
+constexpr const char* kProcesses[] = {"operator_station", "dynamics_proc", "scene_proc", "esg_renderer", "recorder"};
+
+bool ValidName(const std::string& s) {
+  if (s.empty()) return false;
+  for (char c : s) {
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.' || c == '@')) return false;
+  }
+  return true;
+}
+
+std::string Quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+}  // namespace
+
+bool LabFile::all_local() const {
+  for (const auto& [p, h] : hosts) {
+    if (h != "localhost") return false;
+  }
+  return true;
+}
+
+LabFile LoadLabFile(const std::string& path) {
+  LabFile lab;
+  lab.source = path;
+  const toml::table root = ParseToml(ReadTextFile(path, "the lab file"), path);
+  const std::string doc = "docs/sessions.md";
+  TomlReader top(&root, "", &lab.source, doc);
+  {
+    TomlReader h = top.Sub("hosts");
+    for (const char* p : kProcesses) {
+      const std::string v = h.String(p);
+      const bool ok = v == "localhost" || (v.rfind("netns:", 0) == 0 && ValidName(v.substr(6))) ||
+                      (v.rfind("ssh:", 0) == 0 && ValidName(v.substr(4)));
+      if (!ok) h.Fail(p, "must be \"localhost\", \"netns:NAME\" or \"ssh:[USER@]HOST\", got \"" + v + "\"");
+      lab.hosts[p] = v;
+    }
+    h.Finish();
+  }
+  {
+    TomlReader l = top.Sub("lcm");
+    lab.ttl = static_cast<int>(l.Number("ttl", 0, 255));
+    l.Finish();
+  }
+  {
+    TomlReader r = top.Sub("remote");
+    lab.remote_root = r.String("root");
+    lab.remote_build = r.String("build");
+    r.Finish();
+  }
+  top.Finish();
+  return lab;
+}
+
+std::string LabFileShell(const LabFile& lab) {
+  std::ostringstream os;
+  for (const auto& [p, h] : lab.hosts) os << "LAB_HOST_" << p << "=" << Quote(h) << "\n";
+  os << "LAB_TTL=" << lab.ttl << "\n";
+  os << "LAB_ALL_LOCAL=" << (lab.all_local() ? 1 : 0) << "\n";
+  os << "LAB_REMOTE_ROOT=" << Quote(lab.remote_root) << "\n";
+  os << "LAB_REMOTE_BUILD=" << Quote(lab.remote_build) << "\n";
+  return os.str();
+}
+
+}  // namespace rms::session

@@ -1,0 +1,28 @@
+#pragma once
+// A lab file (docs/sessions.md "Several hosts"): which process of a session
+// runs on which host, the multicast TTL, and where rmslab is on remote
+// hosts. Read strictly, as every configuration file: errors name the file,
+// the key and the reason.
+#include <map>
+#include <string>
+
+namespace rms::session {
+
+struct LabFile {
+  std::string source;
+  // "operator_station", "dynamics_proc", "scene_proc", "esg_renderer",
+  // "recorder" (lcm-logger) -> "localhost", "netns:NAME" (a network
+  // namespace on this machine) or "ssh:[USER@]HOST".
+  std::map<std::string, std::string> hosts;
+  int ttl = 1;              // LCM multicast TTL when not all on one host
+  std::string remote_root;  // rmslab on ssh hosts ("" = the same path as here)
+  std::string remote_build; // its build folder ("" = remote_root/build)
+  bool all_local() const;
+};
+
+LabFile LoadLabFile(const std::string& path);
+// LAB_HOST_<process>=..., LAB_TTL=..., LAB_ALL_LOCAL=0|1, LAB_REMOTE_ROOT,
+// LAB_REMOTE_BUILD: shell-quoted assignments for `eval`.
+std::string LabFileShell(const LabFile& lab);
+
+}  // namespace rms::session
