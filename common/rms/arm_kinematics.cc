@@ -17,7 +17,9 @@ ArmSinCos SinCosFromDegrees(const std::array<double, 6>& angles_deg) {
 
 namespace {
 SinCos Normalized(const SinCos& a) {
-  const double n = std::hypot(a.s, a.c);
+  // The pair is near the unit circle: no overflow, so the plain root
+  // (several times cheaper than hypot).
+  const double n = std::sqrt(a.s * a.s + a.c * a.c);
   RMS_CHECK_MSG(n > 1e-6, "arm sine/cosine pair is not on the unit circle");
   return {a.s / n, a.c / n};
 }

@@ -40,7 +40,8 @@ Encoded Encode(const FixedFormat& f, double value) {
     throw InputError("cannot encode " + std::to_string(value) + " as " + Describe(f) +
                      ": not a finite number");
   }
-  const double scaled = std::ldexp(value, f.frac_bits);
+  // Times 2^frac_bits (0..23): exact, as ldexp, without the library call.
+  const double scaled = value * static_cast<double>(std::int64_t{1} << f.frac_bits);
   // Compare in double before rounding so huge values cannot overflow.
   if (scaled < static_cast<double>(f.raw_min) - 0.5) return {RawToWord(f, f.raw_min), true};
   if (scaled >= static_cast<double>(f.raw_max) + 0.5) return {RawToWord(f, f.raw_max), true};
@@ -75,7 +76,8 @@ std::int32_t DecodeRaw(const FixedFormat& f, std::int32_t carried) {
 }
 
 double Decode(const FixedFormat& f, std::int32_t carried) {
-  return std::ldexp(static_cast<double>(DecodeRaw(f, carried)), -f.frac_bits);
+  // Divided by 2^frac_bits: exact (a power of two), as ldexp.
+  return static_cast<double>(DecodeRaw(f, carried)) / static_cast<double>(std::int64_t{1} << f.frac_bits);
 }
 
 Word EncodeAngleBam(double angle_deg) {

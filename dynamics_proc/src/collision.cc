@@ -63,7 +63,7 @@ int EdgePiercesFace(const Hexahedron& P, int i, int k, LocationWord wi, Location
       ++*products;
       // T_j / (|edge| |V|) is how far the edge passes outside the bounding
       // edge (docs/collision.md); within tau it still touches.
-      if (t > tau * Q.edge_len[f][j] * dir_len) {
+      if (t > tau * e.norm() * dir_len) {
         inside = false;
         if (!cand->have) *cand = {true, apex, q0, Q.vertex(b1)};
         break;
@@ -134,34 +134,6 @@ void FindEdgePlane(const Hexahedron& a, const Hexahedron& b, const PlaneCandidat
   if (best_gap >= -tau) SetPlane(r, best_n, best_d);
 }
 
-// One vertex phase: the words of one solid's vertices against `faces`' faces.
-// Returns true when it decided (r filled in).
-bool VertexPhase(const std::array<LocationWord, 8>& words, const Hexahedron& faces, bool a_in_b,
-                 bool want_plane, CollisionResult* r) {
-  LocationWord common = kAllFaces;
-  for (int i = 0; i < kNumVertices; ++i) {
-    if (words[i] == 0) {
-      r->verdict = Verdict::kCollide;
-      r->decider = a_in_b ? Decider::kVertexOfAInB : Decider::kVertexOfBInA;
-      r->index = i;
-      return true;
-    }
-    common &= words[i];
-  }
-  if (common == 0) return false;
-  const int f = std::countr_zero(static_cast<unsigned>(common));
-  r->verdict = Verdict::kSeparate;
-  r->decider = a_in_b ? Decider::kFaceOfBSeparates : Decider::kFaceOfASeparates;
-  r->index = r->face = f;
-  // The plane's normal points from A toward B: B's outward normal reversed,
-  // or A's outward normal.
-  if (want_plane) {
-    if (a_in_b) SetPlane(r, -faces.normal(f), -faces.d[f]);
-    else SetPlane(r, faces.normal(f), faces.d[f]);
-  }
-  return true;
-}
-
 }  // namespace
 
 const std::array<FaceList, 64> kFacesOfMask = MakeFaceLists();
@@ -174,19 +146,79 @@ bool PlaneSeparates(const Hexahedron& a, const Hexahedron& b, const Eigen::Vecto
   return ahi <= d + tol && blo >= d - tol;
 }
 
+double MidGapOffset(const Hexahedron& a, const Hexahedron& b, const Eigen::Vector3d& n) {
+  double alo, ahi, blo, bhi;
+  ProjectionRange(a, n, &alo, &ahi);
+  ProjectionRange(b, n, &blo, &bhi);
+  return 0.5 * (ahi + blo);
+}
+
 CollisionResult Collide(const Hexahedron& a, const Hexahedron& b, const CollideOptions& options) {
   CollisionResult r;
   if (!a.valid || !b.valid) return r;  // kInvalid, kNonFinite
   const double tau = options.relative_tolerance * std::max(a.scale, b.scale);
 
+  if (options.sphere_reject) {
+    const double dx = b.cx - a.cx, dy = b.cy - a.cy, dz = b.cz - a.cz;
+    const double dist2 = dx * dx + dy * dy + dz * dz, reach = a.radius + b.radius + tau;
+    if (dist2 > reach * reach) {
+      r.verdict = Verdict::kSeparate;
+      r.decider = Decider::kSpheresApart;
+      if (options.want_plane) {
+        const double dist = std::sqrt(dist2);
+        const Eigen::Vector3d n(dx / dist, dy / dist, dz / dist);
+        // Midway between the spheres' surfaces along the centre line.
+        const double gap_mid = 0.5 * (dist + a.radius - b.radius);
+        SetPlane(&r, n, n.x() * a.cx + n.y() * a.cy + n.z() * a.cz + gap_mid);
+      }
+      return r;
+    }
+  }
+  if (options.hint && PlaneSeparates(a, b, options.hint->n, options.hint->d, tau)) {
+    r.verdict = Verdict::kSeparate;
+    r.decider = Decider::kHintPlane;
+    if (options.want_plane) SetPlane(&r, options.hint->n, options.hint->d);
+    return r;
+  }
+
   // 1. A's vertices against B's faces; 2. B's against A's. Either decides
   // and ends the algorithm when a word is all zeros (collision) or a face
-  // has a 1 in all eight words (separate).
-  r.words_a = b.Words(a, tau);
-  if (VertexPhase(r.words_a, b, /*a_in_b=*/true, options.want_plane, &r)) return r;
-  r.words_b = a.Words(b, tau);
-  r.words_b_valid = true;
-  if (VertexPhase(r.words_b, a, /*a_in_b=*/false, options.want_plane, &r)) return r;
+  // has a 1 in all eight words (separate). Computed face by face as masks of
+  // the eight vertices: a separating face ends the phase at once (the lowest
+  // such face, as the full words would name), a vertex beyond no face is
+  // inside; the words themselves are formed only for the edge phase.
+  auto phase = [&](const Hexahedron& faces, const Hexahedron& verts, bool a_in_b,
+                   std::array<std::uint8_t, 6>* masks) {
+    const int f = faces.FaceMasks(verts, tau, masks);
+    if (f >= 0) {
+      r.verdict = Verdict::kSeparate;
+      r.decider = a_in_b ? Decider::kFaceOfBSeparates : Decider::kFaceOfASeparates;
+      r.index = r.face = f;
+      // The plane's normal points from A toward B: B's outward normal
+      // reversed, or A's outward normal.
+      if (options.want_plane) {
+        if (a_in_b) SetPlane(&r, -faces.normal(f), -faces.d[f]);
+        else SetPlane(&r, faces.normal(f), faces.d[f]);
+      }
+      return true;
+    }
+    unsigned beyond_some = 0;
+    for (int k = 0; k < kNumFaces; ++k) beyond_some |= (*masks)[k];
+    const unsigned inside = ~beyond_some & 0xFFu;
+    if (inside) {
+      r.verdict = Verdict::kCollide;
+      r.decider = a_in_b ? Decider::kVertexOfAInB : Decider::kVertexOfBInA;
+      r.index = std::countr_zero(inside);
+      return true;
+    }
+    return false;
+  };
+  std::array<std::uint8_t, 6> masks_a{}, masks_b{};
+  if (phase(b, a, /*a_in_b=*/true, &masks_a)) return r;
+  if (phase(a, b, /*a_in_b=*/false, &masks_b)) return r;
+  r.words_a = WordsFromMasks(masks_a);
+  r.words_b = WordsFromMasks(masks_b);
+  r.words_valid = true;
 
   // 3. Potential edge collisions, both directions.
   PlaneCandidate cand;

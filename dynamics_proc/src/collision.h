@@ -15,6 +15,10 @@
 //  4. No collision: a separating plane, the report's non-negative-product
 //     plane when it really separates, else one found from the edge directions.
 //
+// Before step 1, when enabled: bounding spheres apart (by more than tau)
+// means separate, with the plane midway between the spheres; then, when a
+// hint is given, the previous frame's plane if it still separates.
+//
 // Touching counts as collision: a vertex within tau = relative_tolerance x
 // scale of a face's plane is on the FALSE side, and an edge within that
 // distance of a face's boundary pierces it (scale = the larger bounding-box
@@ -41,12 +45,29 @@ enum class Decider : std::uint8_t {
   kEdgeOfBPiercesA,    // index: the edge of B; face: the face of A
   kNoEdgePierces,      // every edge test negative: separate
   kNonFinite,          // invalid input
+  kSpheresApart,       // the bounding spheres are apart (before the report's test, when enabled)
+  kHintPlane,          // the hint plane (the previous frame's) still separates (when given)
+};
+
+// A plane n . p = d, n from A's side toward B's.
+struct SeparatingPlaneHint {
+  Eigen::Vector3d n = Eigen::Vector3d::UnitZ();
+  double d = 0.0;
 };
 
 struct CollideOptions {
   double relative_tolerance = 1e-12;  // tau = relative_tolerance x scale (docs/collision.md)
   bool want_plane = true;             // find a separating plane when separate
+  // Reject pairs whose bounding spheres are apart before the report's test
+  // (a real-time saving; the verdict is the same). Off: the report's
+  // algorithm alone, every decision by its own steps.
+  bool sphere_reject = true;
+  // Frame coherence: a plane to try first (the pair's separating plane of
+  // the previous frame); when it still separates the pair (within tau), the
+  // verdict is separate with this plane. Null: none.
+  const SeparatingPlaneHint* hint = nullptr;
 };
+
 
 struct CollisionResult {
   Verdict verdict = Verdict::kInvalid;
@@ -58,11 +79,12 @@ struct CollisionResult {
   bool plane_valid = false;
   Eigen::Vector3d n = Eigen::Vector3d::UnitZ();
   double d = 0.0;
-  // Location words: A's vertices against B's faces (always computed for a
-  // valid pair) and B's against A's (when words_b_valid).
+  // Location words: A's vertices against B's faces and B's against A's,
+  // when the vertex phases did not decide (words_valid; the edge phase uses
+  // them).
   std::array<LocationWord, 8> words_a{};
   std::array<LocationWord, 8> words_b{};
-  bool words_b_valid = false;
+  bool words_valid = false;
   // Work done, for benchmarks: triple products evaluated.
   int triple_products = 0;
 };
@@ -73,6 +95,13 @@ CollisionResult Collide(const Hexahedron& a, const Hexahedron& b, const CollideO
 // every vertex of B at or above it (n . p >= d - tol)?
 bool PlaneSeparates(const Hexahedron& a, const Hexahedron& b, const Eigen::Vector3d& n, double d,
                     double tol);
+
+// The offset d that puts the plane n . p = d midway in the gap between A
+// (below) and B (above) along n: (max over A + min over B) / 2. The DCP
+// sends its planes centred so that rounding to the 24-bit plane words
+// (docs/performance.md, word precision) leaves them separating unless the
+// gap is within a word's LSB.
+double MidGapOffset(const Hexahedron& a, const Hexahedron& b, const Eigen::Vector3d& n);
 
 // The faces (bits) of a 6-bit mask, in order: the compiled list for each
 // combination of TRUE faces. kFacesOfMask[m] holds the count and the faces.

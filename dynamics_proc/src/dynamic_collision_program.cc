@@ -38,7 +38,8 @@ std::string Names(std::uint32_t bits) {
 
 }  // namespace
 
-DynamicCollisionProgram::DynamicCollisionProgram(const LabConfig& config) : config_(config) {
+DynamicCollisionProgram::DynamicCollisionProgram(const LabConfig& config, const DcpOptions& options)
+    : config_(config), options_(options) {
   X_RP_bay_ = MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft);
   bar_bay_ = MakeBar(config.payload, X_RP_bay_);
   payload_bay_ = MakePayload(config.payload, X_RP_bay_);
@@ -61,8 +62,26 @@ double DynamicCollisionProgram::FingerGapFt(double lever) const {
   return e.finger_gap_open_ft - lever * (e.finger_gap_open_ft - e.finger_gap_closed_ft);
 }
 
-DynamicCollisionProgram::Evaluation DynamicCollisionProgram::Evaluate(const ArmCommand& cmd) const {
-  Evaluation e;
+void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* prev, Evaluation* out) const {
+  RMS_DASSERT(out != prev);
+  Evaluation& e = *out;
+  e.collisions = 0;
+  e.extra_collisions = 0;
+  e.ee_bar = {};
+  e.ee_body = {};
+  // A pair's options: sphere rejection, and its previous plane as the hint.
+  SeparatingPlaneHint hints[2][3];
+  auto opts = [&](const CollisionResult* last, SeparatingPlaneHint* hint) {
+    CollideOptions o;
+    o.relative_tolerance = tau_rel_;
+    o.sphere_reject = options_.sphere_reject;
+    if (options_.frame_coherence && prev && last->verdict == Verdict::kSeparate && last->plane_valid) {
+      hint->n = last->n;
+      hint->d = last->d;
+      o.hint = hint;
+    }
+    return o;
+  };
   e.cmd = cmd;
   e.words = TransmittedArmWords(cmd.angles_deg);
   e.pose = ComputeArmPose(config_.arm, e.words, cmd.shoulder_height_ft);
@@ -79,10 +98,18 @@ DynamicCollisionProgram::Evaluation DynamicCollisionProgram::Evaluate(const ArmC
       e.X_RP = X_RP_bay_;
       e.payload = payload_bay_;
       for (int k = 0; k < 3; ++k) {
-        e.ee_bar[k] = Collide(e.ee.hex[k], bar_bay_);
+        e.ee_bar[k] = Collide(e.ee.hex[k], bar_bay_, opts(prev ? &prev->ee_bar[k] : nullptr, &hints[0][k]));
         if (e.ee_bar[k].verdict != Verdict::kSeparate) e.collisions |= cb::kEffHexRecpt << k;
-        const CollisionResult body = Collide(e.ee.hex[k], payload_bay_.body, {.want_plane = false});
-        if (body.verdict != Verdict::kSeparate) e.collisions |= cb::kEffHexPayload << k;
+        // The body's plane is kept only as the next frame's hint.
+        e.ee_body[k] = Collide(e.ee.hex[k], payload_bay_.body, opts(prev ? &prev->ee_body[k] : nullptr, &hints[1][k]));
+        if (e.ee_body[k].verdict != Verdict::kSeparate) e.collisions |= cb::kEffHexPayload << k;
+      }
+      if (!options_.mode_pairs_only) {
+        // The pairs of Modes 2 and 3, computed and discarded.
+        CollideOptions o;
+        o.sphere_reject = options_.sphere_reject;
+        e.extra_collisions |= Collide(payload_bay_.body, bay_, o).verdict != Verdict::kSeparate;
+        e.extra_collisions |= Collide(payload_bay_.body, cae_, o).verdict != Verdict::kSeparate;
       }
       break;
     }
@@ -114,11 +141,25 @@ DynamicCollisionProgram::Evaluation DynamicCollisionProgram::Evaluate(const ArmC
       break;
     }
   }
-  return e;
+  if (!options_.mode_pairs_only && status_.mode >= 2) {
+    // Every other pair, computed and discarded: the end effector against the
+    // BAR and the payload where they are now, the payload against the bay
+    // and the CAE as whole hexahedra.
+    CollideOptions o;
+    o.sphere_reject = options_.sphere_reject;
+    const EndEffectorModel ee = MakeEndEffector(config_.end_effector, e.pose.X_RS2, e.finger_gap_ft);
+    const Hexahedron bar = MakeBar(config_.payload, e.X_RP);
+    for (int k = 0; k < 3; ++k) {
+      e.extra_collisions |= Collide(ee.hex[k], bar, o).verdict != Verdict::kSeparate;
+      e.extra_collisions |= Collide(ee.hex[k], e.payload.body, o).verdict != Verdict::kSeparate;
+    }
+    e.extra_collisions |= Collide(e.payload.body, bay_, o).verdict != Verdict::kSeparate;
+    e.extra_collisions |= Collide(e.payload.body, cae_, o).verdict != Verdict::kSeparate;
+  }
 }
 
-void DynamicCollisionProgram::Accept(const Evaluation& e) {
-  slave_ = e;
+void DynamicCollisionProgram::AcceptSpare() {
+  std::swap(slave_, spare_);
   have_slave_ = true;
 }
 
@@ -139,53 +180,56 @@ DcpFrameData DynamicCollisionProgram::Step(const OperatorInputs& in) {
   // its pose and only the finger moves, until opening the finger releases it.
   ArmCommand command = master;
   if (status_.docked && !released_ && have_slave_) {
-    if (slave_.finger_gap_ft >= acquisition_gap_ft_ + kReleaseOpeningFt) {
+    if (slave_->finger_gap_ft >= acquisition_gap_ft_ + kReleaseOpeningFt) {
       released_ = true;
       spdlog::info("released: the finger let go of the docked payload; the arm is free");
     } else {
-      command.angles_deg = slave_.cmd.angles_deg;
-      command.shoulder_height_ft = slave_.cmd.shoulder_height_ft;
+      command.angles_deg = slave_->cmd.angles_deg;
+      command.shoulder_height_ft = slave_->cmd.shoulder_height_ft;
     }
   }
-  const Evaluation cand = Evaluate(command);
-  status_.collisions = cand.collisions;
+  Evaluate(command, have_slave_ ? slave_ : nullptr, spare_);
+  const std::uint32_t collisions = spare_->collisions;
+  status_.collisions = collisions;
   if (!have_slave_) {
     // The first frame after start or reset: the slave takes the command.
-    Accept(cand);
-    if (cand.collisions) spdlog::warn("starting in collision: {}", Names(cand.collisions));
-  } else if (cand.collisions == 0) {
-    Accept(cand);
+    AcceptSpare();
+    if (collisions) spdlog::warn("starting in collision: {}", Names(collisions));
+  } else if (collisions == 0) {
+    AcceptSpare();
   } else {
     bool moved = false;
-    if (status_.mode == 1 && master.finger != slave_.cmd.finger) {
+    if (status_.mode == 1 && master.finger != slave_->cmd.finger) {
       // The finger is what collides: let the arm follow and hold the finger.
       ArmCommand arm_only = master;
-      arm_only.finger = slave_.cmd.finger;
-      const Evaluation e2 = Evaluate(arm_only);
-      if (e2.collisions == 0) {
-        Accept(e2);
+      arm_only.finger = slave_->cmd.finger;
+      Evaluate(arm_only, slave_, spare_);
+      if (spare_->collisions == 0) {
+        AcceptSpare();
         status_.finger_held = true;
         moved = true;
       }
     }
     status_.held = !moved;
   }
-  status_.slave_collisions = slave_.collisions;
-  status_.slave = slave_.cmd;
-  status_.X_RS2 = slave_.pose.X_RS2;
-  status_.X_RP = slave_.X_RP;
-  status_.finger_gap_ft = slave_.finger_gap_ft;
+  status_.slave_collisions = slave_->collisions;
+  status_.slave = slave_->cmd;
+  status_.X_RS2 = slave_->pose.X_RS2;
+  status_.X_RP = slave_->X_RP;
+  status_.finger_gap_ft = slave_->finger_gap_ft;
 
   // The three dynamic separating planes, EFF HEX 1-3 against the BAR (Mode 1).
   // A plane not valid this frame is sent as the default (n = Z, d = 0), so
-  // the words depend on this frame's state alone.
+  // its words do not depend on earlier frames (a valid plane may, through
+  // frame coherence; the checkpoint keeps the planes).
   status_.plane_valid = 0;
   status_.planes = {};
   if (status_.mode == 1) {
     for (int k = 0; k < 3; ++k) {
-      const CollisionResult& r = slave_.ee_bar[k];
+      const CollisionResult& r = slave_->ee_bar[k];
       if (r.verdict == Verdict::kSeparate && r.plane_valid) {
-        status_.planes[k] = {r.n, r.d};
+        // Centred in the gap, to survive rounding to the plane words.
+        status_.planes[k] = {r.n, MidGapOffset(slave_->ee.hex[k], bar_bay_, r.n)};
         status_.plane_valid |= 1u << k;
       }
     }
@@ -197,7 +241,7 @@ DcpFrameData DynamicCollisionProgram::Step(const OperatorInputs& in) {
   else if (mode_before == 2) UpdateExtraction();
 
   DcpFrameData out;
-  out.arm = slave_.words;
+  out.arm = slave_->words;
   out.control.camera_station = in.camera_station;
   out.control.reset = in.reset;
   out.control.overlay = in.overlay;
@@ -206,8 +250,8 @@ DcpFrameData DynamicCollisionProgram::Step(const OperatorInputs& in) {
   out.control.receptacle_collision = (status_.collisions & collision_bits::kRecptMask) != 0;
   out.control.acquired = status_.acquired;
   out.control.docked = status_.docked;
-  out.shoulder_height_ft = slave_.cmd.shoulder_height_ft;
-  out.finger_gap_ft = slave_.finger_gap_ft;
+  out.shoulder_height_ft = slave_->cmd.shoulder_height_ft;
+  out.finger_gap_ft = slave_->finger_gap_ft;
   out.camera_pan_deg = in.value[kCameraPan];
   out.camera_tilt_deg = in.value[kCameraTilt];
   out.camera_zoom = in.value[kCameraZoom];
@@ -265,22 +309,22 @@ DockingCheck CheckDocking(const DcpConfig& dcp, const CaeConfig& cae, const Hexa
 void DynamicCollisionProgram::UpdateAcquisition() {
   // Report IV.A.3: the six conditions, on the slave's (collision-free) pose.
   const AcquisitionCheck c =
-      CheckAcquisition(config_.dcp, slave_.ee, bar_bay_, slave_.finger_gap_ft, tau_rel_);
+      CheckAcquisition(config_.dcp, slave_->ee, bar_bay_, slave_->finger_gap_ft, tau_rel_);
   status_.acquisition = c.holds;
   status_.palm_to_bar_ft = c.palm_to_bar_ft;
   if (c.all()) {
     status_.mode = 2;
     status_.acquired = true;
-    X_S2P_ = slave_.pose.X_RS2.inverse() * X_RP_bay_;
+    X_S2P_ = slave_->pose.X_RS2.inverse() * X_RP_bay_;
     // The gap at which face e of EFF HEX 3 would touch the bar: from face b
     // of EFF HEX 2 (at Y2 = W - t) to the bar's nearest vertex along -Y2.
     const Hexahedron& bar = bar_bay_;
     double y_min = 1e30;
     for (int i = 0; i < kNumVertices; ++i) {
-      y_min = std::min(y_min, slave_.pose.X_RS2.linear().col(1).dot(bar.vertex(i) - slave_.pose.X_RS2.translation()));
+      y_min = std::min(y_min, slave_->pose.X_RS2.linear().col(1).dot(bar.vertex(i) - slave_->pose.X_RS2.translation()));
     }
     const auto& ee = config_.end_effector;
-    acquisition_gap_ft_ = slave_.finger_gap_ft;
+    acquisition_gap_ft_ = slave_->finger_gap_ft;
     contact_gap_ft_ = std::clamp(ee.palm_half_width_ft - ee.finger_thickness_ft - y_min + kFingerContactClearanceFt,
                                  0.0, acquisition_gap_ft_);
     spdlog::info("acquisition: Mode 1 -> Mode 2 (finger gap {:.3f} ft, palm to bar {:.3f} ft)",
@@ -291,7 +335,7 @@ void DynamicCollisionProgram::UpdateAcquisition() {
 void DynamicCollisionProgram::UpdateExtraction() {
   // Report IV.A.3: all payload and probe vertices above the bay's face c.
   const double tau = tau_rel_ * bay_.scale;
-  for (const Eigen::Vector3d& v : slave_.payload.v) {
+  for (const Eigen::Vector3d& v : slave_->payload.v) {
     if (!(bay_.Word(v, tau) & FaceBit(kFaceC))) return;
   }
   status_.mode = 3;
@@ -299,13 +343,13 @@ void DynamicCollisionProgram::UpdateExtraction() {
 }
 
 void DynamicCollisionProgram::UpdateDocking() {
-  const DockingCheck d = CheckDocking(config_.dcp, config_.cae, cae_, slave_.payload, tau_rel_);
+  const DockingCheck d = CheckDocking(config_.dcp, config_.cae, cae_, slave_->payload, tau_rel_);
   status_.probe_in_envelope = d.in_envelope;
   status_.dock_distance_ft = d.distance_ft;
   status_.dock_angle_deg = d.angle_deg;
   if (status_.mode == 3 && !status_.docked && d.docked) {
     status_.docked = true;
-    X_RP_docked_ = slave_.X_RP;
+    X_RP_docked_ = slave_->X_RP;
     spdlog::info("docked: distance {:.3f} ft, angle {:.3f} deg", d.distance_ft, d.angle_deg);
   }
 }
@@ -343,6 +387,22 @@ ArmCommand CommandFrom(const nlohmann::json& j) {
 
 constexpr const char* kCheckpointFormat = "rmslab-dcp-state-1";
 
+// A pair's separating plane (frame coherence's hint): [nx, ny, nz, d], or
+// null when the pair had none.
+nlohmann::json PlaneJson(const CollisionResult& r) {
+  if (r.verdict != Verdict::kSeparate || !r.plane_valid) return nullptr;
+  return {r.n.x(), r.n.y(), r.n.z(), r.d};
+}
+
+void PlaneFrom(const nlohmann::json& j, CollisionResult* r) {
+  if (j.is_null()) return;
+  if (!j.is_array() || j.size() != 4) throw InputError("checkpoint: a plane must be null or 4 numbers");
+  r->verdict = Verdict::kSeparate;
+  r->plane_valid = true;
+  r->n = Eigen::Vector3d(j[0].get<double>(), j[1].get<double>(), j[2].get<double>());
+  r->d = j[3].get<double>();
+}
+
 }  // namespace
 
 nlohmann::ordered_json DynamicCollisionProgram::SaveState() const {
@@ -353,13 +413,21 @@ nlohmann::ordered_json DynamicCollisionProgram::SaveState() const {
   j["docked"] = status_.docked;
   j["released"] = released_;
   j["have_slave"] = have_slave_;
-  j["slave"] = CommandJson(slave_.cmd);
-  j["slave_collisions"] = slave_.collisions;
+  j["slave"] = CommandJson(slave_->cmd);
+  j["slave_collisions"] = slave_->collisions;
   j["master"] = CommandJson(status_.master);
   j["X_S2P"] = PoseJson(X_S2P_);
   j["X_RP_docked"] = PoseJson(X_RP_docked_);
   j["contact_gap_ft"] = contact_gap_ft_;
   j["acquisition_gap_ft"] = acquisition_gap_ft_;
+  // The slave's separating planes, the next frame's hints (frame coherence).
+  nlohmann::json bar = nlohmann::json::array(), body = nlohmann::json::array();
+  for (int k = 0; k < 3; ++k) {
+    bar.push_back(PlaneJson(slave_->ee_bar[k]));
+    body.push_back(PlaneJson(slave_->ee_body[k]));
+  }
+  j["planes_ee_bar"] = bar;
+  j["planes_ee_body"] = body;
   return j;
 }
 
@@ -383,12 +451,20 @@ void DynamicCollisionProgram::RestoreState(const nlohmann::json& j) {
     have_slave_ = j.at("have_slave").get<bool>();
     if (have_slave_) {
       // The slave's evaluation follows from its command and the state above.
-      slave_ = Evaluate(CommandFrom(j.at("slave")));
-      slave_.collisions = j.at("slave_collisions").get<std::uint32_t>();
-      status_.slave = slave_.cmd;
-      status_.X_RS2 = slave_.pose.X_RS2;
-      status_.X_RP = slave_.X_RP;
-      status_.finger_gap_ft = slave_.finger_gap_ft;
+      // The saved planes are the hints, as they were for the saved frame.
+      Evaluation prev;
+      if (j.contains("planes_ee_bar")) {
+        for (int k = 0; k < 3; ++k) {
+          PlaneFrom(j.at("planes_ee_bar").at(k), &prev.ee_bar[k]);
+          PlaneFrom(j.at("planes_ee_body").at(k), &prev.ee_body[k]);
+        }
+      }
+      Evaluate(CommandFrom(j.at("slave")), &prev, slave_);
+      slave_->collisions = j.at("slave_collisions").get<std::uint32_t>();
+      status_.slave = slave_->cmd;
+      status_.X_RS2 = slave_->pose.X_RS2;
+      status_.X_RP = slave_->X_RP;
+      status_.finger_gap_ft = slave_->finger_gap_ft;
     } else {
       status_.X_RP = X_RP_bay_;
     }

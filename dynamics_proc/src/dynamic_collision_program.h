@@ -105,9 +105,26 @@ struct DcpStatus {
   Eigen::Isometry3d X_RP = Eigen::Isometry3d::Identity();
 };
 
+// What a real-time frame may skip; none of it changes a verdict, a mode or
+// a control word (docs/performance.md "The DCP's whole frame" measures each
+// saving; the planes sent may differ, each one still separating its pair).
+struct DcpOptions {
+  // Test only the active mode's pairs (report IV.A.3). False: every model
+  // pair every frame, for comparison (end effector against the BAR and the
+  // payload, the payload against the bay and the CAE).
+  bool mode_pairs_only = true;
+  // Bounding-sphere rejection before the report's algorithm.
+  bool sphere_reject = true;
+  // Frame coherence: the previous frame's separating plane of each pair is
+  // tried first (it is part of the checkpoint).
+  bool frame_coherence = true;
+};
+
 class DynamicCollisionProgram {
  public:
-  explicit DynamicCollisionProgram(const LabConfig& config);
+  explicit DynamicCollisionProgram(const LabConfig& config, const DcpOptions& options = {});
+  DynamicCollisionProgram(const DynamicCollisionProgram&) = delete;  // holds pointers into itself
+  DynamicCollisionProgram& operator=(const DynamicCollisionProgram&) = delete;
 
   // One frame. The returned block's frame / time fields are the caller's.
   DcpFrameData Step(const OperatorInputs& in);
@@ -128,7 +145,7 @@ class DynamicCollisionProgram {
 
   int mode() const { return status_.mode; }
   const DcpStatus& status() const { return status_; }
-  const ArmPose& arm_pose() const { return slave_.pose; }
+  const ArmPose& arm_pose() const { return slave_->pose; }
   const Eigen::Isometry3d& X_RP() const { return status_.X_RP; }
   double FingerGapFt(double lever) const;
 
@@ -139,18 +156,25 @@ class DynamicCollisionProgram {
     ArmPose pose{};
     double finger_gap_ft = 0.0;
     EndEffectorModel ee{};
-    std::array<CollisionResult, 3> ee_bar{};
+    std::array<CollisionResult, 3> ee_bar{};   // EFF HEX k against the BAR (Mode 1)
+    std::array<CollisionResult, 3> ee_body{};  // EFF HEX k against the payload's body (Mode 1)
+    std::uint32_t extra_collisions = 0;        // pairs outside the mode (mode_pairs_only false); unused
     Eigen::Isometry3d X_RP = Eigen::Isometry3d::Identity();
     PayloadModel payload{};
     std::uint32_t collisions = 0;
   };
-  Evaluation Evaluate(const ArmCommand& cmd) const;
-  void Accept(const Evaluation& e);
+  // Into *e (not prev). prev: the last accepted evaluation, whose planes are
+  // the hints (frame coherence); null: none. e->ee is left as it was outside
+  // Mode 1 (only Mode 1 reads it).
+  void Evaluate(const ArmCommand& cmd, const Evaluation* prev, Evaluation* e) const;
+  // The spare evaluation becomes the slave's (two buffers, no copy).
+  void AcceptSpare();
   void UpdateAcquisition();
   void UpdateExtraction();
   void UpdateDocking();
 
   const LabConfig& config_;
+  DcpOptions options_;
   double tau_rel_ = 1e-12;
   // Fixed models: the payload in the bay (Mode 1), the bay, the CAE.
   Eigen::Isometry3d X_RP_bay_;
@@ -160,7 +184,9 @@ class DynamicCollisionProgram {
   Hexahedron cae_;
   // State.
   bool have_slave_ = false;
-  Evaluation slave_;
+  std::array<Evaluation, 2> evaluations_;
+  Evaluation* slave_ = &evaluations_[0];  // the slave's (collision-free) evaluation
+  Evaluation* spare_ = &evaluations_[1];  // this frame's candidate
   Eigen::Isometry3d X_S2P_ = Eigen::Isometry3d::Identity();       // payload in System Two, from acquisition
   // Once acquired, the finger holds the bar: its gap stays between the gap at
   // which it touches the bar and the gap at acquisition.

@@ -22,6 +22,8 @@ const char* DeciderName(dcp::Decider d) {
     case dcp::Decider::kEdgeOfBPiercesA: return "edge of B pierces A";
     case dcp::Decider::kNoEdgePierces: return "no edge pierces";
     case dcp::Decider::kNonFinite: return "invalid";
+    case dcp::Decider::kSpheresApart: return "bounding spheres apart";
+    case dcp::Decider::kHintPlane: return "previous plane separates";
   }
   return "?";
 }

@@ -67,7 +67,17 @@ TEST(Collide, VertexInsideAndFaceSeparation) {
   EXPECT_EQ(r.index, 6);  // v7 = (1, 1, 1) is inside b
 
   const Hexahedron c = AxisBox(Vector3d(3, 0, 0), Vector3d(4, 1, 1));
-  const CollisionResult s = Collide(a, c);
+  // With bounding-sphere rejection (the default) the spheres decide first,
+  // with a plane that still separates.
+  const CollisionResult fast = Collide(a, c);
+  EXPECT_EQ(fast.verdict, Verdict::kSeparate);
+  EXPECT_EQ(fast.decider, Decider::kSpheresApart);
+  ASSERT_TRUE(fast.plane_valid);
+  EXPECT_TRUE(PlaneSeparates(a, c, fast.n, fast.d, 0.0));
+  // The report's algorithm alone names c's face a.
+  CollideOptions report_only;
+  report_only.sphere_reject = false;
+  const CollisionResult s = Collide(a, c, report_only);
   EXPECT_EQ(s.verdict, Verdict::kSeparate);
   EXPECT_EQ(s.decider, Decider::kFaceOfBSeparates);
   EXPECT_EQ(s.face, kFaceA);  // all of a lies beyond c's face a (x = 3)

@@ -10,7 +10,7 @@
 namespace rms::offline {
 
 ClosedLoopResult FlyAutopilot(const LabConfig& config, const op::AutopilotOptions& options, int max_frames,
-                              int latency_frames) {
+                              int latency_frames, std::vector<OperatorInputs>* inputs) {
   ClosedLoopResult r;
   op::Autopilot pilot(config, options);
   dcp::DynamicCollisionProgram program(config);
@@ -20,6 +20,7 @@ ClosedLoopResult FlyAutopilot(const LabConfig& config, const op::AutopilotOption
     const OperatorInputs in = pilot.Step(seen ? &*seen : nullptr);
     const auto words = EncodeInputs(in, config.inputs, &r.dcp);
     const OperatorInputs decoded = DecodeInputs(words, config.inputs, &r.dcp);
+    if (inputs) inputs->push_back(decoded);
     DcpFrameData out = program.Step(decoded);
     out.frame = f;
     out.input_frame = f;

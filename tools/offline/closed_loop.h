@@ -6,6 +6,7 @@
 // the station reads the telemetry before it sends the next block).
 // Deterministic; for tests and for checking a configuration before a session.
 #include <string>
+#include <vector>
 
 #include "autopilot.h"
 #include "rms/config.h"
@@ -28,7 +29,9 @@ struct ClosedLoopResult {
   Counters dcp;                 // what the DCP counted (clamped inputs...)
 };
 
+// inputs: when given, receives each frame's operator inputs as the DCP
+// decoded them (for benchmarks that replay the flight).
 ClosedLoopResult FlyAutopilot(const LabConfig& config, const op::AutopilotOptions& options, int max_frames,
-                              int latency_frames = 1);
+                              int latency_frames = 1, std::vector<OperatorInputs>* inputs = nullptr);
 
 }  // namespace rms::offline

@@ -322,6 +322,7 @@ ResimResult Resimulate(const ResimOptions& opt) {
   progress(0.0, "reading " + (session / "lcmlog").string());
   const Recording rec = ReadRecording(session / "lcmlog");
   const std::vector<std::int64_t> seq = InputSequence(rec);
+  const auto t_read = std::chrono::steady_clock::now();
 
   ResimResult result;
   std::string out_log;
@@ -349,6 +350,7 @@ ResimResult Resimulate(const ResimOptions& opt) {
       if (SafeDecode(d, n, 4096, &m) == DecodeError::kNone) telemetry[m.frame] = m;
     });
     std::size_t next_control = 0;
+    const auto t_run = std::chrono::steady_clock::now();
     for (std::size_t k = 0; k < seq.size(); ++k) {
       // Restores the live DCP applied before this frame (checkpoints it
       // saved and freezes change nothing here).
@@ -369,6 +371,7 @@ ResimResult Resimulate(const ResimOptions& opt) {
         progress(static_cast<double>(k) / seq.size(), std::to_string(k) + " of " + std::to_string(seq.size()) + " frames");
       }
     }
+    result.run_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_run).count();
     result.frames = static_cast<long>(frames.size());
     if (other_design) {
       WriteStatsJson((fs::path(result.out_dir) / "stats" / "dynamics_proc.json").string(), "dynamics_proc",
@@ -394,6 +397,11 @@ ResimResult Resimulate(const ResimOptions& opt) {
     else if (result.first_difference.empty()) result.first_difference = "DCP frame " + std::to_string(r.frame) + ": " + what;
   }
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  result.read_seconds = std::chrono::duration<double>(t_read - t0).count();
+  if (!rec.inputs.empty()) {
+    result.recorded_seconds =
+        (rec.inputs.rbegin()->second.timestamp_us - rec.inputs.begin()->second.timestamp_us) / 1e6;
+  }
 
   if (other_design) {
     const fs::path out(result.out_dir);

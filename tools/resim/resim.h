@@ -26,7 +26,10 @@ struct ResimResult {
   long compared = 0;           // recorded DCP frames compared
   long identical = 0;          // ... identical word for word (and their telemetry field for field)
   std::string first_difference;  // where they first differ ("" if nowhere)
-  double seconds = 0.0;        // wall time of the re-simulation
+  double seconds = 0.0;        // wall time of the re-simulation, all of it
+  double read_seconds = 0.0;   // of which reading and decoding the session's log
+  double run_seconds = 0.0;    // of which the DCP over its LCM interface, frame by frame
+  double recorded_seconds = 0.0;  // the session's own duration (first to last input frame)
   std::string out_dir;         // the new session (with another configuration)
   nlohmann::ordered_json comparison;  // with another configuration: comparison.json
 };
