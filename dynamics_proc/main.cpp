@@ -12,9 +12,13 @@ int main(int argc, char** argv) {
   rms::CommonOptions common;
   std::string restore;
   app.add_option("--restore", restore, "Start from this checkpoint (docs/sessions.md)")->check(CLI::ExistingFile);
+  std::string state_file;
+  app.add_option("--state-file", state_file,
+                 "Keep the DCP's state in this file and, when it exists at start, resume from it instead of "
+                 "Mode 1 (the launcher's restart after a fault; docs/sessions.md \"Faults\")");
   return rms::ProcessMain(app, argc, argv, "dynamics_proc", &common,
                           [&](const rms::LabConfig& config, rms::LcmInterface& lcm) {
                             return rms::dcp::RunDynamicsProc(config, lcm, common.stats_path,
-                                                             common.ready_path, restore);
+                                                             common.ready_path, restore, state_file);
                           });
 }

@@ -1,6 +1,7 @@
 #include "rms/checkpoint.h"
 
 #include <fstream>
+#include <iterator>
 
 #include "rms/check.h"
 
@@ -31,9 +32,14 @@ void WriteCheckpoint(const std::string& path, const Checkpoint& c) {
 Checkpoint ReadCheckpoint(const std::string& path) {
   std::ifstream f(path);
   if (!f) throw InputError("cannot read checkpoint '" + path + "'");
+  const std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  return ParseCheckpoint(text, path);
+}
+
+Checkpoint ParseCheckpoint(std::string_view text, const std::string& path) {
   nlohmann::json j;
   try {
-    j = nlohmann::json::parse(f);
+    j = nlohmann::json::parse(text);
   } catch (const std::exception& e) {
     throw InputError("checkpoint '" + path + "' is not JSON: " + e.what());
   }

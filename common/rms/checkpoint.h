@@ -6,6 +6,7 @@
 // from where the arm is). JSON, doubles exact.
 #include <cstdint>
 #include <string>
+#include <string_view>
 
 #include <nlohmann/json.hpp>
 
@@ -25,5 +26,7 @@ struct Checkpoint {
 // Throw rms::InputError naming the file and what is wrong.
 void WriteCheckpoint(const std::string& path, const Checkpoint& c);
 Checkpoint ReadCheckpoint(const std::string& path);
+// The same from the file's text (path names it in errors).
+Checkpoint ParseCheckpoint(std::string_view text, const std::string& path);
 
 }  // namespace rms

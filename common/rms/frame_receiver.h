@@ -43,6 +43,21 @@ auto ReceiveFrame(const void* data, int size, int max_size, SequenceTracker* seq
     counters->Add(std::string("dropped.") + DecodeErrorName(err));
     return std::nullopt;
   }
+  // Frame numbers and send times a real sender cannot produce (negative, or
+  // beyond 2^48 frames, times outside [0, 2^62) us): dropped before any arithmetic on them.
+  constexpr std::int64_t kMaxFrame = std::int64_t{1} << 48, kMaxTimeUs = std::int64_t{1} << 62;
+  if (msg.frame < 0 || msg.frame >= kMaxFrame) {
+    counters->Add("dropped.bad_frame");
+    return std::nullopt;
+  }
+  bool times_ok = msg.send_time_us >= 0 && msg.send_time_us < kMaxTimeUs;
+  if constexpr (requires { msg.input_send_time_us; }) {
+    times_ok = times_ok && msg.input_send_time_us >= 0 && msg.input_send_time_us < kMaxTimeUs;
+  }
+  if (!times_ok) {
+    counters->Add("dropped.bad_time");
+    return std::nullopt;
+  }
   std::optional<Content> content;
   try {
     content.emplace(unpack(msg));

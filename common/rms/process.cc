@@ -1,5 +1,7 @@
 #include "rms/process.h"
 
+#include <cstdlib>
+
 #include <CLI/CLI.hpp>
 #include <csignal>
 #include <fstream>
@@ -169,6 +171,19 @@ void WriteStatsJson(const std::string& path, const std::string& process, const C
   std::ofstream f(path);
   if (!f) throw InputError("cannot write stats file '" + path + "'");
   f << j.dump(2) << "\n";
+}
+
+std::int64_t FirstFrameNumber(double rate_hz) {
+  const char* v = std::getenv("RMSLAB_SESSION_EPOCH_US");
+  if (!v || !*v) return 0;
+  char* end = nullptr;
+  const long long epoch = std::strtoll(v, &end, 10);
+  if (*end != '\0' || epoch <= 0) {
+    throw InputError(std::string("RMSLAB_SESSION_EPOCH_US='") + v + "': not a time in us since 1970");
+  }
+  const std::int64_t now = WallTimeUs();
+  if (now <= epoch) return 0;
+  return static_cast<std::int64_t>((now - epoch) * 1e-6 * rate_hz);
 }
 
 }  // namespace rms

@@ -43,6 +43,14 @@ int ProcessMain(CLI::App& app, int argc, char** argv, const std::string& process
 void SetUpLogging(const std::string& process, const std::string& level);
 
 // SIGINT / SIGTERM set the stop flag; the main loops poll it.
+// The first frame number a process uses for what it publishes
+// (docs/protocol.md "Frame numbers"): 0, or -- when the launcher set
+// RMSLAB_SESSION_EPOCH_US (the session's start, wall clock, us since 1970) --
+// the frames of rate_hz since then, so a process restarted mid-session
+// continues the numbering and its peers see the frames it missed as a gap,
+// not as stale. A malformed value is an InputError naming the variable.
+std::int64_t FirstFrameNumber(double rate_hz);
+
 void InstallStopHandlers();
 bool StopRequested();
 void RequestStop();

@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <filesystem>
+
 #include "rms/channels.h"
 #include "rms/check.h"
 #include "rms/dcp_frame_t.hpp"
@@ -47,6 +49,37 @@ void DcpNode::RestoreCheckpoint(const std::string& path) {
   }
   spdlog::info("restored the DCP's state from {} (saved at DCP frame {}): Mode {}{}{}", path, c.dcp_frame,
                dcp_.status().mode, dcp_.status().acquired ? ", acquired" : "", dcp_.status().docked ? ", docked" : "");
+}
+
+bool DcpNode::ResumeFromStateFile() {
+  if (state_file_.empty() || !std::filesystem::exists(state_file_)) return false;
+  const Checkpoint c = ReadCheckpoint(state_file_);
+  try {
+    dcp_.RestoreState(c.dcp);
+  } catch (const std::exception& e) {
+    throw InputError("state file '" + state_file_ + "': " + e.what());
+  }
+  next_frame_ = std::max(next_frame_, c.dcp_frame + 1);
+  last_inputs_ = c.inputs;
+  counters_.Add("resumed");
+  spdlog::warn("resumed from the last state written ({}, DCP frame {}): Mode {}{}{}", state_file_, c.dcp_frame,
+               dcp_.status().mode, dcp_.status().acquired ? ", payload attached" : "",
+               dcp_.status().docked ? ", docked" : "");
+  return true;
+}
+
+void DcpNode::WriteStateFile() {
+  if (state_file_.empty()) return;
+  const std::string tmp = state_file_ + ".tmp";
+  try {
+    SaveCheckpoint(tmp);
+    std::filesystem::rename(tmp, state_file_);
+    counters_.Add("state_file.writes");
+  } catch (const std::exception& e) {
+    counters_.Add("state_file.errors");
+    spdlog::error("cannot write the state file: {}", e.what());
+  }
+  state_written_us_ = lcm_->NowUs();
 }
 
 void DcpNode::OnControl(const void* data, int size) {
@@ -97,6 +130,15 @@ void DcpNode::OnInput(const void* data, int size, std::int64_t recv_time_us) {
   const dcp_telemetry_t tm = MakeTelemetry(dcp_.status(), out);
   if (!PublishMessage(*lcm_, channels::kDcpTelemetry, tm)) counters_.Add("publish_failed");
   Report(dcp_.status(), out.frame);
+  if (!state_file_.empty()) {
+    const DcpStatus& st = dcp_.status();
+    const std::uint32_t key = static_cast<std::uint32_t>(st.mode) | (st.acquired << 4) | (st.docked << 5) |
+                              (dcp_.released() << 6);
+    if (key != state_key_ || out.send_time_us - state_written_us_ >= 500000) {
+      state_key_ = key;
+      WriteStateFile();
+    }
+  }
 }
 
 void DcpNode::Report(const DcpStatus& st, std::int64_t frame) {
@@ -167,14 +209,19 @@ dcp_telemetry_t MakeTelemetry(const DcpStatus& st, const DcpFrameData& out) {
 }
 
 int RunDynamicsProc(const LabConfig& config, LcmInterface& lcm, const std::string& stats_path,
-                    const std::string& ready_path, const std::string& restore_path) {
+                    const std::string& ready_path, const std::string& restore_path,
+                    const std::string& state_file) {
   DcpNode node(config, &lcm);
-  if (!restore_path.empty()) node.RestoreCheckpoint(restore_path);
+  node.set_next_frame(FirstFrameNumber(config.session.frame_rate_hz));
+  node.set_state_file(state_file);
+  const bool resumed = node.ResumeFromStateFile();
+  if (!restore_path.empty() && !resumed) node.RestoreCheckpoint(restore_path);
   if (!ready_path.empty()) TouchFile(ready_path);
   spdlog::info("ready: {} -> {}", lcm.FullChannel(channels::kOperatorInput),
                lcm.FullChannel(channels::kDcpFrame));
   RunNodeLoop(lcm, "dynamics_proc", node.counters(), node.latencies(),
               [&] { return node.last_frame(); }, nullptr, stats_path);
+  node.WriteStateFile();
   spdlog::info("published {} DCP frames; inputs missing {}, late {}, dropped {}; final mode {}",
                node.counters().Get("published"), node.counters().Get("input.missing"),
                node.counters().Get("frames.late"), node.counters().SumPrefix("dropped."), node.program().mode());

@@ -33,6 +33,19 @@ class DcpNode {
   // a bad one is counted and logged, never fatal.
   void OnControl(const void* data, int size);
 
+  // Process faults (docs/sessions.md "Faults"): with a state file, the node
+  // writes its checkpoint there (atomically: a temporary file renamed) when
+  // the mode, acquisition, docking or release changes and at least every
+  // 0.5 s, and at exit; ResumeFromStateFile() restores it at start, so a
+  // dynamics_proc restarted by the launcher goes on from its last state
+  // (mode, payload attached, poses), not from Mode 1. Returns false when
+  // there is no file yet; throws InputError for a bad one.
+  void set_state_file(std::string path) { state_file_ = std::move(path); }
+  bool ResumeFromStateFile();
+  void WriteStateFile();
+  // The first DCP frame number to publish (FirstFrameNumber).
+  void set_next_frame(std::int64_t f) { next_frame_ = f; }
+
  private:
   void Report(const DcpStatus& status, std::int64_t frame);
   const LabConfig& config_;
@@ -46,6 +59,9 @@ class DcpNode {
   OperatorInputs last_inputs_{};
   int last_mode_ = 0;
   std::uint32_t last_collisions_ = 0;
+  std::string state_file_;
+  std::int64_t state_written_us_ = 0;
+  std::uint32_t state_key_ = 0;  // mode, acquired, docked, released: a change writes at once
 };
 
 // The telemetry message for a frame (docs/protocol.md "RMS_DCP_TELEMETRY").
@@ -54,7 +70,8 @@ dcp_telemetry_t MakeTelemetry(const DcpStatus& status, const DcpFrameData& frame
 // Main loop until SIGINT / SIGTERM. Returns the exit code.
 // restore_path: a checkpoint to start from ("" for the initial state).
 int RunDynamicsProc(const LabConfig& config, LcmInterface& lcm, const std::string& stats_path,
-                    const std::string& ready_path, const std::string& restore_path = "");
+                    const std::string& ready_path, const std::string& restore_path,
+                    const std::string& state_file = "");
 
 
 }  // namespace rms::dcp

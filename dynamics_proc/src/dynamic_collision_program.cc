@@ -100,8 +100,10 @@ void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* 
       for (int k = 0; k < 3; ++k) {
         e.ee_bar[k] = Collide(e.ee.hex[k], bar_bay_, opts(prev ? &prev->ee_bar[k] : nullptr, &hints[0][k]));
         if (e.ee_bar[k].verdict != Verdict::kSeparate) e.collisions |= cb::kEffHexRecpt << k;
-        // The body's plane is kept only as the next frame's hint.
-        e.ee_body[k] = Collide(e.ee.hex[k], payload_bay_.body, opts(prev ? &prev->ee_body[k] : nullptr, &hints[1][k]));
+        // The body's plane serves only as the next frame's hint.
+        CollideOptions body = opts(prev ? &prev->ee_body[k] : nullptr, &hints[1][k]);
+        body.want_plane = options_.frame_coherence;
+        e.ee_body[k] = Collide(e.ee.hex[k], payload_bay_.body, body);
         if (e.ee_body[k].verdict != Verdict::kSeparate) e.collisions |= cb::kEffHexPayload << k;
       }
       if (!options_.mode_pairs_only) {

@@ -17,6 +17,7 @@
 #include "rms/check.h"
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/message_io.h"
+#include "rms/telemetry_check.h"
 #include "rms/process.h"
 #include "rms/checkpoint.h"
 #include "rms/process_status_t.hpp"
@@ -165,8 +166,12 @@ int RunOperatorStation(const OperatorOptions& options, const LabConfig& config, 
   Counters counters;
   lcm.Subscribe(channels::kDcpTelemetry, [&](const void* data, int size, std::int64_t recv_us) {
     dcp_telemetry_t m{};
-    if (SafeDecode(data, size, 4096, &m) != DecodeError::kNone) {
-      counters.Add("dropped.telemetry_malformed");
+    if (const DecodeError e = SafeDecode(data, size, 4096, &m); e != DecodeError::kNone) {
+      counters.Add(std::string("dropped.telemetry_") + DecodeErrorName(e));
+      return;
+    }
+    if (const auto why = TelemetryProblem(m)) {
+      counters.Add("dropped.telemetry_" + *why);
       return;
     }
     if (telemetry && m.frame <= telemetry->frame && m.frame != 0) {
@@ -248,6 +253,13 @@ int RunOperatorStation(const OperatorOptions& options, const LabConfig& config, 
     if (autopilot) autopilot->Resync(c.inputs);
   }
 
+  // RMSLAB_RESTART (set by the launcher when it restarts this process after a
+  // fault, docs/sessions.md "Faults"): the autopilot resumes from the first
+  // telemetry instead of starting the task over.
+  const char* restart_env = std::getenv("RMSLAB_RESTART");
+  bool resume_from_telemetry = autopilot && restart_env && *restart_env && std::string(restart_env) != "0";
+  if (restart_env && *restart_env && std::string(restart_env) != "0") counters.Add("restarted");
+
   const bool screen_on = options.status == 1 || (options.status == -1 && by_hand && isatty(STDOUT_FILENO));
   std::unique_ptr<StatusScreen> screen;
   if (screen_on) screen = std::make_unique<StatusScreen>(config);
@@ -255,6 +267,7 @@ int RunOperatorStation(const OperatorOptions& options, const LabConfig& config, 
 
   StatusReporter status(&lcm, "operator_station");
   InputBlockBuilder builder(config.inputs);
+  builder.set_next_frame(FirstFrameNumber(config.session.frame_rate_hz));
   if (!ready_path.empty()) TouchFile(ready_path);
 
   std::int64_t next_ns = MonotonicNs();
@@ -314,6 +327,19 @@ int RunOperatorStation(const OperatorOptions& options, const LabConfig& config, 
       if (manual->quit()) break;
       if (manual->freeze_requested()) send_control(session_control_t::FREEZE);
     } else {
+      if (resume_from_telemetry && telemetry) {
+        // Restarted mid-session by the launcher: carry on from the command
+        // the DCP last answered, and let the autopilot pick up the task
+        // where the telemetry says it is (no reset).
+        OperatorInputs from = InitialInputs(config.inputs);
+        for (int i = 0; i < 6; ++i) from.value[i] = telemetry->master_angles_deg[i];
+        from.value[kShoulderHeight] = telemetry->master_shoulder_height_ft;
+        from.value[kFinger] = telemetry->master_finger;
+        autopilot->Resync(from);
+        resume_from_telemetry = false;
+        spdlog::warn("restarted: the autopilot resumes from the DCP's telemetry (Mode {}, frame {})",
+                     static_cast<int>(telemetry->mode), telemetry->frame);
+      }
       in = autopilot->Step(telemetry ? &*telemetry : nullptr);
       if (autopilot->failed()) {
         exit_code = kExitAutopilotFailed;

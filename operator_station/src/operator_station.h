@@ -39,6 +39,7 @@ class InputBlockBuilder {
   explicit InputBlockBuilder(const InputCalibrations& cal) : cal_(cal) {}
   operator_input_t Build(const OperatorInputs& in, std::int64_t send_time_us, Counters* counters);
   std::int64_t next_frame() const { return next_frame_; }
+  void set_next_frame(std::int64_t f) { next_frame_ = f; }
 
  private:
   const InputCalibrations& cal_;

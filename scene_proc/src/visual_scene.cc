@@ -93,6 +93,7 @@ void SceneNode::OnDcpFrame(const void* data, int size, std::int64_t recv_time_us
 int RunSceneProc(const LabConfig& config, LcmInterface& lcm, const std::string& stats_path,
                  const std::string& ready_path) {
   SceneNode node(config, &lcm);
+  node.set_next_frame(FirstFrameNumber(config.session.frame_rate_hz));
   if (!ready_path.empty()) TouchFile(ready_path);
   spdlog::info("ready: {} -> {}", lcm.FullChannel(channels::kDcpFrame),
                lcm.FullChannel(channels::kEsgFrame));

@@ -35,10 +35,12 @@ bool LabFile::all_local() const {
   return true;
 }
 
-LabFile LoadLabFile(const std::string& path) {
+LabFile LoadLabFile(const std::string& path) { return ParseLabFile(ReadTextFile(path, "the lab file"), path); }
+
+LabFile ParseLabFile(std::string_view text, const std::string& path) {
   LabFile lab;
   lab.source = path;
-  const toml::table root = ParseToml(ReadTextFile(path, "the lab file"), path);
+  const toml::table root = ParseToml(std::string(text), path);
   const std::string doc = "docs/sessions.md";
   TomlReader top(&root, "", &lab.source, doc);
   {

@@ -5,6 +5,7 @@
 // the key and the reason.
 #include <map>
 #include <string>
+#include <string_view>
 
 namespace rms::session {
 
@@ -21,6 +22,8 @@ struct LabFile {
 };
 
 LabFile LoadLabFile(const std::string& path);
+// The same from the file's text (path names it in errors).
+LabFile ParseLabFile(std::string_view text, const std::string& path);
 // LAB_HOST_<process>=..., LAB_TTL=..., LAB_ALL_LOCAL=0|1, LAB_REMOTE_ROOT,
 // LAB_REMOTE_BUILD: shell-quoted assignments for `eval`.
 std::string LabFileShell(const LabFile& lab);

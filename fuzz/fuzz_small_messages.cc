@@ -1,0 +1,38 @@
+// The other messages every process reads: RMS_DCP_TELEMETRY (SafeDecode and
+// TelemetryProblem, as operator_station), RMS_STATUS (process_status_t, as
+// operator_station and rms_monitor) and RMS_CONTROL (session_control_t, as
+// every process). The first byte picks the message type.
+#include "fuzz_common.h"
+#include "rms/dcp_telemetry_t.hpp"
+#include "rms/message_io.h"
+#include "rms/process_status_t.hpp"
+#include "rms/session_control_t.hpp"
+#include "rms/telemetry_check.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  if (size < 1) return 0;
+  const int n = static_cast<int>(size - 1);
+  switch (data[0] % 3) {
+    case 0: {
+      rms::dcp_telemetry_t m{};
+      if (rms::SafeDecode(data + 1, n, 4096, &m) == rms::DecodeError::kNone) (void)rms::TelemetryProblem(m);
+      break;
+    }
+    case 1: {
+      rms::process_status_t m;
+      if (rms::SafeDecode(data + 1, n, 1 << 20, &m) == rms::DecodeError::kNone) {
+        std::uint64_t sum = 0;  // read every field, as a monitor does
+        for (int i = 0; i < m.num_counters; ++i)
+          sum += m.counter_names[i].size() + static_cast<std::uint64_t>(m.counter_values[i]);
+        (void)sum;
+      }
+      break;
+    }
+    default: {
+      rms::session_control_t m;
+      (void)rms::SafeDecode(data + 1, n, 1 << 16, &m);
+      break;
+    }
+  }
+  return 0;
+}
