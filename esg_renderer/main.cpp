@@ -1,6 +1,8 @@
 // esg_renderer: the Electronic Scene Generator. RMS_ESG_FRAME in, images out.
 // A thin main over esg_renderer/src; see docs/esg.md.
 #include <CLI/CLI.hpp>
+#include <cstdlib>
+#include <filesystem>
 
 #include "esg_node.h"
 #include "rms/process.h"
@@ -33,6 +35,14 @@ int main(int argc, char** argv) {
   app.add_flag("--no-backface-cull", no_backface, "Draw faces turned away too");
   return rms::ProcessMain(app, argc, argv, "esg_renderer", &common,
                           [&](const rms::LabConfig& config, rms::LcmInterface& lcm) {
+                            // Restarted by the launcher after a fault (RMSLAB_RESTART=N): the
+                            // video so far is kept; this run's goes beside it, NAME.restartN.mp4.
+                            if (const char* r = std::getenv("RMSLAB_RESTART"); r && *r && std::string(r) != "0" &&
+                                                                             !opt.video_path.empty()) {
+                              const std::filesystem::path v(opt.video_path);
+                              opt.video_path = (v.parent_path() / (v.stem().string() + ".restart" + r +
+                                                                   v.extension().string())).string();
+                            }
                             opt.skip_unchanged = !no_skip;
                             opt.frustum_cull = !no_frustum;
                             opt.backface_cull = !no_backface;

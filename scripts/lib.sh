@@ -69,9 +69,66 @@ rmslab_start() {
   RMSLAB_PIDS+=("$!"); RMSLAB_NAMES+=("$name"); RMSLAB_HOSTS+=("$host")
 }
 
-# rmslab_signal INDEX SIGNAL: to the process, wherever it runs.
+# The session's epoch (wall clock, us since 1970): every process numbers its
+# frames from it (docs/protocol.md "Frame numbers"), so one restarted after
+# a fault carries on the numbering and its peers count the frames it missed.
+RMSLAB_EPOCH_US=""
+
+# rmslab_start_supervised NAME HOST CMD...: as rmslab_start, for the
+# session's processes on this machine (localhost or netns:): when the process
+# ends other than by the session's stop -- killed, crashed, a non-zero exit
+# -- it is started again at once with RMSLAB_RESTART=N in its environment,
+# and a line "NAME N EXIT_CODE DOWN_AT READY_AT" (wall clock, s) goes to
+# run/restarts (docs/sessions.md "Faults"). On ssh hosts: rmslab_start.
+rmslab_start_supervised() {
+  local name="$1" host="$2"; shift 2
+  case "$host" in
+    ssh:*) rmslab_start "$name" "$host" "$@"; return ;;
+  esac
+  rmslab_supervise "$name" "$host" "$@" &
+  RMSLAB_PIDS+=("$!"); RMSLAB_NAMES+=("$name"); RMSLAB_HOSTS+=("$host")
+}
+
+rmslab_supervise() {  # (in the background) NAME HOST CMD...
+  local name="$1" host="$2"; shift 2
+  local log="$RMSLAB_OUT/logs/$name.log" n=0 rc=0 pid t_down="" readies=0 i
+  while :; do
+    local envs=(env "RMSLAB_SESSION_EPOCH_US=$RMSLAB_EPOCH_US" "RMSLAB_RESTART=$n")
+    case "$host" in
+      ""|localhost) "${envs[@]}" "$@" >>"$log" 2>&1 & ;;
+      netns:*) "${RMSLAB_SUDO[@]}" nsenter --net="/var/run/netns/${host#netns:}" -- "${envs[@]}" "$@" >>"$log" 2>&1 & ;;
+    esac
+    pid=$!
+    echo "$pid" >"$RMSLAB_OUT/run/$name.pid"
+    if [ "$n" -gt 0 ]; then
+      # Restarted: the time until it says it is ready again.
+      for i in $(seq 1 600); do
+        [ "$(grep -c '\] ready: ' "$log" 2>/dev/null || true)" -gt "$readies" ] && break
+        kill -0 "$pid" 2>/dev/null || break
+        sleep 0.02
+      done
+      echo "$name $n $rc $t_down $(date +%s.%N)" >>"$RMSLAB_OUT/run/restarts"
+    fi
+    rc=0
+    wait "$pid" || rc=$?
+    [ -e "$RMSLAB_OUT/run/stopping" ] && return "$rc"
+    [ "$rc" = 0 ] && return 0
+    t_down=$(date +%s.%N)
+    readies=$(grep -c '\] ready: ' "$log" 2>/dev/null || true)
+    n=$((n + 1))
+    rmslab_say "$name ended with code $rc mid-session; restarting it (restart $n)"
+  done
+}
+
+# rmslab_signal INDEX SIGNAL: to the process, wherever it runs (a
+# supervised one through its pid file).
 rmslab_signal() {
   local i="$1" sig="$2"
+  local pidfile="$RMSLAB_OUT/run/${RMSLAB_NAMES[$i]}.pid"
+  if [ -f "$pidfile" ]; then
+    kill "-$sig" "$(cat "$pidfile")" 2>/dev/null || true
+    return 0
+  fi
   case "${RMSLAB_HOSTS[$i]}" in
     ssh:*) ssh -o BatchMode=yes "${RMSLAB_HOSTS[$i]#ssh:}" \
              "kill -$sig \$(cat $RMSLAB_REMOTE_RUN/${RMSLAB_NAMES[$i]}.pid) 2>/dev/null" 2>/dev/null || true ;;
@@ -96,6 +153,7 @@ rmslab_wait_exit() {
 rmslab_stop_all() {
   [ "$RMSLAB_STOPPED" = 1 ] && return 0
   RMSLAB_STOPPED=1
+  [ -n "$RMSLAB_OUT" ] && touch "$RMSLAB_OUT/run/stopping"  # supervised processes are not restarted now
   local i
   for i in "${!RMSLAB_PIDS[@]}"; do
     [ "${RMSLAB_NAMES[$i]}" = lcm-logger ] || rmslab_signal "$i" INT

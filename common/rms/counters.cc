@@ -79,6 +79,7 @@ SequenceTracker::Verdict SequenceTracker::Accept(std::int64_t frame) {
   }
   ++received_;
   const std::int64_t gap = frame - last_ - 1;
+  previous_ = last_;
   last_ = frame;
   if (gap == 0) return Verdict::kNext;
   missing_ += gap;

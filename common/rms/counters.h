@@ -68,11 +68,12 @@ class SequenceTracker {
   std::int64_t duplicates() const { return duplicates_; }
   std::int64_t stale() const { return stale_; }
   std::int64_t last() const { return last_; }
+  std::int64_t previous() const { return previous_; }  // the last frame before the latest
   bool started() const { return started_; }
 
  private:
   bool started_ = false;
-  std::int64_t last_ = -1;
+  std::int64_t last_ = -1, previous_ = -1;
   std::int64_t received_ = 0, missing_ = 0, duplicates_ = 0, stale_ = 0;
 };
 

@@ -73,6 +73,15 @@ auto ReceiveFrame(const void* data, int size, int max_size, SequenceTracker* seq
   switch (seq->Accept(msg.frame)) {
     case SequenceTracker::Verdict::kDuplicate: counters->Add("dropped.duplicate"); return std::nullopt;
     case SequenceTracker::Verdict::kStale: counters->Add("dropped.stale"); return std::nullopt;
+    case SequenceTracker::Verdict::kGap: {
+      // Frames lost on the way (or while the sender was down): counted by
+      // the caller from seq->missing(); a gap of several frames is said.
+      counters->Add("gaps");
+      if (const std::int64_t n = msg.frame - seq->previous() - 1; n >= 3) {
+        spdlog::warn("gap: {} frames missing before frame {} (a lossy link or a restarted sender)", n, msg.frame);
+      }
+      break;
+    }
     default: break;
   }
   return std::make_pair(std::move(msg), std::move(*content));

@@ -59,7 +59,11 @@ bool DcpNode::ResumeFromStateFile() {
   } catch (const std::exception& e) {
     throw InputError("state file '" + state_file_ + "': " + e.what());
   }
-  next_frame_ = std::max(next_frame_, c.dcp_frame + 1);
+  // The DCP frames are one to one with the operator's: the first input
+  // after the resume sets the numbering, so the scene sees as missing exactly
+  // the inputs that came while this process was down.
+  next_frame_ = c.dcp_frame + 1;
+  resume_ = std::pair{c.dcp_frame, c.input_frame};
   last_inputs_ = c.inputs;
   counters_.Add("resumed");
   spdlog::warn("resumed from the last state written ({}, DCP frame {}): Mode {}{}{}", state_file_, c.dcp_frame,
@@ -90,6 +94,21 @@ void DcpNode::OnControl(const void* data, int size) {
   }
   try {
     if (m.command == session_control_t::CHECKPOINT) {
+      // The path is the sender's (docs/security.md): only a .json file that
+      // is new or already a checkpoint is written, never any other file.
+      const std::filesystem::path path(m.path);
+      if (path.extension() != ".json") {
+        counters_.Add("control.refused");
+        throw InputError("checkpoint refused: '" + m.path + "' is not a .json file");
+      }
+      if (std::filesystem::exists(path)) {
+        try {
+          (void)ReadCheckpoint(m.path);
+        } catch (const InputError&) {
+          counters_.Add("control.refused");
+          throw InputError("checkpoint refused: '" + m.path + "' exists and is not a checkpoint");
+        }
+      }
       SaveCheckpoint(m.path);
       counters_.Add("control.checkpoints");
       spdlog::info("checkpoint: DCP frame {} saved to {}", next_frame_ - 1, m.path);
@@ -116,6 +135,10 @@ void DcpNode::OnInput(const void* data, int size, std::int64_t recv_time_us) {
   RecordEndToEnd(recv_time_us - msg.send_time_us, config_.session.frame_rate_hz, &latencies_["input_to_dcp"],
                  &counters_);
 
+  if (resume_) {
+    if (msg.frame > resume_->second) next_frame_ = resume_->first + (msg.frame - resume_->second);
+    resume_.reset();
+  }
   last_inputs_ = in;
   last_input_frame_ = msg.frame;
   DcpFrameData out = dcp_.Step(in);

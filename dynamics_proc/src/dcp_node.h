@@ -1,4 +1,6 @@
 #pragma once
+#include <optional>
+#include <utility>
 // dynamics_proc's LCM side: RMS_OPERATOR_INPUT in, RMS_DCP_FRAME out, one
 // output frame per input block, counters and latency.
 #include <string>
@@ -60,6 +62,7 @@ class DcpNode {
   int last_mode_ = 0;
   std::uint32_t last_collisions_ = 0;
   std::string state_file_;
+  std::optional<std::pair<std::int64_t, std::int64_t>> resume_;  // (DCP frame, input frame) of the state resumed
   std::int64_t state_written_us_ = 0;
   std::uint32_t state_key_ = 0;  // mode, acquired, docked, released: a change writes at once
 };

@@ -75,7 +75,11 @@ void SceneNode::OnDcpFrame(const void* data, int size, std::int64_t recv_time_us
   RecordEndToEnd(recv_time_us - msg.input_send_time_us, config_.session.frame_rate_hz, &latencies_["input_to_scene"],
                  &counters_);
 
-  const std::int64_t frame = next_frame_++;
+  // An ESG frame is numbered as the DCP frame it answers (one to one), so
+  // the numbering survives a restart of either process and the ESG counts
+  // exactly the frames lost on the way (docs/protocol.md "Frame numbers").
+  const std::int64_t frame = msg.frame;
+  next_frame_ = frame + 1;
   const EsgFrameData e = scene_.Step(dcp, static_cast<std::uint32_t>(frame & 0xFFFFFF), &counters_);
   esg_frame_t out;
   out.frame = frame;
@@ -93,7 +97,6 @@ void SceneNode::OnDcpFrame(const void* data, int size, std::int64_t recv_time_us
 int RunSceneProc(const LabConfig& config, LcmInterface& lcm, const std::string& stats_path,
                  const std::string& ready_path) {
   SceneNode node(config, &lcm);
-  node.set_next_frame(FirstFrameNumber(config.session.frame_rate_hz));
   if (!ready_path.empty()) TouchFile(ready_path);
   spdlog::info("ready: {} -> {}", lcm.FullChannel(channels::kDcpFrame),
                lcm.FullChannel(channels::kEsgFrame));

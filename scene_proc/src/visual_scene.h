@@ -49,8 +49,6 @@ class SceneNode {
   Counters& counters() { return counters_; }
   const LatencyMap& latencies() const { return latencies_; }
   std::int64_t last_frame() const { return next_frame_ - 1; }
-  // The first ESG frame number to publish (FirstFrameNumber).
-  void set_next_frame(std::int64_t f) { next_frame_ = f; }
 
  private:
   const LabConfig& config_;

@@ -46,3 +46,23 @@ TEST(Counters, SumByPrefix) {
 
 }  // namespace
 }  // namespace rms
+
+// Reordering (docs/sessions.md "Lossy links"; this machine's kernel has no
+// tc netem to reorder a real link): a frame overtaken by a later one is
+// counted missing when the later one arrives, then dropped as stale when it
+// comes -- too late for a real-time frame; the count of frames used is
+// exact.
+namespace rms {
+TEST(SequenceTracker, ReorderedFramesAreCountedMissingThenDroppedAsStale) {
+  SequenceTracker t;
+  std::vector<SequenceTracker::Verdict> v;
+  for (std::int64_t f : {10, 11, 13, 12, 14, 16, 15, 15, 17}) v.push_back(t.Accept(f));
+  using V = SequenceTracker::Verdict;
+  EXPECT_EQ(v, (std::vector<V>{V::kFirst, V::kNext, V::kGap, V::kStale, V::kNext, V::kGap, V::kStale, V::kStale,
+                               V::kNext}));
+  EXPECT_EQ(t.received(), 6);  // 10 11 13 14 16 17
+  EXPECT_EQ(t.missing(), 2);   // 12 and 15, overtaken
+  EXPECT_EQ(t.stale(), 3);
+  EXPECT_EQ(t.previous(), 16);
+}
+}  // namespace rms

@@ -1,5 +1,7 @@
 #include "lab_file.h"
 
+#include <cstdio>
+
 #include <fstream>
 #include <sstream>
 
@@ -56,6 +58,17 @@ LabFile ParseLabFile(std::string_view text, const std::string& path) {
   }
   {
     TomlReader l = top.Sub("lcm");
+    // docs/security.md: a lab names its own multicast group and port.
+    lab.group = l.String("group");
+    {
+      int a[4] = {-1, -1, -1, -1};
+      char tail = 0;
+      const bool dotted = std::sscanf(lab.group.c_str(), "%d.%d.%d.%d%c", &a[0], &a[1], &a[2], &a[3], &tail) == 4;
+      bool ok = dotted && a[0] >= 224 && a[0] <= 239;
+      for (int k = 1; k < 4; ++k) ok = ok && a[k] >= 0 && a[k] <= 255;
+      if (!ok) l.Fail("group", "must be an IPv4 multicast address (224.0.0.0 .. 239.255.255.255; 239.x.x.x for a lab), got \"" + lab.group + "\"");
+    }
+    lab.port = static_cast<int>(l.Number("port", 1024, 65535));
     lab.ttl = static_cast<int>(l.Number("ttl", 0, 255));
     l.Finish();
   }
@@ -73,6 +86,8 @@ std::string LabFileShell(const LabFile& lab) {
   std::ostringstream os;
   for (const auto& [p, h] : lab.hosts) os << "LAB_HOST_" << p << "=" << Quote(h) << "\n";
   os << "LAB_TTL=" << lab.ttl << "\n";
+  os << "LAB_GROUP=" << Quote(lab.group) << "\n";
+  os << "LAB_PORT=" << lab.port << "\n";
   os << "LAB_ALL_LOCAL=" << (lab.all_local() ? 1 : 0) << "\n";
   os << "LAB_REMOTE_ROOT=" << Quote(lab.remote_root) << "\n";
   os << "LAB_REMOTE_BUILD=" << Quote(lab.remote_build) << "\n";

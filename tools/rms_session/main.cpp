@@ -102,6 +102,14 @@ int main(int argc, char** argv) {
     }
     std::cout << "\ncollisions " << j["collisions"].size() << ", frames held " << j["held_frames"]
               << "; LCM log events " << j["log"]["events"] << "\n";
+    if (j.contains("restarts") && !j["restarts"].empty()) {
+      std::cout << "restarted after a fault:";
+      for (const auto& r : j["restarts"]) {
+        std::cout << " " << r["process"].get<std::string>() << " (exit " << r["exit_code"] << ", up again in "
+                  << r["restart_s"].get<double>() << " s)";
+      }
+      std::cout << "\n";
+    }
     return 0;
   } catch (const std::exception& e) {
     std::cerr << "rms_session: " << e.what() << "\n";

@@ -80,6 +80,10 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
   int final_mode = 0;
   std::set<int> modes;
   std::map<std::string, bool> final_status_seen;
+  // Each process's runs (a restart after a fault is a new pid): the last
+  // counters each run reported on RMS_STATUS.
+  std::map<std::string, std::map<int, std::map<std::string, std::int64_t>>> status_runs;
+  std::map<std::string, int> last_pid;
   // From the DCP's telemetry: mode changes, collision runs, docking.
   nlohmann::ordered_json mode_changes = nlohmann::ordered_json::array();
   nlohmann::ordered_json collision_events = nlohmann::ordered_json::array();
@@ -178,6 +182,9 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
       process_status_t m;
       if (SafeDecode(ev->data, ev->datalen, 1 << 20, &m) == DecodeError::kNone) {
         if (m.final) final_status_seen[m.process] = true;
+        auto& run = status_runs[m.process][m.pid];
+        for (int i = 0; i < m.num_counters; ++i) run[m.counter_names[i]] = m.counter_values[i];
+        last_pid[m.process] = m.pid;
       } else {
         ++malformed;
       }
@@ -203,6 +210,17 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
   std::map<std::string, nlohmann::json> stats;
   for (const char* p : {"operator_station", "dynamics_proc", "scene_proc", "esg_renderer"}) {
     stats[p] = ReadJson(root / "stats" / (std::string(p) + ".json"));
+    // The stats file is the last run's; a run that ended in a fault (killed,
+    // restarted by the launcher) left its counts on RMS_STATUS in the log:
+    // they are added (counts only: not the mode, not latency percentiles).
+    for (const auto& [pid, counters] : status_runs[p]) {
+      if (pid == last_pid[p]) continue;
+      if (!stats[p].contains("counters")) stats[p]["counters"] = nlohmann::json::object();
+      for (const auto& [k, v] : counters) {
+        if (k == "mode" || k.rfind("latency.", 0) == 0) continue;
+        stats[p]["counters"][k] = stats[p]["counters"].value(k, std::int64_t{0}) + v;
+      }
+    }
   }
   const auto& op = stats["operator_station"];
   const auto& dcp = stats["dynamics_proc"];
@@ -246,6 +264,23 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
     std::ifstream pilot((root / "run" / "pilot").string());
     std::string who;
     if (pilot >> who) j["pilot"] = who;
+  }
+  {
+    // Processes the launcher restarted after a fault (docs/sessions.md
+    // "Faults"): run/restarts, one line "NAME N EXIT_CODE DOWN_AT READY_AT".
+    nlohmann::ordered_json restarts = nlohmann::ordered_json::array();
+    std::ifstream f((root / "run" / "restarts").string());
+    std::string name;
+    int n = 0, rc = 0;
+    double down = 0, ready = 0;
+    while (f >> name >> n >> rc >> down >> ready) {
+      restarts.push_back({{"process", name},
+                          {"restart", n},
+                          {"exit_code", rc},
+                          {"signal", rc > 128 ? rc - 128 : 0},
+                          {"restart_s", ready - down}});
+    }
+    j["restarts"] = restarts;
   }
   j["mode_changes"] = mode_changes;
   j["collisions"] = collision_events;
