@@ -12,6 +12,8 @@
 // arithmetic).
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -73,11 +75,20 @@ class Collector : public benchmark::ConsoleReporter {
  public:
   void ReportRuns(const std::vector<Run>& runs) override {
     for (const Run& r : runs) {
-      if (r.run_type == Run::RT_Iteration) ns[r.benchmark_name()] = r.GetAdjustedCPUTime();
+      if (r.run_type != Run::RT_Iteration) continue;
+      // The name without "/repeats:N"; with repetitions, the median.
+      std::string name = r.benchmark_name();
+      if (const auto k = name.find("/repeats:"); k != std::string::npos) name.resize(k);
+      auto& v = all[name];
+      v.push_back(r.GetAdjustedCPUTime());
+      std::vector<double> sorted = v;
+      std::sort(sorted.begin(), sorted.end());
+      ns[name] = sorted[sorted.size() / 2];
     }
     ConsoleReporter::ReportRuns(runs);
   }
-  std::map<std::string, double> ns;
+  std::map<std::string, double> ns;               // median over repetitions
+  std::map<std::string, std::vector<double>> all;  // every repetition
 };
 
 struct Agreement {
@@ -112,12 +123,18 @@ int main(int argc, char** argv) {
   verdict_only.want_plane = false;
   rms::dcp::CollideOptions report_only = verdict_only;
   report_only.sphere_reject = false;
+  report_only.aabb_reject = false;
+  rms::dcp::CollideOptions spheres_only = verdict_only;
+  spheres_only.aabb_reject = false;
   // Boxes.
   benchmark::RegisterBenchmark("boxes/DCP, verdict", [&](benchmark::State& st) {
     cycle(st, [&](std::size_t i) { return rms::dcp::Collide(sets.hex_boxes[i].first, sets.hex_boxes[i].second, verdict_only).verdict; });
   });
-  benchmark::RegisterBenchmark("boxes/DCP, verdict, no sphere rejection", [&](benchmark::State& st) {
+  benchmark::RegisterBenchmark("boxes/DCP, verdict, no bounding-volume rejection", [&](benchmark::State& st) {
     cycle(st, [&](std::size_t i) { return rms::dcp::Collide(sets.hex_boxes[i].first, sets.hex_boxes[i].second, report_only).verdict; });
+  });
+  benchmark::RegisterBenchmark("boxes/DCP, verdict, spheres but no box rejection", [&](benchmark::State& st) {
+    cycle(st, [&](std::size_t i) { return rms::dcp::Collide(sets.hex_boxes[i].first, sets.hex_boxes[i].second, spheres_only).verdict; });
   });
   benchmark::RegisterBenchmark("boxes/DCP, verdict and separating plane", [&](benchmark::State& st) {
     cycle(st, [&](std::size_t i) { return rms::dcp::Collide(sets.hex_boxes[i].first, sets.hex_boxes[i].second).verdict; });
@@ -206,7 +223,25 @@ int main(int argc, char** argv) {
   const double dcp = collector.ns["boxes/DCP, verdict"];
   const double sat = collector.ns["boxes/separating axes, 15 (double)"];
   const double fcl = collector.ns["boxes/FCL collide() on boxes (computes a contact)"];
-  char line[400];
+  char line[600];
+  // The FCL ratio repetition by repetition (the same pairs, run after run).
+  double ratio_lo = 1e30, ratio_hi = 0;
+  {
+    const auto& d = collector.all["boxes/DCP, verdict"];
+    const auto& f = collector.all["boxes/FCL collide() on boxes (computes a contact)"];
+    for (std::size_t i = 0; i < std::min(d.size(), f.size()); ++i) {
+      ratio_lo = std::min(ratio_lo, f[i] / d[i]);
+      ratio_hi = std::max(ratio_hi, f[i] / d[i]);
+    }
+  }
+  const std::size_t reps = collector.all["boxes/DCP, verdict"].size();
+  md << "## Collision against its peers\n\n"
+     << "`rms_collision_bench` (Google Benchmark): the same 4096 random pairs for every method, cycled, time per "
+        "pair (CPU), the median of " << reps << " repetition" << (reps == 1 ? "" : "s") << ". The DCP is the "
+        "report's algorithm (Section IV.A.1; `docs/collision.md`), verdict only unless said; FCL's `collide()` on "
+        "boxes computes a contact (point, normal, depth) as it decides; ODE's `dBoxTouchesBox` and the 15-axis "
+        "separating-axis test (double) give a verdict only; for general hexahedra FCL works on convex meshes "
+        "(GJK/EPA) and libccd with MPR.\n\n";
   md << "| Method (4096 random box pairs, cycled) | ns / pair | vs the DCP | vs separating axes |\n|---|---|---|---|\n";
   for (const auto& [name, ns] : collector.ns) {
     if (name.rfind("boxes/", 0) != 0) continue;
@@ -223,8 +258,9 @@ int main(int argc, char** argv) {
   std::snprintf(line, sizeof line,
                 "\n- **Target** collision at most 40 ns a random box pair: %.1f ns (%s; twice the separating-axis "
                 "floor here is %.1f ns).\n- **Target** collision at least 8x faster than FCL on the same pairs: "
-                "%.1fx (%s).\n",
-                dcp, dcp <= 40.0 ? "met" : "MISSED", 2 * sat, fcl / dcp, fcl / dcp >= 8.0 ? "met" : "MISSED");
+                "%.1fx (%s; over the repetitions %.1fx to %.1fx).\n",
+                dcp, dcp <= 40.0 ? "met" : "MISSED", 2 * sat, fcl / dcp, fcl / dcp >= 8.0 ? "met" : "MISSED",
+                ratio_lo, ratio_hi);
   md << line;
   auto agreement_table = [&](const Agreement& ag, const char* title) {
     md << "\n| " << title << " | pairs |";

@@ -298,12 +298,12 @@ int main(int argc, char** argv) {
     auto add = [&](std::string name, bool mode_only, bool spheres, bool coherence) {
       FrameVariant v;
       v.name = std::move(name);
-      v.options = {.mode_pairs_only = mode_only, .sphere_reject = spheres, .frame_coherence = coherence};
+      v.options = {.mode_pairs_only = mode_only, .bounding_reject = spheres, .frame_coherence = coherence};
       fv.push_back(std::move(v));
     };
-    add("the default: mode pairs, sphere rejection", true, true, false);
+    add("the default: mode pairs, bounding spheres and boxes", true, true, false);
     add("the default + frame coherence", true, true, true);
-    add("without bounding-sphere rejection", true, false, false);
+    add("without bounding-volume rejection", true, false, false);
     add("every pair every frame (not only the mode's)", false, true, false);
     add("none: every pair, the report's algorithm alone", false, false, false);
     RunFrames(config, flights, reps, &fv);

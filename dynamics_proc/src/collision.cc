@@ -174,6 +174,26 @@ CollisionResult Collide(const Hexahedron& a, const Hexahedron& b, const CollideO
       return r;
     }
   }
+  if (options.aabb_reject) {
+    // The boxes' gap along each axis: centre distance less both half extents.
+    const double d[3] = {b.cx - a.cx, b.cy - a.cy, b.cz - a.cz};
+    const double gap[3] = {std::abs(d[0]) - a.hx - b.hx, std::abs(d[1]) - a.hy - b.hy, std::abs(d[2]) - a.hz - b.hz};
+    const int k = gap[0] >= gap[1] ? (gap[0] >= gap[2] ? 0 : 2) : (gap[1] >= gap[2] ? 1 : 2);
+    if (gap[k] > tau) {
+      r.verdict = Verdict::kSeparate;
+      r.decider = Decider::kBoxesApart;
+      if (options.want_plane) {
+        const double sign = d[k] > 0 ? 1.0 : -1.0;  // from A toward B
+        const double ha[3] = {a.hx, a.hy, a.hz};
+        const double ca[3] = {a.cx, a.cy, a.cz};
+        Eigen::Vector3d n = Eigen::Vector3d::Zero();
+        n[k] = sign;
+        // Midway in the gap: A's face plus half the gap.
+        SetPlane(&r, n, sign * ca[k] + ha[k] + 0.5 * gap[k]);
+      }
+      return r;
+    }
+  }
   if (options.hint && PlaneSeparates(a, b, options.hint->n, options.hint->d, tau)) {
     r.verdict = Verdict::kSeparate;
     r.decider = Decider::kHintPlane;

@@ -16,7 +16,9 @@
 //     plane when it really separates, else one found from the edge directions.
 //
 // Before step 1, when enabled: bounding spheres apart (by more than tau)
-// means separate, with the plane midway between the spheres; then, when a
+// means separate, with the plane midway between the spheres; so do
+// axis-aligned bounding boxes apart, with the plane midway between them
+// normal to that axis; then, when a
 // hint is given, the previous frame's plane if it still separates.
 //
 // Touching counts as collision: a vertex within tau = relative_tolerance x
@@ -47,6 +49,7 @@ enum class Decider : std::uint8_t {
   kNonFinite,          // invalid input
   kSpheresApart,       // the bounding spheres are apart (before the report's test, when enabled)
   kHintPlane,          // the hint plane (the previous frame's) still separates (when given)
+  kBoxesApart,         // the axis-aligned bounding boxes are apart (before the report's test, when enabled)
 };
 
 // A plane n . p = d, n from A's side toward B's.
@@ -62,6 +65,9 @@ struct CollideOptions {
   // (a real-time saving; the verdict is the same). Off: the report's
   // algorithm alone, every decision by its own steps.
   bool sphere_reject = true;
+  // Reject pairs whose axis-aligned bounding boxes are apart (after the
+  // spheres; the same verdict, a plane normal to the axis that parts them).
+  bool aabb_reject = true;
   // Frame coherence: a plane to try first (the pair's separating plane of
   // the previous frame); when it still separates the pair (within tau), the
   // verdict is separate with this plane. Null: none.

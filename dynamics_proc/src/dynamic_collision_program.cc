@@ -74,7 +74,7 @@ void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* 
   auto opts = [&](const CollisionResult* last, SeparatingPlaneHint* hint) {
     CollideOptions o;
     o.relative_tolerance = tau_rel_;
-    o.sphere_reject = options_.sphere_reject;
+    o.sphere_reject = o.aabb_reject = options_.bounding_reject;
     if (options_.frame_coherence && prev && last->verdict == Verdict::kSeparate && last->plane_valid) {
       hint->n = last->n;
       hint->d = last->d;
@@ -109,7 +109,7 @@ void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* 
       if (!options_.mode_pairs_only) {
         // The pairs of Modes 2 and 3, computed and discarded.
         CollideOptions o;
-        o.sphere_reject = options_.sphere_reject;
+        o.sphere_reject = o.aabb_reject = options_.bounding_reject;
         e.extra_collisions |= Collide(payload_bay_.body, bay_, o).verdict != Verdict::kSeparate;
         e.extra_collisions |= Collide(payload_bay_.body, cae_, o).verdict != Verdict::kSeparate;
       }
@@ -148,7 +148,7 @@ void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* 
     // BAR and the payload where they are now, the payload against the bay
     // and the CAE as whole hexahedra.
     CollideOptions o;
-    o.sphere_reject = options_.sphere_reject;
+    o.sphere_reject = o.aabb_reject = options_.bounding_reject;
     const EndEffectorModel ee = MakeEndEffector(config_.end_effector, e.pose.X_RS2, e.finger_gap_ft);
     const Hexahedron bar = MakeBar(config_.payload, e.X_RP);
     for (int k = 0; k < 3; ++k) {

@@ -113,8 +113,9 @@ struct DcpOptions {
   // pair every frame, for comparison (end effector against the BAR and the
   // payload, the payload against the bay and the CAE).
   bool mode_pairs_only = true;
-  // Bounding-sphere rejection before the report's algorithm.
-  bool sphere_reject = true;
+  // Bounding-volume rejection before the report's algorithm: spheres, then
+  // axis-aligned boxes (CollideOptions sphere_reject, aabb_reject).
+  bool bounding_reject = true;
   // Frame coherence: the previous frame's separating plane of each pair is
   // tried first (it is part of the checkpoint). Off by default: measured, it
   // costs about as much as it saves (docs/collision.md "Real-time savings").

@@ -186,6 +186,9 @@ bool Finish(Hexahedron* h) {
                           (h->z[i] - h->cz) * (h->z[i] - h->cz));
   }
   h->radius = std::sqrt(r2);
+  h->hx = 0.5 * (hi[0] - lo[0]);
+  h->hy = 0.5 * (hi[1] - lo[1]);
+  h->hz = 0.5 * (hi[2] - lo[2]);
   return finite && std::isfinite(h->scale) && h->scale > 0.0;
 }
 

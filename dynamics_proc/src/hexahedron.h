@@ -74,6 +74,8 @@ struct Hexahedron {
   // A bounding sphere (centre of the bounding box, radius to the farthest
   // vertex), ft: for rejecting pairs far apart before the report's test.
   double cx = 0.0, cy = 0.0, cz = 0.0, radius = 0.0;
+  // The axis-aligned bounding box's half extents about (cx, cy, cz), ft.
+  double hx = 0.0, hy = 0.0, hz = 0.0;
   // +1 when kFaceVertices runs counter-clockwise seen from outside, -1 when
   // the hexahedron is mirrored (left-handed axes).
   double handedness = 1.0;

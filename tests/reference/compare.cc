@@ -24,6 +24,7 @@ const char* DeciderName(dcp::Decider d) {
     case dcp::Decider::kNonFinite: return "invalid";
     case dcp::Decider::kSpheresApart: return "bounding spheres apart";
     case dcp::Decider::kHintPlane: return "previous plane separates";
+    case dcp::Decider::kBoxesApart: return "bounding boxes apart";
   }
   return "?";
 }

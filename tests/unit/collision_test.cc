@@ -77,6 +77,7 @@ TEST(Collide, VertexInsideAndFaceSeparation) {
   // The report's algorithm alone names c's face a.
   CollideOptions report_only;
   report_only.sphere_reject = false;
+  report_only.aabb_reject = false;
   const CollisionResult s = Collide(a, c, report_only);
   EXPECT_EQ(s.verdict, Verdict::kSeparate);
   EXPECT_EQ(s.decider, Decider::kFaceOfBSeparates);
@@ -84,6 +85,26 @@ TEST(Collide, VertexInsideAndFaceSeparation) {
   ASSERT_TRUE(s.plane_valid);
   EXPECT_LT((s.n - Vector3d::UnitX()).norm(), 1e-15);  // from a toward c
   EXPECT_DOUBLE_EQ(s.d, 3.0);
+}
+
+TEST(Collide, BoundingBoxesApartDecideWhereTheSpheresOverlap) {
+  // Two long bars side by side: their spheres overlap, their boxes do not.
+  const Hexahedron a = AxisBox(Vector3d(0, 0, 0), Vector3d(10, 1, 1));
+  const Hexahedron b = AxisBox(Vector3d(0, 1.5, 0), Vector3d(10, 2.5, 1));
+  const CollisionResult r = Collide(a, b);
+  EXPECT_EQ(r.verdict, Verdict::kSeparate);
+  EXPECT_EQ(r.decider, Decider::kBoxesApart);
+  ASSERT_TRUE(r.plane_valid);
+  EXPECT_LT((r.n - Vector3d::UnitY()).norm(), 1e-15);
+  EXPECT_DOUBLE_EQ(r.d, 1.25);  // midway in the gap
+  const CollisionResult back = Collide(b, a);
+  EXPECT_EQ(back.decider, Decider::kBoxesApart);
+  EXPECT_TRUE(PlaneSeparates(b, a, back.n, back.d, 0.0));
+  // Without the box test the report's algorithm decides the same.
+  CollideOptions report_only;
+  report_only.sphere_reject = report_only.aabb_reject = false;
+  EXPECT_EQ(Collide(a, b, report_only).verdict, Verdict::kSeparate);
+  EXPECT_NE(Collide(a, b, report_only).decider, Decider::kBoxesApart);
 }
 
 TEST(Collide, TouchingCountsAsCollision) {
