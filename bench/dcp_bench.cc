@@ -645,7 +645,10 @@ int main(int argc, char** argv) {
                       t_swept / frames_total);
       }
       md << "\nA trajectory counts as missed only if no frame in the whole run sees a collision (the arm passed "
-            "through and out); the substep test runs only while the arm moves, and stops at the first hit.\n\n";
+            "through and out); the substep test runs only while the arm moves, and stops at the first hit. Substeps "
+            "that move no vertex more than half the thinnest solid cannot pass through a solid; a grazing contact "
+            "shallower than a step can still fall between two of them (as between the truth's own samples), which "
+            "is what a miss in the substep column is.\n\n";
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rms_dcp_bench: %s\n", e.what());
