@@ -338,16 +338,23 @@ ResimResult Resimulate(const ResimOptions& opt) {
 
   std::map<std::int64_t, dcp_frame_t> frames;
   std::map<std::int64_t, dcp_telemetry_t> telemetry;
+  // During the run the outputs are appended to vectors reserved up front (no
+  // allocation a frame); the maps the comparison looks them up in are built
+  // after it.
+  std::vector<dcp_frame_t> frames_run;
+  std::vector<dcp_telemetry_t> telemetry_run;
+  frames_run.reserve(seq.size());
+  telemetry_run.reserve(seq.size());
   {
     LogLcm lcm("", out_log, rec.suffix);
     dcp::DcpNode node(config, &lcm);
     lcm.Subscribe(channels::kDcpFrame, [&](const void* d, int n, std::int64_t) {
-      dcp_frame_t m;
-      if (SafeDecode(d, n, 4096, &m) == DecodeError::kNone) frames[m.frame] = m;
+      frames_run.emplace_back();
+      if (SafeDecode(d, n, 4096, &frames_run.back()) != DecodeError::kNone) frames_run.pop_back();
     });
     lcm.Subscribe(channels::kDcpTelemetry, [&](const void* d, int n, std::int64_t) {
-      dcp_telemetry_t m;
-      if (SafeDecode(d, n, 4096, &m) == DecodeError::kNone) telemetry[m.frame] = m;
+      telemetry_run.emplace_back();
+      if (SafeDecode(d, n, 4096, &telemetry_run.back()) != DecodeError::kNone) telemetry_run.pop_back();
     });
     std::size_t next_control = 0;
     const auto t_run = std::chrono::steady_clock::now();
@@ -372,6 +379,8 @@ ResimResult Resimulate(const ResimOptions& opt) {
       }
     }
     result.run_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_run).count();
+    for (auto& f : frames_run) frames[f.frame] = std::move(f);
+    for (auto& t : telemetry_run) telemetry[t.frame] = std::move(t);
     result.frames = static_cast<long>(frames.size());
     if (other_design) {
       WriteStatsJson((fs::path(result.out_dir) / "stats" / "dynamics_proc.json").string(), "dynamics_proc",
