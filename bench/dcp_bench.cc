@@ -26,6 +26,7 @@
 #include <random>
 #include <sstream>
 
+#include "bench_stats.h"
 #include "closed_loop.h"
 #include "random_operator.h"
 #include "dynamic_collision_program.h"
@@ -35,14 +36,10 @@
 namespace {
 
 using Clock = std::chrono::steady_clock;
+using rms::bench::Percentile;
 using rms::Sprintf;
 using namespace rms::dcp;
 
-double Percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<std::size_t>(p * (v.size() - 1) + 0.5))];
-}
 
 // ---------------------------------------------------------------- 1. frame
 
@@ -123,8 +120,8 @@ rms::ArmSinCos Quantize(const rms::ArmSinCos& sc, int how) {  // 0 double, 1 flo
       a.s = static_cast<float>(a.s);
       a.c = static_cast<float>(a.c);
     } else if (how == 2) {
-      a.s = rms::wire::Decode(rms::wire::kSC22, static_cast<std::int32_t>(rms::wire::Encode(rms::wire::kSC22, a.s).word));
-      a.c = rms::wire::Decode(rms::wire::kSC22, static_cast<std::int32_t>(rms::wire::Encode(rms::wire::kSC22, a.c).word));
+      a.s = rms::wire::RoundTrip(rms::wire::kSC22, a.s);
+      a.c = rms::wire::RoundTrip(rms::wire::kSC22, a.c);
     }
   }
   return q;
@@ -132,12 +129,12 @@ rms::ArmSinCos Quantize(const rms::ArmSinCos& sc, int how) {  // 0 double, 1 flo
 
 double QuantizeFt(double x, int how) {
   if (how == 1) return static_cast<float>(x);
-  if (how == 2) return rms::wire::Decode(rms::wire::kFT12, static_cast<std::int32_t>(rms::wire::Encode(rms::wire::kFT12, x).word));
+  if (how == 2) return rms::wire::RoundTrip(rms::wire::kFT12, x);
   return x;
 }
 double QuantizeUnit(double x, int how) {
   if (how == 1) return static_cast<float>(x);
-  if (how == 2) return rms::wire::Decode(rms::wire::kSC22, static_cast<std::int32_t>(rms::wire::Encode(rms::wire::kSC22, x).word));
+  if (how == 2) return rms::wire::RoundTrip(rms::wire::kSC22, x);
   return x;
 }
 

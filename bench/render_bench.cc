@@ -20,6 +20,7 @@
 #include "rms/check.h"
 #include "rms/text.h"
 
+#include "bench_stats.h"
 #include "gl_context.h"
 #include "offline_session.h"
 #include "overlay.h"
@@ -29,6 +30,8 @@
 namespace {
 
 using Clock = std::chrono::steady_clock;
+using rms::bench::Mean;
+using rms::bench::Percentile;
 double Ms(Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); }
 
 struct Variant {
@@ -40,16 +43,6 @@ struct Variant {
   long clusters = 0, triangles = 0, differing = 0, frames_differing = 0, worst = 0;
 };
 
-double Percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<std::size_t>(p * (v.size() - 1) + 0.5))];
-}
-double Mean(const std::vector<double>& v) {
-  double s = 0;
-  for (double x : v) s += x;
-  return v.empty() ? 0 : s / v.size();
-}
 
 }  // namespace
 

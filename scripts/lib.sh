@@ -89,15 +89,25 @@ rmslab_start_supervised() {
   RMSLAB_PIDS+=("$!"); RMSLAB_NAMES+=("$name"); RMSLAB_HOSTS+=("$host")
 }
 
+# rmslab_exec_on HOST N CMD...: becomes CMD on HOST (this machine or a
+# network namespace) with the session's epoch and RMSLAB_RESTART=N in its
+# environment. Start it in the background (`rmslab_exec_on ... &`): the
+# subshell is replaced by the command, so $! is the command's pid.
+rmslab_exec_on() {
+  local host="$1" n="$2"; shift 2
+  local envs=(env "RMSLAB_SESSION_EPOCH_US=$RMSLAB_EPOCH_US" "RMSLAB_RESTART=$n")
+  case "$host" in
+    ""|localhost) exec "${envs[@]}" "$@" ;;
+    netns:*) exec "${RMSLAB_SUDO[@]}" nsenter --net="/var/run/netns/${host#netns:}" -- "${envs[@]}" "$@" ;;
+    *) rmslab_say "unknown host '$host'"; exit 2 ;;
+  esac
+}
+
 rmslab_supervise() {  # (in the background) NAME HOST CMD...
   local name="$1" host="$2"; shift 2
   local log="$RMSLAB_OUT/logs/$name.log" n=0 rc=0 pid t_down="" readies=0 i
   while :; do
-    local envs=(env "RMSLAB_SESSION_EPOCH_US=$RMSLAB_EPOCH_US" "RMSLAB_RESTART=$n")
-    case "$host" in
-      ""|localhost) "${envs[@]}" "$@" >>"$log" 2>&1 & ;;
-      netns:*) "${RMSLAB_SUDO[@]}" nsenter --net="/var/run/netns/${host#netns:}" -- "${envs[@]}" "$@" >>"$log" 2>&1 & ;;
-    esac
+    rmslab_exec_on "$host" "$n" "$@" >>"$log" 2>&1 &
     pid=$!
     echo "$pid" >"$RMSLAB_OUT/run/$name.pid"
     if [ "$n" -gt 0 ]; then

@@ -80,6 +80,10 @@ double Decode(const FixedFormat& f, std::int32_t carried) {
   return static_cast<double>(DecodeRaw(f, carried)) / static_cast<double>(std::int64_t{1} << f.frac_bits);
 }
 
+double RoundTrip(const FixedFormat& f, double value) {
+  return Decode(f, static_cast<std::int32_t>(Encode(f, value).word));
+}
+
 Word EncodeAngleBam(double angle_deg) {
   if (!std::isfinite(angle_deg)) {
     throw InputError("cannot encode angle " + std::to_string(angle_deg) +

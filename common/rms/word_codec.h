@@ -84,6 +84,8 @@ Word EncodeExact(const FixedFormat& f, double value);
 std::int32_t DecodeRaw(const FixedFormat& f, std::int32_t carried);
 // value = raw * lsb. Same errors as DecodeRaw.
 double Decode(const FixedFormat& f, std::int32_t carried);
+// The value as a receiver reads it back: Decode(Encode(value)) (saturating).
+double RoundTrip(const FixedFormat& f, double value);
 
 // Raw of a word that the caller has already validated (IsValidWord): no checks.
 inline std::int32_t RawUnchecked(const FixedFormat& f, Word w) {

@@ -13,8 +13,8 @@ namespace rms::dcp {
 ArmSinCos TransmittedArmWords(const std::array<double, 6>& angles_deg) {
   ArmSinCos sc = SinCosFromDegrees(angles_deg);
   for (SinCos& a : sc) {
-    a.s = wire::Decode(wire::kSC22, static_cast<std::int32_t>(wire::Encode(wire::kSC22, a.s).word));
-    a.c = wire::Decode(wire::kSC22, static_cast<std::int32_t>(wire::Encode(wire::kSC22, a.c).word));
+    a.s = wire::RoundTrip(wire::kSC22, a.s);
+    a.c = wire::RoundTrip(wire::kSC22, a.c);
   }
   return sc;
 }

@@ -40,10 +40,9 @@ class NetnsLab {
   bool ok_ = false, down_ = false;
 };
 
-TEST(MultiHost, ASessionRunsAcrossNamespaceHosts) {
-  const std::string dir = testing::MakeTempDir("hosts");
-  NetnsLab net("rt" + std::to_string(getpid() % 100000), dir);
-  ASSERT_TRUE(net.ok()) << "network namespaces could not be made (root, iproute2):\n" << ReadFile(dir + "/netns.log");
+// A lab file with one process a host (the recorder beside the operator
+// station), on a group and port of its own, TTL 1.
+std::string WriteLabFile(const NetnsLab& net, const std::string& dir) {
   const std::string lab_file = dir + "/lab.toml";
   std::ofstream(lab_file) << "[hosts]\n"
                           << "operator_station = \"" << net.host(1) << "\"\n"
@@ -52,9 +51,22 @@ TEST(MultiHost, ASessionRunsAcrossNamespaceHosts) {
                           << "esg_renderer = \"" << net.host(4) << "\"\n"
                           << "recorder = \"" << net.host(1) << "\"\n"
                           << "[lcm]\ngroup = \"239.255.76.68\"\nport = 7668\nttl = 1\n[remote]\nroot = \"\"\nbuild = \"\"\n";
-  Subprocess lab({SourcePath("scripts/lab"), "demo", "--no-build", "--lab", lab_file, "--out", dir + "/session", "--speed",
-                  "4", "--png-every", "0", "--no-video", "--width", "160", "--height", "120"},
-                 dir + "/lab.log", {std::string("RMSLAB_BUILD=") + RMSLAB_BUILD_DIR});
+  return lab_file;
+}
+
+// scripts/lab demo across the lab's hosts: the autopilot at 4x, small frames.
+Subprocess FlyAcross(const std::string& lab_file, const std::string& dir) {
+  return Subprocess({SourcePath("scripts/lab"), "demo", "--no-build", "--lab", lab_file, "--out", dir + "/session",
+                     "--speed", "4", "--png-every", "0", "--no-video", "--width", "160", "--height", "120"},
+                    dir + "/lab.log", {std::string("RMSLAB_BUILD=") + RMSLAB_BUILD_DIR});
+}
+
+TEST(MultiHost, ASessionRunsAcrossNamespaceHosts) {
+  const std::string dir = testing::MakeTempDir("hosts");
+  NetnsLab net("rt" + std::to_string(getpid() % 100000), dir);
+  ASSERT_TRUE(net.ok()) << "network namespaces could not be made (root, iproute2):\n" << ReadFile(dir + "/netns.log");
+  const std::string lab_file = WriteLabFile(net, dir);
+  Subprocess lab = FlyAcross(lab_file, dir);
   ASSERT_EQ(lab.Wait(300), 0) << ReadFile(dir + "/lab.log");
   const auto m = nlohmann::json::parse(ReadFile(dir + "/session/manifest.json"));
   EXPECT_EQ(m["hosts"]["dynamics_proc"], net.host(2));
@@ -99,17 +111,8 @@ TEST(MultiHost, OverALossyLinkEveryGapIsCountedAndTheAutopilotStillDocks) {
   Subprocess impair({SourcePath("scripts/netns-lab"), "impair", prefix, "2", "loss=5", "dup=1"}, dir + "/impair.log");
   ASSERT_EQ(impair.Wait(30), 0) << ReadFile(dir + "/impair.log");
   std::printf("%s", ReadFile(dir + "/impair.log").c_str());
-  const std::string lab_file = dir + "/lab.toml";
-  std::ofstream(lab_file) << "[hosts]\n"
-                          << "operator_station = \"" << net.host(1) << "\"\n"
-                          << "dynamics_proc = \"" << net.host(2) << "\"\n"
-                          << "scene_proc = \"" << net.host(3) << "\"\n"
-                          << "esg_renderer = \"" << net.host(4) << "\"\n"
-                          << "recorder = \"" << net.host(1) << "\"\n"
-                          << "[lcm]\ngroup = \"239.255.76.68\"\nport = 7668\nttl = 1\n[remote]\nroot = \"\"\nbuild = \"\"\n";
-  Subprocess lab({SourcePath("scripts/lab"), "demo", "--no-build", "--lab", lab_file, "--out", dir + "/session", "--speed",
-                  "4", "--png-every", "0", "--no-video", "--width", "160", "--height", "120"},
-                 dir + "/lab.log", {std::string("RMSLAB_BUILD=") + RMSLAB_BUILD_DIR});
+  const std::string lab_file = WriteLabFile(net, dir);
+  Subprocess lab = FlyAcross(lab_file, dir);
   ASSERT_EQ(lab.Wait(300), 0) << ReadFile(dir + "/lab.log");
   const auto s = nlohmann::json::parse(ReadFile(dir + "/session/summary.json"));
   EXPECT_TRUE(s["docked"].get<bool>()) << ReadFile(dir + "/lab.log");
