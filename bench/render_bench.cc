@@ -91,6 +91,7 @@ int main(int argc, char** argv) {
     std::vector<std::uint8_t> ref(n * 4), out(n * 4);
     std::vector<std::string> names;
     for (const auto& c : config.cameras) names.push_back(c.name);
+    const rms::esg::OverlayModel overlay = rms::esg::MakeOverlayModel(config);
 
     std::vector<double> all_stations_ms, overlay_ms;
     long frames = 0, unchanged = 0;
@@ -142,7 +143,7 @@ int main(int argc, char** argv) {
       {
         const auto t0 = Clock::now();
         std::memcpy(out.data(), ref.data(), n * 4);
-        rms::esg::DrawOverlay(out.data(), width, height, f, names);
+        rms::esg::DrawOverlay(out.data(), width, height, f, overlay);
         overlay_ms.push_back(Ms(Clock::now() - t0));
       }
     }

@@ -1,18 +1,22 @@
 // The other messages every process reads: RMS_DCP_TELEMETRY (SafeDecode and
 // TelemetryProblem, as operator_station), RMS_STATUS (process_status_t, as
-// operator_station and rms_monitor) and RMS_CONTROL (session_control_t, as
-// every process). The first byte picks the message type.
+// operator_station and rms_monitor), RMS_CONTROL (session_control_t, as
+// every process), RMS_OPERATOR_STATE (operator_state_t, as esg_renderer) and
+// RMS_WINDOW_KEYS (window_keys_t, as operator_station). The first byte picks
+// the message type.
 #include "fuzz_common.h"
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/message_io.h"
 #include "rms/process_status_t.hpp"
 #include "rms/session_control_t.hpp"
+#include "rms/operator_state_t.hpp"
 #include "rms/telemetry_check.h"
+#include "rms/window_keys_t.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
   const int n = static_cast<int>(size - 1);
-  switch (data[0] % 3) {
+  switch (data[0] % 5) {
     case 0: {
       rms::dcp_telemetry_t m{};
       if (rms::SafeDecode(data + 1, n, 4096, &m) == rms::DecodeError::kNone) (void)rms::TelemetryProblem(m);
@@ -28,9 +32,24 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       }
       break;
     }
-    default: {
+    case 2: {
       rms::session_control_t m;
       (void)rms::SafeDecode(data + 1, n, 1 << 16, &m);
+      break;
+    }
+    case 3: {
+      rms::operator_state_t m{};
+      (void)rms::SafeDecode(data + 1, n, 1024, &m);
+      break;
+    }
+    default: {
+      rms::window_keys_t m;
+      if (rms::SafeDecode(data + 1, n, 8 + 16 + 2 + 2 * 512 + 2 + 2 * 512 + 1, &m) == rms::DecodeError::kNone) {
+        long sum = 0;  // every key, as the station reads them
+        for (int i = 0; i < m.num_held; ++i) sum += m.held[i];
+        for (int i = 0; i < m.num_pressed; ++i) sum += m.pressed[i];
+        (void)sum;
+      }
       break;
     }
   }

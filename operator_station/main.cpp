@@ -8,7 +8,7 @@
 int main(int argc, char** argv) {
   CLI::App app{"rmslab operator station: publishes the operator's input block (Table I) on "
                "RMS_OPERATOR_INPUT at the frame rate, from a timeline file, the operator's hand controllers "
-               "(keyboard, gamepad, 3D mouse) or the autopilot, with a live status screen."};
+               "(keyboard, live window, gamepad, 3D mouse) or the autopilot, with a live status screen."};
   rms::CommonOptions common;
   rms::op::OperatorOptions opt;
   app.add_option("--timeline", opt.timeline_path, "Fly a timeline file (docs/timeline.md)")->check(CLI::ExistingFile);
@@ -22,6 +22,8 @@ int main(int argc, char** argv) {
   bool no_gamepad = false, no_spacemouse = false, status_on = false, status_off = false;
   app.add_flag("--no-gamepad", no_gamepad, "Don't look for a gamepad or joystick");
   app.add_flag("--no-spacemouse", no_spacemouse, "Don't look for a 3D mouse");
+  app.add_flag("--window-keys", opt.window_keys,
+               "By hand: fly from the live window's keys too (esg_renderer --window; RMS_WINDOW_KEYS)");
   app.add_flag("--status", status_on, "Show the live status screen (default: on when flying by hand in a terminal)");
   app.add_flag("--no-status", status_off, "No status screen");
   app.add_option("--rate", opt.rate_hz, "Frame rate, Hz (default: config session.frame_rate_hz)")
@@ -39,7 +41,7 @@ int main(int argc, char** argv) {
                             opt.gamepad = !no_gamepad;
                             opt.spacemouse = !no_spacemouse;
                             opt.status = status_on ? 1 : status_off ? 0 : -1;
-                            return rms::op::RunOperatorStation(opt, config, lcm, common.stats_path,
-                                                               common.ready_path);
+                            rms::op::OperatorStation station(opt, config, lcm, rms::op::MakeSource(opt, config));
+                            return station.Run(common.stats_path, common.ready_path);
                           });
 }

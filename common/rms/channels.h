@@ -10,5 +10,7 @@ inline constexpr const char* kEsgFrame = "RMS_ESG_FRAME";            // scene_pr
 inline constexpr const char* kStatus = "RMS_STATUS";                 // every process -> monitors, log
 inline constexpr const char* kDcpTelemetry = "RMS_DCP_TELEMETRY";    // dynamics_proc -> operator_station, monitors
 inline constexpr const char* kControl = "RMS_CONTROL";               // rms_control, operator_station -> every process
+inline constexpr const char* kOperatorState = "RMS_OPERATOR_STATE";  // operator_station -> esg_renderer (window), log
+inline constexpr const char* kWindowKeys = "RMS_WINDOW_KEYS";        // esg_renderer (window) -> operator_station
 
 }  // namespace rms::channels

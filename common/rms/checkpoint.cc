@@ -22,6 +22,7 @@ void WriteCheckpoint(const std::string& path, const Checkpoint& c) {
   for (int i = 0; i < kNumAnalogInputs; ++i) in[std::string(kAnalogInputNames[i])] = c.inputs.value[i];
   in["camera_station"] = c.inputs.camera_station;
   in["overlay"] = c.inputs.overlay;
+  in["crosshairs"] = c.inputs.crosshairs;
   j["operator_inputs"] = in;
   j["dcp"] = c.dcp;
   std::ofstream f(path);
@@ -56,6 +57,7 @@ Checkpoint ParseCheckpoint(std::string_view text, const std::string& path) {
     for (int i = 0; i < kNumAnalogInputs; ++i) c.inputs.value[i] = o.at(std::string(kAnalogInputNames[i])).get<double>();
     c.inputs.camera_station = o.at("camera_station").get<int>();
     c.inputs.overlay = o.at("overlay").get<bool>();
+    c.inputs.crosshairs = o.value("crosshairs", false);  // absent before the crosshairs switch
     c.dcp = j.at("dcp");
   } catch (const std::exception& e) {
     throw InputError("checkpoint '" + path + "': " + e.what());

@@ -60,6 +60,16 @@ LabConfig ParseConfig(std::string_view text, const std::string& source) {
     c.arm.lower_boom_ft = r.Positive("lower_boom_ft");
     c.arm.wrist_to_palm_ft = r.Positive("wrist_to_palm_ft");
     c.arm.boom_diameter_ft = r.Positive("boom_diameter_ft");
+    const std::vector<double> lo = r.Numbers("joint_min_deg", 6, -180.0, 180.0);
+    const std::vector<double> hi = r.Numbers("joint_max_deg", 6, -180.0, 180.0);
+    for (int i = 0; i < 6; ++i) {
+      if (!(lo[i] < hi[i])) {
+        r.Fail("joint_max_deg", "joint " + std::to_string(i + 1) + " (" + std::string(kAnalogInputNames[i]) +
+                                    "): max " + FormatNumber(hi[i]) + " must be greater than min " + FormatNumber(lo[i]));
+      }
+      c.arm.joint_min_deg[i] = lo[i];
+      c.arm.joint_max_deg[i] = hi[i];
+    }
     r.Finish();
   }
   {

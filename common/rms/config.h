@@ -38,6 +38,12 @@ struct ArmGeometry {
   double lower_boom_ft = 0;                 // elbow E to wrist W
   double wrist_to_palm_ft = 0;              // wrist W to point A (System Two origin)
   double boom_diameter_ft = 0;              // rendering
+  // The joints' travel, shoulder yaw .. wrist roll, deg (the arm as flown:
+  // docs/config.md). The operator station's motions (hand controllers,
+  // autopilot) stop a joint at its limit and say so; the DCP takes what it is
+  // given (its inputs' ranges are [inputs.*]).
+  std::array<double, 6> joint_min_deg{};
+  std::array<double, 6> joint_max_deg{};
 };
 
 // [end_effector]: EFF HEX 1 (palm) and the fingers, System Two dimensions.

@@ -14,6 +14,7 @@ wire::Word PackControlWord(const ControlWord& cw) {
   std::uint32_t w = static_cast<std::uint32_t>(cw.camera_station - 1) << kCameraShift;
   if (cw.reset) w |= kReset;
   if (cw.overlay) w |= kOverlay;
+  if (cw.crosshairs) w |= kCrosshairs;
   w |= static_cast<std::uint32_t>(cw.mode) << kModeShift;
   if (cw.collision) w |= kCollision;
   if (cw.receptacle_collision) w |= kReceptacle;
@@ -30,12 +31,13 @@ ControlWord UnpackControlWord(std::int32_t carried) {
   }
   const auto w = static_cast<std::uint32_t>(carried);
   if (w & kReservedMask) {
-    throw InputError("control word " + wire::FormatWord(carried) + " has reserved bits 5-7 set");
+    throw InputError("control word " + wire::FormatWord(carried) + " has reserved bits 6-7 set");
   }
   ControlWord cw;
   cw.camera_station = static_cast<int>((w >> kCameraShift) & kCameraMask) + 1;
   cw.reset = w & kReset;
   cw.overlay = w & kOverlay;
+  cw.crosshairs = w & kCrosshairs;
   cw.mode = static_cast<int>((w >> kModeShift) & kModeMask);
   if (cw.mode == 0) {
     throw InputError("control word " + wire::FormatWord(carried) + " has mode 0 (must be 1-3)");

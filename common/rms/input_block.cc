@@ -55,6 +55,7 @@ std::array<std::int32_t, kInputWords> EncodeInputs(const OperatorInputs& in,
   std::uint32_t d = static_cast<std::uint32_t>(station - 1) & kDiscreteCameraMask;
   if (in.reset) d |= kDiscreteReset;
   if (in.overlay) d |= kDiscreteOverlay;
+  if (in.crosshairs) d |= kDiscreteCrosshairs;
   words[kDiscreteWordIndex] = static_cast<std::int32_t>(d);
   return words;
 }
@@ -69,7 +70,7 @@ OperatorInputs DecodeInputs(const std::array<std::int32_t, kInputWords>& words,
   const std::uint32_t d = static_cast<std::uint32_t>(words[kDiscreteWordIndex]);
   if (d & kDiscreteReservedMask) {
     throw InputError("input discrete word " + wire::FormatWord(words[kDiscreteWordIndex]) +
-                     " has reserved bits 5-23 set");
+                     " has reserved bits 6-23 set");
   }
   OperatorInputs in;
   for (int i = 0; i < kNumAnalogInputs; ++i) {
@@ -91,6 +92,7 @@ OperatorInputs DecodeInputs(const std::array<std::int32_t, kInputWords>& words,
   in.camera_station = static_cast<int>(d & kDiscreteCameraMask) + 1;
   in.reset = (d & kDiscreteReset) != 0;
   in.overlay = (d & kDiscreteOverlay) != 0;
+  in.crosshairs = (d & kDiscreteCrosshairs) != 0;
   return in;
 }
 

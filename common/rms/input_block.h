@@ -51,11 +51,12 @@ struct InputCalibration {
 };
 using InputCalibrations = std::array<InputCalibration, kNumAnalogInputs>;
 
-// Discrete word (word 11) bits. Bits 5-23 are reserved and must be zero.
+// Discrete word (word 11) bits. Bits 6-23 are reserved and must be zero.
 inline constexpr std::uint32_t kDiscreteCameraMask = 0x7;  // bits 0-2: camera station - 1
 inline constexpr std::uint32_t kDiscreteReset = 1u << 3;    // reset pushbutton (momentary)
 inline constexpr std::uint32_t kDiscreteOverlay = 1u << 4;  // overlay switch (frame counter, indicators)
-inline constexpr std::uint32_t kDiscreteReservedMask = 0xFFFFE0u;
+inline constexpr std::uint32_t kDiscreteCrosshairs = 1u << 5;  // crosshairs switch (wrist and port cameras)
+inline constexpr std::uint32_t kDiscreteReservedMask = 0xFFFFC0u;
 
 // The operator's inputs in engineering units.
 struct OperatorInputs {
@@ -63,6 +64,7 @@ struct OperatorInputs {
   int camera_station = 1;                         // 1..8
   bool reset = false;
   bool overlay = true;
+  bool crosshairs = false;
 };
 
 // The initial inputs: each channel's calibration.initial, camera 1.

@@ -322,7 +322,7 @@ std::vector<int> DrawOrder(const PriorityBits& bits, const std::array<ScreenBox,
                            int* cycles_broken, float overlap_tol) {
   // Edges "drawn before": u -> v. A pair's bit set: the first cluster may
   // hide the second, so the second goes first.
-  std::array<std::uint32_t, kNumClusters> before{};  // bit u of before[v]: u must precede v
+  std::array<std::uint64_t, kNumClusters> before{};  // (kNumClusters <= 64)  // bit u of before[v]: u must precede v
   std::vector<int> nodes;
   for (int c = 0; c < kNumClusters; ++c) {
     if (boxes[c].visible) nodes.push_back(c);
@@ -333,13 +333,13 @@ std::vector<int> DrawOrder(const PriorityBits& bits, const std::array<ScreenBox,
       if (!OutlinesOverlap(boxes[a], boxes[b], overlap_tol)) continue;
       const bool a_front = bits[PairIndex(a, b)];
       const int first = a_front ? b : a, second = a_front ? a : b;
-      before[second] |= 1u << first;
+      before[second] |= std::uint64_t{1} << first;
     }
   }
   std::vector<int> order;
   order.reserve(nodes.size());
-  std::uint32_t remaining = 0;
-  for (int c : nodes) remaining |= 1u << c;
+  std::uint64_t remaining = 0;
+  for (int c : nodes) remaining |= std::uint64_t{1} << c;
   if (cycles_broken) *cycles_broken = 0;
   while (remaining) {
     int pick = -1;
@@ -364,7 +364,7 @@ std::vector<int> DrawOrder(const PriorityBits& bits, const std::array<ScreenBox,
       if (cycles_broken) ++*cycles_broken;
     }
     order.push_back(pick);
-    remaining &= ~(1u << pick);
+    remaining &= ~(std::uint64_t{1} << pick);
   }
   return order;
 }

@@ -3,7 +3,7 @@
 // after Schumacker et al. (1969); docs/scene.md "Visual priority" is the
 // design, this implements it.
 //
-// Every pair of the scene's 32 convex clusters has a separating plane. Each
+// Every pair of the scene's 34 convex clusters has a separating plane. Each
 // frame the Visual Scene Program (scene_proc) sets one bit a plane: 1 when the
 // viewpoint is on the side of the pair's first cluster (the lower id), which
 // can then hide the second but not be hidden by it. The ESG turns the bits
@@ -29,7 +29,8 @@
 
 namespace rms {
 
-inline constexpr int kNumPairs = kNumClusters * (kNumClusters - 1) / 2;  // 496
+inline constexpr int kNumPairs = kNumClusters * (kNumClusters - 1) / 2;  // 561
+static_assert(kNumPairs == esg_words::kScenePairs && kNumClusters <= 64);
 // Index of the pair (a, b), a < b, in lexicographic order.
 constexpr int PairIndex(int a, int b) { return a * (2 * kNumClusters - a - 1) / 2 + (b - a - 1); }
 std::pair<int, int> PairOf(int index);
@@ -42,7 +43,7 @@ inline constexpr std::array<std::pair<int, int>, 3> kDcpPairs = {
 using PriorityBits = std::bitset<kNumPairs>;
 
 // The bits on the wire (docs/protocol.md): the DCP pairs in the control
-// word's PRIORITY_DYNAMIC bits, then the other 493 pairs in pair order: the
+// word's PRIORITY_DYNAMIC bits, then the other 558 pairs in pair order: the
 // first 7 in PRIORITY_FIXED, the rest in the ESG frame's priority words,
 // bit 0 of word 0 first, 24 to a word.
 void PackPriority(const PriorityBits& bits, ControlWord* cw,

@@ -138,7 +138,7 @@ void AddLatencyCounters(const LatencyMap& latencies, Counters* counters) {
 
 void RunNodeLoop(LcmInterface& lcm, const std::string& process, Counters& counters,
                  const LatencyMap& latencies, const std::function<std::int64_t()>& last_frame,
-                 const std::function<void()>& after_wait, const std::string& stats_path) {
+                 const std::function<void()>& after_wait, const std::string& stats_path, int wait_ms) {
   StatusReporter status(&lcm, process);
   auto report = [&] {
     Counters r = counters;
@@ -146,7 +146,7 @@ void RunNodeLoop(LcmInterface& lcm, const std::string& process, Counters& counte
     return r;
   };
   while (!StopRequested()) {
-    if (lcm.HandleSubscriptions(100) < 0) counters.Add("transport_errors");
+    if (lcm.HandleSubscriptions(wait_ms) < 0) counters.Add("transport_errors");
     if (after_wait) after_wait();
     status.Tick(last_frame(), report());
   }

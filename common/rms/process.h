@@ -81,13 +81,14 @@ using LatencyMap = std::map<std::string, LatencyHistogram>;
 // "latency.NAME.p50_us" ...), for status reports.
 void AddLatencyCounters(const LatencyMap& latencies, Counters* counters);
 
-// The main loop of a subscribing process: waits for messages (dispatching
-// them to its handlers), calls `after_wait` after each wait, publishes the
-// counters on RMS_STATUS once a second, and at SIGINT / SIGTERM publishes the
-// final report and writes the stats file (if stats_path is set).
+// The main loop of a subscribing process: waits for messages (at most
+// wait_ms, dispatching them to its handlers), calls `after_wait` after each
+// wait, publishes the counters on RMS_STATUS once a second, and at SIGINT /
+// SIGTERM publishes the final report and writes the stats file (if
+// stats_path is set).
 void RunNodeLoop(LcmInterface& lcm, const std::string& process, Counters& counters,
                  const LatencyMap& latencies, const std::function<std::int64_t()>& last_frame,
-                 const std::function<void()>& after_wait, const std::string& stats_path);
+                 const std::function<void()>& after_wait, const std::string& stats_path, int wait_ms = 100);
 
 // Writes {"process":..., "counters":{...}, "latency_us":{NAME:{count,p50,p99,max,mean}}}.
 void WriteStatsJson(const std::string& path, const std::string& process, const Counters& counters,

@@ -14,11 +14,17 @@ std::string_view ClusterName(int id) {
   static constexpr std::array<std::string_view, kNumClusters> kNames = {
       "floor",        "wall_port",    "wall_stbd",  "bulkhead_fwd", "bulkhead_aft", "sill_port",
       "sill_stbd",    "side_port",    "side_stbd",  "cabin",        "aft_fuselage", "tail",
-      "wing_port",    "wing_stbd",    "door_port",  "door_stbd",    "cae_module",   "cae_array",
+      "wing_port",    "wing_stbd",    "door_port",  "door_stbd",    "cae_module",   "cae_array",    "dock_target",
       "post",         "shoulder",     "upper_boom", "elbow",        "lower_boom",   "wrist",
       "eff_hex_1",    "eff_hex_2",    "eff_hex_3",  "payload_body", "bar",          "bar_post_a",
-      "bar_post_b",   "probe"};
+      "bar_post_b",   "probe",        "grapple_target"};
   return id >= 0 && id < kNumClusters ? kNames[id] : "?";
+}
+
+Eigen::Vector3d GrappleTargetCentre_P(const PayloadConfig& p) {
+  // Half a foot beyond the bar's -x_P end, its top 0.1 ft below the bar's bottom.
+  return {p.p_PoBar_P_ft.x() - 0.5 * p.bar_size_P_ft.x() - 0.5, p.p_PoBar_P_ft.y(),
+          p.p_PoBar_P_ft.z() - 0.5 * p.bar_size_P_ft.z() - 0.1};
 }
 
 double MovingFingerCentreY2(const EndEffectorConfig& ee, double gap) {
@@ -33,7 +39,8 @@ constexpr Rgb kWhite{232, 232, 226}, kBayFloor{150, 150, 146}, kBayWall{178, 178
     kBulkhead{160, 158, 150}, kTile{34, 34, 36}, kRadiator{214, 222, 236}, kWindow{20, 26, 40},
     kEngine{70, 70, 74}, kBoom{238, 238, 238}, kJoint{96, 96, 100}, kPalm{120, 122, 132},
     kFinger{214, 170, 40}, kGold{206, 164, 64}, kBarRgb{36, 36, 36}, kProbeRgb{186, 188, 196},
-    kCaeRgb{200, 202, 212}, kPort{24, 24, 28}, kPanel{44, 56, 120};
+    kCaeRgb{200, 202, 212}, kPort{24, 24, 28}, kPanel{44, 56, 120}, kTargetWhite{246, 246, 240},
+    kTargetBlack{12, 12, 12};
 
 constexpr float kDecalOffset = 0.02f;  // ft off the face a decal marks
 constexpr float kGap = static_cast<float>(kClusterClearanceFt);
@@ -176,8 +183,28 @@ void BuildCae(const CaeConfig& cae, std::array<Cluster, kNumClusters>* c) {
   Mesh& m = (*c)[kCaeModule].mesh;
   m.AddExtrusion(hex, V(0, 0, 2 * hl), kCaeRgb);
   m.SetDecal(true);  // the docking port on face c (y_C = 0), facing out (-y_C)
-  Disc(&m, V(0, -kDecalOffset, 0), V(0, -1, 0), static_cast<float>(cae.port_diameter_ft / 2), 12, kPort);
+  const float pr = static_cast<float>(cae.port_diameter_ft / 2);
+  Disc(&m, V(0, -kDecalOffset, 0), V(0, -1, 0), 1.25f * pr, 16, kTargetWhite);  // a white rim round the port
+  Disc(&m, V(0, -2 * kDecalOffset, 0), V(0, -1, 0), pr, 16, kPort);
+  // The docking target beside the port (docs/scene.md "Targets"): a black
+  // disc with a white rim on face c, and a white cross standing off it, so
+  // seen from off its axis the cross moves off the disc's centre.
+  const V at(0, 0, static_cast<float>(kDockTargetAlongFt));
+  Disc(&m, at + V(0, -kDecalOffset, 0), V(0, -1, 0), 0.9f, 16, kTargetWhite);
+  Disc(&m, at + V(0, -2 * kDecalOffset, 0), V(0, -1, 0), 0.75f, 16, kTargetBlack);
   m.SetDecal(false);
+  // Its standoff: a white plate with a black cross, kDockTargetStandoffFt
+  // out from face c (the post that would hold it is left out).
+  Mesh& t = (*c)[kDockTarget].mesh;
+  const float so = static_cast<float>(kDockTargetStandoffFt), half = 0.3f, thick = 0.05f, arm = 0.25f, bar = 0.04f;
+  t.AddBox(at + V(-half, -so - thick, -half), at + V(half, -so, half), kTargetWhite);
+  t.SetDecal(true);
+  const float y = -so - thick - kDecalOffset;
+  t.AddQuad(at + V(-arm, y, -bar), at + V(arm, y, -bar), at + V(arm, y, bar), at + V(-arm, y, bar), V(0, -1, 0),
+            kTargetBlack);
+  t.AddQuad(at + V(-bar, y - kDecalOffset, -arm), at + V(bar, y - kDecalOffset, -arm),
+            at + V(bar, y - kDecalOffset, arm), at + V(-bar, y - kDecalOffset, arm), V(0, -1, 0), kTargetBlack);
+  t.SetDecal(false);
   // The solar array on a boom above the module's far side.
   (*c)[kCaeArray].mesh.AddBox(V(-35, fl + 0.6f, -6), V(35, fl + 0.8f, 6), kPanel);
 }
@@ -210,12 +237,43 @@ void BuildPayload(const PayloadConfig& p, std::array<Cluster, kNumClusters>* c) 
   const V bc = F(p.p_PoBar_P_ft), bs = F(p.bar_size_P_ft);
   (*c)[kBar].mesh.AddBox(bc - 0.5f * bs, bc + 0.5f * bs, kBarRgb);
   const float top = r * std::cos(phase);
+  // The grapple target (docs/scene.md "Targets"): a white plate with a black
+  // cross standing off the body beside the bar's end, over a black disc with
+  // a white rim on the body: from the wrist camera at the grasp the cross
+  // sits on the crosshair, centred in the disc; off, it moves off both.
+  {
+    const V at = F(GrappleTargetCentre_P(p));
+    const float half = 0.25f, thick = 0.05f, arm = 0.2f, bar = 0.035f;
+    Mesh& t = (*c)[kGrappleTarget].mesh;
+    t.AddBox(at + V(-half, -half, -thick), at + V(half, half, 0), kTargetWhite);
+    t.SetDecal(true);
+    const float z = at.z() + kDecalOffset;
+    t.AddQuad(V(at.x() - arm, at.y() - bar, z), V(at.x() + arm, at.y() - bar, z), V(at.x() + arm, at.y() + bar, z),
+              V(at.x() - arm, at.y() + bar, z), V(0, 0, 1), kTargetBlack);
+    t.AddQuad(V(at.x() - bar, at.y() - arm, z + kDecalOffset), V(at.x() + bar, at.y() - arm, z + kDecalOffset),
+              V(at.x() + bar, at.y() + arm, z + kDecalOffset), V(at.x() - bar, at.y() + arm, z + kDecalOffset),
+              V(0, 0, 1), kTargetBlack);
+    t.SetDecal(false);
+    // The disc on the body's facet under it (the facet next to the top flat).
+    Mesh& body = (*c)[kPayloadBody].mesh;
+    const float a = static_cast<float>(M_PI / 2 + 2 * phase);  // the facet's middle: 22.5 deg from the top
+    const V n(std::cos(a) * (at.x() < 0 ? 1.0f : -1.0f), 0, std::sin(a));
+    const float facet_r = r * std::cos(phase);  // the facets' distance from the axis
+    // Where the line from the plate straight down (-z_P) meets the facet.
+    const float z_on = (facet_r - n.x() * at.x()) / n.z();
+    const V on(at.x(), at.y(), z_on);
+    body.SetDecal(true);
+    Disc(&body, on + kDecalOffset * n, n, 0.45f, 16, kTargetWhite);
+    Disc(&body, on + 2 * kDecalOffset * n, n, 0.35f, 16, kTargetBlack);
+    body.SetDecal(false);
+  }
   const float post = std::min(0.3f, 0.4f * bs.x());
   for (int k = 0; k < 2; ++k) {
     const float x = bc.x() + (k ? 1.0f : -1.0f) * (0.5f * bs.x() - 0.5f * post);
     const float z1 = bc.z() - 0.5f * bs.z();
-    if (z1 - kGap > top + kGap) {
-      (*c)[k ? kBarPostB : kBarPostA].mesh.AddBox(V(x - 0.5f * post, bc.y() - 0.5f * post, top + kGap),
+    const float z0 = top + kGap;
+    if (z1 - kGap > z0) {
+      (*c)[k ? kBarPostB : kBarPostA].mesh.AddBox(V(x - 0.5f * post, bc.y() - 0.5f * post, z0),
                                                    V(x + 0.5f * post, bc.y() + 0.5f * post, z1 - kGap), kBarRgb);
     }
   }
@@ -271,7 +329,7 @@ SceneModel BuildSceneModel(const LabConfig& cfg) {
     if (i <= kDoorStbd) {
       k.frame = ClusterFrame::kReference;
       k.group = ClusterGroup::kShuttle;
-    } else if (i <= kCaeArray) {
+    } else if (i <= kDockTarget) {
       k.frame = ClusterFrame::kCae;
       k.group = ClusterGroup::kCae;
     } else if (i <= kEffHex3) {
@@ -309,7 +367,7 @@ ClusterPoses ComputeClusterPoses(const LabConfig& config, const EsgFrameData& f)
   const Eigen::Affine3d X_RF3 = aff(arm.X_RF3), X_RS2 = aff(arm.X_RS2);
   for (int i = 0; i < kNumClusters; ++i) {
     if (i <= kDoorStbd) p.X_RC[i] = Eigen::Affine3d::Identity();
-    else if (i <= kCaeArray) p.X_RC[i] = X_RC;
+    else if (i <= kDockTarget) p.X_RC[i] = X_RC;
     else if (i >= kPayloadBody) p.X_RC[i] = X_RP;
   }
   p.X_RC[kPost] = post;

@@ -1,5 +1,5 @@
 #pragma once
-// The scene's static model data (docs/scene.md): 32 convex clusters, each a
+// The scene's static model data (docs/scene.md): 34 convex clusters, each a
 // flat-shaded mesh in its own frame, posed every frame from the ESG frame's
 // words. The Visual Scene Program (scene_proc) uses the clusters' geometry
 // to place the separating planes of visual priority; the Electronic Scene
@@ -23,15 +23,16 @@ enum ClusterId : int {
   // fuselage sides, the cabin with its nose, the aft fuselage, tail, wings, doors.
   kFloor = 0, kWallPort, kWallStbd, kBulkheadFwd, kBulkheadAft, kSillPort, kSillStbd,
   kSidePort, kSideStbd, kCabin, kAftFuselage, kTail, kWingPort, kWingStbd, kDoorPort, kDoorStbd,
-  // The CAE (fixed in C): the module with its docking port, the solar array.
-  kCaeModule, kCaeArray,
+  // The CAE (fixed in C): the module with its docking port, the solar array,
+  // the docking target's standoff plate beside the port.
+  kCaeModule, kCaeArray, kDockTarget,
   // The arm.
   kPost, kShoulder, kUpperBoom, kElbow, kLowerBoom, kWrist, kEffHex1, kEffHex2, kEffHex3,
-  // The payload (frame P).
-  kPayloadBody, kBar, kBarPostA, kBarPostB, kProbe,
+  // The payload (frame P), with the grapple target's standoff plate beside the bar.
+  kPayloadBody, kBar, kBarPostA, kBarPostB, kProbe, kGrappleTarget,
   kNumClusters
 };
-static_assert(kNumClusters == 32);
+static_assert(kNumClusters == esg_words::kSceneClusters);
 
 std::string_view ClusterName(int id);
 
@@ -91,6 +92,14 @@ inline constexpr double kShoulderRadiusFt = 0.8;
 inline constexpr double kElbowRadiusFt = 1.0;  // the booms clear each other down to a 56 deg elbow
 inline constexpr double kWristRadiusFt = 0.5;
 inline constexpr double kWristClearanceFt = 0.75;  // lower boom's end to W
+// The grapple target (docs/scene.md "Targets"): its standoff plate's top
+// face, centred here in the payload frame P, beyond the bar's end on the
+// side the wrist camera looks from at the grasp.
+Eigen::Vector3d GrappleTargetCentre_P(const PayloadConfig& p);
+// The docking target beside the CAE's port (docs/scene.md "Targets"): this
+// far from the port's centre along z_C, its cross this far out from face c.
+inline constexpr double kDockTargetAlongFt = 3.5;
+inline constexpr double kDockTargetStandoffFt = 1.0;
 // Clusters that would touch are built this far apart (a well-formed scene
 // for visual priority: no two clusters share a surface; docs/scene.md).
 inline constexpr double kClusterClearanceFt = 0.01;

@@ -21,7 +21,9 @@ std::optional<std::string> TelemetryProblem(const dcp_telemetry_t& m) {
   auto all = [&](const double* v, int n) {
     for (int i = 0; i < n; ++i) finite = finite && std::isfinite(v[i]);
   };
-  for (double x : {m.finger_gap_ft, m.palm_to_bar_ft, m.dock_distance_ft, m.dock_angle_deg,
+  all(m.acquisition_margin_ft, 6);
+  for (double x : {m.finger_gap_ft, m.palm_to_bar_ft, m.bay_clearance_ft, m.envelope_margin_ft, m.dock_distance_ft,
+                   m.dock_angle_deg,
                    m.master_shoulder_height_ft, m.slave_shoulder_height_ft, m.master_finger, m.slave_finger})
     finite = finite && std::isfinite(x);
   all(m.plane_n, 9);

@@ -82,11 +82,17 @@ inline constexpr int kView = 19;          // 9 x SC22, R_RE row-major
 inline constexpr int kFov = 28;           // BAM24, vertical field of view
 inline constexpr int kPayloadPos = 29;    // 3 x FT12, p_RoPo_R
 inline constexpr int kPayloadRot = 32;    // 9 x SC22, R_RP row-major
-inline constexpr int kPriority = 41;      // 21 x BITS: visual-priority bits (docs/protocol.md)
-inline constexpr int kPriorityCount = 21;
-inline constexpr int kCount = 62;         // words used; the frame carries exactly these
-// Bits of the last priority word beyond the 493 - 7 pair bits: must be zero.
-inline constexpr std::uint32_t kLastPriorityWordMask = (1u << ((493 - 7) - 24 * (kPriorityCount - 1))) - 1;
+// The scene's convex clusters (rms/scene_model.h), one priority bit a pair:
+// the DCP's 3 in the control word's PRIORITY_DYNAMIC bits, the next 7 in
+// its PRIORITY_FIXED bits, the rest here, 24 a word.
+inline constexpr int kSceneClusters = 34;
+inline constexpr int kScenePairs = kSceneClusters * (kSceneClusters - 1) / 2;  // 561
+inline constexpr int kPriorityBits = kScenePairs - 3 - 7;                      // 551
+inline constexpr int kPriority = 41;      // BITS: visual-priority bits (docs/protocol.md)
+inline constexpr int kPriorityCount = (kPriorityBits + 23) / 24;               // 23
+inline constexpr int kCount = kPriority + kPriorityCount;  // 64 words used; the frame carries exactly these
+// Bits of the last priority word beyond the pair bits: must be zero.
+inline constexpr std::uint32_t kLastPriorityWordMask = (1u << (kPriorityBits - 24 * (kPriorityCount - 1))) - 1;
 }  // namespace esg_words
 static_assert(esg_words::kCount <= kEsgMaxWords);
 

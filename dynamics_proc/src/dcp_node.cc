@@ -201,10 +201,15 @@ dcp_telemetry_t MakeTelemetry(const DcpStatus& st, const DcpFrameData& out) {
   t.finger_held = st.finger_held;
   t.collisions = static_cast<std::int32_t>(st.collisions);
   t.slave_collisions = static_cast<std::int32_t>(st.slave_collisions);
-  for (int i = 0; i < 6; ++i) t.acquisition_conditions[i] = st.acquisition[i];
+  for (int i = 0; i < 6; ++i) {
+    t.acquisition_conditions[i] = st.acquisition[i];
+    t.acquisition_margin_ft[i] = st.acquisition_margin_ft[i];
+  }
   t.finger_gap_ft = st.finger_gap_ft;
   t.palm_to_bar_ft = st.palm_to_bar_ft;
+  t.bay_clearance_ft = st.bay_clearance_ft;
   t.probe_in_envelope = st.probe_in_envelope;
+  t.envelope_margin_ft = st.envelope_margin_ft;
   t.dock_distance_ft = st.dock_distance_ft;
   t.dock_angle_deg = st.dock_angle_deg;
   for (int k = 0; k < 3; ++k) {

@@ -220,33 +220,19 @@ DcpFrameData DynamicCollisionProgram::Step(const OperatorInputs& in) {
   status_.X_RP = slave_->X_RP;
   status_.finger_gap_ft = slave_->finger_gap_ft;
 
-  // The three dynamic separating planes, EFF HEX 1-3 against the BAR (Mode 1).
-  // A plane not valid this frame is sent as the default (n = Z, d = 0), so
-  // its words do not depend on earlier frames (a valid plane may, through
-  // frame coherence; the checkpoint keeps the planes).
-  status_.plane_valid = 0;
-  status_.planes = {};
-  if (status_.mode == 1) {
-    for (int k = 0; k < 3; ++k) {
-      const CollisionResult& r = slave_->ee_bar[k];
-      if (r.verdict == Verdict::kSeparate && r.plane_valid) {
-        // Centred in the gap, to survive rounding to the plane words.
-        status_.planes[k] = {r.n, MidGapOffset(slave_->ee.hex[k], bar_bay_, r.n)};
-        status_.plane_valid |= 1u << k;
-      }
-    }
-  }
-
+  UpdatePlanes();
   const int mode_before = status_.mode;
   UpdateDocking();  // distance and angle every frame; docking in Mode 3
   if (mode_before == 1) UpdateAcquisition();
   else if (mode_before == 2) UpdateExtraction();
+  else status_.bay_clearance_ft = BayClearance(slave_->payload);
 
   DcpFrameData out;
   out.arm = slave_->words;
   out.control.camera_station = in.camera_station;
   out.control.reset = in.reset;
   out.control.overlay = in.overlay;
+  out.control.crosshairs = in.crosshairs;
   out.control.mode = status_.mode;
   out.control.collision = (status_.collisions & ~collision_bits::kRecptMask) != 0;
   out.control.receptacle_collision = (status_.collisions & collision_bits::kRecptMask) != 0;
@@ -262,6 +248,51 @@ DcpFrameData DynamicCollisionProgram::Step(const OperatorInputs& in) {
   out.planes = status_.planes;
   out.plane_valid = status_.plane_valid;
   return out;
+}
+
+void DynamicCollisionProgram::UpdatePlanes() {
+  // The three dynamic separating planes, EFF HEX 1-3 against the BAR (Mode 1).
+  // A plane not valid this frame is sent as the default (n = Z, d = 0), so
+  // its words do not depend on earlier frames (a valid plane may, through
+  // frame coherence; the checkpoint keeps the planes).
+  status_.plane_valid = 0;
+  status_.planes = {};
+  if (status_.mode != 1) return;
+  for (int k = 0; k < 3; ++k) {
+    const CollisionResult& r = slave_->ee_bar[k];
+    if (r.verdict == Verdict::kSeparate && r.plane_valid) {
+      // Centred in the gap, to survive rounding to the plane words.
+      status_.planes[k] = {r.n, MidGapOffset(slave_->ee.hex[k], bar_bay_, r.n)};
+      status_.plane_valid |= 1u << k;
+    }
+  }
+}
+
+void DynamicCollisionProgram::RefreshMeasures() {
+  if (!have_slave_) return;
+  UpdatePlanes();
+  const DockingCheck d = CheckDocking(config_.dcp, config_.cae, cae_, slave_->payload, tau_rel_);
+  status_.probe_in_envelope = d.in_envelope;
+  status_.envelope_margin_ft = d.envelope_margin_ft;
+  status_.dock_distance_ft = d.distance_ft;
+  status_.dock_angle_deg = d.angle_deg;
+  status_.bay_clearance_ft = BayClearance(slave_->payload);
+  status_.acquisition = {};
+  status_.acquisition_margin_ft = {};
+  status_.palm_to_bar_ft = 0.0;
+  if (status_.mode == 1) {
+    const AcquisitionCheck c = CheckAcquisition(config_.dcp, slave_->ee, bar_bay_, slave_->finger_gap_ft, tau_rel_);
+    status_.acquisition = c.holds;
+    status_.acquisition_margin_ft = c.margin_ft;
+    status_.palm_to_bar_ft = c.palm_to_bar_ft;
+  }
+}
+
+double DynamicCollisionProgram::BayClearance(const PayloadModel& p) const {
+  // Height above the bay's top face c (its outward normal is +Z_R).
+  double lowest = 1e30;
+  for (const Eigen::Vector3d& v : p.v) lowest = std::min(lowest, bay_.Beyond(kFaceC, v.x(), v.y(), v.z()));
+  return lowest;
 }
 
 bool AcquisitionCheck::all() const {
@@ -284,10 +315,29 @@ AcquisitionCheck CheckAcquisition(const DcpConfig& dcp, const EndEffectorModel& 
   for (int v : kFaceVertices[kFaceC]) top += bar.vertex(v);
   top *= 0.25;
   c.palm_to_bar_ft = h1.Beyond(kFaceD, top.x(), top.y(), top.z());
-  c.holds[4] = c.palm_to_bar_ft < dcp.tpob_ft;
+  // The report's "distance": unsigned (a BAR behind the palm's face d is not
+  // near it; condition 1 fails there anyway, so acquisition is unchanged).
+  c.holds[4] = std::abs(c.palm_to_bar_ft) < dcp.tpob_ft;
   bool between = true;
   for (LocationWord w : bar.Words(h1, tau)) between = between && !(w & (FaceBit(kFaceA) | FaceBit(kFaceD)));
   c.holds[5] = between;
+  // Margins (docs/collision.md "Margins"): least depths, ft.
+  auto least_beyond = [](const Hexahedron& h, int face, const Hexahedron& of) {
+    double m = 1e30;
+    for (int i = 0; i < kNumVertices; ++i) m = std::min(m, h.Beyond(face, of.x[i], of.y[i], of.z[i]));
+    return m;
+  };
+  c.margin_ft[0] = least_beyond(h1, kFaceD, bar);
+  c.margin_ft[1] = least_beyond(h2, kFaceB, bar);
+  c.margin_ft[2] = least_beyond(h3, kFaceE, bar);
+  c.margin_ft[3] = dcp.d3y_ft - finger_gap_ft;
+  c.margin_ft[4] = dcp.tpob_ft - std::abs(c.palm_to_bar_ft);
+  double inside = 1e30;
+  for (int i = 0; i < kNumVertices; ++i) {
+    inside = std::min({inside, -bar.Beyond(kFaceA, h1.x[i], h1.y[i], h1.z[i]),
+                       -bar.Beyond(kFaceD, h1.x[i], h1.y[i], h1.z[i])});
+  }
+  c.margin_ft[5] = inside;
   return c;
 }
 
@@ -297,9 +347,14 @@ DockingCheck CheckDocking(const DcpConfig& dcp, const CaeConfig& cae, const Hexa
   const double tau = relative_tolerance * front.scale;
   const LocationWord sides = FaceBit(kFaceA) | FaceBit(kFaceB) | FaceBit(kFaceD) | FaceBit(kFaceE);
   d.in_envelope = true;
+  d.envelope_margin_ft = 1e30;
   for (int i = kProbeFirst; i < kPayloadVertices; ++i) {
     const LocationWord w = front.Word(p.v[i], tau);
     d.in_envelope = d.in_envelope && (w & FaceBit(kFaceC)) && !(w & sides);
+    const Eigen::Vector3d& v = p.v[i];
+    d.envelope_margin_ft = std::min({d.envelope_margin_ft, front.Beyond(kFaceC, v.x(), v.y(), v.z()),
+                                     -front.Beyond(kFaceA, v.x(), v.y(), v.z()), -front.Beyond(kFaceB, v.x(), v.y(), v.z()),
+                                     -front.Beyond(kFaceD, v.x(), v.y(), v.z()), -front.Beyond(kFaceE, v.x(), v.y(), v.z())});
   }
   d.distance_ft = (p.probe_tip_centre - cae.p_RoCo_R_ft).norm();
   const double c = std::clamp(p.probe_axis.dot(cae.R_RC.col(1)), -1.0, 1.0);
@@ -313,7 +368,9 @@ void DynamicCollisionProgram::UpdateAcquisition() {
   const AcquisitionCheck c =
       CheckAcquisition(config_.dcp, slave_->ee, bar_bay_, slave_->finger_gap_ft, tau_rel_);
   status_.acquisition = c.holds;
+  status_.acquisition_margin_ft = c.margin_ft;
   status_.palm_to_bar_ft = c.palm_to_bar_ft;
+  status_.bay_clearance_ft = BayClearance(slave_->payload);
   if (c.all()) {
     status_.mode = 2;
     status_.acquired = true;
@@ -336,6 +393,11 @@ void DynamicCollisionProgram::UpdateAcquisition() {
 
 void DynamicCollisionProgram::UpdateExtraction() {
   // Report IV.A.3: all payload and probe vertices above the bay's face c.
+  // The conditions of acquisition are not evaluated after it.
+  status_.acquisition = {};
+  status_.acquisition_margin_ft = {};
+  status_.palm_to_bar_ft = 0.0;
+  status_.bay_clearance_ft = BayClearance(slave_->payload);
   const double tau = tau_rel_ * bay_.scale;
   for (const Eigen::Vector3d& v : slave_->payload.v) {
     if (!(bay_.Word(v, tau) & FaceBit(kFaceC))) return;
@@ -347,6 +409,7 @@ void DynamicCollisionProgram::UpdateExtraction() {
 void DynamicCollisionProgram::UpdateDocking() {
   const DockingCheck d = CheckDocking(config_.dcp, config_.cae, cae_, slave_->payload, tau_rel_);
   status_.probe_in_envelope = d.in_envelope;
+  status_.envelope_margin_ft = d.envelope_margin_ft;
   status_.dock_distance_ft = d.distance_ft;
   status_.dock_angle_deg = d.angle_deg;
   if (status_.mode == 3 && !status_.docked && d.docked) {
@@ -467,6 +530,7 @@ void DynamicCollisionProgram::RestoreState(const nlohmann::json& j) {
       status_.X_RS2 = slave_->pose.X_RS2;
       status_.X_RP = slave_->X_RP;
       status_.finger_gap_ft = slave_->finger_gap_ft;
+      RefreshMeasures();  // nothing of the frames before the restore
     } else {
       status_.X_RP = X_RP_bay_;
     }

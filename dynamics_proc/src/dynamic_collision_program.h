@@ -51,13 +51,19 @@ inline constexpr double kReleaseOpeningFt = 0.05;
 //  2 all BAR vertices beyond face e of EFF HEX 3
 //  3 the distance between faces b (EFF HEX 2) and e (EFF HEX 3) below D3Y
 //  4 the distance from face d of EFF HEX 1 to the centre of the BAR's top
-//    face c below TPOB
+//    face c below TPOB (a distance: |palm_to_bar_ft| < TPOB)
 //  5 the end effector between the BAR's ends: no EFF HEX 1 vertex beyond
 //    the BAR's faces a or d
+// Each condition's margin, ft: by how much it holds (> 0) or how far it is
+// from holding (< 0) -- conditions 1-3 the least depth of a BAR vertex
+// beyond the face, 4 D3Y - gap, 5 TPOB - |palm_to_bar_ft|, 6 the least
+// depth of an EFF HEX 1 vertex inside the BAR's ends (docs/collision.md
+// "Margins").
 struct AcquisitionCheck {
   std::array<bool, 6> holds{};
+  std::array<double, 6> margin_ft{};
   double finger_gap_ft = 0.0;
-  double palm_to_bar_ft = 0.0;
+  double palm_to_bar_ft = 0.0;  // signed: positive when the BAR's top is beyond face d
   bool all() const;
 };
 AcquisitionCheck CheckAcquisition(const DcpConfig& dcp, const EndEffectorModel& ee, const Hexahedron& bar,
@@ -69,6 +75,7 @@ AcquisitionCheck CheckAcquisition(const DcpConfig& dcp, const EndEffectorModel& 
 // probe's y axis within dock_angle_deg of the port's.
 struct DockingCheck {
   bool in_envelope = false;
+  double envelope_margin_ft = 0.0;  // least depth of a probe vertex inside the envelope (< 0: outside by)
   double distance_ft = 0.0;
   double angle_deg = 0.0;
   bool docked = false;
@@ -92,10 +99,13 @@ struct DcpStatus {
   bool finger_held = false;
   std::uint32_t collisions = 0;        // of the master's command
   std::uint32_t slave_collisions = 0;  // of the pose the slave holds
-  std::array<bool, 6> acquisition{};   // the six conditions, report order
+  std::array<bool, 6> acquisition{};   // the six conditions, report order (Mode 1; false after)
+  std::array<double, 6> acquisition_margin_ft{};  // their margins (Mode 1; 0 after)
   double finger_gap_ft = 0.0;
   double palm_to_bar_ft = 0.0;
+  double bay_clearance_ft = 0.0;       // the lowest payload vertex above bay face c (> 0 for all: clear)
   bool probe_in_envelope = false;
+  double envelope_margin_ft = 0.0;
   double dock_distance_ft = 0.0;
   double dock_angle_deg = 0.0;
   std::array<SeparatingPlane, 3> planes{};
@@ -175,6 +185,11 @@ class DynamicCollisionProgram {
   void UpdateAcquisition();
   void UpdateExtraction();
   void UpdateDocking();
+  // The status's measures of the slave's pose (planes, conditions, bay
+  // clearance, docking), without changing the mode: after a restore.
+  void RefreshMeasures();
+  void UpdatePlanes();
+  double BayClearance(const PayloadModel& p) const;
 
   const LabConfig& config_;
   DcpOptions options_;

@@ -1,12 +1,14 @@
 #include "esg_node.h"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <spdlog/spdlog.h>
 
 #include "overlay.h"
+#include "rms/window_keys_t.hpp"
 #include "png_io.h"
 #include "rms/channels.h"
 #include "rms/check.h"
@@ -29,8 +31,54 @@ std::int64_t MonotonicUs() {
 EsgNode::EsgNode(const LabConfig& config, LcmInterface* lcm, EsgRenderer* renderer, EsgOptions options,
                  VideoWriter* video, LiveWindow* window)
     : config_(config), lcm_(lcm), renderer_(renderer), options_(std::move(options)), video_(video), window_(window) {
-  for (const auto& cam : config.cameras) camera_names_.push_back(cam.name);
+  overlay_ = MakeOverlayModel(config);
   lcm_->Subscribe(channels::kEsgFrame, [this](const void* d, int n, std::int64_t t) { OnFrame(d, n, t); });
+  if (window_) {
+    lcm_->Subscribe(channels::kOperatorState, [this](const void* d, int n, std::int64_t) { OnOperatorState(d, n); });
+  }
+}
+
+void EsgNode::OnOperatorState(const void* data, int size) {
+  operator_state_t m{};
+  if (const DecodeError e = SafeDecode(data, size, 1024, &m); e != DecodeError::kNone) {
+    counters_.Add(std::string("dropped.operator_state_") + DecodeErrorName(e));
+    return;
+  }
+  bool finite = std::isfinite(m.distance_ft) && std::isfinite(m.angle_deg) && std::isfinite(m.bay_clearance_ft) &&
+                std::isfinite(m.dock_distance_ft) && std::isfinite(m.dock_angle_deg);
+  for (int i = 0; i < 3; ++i) finite = finite && std::isfinite(m.offset_ft[i]) && std::isfinite(m.rotation_deg[i]);
+  for (int i = 0; i < 6; ++i) finite = finite && std::isfinite(m.margin_ft[i]);
+  if (!finite) {
+    counters_.Add("dropped.operator_state_non_finite");
+    return;
+  }
+  if (operator_state_ && m.frame < operator_state_->frame) {
+    counters_.Add("dropped.operator_state_stale");
+    return;
+  }
+  operator_state_ = m;
+}
+
+void EsgNode::PollWindow() {
+  if (!window_ || !window_->open()) return;
+  const WindowKeys k = window_->Poll();
+  if (!window_->open()) spdlog::info("the live window was closed; rendering goes on");
+  const std::int64_t now = lcm_->NowUs();
+  const bool heartbeat = (keys_held_ || !k.held.empty()) && now - keys_sent_us_ >= 100000;
+  if (!k.changed && !heartbeat) return;
+  window_keys_t m;
+  m.send_time_us = now;
+  m.sequence = keys_sequence_++;
+  for (int c : k.held) m.held.push_back(static_cast<std::int16_t>(c));
+  for (int c : k.pressed) m.pressed.push_back(static_cast<std::int16_t>(c));
+  m.num_held = static_cast<std::int16_t>(m.held.size());
+  m.num_pressed = static_cast<std::int16_t>(m.pressed.size());
+  m.focused = k.focused;
+  if (PublishMessage(*lcm_, channels::kWindowKeys, m)) counters_.Add("window.keys_messages");
+  else counters_.Add("publish_failed");
+  counters_.Add("window.keys_pressed", static_cast<std::int64_t>(k.pressed.size()));
+  keys_sent_us_ = now;
+  keys_held_ = !k.held.empty();
 }
 
 void EsgNode::OnFrame(const void* data, int size, std::int64_t recv_time_us) {
@@ -75,7 +123,7 @@ bool EsgNode::RenderPending() {
     latencies_["render"].Add(MonotonicUs() - t0);
   }
   output_ = scene_;
-  if (!options_.id_colors) DrawOverlay(output_.data(), w, h, frame, camera_names_);
+  if (!options_.id_colors) DrawOverlay(output_.data(), w, h, frame, overlay_);
   const std::int64_t done = lcm_->NowUs();
   counters_.Add("rendered");
   latencies_["esg_to_render"].Add(done - msg.send_time_us);
@@ -88,8 +136,10 @@ bool EsgNode::RenderPending() {
     video_->Add(output_.data(), static_cast<int>(gap));
   }
   if (window_ && window_->open()) {
-    if (window_->Show(output_.data())) counters_.Add("window.frames");
-    else spdlog::info("the live window was closed; rendering goes on");
+    // The window alone shows the operator's guidance over the ESG's image.
+    shown_ = output_;
+    if (operator_state_) DrawGuidance(shown_.data(), w, h, *operator_state_);
+    if (window_->Show(shown_.data())) counters_.Add("window.frames");
   }
   last_rendered_ = msg.frame;
   if (options_.png_every > 0 && !options_.png_dir.empty() && msg.frame % options_.png_every == 0) {
@@ -138,8 +188,14 @@ int RunEsgRenderer(const LabConfig& config, LcmInterface& lcm, const EsgOptions&
   EsgNode node(config, &lcm, &renderer, options, video.get(), window.get());
   if (!ready_path.empty()) TouchFile(ready_path);
   spdlog::info("ready: {}", lcm.FullChannel(channels::kEsgFrame));
-  RunNodeLoop(lcm, "esg_renderer", node.counters(), node.latencies(), [&] { return node.last_rendered(); },
-              [&] { node.RenderPending(); }, stats_path);
+  // With a window, wake often enough that a released key is sent at once.
+  RunNodeLoop(
+      lcm, "esg_renderer", node.counters(), node.latencies(), [&] { return node.last_rendered(); },
+      [&] {
+        node.RenderPending();
+        node.PollWindow();
+      },
+      stats_path, window ? 5 : 100);
   if (video) {
     video->Close();
     node.counters().Set("video.frames", video->frames_written());

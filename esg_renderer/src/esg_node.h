@@ -10,10 +10,12 @@
 #include <string>
 #include <vector>
 
+#include "overlay.h"
 #include "renderer.h"
 #include "rms/counters.h"
 #include "rms/esg_frame_t.hpp"
 #include "rms/lcm_interface.h"
+#include "rms/operator_state_t.hpp"
 #include "rms/process.h"
 #include "rms/word_blocks.h"
 #include "video.h"
@@ -43,6 +45,10 @@ class EsgNode {
   void OnFrame(const void* data, int size, std::int64_t recv_time_us);
   // Renders the newest frame received since the last call, if any.
   bool RenderPending();
+  // The live window's events: its keys go out on RMS_WINDOW_KEYS at every
+  // change and every 100 ms while one is held.
+  void PollWindow();
+  void OnOperatorState(const void* data, int size);
 
   Counters& counters() { return counters_; }
   const LatencyMap& latencies() const { return latencies_; }
@@ -56,7 +62,7 @@ class EsgNode {
   EsgOptions options_;
   VideoWriter* video_;
   LiveWindow* window_;
-  std::vector<std::string> camera_names_;
+  OverlayModel overlay_;
   Counters counters_;
   LatencyMap latencies_;
   SequenceTracker frames_;
@@ -65,6 +71,10 @@ class EsgNode {
   std::vector<std::int32_t> last_words_;  // the words of the image in scene_
   std::vector<std::uint8_t> scene_;       // the last rendered scene, before the overlay
   std::vector<std::uint8_t> output_;      // the last output image, overlay included
+  std::vector<std::uint8_t> shown_;       // the window's: the output and the operator's guidance
+  std::optional<operator_state_t> operator_state_;  // the newest RMS_OPERATOR_STATE (the window's guidance)
+  std::int64_t keys_sequence_ = 0, keys_sent_us_ = 0;
+  bool keys_held_ = false;
 };
 
 int RunEsgRenderer(const LabConfig& config, LcmInterface& lcm, const EsgOptions& options,

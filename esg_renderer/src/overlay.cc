@@ -3,7 +3,12 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
+
+#include "rms/arm_kinematics.h"
+#include "rms/mission_geometry.h"
+#include "rms/scene_model.h"
 
 namespace rms::esg {
 
@@ -36,6 +41,11 @@ const std::uint8_t* Glyph(char ch) {
   static const std::uint8_t kDot[7] = {0, 0, 0, 0, 0, 0x0C, 0x0C};
   static const std::uint8_t kSlash[7] = {0, 0x01, 0x02, 0x04, 0x08, 0x10, 0};
   static const std::uint8_t kComma[7] = {0, 0, 0, 0, 0x0C, 0x04, 0x08};
+  static const std::uint8_t kPlus[7] = {0, 0x04, 0x04, 0x1F, 0x04, 0x04, 0};
+  static const std::uint8_t kOpen[7] = {0x02, 0x04, 0x08, 0x08, 0x08, 0x04, 0x02};
+  static const std::uint8_t kClose[7] = {0x08, 0x04, 0x02, 0x02, 0x02, 0x04, 0x08};
+  static const std::uint8_t kLess[7] = {0x02, 0x04, 0x08, 0x10, 0x08, 0x04, 0x02};
+  static const std::uint8_t kEqual[7] = {0, 0, 0x1F, 0, 0x1F, 0, 0};
   static const std::uint8_t kBlank[7] = {0, 0, 0, 0, 0, 0, 0};
   const char c = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
   if (c >= '0' && c <= '9') return kDigits[c - '0'];
@@ -46,6 +56,11 @@ const std::uint8_t* Glyph(char ch) {
     case '.': return kDot;
     case '/': return kSlash;
     case ',': return kComma;
+    case '+': return kPlus;
+    case '(': return kOpen;
+    case ')': return kClose;
+    case '<': return kLess;
+    case '=': return kEqual;
     default: return kBlank;
   }
 }
@@ -76,7 +91,86 @@ void DrawText(std::uint8_t* rgba, int w, int h, int x, int y, std::string_view t
   }
 }
 
-void DrawOverlay(std::uint8_t* rgba, int w, int h, const EsgFrameData& f, const std::vector<std::string>& names) {
+OverlayModel MakeOverlayModel(const LabConfig& config) {
+  OverlayModel m;
+  for (const auto& cam : config.cameras) {
+    m.camera_names.push_back(cam.name);
+    m.mounts.push_back(cam.mount);
+  }
+  m.p_S2oT_S2 = mission::PlanGeometry(config).X_S2P * GrappleTargetCentre_P(config.payload);
+  m.p_RoPort_R = config.cae.p_RoCo_R_ft;
+  m.y_port_R = config.cae.R_RC.col(1);
+  m.arm = config.arm;
+  return m;
+}
+
+bool ProjectToImage(const EsgFrameData& f, int w, int h, const Eigen::Vector3d& p_R, double* x, double* y) {
+  const Eigen::Vector3d d = f.R_RE.transpose() * (p_R - f.p_RoEye_R_ft);
+  if (d.x() < 0.05) return false;
+  const double focal = 0.5 * h / std::tan(0.5 * f.fov_deg * M_PI / 180.0);
+  *x = 0.5 * w + focal * d.y() / d.x();
+  *y = 0.5 * h + focal * d.z() / d.x();
+  return true;
+}
+
+void DrawLine(std::uint8_t* rgba, int w, int h, int x0, int y0, int x1, int y1, const Rgb& c, int thick) {
+  const int n = std::max({std::abs(x1 - x0), std::abs(y1 - y0), 1});
+  if (n > 4 * (w + h)) return;  // far off the image: nothing to draw
+  for (int i = 0; i <= n; ++i) {
+    const int x = x0 + (x1 - x0) * i / n, y = y0 + (y1 - y0) * i / n;
+    FillRect(rgba, w, h, x - thick / 2, y - thick / 2, x - thick / 2 + thick, y - thick / 2 + thick, c);
+  }
+}
+
+void DrawCrosshairs(std::uint8_t* rgba, int w, int h, const EsgFrameData& f, const OverlayModel& m) {
+  const int st = f.control.camera_station;
+  if (st < 1 || st > static_cast<int>(m.mounts.size())) return;
+  const int t = std::max(1, h / 400);
+  const Rgb green{60, 240, 110};
+  double x = 0, y = 0;
+  if (m.mounts[st - 1] == CameraMount::kWrist) {
+    // Fixed in System Two: where the grapple target's cross is at the grasp.
+    const ArmPose arm = ComputeArmPose(m.arm, f.arm, f.shoulder_height_ft);
+    if (!ProjectToImage(f, w, h, arm.X_RS2 * m.p_S2oT_S2, &x, &y)) return;
+    const int cx = static_cast<int>(std::lround(x)), cy = static_cast<int>(std::lround(y));
+    const int arm_px = h / 10, gap = h / 60;
+    DrawLine(rgba, w, h, cx - arm_px, cy, cx - gap, cy, green, t);
+    DrawLine(rgba, w, h, cx + gap, cy, cx + arm_px, cy, green, t);
+    DrawLine(rgba, w, h, cx, cy - arm_px, cx, cy - gap, green, t);
+    DrawLine(rgba, w, h, cx, cy + gap, cx, cy + arm_px, green, t);
+    return;
+  }
+  if (m.mounts[st - 1] != CameraMount::kCae) return;
+  // The port's axis, out from the port: the probe's tip comes in along it.
+  double px = 0, py = 0;
+  bool have_prev = false;
+  const int s = std::max(1, h / 300);
+  for (int k = 2; k <= 24; ++k) {
+    const double dist = 0.5 * k;
+    if (!ProjectToImage(f, w, h, m.p_RoPort_R - dist * m.y_port_R, &x, &y)) {
+      have_prev = false;
+      continue;
+    }
+    if (have_prev) {
+      DrawLine(rgba, w, h, static_cast<int>(px), static_cast<int>(py), static_cast<int>(x), static_cast<int>(y), green, t);
+    }
+    if (k % 4 == 0) {
+      const int tick = h / 60;
+      DrawLine(rgba, w, h, static_cast<int>(x) - tick, static_cast<int>(y), static_cast<int>(x) + tick,
+               static_cast<int>(y), green, t);
+      char label[8];
+      std::snprintf(label, sizeof label, "%d", k / 2);
+      DrawText(rgba, w, h, static_cast<int>(x) + tick + 2 * s, static_cast<int>(y) - 3 * s, label, green, s);
+    }
+    px = x;
+    py = y;
+    have_prev = true;
+  }
+}
+
+void DrawOverlay(std::uint8_t* rgba, int w, int h, const EsgFrameData& f, const OverlayModel& model) {
+  if (f.control.crosshairs) DrawCrosshairs(rgba, w, h, f, model);
+  const std::vector<std::string>& names = model.camera_names;
   if (!f.control.overlay) return;
   const int s = std::max(1, h / 300);
   const int line = 9 * s, margin = 4 * s;
@@ -108,6 +202,56 @@ void DrawOverlay(std::uint8_t* rgba, int w, int h, const EsgFrameData& f, const 
     if (l.on) FillRect(rgba, w, h, x - s, margin - s, x + tw - 2 * s, margin + 8 * s, l.colour);
     DrawText(rgba, w, h, x + s, margin, l.label, l.on ? black : dim, s);
     x -= 2 * s;
+  }
+}
+
+namespace {
+
+std::string Offset(const char* axis, double v, const char* plus, const char* minus, const char* unit) {
+  char b[48];
+  std::snprintf(b, sizeof b, "%s %s %.2f%s", axis, v >= 0 ? plus : minus, std::abs(v), unit);
+  return b;
+}
+
+}  // namespace
+
+void DrawGuidance(std::uint8_t* rgba, int w, int h, const operator_state_t& st) {
+  if (!st.show_guidance || !st.guidance_valid) return;
+  const int s = std::max(1, h / 300);
+  const int line = 9 * s, margin = 4 * s;
+  std::vector<std::string> L;
+  static const char* kFrames[4] = {"", "END EFFECTOR", "ORBITER", "PAYLOAD"};
+  const int frame = st.command_frame >= 1 && st.command_frame <= 3 ? st.command_frame : 1;
+  char b[96];
+  std::snprintf(b, sizeof b, "%s  %s FRAME  %s", st.target == 1 ? "TO THE GRASP" : "TO THE PORT", kFrames[frame],
+                st.control_mode == 1 ? "SINGLE JOINT" : st.vernier ? "VERNIER" : st.control_mode ? "COARSE" : "");
+  L.push_back(b);
+  L.push_back(Offset("X", st.offset_ft[0], "FWD", "BACK", "") + "  " + Offset("Y", st.offset_ft[1], "RIGHT", "LEFT", "") +
+              "  " + Offset("Z", st.offset_ft[2], "DOWN", "UP", " FT"));
+  L.push_back(Offset("ROLL", st.rotation_deg[0], "R", "L", "") + "  " + Offset("PITCH", st.rotation_deg[1], "UP", "DN", "") +
+              "  " + Offset("YAW", st.rotation_deg[2], "R", "L", " DEG"));
+  if (st.mode == 1) {
+    std::string c = "ACQ";
+    for (int i = 0; i < 6; ++i) {
+      std::snprintf(b, sizeof b, "  %d %s %.2f", i + 1, st.margin_ft[i] >= 0 ? "OK" : "NO", std::abs(st.margin_ft[i]));
+      c += b;
+    }
+    L.push_back(c);
+  } else if (st.mode == 2) {
+    std::snprintf(b, sizeof b, "BAY: %.2f FT TO CLEAR", std::max(0.0, -st.bay_clearance_ft));
+    L.push_back(b);
+  } else {
+    std::snprintf(b, sizeof b, "DOCK: %.2f FT  %.2f DEG", st.dock_distance_ft, st.dock_angle_deg);
+    L.push_back(b);
+  }
+  std::size_t longest = 0;
+  for (const auto& l : L) longest = std::max(longest, l.size());
+  const int panel_w = static_cast<int>(longest) * 6 * s + 2 * margin;
+  const int panel_h = static_cast<int>(L.size()) * line + 2 * margin;
+  const int x0 = margin, y0 = h - margin - panel_h;
+  FillRect(rgba, w, h, x0, y0, x0 + panel_w, y0 + panel_h, {16, 20, 28});
+  for (std::size_t i = 0; i < L.size(); ++i) {
+    DrawText(rgba, w, h, x0 + margin, y0 + margin + static_cast<int>(i) * line, L[i], {120, 230, 255}, s);
   }
 }
 

@@ -4,11 +4,35 @@
 
 #include <stdexcept>
 
+#include "rms/key_codes.h"
+
 namespace rms::esg {
 
 struct LiveWindow::Impl {
   SDL_Window* window = nullptr;
 };
+
+int KeyCodeFromSdl(int sym, int mod) {
+  switch (sym) {
+    case SDLK_UP: return kKeyUp;
+    case SDLK_DOWN: return kKeyDown;
+    case SDLK_LEFT: return kKeyLeft;
+    case SDLK_RIGHT: return kKeyRight;
+    case SDLK_PAGEUP: return kKeyPageUp;
+    case SDLK_PAGEDOWN: return kKeyPageDown;
+    case SDLK_BACKSPACE: return kKeyBackspace;
+    case SDLK_TAB: return kKeyTab;
+    case SDLK_RETURN: case SDLK_KP_ENTER: return kKeyEnter;
+    case SDLK_KP_PLUS: return '+';
+    case SDLK_KP_MINUS: return '-';
+    default: break;
+  }
+  if (sym >= 'a' && sym <= 'z') return (mod & KMOD_SHIFT) ? sym - 'a' + 'A' : sym;
+  if (sym == '=' && (mod & KMOD_SHIFT)) return '+';  // the US layout's shifted keys that bindings name
+  if (sym == '-' && (mod & KMOD_SHIFT)) return '_';
+  if (sym >= ' ' && sym < 127) return sym;
+  return -1;
+}
 
 LiveWindow::LiveWindow(int width, int height, const std::string& title)
     : impl_(std::make_unique<Impl>()), width_(width), height_(height) {
@@ -30,17 +54,47 @@ LiveWindow::~LiveWindow() {
   SDL_QuitSubSystem(SDL_INIT_VIDEO);
 }
 
-bool LiveWindow::Show(const std::uint8_t* rgba) {
-  if (!open_) return false;
+WindowKeys LiveWindow::Poll() {
   SDL_Event e;
-  while (SDL_PollEvent(&e)) {
+  while (open_ && SDL_PollEvent(&e)) {
     if (e.type == SDL_QUIT || (e.type == SDL_WINDOWEVENT && e.window.event == SDL_WINDOWEVENT_CLOSE)) {
       open_ = false;
       SDL_DestroyWindow(impl_->window);
       impl_->window = nullptr;
-      return false;
+      held_.clear();
+      changed_ = true;
+    } else if (e.type == SDL_WINDOWEVENT && e.window.event == SDL_WINDOWEVENT_FOCUS_LOST) {
+      // No key-up will come for keys held when the focus went: let go.
+      focused_ = false;
+      held_.clear();
+      changed_ = true;
+    } else if (e.type == SDL_WINDOWEVENT && e.window.event == SDL_WINDOWEVENT_FOCUS_GAINED) {
+      focused_ = true;
+      changed_ = true;
+    } else if (e.type == SDL_KEYDOWN && !e.key.repeat) {
+      const int code = KeyCodeFromSdl(e.key.keysym.sym, e.key.keysym.mod);
+      if (code < 0) continue;
+      held_[e.key.keysym.scancode] = code;  // released by scancode: shift may change first
+      pressed_.push_back(code);
+      focused_ = true;
+      changed_ = true;
+    } else if (e.type == SDL_KEYUP) {
+      if (held_.erase(e.key.keysym.scancode)) changed_ = true;
     }
   }
+  WindowKeys k;
+  std::set<int> held;
+  for (const auto& [scancode, code] : held_) held.insert(code);
+  k.held.assign(held.begin(), held.end());
+  k.pressed.swap(pressed_);
+  k.focused = focused_;
+  k.changed = changed_;
+  changed_ = false;
+  return k;
+}
+
+bool LiveWindow::Show(const std::uint8_t* rgba) {
+  if (!open_) return false;
   SDL_Surface* frame = SDL_CreateRGBSurfaceWithFormatFrom(const_cast<std::uint8_t*>(rgba), width_, height_, 32,
                                                           width_ * 4, SDL_PIXELFORMAT_RGBA32);
   SDL_Surface* target = SDL_GetWindowSurface(impl_->window);

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <spdlog/spdlog.h>
 
-#include "rms/arm_ik.h"
+#include "guidance.h"
 #include "rms/arm_kinematics.h"
 #include "rms/collision_bits.h"
 
@@ -31,32 +31,6 @@ const char* AutopilotPhaseName(AutopilotPhase p) {
 
 namespace {
 
-double WrapDeg(double d) {
-  d = std::fmod(d + 180.0, 360.0);
-  if (d < 0) d += 360.0;
-  return d - 180.0;
-}
-
-Eigen::Isometry3d PoseOf(const double p[3], const double R_rowmajor[9]) {
-  Eigen::Matrix3d R;
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) R(i, j) = R_rowmajor[3 * i + j];
-  }
-  return MakeIsometry(R, Eigen::Vector3d(p[0], p[1], p[2]));
-}
-
-Eigen::Isometry3d Interpolate(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, double s) {
-  const Eigen::Quaterniond qa(a.linear()), qb(b.linear());
-  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  X.linear() = qa.slerp(s, qb).toRotationMatrix();
-  X.translation() = (1 - s) * a.translation() + s * b.translation();
-  return X;
-}
-
-double AngleDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
-  return Eigen::AngleAxisd(a.transpose() * b).angle() * 180.0 / M_PI;
-}
-
 Eigen::Isometry3d Shifted(Eigen::Isometry3d X, const Eigen::Vector3d& d) {
   X.translation() += d;
   return X;
@@ -65,7 +39,11 @@ Eigen::Isometry3d Shifted(Eigen::Isometry3d X, const Eigen::Vector3d& d) {
 }  // namespace
 
 Autopilot::Autopilot(const LabConfig& config, AutopilotOptions options)
-    : config_(config), opt_(options), model_(BuildSceneModel(config)), dt_s_(1.0 / config.session.frame_rate_hz) {
+    : config_(config),
+      opt_(options),
+      limits_(LimitsFromConfig(config, options.joint_rate_deg_s)),
+      model_(BuildSceneModel(config)),
+      dt_s_(1.0 / config.session.frame_rate_hz) {
   cmd_ = InitialInputs(config.inputs);
   cmd_.camera_station = 8;
   cmd_.overlay = true;
@@ -102,30 +80,19 @@ std::array<double, 6> Autopilot::CommandedAngles() const {
 }
 
 Eigen::Isometry3d Autopilot::CommandedPose() const {
-  return ComputeArmPose(config_.arm, SinCosFromDegrees(CommandedAngles()), cmd_.value[kShoulderHeight]).X_RS2;
+  return ForwardPose(config_.arm, CommandedAngles(), cmd_.value[kShoulderHeight]);
 }
 
 std::optional<std::array<double, 6>> Autopilot::Solve(const Eigen::Isometry3d& X_RS2) const {
-  const auto s = SolveArmIk(config_.arm, X_RS2, cmd_.value[kShoulderHeight], Elbow::kUp);
-  if (!s) return std::nullopt;
-  // The master arm's range (config [inputs.*]): beyond it the command would be clamped.
-  for (int i = 0; i < 6; ++i) {
-    if (s->angles_deg[i] < config_.inputs[i].min || s->angles_deg[i] > config_.inputs[i].max) return std::nullopt;
-  }
-  return s->angles_deg;
+  // Within the joints' travel and the master arm's range (arm_motion.h).
+  return SolveWithinLimits(config_.arm, limits_, X_RS2, cmd_.value[kShoulderHeight]);
 }
 
 bool Autopilot::StepJoints(const std::array<double, 6>& target) {
-  double m = 0.0;
-  std::array<double, 6> d{};
-  for (int i = 0; i < 6; ++i) {
-    d[i] = WrapDeg(target[i] - cmd_.value[i]);
-    m = std::max(m, std::abs(d[i]));
-  }
-  const double lim = opt_.joint_rate_deg_s * dt_s_;
-  const double k = m <= lim ? 1.0 : lim / m;  // all joints arrive together
-  for (int i = 0; i < 6; ++i) cmd_.value[i] = WrapDeg(cmd_.value[i] + k * d[i]);
-  return m <= lim;
+  JointAngles q = CommandedAngles();
+  const bool there = StepJointsToward(&q, target, limits_.rate_deg_s, dt_s_);
+  for (int i = 0; i < 6; ++i) cmd_.value[i] = q[i];
+  return there;
 }
 
 void Autopilot::PlanLine(const Eigen::Isometry3d& X1, double speed_ft_s) {
@@ -154,7 +121,7 @@ Autopilot::PlanState Autopilot::StepPlan() {
       g.started = true;
       g.X0 = CommandedPose();
       const double dist = (g.X1.translation() - g.X0.translation()).norm();
-      const double turn = AngleDeg(g.X0.linear(), g.X1.linear());
+      const double turn = AngleBetweenDeg(g.X0.linear(), g.X1.linear());
       g.duration_s = std::max({dist / g.speed_ft_s, turn / opt_.turn_rate_deg_s, 2 * dt_s_});
     }
     const double s_next = std::min(1.0, g.s + dt_s_ / g.duration_s);
@@ -184,7 +151,7 @@ std::string Autopilot::JointPathHits(const std::array<double, 6>& q0, const std:
   double m = 0.0;
   for (int i = 0; i < 6; ++i) m = std::max(m, std::abs(WrapDeg(q1[i] - q0[i])));
   const int n = std::max(1, static_cast<int>(std::ceil(m / 1.0)));  // a sample a degree
-  const Eigen::Isometry3d X_RP = PoseOf(tm.p_RoPo_R_ft, tm.R_RP);
+  const Eigen::Isometry3d X_RP = TelemetryPose(tm.p_RoPo_R_ft, tm.R_RP);
   const double margin = payload == mission::PayloadState::kInBay ? margin_ft_ : opt_.clearance_ft;
   for (int k = 1; k <= n; ++k) {
     std::array<double, 6> q{};
@@ -198,11 +165,11 @@ std::string Autopilot::JointPathHits(const std::array<double, 6>& q0, const std:
 
 std::string Autopilot::LinePathHits(const Eigen::Isometry3d& X0, const Eigen::Isometry3d& X1,
                                     const dcp_telemetry_t& tm, mission::PayloadState payload) const {
-  const double len = (X1.translation() - X0.translation()).norm() + AngleDeg(X0.linear(), X1.linear()) / 10.0;
+  const double len = (X1.translation() - X0.translation()).norm() + AngleBetweenDeg(X0.linear(), X1.linear()) / 10.0;
   const double margin = payload == mission::PayloadState::kInBay ? margin_ft_ : opt_.clearance_ft;
   const int n = std::max(1, static_cast<int>(std::ceil(len / 0.5)));  // a sample every half foot
   // The payload: where it is (in the bay), or carried along with System Two.
-  const Eigen::Isometry3d X_RP_bay = PoseOf(tm.p_RoPo_R_ft, tm.R_RP);
+  const Eigen::Isometry3d X_RP_bay = TelemetryPose(tm.p_RoPo_R_ft, tm.R_RP);
   for (int k = 1; k <= n; ++k) {
     const Eigen::Isometry3d X = Interpolate(X0, X1, static_cast<double>(k) / n);
     const auto q = Solve(X);
@@ -217,7 +184,7 @@ std::string Autopilot::LinePathHits(const Eigen::Isometry3d& X0, const Eigen::Is
 
 void Autopilot::PlanApproach(const dcp_telemetry_t& tm) {
   plan_.clear();
-  const Eigen::Isometry3d X_grasp = PoseOf(tm.p_RoPo_R_ft, tm.R_RP) * X_PS2_grasp_;
+  const Eigen::Isometry3d X_grasp = TelemetryPose(tm.p_RoPo_R_ft, tm.R_RP) * X_PS2_grasp_;
   const Eigen::Isometry3d X_hover = Shifted(X_grasp, -opt_.hover_ft * X_grasp.linear().col(0));
   const auto q_hover = Solve(X_hover);
   if (!q_hover) return Fail("the pose above the bar receptacle is out of the arm's reach");
@@ -237,7 +204,7 @@ void Autopilot::PlanApproach(const dcp_telemetry_t& tm) {
   // payload), paths are only asked not to run into anything.
   margin_ft_ = opt_.clearance_ft;
   if (!mission::Interpenetration(config_, model_, q0, cmd_.value[kShoulderHeight], tm.finger_gap_ft,
-                                 PoseOf(tm.p_RoPo_R_ft, tm.R_RP), kInBay, margin_ft_)
+                                 TelemetryPose(tm.p_RoPo_R_ft, tm.R_RP), kInBay, margin_ft_)
            .empty()) {
     margin_ft_ = 0.0;
   }
@@ -270,7 +237,7 @@ void Autopilot::PlanApproach(const dcp_telemetry_t& tm) {
 void Autopilot::PlanTransfer(const dcp_telemetry_t& tm) {
   plan_.clear();
   // The payload as the DCP holds it, in System Two.
-  X_S2P_ = PoseOf(tm.p_RoA_R_ft, tm.R_RS2).inverse() * PoseOf(tm.p_RoPo_R_ft, tm.R_RP);
+  X_S2P_ = TelemetryPose(tm.p_RoA_R_ft, tm.R_RS2).inverse() * TelemetryPose(tm.p_RoPo_R_ft, tm.R_RP);
   X_RP_dock_ = mission::PlanGeometry(config_, cmd_.value[kShoulderHeight]).X_RP_dock;
   const Eigen::Vector3d yC = config_.cae.R_RC.col(1);
   const Eigen::Isometry3d X_predock = Shifted(X_RP_dock_ * X_S2P_.inverse(), -opt_.predock_ft * yC);
@@ -303,7 +270,7 @@ void Autopilot::StartPhase(AutopilotPhase p, const dcp_telemetry_t& tm) {
       break;
     case AutopilotPhase::kDescend:
       Camera(4, 0.3);
-      PlanLine(PoseOf(tm.p_RoPo_R_ft, tm.R_RP) * X_PS2_grasp_, opt_.descend_speed_ft_s);
+      PlanLine(TelemetryPose(tm.p_RoPo_R_ft, tm.R_RP) * X_PS2_grasp_, opt_.descend_speed_ft_s);
       break;
     case AutopilotPhase::kClose:
       Camera(5);
@@ -356,7 +323,7 @@ void Autopilot::Relieve(const dcp_telemetry_t& tm) {
   plan_.clear();
   if (tm.mode == 1) {
     // Up and away from the payload's axis, horizontally.
-    const Eigen::Isometry3d X_RP = PoseOf(tm.p_RoPo_R_ft, tm.R_RP);
+    const Eigen::Isometry3d X_RP = TelemetryPose(tm.p_RoPo_R_ft, tm.R_RP);
     const Eigen::Vector3d axis = X_RP.linear().col(1);
     Eigen::Vector3d away = X.translation() - X_RP.translation();
     away -= away.dot(axis) * axis;
@@ -514,7 +481,7 @@ OperatorInputs Autopilot::Step(const dcp_telemetry_t* tm_ptr) {
                cmd_;
       }
       counters_.Add("autopilot.dock_corrections");
-      X_S2P_ = PoseOf(tm.p_RoA_R_ft, tm.R_RS2).inverse() * PoseOf(tm.p_RoPo_R_ft, tm.R_RP);
+      X_S2P_ = TelemetryPose(tm.p_RoA_R_ft, tm.R_RS2).inverse() * TelemetryPose(tm.p_RoPo_R_ft, tm.R_RP);
       PlanLine(X_RP_dock_ * X_S2P_.inverse(), opt_.dock_speed_ft_s);
       break;
     }

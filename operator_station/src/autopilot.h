@@ -21,6 +21,7 @@
 
 #include <Eigen/Geometry>
 
+#include "arm_motion.h"
 #include "rms/config.h"
 #include "rms/counters.h"
 #include "rms/dcp_telemetry_t.hpp"
@@ -131,6 +132,7 @@ class Autopilot {
 
   const LabConfig& config_;
   AutopilotOptions opt_;
+  JointLimits limits_;
   SceneModel model_;
   double dt_s_;
   double t_s_ = 0.0, phase_t0_s_ = 0.0;

@@ -16,39 +16,80 @@ namespace rms::op {
 
 std::string DefaultBindingsPath() { return RMSLAB_DEFAULT_BINDINGS; }
 
+namespace {
+
+// The direct inputs: the analog inputs a device moves itself (the six arm
+// joints move only through the control modes).
+bool IsDirectInput(int input) { return input >= kFinger && input < kNumAnalogInputs; }
+
+struct Named {
+  std::string_view name;
+  ActionKind kind;
+};
+constexpr Named kNamedActions[] = {
+    {"camera_next", ActionKind::kCameraNext}, {"camera_prev", ActionKind::kCameraPrev},
+    {"reset", ActionKind::kReset},            {"overlay", ActionKind::kOverlay},
+    {"crosshairs", ActionKind::kCrosshairs},  {"guidance", ActionKind::kGuidance},
+    {"stop", ActionKind::kStop},              {"mode", ActionKind::kMode},
+    {"frame", ActionKind::kFrame},            {"vernier", ActionKind::kVernier},
+    {"joint_next", ActionKind::kJointNext},   {"joint_prev", ActionKind::kJointPrev},
+    {"quit", ActionKind::kQuit},              {"freeze", ActionKind::kFreeze},
+    {"step", ActionKind::kStep},
+};
+
+}  // namespace
+
 Action ParseAction(std::string_view t) {
   Action a;
-  if (t == "camera_next") a.kind = ActionKind::kCameraNext;
-  else if (t == "camera_prev") a.kind = ActionKind::kCameraPrev;
-  else if (t == "reset") a.kind = ActionKind::kReset;
-  else if (t == "overlay") a.kind = ActionKind::kOverlay;
-  else if (t == "quit") a.kind = ActionKind::kQuit;
-  else if (t == "freeze") a.kind = ActionKind::kFreeze;
-  else if (t == "step") a.kind = ActionKind::kStep;
-  else if (t.size() == 8 && t.substr(0, 7) == "camera_" && t[7] >= '1' && t[7] <= '8') {
+  for (const Named& n : kNamedActions) {
+    if (t == n.name) {
+      a.kind = n.kind;
+      return a;
+    }
+  }
+  if (t.size() == 8 && t.substr(0, 7) == "camera_" && t[7] >= '1' && t[7] <= '8') {
     a.kind = ActionKind::kCamera;
     a.camera = t[7] - '0';
-  } else if (!t.empty() && (t.back() == '+' || t.back() == '-') && AnalogInputIndex(t.substr(0, t.size() - 1)) >= 0) {
-    a.kind = t.back() == '+' ? ActionKind::kIncrease : ActionKind::kDecrease;
-    a.input = AnalogInputIndex(t.substr(0, t.size() - 1));
-  } else {
-    throw InputError("unknown action \"" + std::string(t) +
-                     "\" (INPUT+ / INPUT- for an analog input, camera_1..camera_8, camera_next, camera_prev, reset, "
-                     "overlay, quit, freeze, step)");
+    return a;
   }
-  return a;
+  if (!t.empty() && (t.back() == '+' || t.back() == '-')) {
+    const std::string_view base = t.substr(0, t.size() - 1);
+    a.sign = t.back() == '+' ? 1.0 : -1.0;
+    if ((a.index = HandAxisIndex(base)) >= 0) {
+      a.kind = ActionKind::kHand;
+      return a;
+    }
+    const int input = AnalogInputIndex(base);
+    if (IsDirectInput(input)) {
+      a.kind = ActionKind::kInput;
+      a.index = input;
+      return a;
+    }
+    if (input >= 0) {
+      throw InputError("\"" + std::string(t) +
+                       "\": the arm's joints move through the control modes (thc_x+ / thc_x- drive the joint "
+                       "joint_next and joint_prev select in single joint mode; docs/operator.md)");
+    }
+  }
+  throw InputError("unknown action \"" + std::string(t) +
+                   "\" (thc_x, thc_y, thc_z, rhc_roll, rhc_pitch, rhc_yaw, finger, shoulder_height, camera_pan, "
+                   "camera_tilt, camera_zoom with + or -; camera_1..camera_8, camera_next, camera_prev, reset, "
+                   "overlay, crosshairs, guidance, stop, mode, frame, vernier, joint_next, joint_prev, quit, "
+                   "freeze, step)");
 }
 
-int KeyCode(std::string_view n) {
-  if (n == "space") return ' ';
-  if (n == "plus") return '+';
-  if (n == "minus") return '-';
-  if (n == "up") return kKeyUp;
-  if (n == "down") return kKeyDown;
-  if (n == "left") return kKeyLeft;
-  if (n == "right") return kKeyRight;
-  if (n.size() == 1 && n[0] > ' ' && n[0] < 127) return static_cast<unsigned char>(n[0]);
-  return -1;
+std::string ActionName(const Action& a) {
+  const std::string sign = a.sign > 0 ? "+" : "-";
+  switch (a.kind) {
+    case ActionKind::kHand: return std::string(kHandAxisNames[a.index]) + sign;
+    case ActionKind::kInput: return std::string(kAnalogInputNames[a.index]) + sign;
+    case ActionKind::kCamera: return "camera_" + std::to_string(a.camera);
+    default: break;
+  }
+  for (const Named& n : kNamedActions) {
+    if (n.kind == a.kind) return std::string(n.name);
+  }
+  return "?";
 }
 
 namespace {
@@ -63,26 +104,144 @@ Action ActionAt(TomlReader& r, std::string_view key) {
   }
 }
 
-AxisBinding AxisTo(TomlReader& r, std::string_view key, const std::array<std::string_view, 3>* names) {
+// "thc_x", "-rhc_yaw", "camera_pan": a hand-controller axis or a direct
+// input, a leading '-' reversing it. hand_only: a 3D mouse axis.
+AxisBinding AxisAt(TomlReader& r, std::string_view key, bool hand_only) {
   std::string text = r.String(key);
   AxisBinding b;
   if (!text.empty() && text[0] == '-') {
     b.sign = -1.0;
     text.erase(0, 1);
   }
-  if (names) {
-    for (int i = 0; i < 3; ++i) {
-      if (text == (*names)[i]) b.input = i;
-    }
-    if (b.input < 0) {
-      r.Fail(key, "must be one of " + std::string((*names)[0]) + ", " + std::string((*names)[1]) + ", " +
-                      std::string((*names)[2]) + " (a leading '-' reverses it)");
-    }
-  } else {
-    b.input = AnalogInputIndex(text);
-    if (b.input < 0) r.Fail(key, "must name an analog input (a leading '-' reverses it), got \"" + text + "\"");
+  if ((b.index = HandAxisIndex(text)) >= 0) return b;
+  const int input = AnalogInputIndex(text);
+  if (!hand_only && IsDirectInput(input)) {
+    b.hand = false;
+    b.index = input;
+    return b;
   }
-  return b;
+  r.Fail(key, std::string("must name a hand-controller axis (thc_x, thc_y, thc_z, rhc_roll, rhc_pitch, rhc_yaw)") +
+                  (hand_only ? "" : " or a direct input (finger, shoulder_height, camera_pan, camera_tilt, camera_zoom)") +
+                  ", a leading '-' reversing it; got \"" + text + "\"");
+}
+
+void ReadControl(TomlReader& top, Bindings* b) {
+  TomlReader r = top.Sub("control");
+  const std::string mode = r.String("mode");
+  const auto m = ParseControlMode(mode);
+  if (!m) r.Fail("mode", "must be \"manual_augmented\" or \"single_joint\", got \"" + mode + "\"");
+  b->initial_mode = *m;
+  const std::string frame = r.String("frame");
+  const auto f = ParseCommandFrame(frame);
+  if (!f || *f == CommandFrame::kPayload) {
+    r.Fail("frame", "must be \"end_effector\" or \"orbiter\" (the payload's frame needs a payload held), got \"" +
+                        frame + "\"");
+  }
+  b->initial_frame = *f;
+  const std::string scale = r.String("scale");
+  if (scale != "coarse" && scale != "vernier") r.Fail("scale", "must be \"coarse\" or \"vernier\", got \"" + scale + "\"");
+  b->initial_vernier = scale == "vernier";
+  r.Finish();
+}
+
+void ReadRates(TomlReader& top, Bindings* b) {
+  TomlReader r = top.Sub("rates");
+  HandRates& h = b->rates;
+  h.coarse_ft_s = r.Positive("coarse_ft_s", 100.0);
+  h.coarse_deg_s = r.Positive("coarse_deg_s", 360.0);
+  h.vernier_ft_s = r.Positive("vernier_ft_s", 100.0);
+  h.vernier_deg_s = r.Positive("vernier_deg_s", 360.0);
+  h.joint_coarse_deg_s = r.Positive("joint_coarse_deg_s", 360.0);
+  h.joint_vernier_deg_s = r.Positive("joint_vernier_deg_s", 360.0);
+  if (h.vernier_ft_s >= h.coarse_ft_s) r.Fail("vernier_ft_s", "must be less than rates.coarse_ft_s");
+  if (h.vernier_deg_s >= h.coarse_deg_s) r.Fail("vernier_deg_s", "must be less than rates.coarse_deg_s");
+  if (h.joint_vernier_deg_s >= h.joint_coarse_deg_s) {
+    r.Fail("joint_vernier_deg_s", "must be less than rates.joint_coarse_deg_s");
+  }
+  r.Finish();
+}
+
+void ReadKeyboard(TomlReader& top, Bindings* b) {
+  TomlReader r = top.Sub("keyboard");
+  {
+    TomlReader s = r.Sub("increment");
+    HandIncrements& h = b->increments;
+    h.coarse_ft = s.Positive("coarse_ft", 100.0);
+    h.coarse_deg = s.Positive("coarse_deg", 180.0);
+    h.vernier_ft = s.Positive("vernier_ft", 100.0);
+    h.vernier_deg = s.Positive("vernier_deg", 180.0);
+    h.joint_coarse_deg = s.Positive("joint_coarse_deg", 180.0);
+    h.joint_vernier_deg = s.Positive("joint_vernier_deg", 180.0);
+    s.Finish();
+  }
+  {
+    TomlReader s = r.Sub("step");
+    for (int i = kFinger; i < kNumAnalogInputs; ++i) b->key_step[i] = s.Positive(kAnalogInputNames[i]);
+    s.Finish();
+  }
+  TomlReader k = r.Sub("keys");
+  for (auto&& [key, node] : k.table()) {
+    const std::string name(key.str());
+    const int code = KeyCode(name);
+    if (code < 0) {
+      k.Fail(name, "is not a key (a printable character, space, up, down, left, right, pageup, pagedown, "
+                   "backspace, tab, enter, plus, minus)");
+    }
+    if (b->keys.count(code)) k.Fail(name, "is bound twice");
+    b->keys[code] = ActionAt(k, name);
+  }
+  k.Finish();
+  r.Finish();
+}
+
+void ReadGamepad(TomlReader& top, Bindings* b) {
+  TomlReader r = top.Sub("gamepad");
+  TomlReader ax = r.Sub("axes");
+  for (auto&& [key, node] : ax.table()) {
+    const std::string name(key.str());
+    if (SDL_GameControllerGetAxisFromString(name.c_str()) == SDL_CONTROLLER_AXIS_INVALID) {
+      ax.Fail(name, "is not an SDL game controller axis (leftx, lefty, rightx, righty, lefttrigger, righttrigger)");
+    }
+    b->gamepad_axes[name] = AxisAt(ax, name, false);
+  }
+  ax.Finish();
+  TomlReader bt = r.Sub("buttons");
+  for (auto&& [key, node] : bt.table()) {
+    const std::string name(key.str());
+    if (SDL_GameControllerGetButtonFromString(name.c_str()) == SDL_CONTROLLER_BUTTON_INVALID) {
+      bt.Fail(name, "is not an SDL game controller button (a, b, x, y, back, guide, start, leftstick, rightstick, "
+                    "leftshoulder, rightshoulder, dpup, dpdown, dpleft, dpright)");
+    }
+    b->gamepad_buttons[name] = ActionAt(bt, name);
+    if (b->gamepad_buttons[name].kind == ActionKind::kQuit) bt.Fail(name, "quit is for the keyboards only");
+  }
+  bt.Finish();
+  r.Finish();
+}
+
+void ReadSpaceMouse(TomlReader& top, Bindings* b) {
+  TomlReader r = top.Sub("spacemouse");
+  b->spacemouse_full_scale = r.Positive("full_scale", 1e5);
+  TomlReader ax = r.Sub("axes");
+  const char* dev[6] = {"tx", "ty", "tz", "rx", "ry", "rz"};
+  for (int i = 0; i < 6; ++i) b->spacemouse_axes[i] = AxisAt(ax, dev[i], true);
+  ax.Finish();
+  TomlReader bt = r.Sub("buttons");
+  for (auto&& [key, node] : bt.table()) {
+    const std::string name(key.str());
+    int n = -1;
+    try {
+      std::size_t used = 0;
+      n = std::stoi(name, &used);
+      if (used != name.size()) n = -1;
+    } catch (const std::exception&) {
+    }
+    if (n < 0 || n > 63) bt.Fail(name, "must be a button number 0..63");
+    b->spacemouse_buttons[n] = ActionAt(bt, name);
+    if (b->spacemouse_buttons[n].kind == ActionKind::kQuit) bt.Fail(name, "quit is for the keyboards only");
+  }
+  bt.Finish();
+  r.Finish();
 }
 
 }  // namespace
@@ -91,8 +250,8 @@ Bindings ParseBindings(std::string_view text, const std::string& source) {
   toml::table root = ParseToml(text, source);
   Bindings b;
   b.source = source;
-  const std::string doc = "docs/operator.md";
-  TomlReader top(&root, "", &b.source, doc);
+  TomlReader top(&root, "", &b.source, "docs/operator.md");
+  ReadControl(top, &b);
   {
     TomlReader r = top.Sub("conditioning");
     b.deadband = r.Number("deadband", 0.0, 0.9);
@@ -101,76 +260,10 @@ Bindings ParseBindings(std::string_view text, const std::string& source) {
     m.Finish();
     r.Finish();
   }
-  {
-    TomlReader r = top.Sub("keyboard");
-    TomlReader s = r.Sub("step");
-    for (int i = 0; i < kNumAnalogInputs; ++i) b.key_step[i] = s.Positive(kAnalogInputNames[i]);
-    s.Finish();
-    TomlReader k = r.Sub("keys");
-    for (auto&& [key, node] : k.table()) {
-      const std::string name(key.str());
-      const int code = KeyCode(name);
-      if (code < 0) k.Fail(name, "is not a key (a printable character, space, up, down, left, right, plus, minus)");
-      if (b.keys.count(code)) k.Fail(name, "is bound twice");
-      b.keys[code] = ActionAt(k, name);
-    }
-    k.Finish();
-    r.Finish();
-  }
-  {
-    TomlReader r = top.Sub("gamepad");
-    TomlReader ax = r.Sub("axes");
-    for (auto&& [key, node] : ax.table()) {
-      const std::string name(key.str());
-      if (SDL_GameControllerGetAxisFromString(name.c_str()) == SDL_CONTROLLER_AXIS_INVALID) {
-        ax.Fail(name, "is not an SDL game controller axis (leftx, lefty, rightx, righty, lefttrigger, righttrigger)");
-      }
-      b.gamepad_axes[name] = AxisTo(ax, name, nullptr);
-    }
-    ax.Finish();
-    TomlReader bt = r.Sub("buttons");
-    for (auto&& [key, node] : bt.table()) {
-      const std::string name(key.str());
-      if (SDL_GameControllerGetButtonFromString(name.c_str()) == SDL_CONTROLLER_BUTTON_INVALID) {
-        bt.Fail(name, "is not an SDL game controller button (a, b, x, y, back, guide, start, leftstick, rightstick, "
-                      "leftshoulder, rightshoulder, dpup, dpdown, dpleft, dpright)");
-      }
-      b.gamepad_buttons[name] = ActionAt(bt, name);
-      if (b.gamepad_buttons[name].kind == ActionKind::kQuit) bt.Fail(name, "quit is for the keyboard only");
-    }
-    bt.Finish();
-    r.Finish();
-  }
-  {
-    TomlReader r = top.Sub("spacemouse");
-    b.spacemouse_full_scale = r.Positive("full_scale", 1e5);
-    b.spacemouse_speed_ft_s = r.Positive("speed_ft_s", 100.0);
-    b.spacemouse_turn_deg_s = r.Positive("turn_deg_s", 360.0);
-    static constexpr std::array<std::string_view, 3> kR = {"X", "Y", "Z"}, kS2 = {"X2", "Y2", "Z2"};
-    TomlReader t = r.Sub("translate");
-    const char* dev[3] = {"tx", "ty", "tz"};
-    for (int i = 0; i < 3; ++i) b.spacemouse_translate[i] = AxisTo(t, dev[i], &kR);
-    t.Finish();
-    TomlReader o = r.Sub("rotate");
-    const char* rdev[3] = {"rx", "ry", "rz"};
-    for (int i = 0; i < 3; ++i) b.spacemouse_rotate[i] = AxisTo(o, rdev[i], &kS2);
-    o.Finish();
-    TomlReader bt = r.Sub("buttons");
-    for (auto&& [key, node] : bt.table()) {
-      const std::string name(key.str());
-      int n = -1;
-      try {
-        std::size_t used = 0;
-        n = std::stoi(name, &used);
-        if (used != name.size()) n = -1;
-      } catch (const std::exception&) {
-      }
-      if (n < 0 || n > 63) bt.Fail(name, "must be a button number 0..63");
-      b.spacemouse_buttons[n] = ActionAt(bt, name);
-    }
-    bt.Finish();
-    r.Finish();
-  }
+  ReadRates(top, &b);
+  ReadKeyboard(top, &b);
+  ReadGamepad(top, &b);
+  ReadSpaceMouse(top, &b);
   top.Finish();
   return b;
 }

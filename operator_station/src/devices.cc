@@ -2,6 +2,7 @@
 
 #include <SDL2/SDL.h>
 
+#include <algorithm>
 #include <cmath>
 
 #ifdef RMSLAB_HAVE_SPNAV
@@ -18,19 +19,30 @@ double ApplyDeadband(double x, double band) {
 
 namespace {
 
-// A held control bound to INPUT+ / INPUT- moves the input at its max rate;
-// other actions fire once, when pressed.
-void Apply(const Bindings& b, const Action& a, bool down, bool was_down, DeviceCommands* out) {
-  if (a.kind == ActionKind::kIncrease || a.kind == ActionKind::kDecrease) {
-    if (down) out->rate[a.input] += (a.kind == ActionKind::kIncrease ? 1.0 : -1.0) * b.max_rate[a.input];
-  } else if (down && !was_down) {
-    out->events.push_back(a);
-  }
+bool Moves(const Action& a) { return a.kind == ActionKind::kHand || a.kind == ActionKind::kInput; }
+
+// A control held down: an axis or an input at full rate.
+void AddHeld(const Action& a, DeviceCommands* out) {
+  if (a.kind == ActionKind::kHand) out->hand[a.index] += a.sign;
+  else if (a.kind == ActionKind::kInput) out->input_rate[a.index] += a.sign;
+}
+
+// A control that went down this frame: a discrete action fires once.
+void AddPressed(const Action& a, DeviceCommands* out) {
+  ++out->key_actions;
+  if (!Moves(a)) out->events.push_back(a);
+}
+
+// An analog axis, deadband applied.
+void AddAxis(const AxisBinding& b, double deflection, double deadband, DeviceCommands* out) {
+  const double v = b.sign * ApplyDeadband(std::clamp(deflection, -1.0, 1.0), deadband);
+  if (b.hand) out->hand[b.index] += v;
+  else out->input_rate[b.index] += v;
 }
 
 }  // namespace
 
-// ---- keyboard ----
+// ---- a terminal's keyboard ----
 
 KeyboardDevice::KeyboardDevice(const Bindings& bindings, std::function<int()> next_key, std::string where)
     : b_(bindings), next_key_(std::move(next_key)), where_(std::move(where)) {}
@@ -43,9 +55,43 @@ void KeyboardDevice::Poll(DeviceCommands* out) {
       continue;
     }
     const Action& a = it->second;
-    if (a.kind == ActionKind::kIncrease) out->step[a.input] += b_.key_step[a.input];
-    else if (a.kind == ActionKind::kDecrease) out->step[a.input] -= b_.key_step[a.input];
+    ++out->key_actions;
+    if (a.kind == ActionKind::kHand) out->hand_presses.push_back({a.index, a.sign});
+    else if (a.kind == ActionKind::kInput) out->input_presses.push_back({a.index, a.sign});
     else out->events.push_back(a);
+  }
+}
+
+// ---- the live window's keyboard ----
+
+WindowKeyboardDevice::WindowKeyboardDevice(const Bindings& bindings, std::int64_t timeout_us)
+    : b_(bindings), timeout_us_(timeout_us) {}
+
+bool WindowKeyboardDevice::Receive(const Message& m, std::int64_t now_us) {
+  if (m.sequence <= last_sequence_) return false;
+  last_sequence_ = m.sequence;
+  heard_us_ = now_us;
+  held_.clear();
+  if (m.focused) held_.insert(m.held.begin(), m.held.end());
+  pressed_.insert(pressed_.end(), m.pressed.begin(), m.pressed.end());
+  return true;
+}
+
+void WindowKeyboardDevice::Poll(DeviceCommands* out) {
+  for (int k : pressed_) {
+    const auto it = b_.keys.find(k);
+    if (it != b_.keys.end()) AddPressed(it->second, out);
+  }
+  pressed_.clear();
+  if (!held_.empty() && now_us_ - heard_us_ > timeout_us_) {
+    // The window went quiet with keys held (closed, stalled, the link
+    // lost): let go of everything rather than fly on.
+    held_.clear();
+    ++timeouts_;
+  }
+  for (int k : held_) {
+    const auto it = b_.keys.find(k);
+    if (it != b_.keys.end()) AddHeld(it->second, out);
   }
 }
 
@@ -90,12 +136,12 @@ void GamepadDevice::Poll(DeviceCommands* out) {
   SDL_GameControllerUpdate();
   for (const auto& [name, bind] : b_.gamepad_axes) {
     const SDL_GameControllerAxis axis = SDL_GameControllerGetAxisFromString(name.c_str());
-    const double raw = SDL_GameControllerGetAxis(c, axis) / 32767.0;
-    out->rate[bind.input] += bind.sign * ApplyDeadband(std::clamp(raw, -1.0, 1.0), b_.deadband) * b_.max_rate[bind.input];
+    AddAxis(bind, SDL_GameControllerGetAxis(c, axis) / 32767.0, b_.deadband, out);
   }
   for (const auto& [name, action] : b_.gamepad_buttons) {
     const bool down = SDL_GameControllerGetButton(c, SDL_GameControllerGetButtonFromString(name.c_str())) != 0;
-    Apply(b_, action, down, was_down_[name], out);
+    if (down && !was_down_[name]) AddPressed(action, out);
+    if (down) AddHeld(action, out);
     was_down_[name] = down;
   }
 }
@@ -124,22 +170,14 @@ void SpaceMouseDevice::Poll(DeviceCommands* out) {
       if (it == b_.spacemouse_buttons.end()) continue;
       const bool was = held_[ev.button.bnum];
       held_[ev.button.bnum] = ev.button.press != 0;
-      if (ev.button.press && !was && it->second.kind != ActionKind::kIncrease &&
-          it->second.kind != ActionKind::kDecrease) {
-        out->events.push_back(it->second);
-      }
+      if (ev.button.press && !was) AddPressed(it->second, out);
     }
   }
   for (const auto& [bnum, down] : held_) {
     const auto it = b_.spacemouse_buttons.find(bnum);
-    if (down && it != b_.spacemouse_buttons.end()) Apply(b_, it->second, true, true, out);
+    if (down && it != b_.spacemouse_buttons.end()) AddHeld(it->second, out);
   }
-  for (int i = 0; i < 3; ++i) {
-    const double t = ApplyDeadband(std::clamp(axes_[i] / b_.spacemouse_full_scale, -1.0, 1.0), b_.deadband);
-    const double r = ApplyDeadband(std::clamp(axes_[3 + i] / b_.spacemouse_full_scale, -1.0, 1.0), b_.deadband);
-    out->v_R_ft_s[b_.spacemouse_translate[i].input] += b_.spacemouse_translate[i].sign * t * b_.spacemouse_speed_ft_s;
-    out->w_S2_deg_s[b_.spacemouse_rotate[i].input] += b_.spacemouse_rotate[i].sign * r * b_.spacemouse_turn_deg_s;
-  }
+  for (int i = 0; i < 6; ++i) AddAxis(b_.spacemouse_axes[i], axes_[i] / b_.spacemouse_full_scale, b_.deadband, out);
 }
 #else
 std::unique_ptr<SpaceMouseDevice> SpaceMouseDevice::Open(const Bindings&, std::string* why) {

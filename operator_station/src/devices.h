@@ -1,34 +1,41 @@
 #pragma once
-// The operator's hand controllers (docs/operator.md "Devices"): the keyboard
-// of a terminal, a gamepad or joystick through SDL2, a 3D mouse through
+// The operator's hand controllers (docs/operator.md "Devices"): the
+// keyboard of a terminal, the keyboard of the live window (over LCM from
+// esg_renderer), a gamepad or joystick through SDL2, a 3D mouse through
 // libspnav (spacenavd). Each is optional, looked for at start and reported;
 // what each control does is in config/bindings.toml.
 //
-// A device reports, each frame, what the operator asks for: steps (a key
-// press moves an input by its step), rates (a deflected axis or a held
-// button moves an input at up to its max rate), a velocity of System Two
-// (the 3D mouse, resolved rate) and discrete events (camera, reset,
-// overlay). ManualControl (manual_control.h) conditions and combines them.
+// A device reports, each frame, what the operator asks for: deflections of
+// the hand controllers' six axes (sticks, the 3D mouse, keys held in the
+// window), presses (a terminal's keys, which have no key-up), the direct
+// inputs' rates and presses (finger, shoulder height, camera) and discrete
+// events. HandControllers (hand_controllers.h) turns them into the inputs.
 #include <array>
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "bindings.h"
 #include "rms/input_block.h"
 
 namespace rms::op {
 
+struct Press {
+  int index = 0;      // the HandAxis, or the analog input
+  double sign = 1.0;
+};
+
 struct DeviceCommands {
-  std::array<double, kNumAnalogInputs> step{};  // units of each input, this frame
-  std::array<double, kNumAnalogInputs> rate{};  // units a second
-  Eigen::Vector3d v_R_ft_s = Eigen::Vector3d::Zero();    // System Two's translation, Reference frame
-  Eigen::Vector3d w_S2_deg_s = Eigen::Vector3d::Zero();  // System Two's rotation about its own axes
-  std::vector<Action> events;                    // camera, reset, overlay, quit
+  std::array<double, kNumHandAxes> hand{};            // deflection, [-1, 1] each
+  std::vector<Press> hand_presses;                    // a terminal's presses, in order
+  std::array<double, kNumAnalogInputs> input_rate{};  // direct inputs: fraction of max rate, [-1, 1]
+  std::vector<Press> input_presses;                   // a terminal's presses of direct inputs
+  std::vector<Action> events;                         // camera, mode, stop, reset, ...
+  int key_actions = 0;                                // keys and buttons pressed this frame
 };
 
 class InputDevice {
@@ -46,8 +53,10 @@ class InputDevice {
 // rescaled so full deflection still reads 1.
 double ApplyDeadband(double x, double band);
 
-// The keyboard: keys from `next_key` (a key code, or -1 when none is
-// pending: TerminalKeys::Next for a terminal; tests give their own).
+// A terminal's keyboard: keys from `next_key` (a key code, or -1 when none is
+// pending: TerminalKeys::Next for a terminal; tests give their own). Each
+// press is one increment (HandControllers merges presses faster than it can
+// fly them).
 class KeyboardDevice : public InputDevice {
  public:
   KeyboardDevice(const Bindings& bindings, std::function<int()> next_key, std::string where = "this terminal");
@@ -60,6 +69,36 @@ class KeyboardDevice : public InputDevice {
   std::function<int()> next_key_;
   std::string where_;
   long unbound_ = 0;
+};
+
+// The live window's keyboard (RMS_WINDOW_KEYS from esg_renderer): a held
+// key moves its axis at full rate, a released one stops; discrete actions
+// fire on key down. Keys not heard about for `timeout_us` are released.
+class WindowKeyboardDevice : public InputDevice {
+ public:
+  struct Message {
+    std::int64_t sequence = 0;
+    std::vector<int> held, pressed;
+    bool focused = true;
+  };
+  explicit WindowKeyboardDevice(const Bindings& bindings, std::int64_t timeout_us = 300000);
+  std::string Describe() const override { return "keyboard (the live window)"; }
+  // A message from the window, received at now_us. False (and counted by the
+  // caller) when it is stale or a duplicate.
+  bool Receive(const Message& m, std::int64_t now_us);
+  // The time the next Poll is for (the station's clock, us).
+  void SetNow(std::int64_t now_us) { now_us_ = now_us; }
+  void Poll(DeviceCommands* out) override;
+  long timeouts() const { return timeouts_; }
+  bool heard() const { return last_sequence_ >= 0; }
+
+ private:
+  const Bindings& b_;
+  std::int64_t timeout_us_;
+  std::int64_t now_us_ = 0, heard_us_ = 0, last_sequence_ = -1;
+  std::set<int> held_;
+  std::vector<int> pressed_;
+  long timeouts_ = 0;
 };
 
 // The first SDL2 game controller (a gamepad or a joystick SDL knows a
@@ -81,8 +120,9 @@ class GamepadDevice : public InputDevice {
 };
 
 // A 3D mouse through spacenavd (libspnav's AF_UNIX protocol; SPNAV_SOCKET
-// names another socket). Open() returns nothing, with the reason, when
-// there is no daemon or libspnav was not built in.
+// names another socket): both hand controllers in one cap. Open() returns
+// nothing, with the reason, when there is no daemon or libspnav was not
+// built in.
 class SpaceMouseDevice : public InputDevice {
  public:
   static std::unique_ptr<SpaceMouseDevice> Open(const Bindings& bindings, std::string* why);

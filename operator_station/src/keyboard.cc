@@ -43,6 +43,9 @@ int TerminalKeys::ReadByte() {
 
 int TerminalKeys::Next() {
   const int c = ReadByte();
+  if (c == 127 || c == 8) return kKeyBackspace;
+  if (c == '\t') return kKeyTab;
+  if (c == '\r' || c == '\n') return kKeyEnter;
   if (c != 27) return c;
   const int b = ReadByte();
   if (b != '[') return 27;
@@ -51,6 +54,8 @@ int TerminalKeys::Next() {
     case 'B': return kKeyDown;
     case 'C': return kKeyRight;
     case 'D': return kKeyLeft;
+    case '5': return ReadByte() == '~' ? kKeyPageUp : -1;
+    case '6': return ReadByte() == '~' ? kKeyPageDown : -1;
     default: return -1;
   }
 }

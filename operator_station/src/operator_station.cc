@@ -2,28 +2,19 @@
 
 #include <cerrno>
 #include <cmath>
-#include <memory>
-#include <optional>
 #include <spdlog/spdlog.h>
 #include <time.h>
 #include <unistd.h>
 
-#include "autopilot.h"
-#include "bindings.h"
-#include "devices.h"
-#include "keyboard.h"
-#include "manual_control.h"
 #include "rms/channels.h"
 #include "rms/check.h"
-#include "rms/dcp_telemetry_t.hpp"
-#include "rms/message_io.h"
-#include "rms/telemetry_check.h"
-#include "rms/process.h"
 #include "rms/checkpoint.h"
+#include "rms/message_io.h"
+#include "rms/operator_state_t.hpp"
 #include "rms/process_status_t.hpp"
 #include "rms/session_control_t.hpp"
-#include "status_screen.h"
-#include "timeline.h"
+#include "rms/telemetry_check.h"
+#include "rms/window_keys_t.hpp"
 
 namespace rms::op {
 
@@ -54,355 +45,370 @@ void SleepUntilNs(std::int64_t t_ns) {
   }
 }
 
-// Events a second over the last second or so.
-class RateMeter {
- public:
-  void Tick(std::int64_t now_us) {
-    if (t0_us_ == 0) {  // the first event opens the window
-      t0_us_ = now_us;
-      return;
-    }
-    ++count_;
-    if (now_us - t0_us_ >= 1000000) {
-      hz_ = count_ * 1e6 / static_cast<double>(now_us - t0_us_);
-      count_ = 0;
-      t0_us_ = now_us;
-    }
-  }
-  double hz() const { return hz_; }
+// The biggest message of each kind a station accepts (docs/protocol.md).
+constexpr int kMaxTelemetrySize = 4096;
+constexpr int kMaxStatusSize = 1 << 20;
+constexpr int kMaxControlSize = 1 << 16;
+constexpr int kMaxWindowKeysSize = 8 + 16 + 2 + 2 * 512 + 2 + 2 * 512 + 1;
 
- private:
-  std::int64_t t0_us_ = 0, count_ = 0;
-  double hz_ = 0.0;
-};
-
-std::string KeyHelp(const Bindings& b) {
-  std::string s = "keys:";
-  for (const auto& [code, a] : b.keys) {
-    std::string key = code == ' ' ? "space" : code == kKeyUp ? "up" : code == kKeyDown ? "down" : code == kKeyLeft ? "left"
-                      : code == kKeyRight ? "right" : std::string(1, static_cast<char>(code));
-    std::string what;
-    switch (a.kind) {
-      case ActionKind::kIncrease: what = std::string(kAnalogInputNames[a.input]) + "+"; break;
-      case ActionKind::kDecrease: what = std::string(kAnalogInputNames[a.input]) + "-"; break;
-      case ActionKind::kCamera: what = "cam" + std::to_string(a.camera); break;
-      case ActionKind::kCameraNext: what = "cam+"; break;
-      case ActionKind::kCameraPrev: what = "cam-"; break;
-      case ActionKind::kReset: what = "reset"; break;
-      case ActionKind::kOverlay: what = "overlay"; break;
-      case ActionKind::kQuit: what = "quit"; break;
-      case ActionKind::kFreeze: what = "freeze"; break;
-      case ActionKind::kStep: what = "step"; break;
-    }
-    s += " " + key + "=" + what;
-  }
-  return s;
+bool Restarted() {
+  const char* r = std::getenv("RMSLAB_RESTART");
+  return r && *r && std::string(r) != "0";
 }
 
 }  // namespace
 
-int RunOperatorStation(const OperatorOptions& options, const LabConfig& config, LcmInterface& lcm,
-                       const std::string& stats_path, const std::string& ready_path) {
-  const int sources = !options.timeline_path.empty() + options.keyboard + options.manual + options.autopilot;
+std::unique_ptr<InputSource> MakeSource(const OperatorOptions& o, const LabConfig& config) {
+  const int sources = !o.timeline_path.empty() + o.keyboard + o.manual + o.autopilot;
   if (sources != 1) {
     throw InputError("give exactly one input source: --timeline FILE, --keyboard, --manual or --autopilot");
   }
-  const bool by_hand = options.keyboard || options.manual;
-  const double rate = options.rate_hz > 0 ? options.rate_hz : config.session.frame_rate_hz;
-  const std::int64_t period_ns = static_cast<std::int64_t>(std::llround(1e9 / rate));
-
-  // The source.
-  std::unique_ptr<Timeline> timeline;
-  std::unique_ptr<Bindings> bindings;
-  std::unique_ptr<TerminalKeys> terminal;
-  std::unique_ptr<ManualControl> manual;
-  std::unique_ptr<Autopilot> autopilot;
-  std::vector<std::string> device_report;
-  std::string source;
-  if (!options.timeline_path.empty()) {
-    timeline = std::make_unique<Timeline>(Timeline::Load(options.timeline_path, config.inputs));
-    for (const std::string& w : timeline->warnings()) spdlog::warn("{}", w);
-    spdlog::info("timeline {}: {:.2f} s at {:.1f} Hz, speed {}", options.timeline_path, timeline->end_time(), rate,
-                 options.speed);
-    source = "timeline " + options.timeline_path;
-  } else if (by_hand) {
-    bindings = std::make_unique<Bindings>(
-        LoadBindings(options.bindings_path.empty() ? DefaultBindingsPath() : options.bindings_path));
-    manual = std::make_unique<ManualControl>(config, *bindings);
-    // Each device is optional: looked for, and reported either way.
-    if (isatty(STDIN_FILENO)) {
-      terminal = std::make_unique<TerminalKeys>();
-      manual->AddDevice(std::make_unique<KeyboardDevice>(*bindings, [t = terminal.get()] { return t->Next(); }));
-    } else if (options.keyboard) {
-      throw InputError("--keyboard needs a terminal on standard input");
-    } else {
-      device_report.push_back("keyboard: none (standard input is not a terminal)");
-    }
-    std::string why;
-    if (options.gamepad) {
-      if (auto g = GamepadDevice::Open(*bindings, &why)) manual->AddDevice(std::move(g));
-      else device_report.push_back("gamepad: none (" + why + ")");
-    }
-    if (options.spacemouse) {
-      if (auto m = SpaceMouseDevice::Open(*bindings, &why)) manual->AddDevice(std::move(m));
-      else device_report.push_back("3D mouse: none (" + why + ")");
-    }
-    for (const auto& d : device_report) spdlog::info("{}", d);
-    if (manual->devices().empty()) throw InputError("no input device found (" + device_report.front() + ")");
-    for (const auto& d : manual->devices()) device_report.insert(device_report.begin(), d->Describe());
-    source = "by hand";
-  } else {
-    AutopilotOptions ao;
-    ao.plan_clear_paths = !options.autopilot_straight;
-    autopilot = std::make_unique<Autopilot>(config, ao);
-    source = "autopilot";
+  if (!o.timeline_path.empty()) return std::make_unique<TimelineSource>(o.timeline_path, config, o.speed, o.hold);
+  if (o.keyboard || o.manual) {
+    HandOptions h;
+    h.bindings_path = o.bindings_path;
+    h.keyboard_required = o.keyboard;
+    h.gamepad = o.gamepad;
+    h.spacemouse = o.spacemouse;
+    h.window = o.window_keys;
+    return std::make_unique<HandSource>(config, h);
   }
+  AutopilotOptions ao;
+  ao.plan_clear_paths = !o.autopilot_straight;
+  return std::make_unique<AutopilotSource>(config, ao, o.hold, false);
+}
 
-  // What the DCP and the other processes say.
-  std::optional<dcp_telemetry_t> telemetry;
-  RateMeter publish_rate, telemetry_rate;
-  double input_to_dcp_ms = -1.0, render_hz = -1.0, render_p50_ms = -1.0, render_p99_ms = -1.0;
-  std::int64_t esg_rendered = -1, esg_status_us = 0;
-  Counters counters;
-  lcm.Subscribe(channels::kDcpTelemetry, [&](const void* data, int size, std::int64_t recv_us) {
-    dcp_telemetry_t m{};
-    if (const DecodeError e = SafeDecode(data, size, 4096, &m); e != DecodeError::kNone) {
-      counters.Add(std::string("dropped.telemetry_") + DecodeErrorName(e));
-      return;
-    }
-    if (const auto why = TelemetryProblem(m)) {
-      counters.Add("dropped.telemetry_" + *why);
-      return;
-    }
-    if (telemetry && m.frame <= telemetry->frame && m.frame != 0) {
-      counters.Add("telemetry.stale");
-      return;
-    }
-    telemetry = m;
-    telemetry_rate.Tick(recv_us);
-    input_to_dcp_ms = (recv_us - m.input_send_time_us) / 1000.0;
-  });
-  lcm.Subscribe(channels::kStatus, [&](const void* data, int size, std::int64_t recv_us) {
-    process_status_t m;
-    if (SafeDecode(data, size, 1 << 20, &m) != DecodeError::kNone) {
-      counters.Add("dropped.status_malformed");
-      return;
-    }
-    if (m.process != "esg_renderer") return;
-    for (int i = 0; i < m.num_counters; ++i) {
-      const std::string& n = m.counter_names[i];
-      const std::int64_t v = m.counter_values[i];
-      if (n == "rendered") {
-        if (esg_rendered >= 0 && recv_us > esg_status_us) render_hz = (v - esg_rendered) * 1e6 / (recv_us - esg_status_us);
-        esg_rendered = v;
-        esg_status_us = recv_us;
-      } else if (n == "latency.input_to_render.p50_us") {
-        render_p50_ms = v / 1000.0;
-      } else if (n == "latency.input_to_render.p99_us") {
-        render_p99_ms = v / 1000.0;
-      }
-    }
-  });
-
-  // RMS_CONTROL: freeze, run, step; a restored checkpoint (docs/sessions.md).
-  // The station is the session's clock: frozen, it stops its source and
-  // publishes nothing, so every process holds its frame and nothing is lost.
-  bool frozen = false;
-  int steps_pending = 0;
-  std::optional<std::string> restored_from;
-  std::int64_t control_sequence = 0;
-  lcm.Subscribe(channels::kControl, [&](const void* data, int size, std::int64_t) {
-    session_control_t m;
-    if (SafeDecode(data, size, 1 << 16, &m) != DecodeError::kNone) {
-      counters.Add("dropped.control_malformed");
-      return;
-    }
-    switch (m.command) {
-      case session_control_t::FREEZE:
-        if (!frozen) spdlog::info("frozen");
-        frozen = true;
-        counters.Add("control.freezes");
-        break;
-      case session_control_t::RUN:
-        if (frozen) spdlog::info("running again");
-        frozen = false;
-        steps_pending = 0;
-        break;
-      case session_control_t::STEP:
-        if (frozen) ++steps_pending;
-        counters.Add("control.steps");
-        break;
-      case session_control_t::RESTORE:
-        restored_from = m.path;
-        break;
-      default:
-        break;
-    }
-  });
-  auto send_control = [&](std::int8_t command) {
-    session_control_t m;
-    m.send_time_us = lcm.NowUs();
-    m.sequence = control_sequence++;
-    m.command = command;
-    if (!PublishMessage(lcm, channels::kControl, m)) counters.Add("publish_failed");
-  };
-  if (!options.restore_path.empty()) {
-    const Checkpoint c = ReadCheckpoint(options.restore_path);
-    spdlog::info("starting from the checkpoint {} (DCP frame {})", options.restore_path, c.dcp_frame);
-    if (manual) manual->SetInputs(c.inputs);
-    if (autopilot) autopilot->Resync(c.inputs);
+void OperatorStation::RateMeter::Tick(std::int64_t now_us) {
+  if (t0_us == 0) {  // the first event opens the window
+    t0_us = now_us;
+    return;
   }
+  ++count;
+  if (now_us - t0_us >= 1000000) {
+    hz_ = count * 1e6 / static_cast<double>(now_us - t0_us);
+    count = 0;
+    t0_us = now_us;
+  }
+}
 
+OperatorStation::OperatorStation(const OperatorOptions& options, const LabConfig& config, LcmInterface& lcm,
+                                 std::unique_ptr<InputSource> source)
+    : options_(options),
+      config_(config),
+      lcm_(lcm),
+      source_(std::move(source)),
+      geometry_(MakeGuidanceGeometry(config)),
+      rate_hz_(options.rate_hz > 0 ? options.rate_hz : config.session.frame_rate_hz),
+      period_ns_(static_cast<std::int64_t>(std::llround(1e9 / rate_hz_))),
+      builder_(config.inputs) {
+  Subscribe();
+}
+
+void OperatorStation::Subscribe() {
+  lcm_.Subscribe(channels::kDcpTelemetry, [this](const void* d, int n, std::int64_t t) { OnTelemetry(d, n, t); });
+  lcm_.Subscribe(channels::kStatus, [this](const void* d, int n, std::int64_t t) { OnStatus(d, n, t); });
+  lcm_.Subscribe(channels::kControl, [this](const void* d, int n, std::int64_t t) { OnControl(d, n, t); });
+  if (source_->window_keyboard()) {
+    lcm_.Subscribe(channels::kWindowKeys, [this](const void* d, int n, std::int64_t t) { OnWindowKeys(d, n, t); });
+  }
+}
+
+void OperatorStation::OnTelemetry(const void* data, int size, std::int64_t recv_us) {
+  dcp_telemetry_t m{};
+  if (const DecodeError e = SafeDecode(data, size, kMaxTelemetrySize, &m); e != DecodeError::kNone) {
+    counters_.Add(std::string("dropped.telemetry_") + DecodeErrorName(e));
+    return;
+  }
+  if (const auto why = TelemetryProblem(m)) {
+    counters_.Add("dropped.telemetry_" + *why);
+    return;
+  }
+  if (m.input_frame < fresh_from_input_frame_) {
+    counters_.Add("telemetry.before_reset");  // answers an input from before the last reset or restore
+    return;
+  }
+  if (telemetry_ && m.frame <= telemetry_->frame && m.frame != 0) {
+    counters_.Add("telemetry.stale");
+    return;
+  }
+  telemetry_ = m;
+  telemetry_rate_.Tick(recv_us);
+  input_to_dcp_ms_ = (recv_us - m.input_send_time_us) / 1000.0;
+  events_.Observe(m);
+}
+
+void OperatorStation::OnStatus(const void* data, int size, std::int64_t recv_us) {
+  process_status_t m;
+  if (SafeDecode(data, size, kMaxStatusSize, &m) != DecodeError::kNone) {
+    counters_.Add("dropped.status_malformed");
+    return;
+  }
+  if (m.process != "esg_renderer") return;
+  for (int i = 0; i < m.num_counters; ++i) {
+    const std::string& n = m.counter_names[i];
+    const std::int64_t v = m.counter_values[i];
+    if (n == "rendered") {
+      if (esg_rendered_ >= 0 && recv_us > esg_status_us_) render_hz_ = (v - esg_rendered_) * 1e6 / (recv_us - esg_status_us_);
+      esg_rendered_ = v;
+      esg_status_us_ = recv_us;
+    } else if (n == "latency.input_to_render.p50_us") {
+      render_p50_ms_ = v / 1000.0;
+    } else if (n == "latency.input_to_render.p99_us") {
+      render_p99_ms_ = v / 1000.0;
+    }
+  }
+}
+
+// RMS_CONTROL: freeze, run, step; a restored checkpoint (docs/sessions.md).
+// The station is the session's clock: frozen, it stops its source and
+// publishes nothing, so every process holds its frame and nothing is lost.
+void OperatorStation::OnControl(const void* data, int size, std::int64_t) {
+  session_control_t m;
+  if (SafeDecode(data, size, kMaxControlSize, &m) != DecodeError::kNone) {
+    counters_.Add("dropped.control_malformed");
+    return;
+  }
+  switch (m.command) {
+    case session_control_t::FREEZE:
+      if (!frozen_) spdlog::info("FROZEN: the session holds its frame");
+      frozen_ = true;
+      counters_.Add("control.freezes");
+      break;
+    case session_control_t::RUN:
+      if (frozen_) spdlog::info("running again");
+      frozen_ = false;
+      steps_pending_ = 0;
+      break;
+    case session_control_t::STEP:
+      if (frozen_) ++steps_pending_;
+      counters_.Add("control.steps");
+      break;
+    case session_control_t::RESTORE: restored_from_ = m.path; break;
+    default: break;
+  }
+}
+
+void OperatorStation::OnWindowKeys(const void* data, int size, std::int64_t recv_us) {
+  window_keys_t m;
+  if (const DecodeError e = SafeDecode(data, size, kMaxWindowKeysSize, &m); e != DecodeError::kNone) {
+    counters_.Add(std::string("dropped.window_keys_") + DecodeErrorName(e));
+    return;
+  }
+  WindowKeyboardDevice::Message k;
+  k.sequence = m.sequence;
+  k.held.assign(m.held.begin(), m.held.end());
+  k.pressed.assign(m.pressed.begin(), m.pressed.end());
+  k.focused = m.focused;
+  if (!source_->window_keyboard()->Receive(k, recv_us)) counters_.Add("dropped.window_keys_stale");
+}
+
+void OperatorStation::SendControl(std::int8_t command) {
+  session_control_t m;
+  m.send_time_us = lcm_.NowUs();
+  m.sequence = control_sequence_++;
+  m.command = command;
+  if (!PublishMessage(lcm_, channels::kControl, m)) counters_.Add("publish_failed");
+}
+
+void OperatorStation::ForgetTelemetry(std::int64_t fresh_from_input_frame) {
+  fresh_from_input_frame_ = fresh_from_input_frame;
+  telemetry_.reset();
+  events_.Forget();
+}
+
+void OperatorStation::ApplyRestore() {
+  // Carry on from the checkpoint's inputs, so the first frame after it
+  // commands the arm where the DCP now has it.
+  try {
+    const Checkpoint c = ReadCheckpoint(*restored_from_);
+    source_->Resume(c.inputs, true);
+    ForgetTelemetry(builder_.next_frame());
+    spdlog::info("RESTORED the checkpoint {}: carrying on from its inputs", *restored_from_);
+    counters_.Add("control.restores");
+  } catch (const InputError& e) {
+    counters_.Add("control.errors");
+    spdlog::error("{}", e.what());
+  }
+  restored_from_.reset();
+}
+
+std::optional<Guidance> OperatorStation::CurrentGuidance() const {
+  if (!telemetry_) return std::nullopt;
+  const ArmState s = ArmStateFrom(*telemetry_);
+  CommandFrame f = source_->hand() ? source_->hand()->status().frame : CommandFrame::kEndEffector;
+  if (f == CommandFrame::kPayload && s.mode == 1) f = CommandFrame::kEndEffector;
+  return ComputeGuidance(geometry_, s, f);
+}
+
+void OperatorStation::PublishState(std::int64_t frame, const OperatorInputs& in) {
+  operator_state_t m{};
+  m.frame = frame;
+  m.send_time_us = lcm_.NowUs();
+  m.source = source_->kind();
+  if (const HandControllers* h = source_->hand()) {
+    const HandStatus& s = h->status();
+    m.control_mode = static_cast<std::int8_t>(s.mode);
+    m.command_frame = static_cast<std::int8_t>(s.frame);
+    m.vernier = s.vernier;
+    m.joint = static_cast<std::int8_t>(s.joint);
+    for (int i = 0; i < 6; ++i) m.hand_rate[i] = s.rate[i];
+    m.joint_limits = static_cast<std::int8_t>(s.at_limit);
+    m.singular = s.singular;
+    m.sigma_min_ft = s.sigma_min_ft;
+    m.show_guidance = h->show_guidance();
+    m.key_actions = static_cast<std::int32_t>(h->key_actions());
+  }
+  if (const auto g = CurrentGuidance()) {
+    const dcp_telemetry_t& t = *telemetry_;
+    m.guidance_valid = true;
+    m.mode = t.mode;
+    m.target = static_cast<std::int8_t>(g->target);
+    if (!source_->hand()) m.command_frame = static_cast<std::int8_t>(g->frame);
+    for (int i = 0; i < 3; ++i) {
+      m.offset_ft[i] = g->offset_ft[i];
+      m.rotation_deg[i] = g->rotation_deg[i];
+    }
+    m.distance_ft = g->distance_ft;
+    m.angle_deg = g->angle_deg;
+    for (int i = 0; i < 6; ++i) {
+      m.conditions[i] = t.acquisition_conditions[i];
+      m.margin_ft[i] = t.acquisition_margin_ft[i];
+    }
+    m.bay_clearance_ft = t.bay_clearance_ft;
+    m.dock_distance_ft = t.dock_distance_ft;
+    m.dock_angle_deg = t.dock_angle_deg;
+  }
+  (void)in;
+  if (!PublishMessage(lcm_, channels::kOperatorState, m)) counters_.Add("publish_failed");
+}
+
+void OperatorStation::DrawScreen(std::int64_t frame, const OperatorInputs& in, bool frozen) {
+  if (!screen_) return;
+  StatusSnapshot s;
+  s.source = source_->Describe() +
+             (frozen ? std::string(" -- FROZEN (") + (source_->hand() ? "freeze key runs, step key steps" : "rms_control run") + ")"
+                     : "");
+  s.frame = frame;
+  s.session_s = static_cast<double>(frames_) / rate_hz_;
+  s.inputs = in;
+  s.telemetry = telemetry_;
+  s.guidance = CurrentGuidance();
+  if (const HandControllers* h = source_->hand()) {
+    s.hand = h->status();
+    s.show_guidance = h->show_guidance();
+    s.key_actions = h->key_actions();
+  }
+  s.keys = source_->key_hints();
+  s.publish_hz = publish_rate_.hz();
+  s.telemetry_hz = telemetry_rate_.hz();
+  s.input_to_dcp_ms = input_to_dcp_ms_;
+  s.render_hz = render_hz_;
+  s.input_to_render_p50_ms = render_p50_ms_;
+  s.input_to_render_p99_ms = render_p99_ms_;
+  s.clamped_inputs = counters_.SumPrefix("clamped.") + (source_->hand() ? source_->hand()->counters().SumPrefix("clamped.") : 0);
+  s.devices = source_->devices();
+  s.help = source_->help();
+  screen_->Draw(std::move(s));
+}
+
+bool OperatorStation::RunFrozen() {
+  // Frozen: no clock, no frames. The session's keys still work.
+  source_->WhileFrozen();
+  const Requests r = source_->requests();
+  if (r.quit) return false;
+  if (r.freeze) SendControl(session_control_t::RUN);
+  if (r.step) SendControl(session_control_t::STEP);
+  DrawScreen(builder_.next_frame() - 1, last_, true);
+  return true;
+}
+
+int OperatorStation::Run(const std::string& stats_path, const std::string& ready_path) {
+  if (!options_.restore_path.empty()) {
+    const Checkpoint c = ReadCheckpoint(options_.restore_path);
+    spdlog::info("starting from the checkpoint {} (DCP frame {})", options_.restore_path, c.dcp_frame);
+    source_->Resume(c.inputs, true);
+  }
   // RMSLAB_RESTART (set by the launcher when it restarts this process after a
-  // fault, docs/sessions.md "Faults"): the autopilot resumes from the first
-  // telemetry instead of starting the task over.
-  const char* restart_env = std::getenv("RMSLAB_RESTART");
-  bool resume_from_telemetry = autopilot && restart_env && *restart_env && std::string(restart_env) != "0";
-  if (restart_env && *restart_env && std::string(restart_env) != "0") counters.Add("restarted");
-
-  const bool screen_on = options.status == 1 || (options.status == -1 && by_hand && isatty(STDOUT_FILENO));
-  std::unique_ptr<StatusScreen> screen;
-  if (screen_on) screen = std::make_unique<StatusScreen>(config);
-  const std::string help = bindings ? KeyHelp(*bindings) : "";
-
-  StatusReporter status(&lcm, "operator_station");
-  InputBlockBuilder builder(config.inputs);
-  builder.set_next_frame(FirstFrameNumber(config.session.frame_rate_hz));
+  // fault, docs/sessions.md "Faults"): the source resumes from the first
+  // telemetry's command instead of starting the task over.
+  bool resume_from_telemetry = Restarted() && options_.restore_path.empty() && options_.timeline_path.empty();
+  if (Restarted()) counters_.Add("restarted");
+  const bool by_hand = source_->hand() != nullptr;
+  if (options_.status == 1 || (options_.status == -1 && by_hand && isatty(STDOUT_FILENO))) {
+    screen_ = std::make_unique<StatusScreen>(config_);
+  }
+  StatusReporter status(&lcm_, "operator_station");
+  builder_.set_next_frame(FirstFrameNumber(config_.session.frame_rate_hz));
   if (!ready_path.empty()) TouchFile(ready_path);
 
   std::int64_t next_ns = MonotonicNs();
-  double prev_t = -1.0;
-  std::int64_t frames = 0, docked_frames = 0;
-  int exit_code = 0;
+  last_ = InitialInputs(config_.inputs);
   while (!StopRequested()) {
-    if (options.max_frames >= 0 && frames >= options.max_frames) break;
-    if (lcm.HandleSubscriptions(0) < 0) counters.Add("transport_errors");
-    if (restored_from) {
-      // Carry on from the checkpoint's inputs, so the first frame after it
-      // commands the arm where the DCP now has it.
-      try {
-        const Checkpoint c = ReadCheckpoint(*restored_from);
-        if (manual) manual->SetInputs(c.inputs);
-        if (autopilot) autopilot->Resync(c.inputs);
-        spdlog::info("restored checkpoint {}: carrying on from its inputs", *restored_from);
-        counters.Add("control.restores");
-      } catch (const InputError& e) {
-        counters.Add("control.errors");
-        spdlog::error("{}", e.what());
-      }
-      restored_from.reset();
-    }
-    if (frozen && steps_pending == 0) {
-      // Frozen: no clock, no frames. The session's keys still work.
-      if (manual) {
-        manual->PollFrozen();
-        if (manual->quit()) break;
-        if (manual->freeze_requested()) send_control(session_control_t::RUN);
-        if (manual->step_requested()) send_control(session_control_t::STEP);
-      }
-      if (screen) {
-        StatusSnapshot s;
-        s.source = source + " -- FROZEN (" + (bindings ? "freeze key runs, step key steps" : "rms_control run") + ")";
-        s.frame = builder.next_frame() - 1;
-        s.telemetry = telemetry;
-        s.devices = device_report;
-        s.help = help;
-        screen->Draw(std::move(s));
-      }
-      status.Tick(builder.next_frame() - 1, counters);
-      SleepUntilNs(MonotonicNs() + period_ns);
+    if (options_.max_frames >= 0 && frames_ >= options_.max_frames) break;
+    if (lcm_.HandleSubscriptions(0) < 0) counters_.Add("transport_errors");
+    if (restored_from_) ApplyRestore();
+    if (frozen_ && steps_pending_ == 0) {
+      if (!RunFrozen()) break;
+      status.Tick(builder_.next_frame() - 1, counters_);
+      SleepUntilNs(MonotonicNs() + period_ns_);
       next_ns = MonotonicNs();
       continue;
     }
-    if (steps_pending > 0) --steps_pending;
-    // Timeline time is the frame count over the rate: jitter-free and reproducible.
-    const double t = options.speed * static_cast<double>(frames) / rate;
-    OperatorInputs in;
-    if (timeline) {
-      if (t > timeline->end_time() + 1e-9 && !options.hold) break;
-      in = timeline->Sample(t);
-      in.reset = timeline->ResetIn(prev_t, t);
-    } else if (manual) {
-      in = manual->Step(1.0 / rate);
-      if (manual->quit()) break;
-      if (manual->freeze_requested()) send_control(session_control_t::FREEZE);
-    } else {
-      if (resume_from_telemetry && telemetry) {
-        // Restarted mid-session by the launcher: carry on from the command
-        // the DCP last answered, and let the autopilot pick up the task
-        // where the telemetry says it is (no reset).
-        OperatorInputs from = InitialInputs(config.inputs);
-        for (int i = 0; i < 6; ++i) from.value[i] = telemetry->master_angles_deg[i];
-        from.value[kShoulderHeight] = telemetry->master_shoulder_height_ft;
-        from.value[kFinger] = telemetry->master_finger;
-        autopilot->Resync(from);
-        resume_from_telemetry = false;
-        spdlog::warn("restarted: the autopilot resumes from the DCP's telemetry (Mode {}, frame {})",
-                     static_cast<int>(telemetry->mode), telemetry->frame);
-      }
-      in = autopilot->Step(telemetry ? &*telemetry : nullptr);
-      if (autopilot->failed()) {
-        exit_code = kExitAutopilotFailed;
-        if (!options.hold) break;
-      }
-      // Docked: hold two seconds of session time (the scene shows it), then stop.
-      if (autopilot->docked() && ++docked_frames > 2 * config.session.frame_rate_hz && !options.hold) break;
+    if (steps_pending_ > 0) --steps_pending_;
+    if (resume_from_telemetry && telemetry_) {
+      const dcp_telemetry_t& t = *telemetry_;
+      OperatorInputs from = last_;
+      for (int i = 0; i < 6; ++i) from.value[i] = t.master_angles_deg[i];
+      from.value[kShoulderHeight] = t.master_shoulder_height_ft;
+      from.value[kFinger] = t.master_finger;
+      source_->Resume(from, false);
+      resume_from_telemetry = false;
+      spdlog::warn("restarted: resuming from the DCP's telemetry (Mode {}, frame {})", static_cast<int>(t.mode),
+                   t.frame);
     }
-    prev_t = t;
-    const operator_input_t block = builder.Build(in, lcm.NowUs(), &counters);
-    if (PublishMessage(lcm, channels::kOperatorInput, block)) counters.Add("published");
-    else counters.Add("publish_failed");
-    publish_rate.Tick(lcm.NowUs());
-    ++frames;
-    status.Tick(block.frame, counters);
-
-    if (screen) {
-      StatusSnapshot s;
-      s.source = source + (autopilot ? std::string(": ") + AutopilotPhaseName(autopilot->phase()) : "");
-      s.frame = block.frame;
-      s.inputs = in;
-      s.telemetry = telemetry;
-      s.publish_hz = publish_rate.hz();
-      s.telemetry_hz = telemetry_rate.hz();
-      s.input_to_dcp_ms = input_to_dcp_ms;
-      s.render_hz = render_hz;
-      s.input_to_render_p50_ms = render_p50_ms;
-      s.input_to_render_p99_ms = render_p99_ms;
-      s.clamped_inputs = counters.SumPrefix("clamped.") + (manual ? manual->counters().SumPrefix("clamped.") : 0);
-      s.devices = device_report;
-      s.help = help;
-      screen->Draw(std::move(s));
+    Frame f;
+    f.count = frames_;
+    f.dt_s = 1.0 / config_.session.frame_rate_hz;
+    f.telemetry = telemetry_ ? &*telemetry_ : nullptr;
+    f.now_us = lcm_.NowUs();
+    const std::optional<OperatorInputs> in = source_->Next(f);
+    if (source_->requests().freeze) SendControl(session_control_t::FREEZE);
+    if (!in) break;
+    last_ = *in;
+    if (in->reset) {
+      spdlog::info("reset pressed: back to Mode 1");
+      ForgetTelemetry(builder_.next_frame());
     }
+    const operator_input_t block = builder_.Build(*in, lcm_.NowUs(), &counters_);
+    if (PublishMessage(lcm_, channels::kOperatorInput, block)) counters_.Add("published");
+    else counters_.Add("publish_failed");
+    PublishState(block.frame, *in);
+    publish_rate_.Tick(lcm_.NowUs());
+    ++frames_;
+    status.Tick(block.frame, counters_);
+    DrawScreen(block.frame, *in, false);
 
-    next_ns += period_ns;
+    next_ns += period_ns_;
     const std::int64_t now = MonotonicNs();
-    if (now > next_ns + period_ns) {
-      counters.Add("frames.late");
+    if (now > next_ns + period_ns_) {
+      counters_.Add("frames.late");
       next_ns = now;  // don't try to catch up with a burst
     } else {
       SleepUntilNs(next_ns);
     }
   }
-  screen.reset();  // the terminal back, the captured log written out
-  if (manual) {
-    for (const auto& [k, v] : manual->counters().values()) counters.Add(k, v);
-  }
-  if (autopilot) {
-    for (const auto& [k, v] : autopilot->counters().values()) counters.Add(k, v);
-    counters.Set("autopilot.docked", autopilot->docked());
-    if (autopilot->failed()) spdlog::error("autopilot failed: {}", autopilot->failure());
-    else if (autopilot->docked()) spdlog::info("autopilot: docked {:.1f} s into the session", autopilot->docked_at_s());
-  }
-  counters.Set("frames.total", frames);
-  status.Final(builder.next_frame() - 1, counters);
-  if (!stats_path.empty()) WriteStatsJson(stats_path, "operator_station", counters, {});
-  spdlog::info("published {} input blocks ({} late, {} clamped inputs)", counters.Get("published"),
-               counters.Get("frames.late"), counters.SumPrefix("clamped."));
+  screen_.reset();  // the terminal back, the captured log written out
+  source_->AddCounters(&counters_);
+  counters_.Set("frames.total", frames_);
+  status.Final(builder_.next_frame() - 1, counters_);
+  if (!stats_path.empty()) WriteStatsJson(stats_path, "operator_station", counters_, {});
+  spdlog::info("published {} input blocks ({} late, {} clamped inputs)", counters_.Get("published"),
+               counters_.Get("frames.late"), counters_.SumPrefix("clamped."));
   if (StopRequested()) {
-    spdlog::info("stopped by a signal at frame {}", builder.next_frame() - 1);
+    spdlog::info("stopped by a signal at frame {}", builder_.next_frame() - 1);
     return kExitInterrupted;
   }
-  return exit_code;
+  return source_->exit_code();
 }
 
 }  // namespace rms::op

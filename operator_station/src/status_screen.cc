@@ -2,13 +2,16 @@
 
 #include <spdlog/sinks/base_sink.h>
 #include <spdlog/spdlog.h>
+#include <sys/ioctl.h>
 #include <unistd.h>
 
-#include <cstdarg>
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <mutex>
 #include <sstream>
 
+#include "rms/acquisition_conditions.h"
 #include "rms/collision_bits.h"
 #include "rms/text.h"
 
@@ -25,69 +28,254 @@ const char* ModeName(int m) {
   }
 }
 
+// Fields packed into lines of at most `width` characters: a field that does
+// not fit starts a new line, indented.
+class Flow {
+ public:
+  Flow(std::vector<std::string>* lines, int width) : lines_(lines), width_(width) {}
+  Flow& Line(const std::string& first) {
+    lines_->push_back(first);
+    return *this;
+  }
+  Flow& Field(const std::string& f) {
+    std::string& l = lines_->back();
+    if (static_cast<int>(l.size() + 3 + f.size()) > width_ && l.find_first_not_of(' ') != std::string::npos &&
+        l.size() > 4) {
+      lines_->push_back("    " + f);
+    } else {
+      l += (l.empty() || l.back() == ' ' ? "" : "   ") + f;
+    }
+    return *this;
+  }
+
+ private:
+  std::vector<std::string>* lines_;
+  int width_;
+};
+
+// "short by 12.345 ft" / "holds by 0.050 ft": a margin as an unsigned distance.
+std::string Margin(double m) {
+  return m >= 0 ? Sprintf("holds by %.3f ft", m) : Sprintf("short by %.3f ft", -m);
+}
+
+// The key that moves `action`, for hints: "(w)", or "" when unbound.
+std::string KeyHint(const StatusSnapshot& s, const std::string& action) {
+  const auto it = s.keys.find(action);
+  return it == s.keys.end() ? "" : " (" + it->second + ")";
+}
+
+void GuidanceLines(const StatusSnapshot& s, Flow& flow) {
+  const Guidance& g = *s.guidance;
+  flow.Line(Sprintf("GUIDANCE %s, %s axes:",
+                    g.target == GuidanceTarget::kGrasp ? "to the grasp on the bar receptacle, from the grasp point"
+                                                       : "to the CAE's docking port, from the probe's tip",
+                    std::string(CommandFrameName(g.frame)).c_str()));
+  // Each offset unsigned, with the direction that closes it and its key.
+  static const char* kAxis[3] = {"x", "y", "z"};
+  static const char* kWord[3][2] = {{"forward", "back"}, {"right", "left"}, {"down", "up"}};
+  flow.Line(" ");
+  for (int i = 0; i < 3; ++i) {
+    const double d = g.offset_ft[i];
+    const std::string action = std::string(kHandAxisNames[i]) + (d >= 0 ? "+" : "-");
+    flow.Field(Sprintf("%s %s %.2f ft", kAxis[i], kWord[i][d >= 0 ? 0 : 1], std::abs(d)) + KeyHint(s, action));
+  }
+  flow.Field(Sprintf("distance %.2f ft", g.distance_ft));
+  static const char* kRot[3] = {"roll", "pitch", "yaw"};
+  static const char* kRotWord[3][2] = {{"right", "left"}, {"up", "down"}, {"right", "left"}};
+  flow.Line(" ");
+  for (int i = 0; i < 3; ++i) {
+    const double d = g.rotation_deg[i];
+    const std::string action = std::string(kHandAxisNames[3 + i]) + (d >= 0 ? "+" : "-");
+    flow.Field(Sprintf("%s %s %.1f deg", kRot[i], kRotWord[i][d >= 0 ? 0 : 1], std::abs(d)) + KeyHint(s, action));
+  }
+  flow.Field(Sprintf("angle %.1f deg", g.angle_deg));
+}
+
+void ControlLines(const StatusSnapshot& s, Flow& flow) {
+  const HandStatus& h = *s.hand;
+  flow.Line("CONTROL " + std::string(ControlModeName(h.mode)));
+  if (h.mode == ControlMode::kManualAugmented) flow.Field("frame: " + std::string(CommandFrameName(h.frame)));
+  else flow.Field(Sprintf("joint: %s", std::string(kAnalogInputNames[h.joint]).c_str()));
+  flow.Field(std::string("scale: ") + (h.vernier ? "VERNIER" : "COARSE"));
+  // What each axis does: "moving x +2.00 ft/s (1.20 ft to go)".
+  static const char* kAxis[6] = {"x", "y", "z", "roll", "pitch", "yaw"};
+  static const char* kUnit[6] = {"ft", "ft", "ft", "deg", "deg", "deg"};
+  bool moving = false;
+  for (int i = 0; i < kNumHandAxes; ++i) {
+    if (h.rate[i] == 0.0) continue;
+    const bool joint = h.mode == ControlMode::kSingleJoint;
+    std::string m = Sprintf("%s %s %+.2f %s/s", moving ? "" : "moving", joint ? "joint" : kAxis[i], h.rate[i],
+                            joint ? "deg" : kUnit[i]);
+    if (h.pending[i] != 0.0) m += Sprintf(" (%.2f %s to go)", std::abs(h.pending[i]), joint ? "deg" : kUnit[i]);
+    flow.Field(moving ? m.substr(1) : m);
+    moving = true;
+  }
+  if (!moving) flow.Field("still");
+  if (h.at_limit) {
+    std::string j;
+    for (int i = 0; i < 6; ++i) {
+      if (h.at_limit & (1u << i)) j += std::string(j.empty() ? "" : ", ") + std::string(kAnalogInputNames[i]);
+    }
+    flow.Field("AT JOINT LIMIT: " + j);
+  }
+  if (h.singular) flow.Field(Sprintf("NEAR A SINGULAR POSE (%.1f ft/rad): damped", h.sigma_min_ft));
+  if (h.rate_limited) flow.Field("slowed: a joint at its rate");
+}
+
+void DcpLines(const StatusSnapshot& s, const LabConfig& config, Flow& flow) {
+  const dcp_telemetry_t& t = *s.telemetry;
+  flow.Line(Sprintf("MODE %s", ModeName(t.mode)))
+      .Field(Sprintf("acquired %s", t.acquired ? "YES" : "no"))
+      .Field(Sprintf("docked %s", t.docked ? "YES" : "no"))
+      .Field(std::string("arm ") + (t.held ? "HELD: the command collides" : t.finger_held ? "follows, finger held on the bar" : "follows"));
+  std::string coll;
+  for (int b = 0; b < collision_bits::kCount; ++b) {
+    if (t.collisions & (1 << b)) coll += std::string(coll.empty() ? "" : ", ") + CollisionName(b);
+  }
+  flow.Line("collisions: " + (coll.empty() ? std::string("none") : coll));
+  if (t.mode == 1) {
+    flow.Line("ACQUISITION (each condition's margin):");
+    for (int i = 0; i < kNumAcquisitionConditions; ++i) {
+      if (i % 2 == 0) flow.Line(" ");
+      flow.Field(Sprintf("[%c] %d %-24s %-20s", t.acquisition_conditions[i] ? 'x' : ' ', i + 1,
+                         kAcquisitionConditionNames[i].brief, Margin(t.acquisition_margin_ft[i]).c_str()));
+    }
+    flow.Line(Sprintf("  finger gap %.3f ft (D3Y %.3f)", t.finger_gap_ft, config.dcp.d3y_ft))
+        .Field(Sprintf("palm to BAR %.3f ft (TPOB %.3f)", std::abs(t.palm_to_bar_ft), config.dcp.tpob_ft));
+    if (s.guidance && s.guidance->close_gap_ft > 0) {
+      const double g = s.guidance->close_gap_ft;
+      flow.Field(Sprintf("closed, the finger would stop at %.3f ft: %s", g,
+                         g < config.dcp.d3y_ft ? "below D3Y" : "NOT below D3Y (the BAR nearer the fixed finger)"));
+    }
+  } else {
+    flow.Line("ACQUISITION: acquired; the payload is held")
+        .Field(t.bay_clearance_ft > 0 ? Sprintf("clear of the bay by %.2f ft", t.bay_clearance_ft)
+                                      : Sprintf("in the bay: %.2f ft to lift it clear", -t.bay_clearance_ft));
+  }
+  flow.Line(Sprintf("DOCKING distance %.3f ft (<= %.2f)", t.dock_distance_ft, config.dcp.dock_distance_ft))
+      .Field(Sprintf("angle %.2f deg (<= %.2f)", t.dock_angle_deg, config.dcp.dock_angle_deg))
+      .Field(t.probe_in_envelope ? Sprintf("probe in the envelope (by %.2f ft)", t.envelope_margin_ft)
+                                 : Sprintf("probe outside the envelope by %.2f ft", -t.envelope_margin_ft));
+}
 
 }  // namespace
 
-std::string RenderStatusScreen(const StatusSnapshot& s, const LabConfig& config, int width) {
-  std::vector<std::string> L;
-  const OperatorInputs& in = s.inputs;
-  L.push_back(Sprintf("rmslab operator station -- %s", s.source.c_str()));
-  L.back() += std::string(std::max<int>(1, width - 14 - static_cast<int>(L.back().size())), ' ') +
-              Sprintf("frame %06lld", static_cast<long long>(s.frame));
-  if (s.telemetry) {
-    const dcp_telemetry_t& t = *s.telemetry;
-    L.push_back(Sprintf("MODE %-26s acquired %-3s  docked %-3s  arm %s", ModeName(t.mode), t.acquired ? "YES" : "no",
-                    t.docked ? "YES" : "no",
-                    t.held ? "HELD: the command collides" : t.finger_held ? "follows, finger held on the bar" : "follows"));
-    std::string coll;
-    for (int b = 0; b < collision_bits::kCount; ++b) {
-      if (t.collisions & (1 << b)) coll += std::string(coll.empty() ? "" : ", ") + CollisionName(b);
-    }
-    L.push_back("collisions: " + (coll.empty() ? std::string("none") : coll));
-    static const char* kCond[6] = {"BAR past palm d", "BAR past finger b", "BAR past finger e", "gap < D3Y",
-                                   "palm-BAR < TPOB", "between BAR ends"};
-    for (int half = 0; half < 2; ++half) {
-      std::string cond = half == 0 ? "acquisition:" : "            ";
-      for (int i = 3 * half; i < 3 * half + 3; ++i) {
-        cond += Sprintf(" [%c] %d %-18s", t.acquisition_conditions[i] ? 'x' : ' ', i + 1, kCond[i]);
-      }
-      L.push_back(cond);
-    }
-    L.push_back(Sprintf("  finger gap %.3f ft (D3Y %.3f)   palm to BAR %.3f ft (TPOB %.3f)", t.finger_gap_ft,
-                    config.dcp.d3y_ft, t.palm_to_bar_ft, config.dcp.tpob_ft));
-    L.push_back(Sprintf("docking: distance %.3f ft (<= %.2f)  angle %.2f deg (<= %.2f)  probe in envelope %s",
-                    t.dock_distance_ft, config.dcp.dock_distance_ft, t.dock_angle_deg, config.dcp.dock_angle_deg,
-                    t.probe_in_envelope ? "yes" : "no"));
-  } else {
-    L.push_back("MODE ?  (no telemetry from dynamics_proc yet)");
+std::string RenderStatusScreen(const StatusSnapshot& s, const LabConfig& config, int width, int height) {
+  width = std::max(width, 40);
+  // Sections in the order shown; when the terminal is short, the ones of
+  // lowest priority go first, so the events pane keeps at least 3 lines.
+  struct Section {
+    int priority;  // 0: always
+    std::vector<std::string> lines;
+  };
+  std::vector<Section> sections;
+  auto section = [&](int priority) -> Flow {
+    sections.push_back({priority, {}});
+    return Flow(&sections.back().lines, width);
+  };
+  {
+    Section top{0, {}};
+    const std::string title = "rmslab operator station -- " + s.source;
+    const std::string right = Sprintf("t %.1f s  frame %06lld", s.session_s, static_cast<long long>(s.frame));
+    top.lines.push_back(title + std::string(std::max<int>(1, width - static_cast<int>(title.size() + right.size())), ' ') +
+                        right);
+    sections.push_back(std::move(top));
   }
-  const int st = in.camera_station;
-  L.push_back(Sprintf("camera %d %-34s pan %+6.1f  tilt %+6.1f  zoom %.2f", st,
-                  st >= 1 && st <= static_cast<int>(config.cameras.size()) ? config.cameras[st - 1].name.c_str() : "?",
-                  in.value[kCameraPan], in.value[kCameraTilt], in.value[kCameraZoom]));
-  L.push_back(Sprintf("arm, deg: yaw %+7.2f  pitch %+7.2f  elbow %+7.2f  wrist pitch %+7.2f  yaw %+7.2f  roll %+7.2f",
-                  in.value[0], in.value[1], in.value[2], in.value[3], in.value[4], in.value[5]));
-  L.push_back(Sprintf("shoulder height %.2f ft   finger %.2f (0 open, 1 closed)   overlay %s", in.value[kShoulderHeight],
-                  in.value[kFinger], in.overlay ? "on" : "off"));
-  std::string rates = Sprintf("rates: published %.1f Hz   DCP %.1f Hz   rendered ", s.publish_hz, s.telemetry_hz);
-  rates += s.render_hz >= 0 ? Sprintf("%.1f Hz", s.render_hz) : "? (no status from esg_renderer)";
-  L.push_back(rates);
-  std::string lat = "latency: input to DCP ";
-  lat += s.input_to_dcp_ms >= 0 ? Sprintf("%.1f ms", s.input_to_dcp_ms) : "?";
-  lat += "   input to rendered frame ";
-  lat += s.input_to_render_p50_ms >= 0
-             ? Sprintf("p50 %.1f ms, p99 %.1f ms", s.input_to_render_p50_ms, s.input_to_render_p99_ms)
-             : "? (no status from esg_renderer)";
-  L.push_back(lat);
-  L.push_back(Sprintf("inputs clamped to their range: %ld", s.clamped_inputs));
-  std::string dev = "devices:";
-  for (const auto& d : s.devices) dev += " " + d + ";";
-  L.push_back(dev);
-  L.push_back("--- log ---");
-  const std::size_t first = s.log.size() > 6 ? s.log.size() - 6 : 0;
+  {
+    Flow flow = section(0);
+    if (s.telemetry) DcpLines(s, config, flow);
+    else flow.Line("MODE ?  (no telemetry from dynamics_proc since the start, the last reset or restore)");
+  }
+  if (s.hand) {
+    Flow flow = section(0);
+    ControlLines(s, flow);
+  }
+  if (s.guidance) {
+    Flow flow = section(0);
+    GuidanceLines(s, flow);
+  }
+  const OperatorInputs& in = s.inputs;
+  {
+    Flow flow = section(1);
+    const int st = in.camera_station;
+    flow.Line(Sprintf("camera %d %s", st,
+                      st >= 1 && st <= static_cast<int>(config.cameras.size()) ? config.cameras[st - 1].name.c_str() : "?"))
+        .Field(Sprintf("pan %+6.1f  tilt %+6.1f  zoom %.2f", in.value[kCameraPan], in.value[kCameraTilt],
+                       in.value[kCameraZoom]))
+        .Field(std::string("crosshairs ") + (in.crosshairs ? "on" : "off"))
+        .Field(std::string("overlay ") + (in.overlay ? "on" : "off"));
+    if (s.hand) flow.Field(std::string("window guidance ") + (s.show_guidance ? "on" : "off"));
+  }
+  {
+    Flow flow = section(3);
+    flow.Line(Sprintf("arm, deg: yaw %+7.2f", in.value[0]))
+        .Field(Sprintf("pitch %+7.2f", in.value[1]))
+        .Field(Sprintf("elbow %+7.2f", in.value[2]))
+        .Field(Sprintf("wrist pitch %+7.2f", in.value[3]))
+        .Field(Sprintf("yaw %+7.2f", in.value[4]))
+        .Field(Sprintf("roll %+7.2f", in.value[5]))
+        .Field(Sprintf("shoulder height %.2f ft", in.value[kShoulderHeight]))
+        .Field(Sprintf("finger %.2f (0 open, 1 closed)", in.value[kFinger]));
+  }
+  {
+    Flow flow = section(2);
+    flow.Line(Sprintf("rates: published %.1f Hz", s.publish_hz))
+        .Field(Sprintf("DCP %.1f Hz", s.telemetry_hz))
+        .Field(s.render_hz >= 0 ? Sprintf("rendered %.1f Hz", s.render_hz) : "rendered ? (no status from esg_renderer)");
+    flow.Line("latency: input to DCP " + (s.input_to_dcp_ms >= 0 ? Sprintf("%.1f ms", s.input_to_dcp_ms) : "?"))
+        .Field("input to rendered frame " +
+               (s.input_to_render_p50_ms >= 0
+                    ? Sprintf("p50 %.1f ms, p99 %.1f ms", s.input_to_render_p50_ms, s.input_to_render_p99_ms)
+                    : std::string("? (no status from esg_renderer)")));
+    flow.Line(Sprintf("inputs clamped to their range: %ld", s.clamped_inputs));
+    if (s.key_actions >= 0) flow.Field(Sprintf("keys pressed: %ld", s.key_actions));
+  }
+  {
+    Flow flow = section(4);
+    flow.Line(s.devices.empty() ? "devices: none" : "devices: " + s.devices[0] + ";");
+    for (std::size_t i = 1; i < s.devices.size(); ++i) flow.Field(s.devices[i] + ";");
+  }
+  {
+    Flow flow = section(5);
+    if (!s.help.empty()) {
+      flow.Line("");
+      // Groups are two spaces apart ("w/s fwd/back  d/a right/left ...").
+      std::size_t from = 0;
+      while (from < s.help.size()) {
+        std::size_t to = s.help.find("  ", from);
+        if (to == std::string::npos) to = s.help.size();
+        if (to > from) flow.Field(s.help.substr(from, to - from));
+        from = to + 2;
+      }
+    }
+  }
+  // Drop the least important sections until the events pane has 3 lines.
+  constexpr int kMinPane = 3;
+  auto used = [&] {
+    int n = 1;  // the pane's heading
+    for (const Section& sec : sections) n += static_cast<int>(sec.lines.size());
+    return n;
+  };
+  for (int p = 5; p >= 1 && used() + kMinPane > height; --p) {
+    for (Section& sec : sections) {
+      if (sec.priority == p) sec.lines.clear();
+    }
+  }
+  const int pane = std::max(kMinPane, height - used());
+  std::vector<std::string> L;
+  const Section* help = nullptr;
+  for (const Section& sec : sections) {
+    if (sec.priority == 5) {
+      help = &sec;
+      continue;
+    }
+    L.insert(L.end(), sec.lines.begin(), sec.lines.end());
+  }
+  L.push_back("--- events and log ---");
+  const std::size_t first = s.log.size() > static_cast<std::size_t>(pane) ? s.log.size() - pane : 0;
   for (std::size_t i = first; i < s.log.size(); ++i) L.push_back(s.log[i]);
-  for (std::size_t i = s.log.size() - first; i < 6; ++i) L.push_back("");
-  if (!s.help.empty()) L.push_back(s.help);
+  for (std::size_t i = s.log.size() - first; i < static_cast<std::size_t>(pane); ++i) L.push_back("");
+  if (help) L.insert(L.end(), help->lines.begin(), help->lines.end());
   std::string out;
   for (auto& l : L) {
     if (static_cast<int>(l.size()) > width) l.resize(width);
@@ -97,13 +285,15 @@ std::string RenderStatusScreen(const StatusSnapshot& s, const LabConfig& config,
 }
 
 namespace {
-// Keeps every formatted line (the screen shows the last ones; all are
-// written out when the screen closes).
+// Keeps every formatted line (all are written out when the screen closes)
+// and a short form for the pane ("12:03:04 warn: ..." without the date and
+// the process).
 class LineSink : public spdlog::sinks::base_sink<std::mutex> {
  public:
   std::vector<std::string> Last(std::size_t n) {
     std::lock_guard<std::mutex> lock(mutex_);
-    return {lines_.end() - static_cast<long>(std::min(n, lines_.size())), lines_.end()};
+    const std::size_t k = std::min(n, brief_.size());
+    return {brief_.end() - static_cast<long>(k), brief_.end()};
   }
   std::vector<std::string> All() {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -117,12 +307,26 @@ class LineSink : public spdlog::sinks::base_sink<std::mutex> {
     std::string line(buf.data(), buf.size());
     while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.pop_back();
     lines_.push_back(std::move(line));
+    const std::time_t t = std::chrono::system_clock::to_time_t(msg.time);
+    std::tm tm{};
+    localtime_r(&t, &tm);
+    char hms[16];
+    std::strftime(hms, sizeof hms, "%H:%M:%S", &tm);
+    const std::string level = msg.level == spdlog::level::info ? "" : std::string(spdlog::level::to_string_view(msg.level).data()) + ": ";
+    brief_.push_back(std::string(hms) + " " + level + std::string(msg.payload.data(), msg.payload.size()));
   }
   void flush_() override {}
 
  private:
-  std::vector<std::string> lines_;
+  std::vector<std::string> lines_, brief_;
 };
+
+// The terminal's size (columns, rows), or 100 x 48 when it cannot be asked.
+std::pair<int, int> TerminalSize() {
+  winsize ws{};
+  if (ioctl(STDOUT_FILENO, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 0 && ws.ws_row > 0) return {ws.ws_col, ws.ws_row};
+  return {100, 48};
+}
 }  // namespace
 
 struct StatusScreen::LogCapture {
@@ -150,11 +354,15 @@ StatusScreen::~StatusScreen() {
 }
 
 void StatusScreen::Draw(StatusSnapshot s) {
-  for (std::string& line : capture_->lines->Last(6)) s.log.push_back(std::move(line));
-  const std::string text = RenderStatusScreen(s, config_);
+  const auto [width, height] = TerminalSize();
+  for (std::string& line : capture_->lines->Last(static_cast<std::size_t>(height))) s.log.push_back(std::move(line));
+  const std::string text = RenderStatusScreen(s, config_, width, height);
   std::string frame = "\x1b[H";
   std::istringstream is(text);
-  for (std::string line; std::getline(is, line);) frame += line + "\x1b[K\n";
+  int rows = 0;
+  for (std::string line; std::getline(is, line) && rows < height; ++rows) {
+    frame += line + "\x1b[K" + (rows + 1 < height ? "\n" : "");
+  }
   frame += "\x1b[J";
   std::fwrite(frame.data(), 1, frame.size(), stdout);
   std::fflush(stdout);

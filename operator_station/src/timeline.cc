@@ -37,7 +37,7 @@ bool ParseDouble(std::string_view s, double* out) {
 std::string KnownKeys() {
   std::string k;
   for (auto n : kAnalogInputNames) k += std::string(n) + ", ";
-  return k + "camera, overlay, reset, end";
+  return k + "camera, overlay, crosshairs, reset, end";
 }
 
 }  // namespace
@@ -97,10 +97,11 @@ Timeline Timeline::Parse(std::string_view text, const std::string& source,
         tl.camera_.emplace_back(t, static_cast<int>(v));
         continue;
       }
-      if (key == "overlay") {
-        if (val == "on" || val == "1") tl.overlay_.emplace_back(t, true);
-        else if (val == "off" || val == "0") tl.overlay_.emplace_back(t, false);
-        else fail("overlay must be on or off, got '" + std::string(val) + "'");
+      if (key == "overlay" || key == "crosshairs") {
+        auto& steps = key == "overlay" ? tl.overlay_ : tl.crosshairs_;
+        if (val == "on" || val == "1") steps.emplace_back(t, true);
+        else if (val == "off" || val == "0") steps.emplace_back(t, false);
+        else fail(std::string(key) + " must be on or off, got '" + std::string(val) + "'");
         continue;
       }
       const int idx = AnalogInputIndex(key);
@@ -157,6 +158,9 @@ OperatorInputs Timeline::Sample(double t) const {
   }
   for (const auto& [tc, cam] : camera_) {
     if (tc <= t) in.camera_station = cam;
+  }
+  for (const auto& [to, on] : crosshairs_) {
+    if (to <= t) in.crosshairs = on;
   }
   for (const auto& [to, on] : overlay_) {
     if (to <= t) in.overlay = on;

@@ -42,6 +42,7 @@ class Timeline {
   std::array<std::vector<Key>, kNumAnalogInputs> analog_;
   std::vector<std::pair<double, int>> camera_;
   std::vector<std::pair<double, bool>> overlay_;
+  std::vector<std::pair<double, bool>> crosshairs_;
   std::vector<double> resets_;
   double end_time_ = 0.0;
   OperatorInputs initial_;

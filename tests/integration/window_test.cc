@@ -1,7 +1,9 @@
 // The operator's live window under Xvfb: esg_renderer --window opens a
-// window on the X display and shows the frame it rendered. The window's
-// pixels are read back from the X server (xwd) and compared with the PNG of
-// the same frame.
+// window on the X display and shows the frame it rendered (the window's
+// pixels are read back from the X server with xwd and compared with the PNG
+// of the same frame); and a person flies from it: keys held down in the
+// window (synthetic key down / up through XTEST, xdotool) move the arm while
+// held, and it stops within one frame of the release.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -11,7 +13,12 @@
 #include <nlohmann/json.hpp>
 
 #include "lab_processes.h"
+#include "rms/channels.h"
+#include "rms/dcp_telemetry_t.hpp"
 #include "rms/lcm_interface.h"
+#include "rms/message_io.h"
+#include "rms/operator_input_t.hpp"
+#include "rms/window_keys_t.hpp"
 #include "subprocess.h"
 
 namespace rms {
@@ -98,6 +105,113 @@ TEST(LiveWindow, OpensUnderXvfbAndShowsTheRenderedFrame) {
 
   const auto stats = nlohmann::json::parse(testing::ReadFile(dir + "/esg_renderer.json"));
   EXPECT_GE(stats["counters"]["window.frames"].get<int>(), 85);
+  fs::remove_all(dir);
+}
+
+// xdotool against the display: 0 when it did what it was asked.
+int Xdotool(const std::string& display, std::vector<std::string> args, const std::string& log) {
+  args.insert(args.begin(), "/usr/bin/xdotool");
+  Subprocess p(args, log, {"DISPLAY=" + display});
+  return p.Wait(20);
+}
+
+TEST(LiveWindow, AKeyHeldInTheWindowMovesTheArmAndItStopsWithinAFrameOfTheRelease) {
+  const std::string dir = testing::MakeTempDir("window_keys");
+  Xvfb x(dir);
+  ASSERT_FALSE(x.display().empty()) << "Xvfb did not start:\n" << testing::ReadFile(dir + "/xvfb.log");
+  testing::LabProcesses lab(dir, testing::UniqueLcmUrl(8750), {"--width", "320", "--height", "240", "--window"});
+  lab.set_esg_env({"DISPLAY=" + x.display()});
+  std::string error;
+  ASSERT_TRUE(lab.Start(&error)) << error;
+  LcmOptions o;
+  o.url = lab.url();
+  UdpLcm lcm(o);
+  // What went out: each operator block's arm words (did the command move?)
+  // and the window's key messages, in the order they were heard.
+  struct Input {
+    std::int64_t frame;
+    bool moved;
+  };
+  std::vector<Input> inputs;
+  std::vector<std::int32_t> last_words;
+  std::int64_t release_seen_at_input = -1, hold_seen_at_input = -1;
+  std::int64_t latest_input = -1;
+  std::optional<dcp_telemetry_t> tm;
+  lcm.Subscribe(channels::kOperatorInput, [&](const void* d, int n, std::int64_t) {
+    operator_input_t m;
+    if (SafeDecode(d, n, 1024, &m) != DecodeError::kNone) return;
+    const std::vector<std::int32_t> words(m.words, m.words + 6);
+    inputs.push_back({m.frame, !last_words.empty() && words != last_words});
+    last_words = words;
+    latest_input = m.frame;
+  });
+  lcm.Subscribe(channels::kWindowKeys, [&](const void* d, int n, std::int64_t) {
+    window_keys_t m;
+    if (SafeDecode(d, n, 4096, &m) != DecodeError::kNone) return;
+    const bool r_held = std::find(m.held.begin(), m.held.end(), 'r') != m.held.end();
+    if (r_held && hold_seen_at_input < 0) hold_seen_at_input = latest_input;
+    if (!r_held && hold_seen_at_input >= 0 && release_seen_at_input < 0) release_seen_at_input = latest_input;
+  });
+  lcm.Subscribe(channels::kDcpTelemetry, [&](const void* d, int n, std::int64_t) {
+    dcp_telemetry_t m;
+    if (SafeDecode(d, n, 4096, &m) == DecodeError::kNone) tm = m;
+  });
+  auto pump = [&](double seconds) {
+    const std::int64_t until = lcm.NowUs() + static_cast<std::int64_t>(seconds * 1e6);
+    while (lcm.NowUs() < until) lcm.HandleSubscriptions(5);
+  };
+  // A person at the window: no terminal (stdin is not one), the window's keys.
+  Subprocess op({testing::BuildPath("operator_station/operator_station"), "--lcm-url", lab.url(), "--manual",
+                 "--window-keys", "--no-gamepad", "--no-spacemouse", "--stats", dir + "/op.json"},
+                dir + "/op.log");
+  for (int i = 0; i < 100 && !tm; ++i) pump(0.1);
+  ASSERT_TRUE(tm.has_value()) << testing::ReadFile(dir + "/op.log");
+  const std::string log = dir + "/xdotool.log";
+  ASSERT_EQ(Xdotool(x.display(), {"search", "--sync", "--name", "rmslab ESG", "windowfocus", "--sync"}, log), 0)
+      << testing::ReadFile(log);
+  pump(0.5);
+  const double z0 = tm->p_RoA_R_ft[2];
+  // 'r' held for 1.5 s (up, in the end effector's frame: +Z_R from the start).
+  ASSERT_EQ(Xdotool(x.display(), {"keydown", "r"}, log), 0) << testing::ReadFile(log);
+  pump(1.5);
+  ASSERT_EQ(Xdotool(x.display(), {"keyup", "r"}, log), 0) << testing::ReadFile(log);
+  pump(1.5);
+  const double z1 = tm->p_RoA_R_ft[2];
+  ASSERT_GE(hold_seen_at_input, 0) << "the window never said 'r' was held";
+  ASSERT_GE(release_seen_at_input, 0) << "the window never said 'r' was let go";
+  // While held: it moved, at the coarse rate (2 ft/s) for about 1.5 s.
+  int moved_while_held = 0, moved_after_release = 0;
+  for (const Input& in : inputs) {
+    if (in.frame > hold_seen_at_input && in.frame <= release_seen_at_input && in.moved) ++moved_while_held;
+    if (in.frame > release_seen_at_input && in.moved) ++moved_after_release;
+  }
+  EXPECT_GT(moved_while_held, 30) << "frames the command moved while the key was held";
+  EXPECT_NEAR(z1 - z0, 2.0 * (release_seen_at_input - hold_seen_at_input) / 30.0, 0.5);
+  // Released: at most one more frame of motion (the one already on its way
+  // when the window's message arrived).
+  EXPECT_LE(moved_after_release, 1) << "frames the command still moved after the window said the key was up";
+  // The window shows the operator's guidance panel (its text's colour at
+  // the image's foot); the guidance key takes it away.
+  auto panel_pixels = [&](const std::string& name) {
+    Subprocess xwd({"/usr/bin/xwd", "-display", x.display(), "-name", "rmslab ESG", "-silent", "-out",
+                    dir + "/" + name + ".xwd"},
+                   dir + "/xwd.log");
+    EXPECT_EQ(xwd.Wait(20), 0) << testing::ReadFile(dir + "/xwd.log");
+    const auto rgb = DecodeRgb(dir + "/" + name + ".xwd", dir);
+    int n = 0;
+    for (std::size_t i = 0; i + 2 < rgb.size(); i += 3) n += rgb[i] == 120 && rgb[i + 1] == 230 && rgb[i + 2] == 255;
+    return n;
+  };
+  EXPECT_GT(panel_pixels("with_guidance"), 200);
+  ASSERT_EQ(Xdotool(x.display(), {"key", "g"}, log), 0) << testing::ReadFile(log);
+  pump(0.5);
+  EXPECT_EQ(panel_pixels("without_guidance"), 0);
+  // Q from the window ends the station.
+  ASSERT_EQ(Xdotool(x.display(), {"key", "Q"}, log), 0) << testing::ReadFile(log);
+  EXPECT_EQ(op.Wait(10), 0) << testing::ReadFile(dir + "/op.log");
+  const auto stats = nlohmann::json::parse(testing::ReadFile(dir + "/op.json"));
+  EXPECT_EQ(stats["counters"]["key_actions"].get<int>(), 3);  // r, g, Q
+  ASSERT_TRUE(lab.Stop(&error)) << error;
   fs::remove_all(dir);
 }
 

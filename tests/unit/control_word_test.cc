@@ -24,8 +24,8 @@ TEST(ControlWord, ExhaustiveEveryValidWordRoundTripsAndEveryOtherIsRefused) {
     const ControlWord cw = UnpackControlWord(static_cast<std::int32_t>(w));
     ASSERT_EQ(PackControlWord(cw), w);
   }
-  // 2^24 words; reserved bits 5-7 must be 0 (1/8) and mode 1-3 (3/4).
-  EXPECT_EQ(valid, (1 << 24) / 8 * 3 / 4);
+  // 2^24 words; reserved bits 6-7 must be 0 (1/4) and mode 1-3 (3/4).
+  EXPECT_EQ(valid, (1 << 24) / 4 * 3 / 4);
   EXPECT_GT(refused_checked, 10000);
 }
 
@@ -44,6 +44,9 @@ TEST(ControlWord, FieldsLandInTheDocumentedBits) {
   cw = {};
   cw.collision = cw.receptacle_collision = cw.acquired = cw.reset = cw.overlay = true;
   EXPECT_EQ(PackControlWord(cw), (1u << 8) | (1u << 10) | (1u << 11) | (1u << 12) | (1u << 3) | (1u << 4));
+  cw = {};
+  cw.crosshairs = true;
+  EXPECT_EQ(PackControlWord(cw), (1u << 8) | (1u << 5));
 }
 
 TEST(ControlWord, BitsAbove23AreRefused) {

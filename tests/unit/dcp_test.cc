@@ -2,6 +2,9 @@
 // response, frame by frame in process.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <random>
+
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -85,6 +88,40 @@ TEST_F(Dcp, AllSixAcquisitionConditionsHoldAtTheGraspAndEachFailsAlone) {
     }
     EXPECT_FALSE(r.all()) << c.what;
   }
+}
+
+TEST_F(Dcp, EachConditionsMarginAgreesWithItAndIsADistance) {
+  // Random poses about the grasp (seeded): where a margin is clearly
+  // positive its condition holds, where clearly negative it fails; and the
+  // margin moves with the pose as the distance it names.
+  constexpr unsigned kSeed = 1970;
+  std::printf("seed %u\n", kSeed);
+  std::mt19937 rng(kSeed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const Isometry3d G = geo.X_RS2_grasp;
+  int checked = 0;
+  for (int k = 0; k < 2000; ++k) {
+    Isometry3d X = Shifted(G, Vector3d(0.6 * u(rng), 0.4 * u(rng), 0.8 * u(rng)));
+    X.linear() = X.linear() * Eigen::AngleAxisd(0.1 * u(rng), Vector3d(u(rng), u(rng), u(rng)).normalized()).toRotationMatrix();
+    const double gap = 0.45 + 0.3 * (u(rng) + 1) / 2;
+    const AcquisitionCheck c = Check(X, gap);
+    for (int i = 0; i < 6; ++i) {
+      if (std::abs(c.margin_ft[i]) < 1e-9) continue;
+      EXPECT_EQ(c.holds[i], c.margin_ft[i] > 0) << "pose " << k << " condition " << i + 1 << " margin " << c.margin_ft[i];
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 11000);
+  // Along the approach axis the palm's margin (condition 5) moves foot for foot.
+  const Vector3d X2 = G.linear().col(0);
+  const AcquisitionCheck a = Check(G, 0.55), b = Check(Shifted(G, -0.1 * X2), 0.55);
+  EXPECT_NEAR(a.margin_ft[4] - b.margin_ft[4], 0.1, 1e-9);
+  EXPECT_NEAR(b.margin_ft[0] - a.margin_ft[0], 0.1, 1e-9);  // condition 1: the BAR further beyond face d
+  // Condition 5 is a distance: the BAR far behind the palm is not within TPOB.
+  const AcquisitionCheck far = Check(Shifted(G, 20.0 * X2), 0.55);
+  EXPECT_LT(far.palm_to_bar_ft, -19.0);
+  EXPECT_FALSE(far.holds[4]);
+  EXPECT_LT(far.margin_ft[4], -19.0);
 }
 
 TEST_F(Dcp, DockingNeedsTheEnvelopeTheDistanceAndTheAngle) {
@@ -254,9 +291,21 @@ TEST_F(Dcp, ACheckpointRestoresTheStateExactly) {
     for (std::size_t k = 0; k < at; ++k) live.Step(inputs[k]);
     // Through the text of a file, as a checkpoint goes.
     const nlohmann::json saved = nlohmann::json::parse(live.SaveState().dump());
+    // Into a DCP that had flown elsewhere (fingers closed in Mode 1, say):
+    // nothing of that is reported after the restore.
     DynamicCollisionProgram restored(config);
+    for (std::size_t k = 0; k < 30; ++k) restored.Step(inputs[k]);
     restored.RestoreState(saved);
     EXPECT_EQ(restored.mode(), live.mode()) << "at frame " << at;
+    for (int i = 0; i < 6; ++i) {
+      EXPECT_EQ(restored.status().acquisition[i], live.status().acquisition[i]) << at << " condition " << i + 1;
+      EXPECT_DOUBLE_EQ(restored.status().acquisition_margin_ft[i], live.status().acquisition_margin_ft[i]) << at;
+    }
+    EXPECT_DOUBLE_EQ(restored.status().dock_distance_ft, live.status().dock_distance_ft) << at;
+    EXPECT_DOUBLE_EQ(restored.status().bay_clearance_ft, live.status().bay_clearance_ft) << at;
+    if (live.mode() >= 2) {
+      for (int i = 0; i < 6; ++i) EXPECT_FALSE(live.status().acquisition[i]) << "not evaluated after acquisition";
+    }
     for (std::size_t k = at; k < inputs.size(); ++k) {
       const DcpFrameData a = live.Step(inputs[k]), b = restored.Step(inputs[k]);
       dcp_frame_t wa, wb;

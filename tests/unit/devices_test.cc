@@ -1,8 +1,10 @@
-// The operator's devices and their conditioning: the bindings file (and its
-// errors), the keyboard through the bindings, rate limits and clamping with
-// a report, a gamepad through SDL2's virtual joystick, a 3D mouse through
-// libspnav talking to a stand-in spacenavd on a socket, and the status
-// screen's text.
+// The operator's hand controllers: the bindings file (and its errors);
+// manual augmented control in each command frame (finite differences of the
+// forward kinematics); single joint; a terminal's presses as increments,
+// merged and never queued, and the stop key; the live window's held keys
+// (hold to move, release to stop, a silent window lets go); a gamepad
+// through SDL2's virtual joystick; a 3D mouse through libspnav talking to a
+// stand-in spacenavd; clamping with a report; and the status screen.
 #include <gtest/gtest.h>
 #include <SDL2/SDL.h>
 #include <sys/socket.h>
@@ -10,26 +12,68 @@
 #include <unistd.h>
 
 #include <cstdlib>
-#include <fstream>
-#include <sstream>
 #include <deque>
+#include <fstream>
+#include <regex>
+#include <sstream>
 #include <thread>
 
 #include "bindings.h"
 #include "devices.h"
-#include "manual_control.h"
+#include "guidance.h"
+#include "hand_controllers.h"
 #include "rms/arm_kinematics.h"
 #include "rms/check.h"
 #include "rms/config.h"
+#include "rms/mission_geometry.h"
 #include "status_screen.h"
 
 namespace rms::op {
 namespace {
 
+constexpr double kDt = 1.0 / 30;
+constexpr double kDeg = M_PI / 180.0;
+
 class Devices : public ::testing::Test {
  protected:
   LabConfig config = LoadConfig(DefaultConfigPath());
   Bindings bindings = LoadBindings(DefaultBindingsPath());
+  GuidanceGeometry geometry = MakeGuidanceGeometry(config);
+
+  // A pose in the middle of the workspace, over the bay.
+  OperatorInputs MidPose() const {
+    OperatorInputs in = InitialInputs(config.inputs);
+    const double q[6] = {15, 60, -75, -60, 5, -70};
+    for (int i = 0; i < 6; ++i) in.value[i] = q[i];
+    return in;
+  }
+  static JointAngles Angles(const OperatorInputs& in) {
+    JointAngles q{};
+    for (int i = 0; i < 6; ++i) q[i] = in.value[i];
+    return q;
+  }
+  Eigen::Isometry3d X_RS2(const OperatorInputs& in) const {
+    return ForwardPose(config.arm, Angles(in), in.value[kShoulderHeight]);
+  }
+  // Telemetry as the DCP would send it for these inputs: Mode 1, or the
+  // payload held (Mode 2) at the grasp's attachment.
+  dcp_telemetry_t Telemetry(const OperatorInputs& in, int mode) const {
+    dcp_telemetry_t t{};
+    t.mode = static_cast<std::int8_t>(mode);
+    const Eigen::Isometry3d X = X_RS2(in);
+    const Eigen::Isometry3d P = mode == 1 ? MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft)
+                                          : X * mission::PlanGeometry(config).X_S2P;
+    for (int i = 0; i < 3; ++i) {
+      t.p_RoA_R_ft[i] = X.translation()[i];
+      t.p_RoPo_R_ft[i] = P.translation()[i];
+      for (int j = 0; j < 3; ++j) {
+        t.R_RS2[3 * i + j] = X.linear()(i, j);
+        t.R_RP[3 * i + j] = P.linear()(i, j);
+      }
+    }
+    for (int i = 0; i < 6; ++i) t.slave_angles_deg[i] = t.master_angles_deg[i] = in.value[i];
+    return t;
+  }
 };
 
 std::string Replace(std::string s, const std::string& from, const std::string& to) {
@@ -46,26 +90,51 @@ std::string DefaultBindingsText() {
   return ss.str();
 }
 
+// A keyboard whose keys the test types.
+struct TypedKeys {
+  std::deque<int> keys;
+  std::function<int()> Source() {
+    return [this] {
+      if (keys.empty()) return -1;
+      const int k = keys.front();
+      keys.pop_front();
+      return k;
+    };
+  }
+};
+
 TEST_F(Devices, TheBindingsFileIsReadAndBadOnesAreRefusedNamingTheKey) {
-  EXPECT_EQ(bindings.keys.at('q').kind, ActionKind::kIncrease);
-  EXPECT_EQ(bindings.keys.at('q').input, kShoulderYaw);
-  EXPECT_EQ(bindings.keys.at(kKeyUp).input, kCameraTilt);
+  EXPECT_EQ(bindings.keys.at('w').kind, ActionKind::kHand);
+  EXPECT_EQ(bindings.keys.at('w').index, kThcX);
+  EXPECT_EQ(bindings.keys.at('i').index, kRhcPitch);
+  EXPECT_EQ(bindings.keys.at('i').sign, -1.0);
+  EXPECT_EQ(bindings.keys.at(' ').kind, ActionKind::kStop);
+  EXPECT_EQ(bindings.keys.at(kKeyBackspace).kind, ActionKind::kReset);
+  EXPECT_EQ(bindings.keys.at('Q').kind, ActionKind::kQuit);
+  EXPECT_EQ(bindings.keys.at(kKeyUp).index, kCameraTilt);
   EXPECT_EQ(bindings.keys.at('5').camera, 5);
   EXPECT_EQ(bindings.gamepad_axes.at("lefty").sign, -1.0);
-  EXPECT_DOUBLE_EQ(bindings.max_rate[kFinger], 0.5);
+  EXPECT_EQ(bindings.initial_mode, ControlMode::kManualAugmented);
+  EXPECT_DOUBLE_EQ(bindings.rates.vernier_ft_s * 10, bindings.rates.coarse_ft_s);
   const std::string good = DefaultBindingsText();
   struct Case {
     std::string from, to, message;
   };
   const Case cases[] = {
-      {"q = \"shoulder_yaw+\"", "q = \"shoulder_yaww+\"", "key 'keyboard.keys.q': unknown action \"shoulder_yaww+\""},
+      {"w = \"thc_x+\"", "w = \"thc_w+\"", "key 'keyboard.keys.w': unknown action \"thc_w+\""},
+      {"w = \"thc_x+\"", "w = \"shoulder_yaw+\"", "key 'keyboard.keys.w': \"shoulder_yaw+\": the arm's joints move"},
       {"deadband = 0.12", "deadband = 1.5", "key 'conditioning.deadband': must be <= 0.9"},
       {"finger = 0.5 ", "finger = -0.5 ", "key 'conditioning.max_rate.finger': must be > 0"},
-      {"leftx = \"shoulder_yaw\"", "leftz = \"shoulder_yaw\"", "key 'gamepad.axes.leftz': is not an SDL game controller axis"},
-      {"start = \"reset\"", "start = \"quit\"", "key 'gamepad.buttons.start': quit is for the keyboard only"},
-      {"tx = \"X\"", "tx = \"W\"", "key 'spacemouse.translate.tx': must be one of X, Y, Z"},
+      {"vernier_ft_s = 0.2", "vernier_ft_s = 3.0", "key 'rates.vernier_ft_s': must be less than rates.coarse_ft_s"},
+      {"mode = \"manual_augmented\"", "mode = \"auto\"", "key 'control.mode': must be \"manual_augmented\""},
+      {"frame = \"end_effector\"", "frame = \"payload\"", "key 'control.frame': must be \"end_effector\" or \"orbiter\""},
+      {"leftx = \"thc_y\"", "leftz = \"thc_y\"", "key 'gamepad.axes.leftz': is not an SDL game controller axis"},
+      {"start = \"stop\"", "start = \"quit\"", "key 'gamepad.buttons.start': quit is for the keyboards only"},
+      {"\ntx = \"thc_y\"", "\ntx = \"camera_pan\"", "key 'spacemouse.axes.tx': must name a hand-controller axis"},
       {"full_scale = 350.0", "fullscale = 350.0", "key 'spacemouse.full_scale': missing"},
+      {"coarse_ft = 5.0", "coarse_ft = 0", "key 'keyboard.increment.coarse_ft': must be > 0"},
       {"[spacemouse.buttons]", "[spacemouse.buttons]\nextra = 1", "key 'spacemouse.buttons.extra'"},
+      {"Q = \"quit\"", "Q = \"quit\"\nq = \"stop\"\n\" \" = \"stop\"", "key 'keyboard.keys. ': is not a key"},
   };
   for (const Case& c : cases) {
     try {
@@ -77,53 +146,227 @@ TEST_F(Devices, TheBindingsFileIsReadAndBadOnesAreRefusedNamingTheKey) {
   }
 }
 
-TEST_F(Devices, KeysStepTargetsAndTheOutputFollowsAtTheRateLimit) {
-  ManualControl mc(config, bindings);
-  std::deque<int> keys;
-  mc.AddDevice(std::make_unique<KeyboardDevice>(bindings, [&] {
-    if (keys.empty()) return -1;
-    const int k = keys.front();
-    keys.pop_front();
-    return k;
-  }));
-  const double dt = 1.0 / 30;
-  // Ten presses of 'w': the target moves 10 steps at once, the output at max_rate.
-  for (int i = 0; i < 10; ++i) keys.push_back('w');
-  OperatorInputs out = mc.Step(dt);
-  EXPECT_DOUBLE_EQ(mc.target().value[kShoulderPitch], 10 * bindings.key_step[kShoulderPitch]);
-  EXPECT_NEAR(out.value[kShoulderPitch], bindings.max_rate[kShoulderPitch] * dt, 1e-12);
+// Manual augmented, each command frame: full deflection of each axis for one
+// frame moves the point of resolution (or turns the end effector about it)
+// along that frame's axis at the scale's rate, by finite differences of the
+// forward kinematics.
+TEST_F(Devices, ManualAugmentedMovesThePointOfResolutionAlongEachFramesAxes) {
+  struct Case {
+    CommandFrame frame;
+    int mode;
+  };
+  for (const Case c : {Case{CommandFrame::kEndEffector, 1}, Case{CommandFrame::kOrbiter, 1},
+                       Case{CommandFrame::kPayload, 2}, Case{CommandFrame::kEndEffector, 2}}) {
+    for (int axis = 0; axis < kNumHandAxes; ++axis) {
+      Bindings b = bindings;
+      b.initial_frame = c.frame;
+      HandControllers hc(config, b);
+      const OperatorInputs in0 = MidPose();
+      hc.SetInputs(in0);
+      const dcp_telemetry_t t = Telemetry(in0, c.mode);
+      DeviceCommands cmd;
+      cmd.hand[axis] = 1.0;
+      const OperatorInputs in1 = hc.Apply(cmd, kDt, &t);
+      ArmState s = ArmStateFrom(t);
+      const Eigen::Matrix3d R_RF = CommandAxes(geometry, c.frame, s);
+      const Eigen::Vector3d por = PointOfResolution(geometry, s);
+      const Eigen::Isometry3d X0 = X_RS2(in0), X1 = X_RS2(in1);
+      const Eigen::Vector3d v = (X1 * por - X0 * por) / kDt;
+      const Eigen::Vector3d w = RotationVector(X1.linear() * X0.linear().transpose()) / kDt;
+      Eigen::Vector3d v_want = Eigen::Vector3d::Zero(), w_want = Eigen::Vector3d::Zero();
+      if (axis < 3) v_want = R_RF.col(axis) * b.rates.coarse_ft_s;
+      else w_want = R_RF.col(axis - 3) * b.rates.coarse_deg_s * kDeg;
+      SCOPED_TRACE(std::string(CommandFrameName(c.frame)) + " frame, Mode " + std::to_string(c.mode) + ", " +
+                   std::string(kHandAxisNames[axis]));
+      if (hc.status().rate_limited) {
+        // A joint at its rate: slower, the direction kept.
+        const double k = axis < 3 ? v.norm() / v_want.norm() : w.norm() / w_want.norm();
+        EXPECT_LT(k, 1.0);
+        EXPECT_GT(k, 0.2);
+        v_want *= k;
+        w_want *= k;
+      }
+      EXPECT_LT((v - v_want).norm(), 0.01 * b.rates.coarse_ft_s);
+      EXPECT_LT((w - w_want).norm(), 0.01 * b.rates.coarse_deg_s * kDeg);
+      EXPECT_EQ(hc.status().frame, c.frame);
+      EXPECT_DOUBLE_EQ(hc.status().rate[axis], axis < 3 ? b.rates.coarse_ft_s : b.rates.coarse_deg_s);
+    }
+  }
+}
+
+TEST_F(Devices, ATerminalPressIsOneIncrementMergedNeverQueuedAndStopHaltsIt) {
+  HandControllers hc(config, bindings);
+  TypedKeys typed;
+  hc.AddDevice(std::make_unique<KeyboardDevice>(bindings, typed.Source()));
+  const OperatorInputs in0 = MidPose();
+  hc.SetInputs(in0);
+  const dcp_telemetry_t t = Telemetry(in0, 1);
+  auto por = [&](const OperatorInputs& in) { return X_RS2(in) * geometry.p_S2oG_S2; };
+  const Eigen::Vector3d p0 = por(in0);
+  // Ten presses of 'w' in one frame: one coarse increment (2 ft) forward.
+  for (int i = 0; i < 10; ++i) typed.keys.push_back('w');
+  OperatorInputs in = hc.Step(kDt, &t);
   int frames = 1;
-  while (out.value[kShoulderPitch] < mc.target().value[kShoulderPitch] && frames < 1000) {
-    out = mc.Step(dt);
+  while (hc.status().rate[kThcX] != 0.0 && frames < 1000) {
+    in = hc.Step(kDt, &t);
     ++frames;
   }
-  const double expected_s = 10 * bindings.key_step[kShoulderPitch] / bindings.max_rate[kShoulderPitch];
-  EXPECT_NEAR(frames * dt, expected_s, dt + 1e-9);
-  // Camera, overlay, reset (one frame), quit.
-  keys = {'3', 'o', ' '};
-  out = mc.Step(dt);
-  EXPECT_EQ(out.camera_station, 3);
-  EXPECT_FALSE(out.overlay);
-  EXPECT_TRUE(out.reset);
-  EXPECT_FALSE(mc.Step(dt).reset);
-  EXPECT_FALSE(mc.quit());
-  keys = {'x'};
-  mc.Step(dt);
-  EXPECT_TRUE(mc.quit());
+  const double inc = bindings.increments.coarse_ft;
+  EXPECT_NEAR((por(in) - p0).norm(), inc, 0.01 * inc);
+  EXPECT_NEAR(frames * kDt, inc / bindings.rates.coarse_ft_s + kDt, 1.5 * kDt);
+  EXPECT_EQ(hc.key_actions(), 10);
+  // Presses that keep coming while it moves (a held key's repeat) keep it
+  // moving but never more than one increment ahead: when they stop, it
+  // stops within one increment.
+  const Eigen::Vector3d p1 = por(in);
+  for (int f = 0; f < 60; ++f) {
+    typed.keys = {'w', 'w'};
+    in = hc.Step(kDt, &t);
+  }
+  const double moved_while_held = (por(in) - p1).norm();
+  EXPECT_NEAR(moved_while_held, 60 * kDt * bindings.rates.coarse_ft_s, 0.02 * moved_while_held);
+  frames = 0;
+  const Eigen::Vector3d p2 = por(in);
+  while (hc.status().rate[kThcX] != 0.0 && frames < 1000) {
+    in = hc.Step(kDt, &t);
+    ++frames;
+  }
+  EXPECT_LE((por(in) - p2).norm(), inc * 1.01);
+  // The stop key halts a motion at once; a press the other way stops it too.
+  typed.keys = {'d'};
+  hc.Step(kDt, &t);
+  EXPECT_GT(hc.status().rate[kThcY], 0.0);
+  typed.keys = {' '};
+  in = hc.Step(kDt, &t);
+  EXPECT_EQ(hc.status().rate[kThcY], 0.0);
+  EXPECT_EQ(hc.status().pending[kThcY], 0.0);
+  const OperatorInputs still = hc.Step(kDt, &t);
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(still.value[i], in.value[i]);
+  typed.keys = {'f'};
+  hc.Step(kDt, &t);
+  typed.keys = {'r'};
+  hc.Step(kDt, &t);
+  EXPECT_EQ(hc.status().pending[kThcZ], 0.0);
+  // Vernier: a tenth of the rate, a finer increment.
+  typed.keys = {'v', 'w'};
+  hc.Step(kDt, &t);
+  EXPECT_TRUE(hc.status().vernier);
+  EXPECT_DOUBLE_EQ(hc.status().rate[kThcX], bindings.rates.vernier_ft_s);
+  EXPECT_EQ(hc.counters().Get("control.scale_changes"), 1);
+}
+
+TEST_F(Devices, TheLiveWindowsHeldKeysMoveAndReleasedOnesStopAtOnce) {
+  HandControllers hc(config, bindings);
+  auto dev = std::make_unique<WindowKeyboardDevice>(bindings, 300000);
+  WindowKeyboardDevice* window = dev.get();
+  hc.AddDevice(std::move(dev));
+  const OperatorInputs in0 = MidPose();
+  hc.SetInputs(in0);
+  const dcp_telemetry_t t = Telemetry(in0, 1);
+  std::int64_t now = 1000000;
+  window->Receive({0, {'w'}, {'w'}, true}, now);
+  OperatorInputs in = in0;
+  std::int64_t seq = 0;
+  for (int f = 0; f < 30; ++f) {
+    window->SetNow(now += 33333);
+    if (f % 3 == 2) window->Receive({++seq, {'w'}, {}, true}, now);  // the window's heartbeat while held
+    in = hc.Step(kDt, &t);
+  }
+  EXPECT_DOUBLE_EQ(hc.status().rate[kThcX], bindings.rates.coarse_ft_s);
+  const Eigen::Vector3d moved = X_RS2(in) * geometry.p_S2oG_S2 - X_RS2(in0) * geometry.p_S2oG_S2;
+  EXPECT_NEAR(moved.norm(), 30 * kDt * bindings.rates.coarse_ft_s, 0.02);
+  // Released: the very next frame commands no motion.
+  window->Receive({++seq, {}, {}, true}, now);
+  window->SetNow(now += 33333);
+  const OperatorInputs after = hc.Step(kDt, &t);
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(after.value[i], in.value[i]);
+  // A stale message is refused; a window that goes silent with a key held
+  // is let go of after the timeout.
+  EXPECT_FALSE(window->Receive({seq, {'w'}, {}, true}, now));
+  window->Receive({++seq, {'d'}, {'d'}, true}, now);
+  window->SetNow(now += 33333);
+  hc.Step(kDt, &t);
+  EXPECT_GT(hc.status().rate[kThcY], 0.0);
+  window->SetNow(now += 400000);
+  hc.Step(kDt, &t);
+  EXPECT_EQ(hc.status().rate[kThcY], 0.0);
+  EXPECT_EQ(window->timeouts(), 1);
+  EXPECT_EQ(hc.key_actions(), 2);
+}
+
+TEST_F(Devices, SingleJointDrivesTheSelectedJointAtARateWithinItsLimit) {
+  Bindings b = bindings;
+  b.initial_mode = ControlMode::kSingleJoint;
+  HandControllers hc(config, b);
+  const OperatorInputs in0 = MidPose();
+  hc.SetInputs(in0);
+  DeviceCommands select;
+  select.events.push_back(ParseAction("joint_next"));  // shoulder yaw -> shoulder pitch
+  hc.Apply(select, kDt, nullptr);
+  EXPECT_EQ(hc.status().joint, 1);
+  DeviceCommands push;
+  push.hand[kThcX] = 1.0;
+  push.hand[kThcY] = 1.0;  // not used in single joint
+  OperatorInputs in = hc.Apply(push, 1.0, nullptr);
+  EXPECT_NEAR(in.value[1] - in0.value[1], b.rates.joint_coarse_deg_s, 1e-9);
+  for (int i : {0, 2, 3, 4, 5}) EXPECT_EQ(in.value[i], in0.value[i]);
+  // Driven past its limit it stops on it, reported once.
+  for (int k = 0; k < 40; ++k) in = hc.Apply(push, 1.0, nullptr);
+  EXPECT_DOUBLE_EQ(in.value[1], config.arm.joint_max_deg[1]);
+  EXPECT_EQ(hc.counters().Get("joint_limit.shoulder_pitch"), 1);
+  EXPECT_EQ(hc.status().at_limit, 1u << 1);
+  DeviceCommands mode;
+  mode.events.push_back(ParseAction("mode"));
+  hc.Apply(mode, kDt, nullptr);
+  EXPECT_EQ(hc.status().mode, ControlMode::kManualAugmented);
+  EXPECT_EQ(hc.counters().Get("control.mode_changes"), 1);
+}
+
+TEST_F(Devices, ThePayloadFrameIsOfferedOnlyOnceThePayloadIsHeld) {
+  HandControllers hc(config, bindings);
+  const OperatorInputs in0 = MidPose();
+  hc.SetInputs(in0);
+  DeviceCommands frame;
+  frame.events.push_back(ParseAction("frame"));
+  dcp_telemetry_t t = Telemetry(in0, 1);
+  hc.Apply(frame, kDt, &t);
+  EXPECT_EQ(hc.status().frame, CommandFrame::kOrbiter);
+  hc.Apply(frame, kDt, &t);
+  EXPECT_EQ(hc.status().frame, CommandFrame::kEndEffector);  // no payload held: skipped
+  t = Telemetry(in0, 2);
+  hc.Apply(frame, kDt, &t);
+  hc.Apply(frame, kDt, &t);
+  EXPECT_EQ(hc.status().frame, CommandFrame::kPayload);
+  t = Telemetry(in0, 1);  // reset: the payload back in the bay
+  hc.Apply({}, kDt, &t);
+  EXPECT_EQ(hc.status().frame, CommandFrame::kEndEffector);
+  EXPECT_EQ(hc.counters().Get("control.frame_changes"), 4);
 }
 
 TEST_F(Devices, OutOfRangeCommandsAreClampedAndReportedOnce) {
-  ManualControl mc(config, bindings);
+  HandControllers hc(config, bindings);
   DeviceCommands close;
-  close.step[kFinger] = 0.4;
-  for (int i = 0; i < 5; ++i) mc.Apply(close, 1.0 / 30);  // 2.0 asked of a 0..1 lever
-  EXPECT_DOUBLE_EQ(mc.target().value[kFinger], config.inputs[kFinger].max);
-  EXPECT_EQ(mc.counters().Get("clamped.finger"), 3);  // the 3rd, 4th and 5th presses went beyond
+  close.input_rate[kFinger] = 1.0;
+  for (int i = 0; i < 90; ++i) hc.Apply(close, kDt, nullptr);  // 3 s at 0.5/s on a 0..1 lever
+  EXPECT_DOUBLE_EQ(hc.target().value[kFinger], config.inputs[kFinger].max);
+  EXPECT_GT(hc.counters().Get("clamped.finger"), 20);
   DeviceCommands down;
-  down.rate[kShoulderHeight] = -1000.0;
-  mc.Apply(down, 1.0);
-  EXPECT_DOUBLE_EQ(mc.target().value[kShoulderHeight], config.inputs[kShoulderHeight].min);
-  EXPECT_EQ(mc.counters().Get("clamped.shoulder_height"), 1);
+  down.input_rate[kShoulderHeight] = -1.0;
+  for (int i = 0; i < 200; ++i) hc.Apply(down, 0.1, nullptr);
+  EXPECT_DOUBLE_EQ(hc.target().value[kShoulderHeight], config.inputs[kShoulderHeight].min);
+  // A terminal press closes the finger all the way at its rate; the stop key stops it.
+  HandControllers h2(config, bindings);
+  DeviceCommands press;
+  press.input_presses.push_back({kFinger, 1.0});
+  OperatorInputs in = h2.Apply(press, kDt, nullptr);
+  EXPECT_NEAR(in.value[kFinger], bindings.max_rate[kFinger] * kDt, 1e-12);
+  for (int i = 0; i < 10; ++i) in = h2.Apply({}, kDt, nullptr);
+  DeviceCommands stop;
+  stop.events.push_back(ParseAction("stop"));
+  in = h2.Apply(stop, kDt, nullptr);
+  const double held = in.value[kFinger];
+  EXPECT_LT(held, 0.5);
+  EXPECT_DOUBLE_EQ(h2.Apply({}, kDt, nullptr).value[kFinger], held);
 }
 
 TEST_F(Devices, DeadbandZeroesSmallDeflectionsAndKeepsFullScale) {
@@ -134,7 +377,7 @@ TEST_F(Devices, DeadbandZeroesSmallDeflectionsAndKeepsFullScale) {
   EXPECT_NEAR(ApplyDeadband(0.56, 0.12), 0.5, 1e-12);
 }
 
-TEST_F(Devices, AGamepadThroughSdlMovesWhatItsBindingsSay) {
+TEST_F(Devices, AGamepadsSticksAreProportionalWithADeadband) {
   ASSERT_EQ(SDL_InitSubSystem(SDL_INIT_GAMECONTROLLER), 0) << SDL_GetError();
   SDL_VirtualJoystickDesc desc{};
   desc.version = SDL_VIRTUAL_JOYSTICK_DESC_VERSION;
@@ -153,29 +396,35 @@ TEST_F(Devices, AGamepadThroughSdlMovesWhatItsBindingsSay) {
     auto pad = GamepadDevice::Open(bindings, &why);
     ASSERT_NE(pad, nullptr) << why;
     EXPECT_NE(pad->Describe().find("rmslab test gamepad"), std::string::npos) << pad->Describe();
-    // Left stick pushed fully forward: shoulder pitch up at its max rate.
+    // Left stick pushed fully forward: forward at full rate; half way
+    // (beyond the deadband): proportionally less.
     SDL_JoystickSetVirtualAxis(js, SDL_CONTROLLER_AXIS_LEFTY, -32768);
     DeviceCommands c;
     pad->Poll(&c);
-    EXPECT_NEAR(c.rate[kShoulderPitch], bindings.max_rate[kShoulderPitch], 1e-9);
+    EXPECT_NEAR(c.hand[kThcX], 1.0, 1e-9);
+    SDL_JoystickSetVirtualAxis(js, SDL_CONTROLLER_AXIS_LEFTY, static_cast<Sint16>(-0.56 * 32767));
+    c = {};
+    pad->Poll(&c);
+    EXPECT_NEAR(c.hand[kThcX], 0.5, 1e-3);
     // Inside the deadband: nothing.
     SDL_JoystickSetVirtualAxis(js, SDL_CONTROLLER_AXIS_LEFTY, 0);
-    SDL_JoystickSetVirtualAxis(js, SDL_CONTROLLER_AXIS_LEFTX, static_cast<Sint16>(0.1 * 32767));
+    SDL_JoystickSetVirtualAxis(js, SDL_CONTROLLER_AXIS_RIGHTX, static_cast<Sint16>(0.1 * 32767));
     c = {};
     pad->Poll(&c);
-    EXPECT_EQ(c.rate[kShoulderPitch], 0.0);
-    EXPECT_EQ(c.rate[kShoulderYaw], 0.0);
-    // A held button moves its input; camera_next fires once per press.
-    SDL_JoystickSetVirtualButton(js, SDL_CONTROLLER_BUTTON_A, 1);
-    SDL_JoystickSetVirtualButton(js, SDL_CONTROLLER_BUTTON_RIGHTSTICK, 1);
+    EXPECT_EQ(c.hand[kThcX], 0.0);
+    EXPECT_EQ(c.hand[kRhcYaw], 0.0);
+    // A held button moves its axis; the vernier button fires once per press.
+    SDL_JoystickSetVirtualButton(js, SDL_CONTROLLER_BUTTON_RIGHTSHOULDER, 1);
+    SDL_JoystickSetVirtualButton(js, SDL_CONTROLLER_BUTTON_X, 1);
     c = {};
     pad->Poll(&c);
-    EXPECT_NEAR(c.rate[kFinger], bindings.max_rate[kFinger], 1e-12);
+    EXPECT_EQ(c.hand[kRhcRoll], 1.0);
     ASSERT_EQ(c.events.size(), 1u);
-    EXPECT_EQ(c.events[0].kind, ActionKind::kCameraNext);
+    EXPECT_EQ(c.events[0].kind, ActionKind::kVernier);
     c = {};
     pad->Poll(&c);
     EXPECT_TRUE(c.events.empty());  // still held: no second event
+    EXPECT_EQ(c.hand[kRhcRoll], 1.0);
     EXPECT_TRUE(pad->connected());
   }
   SDL_JoystickClose(js);
@@ -216,7 +465,7 @@ class FakeSpacenavd {
   std::thread thread_;
 };
 
-TEST_F(Devices, A3DMouseThroughSpacenavdMovesSystemTwo) {
+TEST_F(Devices, A3DMouseIsBothHandControllers) {
   const std::string sock = ::testing::TempDir() + "/rmslab_spnav_" + std::to_string(getpid()) + ".sock";
   FakeSpacenavd daemon(sock);
   setenv("SPNAV_SOCKET", sock.c_str(), 1);
@@ -224,31 +473,30 @@ TEST_F(Devices, A3DMouseThroughSpacenavdMovesSystemTwo) {
   auto mouse = SpaceMouseDevice::Open(bindings, &why);
   unsetenv("SPNAV_SOCKET");
   ASSERT_NE(mouse, nullptr) << why;
-  // Full deflection along the device's x: System Two moves along +X_R.
-  daemon.Send({0, 350, 0, 0, 0, 0, 0, 16});
+  // Pushed away at full deflection and twisted clockwise at half:
+  // forward, and yaw right at half rate.
+  daemon.Send({0, 0, 0, -350, 0, static_cast<int32_t>(-0.56 * 350), 0, 16});
   daemon.Send({1, 0, 0, 0, 0, 0, 0, 0});  // button 0 pressed: finger+
-  ManualControl mc(config, bindings);
-  // Start from a pose in the middle of the workspace.
-  DeviceCommands pose;
-  const double q[6] = {15, 60, -75, -70, 0, -75};
-  for (int i = 0; i < 6; ++i) pose.step[i] = q[i];
-  mc.Apply(pose, 1.0);
-  auto X_of = [&](const OperatorInputs& t) {
-    std::array<double, 6> a{};
-    for (int i = 0; i < 6; ++i) a[i] = t.value[i];
-    return ComputeArmPose(config.arm, SinCosFromDegrees(a), t.value[kShoulderHeight]).X_RS2;
-  };
-  const Eigen::Isometry3d X0 = X_of(mc.target());
   DeviceCommands c;
   usleep(100000);
   mouse->Poll(&c);
-  EXPECT_NEAR(c.v_R_ft_s.x(), bindings.spacemouse_speed_ft_s, 1e-9);
-  EXPECT_NEAR(c.v_R_ft_s.tail<2>().norm(), 0.0, 1e-12);
-  EXPECT_NEAR(c.rate[kFinger], bindings.max_rate[kFinger], 1e-12);
-  mc.Apply(c, 0.5);
-  const Eigen::Isometry3d X1 = X_of(mc.target());
-  EXPECT_NEAR((X1.translation() - X0.translation() - Eigen::Vector3d(0.5, 0, 0)).norm(), 0.0, 1e-6);
-  EXPECT_NEAR(Eigen::AngleAxisd(X0.linear().transpose() * X1.linear()).angle(), 0.0, 1e-9);
+  EXPECT_NEAR(c.hand[kThcX], 1.0, 1e-9);
+  EXPECT_NEAR(c.hand[kRhcYaw], 0.5, 1e-3);
+  for (int i : {kThcY, kThcZ, kRhcRoll, kRhcPitch}) EXPECT_EQ(c.hand[i], 0.0);
+  EXPECT_NEAR(c.input_rate[kFinger], 1.0, 1e-12);
+  // Through the hand controllers: the point of resolution moves forward
+  // and the end effector turns, in one frame.
+  HandControllers hc(config, bindings);
+  const OperatorInputs in0 = MidPose();
+  hc.SetInputs(in0);
+  const dcp_telemetry_t t = Telemetry(in0, 1);
+  const OperatorInputs in1 = hc.Apply(c, kDt, &t);
+  const Eigen::Isometry3d X0 = X_RS2(in0), X1 = X_RS2(in1);
+  const Eigen::Matrix3d R_RF = CommandAxes(geometry, CommandFrame::kEndEffector, ArmStateFrom(t));
+  const Eigen::Vector3d v = (X1 * geometry.p_S2oG_S2 - X0 * geometry.p_S2oG_S2) / kDt;
+  EXPECT_NEAR(v.dot(R_RF.col(0)), bindings.rates.coarse_ft_s, 0.02);
+  const Eigen::Vector3d w = RotationVector(X1.linear() * X0.linear().transpose()) / kDt;
+  EXPECT_NEAR(w.dot(R_RF.col(2)), 0.5 * bindings.rates.coarse_deg_s * kDeg, 0.002);
 }
 
 TEST_F(Devices, WithoutADaemonThe3DMouseIsReportedAbsent) {
@@ -261,7 +509,7 @@ TEST_F(Devices, WithoutADaemonThe3DMouseIsReportedAbsent) {
   EXPECT_NE(why.find("no 3D mouse"), std::string::npos) << why;
 }
 
-TEST_F(Devices, TheStatusScreenShowsTheModeCollisionsConditionsAndLatency) {
+TEST_F(Devices, TheStatusScreenShowsGuidanceMarginsAndFollowsTheWidth) {
   StatusSnapshot s;
   s.source = "by hand";
   s.frame = 1234;
@@ -273,10 +521,19 @@ TEST_F(Devices, TheStatusScreenShowsTheModeCollisionsConditionsAndLatency) {
   t.held = true;
   t.collisions = 1 << 3;  // eff_hex_1-payload
   t.acquisition_conditions[0] = true;
-  t.acquisition_conditions[4] = true;
+  t.acquisition_margin_ft[0] = 0.25;
+  t.acquisition_margin_ft[1] = -1.5;
   t.finger_gap_ft = 0.587;
+  t.palm_to_bar_ft = -20.75;  // the BAR far behind the palm: shown as a distance
   t.dock_distance_ft = 31.5;
   s.telemetry = t;
+  Guidance g;
+  g.offset_ft = {3.25, -0.5, 1.0};
+  g.rotation_deg = {-12.0, 30.0, 0.0};
+  g.distance_ft = 3.44;
+  s.guidance = g;
+  s.hand = HandStatus{};
+  for (const auto& [code, a] : bindings.keys) s.keys[ActionName(a)] = KeyName(code);
   s.publish_hz = 30.0;
   s.telemetry_hz = 29.9;
   s.input_to_dcp_ms = 1.2;
@@ -284,13 +541,28 @@ TEST_F(Devices, TheStatusScreenShowsTheModeCollisionsConditionsAndLatency) {
   s.input_to_render_p50_ms = 3.1;
   s.input_to_render_p99_ms = 5.5;
   s.devices = {"keyboard (this terminal)", "gamepad: none (no gamepad or joystick found)"};
-  const std::string screen = RenderStatusScreen(s, config);
-  for (const char* want : {"frame 001234", "MODE 1 ACQUISITION", "HELD", "eff_hex_1-payload", "[x] 1 BAR past palm d",
-                           "[ ] 2 BAR past finger b", "[x] 5 palm-BAR < TPOB", "finger gap 0.587 ft",
+  for (int i = 0; i < 50; ++i) s.log.push_back("event " + std::to_string(i));
+  const std::string screen = RenderStatusScreen(s, config, 120, 50);
+  for (const char* want : {"frame 001234", "MODE 1 ACQUISITION", "HELD", "eff_hex_1-payload",
+                           "[x] 1 BAR beyond palm face d", "holds by 0.250 ft", "short by 1.500 ft",
+                           "palm to BAR 20.750 ft", "finger gap 0.587 ft", "x forward 3.25 ft (w)",
+                           "y left 0.50 ft (a)", "z down 1.00 ft (f)", "roll left 12.0 deg (u)",
+                           "pitch up 30.0 deg (k)", "CONTROL manual augmented", "frame: end effector",
                            "distance 31.500 ft", "camera 4 wrist", "zoom 0.30", "published 30.0 Hz",
-                           "DCP 29.9 Hz", "rendered 30.0 Hz", "input to DCP 1.2 ms", "p50 3.1 ms, p99 5.5 ms",
-                           "gamepad: none"}) {
+                           "DCP 29.9 Hz", "input to DCP 1.2 ms", "p50 3.1 ms, p99 5.5 ms", "gamepad: none",
+                           "event 49"}) {
     EXPECT_NE(screen.find(want), std::string::npos) << "missing \"" << want << "\" in\n" << screen;
+  }
+  EXPECT_EQ(screen.find("-20.75"), std::string::npos) << screen;
+  // The screen fits any terminal: never wider than it, never taller.
+  for (const auto& [w, h] : std::vector<std::pair<int, int>>{{60, 30}, {80, 24}, {200, 60}}) {
+    const std::string sc = RenderStatusScreen(s, config, w, h);
+    std::istringstream is(sc);
+    int lines = 0;
+    for (std::string l; std::getline(is, l); ++lines) EXPECT_LE(static_cast<int>(l.size()), w) << l;
+    EXPECT_LE(lines, h) << sc;
+    EXPECT_NE(sc.find("GUIDANCE"), std::string::npos) << sc;
+    EXPECT_NE(sc.find("event 49"), std::string::npos) << "the newest event is shown at " << w << "x" << h;
   }
 }
 

@@ -4,6 +4,9 @@
 // first visit to it (or, with --time, all at one moment); one PNG a station
 // and a contact sheet of all eight. The README's pictures come from
 //   build/tools/rms_snapshot --out-dir docs/images
+// With --shot T:STATION:NAME (repeated) it takes just those pictures, with
+// the crosshairs on and the live window's guidance panel drawn as the
+// operator station would fill it (docs/operator.md's pictures).
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <array>
@@ -11,11 +14,89 @@
 #include <cstring>
 #include <optional>
 
+#include "dcp_node.h"
 #include "gl_context.h"
+#include "guidance.h"
 #include "offline_session.h"
 #include "overlay.h"
 #include "png_io.h"
 #include "renderer.h"
+#include "rms/check.h"
+
+namespace {
+
+// The live window's guidance panel as the operator station would fill it
+// from this frame's telemetry (a by-hand session in manual augmented control).
+rms::operator_state_t StateOf(const rms::LabConfig& config, const rms::offline::OfflineSession& s,
+                              rms::op::CommandFrame frame) {
+  const rms::dcp_telemetry_t t = rms::dcp::MakeTelemetry(s.status(), s.dcp());
+  const rms::op::ArmState arm = rms::op::ArmStateFrom(t);
+  if (frame == rms::op::CommandFrame::kPayload && arm.mode == 1) frame = rms::op::CommandFrame::kEndEffector;
+  const rms::op::Guidance g = rms::op::ComputeGuidance(rms::op::MakeGuidanceGeometry(config), arm, frame);
+  rms::operator_state_t m{};
+  m.source = rms::operator_state_t::SOURCE_BY_HAND;
+  m.control_mode = 2;
+  m.command_frame = static_cast<std::int8_t>(frame);
+  m.guidance_valid = true;
+  m.show_guidance = true;
+  m.mode = t.mode;
+  m.target = static_cast<std::int8_t>(g.target);
+  for (int i = 0; i < 3; ++i) {
+    m.offset_ft[i] = g.offset_ft[i];
+    m.rotation_deg[i] = g.rotation_deg[i];
+  }
+  for (int i = 0; i < 6; ++i) m.margin_ft[i] = t.acquisition_margin_ft[i];
+  m.bay_clearance_ft = t.bay_clearance_ft;
+  m.dock_distance_ft = t.dock_distance_ft;
+  m.dock_angle_deg = t.dock_angle_deg;
+  return m;
+}
+
+int TakeShots(const rms::LabConfig& config, const rms::op::Timeline& tl, const std::vector<std::string>& shots,
+              rms::op::CommandFrame frame, const std::string& out_dir, int width, int height,
+              const std::string& gl_name) {
+  struct Shot {
+    double t;
+    int station;
+    std::string name;
+    bool done = false;
+  };
+  std::vector<Shot> list;
+  for (const std::string& spec : shots) {
+    Shot sh;
+    char name[256] = {};
+    if (std::sscanf(spec.c_str(), "%lf:%d:%255s", &sh.t, &sh.station, name) != 3 || sh.station < 1 ||
+        sh.station > rms::kNumCameraStations) {
+      throw rms::InputError("--shot '" + spec + "': must be TIME:STATION:NAME, station 1..8");
+    }
+    sh.name = name;
+    list.push_back(sh);
+  }
+  auto gl = rms::esg::CreateGlContext(rms::esg::ParseGlBackend(gl_name), width, height);
+  rms::esg::EsgRenderer renderer(config, gl.get(), {});
+  const rms::esg::OverlayModel overlay = rms::esg::MakeOverlayModel(config);
+  std::vector<std::uint8_t> img(static_cast<std::size_t>(width) * height * 4);
+  rms::offline::OfflineSession session(config, tl);
+  while (session.Next()) {
+    for (Shot& sh : list) {
+      if (sh.done || session.t_s() + 1e-9 < sh.t) continue;
+      rms::EsgFrameData f = session.esg(sh.station);
+      f.control.overlay = true;
+      f.control.crosshairs = true;
+      renderer.Render(f);
+      std::memcpy(img.data(), renderer.pixels(), img.size());
+      rms::esg::DrawOverlay(img.data(), width, height, f, overlay);
+      rms::esg::DrawGuidance(img.data(), width, height, StateOf(config, session, frame));
+      const std::string path = out_dir + "/" + sh.name + ".png";
+      rms::esg::WritePng(path, width, height, img.data());
+      std::printf("%s: station %d at t = %.2f s\n", path.c_str(), sh.station, session.t_s());
+      sh.done = true;
+    }
+  }
+  return 0;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"rmslab rms_snapshot: one picture from each camera station over a mission, and a contact sheet"};
@@ -32,6 +113,14 @@ int main(int argc, char** argv) {
   app.add_option("--height", height, "Height of each picture")->capture_default_str()->check(CLI::Range(48, 4096));
   app.add_option("--columns", columns, "Pictures a row in the contact sheet")->capture_default_str()->check(CLI::Range(1, 8));
   app.add_option("--gl", gl_name, "GL backend: osmesa or egl")->capture_default_str();
+  std::vector<std::string> shots;
+  app.add_option("--shot", shots,
+                 "T:STATION:NAME: one picture at time T (s) from STATION into NAME.png, crosshairs on, with the "
+                 "window's guidance panel (repeat for more)");
+  std::string guidance_frame = "end_effector";
+  app.add_option("--guidance-frame", guidance_frame, "The guidance panel's command frame: end_effector, orbiter, payload")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"end_effector", "orbiter", "payload"}));
   CLI11_PARSE(app, argc, argv);
   try {
     const rms::LabConfig config = rms::LoadConfig(config_path);
@@ -61,10 +150,14 @@ int main(int argc, char** argv) {
         if (first[s] < 0) std::fprintf(stderr, "station %d is never selected: shown at the end\n", s + 1);
       }
     }
+    if (!shots.empty()) {
+      return TakeShots(config, tl, shots, *rms::op::ParseCommandFrame(guidance_frame), out_dir, width, height, gl_name);
+    }
     auto gl = rms::esg::CreateGlContext(rms::esg::ParseGlBackend(gl_name), width, height);
     rms::esg::EsgRenderer renderer(config, gl.get(), {});
     std::vector<std::string> names;
     for (const auto& c : config.cameras) names.push_back(c.name);
+    const rms::esg::OverlayModel overlay = rms::esg::MakeOverlayModel(config);
     const int rows = (kN + columns - 1) / columns;
     const int sheet_w = columns * width, sheet_h = rows * height;
     std::vector<std::uint8_t> sheet(static_cast<std::size_t>(sheet_w) * sheet_h * 4, 0);
@@ -78,7 +171,7 @@ int main(int argc, char** argv) {
         f.control.overlay = true;
         renderer.Render(f);
         std::memcpy(img.data(), renderer.pixels(), img.size());
-        rms::esg::DrawOverlay(img.data(), width, height, f, names);
+        rms::esg::DrawOverlay(img.data(), width, height, f, overlay);
         const std::string path = out_dir + "/station_" + std::to_string(s) + ".png";
         rms::esg::WritePng(path, width, height, img.data());
         const int x0 = ((s - 1) % columns) * width, y0 = ((s - 1) / columns) * height;

@@ -1,5 +1,7 @@
 #include "resim.h"
 
+#include "rms/acquisition_conditions.h"
+
 #include <chrono>
 #include <cstring>
 #include <filesystem>
@@ -257,9 +259,6 @@ nlohmann::ordered_json Compare(const Recording& rec, const std::map<std::int64_t
                       "(at %.1f s).",
                       first_apart / rate_hz, static_cast<double>(first_apart), max_ft, max_at / rate_hz));
   }
-  static const char* kCond[6] = {"the BAR beyond face d of EFF HEX 1 (the palm)", "the BAR beyond face b of EFF HEX 2",
-                                 "the BAR beyond face e of EFF HEX 3", "the finger gap below D3Y",
-                                 "the palm within TPOB of the BAR's top", "the end effector between the BAR's ends"};
   if (a.acquired >= 0 && b.acquired < 0) {
     std::string s = Fmt("No acquisition: at %.1f s, where the recorded session acquired the payload,", a.acquired / rate_hz);
     const auto it = now.find(a.acquired);
@@ -267,7 +266,7 @@ nlohmann::ordered_json Compare(const Recording& rec, const std::map<std::int64_t
       std::string failing;
       for (int i = 0; i < 6; ++i) {
         if (!it->second.acquisition_conditions[i]) {
-          failing += std::string(failing.empty() ? "" : "; ") + "condition " + std::to_string(i + 1) + ", " + kCond[i];
+          failing += std::string(failing.empty() ? "" : "; ") + "condition " + std::to_string(i + 1) + ", " + kAcquisitionConditionNames[i].text;
           if (i == 3) failing += Fmt(" (gap %.3f ft, D3Y %.3f ft)", it->second.finger_gap_ft, cfg_now.dcp.d3y_ft);
           if (i == 4) failing += Fmt(" (%.3f ft, TPOB %.3f ft)", it->second.palm_to_bar_ft, cfg_now.dcp.tpob_ft);
         }

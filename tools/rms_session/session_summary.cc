@@ -20,6 +20,7 @@
 #include "rms/esg_frame_t.hpp"
 #include "rms/message_io.h"
 #include "rms/operator_input_t.hpp"
+#include "rms/operator_state_t.hpp"
 #include "rms/process_status_t.hpp"
 #include "rms/lcm_interface.h"
 #include "rms/version.h"
@@ -57,11 +58,49 @@ std::int64_t SumPrefix(const nlohmann::json& stats, const std::string& prefix) {
 
 constexpr int kCollisionBits = collision_bits::kCount;
 
+// The hand controllers' modes over the session, from RMS_OPERATOR_STATE
+// (docs/sessions.md "summary.json", "by_hand").
+class HandControlLog {
+ public:
+  void Observe(const operator_state_t& m, double t_s) {
+    if (m.source != operator_state_t::SOURCE_BY_HAND) return;
+    seen_ = true;
+    const int key = m.control_mode * 100 + m.command_frame * 10 + m.vernier;
+    if (key != last_key_) {
+      static const char* kModes[3] = {"?", "single joint", "manual augmented"};
+      static const char* kFrames[4] = {"?", "end effector", "orbiter", "payload"};
+      changes_.push_back({{"time_s", t_s},
+                          {"frame", m.frame},
+                          {"control_mode", kModes[m.control_mode >= 1 && m.control_mode <= 2 ? m.control_mode : 0]},
+                          {"command_frame", kFrames[m.command_frame >= 1 && m.command_frame <= 3 ? m.command_frame : 0]},
+                          {"scale", m.vernier ? "vernier" : "coarse"}});
+      last_key_ = key;
+    }
+    key_actions_ = std::max<std::int64_t>(key_actions_, m.key_actions);
+    joint_limit_frames_ += m.joint_limits != 0;
+    singular_frames_ += m.singular;
+  }
+  nlohmann::ordered_json Json() const {
+    if (!seen_) return nullptr;
+    return {{"control_changes", changes_},
+            {"key_actions", key_actions_},
+            {"joint_limit_frames", joint_limit_frames_},
+            {"singular_frames", singular_frames_}};
+  }
+
+ private:
+  bool seen_ = false;
+  int last_key_ = -1;
+  nlohmann::ordered_json changes_ = nlohmann::ordered_json::array();
+  std::int64_t key_actions_ = 0, joint_limit_frames_ = 0, singular_frames_ = 0;
+};
+
 }  // namespace
 
 std::string BaseChannel(const std::string& channel) {
-  for (const char* base : {channels::kOperatorInput, channels::kDcpTelemetry, channels::kDcpFrame,
-                           channels::kEsgFrame, channels::kStatus, channels::kControl}) {
+  for (const char* base : {channels::kOperatorInput, channels::kOperatorState, channels::kWindowKeys,
+                           channels::kDcpTelemetry, channels::kDcpFrame, channels::kEsgFrame, channels::kStatus,
+                           channels::kControl}) {
     if (channel.rfind(base, 0) == 0) return base;
   }
   return channel;
@@ -100,13 +139,18 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
   // Mode 1 (the session's start or a reset), acquisition (1 -> 2), clear of
   // the bay (2 -> 3), the probe first in the docking envelope, docked.
   std::int64_t f_start = -1, f_acquired = -1, f_clear = -1, f_envelope = -1, f_docked = -1;
+  HandControlLog hand;
   while (const lcm::LogEvent* ev = log.readNextEvent()) {
     ++events;
     if (first_us < 0) first_us = ev->timestamp;
     last_us = ev->timestamp;
     const std::string base = BaseChannel(ev->channel);
     ++by_channel[ev->channel];
-    if (base == channels::kOperatorInput) {
+    if (base == channels::kOperatorState) {
+      operator_state_t m;
+      if (SafeDecode(ev->data, ev->datalen, 1024, &m) == DecodeError::kNone) hand.Observe(m, (ev->timestamp - first_us) * 1e-6);
+      else ++malformed;
+    } else if (base == channels::kOperatorInput) {
       operator_input_t m;
       if (SafeDecode(ev->data, ev->datalen, 1024, &m) == DecodeError::kNone) logged_input.Accept(m.frame);
       else ++malformed;
@@ -282,7 +326,13 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
     }
     j["restarts"] = restarts;
   }
-  j["mode_changes"] = mode_changes;
+  j["mode_changes"] = mode_changes;  j["by_hand"] = hand.Json();
+  if (j["by_hand"].is_object()) {
+    // The station's own count has the last key too (a quit ends it before
+    // another state message goes out).
+    j["by_hand"]["key_actions"] = std::max(j["by_hand"]["key_actions"].get<std::int64_t>(), Counter(op, "key_actions"));
+  }
+
   j["collisions"] = collision_events;
   nlohmann::ordered_json by_kind = nlohmann::ordered_json::object();
   for (const auto& [kind, t] : collision_totals) {

@@ -1,0 +1,42 @@
+#include "control_modes.h"
+
+namespace rms::op {
+
+std::string_view ControlModeName(ControlMode m) {
+  switch (m) {
+    case ControlMode::kSingleJoint: return "single joint";
+    case ControlMode::kManualAugmented: return "manual augmented";
+  }
+  return "?";
+}
+
+std::string_view CommandFrameName(CommandFrame f) {
+  switch (f) {
+    case CommandFrame::kEndEffector: return "end effector";
+    case CommandFrame::kOrbiter: return "orbiter";
+    case CommandFrame::kPayload: return "payload";
+  }
+  return "?";
+}
+
+std::optional<ControlMode> ParseControlMode(std::string_view s) {
+  if (s == "single_joint") return ControlMode::kSingleJoint;
+  if (s == "manual_augmented") return ControlMode::kManualAugmented;
+  return std::nullopt;
+}
+
+std::optional<CommandFrame> ParseCommandFrame(std::string_view s) {
+  if (s == "end_effector") return CommandFrame::kEndEffector;
+  if (s == "orbiter") return CommandFrame::kOrbiter;
+  if (s == "payload") return CommandFrame::kPayload;
+  return std::nullopt;
+}
+
+int HandAxisIndex(std::string_view name) {
+  for (int i = 0; i < kNumHandAxes; ++i) {
+    if (kHandAxisNames[i] == name) return i;
+  }
+  return -1;
+}
+
+}  // namespace rms::op

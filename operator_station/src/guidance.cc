@@ -1,0 +1,138 @@
+#include "guidance.h"
+
+#include <cmath>
+
+#include "arm_motion.h"
+#include "rms/arm_kinematics.h"
+#include "rms/mission_geometry.h"
+
+namespace rms::op {
+
+namespace {
+
+// The wrist camera's image axes (right, down) as the end effector's command
+// axes, with x exactly X2; (X2, -Y2, -Z2) when no camera rides the wrist.
+Eigen::Matrix3d HandAxesInSystemTwo(const LabConfig& c) {
+  Eigen::Vector3d right = -Eigen::Vector3d::UnitY();
+  for (const CameraStationConfig& cam : c.cameras) {
+    if (cam.mount != CameraMount::kWrist) continue;
+    // docs/scene.md: image right = line of sight x the mount's z axis.
+    const Eigen::Vector3d look = (cam.p_MoAim_M_ft - cam.p_MoCam_M_ft).normalized();
+    right = look.cross(Eigen::Vector3d::UnitZ());
+    break;
+  }
+  const Eigen::Vector3d x = Eigen::Vector3d::UnitX();
+  right -= right.dot(x) * x;
+  if (right.norm() < 1e-6) right = -Eigen::Vector3d::UnitY();
+  Eigen::Matrix3d R;
+  R.col(0) = x;
+  R.col(1) = right.normalized();
+  R.col(2) = x.cross(R.col(1));
+  return R;
+}
+
+}  // namespace
+
+Eigen::Isometry3d TelemetryPose(const double p[3], const double R_rowmajor[9]) {
+  Eigen::Matrix3d R;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) R(i, j) = R_rowmajor[3 * i + j];
+  }
+  return MakeIsometry(R, Eigen::Vector3d(p[0], p[1], p[2]));
+}
+
+GuidanceGeometry MakeGuidanceGeometry(const LabConfig& c) {
+  GuidanceGeometry g;
+  g.R_S2H = HandAxesInSystemTwo(c);
+  const mission::MissionGeometry m = mission::PlanGeometry(c);
+  g.p_S2oG_S2 = m.X_S2P * c.payload.p_PoBar_P_ft;
+  // The bar is symmetric: the same grasp turned half a turn about X2 holds it too.
+  g.X_RS2_grasp[0] = m.X_RS2_grasp;
+  Eigen::Isometry3d flip = Eigen::Isometry3d::Identity();
+  flip.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const Eigen::Vector3d G_R = m.X_RS2_grasp * g.p_S2oG_S2;
+  g.X_RS2_grasp[1] = m.X_RS2_grasp * flip;
+  // ... about the line through the grasp point, so the bar's centre stays put.
+  g.X_RS2_grasp[1].translation() += G_R - g.X_RS2_grasp[1] * g.p_S2oG_S2;
+  g.p_PoT_P = Eigen::Vector3d(0, 0.5 * c.payload.length_ft + c.payload.probe_length_ft, 0);
+  g.p_RoPort_R = c.cae.p_RoCo_R_ft;
+  g.y_port_R = c.cae.R_RC.col(1);
+  const Eigen::Vector3d bc = c.payload.p_PoBar_P_ft, half = 0.5 * c.payload.bar_size_P_ft;
+  for (int k = 0; k < 8; ++k) {
+    g.bar_P[k] = bc + Eigen::Vector3d((k & 1) ? half.x() : -half.x(), (k & 2) ? half.y() : -half.y(),
+                                      (k & 4) ? half.z() : -half.z());
+  }
+  g.fixed_finger_face_Y2_ft = c.end_effector.palm_half_width_ft - c.end_effector.finger_thickness_ft;
+  return g;
+}
+
+ArmState ArmStateFrom(const dcp_telemetry_t& t) {
+  ArmState s;
+  s.mode = t.mode;
+  s.X_RS2 = TelemetryPose(t.p_RoA_R_ft, t.R_RS2);
+  s.X_RP = TelemetryPose(t.p_RoPo_R_ft, t.R_RP);
+  return s;
+}
+
+Eigen::Matrix3d CommandAxes(const GuidanceGeometry& g, CommandFrame f, const ArmState& s) {
+  switch (f) {
+    case CommandFrame::kOrbiter: {
+      Eigen::Matrix3d R;
+      R.col(0) = -Eigen::Vector3d::UnitX();
+      R.col(1) = Eigen::Vector3d::UnitY();
+      R.col(2) = -Eigen::Vector3d::UnitZ();
+      return R;
+    }
+    case CommandFrame::kPayload:
+      if (s.mode >= 2) return s.X_RP.linear();
+      [[fallthrough]];
+    case CommandFrame::kEndEffector:
+      break;
+  }
+  return s.X_RS2.linear() * g.R_S2H;
+}
+
+Eigen::Vector3d PointOfResolution(const GuidanceGeometry& g, const ArmState& s) {
+  if (s.mode == 1) return g.p_S2oG_S2;
+  return s.X_RS2.inverse() * (s.X_RP * g.p_PoT_P);
+}
+
+Guidance ComputeGuidance(const GuidanceGeometry& g, const ArmState& s, CommandFrame f) {
+  Guidance out;
+  out.frame = f;
+  const Eigen::Matrix3d R_RF = CommandAxes(g, f, s);
+  Eigen::Vector3d d_R, phi_R;
+  if (s.mode == 1) {
+    out.target = GuidanceTarget::kGrasp;
+    const Eigen::Vector3d Q = s.X_RS2 * g.p_S2oG_S2;
+    // The nearer of the two grasps (the smaller turn).
+    const Eigen::Vector3d phi0 = RotationVector(g.X_RS2_grasp[0].linear() * s.X_RS2.linear().transpose());
+    const Eigen::Vector3d phi1 = RotationVector(g.X_RS2_grasp[1].linear() * s.X_RS2.linear().transpose());
+    const Eigen::Isometry3d& X = phi0.norm() <= phi1.norm() ? g.X_RS2_grasp[0] : g.X_RS2_grasp[1];
+    phi_R = phi0.norm() <= phi1.norm() ? phi0 : phi1;
+    d_R = X * g.p_S2oG_S2 - Q;
+    // Where the finger would stop: on the BAR's corner nearest it along Y2.
+    const Eigen::Vector3d y2 = s.X_RS2.linear().col(1);
+    double y_min = 1e30;
+    for (const Eigen::Vector3d& v : g.bar_P) y_min = std::min(y_min, y2.dot(s.X_RP * v - s.X_RS2.translation()));
+    const double gap = g.fixed_finger_face_Y2_ft - y_min;
+    out.close_gap_ft = gap > 0 ? gap : -1.0;
+  } else {
+    out.target = GuidanceTarget::kPort;
+    const Eigen::Vector3d tip = s.X_RP * g.p_PoT_P;
+    d_R = g.p_RoPort_R - tip;
+    const Eigen::Vector3d y = s.X_RP.linear().col(1);
+    const Eigen::Vector3d axis = y.cross(g.y_port_R);
+    const double angle = std::atan2(axis.norm(), y.dot(g.y_port_R));
+    if (axis.norm() > 1e-12) phi_R = angle * axis.normalized();
+    else if (angle > 1.0) phi_R = M_PI * s.X_RP.linear().col(0);  // exactly reversed: half a turn about x_P
+    else phi_R.setZero();
+  }
+  out.offset_ft = R_RF.transpose() * d_R;
+  out.rotation_deg = R_RF.transpose() * phi_R * (180.0 / M_PI);
+  out.distance_ft = d_R.norm();
+  out.angle_deg = phi_R.norm() * 180.0 / M_PI;
+  return out;
+}
+
+}  // namespace rms::op

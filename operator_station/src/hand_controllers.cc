@@ -1,0 +1,372 @@
+#include "hand_controllers.h"
+
+#include <algorithm>
+#include <cmath>
+#include <spdlog/spdlog.h>
+
+#include "rms/arm_kinematics.h"
+
+namespace rms::op {
+
+namespace {
+constexpr double kDeg = M_PI / 180.0;
+
+}  // namespace
+
+HandControllers::HandControllers(const LabConfig& config, const Bindings& bindings)
+    : config_(config),
+      b_(bindings),
+      geometry_(MakeGuidanceGeometry(config)),
+      limits_(LimitsFromConfig(config, 0.0)),
+      target_(InitialInputs(config.inputs)),
+      out_(target_) {
+  for (int i = 0; i < 6; ++i) limits_.rate_deg_s[i] = bindings.max_rate[i];
+  status_.mode = bindings.initial_mode;
+  status_.frame = bindings.initial_frame;
+  status_.vernier = bindings.initial_vernier;
+  target_.crosshairs = out_.crosshairs = true;
+}
+
+void HandControllers::AddDevice(std::unique_ptr<InputDevice> device) {
+  spdlog::info("device: {}", device->Describe());
+  devices_.push_back(std::move(device));
+  reported_gone_.push_back(false);
+}
+
+OperatorInputs HandControllers::Step(double dt_s, const dcp_telemetry_t* telemetry) {
+  DeviceCommands cmd;
+  for (std::size_t i = 0; i < devices_.size(); ++i) {
+    if (!devices_[i]->connected()) {
+      if (!reported_gone_[i]) {
+        spdlog::warn("device gone: {}", devices_[i]->Describe());
+        counters_.Add("device.disconnected");
+        reported_gone_[i] = true;
+      }
+      continue;
+    }
+    devices_[i]->Poll(&cmd);
+  }
+  return Apply(cmd, dt_s, telemetry);
+}
+
+void HandControllers::SetInputs(const OperatorInputs& in) {
+  const bool crosshairs = target_.crosshairs;
+  target_ = in;
+  target_.reset = false;
+  target_.crosshairs = crosshairs;
+  out_ = target_;
+  status_.pending = {};
+  status_.rate = {};
+  X_ref_.reset();
+}
+
+void HandControllers::PollFrozen() {
+  freeze_requested_ = step_requested_ = false;
+  DeviceCommands cmd;
+  for (std::size_t i = 0; i < devices_.size(); ++i) {
+    if (devices_[i]->connected()) devices_[i]->Poll(&cmd);
+  }
+  key_actions_ += cmd.key_actions;
+  bool ignored = !cmd.hand_presses.empty() || !cmd.input_presses.empty();
+  for (const Action& a : cmd.events) {
+    if (a.kind == ActionKind::kFreeze) freeze_requested_ = true;
+    else if (a.kind == ActionKind::kStep) step_requested_ = true;
+    else if (a.kind == ActionKind::kQuit) quit_ = true;
+    else ignored = true;
+  }
+  if (ignored) counters_.Add("frozen.inputs_ignored");
+}
+
+void HandControllers::Announce(const char* what) {
+  std::string s = std::string(ControlModeName(status_.mode));
+  if (status_.mode == ControlMode::kManualAugmented) s += ", " + std::string(CommandFrameName(status_.frame)) + " frame";
+  else s += " (" + std::string(kAnalogInputNames[status_.joint]) + ")";
+  s += status_.vernier ? ", vernier" : ", coarse";
+  spdlog::info("{}: {}", what, s);
+}
+
+void HandControllers::StopMotion() {
+  status_.pending = {};
+  status_.rate = {};
+  for (int i = kFinger; i < kNumAnalogInputs; ++i) target_.value[i] = out_.value[i];
+}
+
+double HandControllers::Increment(int axis) const {
+  const HandIncrements& k = b_.increments;
+  if (status_.mode == ControlMode::kSingleJoint) return status_.vernier ? k.joint_vernier_deg : k.joint_coarse_deg;
+  if (axis < 3) return status_.vernier ? k.vernier_ft : k.coarse_ft;
+  return status_.vernier ? k.vernier_deg : k.coarse_deg;
+}
+
+double HandControllers::FullRate(int axis) const {
+  const HandRates& r = b_.rates;
+  if (status_.mode == ControlMode::kSingleJoint) return status_.vernier ? r.joint_vernier_deg_s : r.joint_coarse_deg_s;
+  if (axis < 3) return status_.vernier ? r.vernier_ft_s : r.coarse_ft_s;
+  return status_.vernier ? r.vernier_deg_s : r.coarse_deg_s;
+}
+
+void HandControllers::HandleEvents(const DeviceCommands& cmd, const dcp_telemetry_t* tm) {
+  const bool held = tm && tm->mode >= 2;
+  for (const Action& a : cmd.events) {
+    switch (a.kind) {
+      case ActionKind::kCamera: target_.camera_station = a.camera; break;
+      case ActionKind::kCameraNext: target_.camera_station = target_.camera_station % kNumCameraStations + 1; break;
+      case ActionKind::kCameraPrev:
+        target_.camera_station = (target_.camera_station + kNumCameraStations - 2) % kNumCameraStations + 1;
+        break;
+      case ActionKind::kReset:
+        out_.reset = true;
+        StopMotion();
+        break;
+      case ActionKind::kOverlay: target_.overlay = !target_.overlay; break;
+      case ActionKind::kCrosshairs: target_.crosshairs = !target_.crosshairs; break;
+      case ActionKind::kGuidance: show_guidance_ = !show_guidance_; break;
+      case ActionKind::kStop:
+        StopMotion();
+        counters_.Add("control.stops");
+        break;
+      case ActionKind::kMode:
+        StopMotion();
+        status_.mode = status_.mode == ControlMode::kManualAugmented ? ControlMode::kSingleJoint
+                                                                     : ControlMode::kManualAugmented;
+        counters_.Add("control.mode_changes");
+        Announce("control mode");
+        break;
+      case ActionKind::kFrame: {
+        StopMotion();
+        int f = static_cast<int>(status_.frame) % 3 + 1;
+        if (f == static_cast<int>(CommandFrame::kPayload) && !held) f = static_cast<int>(CommandFrame::kEndEffector);
+        status_.frame = static_cast<CommandFrame>(f);
+        counters_.Add("control.frame_changes");
+        Announce("command frame");
+        break;
+      }
+      case ActionKind::kVernier:
+        StopMotion();
+        status_.vernier = !status_.vernier;
+        counters_.Add("control.scale_changes");
+        Announce("rate scale");
+        break;
+      case ActionKind::kJointNext:
+      case ActionKind::kJointPrev:
+        StopMotion();
+        status_.joint = (status_.joint + (a.kind == ActionKind::kJointNext ? 1 : 5)) % 6;
+        if (status_.mode == ControlMode::kSingleJoint) Announce("joint");
+        break;
+      case ActionKind::kQuit: quit_ = true; break;
+      case ActionKind::kFreeze: freeze_requested_ = true; break;
+      case ActionKind::kStep: step_requested_ = true; break;
+      case ActionKind::kHand:
+      case ActionKind::kInput: break;  // not events
+    }
+  }
+}
+
+void HandControllers::AddPress(const struct Press& p) {
+  if (status_.mode == ControlMode::kSingleJoint && p.index != kThcX) {
+    counters_.Add("single_joint.presses_ignored");
+    return;
+  }
+  // One increment a press, flown at the scale's rate. A press in the
+  // direction the axis is still moving is merged into that motion (it
+  // never runs on more than one increment from now); one the other way
+  // stops it.
+  double& pending = status_.pending[p.index];
+  const double inc = Increment(p.index);
+  if (pending * p.sign > 0) pending = p.sign * std::max(std::abs(pending), inc);
+  else if (pending * p.sign < 0) pending = 0.0;
+  else pending = p.sign * inc;
+}
+
+std::array<double, kNumHandAxes> HandControllers::CommandedRates(const DeviceCommands& cmd, double dt_s) {
+  std::array<double, kNumHandAxes> rate{};
+  for (int i = 0; i < kNumHandAxes; ++i) {
+    const double full = FullRate(i);
+    double r = std::clamp(cmd.hand[i], -1.0, 1.0) * full;
+    const double pending = status_.pending[i];
+    if (pending != 0.0) r += std::copysign(std::min(full, std::abs(pending) / dt_s), pending);
+    rate[i] = std::clamp(r, -full, full);
+  }
+  if (status_.mode == ControlMode::kSingleJoint) {
+    for (int i = 1; i < kNumHandAxes; ++i) rate[i] = 0.0;
+  }
+  return rate;
+}
+
+void HandControllers::FlyManualAugmented(const std::array<double, kNumHandAxes>& rate, double dt_s) {
+  JointAngles q{};
+  for (int i = 0; i < 6; ++i) q[i] = target_.value[i];
+  const double h = target_.value[kShoulderHeight];
+  ArmState s;
+  s.mode = dcp_mode_;
+  s.X_RS2 = ForwardPose(config_.arm, q, h);
+  if (X_S2P_) s.X_RP = s.X_RS2 * *X_S2P_;
+  else s.mode = 1;
+  const CommandFrame frame = status_.frame == CommandFrame::kPayload && !X_S2P_ ? CommandFrame::kEndEffector
+                                                                                  : status_.frame;
+  const Eigen::Matrix3d R_RF = CommandAxes(geometry_, frame, s);
+  const Eigen::Vector3d por = PointOfResolution(geometry_, s);
+  const Eigen::Vector3d v_R = R_RF * Eigen::Vector3d(rate[kThcX], rate[kThcY], rate[kThcZ]);
+  const Eigen::Vector3d w_R = R_RF * Eigen::Vector3d(rate[kRhcRoll], rate[kRhcPitch], rate[kRhcYaw]) * kDeg;
+  // The motion is flown closed loop on a reference pose that moves exactly
+  // as commanded (about the point of resolution), so the rate's first-order
+  // steps and the elbow's self-motion do not drift; released, nothing moves.
+  if (v_R.squaredNorm() == 0.0 && w_R.squaredNorm() == 0.0) {
+    X_ref_.reset();
+  } else {
+    if (!X_ref_) X_ref_ = s.X_RS2;
+    const Eigen::Vector3d Q_ref = *X_ref_ * por + v_R * dt_s;
+    X_ref_->linear() = Eigen::AngleAxisd(w_R.norm() * dt_s, w_R.norm() > 0 ? w_R.normalized() : Eigen::Vector3d::UnitX())
+                           .toRotationMatrix() *
+                       X_ref_->linear();
+    X_ref_->translation() = Q_ref - X_ref_->linear() * por;
+  }
+  Eigen::Vector3d v_fly = v_R, w_fly = w_R;
+  if (X_ref_) {
+    // Where the reference will be after this frame, less where the arm is.
+    constexpr double kCatchUpS = 0.2;
+    const Eigen::Vector3d e_v = *X_ref_ * por - s.X_RS2 * por - v_R * dt_s;
+    const Eigen::Vector3d e_w = RotationVector(X_ref_->linear() * s.X_RS2.linear().transpose()) - w_R * dt_s;
+    if (e_v.norm() > 0.5 || e_w.norm() > 5.0 * kDeg) {
+      X_ref_ = s.X_RS2;  // the arm cannot follow (a limit, a singular pose): start again from where it is
+    } else {
+      v_fly += e_v / kCatchUpS;
+      w_fly += e_w / kCatchUpS;
+    }
+  }
+  const RateResult r = ResolveRate(config_.arm, limits_, q, h, por, v_fly, w_fly, dt_s);
+  for (int i = 0; i < 6; ++i) target_.value[i] = r.q_deg[i];
+  const Eigen::Vector3d v_done = R_RF.transpose() * r.achieved.head<3>();
+  const Eigen::Vector3d w_done = R_RF.transpose() * r.achieved.tail<3>() / kDeg;
+  ConsumePending({v_done.x(), v_done.y(), v_done.z(), w_done.x(), w_done.y(), w_done.z()}, dt_s);
+  status_.singular = r.singular;
+  status_.rate_limited = r.rate_limited;
+  status_.sigma_min_ft = r.sigma_min_ft;
+  ReportLimits(r.at_limit);
+}
+
+void HandControllers::ConsumePending(const std::array<double, kNumHandAxes>& achieved, double dt_s) {
+  // An increment is done when the arm has moved it (not when it was asked
+  // for): near a singular pose the first of it may go slowly. One that
+  // makes no headway for kBlockedS (a joint at its limit, the arm at the
+  // end of its reach) is given up, and said so.
+  constexpr double kBlockedS = 1.5;
+  for (int i = 0; i < kNumHandAxes; ++i) {
+    double& pending = status_.pending[i];
+    if (pending == 0.0) {
+      stalled_s_[i] = 0.0;
+      continue;
+    }
+    const double along = std::copysign(1.0, pending) * achieved[i];  // > 0: toward completing it
+    if (along > 0) pending -= std::copysign(std::min(std::abs(pending), along * dt_s), pending);
+    if (std::abs(pending) < 1e-3 * Increment(i)) pending = 0.0;  // done, to a thousandth
+    stalled_s_[i] = along < 0.05 * FullRate(i) ? stalled_s_[i] + dt_s : 0.0;
+    if (stalled_s_[i] > kBlockedS) {
+      pending = 0.0;
+      stalled_s_[i] = 0.0;
+      counters_.Add("increments.blocked");
+      spdlog::warn("{}: the arm cannot move that way (at a joint limit or the end of its reach): motion stopped",
+                   kHandAxisNames[i]);
+    }
+  }
+}
+
+void HandControllers::FlySingleJoint(double rate_deg_s, double dt_s) {
+  const int j = status_.joint;
+  const double rate = std::clamp(rate_deg_s, -b_.max_rate[j], b_.max_rate[j]);
+  double q = target_.value[j] + rate * dt_s;
+  std::uint32_t at_limit = 0;
+  if (rate > 0 && q > limits_.max_deg[j]) {
+    q = std::max(target_.value[j], limits_.max_deg[j]);
+    at_limit = 1u << j;
+  } else if (rate < 0 && q < limits_.min_deg[j]) {
+    q = std::min(target_.value[j], limits_.min_deg[j]);
+    at_limit = 1u << j;
+  }
+  status_.rate_limited = std::abs(rate) < std::abs(rate_deg_s);
+  ConsumePending({(q - target_.value[j]) / dt_s, 0, 0, 0, 0, 0}, dt_s);
+  target_.value[j] = q;
+  status_.singular = false;
+  ReportLimits(at_limit);
+}
+
+void HandControllers::ReportLimits(std::uint32_t at_limit) {
+  status_.at_limit = at_limit;
+  for (int i = 0; i < 6; ++i) {
+    const std::uint32_t bit = 1u << i;
+    const double q = target_.value[i];
+    const bool on_limit = q <= limits_.min_deg[i] + 1e-6 || q >= limits_.max_deg[i] - 1e-6;
+    if ((at_limit & bit) && !(limit_reported_ & bit)) {
+      counters_.Add("joint_limit." + std::string(kAnalogInputNames[i]));
+      spdlog::warn("joint limit: {} stopped at {:+.1f} deg (its travel {:+.1f} .. {:+.1f})", kAnalogInputNames[i], q,
+                   limits_.min_deg[i], limits_.max_deg[i]);
+      limit_reported_ |= bit;
+    } else if (!on_limit) {
+      limit_reported_ &= ~bit;
+    }
+  }
+}
+
+void HandControllers::DirectInputs(const DeviceCommands& cmd, double dt_s) {
+  const InputCalibrations& cal = config_.inputs;
+  for (const struct Press& p : cmd.input_presses) {
+    // As the hand controllers' increments: one step ahead of the output at
+    // most; a press the other way stops it.
+    double& t = target_.value[p.index];
+    const double o = out_.value[p.index], moving = t - o;
+    if (moving * p.sign > 1e-12) t = o + p.sign * std::max(std::abs(moving), b_.key_step[p.index]);
+    else if (moving * p.sign < -1e-12) t = o;
+    else t = o + p.sign * b_.key_step[p.index];
+  }
+  for (int i = kFinger; i < kNumAnalogInputs; ++i) {
+    const double lim = b_.max_rate[i] * dt_s;
+    double t = target_.value[i] + std::clamp(cmd.input_rate[i], -1.0, 1.0) * lim;
+    // Clamping to the calibrated range, reported once per excursion.
+    const double c = std::clamp(t, cal[i].min, cal[i].max);
+    if (c != t) {
+      counters_.Add("clamped." + std::string(kAnalogInputNames[i]));
+      if (!clamping_[i]) {
+        spdlog::warn("{} command {:.3f} beyond its range [{}, {}] {}: clamped", kAnalogInputNames[i], t, cal[i].min,
+                     cal[i].max, cal[i].unit);
+      }
+    }
+    clamping_[i] = c != t;
+    target_.value[i] = c;
+    out_.value[i] += std::clamp(target_.value[i] - out_.value[i], -lim, lim);
+  }
+}
+
+OperatorInputs HandControllers::Apply(const DeviceCommands& cmd, double dt_s, const dcp_telemetry_t* tm) {
+  out_.reset = false;
+  freeze_requested_ = step_requested_ = false;
+  key_actions_ += cmd.key_actions;
+  if (tm) {
+    if (tm->mode == 1 && dcp_mode_ != 1 && status_.frame == CommandFrame::kPayload) {
+      status_.frame = CommandFrame::kEndEffector;  // reset: no payload held any more
+      Announce("command frame");
+    }
+    dcp_mode_ = tm->mode;
+    if (tm->mode >= 2) X_S2P_ = TelemetryPose(tm->p_RoA_R_ft, tm->R_RS2).inverse() * TelemetryPose(tm->p_RoPo_R_ft, tm->R_RP);
+    else X_S2P_.reset();
+    // The DCP holds the arm (the command collides): carry on from the pose
+    // the slave holds, so the next command away from the contact relieves it.
+    if (tm->held && tm->slave_collisions == 0) {
+      for (int i = 0; i < 6; ++i) target_.value[i] = tm->slave_angles_deg[i];
+      X_ref_.reset();
+    }
+  }
+  HandleEvents(cmd, tm);
+  for (const struct Press& p : cmd.hand_presses) AddPress(p);
+  const auto rate = CommandedRates(cmd, dt_s);
+  status_.rate = rate;
+  if (status_.mode == ControlMode::kManualAugmented) FlyManualAugmented(rate, dt_s);
+  else FlySingleJoint(rate[kThcX], dt_s);
+  DirectInputs(cmd, dt_s);
+  for (int i = 0; i < 6; ++i) out_.value[i] = target_.value[i];
+  out_.camera_station = target_.camera_station;
+  out_.overlay = target_.overlay;
+  out_.crosshairs = target_.crosshairs;
+  return out_;
+}
+
+}  // namespace rms::op
