@@ -43,5 +43,6 @@ int main(int argc, char** argv) {
                             opt.status = status_on ? 1 : status_off ? 0 : -1;
                             rms::op::OperatorStation station(opt, config, lcm, rms::op::MakeSource(opt, config));
                             return station.Run(common.stats_path, common.ready_path);
-                          });
+                          },
+                          [&](const rms::LabConfig& config) { rms::op::CheckSourceFiles(opt, config); });
 }

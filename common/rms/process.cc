@@ -37,12 +37,15 @@ void AddCommonOptions(CLI::App& app, CommonOptions* o) {
   app.add_option("--log-level", o->log_level, "trace, debug, info, warn, error")
       ->capture_default_str()
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
+  app.add_flag("--check", o->check,
+               "Check the configuration (and this process's own files), say what is wrong, and exit (0: good)");
   app.set_version_flag("--version", VersionString(), "Print the software version and exit");
 }
 
 int ProcessMain(CLI::App& app, int argc, char** argv, const std::string& process,
                 CommonOptions* common,
-                const std::function<int(const LabConfig&, LcmInterface&)>& body) {
+                const std::function<int(const LabConfig&, LcmInterface&)>& body,
+                const std::function<void(const LabConfig&)>& check) {
   AddCommonOptions(app, common);
   try {
     app.parse(argc, argv);
@@ -51,6 +54,17 @@ int ProcessMain(CLI::App& app, int argc, char** argv, const std::string& process
   }
   SetUpLogging(process, common->log_level);
   InstallStopHandlers();
+  if (common->check) {
+    try {
+      const LabConfig config = LoadConfig(common->config_path);
+      if (check) check(config);
+      spdlog::info("check: {} and this process's files are good", common->config_path);
+      return 0;
+    } catch (const std::exception& e) {
+      spdlog::error("{}", e.what());
+      return 2;
+    }
+  }
   try {
     const LabConfig config = LoadConfig(common->config_path);
     UdpLcm lcm(common->lcm);

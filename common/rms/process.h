@@ -25,6 +25,7 @@ struct CommonOptions {
   std::string stats_path;   // --stats FILE: final counters as JSON at exit
   std::string ready_path;   // --ready-file FILE: created once subscribed and running
   std::string log_level = "info";  // --log-level
+  bool check = false;       // --check: check the configuration (and the process's own files), then exit
 };
 
 void AddCommonOptions(CLI::App& app, CommonOptions* options);
@@ -34,10 +35,15 @@ struct LabConfig;
 // The main() every process shares: adds the common options to `app`, parses
 // the command line, sets up logging and the stop signals, loads the
 // configuration, opens LCM and runs `body`. Bad input (a config error, no
-// multicast route) is logged with its reason and exits 2.
+// multicast route) is logged with its reason and exits 2. With --check it
+// loads the configuration, runs `check` (the process's own files: throws
+// rms::InputError naming what is wrong), says so on stderr and exits: 0 when
+// all is good, 2 otherwise -- no LCM, nothing started (launchers check
+// before they start anything).
 int ProcessMain(CLI::App& app, int argc, char** argv, const std::string& process,
                 CommonOptions* common,
-                const std::function<int(const LabConfig&, LcmInterface&)>& body);
+                const std::function<int(const LabConfig&, LcmInterface&)>& body,
+                const std::function<void(const LabConfig&)>& check = {});
 
 // Sets up spdlog's default logger (stderr, "[time] [process] [level] msg").
 void SetUpLogging(const std::string& process, const std::string& level);

@@ -4,6 +4,7 @@
 // well-formed, and Finish() refuses keys nobody asked for. Errors are
 // rms::InputError naming the file, the key and the reason:
 //   "config/rmslab.toml: key 'arm.upper_boom_ft': must be > 0, got -3"
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <optional>
@@ -47,8 +48,32 @@ class TomlReader {
   const toml::node* Get(std::string_view key) {
     used_.insert(std::string(key));
     const toml::node* n = table_->get(key);
-    if (n == nullptr) Fail(key, "missing (every key is required; see " + doc_ + ")");
+    if (n == nullptr) {
+      // A key present under a near spelling is named: the likely typo.
+      std::string near;
+      for (auto&& [k, v] : *table_) {
+        if (!used_.count(std::string(k.str())) && EditDistance(k.str(), key) <= 2) near = std::string(k.str());
+      }
+      Fail(key, "missing (every key is required; see " + doc_ + ")" +
+                    (near.empty() ? "" : "; the file has '" + Key(near) + "': misspelt?"));
+    }
     return n;
+  }
+
+  // Levenshtein distance, for naming a misspelt key.
+  static std::size_t EditDistance(std::string_view a, std::string_view b) {
+    std::vector<std::size_t> row(b.size() + 1);
+    for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+      std::size_t diag = row[0];
+      row[0] = i;
+      for (std::size_t j = 1; j <= b.size(); ++j) {
+        const std::size_t up = row[j];
+        row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+        diag = up;
+      }
+    }
+    return row[b.size()];
   }
 
   double Number(std::string_view key, double lo, double hi, bool open_lo = false) {
@@ -109,7 +134,7 @@ class TomlReader {
     const toml::node* n = Get(key);
     const toml::table* t = n->as_table();
     if (t == nullptr) Fail(key, "must be a table");
-    return TomlReader(t, Key(key), source_);
+    return TomlReader(t, Key(key), source_, doc_);
   }
 
   const toml::array* Array(std::string_view key) {

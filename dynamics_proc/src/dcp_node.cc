@@ -197,6 +197,7 @@ dcp_telemetry_t MakeTelemetry(const DcpStatus& st, const DcpFrameData& out) {
   t.mode = static_cast<std::int8_t>(st.mode);
   t.acquired = st.acquired;
   t.docked = st.docked;
+  t.released = st.released;
   t.held = st.held;
   t.finger_held = st.finger_held;
   t.collisions = static_cast<std::int32_t>(st.collisions);

@@ -50,6 +50,7 @@ DynamicCollisionProgram::DynamicCollisionProgram(const LabConfig& config, const 
 
 void DynamicCollisionProgram::Reset() {
   released_ = false;
+  status_.released = false;
   status_.mode = 1;
   status_.acquired = false;
   status_.docked = false;
@@ -214,6 +215,7 @@ DcpFrameData DynamicCollisionProgram::Step(const OperatorInputs& in) {
     }
     status_.held = !moved;
   }
+  status_.released = released_;
   status_.slave_collisions = slave_->collisions;
   status_.slave = slave_->cmd;
   status_.X_RS2 = slave_->pose.X_RS2;
@@ -508,6 +510,7 @@ void DynamicCollisionProgram::RestoreState(const nlohmann::json& j) {
     status_.acquired = j.at("acquired").get<bool>();
     status_.docked = j.at("docked").get<bool>();
     released_ = j.at("released").get<bool>();
+    status_.released = released_;
     X_S2P_ = PoseFrom(j.at("X_S2P"), "X_S2P");
     X_RP_docked_ = PoseFrom(j.at("X_RP_docked"), "X_RP_docked");
     contact_gap_ft_ = j.at("contact_gap_ft").get<double>();

@@ -95,6 +95,7 @@ struct DcpStatus {
   int mode = 1;
   bool acquired = false;
   bool docked = false;
+  bool released = false;               // docked and let go by the finger: the arm is free
   bool held = false;
   bool finger_held = false;
   std::uint32_t collisions = 0;        // of the master's command

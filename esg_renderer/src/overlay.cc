@@ -237,6 +237,11 @@ void DrawGuidance(std::uint8_t* rgba, int w, int h, const operator_state_t& st) 
       c += b;
     }
     L.push_back(c);
+    if (st.close_gap_ft > 0) {
+      std::snprintf(b, sizeof b, "CLOSED, THE FINGER WOULD STOP AT %.2f FT: %s", st.close_gap_ft,
+                    st.close_ok ? "ACQUIRES" : "NOT BELOW D3Y");
+      L.push_back(b);
+    }
   } else if (st.mode == 2) {
     std::snprintf(b, sizeof b, "BAY: %.2f FT TO CLEAR", std::max(0.0, -st.bay_clearance_ft));
     L.push_back(b);

@@ -49,11 +49,13 @@ VideoWriter::~VideoWriter() { Close(); }
 void VideoWriter::Add(const std::uint8_t* rgba, int repeat) {
   std::lock_guard<std::mutex> lock(mu_);
   if (closing_) return;
-  if (queue_.size() >= kMaxQueue) {
+  const std::size_t bytes = static_cast<std::size_t>(width_) * height_ * 4;
+  if (!queue_.empty() && queued_bytes_ + bytes > kMaxQueueBytes) {
     dropped_ += repeat;
     return;
   }
-  queue_.emplace_back(std::vector<std::uint8_t>(rgba, rgba + static_cast<std::size_t>(width_) * height_ * 4), repeat);
+  queue_.emplace_back(std::vector<std::uint8_t>(rgba, rgba + bytes), repeat);
+  queued_bytes_ += bytes;
   cv_.notify_one();
 }
 
@@ -66,6 +68,7 @@ void VideoWriter::Run() {
       if (queue_.empty()) return;
       item = std::move(queue_.front());
       queue_.pop_front();
+      queued_bytes_ -= item.first.size();
     }
     for (int r = 0; r < item.second; ++r) {
       const std::uint8_t* p = item.first.data();

@@ -1,7 +1,10 @@
 #pragma once
 // The session's video: frames piped raw to ffmpeg (libx264, from Debian) by
-// a writer thread, so encoding never holds up the frame loop. A full queue
-// drops the frame (counted), never blocks.
+// a writer thread, so encoding never holds up the frame loop. The queue holds
+// up to kMaxQueueBytes of frames (256 MiB: 85 frames at 1024x768, thousands
+// at a small size), so a stall of the encoder (a loaded machine) is ridden
+// out; a full queue drops the frame (counted, video.dropped), never blocks
+// (docs/esg.md "Video").
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -37,7 +40,8 @@ class VideoWriter {
   bool closing_ = false;
   bool closed_ = false;
   std::int64_t written_ = 0, dropped_ = 0;
-  static constexpr std::size_t kMaxQueue = 60;
+  std::size_t queued_bytes_ = 0;
+  static constexpr std::size_t kMaxQueueBytes = std::size_t{256} << 20;
 };
 
 }  // namespace rms::esg

@@ -2,6 +2,7 @@
 
 #include <SDL2/SDL_gamecontroller.h>
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 
@@ -191,6 +192,10 @@ void ReadKeyboard(TomlReader& top, Bindings* b) {
     b->keys[code] = ActionAt(k, name);
   }
   k.Finish();
+  // A session must be able to end from its keyboards.
+  if (std::none_of(b->keys.begin(), b->keys.end(), [](const auto& kv) { return kv.second.kind == ActionKind::kQuit; })) {
+    r.Fail("keys", "no key is bound to quit (add one, e.g. Q = \"quit\")");
+  }
   r.Finish();
 }
 

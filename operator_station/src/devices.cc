@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <spdlog/spdlog.h>
 
 #ifdef RMSLAB_HAVE_SPNAV
 #include <spnav.h>
@@ -51,6 +52,8 @@ void KeyboardDevice::Poll(DeviceCommands* out) {
   for (int k = next_key_(); k >= 0; k = next_key_()) {
     const auto it = b_.keys.find(k);
     if (it == b_.keys.end()) {
+      // Said once a key, so a person knows the press did nothing.
+      if (unbound_seen_.insert(k).second) spdlog::info("key '{}' is not bound to anything ({})", KeyName(k), b_.source);
       ++unbound_;
       continue;
     }
@@ -80,7 +83,11 @@ bool WindowKeyboardDevice::Receive(const Message& m, std::int64_t now_us) {
 void WindowKeyboardDevice::Poll(DeviceCommands* out) {
   for (int k : pressed_) {
     const auto it = b_.keys.find(k);
-    if (it != b_.keys.end()) AddPressed(it->second, out);
+    if (it == b_.keys.end()) continue;
+    AddPressed(it->second, out);
+    // A direct input's key down is a terminal's press too (a tap of the
+    // finger key closes it all the way); held, it moves on at its rate.
+    if (it->second.kind == ActionKind::kInput) out->input_presses.push_back({it->second.index, it->second.sign});
   }
   pressed_.clear();
   if (!held_.empty() && now_us_ - heard_us_ > timeout_us_) {

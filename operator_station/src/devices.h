@@ -69,6 +69,7 @@ class KeyboardDevice : public InputDevice {
   std::function<int()> next_key_;
   std::string where_;
   long unbound_ = 0;
+  std::set<int> unbound_seen_;
 };
 
 // The live window's keyboard (RMS_WINDOW_KEYS from esg_renderer): a held

@@ -46,14 +46,9 @@ GuidanceGeometry MakeGuidanceGeometry(const LabConfig& c) {
   g.R_S2H = HandAxesInSystemTwo(c);
   const mission::MissionGeometry m = mission::PlanGeometry(c);
   g.p_S2oG_S2 = m.X_S2P * c.payload.p_PoBar_P_ft;
-  // The bar is symmetric: the same grasp turned half a turn about X2 holds it too.
-  g.X_RS2_grasp[0] = m.X_RS2_grasp;
-  Eigen::Isometry3d flip = Eigen::Isometry3d::Identity();
-  flip.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
-  const Eigen::Vector3d G_R = m.X_RS2_grasp * g.p_S2oG_S2;
-  g.X_RS2_grasp[1] = m.X_RS2_grasp * flip;
-  // ... about the line through the grasp point, so the bar's centre stays put.
-  g.X_RS2_grasp[1].translation() += G_R - g.X_RS2_grasp[1] * g.p_S2oG_S2;
+  // (The bar is symmetric, but only this grasp puts the wrist camera on the
+  // grapple target's side: docs/scene.md "Targets".)
+  g.X_RS2_grasp = m.X_RS2_grasp;
   g.p_PoT_P = Eigen::Vector3d(0, 0.5 * c.payload.length_ft + c.payload.probe_length_ft, 0);
   g.p_RoPort_R = c.cae.p_RoCo_R_ft;
   g.y_port_R = c.cae.R_RC.col(1);
@@ -69,6 +64,7 @@ GuidanceGeometry MakeGuidanceGeometry(const LabConfig& c) {
 ArmState ArmStateFrom(const dcp_telemetry_t& t) {
   ArmState s;
   s.mode = t.mode;
+  s.bay_clearance_ft = t.bay_clearance_ft;
   s.X_RS2 = TelemetryPose(t.p_RoA_R_ft, t.R_RS2);
   s.X_RP = TelemetryPose(t.p_RoPo_R_ft, t.R_RP);
   return s;
@@ -105,12 +101,8 @@ Guidance ComputeGuidance(const GuidanceGeometry& g, const ArmState& s, CommandFr
   if (s.mode == 1) {
     out.target = GuidanceTarget::kGrasp;
     const Eigen::Vector3d Q = s.X_RS2 * g.p_S2oG_S2;
-    // The nearer of the two grasps (the smaller turn).
-    const Eigen::Vector3d phi0 = RotationVector(g.X_RS2_grasp[0].linear() * s.X_RS2.linear().transpose());
-    const Eigen::Vector3d phi1 = RotationVector(g.X_RS2_grasp[1].linear() * s.X_RS2.linear().transpose());
-    const Eigen::Isometry3d& X = phi0.norm() <= phi1.norm() ? g.X_RS2_grasp[0] : g.X_RS2_grasp[1];
-    phi_R = phi0.norm() <= phi1.norm() ? phi0 : phi1;
-    d_R = X * g.p_S2oG_S2 - Q;
+    phi_R = RotationVector(g.X_RS2_grasp.linear() * s.X_RS2.linear().transpose());
+    d_R = g.X_RS2_grasp * g.p_S2oG_S2 - Q;
     // Where the finger would stop: on the BAR's corner nearest it along Y2.
     const Eigen::Vector3d y2 = s.X_RS2.linear().col(1);
     double y_min = 1e30;
@@ -127,6 +119,11 @@ Guidance ComputeGuidance(const GuidanceGeometry& g, const ArmState& s, CommandFr
     if (axis.norm() > 1e-12) phi_R = angle * axis.normalized();
     else if (angle > 1.0) phi_R = M_PI * s.X_RP.linear().col(0);  // exactly reversed: half a turn about x_P
     else phi_R.setZero();
+  }
+  if (s.mode == 2) {
+    out.leave_bay = true;
+    const double up = std::max(0.0, kLeaveBayMarginFt - s.bay_clearance_ft);
+    out.leave_bay_ft = R_RF.transpose() * Eigen::Vector3d(0, 0, up);
   }
   out.offset_ft = R_RF.transpose() * d_R;
   out.rotation_deg = R_RF.transpose() * phi_R * (180.0 / M_PI);

@@ -19,7 +19,8 @@ namespace rms::op {
 struct GuidanceGeometry {
   Eigen::Matrix3d R_S2H = Eigen::Matrix3d::Identity();  // end-effector command axes in System Two
   Eigen::Vector3d p_S2oG_S2 = Eigen::Vector3d::Zero();  // the grasp point: the bar's centre at the grasp
-  std::array<Eigen::Isometry3d, 2> X_RS2_grasp;         // System Two at the grasp, fingers either way along the bar
+  Eigen::Isometry3d X_RS2_grasp = Eigen::Isometry3d::Identity();  // System Two at the grasp (the mission's: the
+                                                        // wrist camera on the grapple target's side)
   Eigen::Vector3d p_PoT_P = Eigen::Vector3d::Zero();    // the probe's tip centre, payload frame
   Eigen::Vector3d p_RoPort_R = Eigen::Vector3d::Zero(); // the docking port's centre
   Eigen::Vector3d y_port_R = Eigen::Vector3d::UnitZ();  // the port's axis (into the CAE)
@@ -34,6 +35,7 @@ Eigen::Isometry3d TelemetryPose(const double p[3], const double R_rowmajor[9]);
 // The poses guidance reads from one telemetry message.
 struct ArmState {
   int mode = 1;
+  double bay_clearance_ft = 0.0;  // the payload's lowest vertex above the bay's top
   Eigen::Isometry3d X_RS2 = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d X_RP = Eigen::Isometry3d::Identity();
 };
@@ -56,14 +58,20 @@ struct Guidance {
   Eigen::Vector3d rotation_deg = Eigen::Vector3d::Zero(); // about x (roll), y (pitch), z (yaw) to align
   double distance_ft = 0.0;                              // |offset|
   double angle_deg = 0.0;                                // |rotation|
+  // Mode 2: the way out of the bay first -- straight up (+Z_R) until the
+  // payload is kLeaveBayMarginFt clear -- in the command frame's axes.
+  bool leave_bay = false;
+  Eigen::Vector3d leave_bay_ft = Eigen::Vector3d::Zero();
   // Mode 1: the gap at which the closing finger would stop on the BAR (face
   // b to the BAR's far side along Y2): condition 4 needs it below D3Y. -1
   // when the BAR is not between the fingers' planes.
   double close_gap_ft = -1.0;
 };
-// In Mode 1: to the nearer of the two grasps. In Modes 2 and 3: from the
-// probe's tip to the port's centre, and the turn that brings the probe's
-// axis onto the port's (roll about the port's axis is free: 0).
+// In Mode 1: to the grasp. In Modes 2 and 3: from the probe's tip to the
+// port's centre, and the turn that brings the probe's axis onto the port's
+// (roll about the port's axis is free: 0); in Mode 2 also the way up out of
+// the bay, which comes first.
+inline constexpr double kLeaveBayMarginFt = 2.0;
 Guidance ComputeGuidance(const GuidanceGeometry& g, const ArmState& s, CommandFrame f);
 
 }  // namespace rms::op

@@ -61,7 +61,8 @@ void HandControllers::SetInputs(const OperatorInputs& in) {
 }
 
 void HandControllers::PollFrozen() {
-  freeze_requested_ = step_requested_ = false;
+  freeze_requested_ = false;
+  step_requests_ = 0;
   DeviceCommands cmd;
   for (std::size_t i = 0; i < devices_.size(); ++i) {
     if (devices_[i]->connected()) devices_[i]->Poll(&cmd);
@@ -70,11 +71,18 @@ void HandControllers::PollFrozen() {
   bool ignored = !cmd.hand_presses.empty() || !cmd.input_presses.empty();
   for (const Action& a : cmd.events) {
     if (a.kind == ActionKind::kFreeze) freeze_requested_ = true;
-    else if (a.kind == ActionKind::kStep) step_requested_ = true;
+    else if (a.kind == ActionKind::kStep) ++step_requests_;
     else if (a.kind == ActionKind::kQuit) quit_ = true;
+    else if (a.kind == ActionKind::kStop) StopAndRelease(cmd);  // nothing resumes when the session runs again
     else ignored = true;
   }
-  if (ignored) counters_.Add("frozen.inputs_ignored");
+  if (ignored) {
+    counters_.Add("frozen.inputs_ignored");
+    if (!frozen_noted_) {
+      spdlog::info("frozen: only freeze (to run again), step, stop and quit act; other keys do nothing");
+      frozen_noted_ = true;
+    }
+  }
 }
 
 void HandControllers::Announce(const char* what) {
@@ -83,6 +91,17 @@ void HandControllers::Announce(const char* what) {
   else s += " (" + std::string(kAnalogInputNames[status_.joint]) + ")";
   s += status_.vernier ? ", vernier" : ", coarse";
   spdlog::info("{}: {}", what, s);
+}
+
+void HandControllers::StopAndRelease(const DeviceCommands& cmd) {
+  StopMotion();
+  for (int i = 0; i < kNumHandAxes; ++i) hand_suppressed_[i] = hand_suppressed_[i] || cmd.hand[i] != 0.0;
+  for (int i = 0; i < kNumAnalogInputs; ++i) input_suppressed_[i] = input_suppressed_[i] || cmd.input_rate[i] != 0.0;
+}
+
+void HandControllers::FollowHeldArm(const dcp_telemetry_t& tm) {
+  for (int i = 0; i < 6; ++i) target_.value[i] = tm.slave_angles_deg[i];
+  X_ref_.reset();
 }
 
 void HandControllers::StopMotion() {
@@ -122,7 +141,7 @@ void HandControllers::HandleEvents(const DeviceCommands& cmd, const dcp_telemetr
       case ActionKind::kCrosshairs: target_.crosshairs = !target_.crosshairs; break;
       case ActionKind::kGuidance: show_guidance_ = !show_guidance_; break;
       case ActionKind::kStop:
-        StopMotion();
+        StopAndRelease(cmd);
         counters_.Add("control.stops");
         break;
       case ActionKind::kMode:
@@ -155,7 +174,7 @@ void HandControllers::HandleEvents(const DeviceCommands& cmd, const dcp_telemetr
         break;
       case ActionKind::kQuit: quit_ = true; break;
       case ActionKind::kFreeze: freeze_requested_ = true; break;
-      case ActionKind::kStep: step_requested_ = true; break;
+      case ActionKind::kStep: ++step_requests_; break;
       case ActionKind::kHand:
       case ActionKind::kInput: break;  // not events
     }
@@ -182,7 +201,8 @@ std::array<double, kNumHandAxes> HandControllers::CommandedRates(const DeviceCom
   std::array<double, kNumHandAxes> rate{};
   for (int i = 0; i < kNumHandAxes; ++i) {
     const double full = FullRate(i);
-    double r = std::clamp(cmd.hand[i], -1.0, 1.0) * full;
+    if (cmd.hand[i] == 0.0) hand_suppressed_[i] = false;  // let go since the stop: it acts again
+    double r = hand_suppressed_[i] ? 0.0 : std::clamp(cmd.hand[i], -1.0, 1.0) * full;
     const double pending = status_.pending[i];
     if (pending != 0.0) r += std::copysign(std::min(full, std::abs(pending) / dt_s), pending);
     rate[i] = std::clamp(r, -full, full);
@@ -227,7 +247,7 @@ void HandControllers::FlyManualAugmented(const std::array<double, kNumHandAxes>&
     constexpr double kCatchUpS = 0.2;
     const Eigen::Vector3d e_v = *X_ref_ * por - s.X_RS2 * por - v_R * dt_s;
     const Eigen::Vector3d e_w = RotationVector(X_ref_->linear() * s.X_RS2.linear().transpose()) - w_R * dt_s;
-    if (e_v.norm() > 0.5 || e_w.norm() > 5.0 * kDeg) {
+    if (e_v.norm() > 1.5 || e_w.norm() > 10.0 * kDeg) {
       X_ref_ = s.X_RS2;  // the arm cannot follow (a limit, a singular pose): start again from where it is
     } else {
       v_fly += e_v / kCatchUpS;
@@ -320,15 +340,17 @@ void HandControllers::DirectInputs(const DeviceCommands& cmd, double dt_s) {
   }
   for (int i = kFinger; i < kNumAnalogInputs; ++i) {
     const double lim = b_.max_rate[i] * dt_s;
-    double t = target_.value[i] + std::clamp(cmd.input_rate[i], -1.0, 1.0) * lim;
-    // Clamping to the calibrated range, reported once per excursion.
+    if (cmd.input_rate[i] == 0.0) input_suppressed_[i] = false;
+    const double rate = input_suppressed_[i] ? 0.0 : std::clamp(cmd.input_rate[i], -1.0, 1.0);
+    double t = target_.value[i] + rate * lim;
+    // Clamping to the calibrated range, counted and reported once per
+    // excursion (a lever held against its stop is one excursion).
     const double c = std::clamp(t, cal[i].min, cal[i].max);
-    if (c != t) {
+    if (c != t && !clamping_[i]) {
       counters_.Add("clamped." + std::string(kAnalogInputNames[i]));
-      if (!clamping_[i]) {
-        spdlog::warn("{} command {:.3f} beyond its range [{}, {}] {}: clamped", kAnalogInputNames[i], t, cal[i].min,
-                     cal[i].max, cal[i].unit);
-      }
+      const std::string unit = cal[i].unit == "1" ? std::string() : " " + cal[i].unit;
+      spdlog::warn("{} command held against the end of its range [{}, {}]{}: clamped", kAnalogInputNames[i],
+                   cal[i].min, cal[i].max, unit);
     }
     clamping_[i] = c != t;
     target_.value[i] = c;
@@ -338,7 +360,9 @@ void HandControllers::DirectInputs(const DeviceCommands& cmd, double dt_s) {
 
 OperatorInputs HandControllers::Apply(const DeviceCommands& cmd, double dt_s, const dcp_telemetry_t* tm) {
   out_.reset = false;
-  freeze_requested_ = step_requested_ = false;
+  freeze_requested_ = false;
+  step_requests_ = 0;
+  frozen_noted_ = false;
   key_actions_ += cmd.key_actions;
   if (tm) {
     if (tm->mode == 1 && dcp_mode_ != 1 && status_.frame == CommandFrame::kPayload) {
@@ -349,18 +373,25 @@ OperatorInputs HandControllers::Apply(const DeviceCommands& cmd, double dt_s, co
     if (tm->mode >= 2) X_S2P_ = TelemetryPose(tm->p_RoA_R_ft, tm->R_RS2).inverse() * TelemetryPose(tm->p_RoPo_R_ft, tm->R_RP);
     else X_S2P_.reset();
     // The DCP holds the arm (the command collides): carry on from the pose
-    // the slave holds, so the next command away from the contact relieves it.
-    if (tm->held && tm->slave_collisions == 0) {
-      for (int i = 0; i < 6; ++i) target_.value[i] = tm->slave_angles_deg[i];
-      X_ref_.reset();
-    }
+    // the slave holds, so the next command away from the contact relieves
+    // it. Docked, the port holds the payload and the arm until the finger
+    // opens: nothing the hand controllers do moves it meanwhile.
+    status_.held_at_port = tm->docked && !tm->released;
+    if ((tm->held && tm->slave_collisions == 0) || status_.held_at_port) FollowHeldArm(*tm);
   }
   HandleEvents(cmd, tm);
-  for (const struct Press& p : cmd.hand_presses) AddPress(p);
-  const auto rate = CommandedRates(cmd, dt_s);
-  status_.rate = rate;
-  if (status_.mode == ControlMode::kManualAugmented) FlyManualAugmented(rate, dt_s);
-  else FlySingleJoint(rate[kThcX], dt_s);
+  if (status_.held_at_port) {
+    // Held at the port: the arm's motions are not flown (nor kept for
+    // later); the finger and the other inputs are.
+    status_.pending = {};
+    status_.rate = {};
+  } else {
+    for (const struct Press& p : cmd.hand_presses) AddPress(p);
+    const auto rate = CommandedRates(cmd, dt_s);
+    status_.rate = rate;
+    if (status_.mode == ControlMode::kManualAugmented) FlyManualAugmented(rate, dt_s);
+    else FlySingleJoint(rate[kThcX], dt_s);
+  }
   DirectInputs(cmd, dt_s);
   for (int i = 0; i < 6; ++i) out_.value[i] = target_.value[i];
   out_.camera_station = target_.camera_station;

@@ -49,6 +49,7 @@ struct HandStatus {
   std::uint32_t at_limit = 0;                 // joints held at a limit
   bool singular = false;
   bool rate_limited = false;                  // slower than commanded: a joint at its rate
+  bool held_at_port = false;                  // docked: the CAE holds the payload and the arm until the finger opens
   double sigma_min_ft = 0.0;
 };
 
@@ -67,9 +68,10 @@ class HandControllers {
   bool quit() const { return quit_; }
   // Freeze / step asked for this frame (the station sends them on RMS_CONTROL).
   bool freeze_requested() const { return freeze_requested_; }
-  bool step_requested() const { return step_requested_; }
-  // Only the session's keys (freeze, step, quit) while frozen: everything
-  // else is read and dropped, counted ("frozen.inputs_ignored").
+  // Step presses this frame (each is one frame while frozen).
+  int step_requests() const { return step_requests_; }
+  // While frozen only freeze, step, stop and quit act: everything else is
+  // read and dropped, counted ("frozen.inputs_ignored") and said once.
   void PollFrozen();
   // Carry on from these inputs (a restored checkpoint, a restart): the
   // command, targets and outputs; every motion in progress stops.
@@ -94,6 +96,11 @@ class HandControllers {
   void ReportLimits(std::uint32_t at_limit);
   void DirectInputs(const DeviceCommands& cmd, double dt_s);
   void StopMotion();
+  // Stop, and let go of every axis and input `cmd` holds until it is released.
+  void StopAndRelease(const DeviceCommands& cmd);
+  // The DCP holds the arm (a collision, or docked at the port): carry on
+  // from the pose it holds.
+  void FollowHeldArm(const dcp_telemetry_t& tm);
   void Announce(const char* what);
   double Increment(int axis) const;
   double FullRate(int axis) const;
@@ -119,7 +126,13 @@ class HandControllers {
   Counters counters_;
   long key_actions_ = 0;
   bool quit_ = false;
-  bool freeze_requested_ = false, step_requested_ = false;
+  bool freeze_requested_ = false;
+  int step_requests_ = 0;
+  // Stop lets go of what is held: a held key, a stick, a button acts again
+  // only once it has been let go (a key up, the stick back to centre).
+  std::array<bool, kNumHandAxes> hand_suppressed_{};
+  std::array<bool, kNumAnalogInputs> input_suppressed_{};
+  bool frozen_noted_ = false;
   bool show_guidance_ = true;
 };
 

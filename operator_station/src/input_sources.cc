@@ -101,14 +101,14 @@ HandSource::HandSource(const LabConfig& config, const HandOptions& o)
 std::optional<OperatorInputs> HandSource::Next(const Frame& f) {
   if (window_) window_->SetNow(f.now_us);
   const OperatorInputs in = hands_->Step(f.dt_s, f.telemetry);
-  requests_ = {hands_->quit(), hands_->freeze_requested(), hands_->step_requested()};
+  requests_ = {hands_->quit(), hands_->freeze_requested(), hands_->step_requests()};
   if (hands_->quit()) return std::nullopt;
   return in;
 }
 
 void HandSource::WhileFrozen() {
   hands_->PollFrozen();
-  requests_ = {hands_->quit(), hands_->freeze_requested(), hands_->step_requested()};
+  requests_ = {hands_->quit(), hands_->freeze_requested(), hands_->step_requests()};
 }
 
 std::map<std::string, std::string> HandSource::key_hints() const {

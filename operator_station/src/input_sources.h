@@ -35,7 +35,7 @@ struct Frame {
 struct Requests {
   bool quit = false;    // stop the station (a person's quit key)
   bool freeze = false;  // freeze the session, or run it again
-  bool step = false;    // one frame while frozen
+  int steps = 0;        // frames to step while frozen
 };
 
 class InputSource {

@@ -78,6 +78,16 @@ std::unique_ptr<InputSource> MakeSource(const OperatorOptions& o, const LabConfi
   return std::make_unique<AutopilotSource>(config, ao, o.hold, false);
 }
 
+void CheckSourceFiles(const OperatorOptions& o, const LabConfig& config) {
+  const int sources = !o.timeline_path.empty() + o.keyboard + o.manual + o.autopilot;
+  if (sources > 1) throw InputError("give one input source: --timeline FILE, --keyboard, --manual or --autopilot");
+  if (!o.timeline_path.empty()) (void)Timeline::Load(o.timeline_path, config.inputs);
+  if (o.keyboard || o.manual || !o.bindings_path.empty()) {
+    (void)LoadBindings(o.bindings_path.empty() ? DefaultBindingsPath() : o.bindings_path);
+  }
+  if (!o.restore_path.empty()) (void)ReadCheckpoint(o.restore_path);
+}
+
 void OperatorStation::RateMeter::Tick(std::int64_t now_us) {
   if (t0_us == 0) {  // the first event opens the window
     t0_us = now_us;
@@ -274,6 +284,8 @@ void OperatorStation::PublishState(std::int64_t frame, const OperatorInputs& in)
       m.conditions[i] = t.acquisition_conditions[i];
       m.margin_ft[i] = t.acquisition_margin_ft[i];
     }
+    m.close_gap_ft = g->close_gap_ft;
+    m.close_ok = g->close_gap_ft > 0 && g->close_gap_ft < config_.dcp.d3y_ft;
     m.bay_clearance_ft = t.bay_clearance_ft;
     m.dock_distance_ft = t.dock_distance_ft;
     m.dock_angle_deg = t.dock_angle_deg;
@@ -317,7 +329,7 @@ bool OperatorStation::RunFrozen() {
   const Requests r = source_->requests();
   if (r.quit) return false;
   if (r.freeze) SendControl(session_control_t::RUN);
-  if (r.step) SendControl(session_control_t::STEP);
+  for (int i = 0; i < r.steps; ++i) SendControl(session_control_t::STEP);
   DrawScreen(builder_.next_frame() - 1, last_, true);
   return true;
 }

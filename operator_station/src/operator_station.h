@@ -64,6 +64,10 @@ inline constexpr int kExitInterrupted = 130;
 
 // The source the options ask for (exactly one); throws rms::InputError.
 std::unique_ptr<InputSource> MakeSource(const OperatorOptions& options, const LabConfig& config);
+// Checks the files the options name (the bindings, the timeline, the
+// checkpoint) without opening a device; throws rms::InputError naming what
+// is wrong (operator_station --check).
+void CheckSourceFiles(const OperatorOptions& options, const LabConfig& config);
 
 class OperatorStation {
  public:

@@ -64,21 +64,32 @@ std::string KeyHint(const StatusSnapshot& s, const std::string& action) {
   return it == s.keys.end() ? "" : " (" + it->second + ")";
 }
 
-void GuidanceLines(const StatusSnapshot& s, Flow& flow) {
-  const Guidance& g = *s.guidance;
-  flow.Line(Sprintf("GUIDANCE %s, %s axes:",
-                    g.target == GuidanceTarget::kGrasp ? "to the grasp on the bar receptacle, from the grasp point"
-                                                       : "to the CAE's docking port, from the probe's tip",
-                    std::string(CommandFrameName(g.frame)).c_str()));
-  // Each offset unsigned, with the direction that closes it and its key.
+// "x forward 3.25 ft (w)   y left 0.50 ft (a)   z down 1.00 ft (f)": each
+// offset unsigned, with the direction that closes it and its key.
+void OffsetFields(const StatusSnapshot& s, const Eigen::Vector3d& d_ft, Flow& flow) {
   static const char* kAxis[3] = {"x", "y", "z"};
   static const char* kWord[3][2] = {{"forward", "back"}, {"right", "left"}, {"down", "up"}};
   flow.Line(" ");
   for (int i = 0; i < 3; ++i) {
-    const double d = g.offset_ft[i];
+    const double d = d_ft[i];
     const std::string action = std::string(kHandAxisNames[i]) + (d >= 0 ? "+" : "-");
     flow.Field(Sprintf("%s %s %.2f ft", kAxis[i], kWord[i][d >= 0 ? 0 : 1], std::abs(d)) + KeyHint(s, action));
   }
+}
+
+void GuidanceLines(const StatusSnapshot& s, Flow& flow) {
+  const Guidance& g = *s.guidance;
+  const std::string axes = std::string(CommandFrameName(g.frame)) + " axes";
+  if (g.leave_bay) {
+    const bool out = g.leave_bay_ft.norm() < 1e-9;
+    flow.Line(out ? "GUIDANCE out of the cargo bay: clear" : "GUIDANCE out of the cargo bay first, straight up, " + axes + ":");
+    if (!out) OffsetFields(s, g.leave_bay_ft, flow);
+  }
+  flow.Line(std::string(g.leave_bay ? "then " : "GUIDANCE ") +
+            (g.target == GuidanceTarget::kGrasp ? "to the grasp on the bar receptacle, from the grasp point"
+                                                : "to the CAE's docking port, from the probe's tip") +
+            ", " + axes + ":");
+  OffsetFields(s, g.offset_ft, flow);
   flow.Field(Sprintf("distance %.2f ft", g.distance_ft));
   static const char* kRot[3] = {"roll", "pitch", "yaw"};
   static const char* kRotWord[3][2] = {{"right", "left"}, {"up", "down"}, {"right", "left"}};
@@ -118,27 +129,41 @@ void ControlLines(const StatusSnapshot& s, Flow& flow) {
     }
     flow.Field("AT JOINT LIMIT: " + j);
   }
-  if (h.singular) flow.Field(Sprintf("NEAR A SINGULAR POSE (%.1f ft/rad): damped", h.sigma_min_ft));
+  if (h.singular) flow.Field("NEAR A SINGULAR POSE (the arm straight, or the wrist yaw near 90 deg): some motions slowed");
   if (h.rate_limited) flow.Field("slowed: a joint at its rate");
+  if (h.held_at_port) {
+    flow.Field("DOCKED: the port holds the payload and the arm; open the finger" + KeyHint(s, "finger-") + " to let go");
+  }
 }
 
-void DcpLines(const StatusSnapshot& s, const LabConfig& config, Flow& flow) {
+void ModeLines(const StatusSnapshot& s, Flow& flow) {
   const dcp_telemetry_t& t = *s.telemetry;
   flow.Line(Sprintf("MODE %s", ModeName(t.mode)))
       .Field(Sprintf("acquired %s", t.acquired ? "YES" : "no"))
       .Field(Sprintf("docked %s", t.docked ? "YES" : "no"))
       .Field(std::string("arm ") + (t.held ? "HELD: the command collides" : t.finger_held ? "follows, finger held on the bar" : "follows"));
+}
+
+void CollisionLines(const StatusSnapshot& s, Flow& flow) {
+  const dcp_telemetry_t& t = *s.telemetry;
   std::string coll;
   for (int b = 0; b < collision_bits::kCount; ++b) {
     if (t.collisions & (1 << b)) coll += std::string(coll.empty() ? "" : ", ") + CollisionName(b);
   }
   flow.Line("collisions: " + (coll.empty() ? std::string("none") : coll));
+}
+
+void ConditionLines(const StatusSnapshot& s, const LabConfig& config, int width, Flow& flow) {
+  const dcp_telemetry_t& t = *s.telemetry;
   if (t.mode == 1) {
     flow.Line("ACQUISITION (each condition's margin):");
+    // Two a line, named in full on a wide screen; three, by tag, on a narrow one.
+    const bool wide = width >= 110;
     for (int i = 0; i < kNumAcquisitionConditions; ++i) {
-      if (i % 2 == 0) flow.Line(" ");
-      flow.Field(Sprintf("[%c] %d %-24s %-20s", t.acquisition_conditions[i] ? 'x' : ' ', i + 1,
-                         kAcquisitionConditionNames[i].brief, Margin(t.acquisition_margin_ft[i]).c_str()));
+      if (i % (wide ? 2 : 3) == 0) flow.Line(" ");
+      flow.Field(Sprintf(wide ? "[%c] %d %-24s %-20s" : "[%c] %d %s: %s", t.acquisition_conditions[i] ? 'x' : ' ', i + 1,
+                         wide ? kAcquisitionConditionNames[i].brief : kAcquisitionConditionNames[i].tag,
+                         Margin(t.acquisition_margin_ft[i]).c_str()));
     }
     flow.Line(Sprintf("  finger gap %.3f ft (D3Y %.3f)", t.finger_gap_ft, config.dcp.d3y_ft))
         .Field(Sprintf("palm to BAR %.3f ft (TPOB %.3f)", std::abs(t.palm_to_bar_ft), config.dcp.tpob_ft));
@@ -161,7 +186,19 @@ void DcpLines(const StatusSnapshot& s, const LabConfig& config, Flow& flow) {
 }  // namespace
 
 std::string RenderStatusScreen(const StatusSnapshot& s, const LabConfig& config, int width, int height) {
-  width = std::max(width, 40);
+  if (width < kMinWidth || height < kMinHeight) {
+    // Too small for the screen: say so, in what room there is.
+    std::vector<std::string> L = {"rmslab operator station",
+                                  Sprintf("terminal %dx%d: needs %dx%d", width, height, kMinWidth, kMinHeight)};
+    if (s.telemetry) L.push_back(Sprintf("MODE %d%s%s", s.telemetry->mode, s.telemetry->acquired ? " ACQ" : "",
+                                         s.telemetry->docked ? " DOCK" : ""));
+    if (s.guidance) L.push_back(Sprintf("to go %.2f ft %.1f deg", s.guidance->distance_ft, s.guidance->angle_deg));
+    std::string out;
+    for (int i = 0; i < std::min<int>(height, static_cast<int>(L.size())); ++i) {
+      out += L[i].substr(0, static_cast<std::size_t>(std::max(width, 1))) + "\n";
+    }
+    return out;
+  }
   // Sections in the order shown; when the terminal is short, the ones of
   // lowest priority go first, so the events pane keeps at least 3 lines.
   struct Section {
@@ -181,10 +218,16 @@ std::string RenderStatusScreen(const StatusSnapshot& s, const LabConfig& config,
                         right);
     sections.push_back(std::move(top));
   }
+  // Priority 0 always; then 1 (conditions, docking), 2 (camera), 3
+  // (rates), 4 (arm), 5 (devices), 6 (the keys' help) go first on a short terminal.
   {
     Flow flow = section(0);
-    if (s.telemetry) DcpLines(s, config, flow);
+    if (s.telemetry) ModeLines(s, flow);
     else flow.Line("MODE ?  (no telemetry from dynamics_proc since the start, the last reset or restore)");
+  }
+  if (s.telemetry) {
+    Flow flow = section(s.telemetry->collisions ? 0 : 1);
+    CollisionLines(s, flow);
   }
   if (s.hand) {
     Flow flow = section(0);
@@ -194,9 +237,13 @@ std::string RenderStatusScreen(const StatusSnapshot& s, const LabConfig& config,
     Flow flow = section(0);
     GuidanceLines(s, flow);
   }
+  if (s.telemetry) {
+    Flow flow = section(1);
+    ConditionLines(s, config, width, flow);
+  }
   const OperatorInputs& in = s.inputs;
   {
-    Flow flow = section(1);
+    Flow flow = section(2);
     const int st = in.camera_station;
     flow.Line(Sprintf("camera %d %s", st,
                       st >= 1 && st <= static_cast<int>(config.cameras.size()) ? config.cameras[st - 1].name.c_str() : "?"))
@@ -207,7 +254,7 @@ std::string RenderStatusScreen(const StatusSnapshot& s, const LabConfig& config,
     if (s.hand) flow.Field(std::string("window guidance ") + (s.show_guidance ? "on" : "off"));
   }
   {
-    Flow flow = section(3);
+    Flow flow = section(4);
     flow.Line(Sprintf("arm, deg: yaw %+7.2f", in.value[0]))
         .Field(Sprintf("pitch %+7.2f", in.value[1]))
         .Field(Sprintf("elbow %+7.2f", in.value[2]))
@@ -218,7 +265,7 @@ std::string RenderStatusScreen(const StatusSnapshot& s, const LabConfig& config,
         .Field(Sprintf("finger %.2f (0 open, 1 closed)", in.value[kFinger]));
   }
   {
-    Flow flow = section(2);
+    Flow flow = section(3);
     flow.Line(Sprintf("rates: published %.1f Hz", s.publish_hz))
         .Field(Sprintf("DCP %.1f Hz", s.telemetry_hz))
         .Field(s.render_hz >= 0 ? Sprintf("rendered %.1f Hz", s.render_hz) : "rendered ? (no status from esg_renderer)");
@@ -231,12 +278,12 @@ std::string RenderStatusScreen(const StatusSnapshot& s, const LabConfig& config,
     if (s.key_actions >= 0) flow.Field(Sprintf("keys pressed: %ld", s.key_actions));
   }
   {
-    Flow flow = section(4);
+    Flow flow = section(5);
     flow.Line(s.devices.empty() ? "devices: none" : "devices: " + s.devices[0] + ";");
     for (std::size_t i = 1; i < s.devices.size(); ++i) flow.Field(s.devices[i] + ";");
   }
   {
-    Flow flow = section(5);
+    Flow flow = section(6);
     if (!s.help.empty()) {
       flow.Line("");
       // Groups are two spaces apart ("w/s fwd/back  d/a right/left ...").
@@ -256,7 +303,7 @@ std::string RenderStatusScreen(const StatusSnapshot& s, const LabConfig& config,
     for (const Section& sec : sections) n += static_cast<int>(sec.lines.size());
     return n;
   };
-  for (int p = 5; p >= 1 && used() + kMinPane > height; --p) {
+  for (int p = 6; p >= 1 && used() + kMinPane > height; --p) {
     for (Section& sec : sections) {
       if (sec.priority == p) sec.lines.clear();
     }
@@ -265,7 +312,7 @@ std::string RenderStatusScreen(const StatusSnapshot& s, const LabConfig& config,
   std::vector<std::string> L;
   const Section* help = nullptr;
   for (const Section& sec : sections) {
-    if (sec.priority == 5) {
+    if (sec.priority == 6) {
       help = &sec;
       continue;
     }

@@ -46,6 +46,9 @@ struct StatusSnapshot {
   std::string help;                    // the key map, one line (wrapped to the width)
 };
 
+// The smallest terminal the screen fits; a smaller one is told so.
+inline constexpr int kMinWidth = 60, kMinHeight = 20;
+
 // The screen as text: lines of at most `width` characters, at most `height`
 // lines (the log pane takes what is left, at least 3 lines).
 std::string RenderStatusScreen(const StatusSnapshot& s, const LabConfig& config, int width = 100, int height = 48);

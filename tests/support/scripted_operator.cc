@@ -37,7 +37,10 @@ std::string Fmt(const char* f, double a, double b = 0, double c = 0) {
 // "1 2 3 . 5 6": the conditions that hold.
 std::string Conditions(const Screen& s) {
   std::string c;
-  for (int i = 0; i < 6; ++i) c += (i ? " " : "") + (s.condition[i] ? std::to_string(i + 1) : std::string("."));
+  for (int i = 0; i < 6; ++i) {
+    if (i > 0) c.push_back(' ');
+    c.push_back(s.condition[i] ? static_cast<char>('1' + i) : '.');
+  }
   return c;
 }
 
@@ -74,7 +77,7 @@ Screen ParseScreen(const std::string& text) {
     const double sign = w == "right" || w == "up" ? 1.0 : -1.0;
     s.offset[AxisIndex((*it)[1])] = sign * std::stod((*it)[3]);
   }
-  const std::regex cond(R"(\[([x ])\] ([1-6]) [A-Za-z ]+?(holds|short) by ([\d.]+) ft)");
+  const std::regex cond(R"(\[([x ])\] ([1-6]) [A-Za-z0-9 :]+?(holds|short) by ([\d.]+) ft)");
   for (auto it = std::sregex_iterator(text.begin(), text.end(), cond); it != std::sregex_iterator(); ++it) {
     const int i = std::stoi((*it)[2]) - 1;
     s.condition[i] = (*it)[1] == "x";

@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -10,6 +11,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -98,7 +101,32 @@ std::string MakeTempDir(const std::string& tag) {
 }
 
 std::string UniqueLcmUrl(int base) {
-  return "udpm://239.255.76.67:" + std::to_string(base + getpid() % 97) + "?ttl=0";
+  // A port no other running test holds: each is claimed by an exclusive
+  // lock on a file in the temp directory, held until this process ends
+  // (tests run in parallel under ctest -j; a port shared by two of them
+  // mixes their sessions). The same base gives the same port within a
+  // process.
+  static std::map<int, std::string> claimed;
+  static std::mutex mu;
+  std::lock_guard<std::mutex> lock(mu);
+  if (const auto it = claimed.find(base); it != claimed.end()) return it->second;
+  constexpr int kFirst = 17000, kCount = 8000;
+  const int start = static_cast<int>((static_cast<unsigned>(getpid()) * 131u + static_cast<unsigned>(base)) % kCount);
+  for (int i = 0; i < kCount; ++i) {
+    const int port = kFirst + (start + i) % kCount;
+    const std::string path = std::filesystem::temp_directory_path().string() + "/rmslab-test-port-" +
+                             std::to_string(port) + ".lock";
+    const int fd = open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+    if (fd < 0) continue;
+    if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+      close(fd);
+      continue;
+    }
+    // fd stays open (and the port claimed) until the process ends.
+    return claimed[base] = "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0";
+  }
+  throw std::runtime_error("no free test LCM port in " + std::to_string(kFirst) + ".." +
+                           std::to_string(kFirst + kCount - 1));
 }
 
 std::string BuildPath(const std::string& rel) { return std::string(RMSLAB_BUILD_DIR) + "/" + rel; }

@@ -294,6 +294,72 @@ TEST_F(Devices, TheLiveWindowsHeldKeysMoveAndReleasedOnesStopAtOnce) {
   EXPECT_EQ(hc.key_actions(), 2);
 }
 
+// The stop key (or a change of scale, frame, mode or joint) stops every
+// motion; what is still held down acts again only once let go. Docked and
+// not yet released, the arm moves with nothing; frozen, stop and step act.
+TEST_F(Devices, StopHoldsUntilReleasedDockedHoldsAndFrozenTakesStopAndSteps) {
+  HandControllers hc(config, bindings);
+  auto dev = std::make_unique<WindowKeyboardDevice>(bindings, 300000);
+  WindowKeyboardDevice* window = dev.get();
+  TypedKeys typed;
+  hc.AddDevice(std::move(dev));
+  hc.AddDevice(std::make_unique<KeyboardDevice>(bindings, typed.Source()));
+  const OperatorInputs in0 = MidPose();
+  hc.SetInputs(in0);
+  dcp_telemetry_t t = Telemetry(in0, 1);
+  std::int64_t now = 1000000, seq = 0;
+  auto frame = [&](std::vector<std::int32_t> held, std::vector<std::int32_t> down = {}) {
+    window->Receive({++seq, std::move(held), std::move(down), true}, now);
+    window->SetNow(now += 33333);
+    return hc.Step(kDt, &t);
+  };
+  frame({'w'}, {'w'});
+  OperatorInputs in = frame({'w'});
+  EXPECT_GT(hc.status().rate[kThcX], 0.0);
+  typed.keys = {' '};  // stop, from the terminal, while the window's key stays down
+  in = frame({'w'});
+  for (int f = 0; f < 10; ++f) {
+    const OperatorInputs next = frame({'w'});
+    for (int i = 0; i < 6; ++i) EXPECT_EQ(next.value[i], in.value[i]) << "a held key acts after the stop";
+  }
+  frame({});  // let go, press again: it moves
+  frame({'w'}, {'w'});
+  EXPECT_GT(hc.status().rate[kThcX], 0.0);
+  // A change of scale stops a terminal increment in flight.
+  frame({});
+  typed.keys = {'d'};
+  frame({});
+  EXPECT_NE(hc.status().pending[kThcY], 0.0);
+  typed.keys = {'v'};
+  frame({});
+  EXPECT_EQ(hc.status().pending[kThcY], 0.0);
+  EXPECT_EQ(hc.status().rate[kThcY], 0.0);
+  // Docked, the finger not yet open: the hand controllers follow the held arm.
+  OperatorInputs closed = in;
+  closed.value[kFinger] = 1.0;
+  hc.SetInputs(closed);
+  t.docked = true;
+  t.released = false;
+  for (int i = 0; i < 6; ++i) t.slave_angles_deg[i] = in0.value[i] + 1.0;
+  frame({'d'}, {'d'});
+  in = frame({'d'});
+  EXPECT_TRUE(hc.status().held_at_port);
+  for (int i = 0; i < 6; ++i) EXPECT_NEAR(in.value[i], in0.value[i] + 1.0, 1e-9) << "joint " << i;
+  typed.keys = {'x'};  // the finger still opens
+  in = frame({'d'});
+  in = frame({'d'});
+  EXPECT_LT(in.value[kFinger], 1.0 - 1e-3);
+  t.released = true;
+  frame({'d'});
+  EXPECT_FALSE(hc.status().held_at_port);
+  // Frozen: each step key is one step; stop acts; other keys are ignored and counted.
+  frame({});
+  typed.keys = {'.', '.', '.', 'w'};
+  hc.PollFrozen();
+  EXPECT_EQ(hc.step_requests(), 3);
+  EXPECT_EQ(hc.counters().Get("frozen.inputs_ignored"), 1);
+}
+
 TEST_F(Devices, SingleJointDrivesTheSelectedJointAtARateWithinItsLimit) {
   Bindings b = bindings;
   b.initial_mode = ControlMode::kSingleJoint;
@@ -349,7 +415,11 @@ TEST_F(Devices, OutOfRangeCommandsAreClampedAndReportedOnce) {
   close.input_rate[kFinger] = 1.0;
   for (int i = 0; i < 90; ++i) hc.Apply(close, kDt, nullptr);  // 3 s at 0.5/s on a 0..1 lever
   EXPECT_DOUBLE_EQ(hc.target().value[kFinger], config.inputs[kFinger].max);
-  EXPECT_GT(hc.counters().Get("clamped.finger"), 20);
+  // A lever held against its stop is one excursion, counted once; a second push, a second.
+  EXPECT_EQ(hc.counters().Get("clamped.finger"), 1);
+  hc.Apply({}, kDt, nullptr);
+  for (int i = 0; i < 5; ++i) hc.Apply(close, kDt, nullptr);
+  EXPECT_EQ(hc.counters().Get("clamped.finger"), 2);
   DeviceCommands down;
   down.input_rate[kShoulderHeight] = -1.0;
   for (int i = 0; i < 200; ++i) hc.Apply(down, 0.1, nullptr);
@@ -564,6 +634,16 @@ TEST_F(Devices, TheStatusScreenShowsGuidanceMarginsAndFollowsTheWidth) {
     EXPECT_NE(sc.find("GUIDANCE"), std::string::npos) << sc;
     EXPECT_NE(sc.find("event 49"), std::string::npos) << "the newest event is shown at " << w << "x" << h;
   }
+  // Narrow: the conditions by number and tag, still with their margins.
+  const std::string narrow = RenderStatusScreen(s, config, 80, 40);
+  EXPECT_NE(narrow.find("short by 1.500 ft"), std::string::npos) << narrow;
+  EXPECT_EQ(narrow.find("BAR beyond palm face d"), std::string::npos) << narrow;
+  // Too small for the screen: it says so, within the terminal, with what is left to go.
+  const std::string tiny = RenderStatusScreen(s, config, 40, 10);
+  EXPECT_NE(tiny.find("terminal 40x10: needs 60x20"), std::string::npos) << tiny;
+  EXPECT_NE(tiny.find("to go 3.44 ft"), std::string::npos) << tiny;
+  std::istringstream is(tiny);
+  for (std::string l; std::getline(is, l);) EXPECT_LE(static_cast<int>(l.size()), 40) << l;
 }
 
 }  // namespace

@@ -85,6 +85,10 @@ int main(int argc, char** argv) {
     std::cout << "frames: operator " << fr["operator_published"] << ", DCP " << fr["dcp_published"]
               << ", ESG " << fr["esg_published"] << ", rendered " << fr["rendered"] << ", PNG "
               << fr["png_written"] << "; dropped " << dropped << "\n";
+    if (fr.value("video_dropped", 0) > 0) {
+      std::cout << "video: " << fr["video_dropped"] << " frames dropped (the encoder fell behind; the video is "
+                << "short of the session by as much)\n";
+    }
     if (j["latency"].contains("input_to_render")) {
       const auto& l = j["latency"]["input_to_render"];
       std::cout << "operator input to rendered frame: median " << l["p50_ms"].get<double>()
