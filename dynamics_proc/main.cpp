@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 
 #include "dcp_node.h"
+#include "rms/checkpoint.h"
 #include "rms/process.h"
 
 int main(int argc, char** argv) {
@@ -16,9 +17,16 @@ int main(int argc, char** argv) {
   app.add_option("--state-file", state_file,
                  "Keep the DCP's state in this file and, when it exists at start, resume from it instead of "
                  "Mode 1 (the launcher's restart after a fault; docs/sessions.md \"Faults\")");
+  std::string checkpoint_dir;
+  app.add_option("--checkpoint-dir", checkpoint_dir,
+                 "The session's checkpoints folder: RMS_CONTROL's CHECKPOINT and RESTORE name files in it and "
+                 "nowhere else (none: they are refused; docs/security.md)");
   return rms::ProcessMain(app, argc, argv, "dynamics_proc", &common,
                           [&](const rms::LabConfig& config, rms::LcmInterface& lcm) {
-                            return rms::dcp::RunDynamicsProc(config, lcm, common.stats_path,
-                                                             common.ready_path, restore, state_file);
+                            return rms::dcp::RunDynamicsProc(config, lcm, common.stats_path, common.ready_path,
+                                                             restore, state_file, checkpoint_dir);
+                          },
+                          [&](const rms::LabConfig&) {
+                            if (!restore.empty()) (void)rms::ReadCheckpoint(restore);
                           });
 }

@@ -36,6 +36,9 @@ int main(int argc, char** argv) {
   app.add_option("--restore", opt.restore_path,
                  "Start from a checkpoint's operator inputs (with dynamics_proc --restore; docs/sessions.md)")
       ->check(CLI::ExistingFile);
+  app.add_option("--checkpoint-dir", opt.checkpoint_dir,
+                 "The session's checkpoints folder: RMS_CONTROL's RESTORE names a file in it and nowhere else "
+                 "(docs/security.md)");
   return rms::ProcessMain(app, argc, argv, "operator_station", &common,
                           [&](const rms::LabConfig& config, rms::LcmInterface& lcm) {
                             opt.gamepad = !no_gamepad;

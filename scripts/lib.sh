@@ -95,7 +95,7 @@ rmslab_start_supervised() {
 # subshell is replaced by the command, so $! is the command's pid.
 rmslab_exec_on() {
   local host="$1" n="$2"; shift 2
-  local envs=(env "RMSLAB_SESSION_EPOCH_US=$RMSLAB_EPOCH_US" "RMSLAB_RESTART=$n")
+  local envs=(env "RMSLAB_SESSION_EPOCH_US=$RMSLAB_EPOCH_US" "RMSLAB_RESTART=$n" "RMSLAB_SESSION_ID=${RMSLAB_SESSION_ID:-}")
   case "$host" in
     ""|localhost) exec "${envs[@]}" "$@" ;;
     netns:*) exec "${RMSLAB_SUDO[@]}" nsenter --net="/var/run/netns/${host#netns:}" -- "${envs[@]}" "$@" ;;

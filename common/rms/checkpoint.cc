@@ -1,5 +1,11 @@
 #include "rms/checkpoint.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 
@@ -9,9 +15,8 @@ namespace rms {
 
 namespace {
 constexpr const char* kFormat = "rmslab-checkpoint-1";
-}  // namespace
 
-void WriteCheckpoint(const std::string& path, const Checkpoint& c) {
+std::string CheckpointText(const Checkpoint& c) {
   nlohmann::ordered_json j;
   j["format"] = kFormat;
   j["saved_us"] = c.saved_us;
@@ -25,16 +30,103 @@ void WriteCheckpoint(const std::string& path, const Checkpoint& c) {
   in["crosshairs"] = c.inputs.crosshairs;
   j["operator_inputs"] = in;
   j["dcp"] = c.dcp;
+  return j.dump(2) + "\n";
+}
+
+// Reads an open file: a regular one of at most kMaxCheckpointBytes, or refused.
+std::string ReadOpenFile(int fd, const std::string& path) {
+  struct stat st {};
+  if (fstat(fd, &st) != 0) throw InputError("cannot read checkpoint '" + path + "': " + std::strerror(errno));
+  if (!S_ISREG(st.st_mode)) throw InputError("checkpoint '" + path + "' is not a regular file: refused");
+  if (st.st_size > kMaxCheckpointBytes) {
+    throw InputError("checkpoint '" + path + "' is " + std::to_string(st.st_size) + " bytes, more than any checkpoint (" +
+                     std::to_string(kMaxCheckpointBytes) + "): refused");
+  }
+  std::string text(static_cast<std::size_t>(st.st_size), '\0');
+  std::size_t got = 0;
+  while (got < text.size()) {
+    const ssize_t n = read(fd, text.data() + got, text.size() - got);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    got += static_cast<std::size_t>(n);
+  }
+  text.resize(got);
+  return text;
+}
+
+struct Fd {
+  int fd;
+  ~Fd() {
+    if (fd >= 0) close(fd);
+  }
+};
+}  // namespace
+
+void WriteCheckpoint(const std::string& path, const Checkpoint& c) {
   std::ofstream f(path);
-  if (f) f << j.dump(2) << "\n";
-  if (!f) throw InputError("cannot write checkpoint '" + path + "'");
+  if (f) f << CheckpointText(c);
+  f.close();
+  if (!f) throw InputError("cannot write checkpoint '" + path + "' (" + std::strerror(errno) + ")");
 }
 
 Checkpoint ReadCheckpoint(const std::string& path) {
-  std::ifstream f(path);
-  if (!f) throw InputError("cannot read checkpoint '" + path + "'");
-  const std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-  return ParseCheckpoint(text, path);
+  const Fd f{open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK)};
+  if (f.fd < 0) throw InputError("cannot read checkpoint '" + path + "': " + std::strerror(errno));
+  return ParseCheckpoint(ReadOpenFile(f.fd, path), path);
+}
+
+void CheckpointFolder::ValidateName(const std::string& name) {
+  bool ok = !name.empty() && name.size() <= 64 && name[0] != '.' && name.size() > 5 &&
+            name.compare(name.size() - 5, 5, ".json") == 0;
+  for (char ch : name) {
+    ok = ok && ((ch >= 'A' && ch <= 'Z') || (ch >= 'a' && ch <= 'z') || (ch >= '0' && ch <= '9') || ch == '_' ||
+                ch == '-' || ch == '.');
+  }
+  if (!ok) {
+    throw InputError("checkpoint name '" + name.substr(0, 80) +
+                     "' refused: a name (not a path) of 1 to 64 letters, digits, '_', '-' or '.', ending in .json, "
+                     "not starting with '.'");
+  }
+}
+
+int CheckpointFolder::OpenDir() const {
+  if (dir_.empty()) throw InputError("no checkpoints folder was given to this process (--checkpoint-dir): refused");
+  const int fd = open(dir_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) throw InputError("cannot open the checkpoints folder '" + dir_ + "': " + std::strerror(errno));
+  return fd;
+}
+
+void CheckpointFolder::Write(const std::string& name, const Checkpoint& c) const {
+  ValidateName(name);
+  const Fd dir{OpenDir()};
+  const Fd f{openat(dir.fd, name.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644)};
+  if (f.fd < 0) {
+    if (errno == EEXIST) throw InputError("checkpoint '" + name + "' exists already in " + dir_ + ": not replaced");
+    throw InputError("cannot write checkpoint '" + name + "' in " + dir_ + ": " + std::strerror(errno));
+  }
+  const std::string text = CheckpointText(c);
+  std::size_t put = 0;
+  while (put < text.size()) {
+    const ssize_t n = write(f.fd, text.data() + put, text.size() - put);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const std::string why = std::strerror(errno);
+      unlinkat(dir.fd, name.c_str(), 0);  // no half-written checkpoint left behind
+      throw InputError("cannot write checkpoint '" + name + "' in " + dir_ + ": " + why);
+    }
+    put += static_cast<std::size_t>(n);
+  }
+}
+
+Checkpoint CheckpointFolder::Read(const std::string& name) const {
+  ValidateName(name);
+  const Fd dir{OpenDir()};
+  const Fd f{openat(dir.fd, name.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC)};
+  if (f.fd < 0) {
+    if (errno == ELOOP) throw InputError("checkpoint '" + name + "' is a symbolic link: refused");
+    throw InputError("cannot read checkpoint '" + name + "' in " + dir_ + ": " + std::strerror(errno));
+  }
+  return ParseCheckpoint(ReadOpenFile(f.fd, PathOf(name)), PathOf(name));
 }
 
 Checkpoint ParseCheckpoint(std::string_view text, const std::string& path) {

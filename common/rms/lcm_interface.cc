@@ -1,11 +1,15 @@
 #include "rms/lcm_interface.h"
 
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
+#include <cstdlib>
 #include <lcm/lcm-cpp.hpp>
+#include <spdlog/spdlog.h>
 
 #include "rms/check.h"
+#include "rms/message_io.h"
 
 namespace rms {
 
@@ -30,11 +34,49 @@ LcmInterface::LcmInterface(std::string suffix) : suffix_(std::move(suffix)) {
   ValidateChannelSuffix(suffix_);
 }
 
+std::int64_t ParseSessionId(const std::string& text, const std::string& what) {
+  const bool hex = text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X');
+  const std::string digits = hex ? text.substr(2) : text;
+  bool ok = !digits.empty() && digits.size() <= (hex ? 16u : 19u);
+  for (char c : digits) ok = ok && (hex ? std::isxdigit(static_cast<unsigned char>(c)) : std::isdigit(static_cast<unsigned char>(c)));
+  if (!ok) throw InputError(what + "='" + text + "': not a session id (decimal, or 0x and up to 16 hex digits)");
+  return static_cast<std::int64_t>(std::strtoull(digits.c_str(), nullptr, hex ? 16 : 10));
+}
+
+std::int64_t SessionIdFromEnv() {
+  const char* v = std::getenv("RMSLAB_SESSION_ID");
+  if (!v || !*v) return 0;
+  return ParseSessionId(v, "RMSLAB_SESSION_ID");
+}
+
+bool LcmInterface::Admit(const std::string& channel, const void* data, int size) {
+  if (sender_.session_id == 0) return true;  // no session: takes every session's messages
+  std::int64_t fp = 0, id = 0;
+  // Only rmslab messages carry a sender; anything else goes on to be
+  // refused by the decoder (dropped.wrong_type), as before.
+  if (!ReadFingerprint(data, size, &fp) || !IsRmslabFingerprint(fp) || !ReadSessionId(data, size, &id)) return true;
+  if (id == sender_.session_id) return true;
+  ++other_session_dropped_;
+  if (other_sessions_[id]++ == 0) {
+    std::int8_t process = 0;
+    std::int32_t pid = 0;
+    ReadSenderProcess(data, size, &process, &pid);
+    spdlog::warn(
+        "{}: a message of another session (session {}, {} pid {}) -- dropped, as every one of it will be "
+        "(dropped.other_session). Two sessions share this address: give each its own --channel-suffix or "
+        "--lcm-url (docs/security.md)",
+        channel, FormatSessionId(id), ProcessCodeName(process), pid);
+  }
+  return false;
+}
+
 // ---------------------------------------------------------------- UdpLcm
 
 struct UdpLcm::Sub {
   Handler handler;
-  static void OnMessage(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/, Sub* self) {
+  UdpLcm* owner = nullptr;
+  static void OnMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel, Sub* self) {
+    if (!self->owner->Admit(channel, rbuf->data, static_cast<int>(rbuf->data_size))) return;
     self->handler(rbuf->data, static_cast<int>(rbuf->data_size), rbuf->recv_utime);
   }
 };
@@ -63,6 +105,7 @@ bool UdpLcm::Publish(std::string_view channel, const void* data, int size) {
 void UdpLcm::Subscribe(std::string_view channel, Handler handler) {
   auto sub = std::make_unique<Sub>();
   sub->handler = std::move(handler);
+  sub->owner = this;
   // LCM treats the channel as a regex; our names hold only [A-Za-z0-9_].
   lcm::Subscription* s = lcm_->subscribeFunction(FullChannel(channel), &Sub::OnMessage, sub.get());
   RMS_CHECK(s != nullptr);
@@ -124,6 +167,7 @@ void LogLcm::Subscribe(std::string_view channel, Handler handler) {
 }
 
 void LogLcm::Dispatch(const std::string& channel, const void* data, int size) {
+  if (!Admit(channel, data, size)) return;
   for (auto& [name, handler] : handlers_) {
     if (name == channel) handler(data, size, now_us_);
   }

@@ -5,6 +5,7 @@
 // replays / records an LCM log file deterministically, without a network.
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -30,6 +31,23 @@ struct LcmOptions {
 
 // Throws rms::InputError when the suffix has characters other than [A-Za-z0-9_].
 void ValidateChannelSuffix(std::string_view suffix);
+
+// Who this process is on the wire: stamped into every message it publishes
+// (the sender_t first field, lcmtypes/sender_t.lcm; docs/protocol.md
+// "Senders"). session_id 0: no session (a process started by hand).
+struct Sender {
+  std::int64_t session_id = 0;
+  std::int8_t process = 0;  // sender_t::PROCESS_*
+  std::int32_t pid = 0;
+};
+
+// A session id from text: decimal, or hexadecimal with 0x (as the manifest
+// writes it). Throws InputError naming `what` otherwise.
+std::int64_t ParseSessionId(const std::string& text, const std::string& what);
+
+// The session id the launcher gave this process in RMSLAB_SESSION_ID, or 0.
+// A malformed value is an InputError naming the variable.
+std::int64_t SessionIdFromEnv();
 
 // Raised when the transport cannot be opened; the message says how to fix it.
 class TransportError : public std::runtime_error {
@@ -62,11 +80,26 @@ class LcmInterface {
     return std::string(channel) + suffix_;
   }
 
+  // This process on the wire (PublishMessage stamps it into every message).
+  // With a session id other than 0, every rmslab message of another session
+  // (or of none) is dropped before it reaches a handler, and counted; the
+  // first from each other session is logged with what sent it.
+  void SetSender(const Sender& sender) { sender_ = sender; }
+  const Sender& sender() const { return sender_; }
+  // Messages of other sessions dropped so far ("dropped.other_session").
+  std::int64_t other_session_dropped() const { return other_session_dropped_; }
+
  protected:
   explicit LcmInterface(std::string suffix);
+  // The session filter every transport applies before dispatching: true
+  // to hand the message on.
+  bool Admit(const std::string& channel, const void* data, int size);
 
  private:
   std::string suffix_;
+  Sender sender_;
+  std::int64_t other_session_dropped_ = 0;
+  std::map<std::int64_t, std::int64_t> other_sessions_;  // id -> messages dropped
 };
 
 // Real LCM. Throws TransportError when LCM is not good() (no multicast route,

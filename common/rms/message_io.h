@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstring>
 #include <exception>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -36,6 +37,23 @@ inline bool ReadFingerprint(const void* data, int size, std::int64_t* out) {
   return true;
 }
 
+// sender_t on the wire: right after the fingerprint (every rmslab message
+// has it first), session_id (8 bytes), process (1), pid (4), big-endian.
+inline constexpr int kSenderBytes = 13;
+
+// True for the fingerprint of one of rmslab's own message types.
+bool IsRmslabFingerprint(std::int64_t fingerprint);
+// The sender's session id / process and pid of a raw rmslab message; false
+// when it is too short to hold them.
+bool ReadSessionId(const void* data, int size, std::int64_t* session_id);
+bool ReadSenderProcess(const void* data, int size, std::int8_t* process, std::int32_t* pid);
+// "0x" and 16 hex digits, as the manifest and the logs write a session id.
+std::string FormatSessionId(std::int64_t session_id);
+// "dynamics_proc", ... for sender_t::PROCESS_*; "unknown" otherwise.
+const char* ProcessCodeName(std::int8_t process);
+// sender_t::PROCESS_* for a process name ("operator_station", ...); PROCESS_TOOL otherwise.
+std::int8_t ProcessCode(std::string_view name);
+
 template <class Msg>
 DecodeError SafeDecode(const void* data, int size, int max_size, Msg* msg) {
   if (size > max_size) return DecodeError::kTooLarge;
@@ -61,9 +79,14 @@ std::vector<std::uint8_t> EncodeMessage(const Msg& msg) {
   return buf;
 }
 
+// Publishes msg with this process's sender stamped in (LcmInterface::sender).
 template <class Msg>
 bool PublishMessage(LcmInterface& lcm, std::string_view channel, const Msg& msg) {
-  const std::vector<std::uint8_t> buf = EncodeMessage(msg);
+  Msg stamped = msg;
+  stamped.sender.session_id = lcm.sender().session_id;
+  stamped.sender.process = lcm.sender().process;
+  stamped.sender.pid = lcm.sender().pid;
+  const std::vector<std::uint8_t> buf = EncodeMessage(stamped);
   if (buf.empty()) return false;
   return lcm.Publish(channel, buf.data(), static_cast<int>(buf.size()));
 }

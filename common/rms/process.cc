@@ -37,6 +37,9 @@ void AddCommonOptions(CLI::App& app, CommonOptions* o) {
   app.add_option("--log-level", o->log_level, "trace, debug, info, warn, error")
       ->capture_default_str()
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
+  app.add_option("--session-id", o->session_id,
+                 "The session this process belongs to (default: $RMSLAB_SESSION_ID; none: takes every session's "
+                 "messages); messages of other sessions are dropped and counted (docs/security.md)");
   app.add_flag("--check", o->check,
                "Check the configuration (and this process's own files), say what is wrong, and exit (0: good)");
   app.set_version_flag("--version", VersionString(), "Print the software version and exit");
@@ -67,7 +70,11 @@ int ProcessMain(CLI::App& app, int argc, char** argv, const std::string& process
   }
   try {
     const LabConfig config = LoadConfig(common->config_path);
+    const std::int64_t session =
+        common->session_id.empty() ? SessionIdFromEnv() : ParseSessionId(common->session_id, "--session-id");
     UdpLcm lcm(common->lcm);
+    lcm.SetSender({session, ProcessCode(process), static_cast<std::int32_t>(getpid())});
+    if (session != 0) spdlog::info("session {}", FormatSessionId(session));
     return body(config, lcm);
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
@@ -140,6 +147,10 @@ void StatusReporter::Publish(std::int64_t frame, const Counters& counters, bool 
   PublishMessage(*lcm_, channels::kStatus, m);
 }
 
+void NoteTransportCounters(const LcmInterface& lcm, Counters* counters) {
+  if (const std::int64_t n = lcm.other_session_dropped(); n > 0) counters->Set("dropped.other_session", n);
+}
+
 void AddLatencyCounters(const LatencyMap& latencies, Counters* counters) {
   for (const auto& [name, h] : latencies) {
     const std::string p = "latency." + name + ".";
@@ -162,8 +173,10 @@ void RunNodeLoop(LcmInterface& lcm, const std::string& process, Counters& counte
   while (!StopRequested()) {
     if (lcm.HandleSubscriptions(wait_ms) < 0) counters.Add("transport_errors");
     if (after_wait) after_wait();
+    NoteTransportCounters(lcm, &counters);
     status.Tick(last_frame(), report());
   }
+  NoteTransportCounters(lcm, &counters);
   status.Final(last_frame(), report());
   if (!stats_path.empty()) WriteStatsJson(stats_path, process, counters, latencies);
 }
@@ -185,6 +198,20 @@ void WriteStatsJson(const std::string& path, const std::string& process, const C
   std::ofstream f(path);
   if (!f) throw InputError("cannot write stats file '" + path + "'");
   f << j.dump(2) << "\n";
+}
+
+FrameClock SessionFrameClock(double rate_hz) {
+  FrameClock c;
+  const char* v = std::getenv("RMSLAB_SESSION_EPOCH_US");
+  if (!v || !*v) return c;
+  char* end = nullptr;
+  const long long epoch = std::strtoll(v, &end, 10);
+  if (*end != '\0' || epoch <= 0) {
+    throw InputError(std::string("RMSLAB_SESSION_EPOCH_US='") + v + "': not a time in us since 1970");
+  }
+  c.epoch_us = epoch;
+  c.max_rate_hz = rate_hz * kMaxSessionSpeed;
+  return c;
 }
 
 std::int64_t FirstFrameNumber(double rate_hz) {

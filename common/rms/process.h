@@ -26,6 +26,7 @@ struct CommonOptions {
   std::string ready_path;   // --ready-file FILE: created once subscribed and running
   std::string log_level = "info";  // --log-level
   bool check = false;       // --check: check the configuration (and the process's own files), then exit
+  std::string session_id;   // --session-id (default: RMSLAB_SESSION_ID, else 0: no session)
 };
 
 void AddCommonOptions(CLI::App& app, CommonOptions* options);
@@ -57,6 +58,15 @@ void SetUpLogging(const std::string& process, const std::string& level);
 // not as stale. A malformed value is an InputError naming the variable.
 std::int64_t FirstFrameNumber(double rate_hz);
 
+// The fastest a session's frames can go: the launcher's --speed is at most
+// this many times the configured rate (docs/sessions.md).
+inline constexpr double kMaxSessionSpeed = 100.0;
+
+// The session's clock for frame-number checks (SequenceTracker::SetClock):
+// RMSLAB_SESSION_EPOCH_US and rate_hz x kMaxSessionSpeed; inactive when the
+// launcher set no epoch.
+FrameClock SessionFrameClock(double rate_hz);
+
 void InstallStopHandlers();
 bool StopRequested();
 void RequestStop();
@@ -86,6 +96,10 @@ using LatencyMap = std::map<std::string, LatencyHistogram>;
 // Adds p50 / p99 / max / count of each histogram to the counters (as
 // "latency.NAME.p50_us" ...), for status reports.
 void AddLatencyCounters(const LatencyMap& latencies, Counters* counters);
+
+// The transport's own counts into the process's counters:
+// "dropped.other_session" (messages of another session, LcmInterface::Admit).
+void NoteTransportCounters(const LcmInterface& lcm, Counters* counters);
 
 // The main loop of a subscribing process: waits for messages (at most
 // wait_ms, dispatching them to its handlers), calls `after_wait` after each

@@ -17,8 +17,8 @@
 namespace rms::dcp {
 
 namespace {
-// operator_input_t has a fixed size: 8 (fingerprint) + 2 x 8 + 12 x 4.
-constexpr int kMaxInputSize = 8 + 16 + 4 * kInputWords;
+// operator_input_t has a fixed size: 8 (fingerprint) + the sender + 2 x 8 + 12 x 4.
+constexpr int kMaxInputSize = 8 + kSenderBytes + 16 + 4 * kInputWords;
 }  // namespace
 
 DcpNode::DcpNode(const LabConfig& config, LcmInterface* lcm)
@@ -29,7 +29,7 @@ DcpNode::DcpNode(const LabConfig& config, LcmInterface* lcm)
   lcm_->Subscribe(channels::kControl, [this](const void* d, int n, std::int64_t) { OnControl(d, n); });
 }
 
-void DcpNode::SaveCheckpoint(const std::string& path) const {
+Checkpoint DcpNode::MakeCheckpoint() const {
   Checkpoint c;
   c.dcp_frame = next_frame_ - 1;
   c.input_frame = last_input_frame_;
@@ -37,17 +37,20 @@ void DcpNode::SaveCheckpoint(const std::string& path) const {
   c.config = config_.source;
   c.inputs = last_inputs_;
   c.dcp = dcp_.SaveState();
-  WriteCheckpoint(path, c);
+  return c;
 }
 
-void DcpNode::RestoreCheckpoint(const std::string& path) {
-  const Checkpoint c = ReadCheckpoint(path);
+void DcpNode::SaveCheckpoint(const std::string& path) const { WriteCheckpoint(path, MakeCheckpoint()); }
+
+void DcpNode::RestoreCheckpoint(const std::string& path) { Restore(ReadCheckpoint(path), path); }
+
+void DcpNode::Restore(const Checkpoint& c, const std::string& what) {
   try {
     dcp_.RestoreState(c.dcp);
   } catch (const std::exception& e) {
-    throw InputError("checkpoint '" + path + "': " + e.what());
+    throw InputError("checkpoint '" + what + "': " + e.what());
   }
-  spdlog::info("restored the DCP's state from {} (saved at DCP frame {}): Mode {}{}{}", path, c.dcp_frame,
+  spdlog::info("restored the DCP's state from {} (saved at DCP frame {}): Mode {}{}{}", what, c.dcp_frame,
                dcp_.status().mode, dcp_.status().acquired ? ", acquired" : "", dcp_.status().docked ? ", docked" : "");
 }
 
@@ -92,47 +95,55 @@ void DcpNode::OnControl(const void* data, int size) {
     counters_.Add("dropped.control_malformed");
     return;
   }
+  if (m.command != session_control_t::CHECKPOINT && m.command != session_control_t::RESTORE) return;
+  // The name is the sender's (docs/security.md "The control channel"): it
+  // is looked up in the session's checkpoints folder only, a few times a
+  // second at most.
+  if (!checkpoint_rate_.Allow(lcm_->NowUs())) {
+    if (counters_.Get("control.rate_limited") == 0) {
+      spdlog::warn("checkpoint commands refused: more than {} a second (control.rate_limited)",
+                   CheckpointRateLimit::kPerSecond);
+    }
+    counters_.Add("control.rate_limited");
+    return;
+  }
   try {
     if (m.command == session_control_t::CHECKPOINT) {
-      // The path is the sender's (docs/security.md): only a .json file that
-      // is new or already a checkpoint is written, never any other file.
-      const std::filesystem::path path(m.path);
-      if (path.extension() != ".json") {
-        counters_.Add("control.refused");
-        throw InputError("checkpoint refused: '" + m.path + "' is not a .json file");
-      }
-      if (std::filesystem::exists(path)) {
-        try {
-          (void)ReadCheckpoint(m.path);
-        } catch (const InputError&) {
-          counters_.Add("control.refused");
-          throw InputError("checkpoint refused: '" + m.path + "' exists and is not a checkpoint");
-        }
-      }
-      SaveCheckpoint(m.path);
+      checkpoints_.Write(m.name, MakeCheckpoint());
       counters_.Add("control.checkpoints");
-      spdlog::info("checkpoint: DCP frame {} saved to {}", next_frame_ - 1, m.path);
-    } else if (m.command == session_control_t::RESTORE) {
-      RestoreCheckpoint(m.path);
+      spdlog::info("checkpoint: DCP frame {} saved as {}", next_frame_ - 1, checkpoints_.PathOf(m.name));
+    } else {
+      Restore(checkpoints_.Read(m.name), checkpoints_.PathOf(m.name));
       counters_.Add("control.restores");
     }
   } catch (const InputError& e) {
-    counters_.Add("control.errors");
+    counters_.Add("control.refused");
     spdlog::error("{}", e.what());
   }
 }
 
+void DcpNode::EnableLiveChecks(double frame_rate_hz) {
+  inputs_.SetClock(SessionFrameClock(frame_rate_hz));
+  late_ = LateFrameFilter(frame_rate_hz);
+}
+
 void DcpNode::OnInput(const void* data, int size, std::int64_t recv_time_us) {
+  // Live, the age is taken as the input is handled (a stopped process's
+  // queue is handled on waking, long after it arrived); from a log, the
+  // log's time.
+  const std::int64_t now_us = late_.enabled() ? lcm_->NowUs() : recv_time_us;
   auto got = ReceiveFrame<operator_input_t>(
-      data, size, kMaxInputSize, &inputs_, &counters_, [this](const operator_input_t& m) {
+      data, size, kMaxInputSize, &inputs_, &counters_,
+      [this](const operator_input_t& m) {
         std::array<std::int32_t, kInputWords> words{};
         std::copy(m.words, m.words + kInputWords, words.begin());
         return DecodeInputs(words, config_.inputs, &counters_);
-      });
+      },
+      now_us, &late_);
   if (!got) return;
   const auto& [msg, in] = *got;
   counters_.Set("input.missing", inputs_.missing());
-  RecordEndToEnd(recv_time_us - msg.send_time_us, config_.session.frame_rate_hz, &latencies_["input_to_dcp"],
+  RecordEndToEnd(now_us - msg.send_time_us, config_.session.frame_rate_hz, &latencies_["input_to_dcp"],
                  &counters_);
 
   if (resume_) {
@@ -239,9 +250,11 @@ dcp_telemetry_t MakeTelemetry(const DcpStatus& st, const DcpFrameData& out) {
 
 int RunDynamicsProc(const LabConfig& config, LcmInterface& lcm, const std::string& stats_path,
                     const std::string& ready_path, const std::string& restore_path,
-                    const std::string& state_file) {
+                    const std::string& state_file, const std::string& checkpoint_dir) {
   DcpNode node(config, &lcm);
   node.set_next_frame(FirstFrameNumber(config.session.frame_rate_hz));
+  node.EnableLiveChecks(config.session.frame_rate_hz);
+  node.set_checkpoint_folder(CheckpointFolder(checkpoint_dir));
   node.set_state_file(state_file);
   const bool resumed = node.ResumeFromStateFile();
   if (!restore_path.empty() && !resumed) node.RestoreCheckpoint(restore_path);

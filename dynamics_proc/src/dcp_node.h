@@ -6,7 +6,9 @@
 #include <string>
 
 #include "dynamic_collision_program.h"
+#include "rms/checkpoint.h"
 #include "rms/counters.h"
+#include "rms/frame_receiver.h"
 #include "rms/lcm_interface.h"
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/process.h"
@@ -29,10 +31,17 @@ class DcpNode {
   // Checkpoints (docs/sessions.md "Freeze, run, step, checkpoint"): the
   // DCP's state and the last operator inputs, to a file and back. Throw
   // rms::InputError naming the file and what is wrong.
+  Checkpoint MakeCheckpoint() const;
   void SaveCheckpoint(const std::string& path) const;
   void RestoreCheckpoint(const std::string& path);
-  // An RMS_CONTROL message: CHECKPOINT and RESTORE act (between frames);
-  // a bad one is counted and logged, never fatal.
+  void Restore(const Checkpoint& c, const std::string& what);
+  // RMS_CONTROL's checkpoints live in this folder, by name only
+  // (CheckpointFolder; docs/security.md "The control channel").
+  void set_checkpoint_folder(CheckpointFolder folder) { checkpoints_ = std::move(folder); }
+  const CheckpointFolder& checkpoint_folder() const { return checkpoints_; }
+  // An RMS_CONTROL message: CHECKPOINT and RESTORE act (between frames),
+  // at most CheckpointRateLimit's rate; a bad or refused one is counted and
+  // logged, never fatal.
   void OnControl(const void* data, int size);
 
   // Process faults (docs/sessions.md "Faults"): with a state file, the node
@@ -47,6 +56,11 @@ class DcpNode {
   void WriteStateFile();
   // The first DCP frame number to publish (FirstFrameNumber).
   void set_next_frame(std::int64_t f) { next_frame_ = f; }
+  // A live session's receive checks (docs/protocol.md "Frame numbers",
+  // "Late frames"): input frame numbers beyond the session clock refused,
+  // inputs that waited too long dropped. Off in re-simulation, which must
+  // answer exactly the inputs the recorded DCP answered.
+  void EnableLiveChecks(double frame_rate_hz);
 
  private:
   void Report(const DcpStatus& status, std::int64_t frame);
@@ -56,12 +70,15 @@ class DcpNode {
   Counters counters_;
   LatencyMap latencies_;
   SequenceTracker inputs_;
+  LateFrameFilter late_;
   std::int64_t next_frame_ = 0;
   std::int64_t last_input_frame_ = -1;
   OperatorInputs last_inputs_{};
   int last_mode_ = 0;
   std::uint32_t last_collisions_ = 0;
   std::string state_file_;
+  CheckpointFolder checkpoints_;
+  CheckpointRateLimit checkpoint_rate_;
   std::optional<std::pair<std::int64_t, std::int64_t>> resume_;  // (DCP frame, input frame) of the state resumed
   std::int64_t state_written_us_ = 0;
   std::uint32_t state_key_ = 0;  // mode, acquired, docked, released: a change writes at once
@@ -74,7 +91,7 @@ dcp_telemetry_t MakeTelemetry(const DcpStatus& status, const DcpFrameData& frame
 // restore_path: a checkpoint to start from ("" for the initial state).
 int RunDynamicsProc(const LabConfig& config, LcmInterface& lcm, const std::string& stats_path,
                     const std::string& ready_path, const std::string& restore_path,
-                    const std::string& state_file = "");
+                    const std::string& state_file = "", const std::string& checkpoint_dir = "");
 
 
 }  // namespace rms::dcp

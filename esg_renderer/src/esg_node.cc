@@ -19,7 +19,7 @@ namespace rms::esg {
 
 namespace {
 // esg_frame_t: 8 (fingerprint) + 5 x 8 + 2 + 64 x 4 at most.
-constexpr int kMaxEsgSize = 8 + 40 + 2 + 4 * kEsgMaxWords;
+constexpr int kMaxEsgSize = 8 + kSenderBytes + 40 + 2 + 4 * kEsgMaxWords;
 
 std::int64_t MonotonicUs() {
   return std::chrono::duration_cast<std::chrono::microseconds>(
@@ -82,17 +82,26 @@ void EsgNode::PollWindow() {
   keys_held_ = !k.held.empty();
 }
 
+void EsgNode::EnableLiveChecks(double frame_rate_hz) {
+  frames_.SetClock(SessionFrameClock(frame_rate_hz));
+  late_ = LateFrameFilter(frame_rate_hz);
+}
+
 void EsgNode::OnFrame(const void* data, int size, std::int64_t recv_time_us) {
-  auto got = ReceiveFrame<esg_frame_t>(data, size, kMaxEsgSize, &frames_, &counters_, [](const esg_frame_t& m) {
-    if (m.num_words < 1 || m.num_words > kEsgMaxWords) {
-      throw MalformedError("word_count", "ESG frame with " + std::to_string(m.num_words) + " words");
-    }
-    return UnpackEsgWords(m.words);
-  });
+  const std::int64_t now_us = late_.enabled() ? lcm_->NowUs() : recv_time_us;
+  auto got = ReceiveFrame<esg_frame_t>(
+      data, size, kMaxEsgSize, &frames_, &counters_,
+      [](const esg_frame_t& m) {
+        if (m.num_words < 1 || m.num_words > kEsgMaxWords) {
+          throw MalformedError("word_count", "ESG frame with " + std::to_string(m.num_words) + " words");
+        }
+        return UnpackEsgWords(m.words);
+      },
+      now_us, &late_);
   if (!got) return;
   auto& [msg, data_words] = *got;
   counters_.Set("esg.missing", frames_.missing());
-  latencies_["scene_to_esg"].Add(recv_time_us - msg.send_time_us);
+  latencies_["scene_to_esg"].Add(now_us - msg.send_time_us);
   if (pending_) counters_.Add("superseded");
   pending_.emplace(std::move(msg), std::move(data_words));
 }
@@ -187,6 +196,7 @@ int RunEsgRenderer(const LabConfig& config, LcmInterface& lcm, const EsgOptions&
     }
   }
   EsgNode node(config, &lcm, &renderer, options, video.get(), window.get());
+  node.EnableLiveChecks(config.session.frame_rate_hz);
   if (!ready_path.empty()) TouchFile(ready_path);
   spdlog::info("ready: {}", lcm.FullChannel(channels::kEsgFrame));
   // With a window, wake often enough that a released key is sent at once.

@@ -13,6 +13,7 @@
 #include "overlay.h"
 #include "renderer.h"
 #include "rms/counters.h"
+#include "rms/frame_receiver.h"
 #include "rms/esg_frame_t.hpp"
 #include "rms/lcm_interface.h"
 #include "rms/operator_state_t.hpp"
@@ -53,6 +54,8 @@ class EsgNode {
   Counters& counters() { return counters_; }
   const LatencyMap& latencies() const { return latencies_; }
   std::int64_t last_rendered() const { return last_rendered_; }
+  // A live session's receive checks (as DcpNode::EnableLiveChecks).
+  void EnableLiveChecks(double frame_rate_hz);
   const std::vector<std::uint8_t>& output() const { return output_; }
 
  private:
@@ -66,6 +69,7 @@ class EsgNode {
   Counters counters_;
   LatencyMap latencies_;
   SequenceTracker frames_;
+  LateFrameFilter late_;
   std::optional<std::pair<esg_frame_t, EsgFrameData>> pending_;
   std::int64_t last_rendered_ = -1;
   std::vector<std::int32_t> last_words_;  // the words of the image in scene_

@@ -71,7 +71,15 @@ WindowKeyboardDevice::WindowKeyboardDevice(const Bindings& bindings, std::int64_
     : b_(bindings), timeout_us_(timeout_us) {}
 
 bool WindowKeyboardDevice::Receive(const Message& m, std::int64_t now_us) {
-  if (m.sequence <= last_sequence_) return false;
+  const SequenceTracker::Verdict v = sequence_.Accept(m.sequence);
+  if (v == SequenceTracker::Verdict::kDuplicate || v == SequenceTracker::Verdict::kStale ||
+      v == SequenceTracker::Verdict::kFarAhead) {
+    return false;
+  }
+  if (v == SequenceTracker::Verdict::kResync) {
+    spdlog::warn("window keys: sequence numbers resynchronised at {} (the window restarted, or {} was not real)",
+                 m.sequence, last_sequence_);
+  }
   last_sequence_ = m.sequence;
   heard_us_ = now_us;
   held_.clear();

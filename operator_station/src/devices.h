@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "bindings.h"
+#include "rms/counters.h"
 #include "rms/input_block.h"
 
 namespace rms::op {
@@ -92,11 +93,15 @@ class WindowKeyboardDevice : public InputDevice {
   void Poll(DeviceCommands* out) override;
   long timeouts() const { return timeouts_; }
   bool heard() const { return last_sequence_ >= 0; }
+  std::int64_t resyncs() const { return sequence_.resyncs(); }
 
  private:
   const Bindings& b_;
   std::int64_t timeout_us_;
   std::int64_t now_us_ = 0, heard_us_ = 0, last_sequence_ = -1;
+  // The window's sequence numbers (a restarted window, or a forged far-ahead
+  // one, is followed again after a run of refusals: SequenceTracker).
+  SequenceTracker sequence_;
   std::set<int> held_;
   std::vector<int> pressed_;
   long timeouts_ = 0;

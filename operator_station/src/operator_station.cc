@@ -49,7 +49,7 @@ void SleepUntilNs(std::int64_t t_ns) {
 constexpr int kMaxTelemetrySize = 4096;
 constexpr int kMaxStatusSize = 1 << 20;
 constexpr int kMaxControlSize = 1 << 16;
-constexpr int kMaxWindowKeysSize = 8 + 16 + 2 + 2 * 512 + 2 + 2 * 512 + 1;
+constexpr int kMaxWindowKeysSize = 8 + kSenderBytes + 16 + 2 + 2 * 512 + 2 + 2 * 512 + 1;
 
 bool Restarted() {
   const char* r = std::getenv("RMSLAB_RESTART");
@@ -110,7 +110,8 @@ OperatorStation::OperatorStation(const OperatorOptions& options, const LabConfig
       geometry_(MakeGuidanceGeometry(config)),
       rate_hz_(options.rate_hz > 0 ? options.rate_hz : config.session.frame_rate_hz),
       period_ns_(static_cast<std::int64_t>(std::llround(1e9 / rate_hz_))),
-      builder_(config.inputs) {
+      builder_(config.inputs),
+      checkpoints_(options.checkpoint_dir) {
   Subscribe();
 }
 
@@ -193,7 +194,10 @@ void OperatorStation::OnControl(const void* data, int size, std::int64_t) {
       if (frozen_) ++steps_pending_;
       counters_.Add("control.steps");
       break;
-    case session_control_t::RESTORE: restored_from_ = m.path; break;
+    case session_control_t::RESTORE:
+      if (checkpoint_rate_.Allow(lcm_.NowUs())) restored_from_ = m.name;
+      else counters_.Add("control.rate_limited");
+      break;
     default: break;
   }
 }
@@ -230,13 +234,13 @@ void OperatorStation::ApplyRestore() {
   // Carry on from the checkpoint's inputs, so the first frame after it
   // commands the arm where the DCP now has it.
   try {
-    const Checkpoint c = ReadCheckpoint(*restored_from_);
+    const Checkpoint c = checkpoints_.Read(*restored_from_);
     source_->Resume(c.inputs, true);
     ForgetTelemetry(builder_.next_frame());
-    spdlog::info("RESTORED the checkpoint {}: carrying on from its inputs", *restored_from_);
+    spdlog::info("RESTORED the checkpoint {}: carrying on from its inputs", checkpoints_.PathOf(*restored_from_));
     counters_.Add("control.restores");
   } catch (const InputError& e) {
-    counters_.Add("control.errors");
+    counters_.Add("control.refused");
     spdlog::error("{}", e.what());
   }
   restored_from_.reset();
@@ -358,6 +362,7 @@ int OperatorStation::Run(const std::string& stats_path, const std::string& ready
   while (!StopRequested()) {
     if (options_.max_frames >= 0 && frames_ >= options_.max_frames) break;
     if (lcm_.HandleSubscriptions(0) < 0) counters_.Add("transport_errors");
+    NoteTransportCounters(lcm_, &counters_);
     if (restored_from_) ApplyRestore();
     if (frozen_ && steps_pending_ == 0) {
       if (!RunFrozen()) break;
@@ -411,6 +416,7 @@ int OperatorStation::Run(const std::string& stats_path, const std::string& ready
   }
   screen_.reset();  // the terminal back, the captured log written out
   source_->AddCounters(&counters_);
+  NoteTransportCounters(lcm_, &counters_);
   counters_.Set("frames.total", frames_);
   status.Final(builder_.next_frame() - 1, counters_);
   if (!stats_path.empty()) WriteStatsJson(stats_path, "operator_station", counters_, {});

@@ -14,6 +14,7 @@
 
 #include "guidance.h"
 #include "input_sources.h"
+#include "rms/checkpoint.h"
 #include "rms/config.h"
 #include "rms/counters.h"
 #include "rms/dcp_telemetry_t.hpp"
@@ -42,6 +43,7 @@ struct OperatorOptions {
   double speed = 1.0;         // --speed: timeline seconds per wall-clock second (frames stay at the rate)
   std::int64_t max_frames = -1;  // --frames N: stop after N frames (-1: no limit)
   std::string restore_path;   // --restore CHECKPOINT: start from its operator inputs (by hand, autopilot)
+  std::string checkpoint_dir; // --checkpoint-dir: RMS_CONTROL's RESTORE names a checkpoint here only
 };
 
 // Builds the numbered, time-stamped input blocks.
@@ -121,7 +123,9 @@ class OperatorStation {
   // RMS_CONTROL.
   bool frozen_ = false;
   int steps_pending_ = 0;
-  std::optional<std::string> restored_from_;
+  std::optional<std::string> restored_from_;  // a checkpoint name (CheckpointFolder)
+  CheckpointFolder checkpoints_;
+  CheckpointRateLimit checkpoint_rate_;
   std::int64_t control_sequence_ = 0;
   std::int64_t frames_ = 0;
   OperatorInputs last_;  // the last inputs published

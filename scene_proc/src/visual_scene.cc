@@ -56,7 +56,7 @@ EsgFrameData VisualScene::Step(const DcpFrameData& dcp, std::uint32_t frame_coun
 
 namespace {
 // dcp_frame_t is fixed-size: 8 + 4 x 8 + (12 + 1 + 12 + 1 + 17) x 4.
-constexpr int kMaxDcpSize = 8 + 32 + 43 * 4;
+constexpr int kMaxDcpSize = 8 + kSenderBytes + 32 + 43 * 4;
 }  // namespace
 
 SceneNode::SceneNode(const LabConfig& config, LcmInterface* lcm)
@@ -65,14 +65,21 @@ SceneNode::SceneNode(const LabConfig& config, LcmInterface* lcm)
                   [this](const void* d, int n, std::int64_t t) { OnDcpFrame(d, n, t); });
 }
 
+void SceneNode::EnableLiveChecks(double frame_rate_hz) {
+  dcp_frames_.SetClock(SessionFrameClock(frame_rate_hz));
+  late_ = LateFrameFilter(frame_rate_hz);
+}
+
 void SceneNode::OnDcpFrame(const void* data, int size, std::int64_t recv_time_us) {
-  auto got = ReceiveFrame<dcp_frame_t>(data, size, kMaxDcpSize, &dcp_frames_, &counters_,
-                                       [](const dcp_frame_t& m) { return UnpackDcpFrame(m); });
+  const std::int64_t now_us = late_.enabled() ? lcm_->NowUs() : recv_time_us;
+  auto got = ReceiveFrame<dcp_frame_t>(
+      data, size, kMaxDcpSize, &dcp_frames_, &counters_, [](const dcp_frame_t& m) { return UnpackDcpFrame(m); },
+      now_us, &late_);
   if (!got) return;
   const auto& [msg, dcp] = *got;
   counters_.Set("dcp.missing", dcp_frames_.missing());
-  latencies_["dcp_to_scene"].Add(recv_time_us - msg.send_time_us);
-  RecordEndToEnd(recv_time_us - msg.input_send_time_us, config_.session.frame_rate_hz, &latencies_["input_to_scene"],
+  latencies_["dcp_to_scene"].Add(now_us - msg.send_time_us);
+  RecordEndToEnd(now_us - msg.input_send_time_us, config_.session.frame_rate_hz, &latencies_["input_to_scene"],
                  &counters_);
 
   // An ESG frame is numbered as the DCP frame it answers (one to one), so
@@ -97,6 +104,7 @@ void SceneNode::OnDcpFrame(const void* data, int size, std::int64_t recv_time_us
 int RunSceneProc(const LabConfig& config, LcmInterface& lcm, const std::string& stats_path,
                  const std::string& ready_path) {
   SceneNode node(config, &lcm);
+  node.EnableLiveChecks(config.session.frame_rate_hz);
   if (!ready_path.empty()) TouchFile(ready_path);
   spdlog::info("ready: {} -> {}", lcm.FullChannel(channels::kDcpFrame),
                lcm.FullChannel(channels::kEsgFrame));

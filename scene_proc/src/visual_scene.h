@@ -10,6 +10,7 @@
 #include "rms/priority.h"
 #include "rms/scene_model.h"
 #include "rms/counters.h"
+#include "rms/frame_receiver.h"
 #include "rms/lcm_interface.h"
 #include "rms/process.h"
 #include "rms/word_blocks.h"
@@ -49,6 +50,8 @@ class SceneNode {
   Counters& counters() { return counters_; }
   const LatencyMap& latencies() const { return latencies_; }
   std::int64_t last_frame() const { return next_frame_ - 1; }
+  // A live session's receive checks (as DcpNode::EnableLiveChecks).
+  void EnableLiveChecks(double frame_rate_hz);
 
  private:
   const LabConfig& config_;
@@ -57,6 +60,7 @@ class SceneNode {
   Counters counters_;
   LatencyMap latencies_;
   SequenceTracker dcp_frames_;
+  LateFrameFilter late_;
   std::int64_t next_frame_ = 0;
 };
 

@@ -305,14 +305,14 @@ TEST(SessionControl, AFrozenSessionHoldsStepsAndResumesWithNothingLost) {
 TEST(SessionControl, ACheckpointRestoresTheDcpAndASessionStartsFromOne) {
   const std::string dir = testing::MakeTempDir("checkpoint");
   const std::string url = testing::UniqueLcmUrl(9500);
-  const std::string cp = dir + "/before_docking.json";
+  const std::string cp = dir + "/checkpoints/before_docking.json";
   {
     testing::LabProcesses lab(dir, url);
     std::string error;
     ASSERT_TRUE(lab.Start(&error)) << error;
     Listener l(url);
     Subprocess op({testing::BuildPath("operator_station/operator_station"), "--lcm-url", url, "--autopilot", "--rate",
-                   "150", "--hold"},
+                   "150", "--hold", "--checkpoint-dir", dir + "/checkpoints"},
                   dir + "/op.log");
     auto control = [&](std::vector<std::string> args) {
       args.insert(args.begin(), {testing::BuildPath("tools/rms_control"), "--lcm-url", url});
@@ -322,7 +322,7 @@ TEST(SessionControl, ACheckpointRestoresTheDcpAndASessionStartsFromOne) {
     // In Mode 3, under way to the port: a checkpoint.
     for (int i = 0; i < 600 && !(l.telemetry && l.telemetry->mode == 3); ++i) l.Pump(0.05);
     ASSERT_TRUE(l.telemetry && l.telemetry->mode == 3) << ReadFile(dir + "/op.log");
-    control({"checkpoint", cp});
+    control({"checkpoint", "before_docking"});  // a name: saved in the session's checkpoints folder
     l.Pump(0.5);
     ASSERT_TRUE(fs::exists(cp)) << ReadFile(dir + "/dynamics_proc.log");
     const auto saved = nlohmann::json::parse(ReadFile(cp));
@@ -332,7 +332,7 @@ TEST(SessionControl, ACheckpointRestoresTheDcpAndASessionStartsFromOne) {
     ASSERT_TRUE(l.telemetry->docked);
     // Restore: back to Mode 3, not docked; the autopilot picks the task up
     // where the DCP now is and docks again.
-    control({"restore", cp, "--run"});
+    control({"restore", "before_docking.json", "--run"});
     bool undocked = false;
     for (int i = 0; i < 100 && !undocked; ++i) {
       l.Pump(0.05);

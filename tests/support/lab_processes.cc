@@ -1,5 +1,6 @@
 #include "lab_processes.h"
 
+#include <filesystem>
 #include <signal.h>
 
 namespace rms::testing {
@@ -20,7 +21,8 @@ std::unique_ptr<Subprocess> LabProcesses::StartOne(const std::string& name, std:
 bool LabProcesses::Start(std::string* error) {
   procs_.emplace_back("esg_renderer", StartOne("esg_renderer", esg_args_, esg_env_));
   procs_.emplace_back("scene_proc", StartOne("scene_proc", {}));
-  procs_.emplace_back("dynamics_proc", StartOne("dynamics_proc", {}));
+  std::filesystem::create_directories(dir_ + "/checkpoints");
+  procs_.emplace_back("dynamics_proc", StartOne("dynamics_proc", {"--checkpoint-dir", dir_ + "/checkpoints"}));
   for (const auto& [name, p] : procs_) {
     if (!WaitForFile(dir_ + "/" + name + ".ready", 15)) {
       *error = name + " did not start:\n" + ReadFile(dir_ + "/" + name + ".log");

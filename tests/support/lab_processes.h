@@ -18,7 +18,8 @@ class LabProcesses {
   LabProcesses(std::string dir, std::string url, std::vector<std::string> esg_args = {"--width", "160", "--height", "120"});
   ~LabProcesses();
 
-  // Starts esg_renderer, scene_proc, dynamics_proc and waits for them.
+  // Starts esg_renderer, scene_proc, dynamics_proc (its checkpoints in
+  // DIR/checkpoints) and waits for them.
   // Returns false (with the logs in `error`) when one does not come up.
   bool Start(std::string* error);
   // Runs operator_station on `timeline` (extra args appended) to its end,

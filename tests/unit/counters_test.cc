@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include "rms/counters.h"
+#include "rms/frame_receiver.h"
 
 namespace rms {
 namespace {
@@ -17,6 +18,61 @@ TEST(SequenceTracker, GapsDuplicatesAndStaleFrames) {
   EXPECT_EQ(t.duplicates(), 1);
   EXPECT_EQ(t.stale(), 1);
   EXPECT_EQ(t.last(), 9);
+}
+
+// One forged frame number far ahead (2^47) must not lock the stream: with
+// the session's clock it is refused outright; with none it may be taken,
+// and then the real stream is followed again after kResyncAfter refusals.
+TEST(SequenceTracker, AFarFutureFrameCannotLockTheStream) {
+  using V = SequenceTracker::Verdict;
+  const std::int64_t forged = std::int64_t{1} << 47;
+  FrameClock clock;
+  clock.epoch_us = 1'000'000'000'000;
+  clock.max_rate_hz = 30 * 100;
+  SequenceTracker with_clock;
+  with_clock.SetClock(clock);
+  const std::int64_t t0 = clock.epoch_us + 5'000'000;  // 5 s into the session
+  EXPECT_EQ(with_clock.Accept(100, t0), V::kFirst);
+  EXPECT_EQ(with_clock.Accept(forged, t0), V::kFarAhead);
+  EXPECT_EQ(with_clock.Accept(clock.Limit(t0) + 1, t0), V::kFarAhead);
+  EXPECT_EQ(with_clock.Accept(101, t0), V::kNext);
+  EXPECT_EQ(with_clock.far_ahead(), 2);
+  // A restarted sender's jump within the clock is a gap, as before.
+  EXPECT_EQ(with_clock.Accept(400, t0 + 10'000'000), V::kGap);
+
+  SequenceTracker none;
+  EXPECT_EQ(none.Accept(forged), V::kFirst);  // nothing to tell it by yet
+  std::int64_t f = 200;
+  for (int i = 1; i < SequenceTracker::kResyncAfter; ++i) EXPECT_EQ(none.Accept(f++), V::kStale) << i;
+  EXPECT_EQ(none.Accept(f), V::kResync);
+  EXPECT_EQ(none.last(), f);
+  EXPECT_EQ(none.Accept(f + 1), V::kNext);
+  EXPECT_EQ(none.resyncs(), 1);
+  // Far ahead of the last without a clock: refused, and followed only as a run.
+  EXPECT_EQ(none.Accept(f + 2 + SequenceTracker::kMaxJump), V::kFarAhead);
+  EXPECT_EQ(none.Accept(f + 2), V::kNext);
+  // Refusals that are not one run (stale frames of a reordering) never resync.
+  SequenceTracker reorder;
+  reorder.Accept(1000);
+  for (int i = 0; i < 100; ++i) EXPECT_EQ(reorder.Accept(999 - (i % 2)), V::kStale);
+  EXPECT_EQ(reorder.resyncs(), 0);
+}
+
+// A woken process's queue of old frames is dropped, not executed: a frame
+// is late when its age exceeds the link's own delay by the limit.
+TEST(LateFrameFilter, DropsWhatWaitedBeyondTheLinksDelayAndFollowsAClockOffset) {
+  LateFrameFilter off;
+  EXPECT_FALSE(off.TooLate(0, 10'000'000));
+  LateFrameFilter late(30.0);
+  EXPECT_EQ(late.limit_us(), 100000);
+  const std::int64_t offset = 2'500'000;  // the sender's clock 2.5 s behind: ages read 2.5 s more
+  std::int64_t now = 50'000'000;
+  for (int i = 0; i < 60; ++i, now += 33333) EXPECT_FALSE(late.TooLate(now - offset - 1500, now));
+  // Stopped for 8 s: the queued frames are 8 s (down to 0.2 s) old when handled.
+  for (int i = 0; i < 234; ++i) EXPECT_TRUE(late.TooLate(now - offset - 8'000'000 + i * 33333, now)) << i;
+  EXPECT_FALSE(late.TooLate(now - offset - 2000, now));
+  // Jitter within the limit passes.
+  EXPECT_FALSE(late.TooLate(now - offset - 90000, now));
 }
 
 TEST(LatencyHistogram, PercentilesAtEachResolution) {

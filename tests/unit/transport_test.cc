@@ -15,6 +15,7 @@
 #include "rms/message_io.h"
 #include "rms/operator_input_t.hpp"
 #include "rms/process_status_t.hpp"
+#include "rms/sender_t.hpp"
 
 namespace rms {
 namespace {
@@ -97,6 +98,66 @@ TEST(UdpLcm, RealMulticastOnLoopbackDeliversToASecondInstance) {
   for (int i = 0; i < 50; ++i) EXPECT_EQ(frames[i], i);
 }
 
+// Every message carries its sender (docs/protocol.md "Senders"); a process
+// of a session takes only its own session's messages and counts the others;
+// one of no session takes all.
+TEST(UdpLcm, MessagesAreStampedWithTheirSenderAndOtherSessionsAreDropped) {
+  LcmOptions o;
+  o.url = "udpm://239.255.76.67:" + std::to_string(7950 + getpid() % 40) + "?ttl=0";
+  o.channel_suffix = "_SID";
+  UdpLcm a(o), b(o), mine(o), none(o);
+  a.SetSender({0x1111, sender_t::PROCESS_OPERATOR_STATION, 4242});
+  b.SetSender({0x2222, sender_t::PROCESS_OPERATOR_STATION, 4343});
+  mine.SetSender({0x1111, sender_t::PROCESS_DYNAMICS, 1});
+  std::vector<sender_t> got_mine, got_none;
+  auto collect = [](std::vector<sender_t>* into) {
+    return [into](const void* d, int n, std::int64_t) {
+      operator_input_t m;
+      if (SafeDecode(d, n, 1000, &m) == DecodeError::kNone) into->push_back(m.sender);
+    };
+  };
+  mine.Subscribe(channels::kOperatorInput, collect(&got_mine));
+  none.Subscribe(channels::kOperatorInput, collect(&got_none));
+  for (int i = 0; i < 10; ++i) {
+    operator_input_t m{};
+    m.frame = i;
+    m.sender.session_id = 0x7777;  // whatever the caller left there, the transport's sender goes out
+    ASSERT_TRUE(PublishMessage(a, channels::kOperatorInput, m));
+    ASSERT_TRUE(PublishMessage(b, channels::kOperatorInput, m));
+  }
+  for (int k = 0; k < 50 && (got_mine.size() < 10 || got_none.size() < 20); ++k) {
+    mine.HandleSubscriptions(20);
+    none.HandleSubscriptions(0);
+  }
+  ASSERT_EQ(got_mine.size(), 10u);
+  for (const sender_t& s : got_mine) {
+    EXPECT_EQ(s.session_id, 0x1111);
+    EXPECT_EQ(s.process, sender_t::PROCESS_OPERATOR_STATION);
+    EXPECT_EQ(s.pid, 4242);
+  }
+  EXPECT_EQ(mine.other_session_dropped(), 10);
+  EXPECT_EQ(got_none.size(), 20u);
+  EXPECT_EQ(none.other_session_dropped(), 0);
+  // Something that is not an rmslab message is left to the decoder to refuse.
+  const char junk[40] = {1, 2, 3};
+  a.Publish(channels::kOperatorInput, junk, sizeof junk);
+  int raw = 0;
+  mine.Subscribe(channels::kStatus, [&](const void*, int, std::int64_t) { ++raw; });
+  a.Publish(channels::kStatus, junk, sizeof junk);
+  for (int k = 0; k < 20 && raw == 0; ++k) mine.HandleSubscriptions(20);
+  EXPECT_EQ(raw, 1);
+  EXPECT_EQ(mine.other_session_dropped(), 10);
+}
+
+TEST(SessionId, ParsedFromDecimalOrHexAndMalformedOnesAreRefused) {
+  EXPECT_EQ(ParseSessionId("0x00000000000000ff", "x"), 255);
+  EXPECT_EQ(ParseSessionId("12", "x"), 12);
+  EXPECT_EQ(ParseSessionId(FormatSessionId(-2), "x"), -2);
+  EXPECT_THROW(ParseSessionId("0x", "x"), InputError);
+  EXPECT_THROW(ParseSessionId("12a", "x"), InputError);
+  EXPECT_THROW(ParseSessionId("0x1234567890abcdef0", "x"), InputError);
+}
+
 TEST(UdpLcm, ABadUrlIsRefusedWithTheFix) {
   LcmOptions o;
   o.url = "udpm://not-an-address:99999";
@@ -128,16 +189,18 @@ TEST(SafeDecode, ClassifiesHostileBytesWithoutThrowing) {
   EXPECT_EQ(SafeDecode(longer.data(), static_cast<int>(longer.size()), 400, &out), DecodeError::kTrailingBytes);
   // Too large.
   EXPECT_EQ(SafeDecode(good.data(), static_cast<int>(good.size()), 10, &out), DecodeError::kTooLarge);
-  // A negative word count (int16 at byte 48) makes lcm-gen's decoder throw.
+  // A negative word count (int16 after the fingerprint, the sender and five
+  // int64s) makes lcm-gen's decoder throw.
+  constexpr int kCountAt = 8 + kSenderBytes + 40;
   std::vector<std::uint8_t> neg = good;
-  neg[48] = 0xFF;
-  neg[49] = 0xFE;
+  neg[kCountAt] = 0xFF;
+  neg[kCountAt + 1] = 0xFE;
   EXPECT_EQ(SafeDecode(neg.data(), static_cast<int>(neg.size()), 400, &out), DecodeError::kBadCount);
   // A string length of zero in a status report.
   process_status_t s{};
   s.process = "x";
   std::vector<std::uint8_t> sb = EncodeMessage(s);
-  sb[8 + 8 + 3] = 0;  // length of "process" (4-byte big-endian at offset 16) -> 0
+  sb[8 + kSenderBytes + 8 + 3] = 0;  // length of "process" (4-byte big-endian after the sender and send_time_us) -> 0
   process_status_t so;
   const DecodeError e = SafeDecode(sb.data(), static_cast<int>(sb.size()), 4000, &so);
   EXPECT_NE(e, DecodeError::kNone);

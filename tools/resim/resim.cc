@@ -136,9 +136,11 @@ bool SameFrame(const dcp_frame_t& a, const dcp_frame_t& b, std::string* what) {
 }
 
 bool SameTelemetry(dcp_telemetry_t a, dcp_telemetry_t b, std::string* what) {
-  // Everything but the wall-clock send time, field for field: the message's
-  // encoding with send_time_us equalised compares every bit of every field.
+  // Everything but the wall-clock send time and the sender (a re-simulation
+  // is another process), field for field: the message's encoding with those
+  // equalised compares every bit of every other field.
   a.send_time_us = b.send_time_us = 0;
+  a.sender = b.sender = sender_t{};
   std::vector<std::uint8_t> ea(a.getEncodedSize()), eb(b.getEncodedSize());
   a.encode(ea.data(), 0, static_cast<int>(ea.size()));
   b.encode(eb.data(), 0, static_cast<int>(eb.size()));
@@ -362,7 +364,11 @@ ResimResult Resimulate(const ResimOptions& opt) {
       // saved and freezes change nothing here).
       while (next_control < rec.controls.size() && rec.controls[next_control].first <= k) {
         const session_control_t& c = rec.controls[next_control++].second;
-        if (c.command == session_control_t::RESTORE) node.RestoreCheckpoint(c.path);
+        if (c.command == session_control_t::RESTORE) {
+          // As the live DCP did: the named checkpoint in the session's folder.
+          const CheckpointFolder folder((session / "checkpoints").string());
+          node.Restore(folder.Read(c.name), folder.PathOf(c.name));
+        }
       }
       const auto it = rec.inputs.find(seq[k]);
       if (it == rec.inputs.end()) {

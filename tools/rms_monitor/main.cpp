@@ -149,7 +149,7 @@ int main(int argc, char** argv) {
       if (rms::SafeDecode(d, n, 1 << 16, &m) != DecodeError::kNone) return false;
       static const char* kNames[] = {"?", "freeze", "run", "step", "checkpoint", "restore"};
       c->last = Sprintf("#%lld %s %s", static_cast<long long>(m.sequence), m.command >= 1 && m.command <= 5 ? kNames[m.command] : "?",
-                    m.path.c_str());
+                    m.name.c_str());
       return true;
     });
 

@@ -267,7 +267,7 @@ std::vector<std::pair<std::string, long>> ExportCsv(const std::string& session_d
         if (SafeDecode(ev->data, ev->datalen, 1 << 16, &m) != DecodeError::kNone) throw InputError("malformed");
         static const char* kNames[] = {"?", "freeze", "run", "step", "checkpoint", "restore"};
         ctl_csv.Row({t, I(m.send_time_us), I(m.sequence), m.command >= 1 && m.command <= 5 ? kNames[m.command] : "?",
-                     m.path});
+                     m.name});
       }
     } catch (const std::exception&) {
       ++skipped;  // a malformed message: counted, not exported

@@ -21,17 +21,18 @@ int main(int argc, char** argv) {
 
   // manifest: what a session ran, written by scripts/lab at the start.
   CLI::App* manifest = app.add_subcommand("manifest", "Write SESSION/manifest.json: config, software, hosts, start");
-  std::string m_dir, pilot, url, suffix, config_sha, command, timeline, restore;
-  std::vector<std::string> hosts;
+  std::string m_dir;
+  rms::session::ManifestFields mf;
   manifest->add_option("session", m_dir, "Session folder")->required()->check(CLI::ExistingDirectory);
-  manifest->add_option("--pilot", pilot, "autopilot, timeline, by-hand, replay")->required();
-  manifest->add_option("--lcm-url", url, "The session's LCM URL")->required();
-  manifest->add_option("--channel-suffix", suffix, "The session's channel suffix");
-  manifest->add_option("--config-sha256", config_sha, "SHA-256 of config.toml");
-  manifest->add_option("--timeline", timeline, "The timeline flown, if any");
-  manifest->add_option("--restore", restore, "The checkpoint the session started from, if any");
-  manifest->add_option("--host", hosts, "PROCESS=HOST, one per process (default: all on this host)");
-  manifest->add_option("--command", command, "The command line that started the session");
+  manifest->add_option("--pilot", mf.pilot, "autopilot, timeline, by-hand, replay")->required();
+  manifest->add_option("--lcm-url", mf.url, "The session's LCM URL")->required();
+  manifest->add_option("--channel-suffix", mf.suffix, "The session's channel suffix");
+  manifest->add_option("--session-id", mf.session_id, "The session's id (0x and 16 hex digits)");
+  manifest->add_option("--config-sha256", mf.config_sha256, "SHA-256 of config.toml");
+  manifest->add_option("--timeline", mf.timeline, "The timeline flown, if any");
+  manifest->add_option("--restore", mf.restore, "The checkpoint the session started from, if any");
+  manifest->add_option("--host", mf.hosts, "PROCESS=HOST, one per process (default: all on this host)");
+  manifest->add_option("--command", mf.command, "The command line that started the session");
 
   // compare-esg: replayed ESG frames against recorded ones.
   CLI::App* compare = app.add_subcommand("compare-esg", "Compare a replay's ESG frames with the recorded session's");
@@ -61,8 +62,11 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (manifest->parsed()) {
-      const auto j = rms::session::MakeManifest(m_dir, pilot, url, suffix, config_sha, timeline, restore, hosts, command);
-      std::ofstream(m_dir + "/manifest.json") << j.dump(2) << "\n";
+      const auto j = rms::session::MakeManifest(m_dir, mf);
+      std::ofstream f(m_dir + "/manifest.json");
+      f << j.dump(2) << "\n";
+      f.close();
+      if (!f) throw std::runtime_error("cannot write " + m_dir + "/manifest.json");
       return 0;
     }
     if (compare->parsed()) {

@@ -429,13 +429,14 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
   return j;
 }
 
-nlohmann::ordered_json MakeManifest(const std::string& dir, const std::string& pilot, const std::string& url,
-                                    const std::string& suffix, const std::string& config_sha256,
-                                    const std::string& timeline, const std::string& restore,
-                                    const std::vector<std::string>& hosts, const std::string& command) {
+nlohmann::ordered_json MakeManifest(const std::string& dir, const ManifestFields& f) {
+  const std::string &pilot = f.pilot, &url = f.url, &suffix = f.suffix, &config_sha256 = f.config_sha256,
+                    &timeline = f.timeline, &restore = f.restore, &command = f.command;
+  const std::vector<std::string>& hosts = f.hosts;
   nlohmann::ordered_json j;
   j["format"] = "rmslab-session-1";
   j["session"] = fs::absolute(dir).lexically_normal().filename().string();
+  if (!f.session_id.empty()) j["session_id"] = FormatSessionId(ParseSessionId(f.session_id, "--session-id"));
   const std::int64_t now = WallTimeUs();
   const std::time_t secs = static_cast<std::time_t>(now / 1000000);
   char utc[32];
@@ -462,6 +463,25 @@ nlohmann::ordered_json MakeManifest(const std::string& dir, const std::string& p
   j["hosts"] = layout;
   if (!command.empty()) j["command"] = command;
   return j;
+}
+
+SessionInfo ReadSessionInfo(const std::string& dir) {
+  const fs::path p = fs::path(dir) / "manifest.json";
+  std::ifstream f(p);
+  if (!f) throw InputError("no manifest.json in " + dir + ": not a session folder");
+  SessionInfo s;
+  s.dir = dir;
+  try {
+    const auto j = nlohmann::json::parse(f);
+    s.lcm_url = j.at("lcm").at("url").get<std::string>();
+    s.channel_suffix = j.at("lcm").value("channel_suffix", "");
+    if (j.contains("session_id")) s.session_id = ParseSessionId(j.at("session_id").get<std::string>(), p.string() + " session_id");
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw InputError(p.string() + ": " + e.what());
+  }
+  return s;
 }
 
 nlohmann::ordered_json CompareEsgFrames(const std::string& original_dir, const std::string& replay_dir) {

@@ -3,6 +3,7 @@
 // rendered and dropped per link, the mode, latency, and what the LCM log holds.
 // Built from the session folder alone: the LCM log (lcmlog) and each
 // process's final counters (stats/*.json).
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -22,10 +23,22 @@ std::string BaseChannel(const std::string& channel);
 // (this build's version), the configuration (file and hash), the pilot, the
 // LCM URL and channel suffix, which process ran on which host, the lab host,
 // and the start time.
-nlohmann::ordered_json MakeManifest(const std::string& session_dir, const std::string& pilot, const std::string& url,
-                                    const std::string& suffix, const std::string& config_sha256,
-                                    const std::string& timeline, const std::string& restore,
-                                    const std::vector<std::string>& hosts, const std::string& command);
+struct ManifestFields {
+  std::string pilot, url, suffix, config_sha256, timeline, restore, command;
+  std::string session_id;           // "0x..." (the launcher's random id; every message carries it)
+  std::vector<std::string> hosts;   // PROCESS=HOST
+};
+nlohmann::ordered_json MakeManifest(const std::string& session_dir, const ManifestFields& f);
+
+// What a tool needs to talk to, or read, a session: from its manifest.json.
+struct SessionInfo {
+  std::string dir;
+  std::string lcm_url;
+  std::string channel_suffix;
+  std::int64_t session_id = 0;  // 0: a session recorded before session ids, or none
+};
+// Throws rms::InputError when SESSION/manifest.json is missing or malformed.
+SessionInfo ReadSessionInfo(const std::string& session_dir);
 
 // A replay's ESG frames against the recorded ones, matched by the DCP frame
 // they were made from: {"recorded", "replayed", "identical", "missing",
