@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "rms/check.h"
@@ -192,9 +193,23 @@ void ReadKeyboard(TomlReader& top, Bindings* b) {
     b->keys[code] = ActionAt(k, name);
   }
   k.Finish();
-  // A session must be able to end from its keyboards.
-  if (std::none_of(b->keys.begin(), b->keys.end(), [](const auto& kv) { return kv.second.kind == ActionKind::kQuit; })) {
-    r.Fail("keys", "no key is bound to quit (add one, e.g. Q = \"quit\")");
+  // What a person needs to fly and to end the session has a key: every
+  // hand-controller axis both ways, the finger, stop, the scale, the mode,
+  // the frame and quit (docs/operator.md "The bindings file").
+  std::set<std::string> bound;
+  for (const auto& [code, a] : b->keys) bound.insert(ActionName(a));
+  std::string missing;
+  for (int i = 0; i < kNumHandAxes; ++i) {
+    for (const char* sign : {"+", "-"}) {
+      const std::string n = std::string(kHandAxisNames[i]) + sign;
+      if (!bound.count(n)) missing += (missing.empty() ? "" : ", ") + n;
+    }
+  }
+  for (const char* n : {"finger+", "finger-", "stop", "vernier", "mode", "frame", "quit"}) {
+    if (!bound.count(n)) missing += (missing.empty() ? "" : ", ") + std::string(n);
+  }
+  if (!missing.empty()) {
+    r.Fail("keys", "no key is bound to " + missing + " (every one needs a key, e.g. Q = \"quit\"; see config/bindings.toml)");
   }
   r.Finish();
 }

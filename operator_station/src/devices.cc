@@ -22,6 +22,27 @@ namespace {
 
 bool Moves(const Action& a) { return a.kind == ActionKind::kHand || a.kind == ActionKind::kInput; }
 
+// An action that stops every motion (HandControllers::HandleEvents): a
+// press before it in the same frame is undone by it, so it is dropped here
+// -- the frame's keys act in the order they came.
+bool StopsMotion(const Action& a) {
+  switch (a.kind) {
+    case ActionKind::kStop:
+    case ActionKind::kMode:
+    case ActionKind::kFrame:
+    case ActionKind::kVernier:
+    case ActionKind::kJointNext:
+    case ActionKind::kJointPrev:
+    case ActionKind::kReset: return true;
+    default: return false;
+  }
+}
+
+void DropEarlierPresses(DeviceCommands* out) {
+  out->hand_presses.clear();
+  out->input_presses.clear();
+}
+
 // A control held down: an axis or an input at full rate.
 void AddHeld(const Action& a, DeviceCommands* out) {
   if (a.kind == ActionKind::kHand) out->hand[a.index] += a.sign;
@@ -59,6 +80,7 @@ void KeyboardDevice::Poll(DeviceCommands* out) {
     }
     const Action& a = it->second;
     ++out->key_actions;
+    if (StopsMotion(a)) DropEarlierPresses(out);
     if (a.kind == ActionKind::kHand) out->hand_presses.push_back({a.index, a.sign});
     else if (a.kind == ActionKind::kInput) out->input_presses.push_back({a.index, a.sign});
     else out->events.push_back(a);
@@ -71,6 +93,15 @@ WindowKeyboardDevice::WindowKeyboardDevice(const Bindings& bindings, std::int64_
     : b_(bindings), timeout_us_(timeout_us) {}
 
 bool WindowKeyboardDevice::Receive(const Message& m, std::int64_t now_us) {
+  if (m.sender_pid != 0 && sender_pid_ != 0 && m.sender_pid != sender_pid_) {
+    // A new window (esg_renderer restarted): its own numbering, from 0.
+    sequence_ = SequenceTracker{};
+    held_.clear();
+    ++new_windows_;
+    spdlog::warn("window keys: a new live window (esg_renderer pid {}, was {}); its keys are taken from now on",
+                 m.sender_pid, sender_pid_);
+  }
+  if (m.sender_pid != 0) sender_pid_ = m.sender_pid;
   const SequenceTracker::Verdict v = sequence_.Accept(m.sequence);
   if (v == SequenceTracker::Verdict::kDuplicate || v == SequenceTracker::Verdict::kStale ||
       v == SequenceTracker::Verdict::kFarAhead) {
@@ -92,6 +123,7 @@ void WindowKeyboardDevice::Poll(DeviceCommands* out) {
   for (int k : pressed_) {
     const auto it = b_.keys.find(k);
     if (it == b_.keys.end()) continue;
+    if (StopsMotion(it->second)) DropEarlierPresses(out);
     AddPressed(it->second, out);
     // A direct input's key down is a terminal's press too (a tap of the
     // finger key closes it all the way); held, it moves on at its rate.

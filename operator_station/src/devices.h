@@ -82,6 +82,7 @@ class WindowKeyboardDevice : public InputDevice {
     std::int64_t sequence = 0;
     std::vector<int> held, pressed;
     bool focused = true;
+    std::int32_t sender_pid = 0;  // the window's process (sender_t.pid); a new one numbers from 0 again
   };
   explicit WindowKeyboardDevice(const Bindings& bindings, std::int64_t timeout_us = 300000);
   std::string Describe() const override { return "keyboard (the live window)"; }
@@ -94,6 +95,8 @@ class WindowKeyboardDevice : public InputDevice {
   long timeouts() const { return timeouts_; }
   bool heard() const { return last_sequence_ >= 0; }
   std::int64_t resyncs() const { return sequence_.resyncs(); }
+  // Windows heard from after the first (esg_renderer restarted).
+  long new_windows() const { return new_windows_; }
 
  private:
   const Bindings& b_;
@@ -102,6 +105,8 @@ class WindowKeyboardDevice : public InputDevice {
   // The window's sequence numbers (a restarted window, or a forged far-ahead
   // one, is followed again after a run of refusals: SequenceTracker).
   SequenceTracker sequence_;
+  std::int32_t sender_pid_ = 0;
+  long new_windows_ = 0;
   std::set<int> held_;
   std::vector<int> pressed_;
   long timeouts_ = 0;

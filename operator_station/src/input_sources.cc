@@ -52,6 +52,10 @@ std::string KeyHelp(const Bindings& b) {
   pair("rhc_yaw+", "rhc_yaw-", "yaw right/left");
   pair("rhc_roll+", "rhc_roll-", "roll right/left");
   pair("finger+", "finger-", "finger close/open");
+  pair("shoulder_height+", "shoulder_height-", "shoulder up/down");
+  pair("camera_pan+", "camera_pan-", "pan");
+  pair("camera_tilt+", "camera_tilt-", "tilt");
+  pair("camera_zoom+", "camera_zoom-", "zoom");
   for (const char* one : {"stop", "vernier", "mode", "frame", "joint_next", "joint_prev", "crosshairs", "guidance",
                           "overlay", "reset", "freeze", "step", "quit"}) {
     if (by_action.count(one)) {

@@ -213,6 +213,7 @@ void OperatorStation::OnWindowKeys(const void* data, int size, std::int64_t recv
   k.held.assign(m.held.begin(), m.held.end());
   k.pressed.assign(m.pressed.begin(), m.pressed.end());
   k.focused = m.focused;
+  k.sender_pid = m.sender.pid;
   if (!source_->window_keyboard()->Receive(k, recv_us)) counters_.Add("dropped.window_keys_stale");
 }
 

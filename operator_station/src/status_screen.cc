@@ -60,6 +60,8 @@ std::string Margin(double m) {
 
 // The key that moves `action`, for hints: "(w)", or "" when unbound.
 std::string KeyHint(const StatusSnapshot& s, const std::string& action) {
+  // In single joint control the hand-controller keys drive a joint: no hint.
+  if (s.hand && s.hand->mode == ControlMode::kSingleJoint && action.rfind("finger", 0) != 0) return "";
   const auto it = s.keys.find(action);
   return it == s.keys.end() ? "" : " (" + it->second + ")";
 }
@@ -82,13 +84,19 @@ void GuidanceLines(const StatusSnapshot& s, Flow& flow) {
   const std::string axes = std::string(CommandFrameName(g.frame)) + " axes";
   if (g.leave_bay) {
     const bool out = g.leave_bay_ft.norm() < 1e-9;
-    flow.Line(out ? "GUIDANCE out of the cargo bay: clear" : "GUIDANCE out of the cargo bay first, straight up, " + axes + ":");
-    if (!out) OffsetFields(s, g.leave_bay_ft, flow);
+    if (out) {
+      flow.Line("GUIDANCE out of the cargo bay: clear");
+    } else {
+      flow.Line("GUIDANCE out of the cargo bay first:")
+          .Field(Sprintf("straight up to %.0f ft above it,", kLeaveBayMarginFt))
+          .Field(axes + ":");
+      OffsetFields(s, g.leave_bay_ft, flow);
+    }
   }
   flow.Line(std::string(g.leave_bay ? "then " : "GUIDANCE ") +
-            (g.target == GuidanceTarget::kGrasp ? "to the grasp on the bar receptacle, from the grasp point"
-                                                : "to the CAE's docking port, from the probe's tip") +
-            ", " + axes + ":");
+            (g.target == GuidanceTarget::kGrasp ? "to the grasp on the bar receptacle," : "to the CAE's docking port,"))
+      .Field(g.target == GuidanceTarget::kGrasp ? "from the grasp point," : "from the probe's tip,")
+      .Field(axes + ":");
   OffsetFields(s, g.offset_ft, flow);
   flow.Field(Sprintf("distance %.2f ft", g.distance_ft));
   static const char* kRot[3] = {"roll", "pitch", "yaw"};
@@ -129,7 +137,7 @@ void ControlLines(const StatusSnapshot& s, Flow& flow) {
     }
     flow.Field("AT JOINT LIMIT: " + j);
   }
-  if (h.singular) flow.Field("NEAR A SINGULAR POSE (the arm straight, or the wrist yaw near 90 deg): some motions slowed");
+  if (h.singular) flow.Field("NEAR A SINGULAR POSE: some motions slowed").Field("(the arm straight, or the wrist yaw near 90 deg)");
   if (h.rate_limited) flow.Field("slowed: a joint at its rate");
   if (h.held_at_port) {
     flow.Field("DOCKED: the port holds the payload and the arm; open the finger" + KeyHint(s, "finger-") + " to let go");
@@ -172,10 +180,12 @@ void ConditionLines(const StatusSnapshot& s, const LabConfig& config, int width,
       flow.Field(Sprintf("closed, the finger would stop at %.3f ft: %s", g,
                          g < config.dcp.d3y_ft ? "below D3Y" : "NOT below D3Y (the BAR nearer the fixed finger)"));
     }
-  } else {
+  } else if (t.mode == 2) {
     flow.Line("ACQUISITION: acquired; the payload is held")
         .Field(t.bay_clearance_ft > 0 ? Sprintf("clear of the bay by %.2f ft", t.bay_clearance_ft)
                                       : Sprintf("in the bay: %.2f ft to lift it clear", -t.bay_clearance_ft));
+  } else {
+    flow.Line("ACQUISITION: acquired; the payload is held, out of the bay");
   }
   flow.Line(Sprintf("DOCKING distance %.3f ft (<= %.2f)", t.dock_distance_ft, config.dcp.dock_distance_ft))
       .Field(Sprintf("angle %.2f deg (<= %.2f)", t.dock_angle_deg, config.dcp.dock_angle_deg))

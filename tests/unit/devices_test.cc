@@ -135,6 +135,9 @@ TEST_F(Devices, TheBindingsFileIsReadAndBadOnesAreRefusedNamingTheKey) {
       {"coarse_ft = 5.0", "coarse_ft = 0", "key 'keyboard.increment.coarse_ft': must be > 0"},
       {"[spacemouse.buttons]", "[spacemouse.buttons]\nextra = 1", "key 'spacemouse.buttons.extra'"},
       {"Q = \"quit\"", "Q = \"quit\"\nq = \"stop\"\n\" \" = \"stop\"", "key 'keyboard.keys. ': is not a key"},
+      {"v = \"vernier\"\n", "", "key 'keyboard.keys': no key is bound to vernier"},
+      {"s = \"thc_x-\"", "s = \"camera_1\"", "key 'keyboard.keys': no key is bound to thc_x-"},
+      {"Q = \"quit\"\n", "", "key 'keyboard.keys': no key is bound to quit"},
   };
   for (const Case& c : cases) {
     try {
@@ -255,6 +258,30 @@ TEST_F(Devices, ATerminalPressIsOneIncrementMergedNeverQueuedAndStopHaltsIt) {
   EXPECT_EQ(hc.counters().Get("control.scale_changes"), 1);
 }
 
+// The keys of one frame act in the order they came: a press then a key that
+// stops every motion (space, v, n, m, [, ]) leaves nothing moving; the
+// other way round, the press moves.
+TEST_F(Devices, OneFramesKeysActInTheOrderTheyCame) {
+  HandControllers hc(config, bindings);
+  TypedKeys typed;
+  hc.AddDevice(std::make_unique<KeyboardDevice>(bindings, typed.Source()));
+  const OperatorInputs in0 = MidPose();
+  hc.SetInputs(in0);
+  const dcp_telemetry_t t = Telemetry(in0, 1);
+  typed.keys = {'w'};
+  hc.Step(kDt, &t);
+  ASSERT_GT(hc.status().rate[kThcX], 0.0);
+  typed.keys = {'s', 'v'};  // stop the axis, then vernier
+  hc.Step(kDt, &t);
+  EXPECT_TRUE(hc.status().vernier);
+  EXPECT_EQ(hc.status().pending[kThcX], 0.0);
+  EXPECT_EQ(hc.status().rate[kThcX], 0.0);
+  typed.keys = {'v', 'd'};  // coarse again, then right: it moves
+  hc.Step(kDt, &t);
+  EXPECT_FALSE(hc.status().vernier);
+  EXPECT_GT(hc.status().rate[kThcY], 0.0);
+}
+
 TEST_F(Devices, TheLiveWindowsHeldKeysMoveAndReleasedOnesStopAtOnce) {
   HandControllers hc(config, bindings);
   auto dev = std::make_unique<WindowKeyboardDevice>(bindings, 300000);
@@ -292,6 +319,18 @@ TEST_F(Devices, TheLiveWindowsHeldKeysMoveAndReleasedOnesStopAtOnce) {
   EXPECT_EQ(hc.status().rate[kThcY], 0.0);
   EXPECT_EQ(window->timeouts(), 1);
   EXPECT_EQ(hc.key_actions(), 2);
+  // A restarted window (a new esg_renderer) numbers its messages from 0
+  // again: taken at once, not refused as stale.
+  WindowKeyboardDevice::Message first{++seq, {}, {}, true};
+  first.sender_pid = 100;
+  EXPECT_TRUE(window->Receive(first, now));
+  WindowKeyboardDevice::Message restarted{0, {'d'}, {'d'}, true};
+  restarted.sender_pid = 200;
+  EXPECT_TRUE(window->Receive(restarted, now));
+  window->SetNow(now += 33333);
+  hc.Step(kDt, &t);
+  EXPECT_GT(hc.status().rate[kThcY], 0.0);
+  EXPECT_EQ(window->new_windows(), 1);
 }
 
 // The stop key (or a change of scale, frame, mode or joint) stops every

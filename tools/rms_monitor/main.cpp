@@ -24,7 +24,10 @@
 #include "rms/operator_input_t.hpp"
 #include "rms/process.h"
 #include "rms/process_status_t.hpp"
+#include "rms/key_codes.h"
+#include "rms/operator_state_t.hpp"
 #include "rms/session_control_t.hpp"
+#include "rms/window_keys_t.hpp"
 #include "rms/word_blocks.h"
 #include "rms/text.h"
 
@@ -142,6 +145,22 @@ int main(int argc, char** argv) {
                                  static_cast<long long>(get("input.missing") + get("dcp.missing") + get("esg.missing")),
                                  m.final ? " (final)" : "");
       c->last = Sprintf("%zu processes reporting", processes.size());
+      return true;
+    });
+    on(rms::channels::kOperatorState, [](const void* d, int n, ChannelStats* c) {
+      rms::operator_state_t m{};
+      if (rms::SafeDecode(d, n, 1 << 16, &m) != DecodeError::kNone) return false;
+      c->last = Sprintf("frame %lld, source %d, to go %.2f ft / %.1f deg", static_cast<long long>(m.frame), m.source,
+                        m.distance_ft, m.angle_deg);
+      return true;
+    });
+    on(rms::channels::kWindowKeys, [](const void* d, int n, ChannelStats* c) {
+      rms::window_keys_t m{};
+      if (rms::SafeDecode(d, n, 1 << 16, &m) != DecodeError::kNone) return false;
+      std::string held;
+      for (int k : m.held) held += (held.empty() ? "" : " ") + rms::KeyName(k);
+      c->last = Sprintf("#%lld held: %s%s", static_cast<long long>(m.sequence), held.empty() ? "none" : held.c_str(),
+                        m.focused ? "" : " (window not focused)");
       return true;
     });
     on(rms::channels::kControl, [](const void* d, int n, ChannelStats* c) {
