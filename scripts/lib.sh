@@ -110,6 +110,7 @@ rmslab_supervise() {  # (in the background) NAME HOST CMD...
     rmslab_exec_on "$host" "$n" "$@" >>"$log" 2>&1 &
     pid=$!
     echo "$pid" >"$RMSLAB_OUT/run/$name.pid"
+    echo "$name $pid" >>"$RMSLAB_OUT/run/pids"
     if [ "$n" -gt 0 ]; then
       # Restarted: the time until it says it is ready again.
       for i in $(seq 1 600); do

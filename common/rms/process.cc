@@ -1,6 +1,8 @@
 #include "rms/process.h"
 
+#include <cstdio>
 #include <cstdlib>
+#include <cstring>
 
 #include <CLI/CLI.hpp>
 #include <csignal>
@@ -11,6 +13,7 @@
 #include <unistd.h>
 
 #include "rms/check.h"
+#include "rms/text.h"
 #include "rms/version.h"
 #include "rms/channels.h"
 #include "rms/config.h"
@@ -60,6 +63,8 @@ int ProcessMain(CLI::App& app, int argc, char** argv, const std::string& process
   if (common->check) {
     try {
       const LabConfig config = LoadConfig(common->config_path);
+      ValidateChannelSuffix(common->lcm.channel_suffix);
+      if (!common->session_id.empty()) (void)ParseSessionId(common->session_id, "--session-id");
       if (check) check(config);
       spdlog::info("check: {} and this process's files are good", common->config_path);
       return 0;
@@ -107,9 +112,17 @@ void InstallStopHandlers() {
 bool StopRequested() { return g_stop.load(); }
 void RequestStop() { g_stop.store(true); }
 
-void TouchFile(const std::string& path) {
-  std::ofstream f(path);
-  if (!f) throw InputError("cannot create '" + path + "'");
+void WriteReadyFile(const std::string& path) {
+  char host[256] = {};
+  gethostname(host, sizeof host - 1);
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp);
+    f << nlohmann::json{{"pid", static_cast<int>(getpid())}, {"host", host}}.dump() << "\n";
+    f.close();
+    if (!f) throw InputError("cannot write the ready file '" + tmp + "'");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw InputError("cannot create the ready file '" + path + "'");
 }
 
 StatusReporter::StatusReporter(LcmInterface* lcm, std::string process)
@@ -195,9 +208,7 @@ void WriteStatsJson(const std::string& path, const std::string& process, const C
                              {"max", h.max_us()},
                              {"mean", h.mean_us()}};
   }
-  std::ofstream f(path);
-  if (!f) throw InputError("cannot write stats file '" + path + "'");
-  f << j.dump(2) << "\n";
+  WriteWholeFile(path, j.dump(2) + "\n");
 }
 
 FrameClock SessionFrameClock(double rate_hz) {
@@ -214,7 +225,16 @@ FrameClock SessionFrameClock(double rate_hz) {
   return c;
 }
 
+bool RestartedByLauncher() {
+  const char* r = std::getenv("RMSLAB_RESTART");
+  return r && *r && std::strcmp(r, "0") != 0;
+}
+
 std::int64_t FirstFrameNumber(double rate_hz) {
+  // A first start numbers from 0 (its peers have seen nothing yet; a
+  // re-simulation starts there too); a restart carries on the session's
+  // numbering from its epoch.
+  if (!RestartedByLauncher()) return 0;
   const char* v = std::getenv("RMSLAB_SESSION_EPOCH_US");
   if (!v || !*v) return 0;
   char* end = nullptr;

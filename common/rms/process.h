@@ -51,12 +51,17 @@ void SetUpLogging(const std::string& process, const std::string& level);
 
 // SIGINT / SIGTERM set the stop flag; the main loops poll it.
 // The first frame number a process uses for what it publishes
-// (docs/protocol.md "Frame numbers"): 0, or -- when the launcher set
-// RMSLAB_SESSION_EPOCH_US (the session's start, wall clock, us since 1970) --
+// (docs/protocol.md "Frame numbers"): 0 at a first start; when the launcher
+// restarted it after a fault (RMSLAB_RESTART > 0) and set
+// RMSLAB_SESSION_EPOCH_US (the session's start, wall clock, us since 1970),
 // the frames of rate_hz since then, so a process restarted mid-session
 // continues the numbering and its peers see the frames it missed as a gap,
 // not as stale. A malformed value is an InputError naming the variable.
 std::int64_t FirstFrameNumber(double rate_hz);
+
+// True when the launcher restarted this process after a fault
+// (RMSLAB_RESTART set and not 0; docs/sessions.md "Faults").
+bool RestartedByLauncher();
 
 // The fastest a session's frames can go: the launcher's --speed is at most
 // this many times the configured rate (docs/sessions.md).
@@ -71,8 +76,11 @@ void InstallStopHandlers();
 bool StopRequested();
 void RequestStop();
 
-// Creates the file (empty); throws rms::InputError if it cannot.
-void TouchFile(const std::string& path);
+// The ready file launchers wait for (--ready-file): {"pid": N, "host": H},
+// written whole (a temporary file renamed), so a reader never sees half of
+// it; the launcher trusts the session's messages by these pids
+// (docs/sessions.md "Ready files"). Throws InputError when it cannot.
+void WriteReadyFile(const std::string& path);
 
 // Publishes process_status_t on RMS_STATUS once a second (transport time)
 // and once at exit.

@@ -2,7 +2,21 @@
 
 #include <vector>
 
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+
+#include "rms/check.h"
+
 namespace rms {
+
+void WriteWholeFile(const std::string& path, const std::string& text) {
+  std::ofstream f(path, std::ios::binary | std::ios::trunc);
+  if (!f) throw InputError("cannot write '" + path + "': " + std::strerror(errno));
+  f << text;
+  f.close();
+  if (!f) throw InputError("could not write all of '" + path + "': " + std::strerror(errno ? errno : EIO));
+}
 
 std::string Sprintf(const char* format, ...) {
   va_list ap;

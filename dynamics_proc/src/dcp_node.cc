@@ -258,7 +258,7 @@ int RunDynamicsProc(const LabConfig& config, LcmInterface& lcm, const std::strin
   node.set_state_file(state_file);
   const bool resumed = node.ResumeFromStateFile();
   if (!restore_path.empty() && !resumed) node.RestoreCheckpoint(restore_path);
-  if (!ready_path.empty()) TouchFile(ready_path);
+  if (!ready_path.empty()) WriteReadyFile(ready_path);
   spdlog::info("ready: {} -> {}", lcm.FullChannel(channels::kOperatorInput),
                lcm.FullChannel(channels::kDcpFrame));
   RunNodeLoop(lcm, "dynamics_proc", node.counters(), node.latencies(),

@@ -197,7 +197,7 @@ int RunEsgRenderer(const LabConfig& config, LcmInterface& lcm, const EsgOptions&
   }
   EsgNode node(config, &lcm, &renderer, options, video.get(), window.get());
   node.EnableLiveChecks(config.session.frame_rate_hz);
-  if (!ready_path.empty()) TouchFile(ready_path);
+  if (!ready_path.empty()) WriteReadyFile(ready_path);
   spdlog::info("ready: {}", lcm.FullChannel(channels::kEsgFrame));
   // With a window, wake often enough that a released key is sent at once.
   RunNodeLoop(

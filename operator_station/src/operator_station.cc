@@ -51,10 +51,7 @@ constexpr int kMaxStatusSize = 1 << 20;
 constexpr int kMaxControlSize = 1 << 16;
 constexpr int kMaxWindowKeysSize = 8 + kSenderBytes + 16 + 2 + 2 * 512 + 2 + 2 * 512 + 1;
 
-bool Restarted() {
-  const char* r = std::getenv("RMSLAB_RESTART");
-  return r && *r && std::string(r) != "0";
-}
+bool Restarted() { return RestartedByLauncher(); }
 
 }  // namespace
 
@@ -356,7 +353,7 @@ int OperatorStation::Run(const std::string& stats_path, const std::string& ready
   }
   StatusReporter status(&lcm_, "operator_station");
   builder_.set_next_frame(FirstFrameNumber(config_.session.frame_rate_hz));
-  if (!ready_path.empty()) TouchFile(ready_path);
+  if (!ready_path.empty()) WriteReadyFile(ready_path);
 
   std::int64_t next_ns = MonotonicNs();
   last_ = InitialInputs(config_.inputs);

@@ -105,7 +105,7 @@ int RunSceneProc(const LabConfig& config, LcmInterface& lcm, const std::string& 
                  const std::string& ready_path) {
   SceneNode node(config, &lcm);
   node.EnableLiveChecks(config.session.frame_rate_hz);
-  if (!ready_path.empty()) TouchFile(ready_path);
+  if (!ready_path.empty()) WriteReadyFile(ready_path);
   spdlog::info("ready: {} -> {}", lcm.FullChannel(channels::kDcpFrame),
                lcm.FullChannel(channels::kEsgFrame));
   RunNodeLoop(lcm, "scene_proc", node.counters(), node.latencies(),

@@ -13,8 +13,10 @@
 #include <toml++/toml.h>
 
 #include "dcp_node.h"
+#include "sender_check.h"
 #include "rms/channels.h"
 #include "rms/check.h"
+#include "rms/text.h"
 #include "rms/collision_bits.h"
 #include "rms/config.h"
 #include "rms/dcp_frame_t.hpp"
@@ -51,9 +53,12 @@ Recording ReadRecording(const fs::path& log_path) {
   if (!log.good()) throw InputError("cannot read the session's LCM log '" + log_path.string() + "'");
   Recording r;
   bool have_suffix = false;
+  // The session's own messages only (docs/security.md "What the summary trusts").
+  session::SenderCheck check(log_path.parent_path().string());
   while (const lcm::LogEvent* ev = log.readNextEvent()) {
     const std::string base = session::BaseChannel(ev->channel);
     if (ev->channel.rfind(base, 0) != 0) continue;
+    if (check.Ignore(base, ev->data, ev->datalen)) continue;
     if (!have_suffix && base == channels::kOperatorInput) {
       r.suffix = ev->channel.substr(base.size());  // the session's channel suffix
       have_suffix = true;
@@ -333,7 +338,7 @@ ResimResult Resimulate(const ResimOptions& opt) {
     fs::create_directories(fs::path(result.out_dir) / "stats");
     fs::create_directories(fs::path(result.out_dir) / "run");
     fs::copy_file(config_path, fs::path(result.out_dir) / "config.toml", fs::copy_options::overwrite_existing);
-    std::ofstream(fs::path(result.out_dir) / "run" / "pilot") << "resim\n";
+    WriteWholeFile((fs::path(result.out_dir) / "run" / "pilot").string(), "resim\n");
     out_log = (fs::path(result.out_dir) / "lcmlog").string();
   }
 
@@ -358,16 +363,22 @@ ResimResult Resimulate(const ResimOptions& opt) {
       if (SafeDecode(d, n, 4096, &telemetry_run.back()) != DecodeError::kNone) telemetry_run.pop_back();
     });
     std::size_t next_control = 0;
+    CheckpointRateLimit restore_rate;
     const auto t_run = std::chrono::steady_clock::now();
     for (std::size_t k = 0; k < seq.size(); ++k) {
       // Restores the live DCP applied before this frame (checkpoints it
       // saved and freezes change nothing here).
       while (next_control < rec.controls.size() && rec.controls[next_control].first <= k) {
         const session_control_t& c = rec.controls[next_control++].second;
-        if (c.command == session_control_t::RESTORE) {
-          // As the live DCP did: the named checkpoint in the session's folder.
+        if (c.command == session_control_t::RESTORE && restore_rate.Allow(c.send_time_us)) {
+          // As the live DCP did: the named checkpoint in the session's
+          // folder, at its rate; one it could not read changed nothing.
           const CheckpointFolder folder((session / "checkpoints").string());
-          node.Restore(folder.Read(c.name), folder.PathOf(c.name));
+          try {
+            node.Restore(folder.Read(c.name), folder.PathOf(c.name));
+          } catch (const InputError& e) {
+            progress(static_cast<double>(k) / seq.size(), std::string("a restore the live DCP refused too: ") + e.what());
+          }
         }
       }
       const auto it = rec.inputs.find(seq[k]);
@@ -425,14 +436,14 @@ ResimResult Resimulate(const ResimOptions& opt) {
     manifest["resimulation_of"] = fs::absolute(session).lexically_normal().string();
     manifest["config"] = {{"file", "config.toml"}, {"source", fs::absolute(config_path).string()}};
     manifest["software"] = {{"version", VersionString()}, {"describe", Version().describe}, {"commit", Version().commit}};
-    std::ofstream(out / "manifest.json") << manifest.dump(2) << "\n";
-    std::ofstream(out / "summary.json") << session::Summarize(out.string()).dump(2) << "\n";
+    WriteWholeFile((out / "manifest.json").string(), manifest.dump(2) + "\n");
+    WriteWholeFile((out / "summary.json").string(), session::Summarize(out.string()).dump(2) + "\n");
     result.comparison = Compare(rec, telemetry, config, config.session.frame_rate_hz);
     result.comparison["config_changes"] = ConfigChanges((session / "config.toml").string(), config_path);
     result.comparison["frames_identical"] = result.identical;
     result.comparison["frames_compared"] = result.compared;
-    std::ofstream(out / "comparison.json") << result.comparison.dump(2) << "\n";
-    std::ofstream md(out / "comparison.md");
+    WriteWholeFile((out / "comparison.json").string(), result.comparison.dump(2) + "\n");
+    std::ostringstream md;
     md << "# Re-simulation of " << fs::absolute(session).lexically_normal().string() << "\n\n";
     md << "The recorded operator inputs, flown again with `" << config_path << "`.\n\n## What changed\n\n";
     for (const auto& c : result.comparison["config_changes"]) {
@@ -442,6 +453,7 @@ ResimResult Resimulate(const ResimOptions& opt) {
     md << "\n## What it did\n\n";
     for (const auto& s : result.comparison["explanation"]) md << "- " << s.get<std::string>() << "\n";
     md << "\n" << result.identical << " of " << result.compared << " DCP frames identical to the recording.\n";
+    WriteWholeFile((out / "comparison.md").string(), md.str());
   }
   return result;
 }

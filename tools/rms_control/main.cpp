@@ -95,6 +95,7 @@ int main(int argc, char** argv) {
     std::int64_t id = session_id.empty() ? 0 : rms::ParseSessionId(session_id, "--session-id");
     if (!session_dir.empty()) {
       const rms::session::SessionInfo s = rms::session::ReadSessionInfo(session_dir);
+      if (s.lcm_url.empty()) throw rms::InputError(session_dir + " ran on no network (a re-simulation): nothing to control");
       lcm_options.url = s.lcm_url;
       lcm_options.channel_suffix = s.channel_suffix;
       id = s.session_id;

@@ -3,6 +3,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "rms/text.h"
 #include "report.h"
 
 int main(int argc, char** argv) {
@@ -17,9 +18,7 @@ int main(int argc, char** argv) {
     if (out.empty()) out = session + "/report.html";
     const std::string html =
         rms::report::MakeReport(session, chart_js, [](const std::string& line) { std::cerr << line << "\n"; });
-    std::ofstream f(out);
-    f << html;
-    if (!f) throw std::runtime_error("cannot write " + out);
+    rms::WriteWholeFile(out, html);
     std::cout << out << "\n";
     return 0;
   } catch (const std::exception& e) {

@@ -16,6 +16,7 @@
 #include "rms/esg_frame_t.hpp"
 #include "rms/message_io.h"
 #include "rms/operator_input_t.hpp"
+#include "sender_check.h"
 #include "session_summary.h"
 
 namespace fs = std::filesystem;
@@ -75,10 +76,12 @@ Traces ReadTraces(const fs::path& log_path) {
   lcm::LogFile log(log_path.string(), "r");
   if (!log.good()) throw InputError("cannot read the session's LCM log '" + log_path.string() + "'");
   std::int64_t t0 = -1, last_input_send = -1;
+  session::SenderCheck check(log_path.parent_path().string());  // the session's own messages only
   while (const lcm::LogEvent* ev = log.readNextEvent()) {
     if (t0 < 0) t0 = ev->timestamp;
     const double ts = (ev->timestamp - t0) * 1e-6;
     const std::string base = session::BaseChannel(ev->channel);
+    if (check.Ignore(base, ev->data, ev->datalen)) continue;
     if (base == channels::kOperatorInput) {
       operator_input_t m{};
       if (SafeDecode(ev->data, ev->datalen, 1024, &m) != DecodeError::kNone) continue;

@@ -1,7 +1,9 @@
 #include "export_csv.h"
 
 #include <charconv>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -20,6 +22,7 @@
 #include "rms/message_io.h"
 #include "rms/operator_input_t.hpp"
 #include "rms/process_status_t.hpp"
+#include "sender_check.h"
 #include "rms/session_control_t.hpp"
 #include "rms/word_blocks.h"
 #include "session_summary.h"
@@ -55,6 +58,12 @@ class Csv {
   }
   long rows() const { return rows_ - 1; }
   const fs::path& path() const { return path_; }
+  // Flushes and closes; throws when any of it could not be written (a full
+  // disk): the export must not end as if it had.
+  void Close() {
+    f_.close();
+    if (!f_) throw InputError("could not write all of '" + path_.string() + "' (" + std::strerror(errno) + ")");
+  }
 
  private:
   fs::path path_;
@@ -161,8 +170,9 @@ std::vector<std::pair<std::string, long>> ExportCsv(const std::string& session_d
   Csv tm_csv(out / "dcp_telemetry.csv", tm_cols);
   Csv st_csv(out / "status.csv", {"log_time [us]", "send_time [us]", "process", "host", "pid", "frame", "final",
                                   "counter", "value"});
-  Csv ctl_csv(out / "control.csv", {"log_time [us]", "send_time [us]", "sequence", "command", "path"});
+  Csv ctl_csv(out / "control.csv", {"log_time [us]", "send_time [us]", "sequence", "command", "name"});
   long skipped = 0;
+  SenderCheck check(session_dir);  // only the session's own messages (docs/security.md)
 
   lcm::LogFile log((root / "lcmlog").string(), "r");
   if (!log.good()) throw InputError("cannot read the session's LCM log '" + (root / "lcmlog").string() + "'");
@@ -179,6 +189,7 @@ std::vector<std::pair<std::string, long>> ExportCsv(const std::string& session_d
       }
     }
     const std::string base = BaseChannel(ev->channel);
+    if (check.Ignore(base, ev->data, ev->datalen)) continue;
     const std::string t = I(ev->timestamp);
     try {
       if (base == channels::kOperatorInput) {
@@ -274,10 +285,12 @@ std::vector<std::pair<std::string, long>> ExportCsv(const std::string& session_d
     }
   }
   std::vector<std::pair<std::string, long>> files;
-  for (const Csv* c : {&in_csv, &dcp_csv, &esg_csv, &tm_csv, &st_csv, &ctl_csv}) {
+  for (Csv* c : {&in_csv, &dcp_csv, &esg_csv, &tm_csv, &st_csv, &ctl_csv}) {
+    c->Close();
     files.emplace_back(c->path().string(), c->rows());
   }
   files.emplace_back("skipped (malformed)", skipped);
+  files.emplace_back("not exported (not the session's own: other sessions, other senders)", static_cast<long>(check.ignored_total()));
   return files;
 }
 

@@ -4,6 +4,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "rms/text.h"
 #include "export_csv.h"
 #include "lab_file.h"
 #include "session_summary.h"
@@ -63,10 +64,7 @@ int main(int argc, char** argv) {
     }
     if (manifest->parsed()) {
       const auto j = rms::session::MakeManifest(m_dir, mf);
-      std::ofstream f(m_dir + "/manifest.json");
-      f << j.dump(2) << "\n";
-      f.close();
-      if (!f) throw std::runtime_error("cannot write " + m_dir + "/manifest.json");
+      rms::WriteWholeFile(m_dir + "/manifest.json", j.dump(2) + "\n");
       return 0;
     }
     if (compare->parsed()) {
@@ -76,9 +74,7 @@ int main(int argc, char** argv) {
     }
     const auto j = rms::session::Summarize(dir);
     if (out.empty()) out = dir + "/summary.json";
-    std::ofstream f(out);
-    if (!f) throw std::runtime_error("cannot write " + out);
-    f << j.dump(2) << "\n";
+    rms::WriteWholeFile(out, j.dump(2) + "\n");
     if (!brief) {
       std::cout << j.dump(2) << "\n";
       return 0;
@@ -89,6 +85,20 @@ int main(int argc, char** argv) {
     std::cout << "frames: operator " << fr["operator_published"] << ", DCP " << fr["dcp_published"]
               << ", ESG " << fr["esg_published"] << ", rendered " << fr["rendered"] << ", PNG "
               << fr["png_written"] << "; dropped " << dropped << "\n";
+    if (j["record"].value("lost", 0) > 0) {
+      std::cout << "the record lost " << j["record"]["lost"] << " frames (the recorder fell behind, was stopped or its "
+                << "disk filled):";
+      for (const auto& [ch, r] : j["record"]["by_channel"].items()) {
+        if (r["lost"].get<std::int64_t>() > 0) std::cout << " " << ch << " " << r["lost"] << " of " << r["published"];
+      }
+      std::cout << "\n";
+    }
+    if (j["ignored"].value("total", 0) > 0) {
+      std::cout << "ignored " << j["ignored"]["total"] << " logged messages not the session's own:";
+      for (const auto& [why, n] : j["ignored"]["by_reason"].items()) std::cout << " " << why << " " << n;
+      if (!j["ignored"]["other_sessions"].empty()) std::cout << " (sessions " << j["ignored"]["other_sessions"].dump() << ")";
+      std::cout << "\n";
+    }
     if (fr.value("video_dropped", 0) > 0) {
       std::cout << "video: " << fr["video_dropped"] << " frames dropped (the encoder fell behind; the video is "
                 << "short of the session by as much)\n";
@@ -99,7 +109,12 @@ int main(int argc, char** argv) {
                 << " ms, p99 " << l["p99_ms"].get<double>() << " ms\n";
     }
     std::cout << "modes 1";
+    std::size_t shown = 0;
     for (const auto& mc : j["mode_changes"]) {
+      if (++shown > 8) {
+        std::cout << " ... (" << j["mode_changes"].size() - 8 << " more mode changes)";
+        break;
+      }
       std::cout << " -> " << mc["to"] << " (" << mc["time_s"].get<double>() << " s)";
     }
     std::cout << "; acquired " << (j["acquired"].get<bool>() ? "yes" : "no") << ", docked "

@@ -8,6 +8,7 @@
 #include <set>
 #include <ctime>
 #include <unistd.h>
+#include <array>
 
 #include "rms/channels.h"
 #include "rms/config.h"
@@ -23,7 +24,10 @@
 #include "rms/operator_state_t.hpp"
 #include "rms/process_status_t.hpp"
 #include "rms/lcm_interface.h"
+#include "rms/process.h"
+#include "rms/sender_t.hpp"
 #include "rms/version.h"
+#include "sender_check.h"
 
 namespace fs = std::filesystem;
 
@@ -106,159 +110,255 @@ std::string BaseChannel(const std::string& channel) {
   return channel;
 }
 
-nlohmann::ordered_json Summarize(const std::string& dir) {
-  const fs::path root(dir);
-  const fs::path log_path = root / "lcmlog";
-  lcm::LogFile log(log_path.string(), "r");
-  if (!log.good()) throw InputError("cannot read the session's LCM log '" + log_path.string() + "'");
+namespace {
 
+// A DCP frame as logged: what confirms the telemetry of the same frame.
+struct DcpFrameRecord {
+  std::int64_t input_frame = -1;
+  ControlWord word;
+};
+
+// First pass: the session's own DCP frames, by frame number (the first of
+// each number; a repeat is not taken).
+std::map<std::int64_t, DcpFrameRecord> ReadDcpFrames(const fs::path& log_path, SenderCheck check) {
+  std::map<std::int64_t, DcpFrameRecord> out;
+  lcm::LogFile log(log_path.string(), "r");
+  while (const lcm::LogEvent* ev = log.readNextEvent()) {
+    if (BaseChannel(ev->channel) != channels::kDcpFrame || check.Ignore(channels::kDcpFrame, ev->data, ev->datalen)) {
+      continue;
+    }
+    dcp_frame_t m;
+    if (SafeDecode(ev->data, ev->datalen, 1024, &m) != DecodeError::kNone) continue;
+    try {
+      out.emplace(m.frame, DcpFrameRecord{m.input_frame, UnpackControlWord(m.control_word)});
+    } catch (const InputError&) {
+    }
+  }
+  return out;
+}
+
+// The telemetry agrees with the DCP frame of its number: the same input
+// frame, mode, acquisition and docking.
+bool Agrees(const dcp_telemetry_t& t, const DcpFrameRecord& f) {
+  return t.input_frame == f.input_frame && t.mode == f.word.mode && t.acquired == f.word.acquired &&
+         t.docked == f.word.docked;
+}
+
+// The mission as the DCP's telemetry tells it: mode changes, collision runs,
+// docking and the phases' boundaries (DCP frame numbers; -1: not reached).
+class TelemetryLog {
+ public:
+  TelemetryLog() {
+    for (const char* name : kCollisionNames) totals_[name] = {0, 0, 0};
+  }
+  void Observe(const dcp_telemetry_t& m, std::int64_t t_us, std::int64_t first_us) {
+    ++frames_;
+    const double t_s = (t_us - first_us) * 1e-6;
+    // The last start of Mode 1 (the session's start or a reset), acquisition
+    // (1 -> 2), clear of the bay (2 -> 3), the probe first in the docking
+    // envelope, docked.
+    if (f_start < 0 || (m.mode == 1 && last_mode_ != 1)) {
+      f_start = m.frame;
+      f_acquired = f_clear = f_envelope = f_docked = -1;
+    }
+    if (m.mode == 2 && last_mode_ == 1) f_acquired = m.frame;
+    if (m.mode == 3 && last_mode_ == 2) f_clear = m.frame;
+    if (m.mode == 3 && m.probe_in_envelope && f_envelope < 0) f_envelope = m.frame;
+    if (m.docked && f_docked < 0) f_docked = m.frame;
+    if (m.mode != last_mode_) {
+      if (last_mode_ != 0) mode_changes.push_back({{"frame", m.frame}, {"time_s", t_s}, {"from", last_mode_}, {"to", m.mode}});
+      last_mode_ = m.mode;
+    }
+    acquired = acquired || m.acquired;
+    if (m.docked && !docked) {
+      docking = {{"frame", m.frame}, {"time_s", t_s}, {"distance_ft", m.dock_distance_ft}, {"angle_deg", m.dock_angle_deg}};
+    }
+    docked = docked || m.docked;
+    held_frames += m.held;
+    const auto bits = static_cast<std::uint32_t>(m.collisions);
+    for (int b = 0; b < kCollisionBits; ++b) {
+      const bool on = bits & (1u << b), was = last_bits_ & (1u << b);
+      if (on && !was) {
+        run_start_us_[b] = t_us;
+        run_frames_[b] = 0;
+      }
+      if (on) ++run_frames_[b];
+      if (was && !on) EndRun(b, first_us, false);
+    }
+    last_bits_ = bits;
+    prev_us_ = t_us;
+  }
+  // Collisions still on at the end of the log; events in time order.
+  void Finish(std::int64_t first_us) {
+    for (int b = 0; b < kCollisionBits; ++b) {
+      if (last_bits_ & (1u << b)) EndRun(b, first_us, true);
+    }
+    std::sort(collisions.begin(), collisions.end(), [](const auto& a, const auto& b) {
+      return a["start_s"].template get<double>() < b["start_s"].template get<double>();
+    });
+  }
+  nlohmann::ordered_json ByKind() const {
+    nlohmann::ordered_json by_kind = nlohmann::ordered_json::object();
+    for (const auto& [kind, t] : totals_) {
+      by_kind[kind] = {{"events", static_cast<std::int64_t>(t[0])}, {"frames", static_cast<std::int64_t>(t[1])},
+                       {"duration_s", t[2]}};
+    }
+    return by_kind;
+  }
+  std::int64_t frames() const { return frames_; }
+
+  nlohmann::ordered_json mode_changes = nlohmann::ordered_json::array();
+  nlohmann::ordered_json collisions = nlohmann::ordered_json::array();
+  nlohmann::ordered_json docking = nullptr;
+  bool acquired = false, docked = false;
+  std::int64_t held_frames = 0;
+  std::int64_t f_start = -1, f_acquired = -1, f_clear = -1, f_envelope = -1, f_docked = -1;
+
+ private:
+  void EndRun(int b, std::int64_t first_us, bool open) {
+    const double dur = (prev_us_ - run_start_us_[b]) * 1e-6;
+    nlohmann::ordered_json e = {{"kind", kCollisionNames[b]},
+                                {"start_s", (run_start_us_[b] - first_us) * 1e-6},
+                                {"duration_s", dur},
+                                {"frames", run_frames_[b]}};
+    if (open) e["open"] = true;
+    collisions.push_back(e);
+    auto& tot = totals_[kCollisionNames[b]];
+    tot[0] += 1;
+    tot[1] += run_frames_[b];
+    tot[2] += dur;
+  }
+  std::map<std::string, std::array<double, 3>> totals_;  // events, frames, seconds; every kind
+  std::array<std::int64_t, kCollisionBits> run_start_us_{}, run_frames_{};
+  std::uint32_t last_bits_ = 0;
+  int last_mode_ = 0;
+  std::int64_t frames_ = 0, prev_us_ = 0;
+};
+
+// Each process's runs (a restart after a fault is a new pid): the last
+// counters each run reported on RMS_STATUS.
+struct StatusRuns {
+  std::map<std::string, std::map<int, std::map<std::string, std::int64_t>>> runs;
+  std::map<std::string, int> last_pid;
+  std::map<std::string, bool> final_seen;
+};
+
+// What one pass over the log finds, the session's own messages only.
+struct LogScan {
   std::map<std::string, std::int64_t> by_channel;
-  std::int64_t events = 0, first_us = -1, last_us = -1;
-  SequenceTracker logged_input, logged_dcp, logged_esg;
-  std::int64_t malformed = 0;
+  std::int64_t events = 0, first_us = -1, last_us = -1, malformed = 0;
+  SequenceTracker input, dcp, esg;  // frame numbers as logged
+  std::set<std::int64_t> telemetry_frames;
   int final_mode = 0;
   std::set<int> modes;
-  std::map<std::string, bool> final_status_seen;
-  // Each process's runs (a restart after a fault is a new pid): the last
-  // counters each run reported on RMS_STATUS.
-  std::map<std::string, std::map<int, std::map<std::string, std::int64_t>>> status_runs;
-  std::map<std::string, int> last_pid;
-  // From the DCP's telemetry: mode changes, collision runs, docking.
-  nlohmann::ordered_json mode_changes = nlohmann::ordered_json::array();
-  nlohmann::ordered_json collision_events = nlohmann::ordered_json::array();
-  std::map<std::string, std::array<double, 3>> collision_totals;  // events, frames, seconds; every kind
-  for (const char* name : kCollisionNames) collision_totals[name] = {0, 0, 0};
-  std::array<std::int64_t, kCollisionBits> run_start_us{};
-  std::array<std::int64_t, kCollisionBits> run_frames{};
-  std::uint32_t last_bits = 0;
-  int last_mode = 0;
-  bool acquired = false, docked = false;
-  std::int64_t held_frames = 0, telemetry_frames = 0, prev_us = 0;
-  nlohmann::ordered_json docking = nullptr;
-  // Phase boundaries, DCP frame numbers (-1: not reached): the last start of
-  // Mode 1 (the session's start or a reset), acquisition (1 -> 2), clear of
-  // the bay (2 -> 3), the probe first in the docking envelope, docked.
-  std::int64_t f_start = -1, f_acquired = -1, f_clear = -1, f_envelope = -1, f_docked = -1;
+  TelemetryLog telemetry;
   HandControlLog hand;
+  StatusRuns status;
+};
+
+void ScanTelemetry(const lcm::LogEvent& ev, const std::map<std::int64_t, DcpFrameRecord>& dcp, SenderCheck* check,
+                   LogScan* s) {
+  dcp_telemetry_t m{};
+  if (SafeDecode(ev.data, ev.datalen, 4096, &m) != DecodeError::kNone) {
+    ++s->malformed;
+    return;
+  }
+  // The telemetry is believed only where the DCP frame of its number says
+  // the same (docs/security.md "What the summary trusts").
+  const auto it = dcp.find(m.frame);
+  if (it == dcp.end()) return check->Count("telemetry_without_its_dcp_frame");
+  if (!Agrees(m, it->second)) return check->Count("telemetry_contradicts_its_dcp_frame");
+  if (!s->telemetry_frames.insert(m.frame).second) return check->Count("repeated_frame");
+  s->telemetry.Observe(m, ev.timestamp, s->first_us);
+}
+
+void ScanStatus(const lcm::LogEvent& ev, LogScan* s) {
+  process_status_t m;
+  if (SafeDecode(ev.data, ev.datalen, 1 << 20, &m) != DecodeError::kNone) {
+    ++s->malformed;
+    return;
+  }
+  if (m.final) s->status.final_seen[m.process] = true;
+  auto& run = s->status.runs[m.process][m.pid];
+  for (int i = 0; i < m.num_counters; ++i) run[m.counter_names[i]] = m.counter_values[i];
+  s->status.last_pid[m.process] = m.pid;
+}
+
+void ScanFrameNumbers(const std::string& base, const lcm::LogEvent& ev, LogScan* s) {
+  if (base == channels::kOperatorState) {
+    operator_state_t m;
+    if (SafeDecode(ev.data, ev.datalen, 1024, &m) == DecodeError::kNone) s->hand.Observe(m, (ev.timestamp - s->first_us) * 1e-6);
+    else ++s->malformed;
+  } else if (base == channels::kOperatorInput) {
+    operator_input_t m;
+    if (SafeDecode(ev.data, ev.datalen, 1024, &m) == DecodeError::kNone) s->input.Accept(m.frame);
+    else ++s->malformed;
+  } else if (base == channels::kDcpFrame) {
+    dcp_frame_t m;
+    bool ok = SafeDecode(ev.data, ev.datalen, 1024, &m) == DecodeError::kNone;
+    if (ok) {
+      s->dcp.Accept(m.frame);
+      try {
+        s->final_mode = UnpackControlWord(m.control_word).mode;
+        s->modes.insert(s->final_mode);
+      } catch (const InputError&) {
+        ok = false;
+      }
+    }
+    if (!ok) ++s->malformed;
+  } else if (base == channels::kEsgFrame) {
+    esg_frame_t m;
+    if (SafeDecode(ev.data, ev.datalen, 1024, &m) == DecodeError::kNone) s->esg.Accept(m.frame);
+    else ++s->malformed;
+  }
+}
+
+LogScan ScanLog(const fs::path& log_path, const std::map<std::int64_t, DcpFrameRecord>& dcp, SenderCheck* check) {
+  lcm::LogFile log(log_path.string(), "r");
+  LogScan s;
   while (const lcm::LogEvent* ev = log.readNextEvent()) {
-    ++events;
-    if (first_us < 0) first_us = ev->timestamp;
-    last_us = ev->timestamp;
+    ++s.events;
+    if (s.first_us < 0) s.first_us = ev->timestamp;
+    s.last_us = ev->timestamp;
     const std::string base = BaseChannel(ev->channel);
-    ++by_channel[ev->channel];
-    if (base == channels::kOperatorState) {
-      operator_state_t m;
-      if (SafeDecode(ev->data, ev->datalen, 1024, &m) == DecodeError::kNone) hand.Observe(m, (ev->timestamp - first_us) * 1e-6);
-      else ++malformed;
-    } else if (base == channels::kOperatorInput) {
-      operator_input_t m;
-      if (SafeDecode(ev->data, ev->datalen, 1024, &m) == DecodeError::kNone) logged_input.Accept(m.frame);
-      else ++malformed;
-    } else if (base == channels::kDcpFrame) {
-      dcp_frame_t m;
-      if (SafeDecode(ev->data, ev->datalen, 1024, &m) == DecodeError::kNone) {
-        logged_dcp.Accept(m.frame);
-        try {
-          final_mode = UnpackControlWord(m.control_word).mode;
-          modes.insert(final_mode);
-        } catch (const InputError&) {
-          ++malformed;
-        }
-      } else {
-        ++malformed;
-      }
-    } else if (base == channels::kDcpTelemetry) {
-      dcp_telemetry_t m{};
-      if (SafeDecode(ev->data, ev->datalen, 4096, &m) != DecodeError::kNone) {
-        ++malformed;
-        continue;
-      }
-      ++telemetry_frames;
-      const double t_s = (ev->timestamp - first_us) * 1e-6;
-      if (f_start < 0 || (m.mode == 1 && last_mode != 1)) {
-        f_start = m.frame;
-        f_acquired = f_clear = f_envelope = f_docked = -1;
-      }
-      if (m.mode == 2 && last_mode == 1) f_acquired = m.frame;
-      if (m.mode == 3 && last_mode == 2) f_clear = m.frame;
-      if (m.mode == 3 && m.probe_in_envelope && f_envelope < 0) f_envelope = m.frame;
-      if (m.docked && f_docked < 0) f_docked = m.frame;
-      if (m.mode != last_mode) {
-        if (last_mode != 0) {
-          mode_changes.push_back({{"frame", m.frame}, {"time_s", t_s}, {"from", last_mode}, {"to", m.mode}});
-        }
-        last_mode = m.mode;
-      }
-      acquired = acquired || m.acquired;
-      if (m.docked && !docked) {
-        docking = {{"frame", m.frame}, {"time_s", t_s}, {"distance_ft", m.dock_distance_ft},
-                   {"angle_deg", m.dock_angle_deg}};
-      }
-      docked = docked || m.docked;
-      held_frames += m.held;
-      const auto bits = static_cast<std::uint32_t>(m.collisions);
-      for (int b = 0; b < kCollisionBits; ++b) {
-        const bool on = bits & (1u << b), was = last_bits & (1u << b);
-        if (on && !was) {
-          run_start_us[b] = ev->timestamp;
-          run_frames[b] = 0;
-        }
-        if (on) ++run_frames[b];
-        if (was && !on) {
-          const double dur = (prev_us - run_start_us[b]) * 1e-6;
-          collision_events.push_back({{"kind", kCollisionNames[b]},
-                                      {"start_s", (run_start_us[b] - first_us) * 1e-6},
-                                      {"duration_s", dur},
-                                      {"frames", run_frames[b]}});
-          auto& tot = collision_totals[kCollisionNames[b]];
-          tot[0] += 1;
-          tot[1] += run_frames[b];
-          tot[2] += dur;
-        }
-      }
-      last_bits = bits;
-      prev_us = ev->timestamp;
-    } else if (base == channels::kEsgFrame) {
-      esg_frame_t m;
-      if (SafeDecode(ev->data, ev->datalen, 1024, &m) == DecodeError::kNone) logged_esg.Accept(m.frame);
-      else ++malformed;
-    } else if (base == channels::kStatus) {
-      process_status_t m;
-      if (SafeDecode(ev->data, ev->datalen, 1 << 20, &m) == DecodeError::kNone) {
-        if (m.final) final_status_seen[m.process] = true;
-        auto& run = status_runs[m.process][m.pid];
-        for (int i = 0; i < m.num_counters; ++i) run[m.counter_names[i]] = m.counter_values[i];
-        last_pid[m.process] = m.pid;
-      } else {
-        ++malformed;
-      }
-    }
+    if (check->Ignore(base, ev->data, ev->datalen)) continue;
+    ++s.by_channel[ev->channel];
+    if (base == channels::kDcpTelemetry) ScanTelemetry(*ev, dcp, check, &s);
+    else if (base == channels::kStatus) ScanStatus(*ev, &s);
+    else ScanFrameNumbers(base, *ev, &s);
   }
+  s.telemetry.Finish(s.first_us);
+  return s;
+}
 
-  // Collisions still on at the end of the log.
-  for (int b = 0; b < kCollisionBits; ++b) {
-    if (last_bits & (1u << b)) {
-      const double dur = (prev_us - run_start_us[b]) * 1e-6;
-      collision_events.push_back({{"kind", kCollisionNames[b]}, {"start_s", (run_start_us[b] - first_us) * 1e-6},
-                                  {"duration_s", dur}, {"frames", run_frames[b]}, {"open", true}});
-      auto& tot = collision_totals[kCollisionNames[b]];
-      tot[0] += 1;
-      tot[1] += run_frames[b];
-      tot[2] += dur;
-    }
+// A status run no real process could have reported: a negative count, or
+// more frames than the session's length allows at any speed.
+bool Plausible(const std::map<std::string, std::int64_t>& run, double duration_s, double rate_hz) {
+  const double most = (duration_s + 10.0) * rate_hz * kMaxSessionSpeed + 1000.0;
+  for (const auto& [k, v] : run) {
+    if (v < 0) return false;
+    if (k.rfind("latency.", 0) != 0 && static_cast<double>(v) > most * 100.0) return false;
+    if ((k == "published" || k == "rendered" || k == "received") && static_cast<double>(v) > most) return false;
   }
+  return true;
+}
 
-  std::sort(collision_events.begin(), collision_events.end(),
-            [](const auto& a, const auto& b) { return a["start_s"].template get<double>() < b["start_s"].template get<double>(); });
-
+// Each process's stats file (the last run's), with the counts of earlier
+// runs (ended in a fault, restarted by the launcher) that only RMS_STATUS in
+// the log kept (counts only: not the mode, not latency percentiles).
+std::map<std::string, nlohmann::json> MergedStats(const fs::path& root, const StatusRuns& st, double duration_s,
+                                                  double rate_hz, SenderCheck* check) {
   std::map<std::string, nlohmann::json> stats;
   for (const char* p : {"operator_station", "dynamics_proc", "scene_proc", "esg_renderer"}) {
     stats[p] = ReadJson(root / "stats" / (std::string(p) + ".json"));
-    // The stats file is the last run's; a run that ended in a fault (killed,
-    // restarted by the launcher) left its counts on RMS_STATUS in the log:
-    // they are added (counts only: not the mode, not latency percentiles).
-    for (const auto& [pid, counters] : status_runs[p]) {
-      if (pid == last_pid[p]) continue;
+    const auto runs = st.runs.find(p);
+    if (runs == st.runs.end()) continue;
+    for (const auto& [pid, counters] : runs->second) {
+      if (pid == st.last_pid.at(p)) continue;
+      if (!Plausible(counters, duration_s, rate_hz)) {
+        check->Count("implausible_status");
+        continue;
+      }
       if (!stats[p].contains("counters")) stats[p]["counters"] = nlohmann::json::object();
       for (const auto& [k, v] : counters) {
         if (k == "mode" || k.rfind("latency.", 0) == 0) continue;
@@ -266,82 +366,64 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
       }
     }
   }
-  const auto& op = stats["operator_station"];
-  const auto& dcp = stats["dynamics_proc"];
-  const auto& scene = stats["scene_proc"];
-  const auto& esg = stats["esg_renderer"];
+  return stats;
+}
 
-  nlohmann::ordered_json j;
-  j["session"] = fs::absolute(root).lexically_normal().filename().string();
-  if (j["session"].get<std::string>().empty()) j["session"] = fs::absolute(root).parent_path().filename().string();
-  j["duration_s"] = first_us >= 0 ? (last_us - first_us) * 1e-6 : 0.0;
-  j["final_mode"] = final_mode;
-  j["modes_seen"] = std::vector<int>(modes.begin(), modes.end());
-  j["acquired"] = acquired;
-  j["docked"] = docked;
-  j["docking"] = docking;
+double FrameRate(const fs::path& root) {
+  try {
+    return LoadConfig((root / "config.toml").string()).session.frame_rate_hz;
+  } catch (const std::exception&) {
+    return 30.0;
+  }
+}
+
+nlohmann::ordered_json Restarts(const fs::path& root) {
+  // Processes the launcher restarted after a fault (docs/sessions.md
+  // "Faults"): run/restarts, one line "NAME N EXIT_CODE DOWN_AT READY_AT".
+  nlohmann::ordered_json restarts = nlohmann::ordered_json::array();
+  std::ifstream f((root / "run" / "restarts").string());
+  std::string name;
+  int n = 0, rc = 0;
+  double down = 0, ready = 0;
+  while (f >> name >> n >> rc >> down >> ready) {
+    restarts.push_back(
+        {{"process", name}, {"restart", n}, {"exit_code", rc}, {"signal", rc > 128 ? rc - 128 : 0}, {"restart_s", ready - down}});
+  }
+  return restarts;
+}
+
+void AddMission(const fs::path& root, const LogScan& s, double rate_hz, nlohmann::ordered_json* out) {
+  nlohmann::ordered_json& j = *out;
+  const TelemetryLog& t = s.telemetry;
+  j["final_mode"] = s.final_mode;
+  j["modes_seen"] = std::vector<int>(s.modes.begin(), s.modes.end());
+  j["acquired"] = t.acquired;
+  j["docked"] = t.docked;
+  j["docking"] = t.docking;
   // Phase durations in session time (DCP frames over the frame rate), so
   // they do not depend on how fast the session ran.
-  double rate_hz = 30.0;
-  try {
-    rate_hz = LoadConfig((root / "config.toml").string()).session.frame_rate_hz;
-  } catch (const std::exception&) {
-  }
   auto span = [&](std::int64_t a, std::int64_t b) -> nlohmann::ordered_json {
     if (a < 0 || b < 0) return nullptr;
     return static_cast<double>(b - a) / rate_hz;
   };
-  j["phase_durations_s"] = {{"acquisition", span(f_start, f_acquired)},
-                            {"extraction", span(f_acquired, f_clear)},
-                            {"maneuvering", span(f_clear, f_envelope >= 0 ? f_envelope : f_docked)},
-                            {"docking", span(f_envelope >= 0 ? f_envelope : f_docked, f_docked)}};
-  if (docked && docking.is_object()) {
+  const std::int64_t envelope = t.f_envelope >= 0 ? t.f_envelope : t.f_docked;
+  j["phase_durations_s"] = {{"acquisition", span(t.f_start, t.f_acquired)},
+                            {"extraction", span(t.f_acquired, t.f_clear)},
+                            {"maneuvering", span(t.f_clear, envelope)},
+                            {"docking", span(envelope, t.f_docked)}};
+  if (t.docked && t.docking.is_object()) {
     try {
       const LabConfig c = LoadConfig((root / "config.toml").string());
-      docking["within_tolerance"] = docking["distance_ft"].get<double>() <= c.dcp.dock_distance_ft &&
-                                    docking["angle_deg"].get<double>() <= c.dcp.dock_angle_deg;
-      j["docking"] = docking;
+      j["docking"]["within_tolerance"] = t.docking["distance_ft"].get<double>() <= c.dcp.dock_distance_ft &&
+                                         t.docking["angle_deg"].get<double>() <= c.dcp.dock_angle_deg;
     } catch (const std::exception&) {
     }
   }
-  {
-    std::ifstream pilot((root / "run" / "pilot").string());
-    std::string who;
-    if (pilot >> who) j["pilot"] = who;
-  }
-  {
-    // Processes the launcher restarted after a fault (docs/sessions.md
-    // "Faults"): run/restarts, one line "NAME N EXIT_CODE DOWN_AT READY_AT".
-    nlohmann::ordered_json restarts = nlohmann::ordered_json::array();
-    std::ifstream f((root / "run" / "restarts").string());
-    std::string name;
-    int n = 0, rc = 0;
-    double down = 0, ready = 0;
-    while (f >> name >> n >> rc >> down >> ready) {
-      restarts.push_back({{"process", name},
-                          {"restart", n},
-                          {"exit_code", rc},
-                          {"signal", rc > 128 ? rc - 128 : 0},
-                          {"restart_s", ready - down}});
-    }
-    j["restarts"] = restarts;
-  }
-  j["mode_changes"] = mode_changes;  j["by_hand"] = hand.Json();
-  if (j["by_hand"].is_object()) {
-    // The station's own count has the last key too (a quit ends it before
-    // another state message goes out).
-    j["by_hand"]["key_actions"] = std::max(j["by_hand"]["key_actions"].get<std::int64_t>(), Counter(op, "key_actions"));
-  }
+}
 
-  j["collisions"] = collision_events;
-  nlohmann::ordered_json by_kind = nlohmann::ordered_json::object();
-  for (const auto& [kind, t] : collision_totals) {
-    by_kind[kind] = {{"events", static_cast<std::int64_t>(t[0])}, {"frames", static_cast<std::int64_t>(t[1])},
-                     {"duration_s", t[2]}};
-  }
-  j["collisions_by_kind"] = by_kind;
-  j["held_frames"] = held_frames;
-  j["telemetry_frames"] = telemetry_frames;
+nlohmann::ordered_json FramesJson(const std::map<std::string, nlohmann::json>& stats) {
+  const auto &op = stats.at("operator_station"), &dcp = stats.at("dynamics_proc"), &scene = stats.at("scene_proc"),
+             &esg = stats.at("esg_renderer");
   nlohmann::ordered_json frames;
   frames["operator_published"] = Counter(op, "published");
   frames["dcp_published"] = Counter(dcp, "published");
@@ -362,14 +444,147 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
       {"malformed_at_scene", SumPrefix(scene, "dropped.")},
       {"malformed_at_esg", SumPrefix(esg, "dropped.")},
   };
+  // Dropped for a reason of their own, not malformed (docs/protocol.md):
+  // too late to act on, of another session, beyond the session's clock.
+  nlohmann::ordered_json refused = nlohmann::ordered_json::object();
+  for (const char* reason : {"late", "other_session", "far_ahead"}) {
+    refused[reason] = Counter(dcp, std::string("dropped.") + reason) + Counter(scene, std::string("dropped.") + reason) +
+                      Counter(esg, std::string("dropped.") + reason);
+  }
+  frames["refused"] = refused;
   frames["clamped_inputs"] = {{"operator_station", SumPrefix(op, "clamped.")},
                               {"dynamics_proc", SumPrefix(dcp, "clamped.")},
                               {"scene_proc", SumPrefix(scene, "clamped.")}};
-  j["frames"] = frames;
+  return frames;
+}
+
+nlohmann::ordered_json Links(const nlohmann::json& st) {
+  nlohmann::ordered_json l = nlohmann::ordered_json::object();
+  if (!st.contains("latency_us")) return l;
+  for (auto it = st["latency_us"].begin(); it != st["latency_us"].end(); ++it) {
+    l[it.key()] = {{"p50_ms", it.value()["p50"].get<double>() / 1000.0},
+                   {"p99_ms", it.value()["p99"].get<double>() / 1000.0},
+                   {"max_ms", it.value()["max"].get<double>() / 1000.0}};
+  }
+  return l;
+}
+
+// Timing health, by process: frames lost on the way in (from the frame
+// numbers), frames late (more than a frame period after the operator sent
+// them), malformed ones dropped, and each link's latency.
+nlohmann::ordered_json TimingJson(const std::map<std::string, nlohmann::json>& stats, double rate_hz) {
+  const auto &op = stats.at("operator_station"), &dcp = stats.at("dynamics_proc"), &scene = stats.at("scene_proc"),
+             &esg = stats.at("esg_renderer");
+  nlohmann::ordered_json timing;
+  timing["frame_period_ms"] = 1000.0 / rate_hz;
+  timing["operator_station"] = {{"late_frames", Counter(op, "frames.late")}};
+  timing["dynamics_proc"] = {{"dropped_frames", Counter(dcp, "input.missing")},
+                             {"late_frames", Counter(dcp, "frames.late")},
+                             {"too_late_dropped", Counter(dcp, "dropped.late")},
+                             {"malformed", SumPrefix(dcp, "dropped.")},
+                             {"latency", Links(dcp)}};
+  timing["scene_proc"] = {{"dropped_frames", Counter(scene, "dcp.missing")},
+                          {"late_frames", Counter(scene, "frames.late")},
+                          {"too_late_dropped", Counter(scene, "dropped.late")},
+                          {"malformed", SumPrefix(scene, "dropped.")},
+                          {"latency", Links(scene)}};
+  timing["esg_renderer"] = {{"dropped_frames", Counter(esg, "esg.missing")},
+                            {"superseded", Counter(esg, "superseded")},
+                            {"late_frames", Counter(esg, "frames.late")},
+                            {"too_late_dropped", Counter(esg, "dropped.late")},
+                            {"malformed", SumPrefix(esg, "dropped.")},
+                            {"latency", Links(esg)}};
+  return timing;
+}
+
+// The record's own losses (docs/sessions.md "Losses"): each channel's frames
+// its publisher says it sent against those the log holds -- frames the
+// recorder lost (it fell behind, was stopped, or its disk filled), distinct
+// from frames lost on the way between the processes.
+nlohmann::ordered_json RecordJson(const std::map<std::string, nlohmann::json>& stats, const LogScan& s) {
+  struct Row {
+    const char* channel;
+    std::int64_t published, logged;
+  };
+  const Row rows[] = {
+      {channels::kOperatorInput, Counter(stats.at("operator_station"), "published"), s.input.received()},
+      {channels::kDcpFrame, Counter(stats.at("dynamics_proc"), "published"), s.dcp.received()},
+      {channels::kDcpTelemetry, Counter(stats.at("dynamics_proc"), "published"),
+       static_cast<std::int64_t>(s.telemetry_frames.size())},
+      {channels::kEsgFrame, Counter(stats.at("scene_proc"), "published"), s.esg.received()},
+  };
+  nlohmann::ordered_json r;
+  std::int64_t lost = 0;
+  for (const Row& row : rows) {
+    if (row.published <= 0) continue;  // no count from the publisher: nothing to hold the log against
+    const std::int64_t l = std::max<std::int64_t>(0, row.published - row.logged);
+    r["by_channel"][row.channel] = {{"published", row.published}, {"logged", row.logged}, {"lost", l}};
+    lost += l;
+  }
+  r["lost"] = lost;
+  return r;
+}
+
+nlohmann::ordered_json LogJson(const LogScan& s) {
+  nlohmann::ordered_json lj;
+  lj["file"] = "lcmlog";
+  lj["events"] = s.events;
+  lj["by_channel"] = s.by_channel;
+  lj["operator_frames"] = s.input.received();
+  lj["dcp_frames"] = s.dcp.received();
+  lj["esg_frames"] = s.esg.received();
+  lj["esg_frames_missing"] = s.esg.missing();
+  lj["malformed"] = s.malformed;
+  lj["final_status_from"] = nlohmann::json::array();
+  for (const auto& [p, seen] : s.status.final_seen) lj["final_status_from"].push_back(p);
+  return lj;
+}
+
+}  // namespace
+
+nlohmann::ordered_json Summarize(const std::string& dir) {
+  const fs::path root(dir);
+  const fs::path log_path = root / "lcmlog";
+  {
+    lcm::LogFile probe(log_path.string(), "r");
+    if (!probe.good()) throw InputError("cannot read the session's LCM log '" + log_path.string() + "'");
+  }
+  SenderCheck check(dir);
+  const auto dcp_frames = ReadDcpFrames(log_path, check);
+  const LogScan s = ScanLog(log_path, dcp_frames, &check);
+  const double rate_hz = FrameRate(root);
+  const double duration_s = s.first_us >= 0 ? (s.last_us - s.first_us) * 1e-6 : 0.0;
+  const auto stats = MergedStats(root, s.status, duration_s, rate_hz, &check);
+
+  nlohmann::ordered_json j;
+  j["session"] = fs::absolute(root).lexically_normal().filename().string();
+  if (j["session"].get<std::string>().empty()) j["session"] = fs::absolute(root).parent_path().filename().string();
+  if (check.session_id() != 0) j["session_id"] = FormatSessionId(check.session_id());
+  j["duration_s"] = duration_s;
+  AddMission(root, s, rate_hz, &j);
+  {
+    std::ifstream pilot((root / "run" / "pilot").string());
+    std::string who;
+    if (pilot >> who) j["pilot"] = who;
+  }
+  j["restarts"] = Restarts(root);
+  j["mode_changes"] = s.telemetry.mode_changes;
+  j["by_hand"] = s.hand.Json();
+  if (j["by_hand"].is_object()) {
+    // The station's own count has the last key too (a quit ends it before
+    // another state message goes out).
+    j["by_hand"]["key_actions"] =
+        std::max(j["by_hand"]["key_actions"].get<std::int64_t>(), Counter(stats.at("operator_station"), "key_actions"));
+  }
+  j["collisions"] = s.telemetry.collisions;
+  j["collisions_by_kind"] = s.telemetry.ByKind();
+  j["held_frames"] = s.telemetry.held_frames;
+  j["telemetry_frames"] = s.telemetry.frames();
+  j["frames"] = FramesJson(stats);
   nlohmann::ordered_json lat = nlohmann::ordered_json::object();
-  for (const auto& [proc, s] : stats) {
-    if (!s.contains("latency_us")) continue;
-    for (auto it = s["latency_us"].begin(); it != s["latency_us"].end(); ++it) {
+  for (const auto& [proc, st] : stats) {
+    if (!st.contains("latency_us")) continue;
+    for (auto it = st["latency_us"].begin(); it != st["latency_us"].end(); ++it) {
       lat[it.key()] = {{"count", it.value()["count"]},
                        {"p50_ms", it.value()["p50"].get<double>() / 1000.0},
                        {"p99_ms", it.value()["p99"].get<double>() / 1000.0},
@@ -377,55 +592,10 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
     }
   }
   j["latency"] = lat;
-  // Timing health, by process: frames lost on the way in (from the frame
-  // numbers), frames late (more than a frame period after the operator sent
-  // them), malformed ones dropped, and each link's latency.
-  {
-    double rate_hz = 30.0;
-    try {
-      rate_hz = LoadConfig((root / "config.toml").string()).session.frame_rate_hz;
-    } catch (const std::exception&) {
-    }
-    nlohmann::ordered_json timing;
-    timing["frame_period_ms"] = 1000.0 / rate_hz;
-    auto links = [&](const nlohmann::json& st) {
-      nlohmann::ordered_json l = nlohmann::ordered_json::object();
-      if (!st.contains("latency_us")) return l;
-      for (auto it = st["latency_us"].begin(); it != st["latency_us"].end(); ++it) {
-        l[it.key()] = {{"p50_ms", it.value()["p50"].get<double>() / 1000.0},
-                       {"p99_ms", it.value()["p99"].get<double>() / 1000.0},
-                       {"max_ms", it.value()["max"].get<double>() / 1000.0}};
-      }
-      return l;
-    };
-    timing["operator_station"] = {{"late_frames", Counter(op, "frames.late")}};
-    timing["dynamics_proc"] = {{"dropped_frames", Counter(dcp, "input.missing")},
-                               {"late_frames", Counter(dcp, "frames.late")},
-                               {"malformed", SumPrefix(dcp, "dropped.")},
-                               {"latency", links(dcp)}};
-    timing["scene_proc"] = {{"dropped_frames", Counter(scene, "dcp.missing")},
-                            {"late_frames", Counter(scene, "frames.late")},
-                            {"malformed", SumPrefix(scene, "dropped.")},
-                            {"latency", links(scene)}};
-    timing["esg_renderer"] = {{"dropped_frames", Counter(esg, "esg.missing")},
-                              {"superseded", Counter(esg, "superseded")},
-                              {"late_frames", Counter(esg, "frames.late")},
-                              {"malformed", SumPrefix(esg, "dropped.")},
-                              {"latency", links(esg)}};
-    j["timing"] = timing;
-  }
-  nlohmann::ordered_json lj;
-  lj["file"] = "lcmlog";
-  lj["events"] = events;
-  lj["by_channel"] = by_channel;
-  lj["operator_frames"] = logged_input.received();
-  lj["dcp_frames"] = logged_dcp.received();
-  lj["esg_frames"] = logged_esg.received();
-  lj["esg_frames_missing"] = logged_esg.missing();
-  lj["malformed"] = malformed;
-  lj["final_status_from"] = nlohmann::json::array();
-  for (const auto& [p, seen] : final_status_seen) lj["final_status_from"].push_back(p);
-  j["log"] = lj;
+  j["timing"] = TimingJson(stats, rate_hz);
+  j["record"] = RecordJson(stats, s);
+  j["log"] = LogJson(s);
+  j["ignored"] = check.Json();
   return j;
 }
 
@@ -473,8 +643,10 @@ SessionInfo ReadSessionInfo(const std::string& dir) {
   s.dir = dir;
   try {
     const auto j = nlohmann::json::parse(f);
-    s.lcm_url = j.at("lcm").at("url").get<std::string>();
-    s.channel_suffix = j.at("lcm").value("channel_suffix", "");
+    if (j.contains("lcm")) {  // a re-simulation's folder has none: it ran on no network
+      s.lcm_url = j.at("lcm").value("url", "");
+      s.channel_suffix = j.at("lcm").value("channel_suffix", "");
+    }
     if (j.contains("session_id")) s.session_id = ParseSessionId(j.at("session_id").get<std::string>(), p.string() + " session_id");
   } catch (const InputError&) {
     throw;

@@ -1,0 +1,52 @@
+#pragma once
+// Which logged messages are the session's own (docs/security.md "What the
+// summary trusts"). The recorder logs everything on the session's channels,
+// strangers' messages included; every tool that reads the log -- the
+// summary, the export, the re-simulation, the report -- takes only messages
+// that carry the session's id (manifest.json) from a process of the session
+// that publishes that channel, with one of the pids the session's processes
+// wrote in their ready files (run/pids). What it leaves out is counted by
+// reason, and the summary lists it.
+#include <cstdint>
+#include <map>
+#include <set>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace rms::session {
+
+class SenderCheck {
+ public:
+  // Reads SESSION/manifest.json (session_id) and SESSION/run/pids ("NAME PID"
+  // lines). A session from before session ids (no session_id) takes every
+  // message; a process with no pid in run/pids (on an ssh host, or
+  // rms_control) is checked by the id and the publisher only.
+  explicit SenderCheck(const std::string& session_dir);
+  // Takes no session: everything (a log that is not a session's).
+  SenderCheck() = default;
+
+  // The reason to leave this logged message out, or nullptr to take it:
+  // "other_session", "not_the_publisher" (a process that does not publish
+  // that channel), "not_the_sessions_process" (a pid none of the session's
+  // processes had), "no_sender" (too short to carry one). base_channel: the
+  // channel without the session's suffix. Counts what it leaves out.
+  const char* Ignore(const std::string& base_channel, const void* data, int size);
+  // A message left out for a reason of the caller's own (e.g. telemetry no
+  // DCP frame confirms): counted with the rest.
+  void Count(const std::string& reason) { ++ignored_[reason]; }
+
+  std::int64_t session_id() const { return session_id_; }
+  bool checks_pids() const { return !pids_.empty(); }
+  std::int64_t ignored_total() const;
+  // {"total": N, "by_reason": {...}, "other_sessions": ["0x...", ...]}
+  nlohmann::ordered_json Json() const;
+
+ private:
+  std::int64_t session_id_ = 0;
+  std::map<std::int8_t, std::set<std::int32_t>> pids_;  // by sender_t::PROCESS_*
+  std::map<std::string, std::int64_t> ignored_;
+  std::set<std::int64_t> other_sessions_;
+};
+
+}  // namespace rms::session
