@@ -1,6 +1,8 @@
 #include "rms/process.h"
 
+#include <cerrno>
 #include <cstdio>
+#include <thread>
 #include <cstdlib>
 #include <cstring>
 
@@ -60,6 +62,7 @@ int ProcessMain(CLI::App& app, int argc, char** argv, const std::string& process
   }
   SetUpLogging(process, common->log_level);
   InstallStopHandlers();
+  WatchLifeline();
   if (common->check) {
     try {
       const LabConfig config = LoadConfig(common->config_path);
@@ -99,6 +102,25 @@ namespace {
 std::atomic<bool> g_stop{false};
 extern "C" void OnStopSignal(int) { g_stop.store(true); }
 }  // namespace
+
+void WatchLifeline() {
+  const char* v = std::getenv("RMSLAB_LIFELINE");
+  if (!v || std::strcmp(v, "stdin") != 0) return;
+  // The launcher holds the other end of this process's standard input and
+  // never writes to it: end of file means the launcher is gone (killed, even
+  // with SIGKILL; or, over ssh, the link to it): stop as on SIGINT.
+  std::thread([] {
+    char buf[256];
+    for (;;) {
+      const ssize_t n = read(STDIN_FILENO, buf, sizeof buf);
+      if (n > 0) continue;
+      if (n < 0 && errno == EINTR) continue;
+      spdlog::warn("the launcher is gone (its lifeline, standard input, closed): stopping");
+      RequestStop();
+      return;
+    }
+  }).detach();
+}
 
 void InstallStopHandlers() {
   struct sigaction sa {};

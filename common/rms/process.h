@@ -73,6 +73,10 @@ inline constexpr double kMaxSessionSpeed = 100.0;
 FrameClock SessionFrameClock(double rate_hz);
 
 void InstallStopHandlers();
+// With RMSLAB_LIFELINE=stdin (set by the launcher), a thread waits on
+// standard input and asks the process to stop when it closes: a session's
+// processes never outlive their launcher (docs/sessions.md "The launcher").
+void WatchLifeline();
 bool StopRequested();
 void RequestStop();
 

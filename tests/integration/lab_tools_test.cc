@@ -34,19 +34,8 @@ using testing::ReadFile;
 using testing::SourcePath;
 using testing::Subprocess;
 
-struct ScriptRun {
-  int rc = -1;
-  std::string out;  // stdout + stderr
-};
-
-// Runs a script or tool to the end.
-ScriptRun Script(const std::vector<std::string>& argv, const std::string& log, double timeout_s = 300) {
-  Subprocess p(argv, log, {std::string("RMSLAB_BUILD=") + RMSLAB_BUILD_DIR});
-  ScriptRun r;
-  r.rc = p.Wait(timeout_s);
-  r.out = ReadFile(log);
-  return r;
-}
+using testing::Script;
+using testing::ScriptRun;
 
 // One recorded session (the autopilot, at 4x, small frames), shared by the
 // tests that only read it.

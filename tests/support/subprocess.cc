@@ -129,6 +129,14 @@ std::string UniqueLcmUrl(int base) {
                            std::to_string(kFirst + kCount - 1));
 }
 
+ScriptRun Script(const std::vector<std::string>& argv, const std::string& log, double timeout_s) {
+  Subprocess p(argv, log, {std::string("RMSLAB_BUILD=") + RMSLAB_BUILD_DIR});
+  ScriptRun r;
+  r.rc = p.Wait(timeout_s);
+  r.out = ReadFile(log);
+  return r;
+}
+
 std::string BuildPath(const std::string& rel) { return std::string(RMSLAB_BUILD_DIR) + "/" + rel; }
 std::string SourcePath(const std::string& rel) { return std::string(RMSLAB_SOURCE_DIR) + "/" + rel; }
 

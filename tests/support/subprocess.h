@@ -29,6 +29,13 @@ class Subprocess {
   int status_ = 0;
 };
 
+// A script or tool run to its end, its output (stdout and stderr) kept.
+struct ScriptRun {
+  int rc = -1;
+  std::string out;
+};
+ScriptRun Script(const std::vector<std::string>& argv, const std::string& log, double timeout_s = 300);
+
 bool WaitForFile(const std::string& path, double timeout_s);
 std::string ReadFile(const std::string& path);
 // A fresh directory under the temp directory.

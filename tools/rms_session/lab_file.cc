@@ -22,12 +22,6 @@ bool ValidName(const std::string& s) {
   return true;
 }
 
-std::string Quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
 }  // namespace
 
 bool LabFile::all_local() const {
@@ -82,16 +76,16 @@ LabFile ParseLabFile(std::string_view text, const std::string& path) {
   return lab;
 }
 
-std::string LabFileShell(const LabFile& lab) {
-  std::ostringstream os;
-  for (const auto& [p, h] : lab.hosts) os << "LAB_HOST_" << p << "=" << Quote(h) << "\n";
-  os << "LAB_TTL=" << lab.ttl << "\n";
-  os << "LAB_GROUP=" << Quote(lab.group) << "\n";
-  os << "LAB_PORT=" << lab.port << "\n";
-  os << "LAB_ALL_LOCAL=" << (lab.all_local() ? 1 : 0) << "\n";
-  os << "LAB_REMOTE_ROOT=" << Quote(lab.remote_root) << "\n";
-  os << "LAB_REMOTE_BUILD=" << Quote(lab.remote_build) << "\n";
-  return os.str();
+nlohmann::ordered_json LabFileJson(const LabFile& lab) {
+  nlohmann::ordered_json j;
+  j["hosts"] = lab.hosts;
+  j["ttl"] = lab.ttl;
+  j["group"] = lab.group;
+  j["port"] = lab.port;
+  j["all_local"] = lab.all_local();
+  j["remote_root"] = lab.remote_root;
+  j["remote_build"] = lab.remote_build;
+  return j;
 }
 
 }  // namespace rms::session

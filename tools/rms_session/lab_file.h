@@ -7,6 +7,8 @@
 #include <string>
 #include <string_view>
 
+#include <nlohmann/json.hpp>
+
 namespace rms::session {
 
 struct LabFile {
@@ -26,8 +28,8 @@ struct LabFile {
 LabFile LoadLabFile(const std::string& path);
 // The same from the file's text (path names it in errors).
 LabFile ParseLabFile(std::string_view text, const std::string& path);
-// LAB_HOST_<process>=..., LAB_TTL=..., LAB_ALL_LOCAL=0|1, LAB_REMOTE_ROOT,
-// LAB_REMOTE_BUILD: shell-quoted assignments for `eval`.
-std::string LabFileShell(const LabFile& lab);
+// {"hosts": {process: host}, "ttl", "group", "port", "all_local",
+// "remote_root", "remote_build"}: for the launcher (scripts/lab).
+nlohmann::ordered_json LabFileJson(const LabFile& lab);
 
 }  // namespace rms::session

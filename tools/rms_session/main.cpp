@@ -46,10 +46,17 @@ int main(int argc, char** argv) {
   exporter->add_option("session", e_dir, "Session folder")->required()->check(CLI::ExistingDirectory);
   exporter->add_option("--out", e_out, "Folder for the CSV files (default SESSION/csv)");
 
-  // labfile: a lab's host layout, checked, as shell assignments for scripts/lab.
-  CLI::App* labfile = app.add_subcommand("labfile", "Check a lab file (docs/sessions.md) and print it for scripts/lab");
+  // labfile: a lab's host layout, checked, as JSON for scripts/lab.
+  CLI::App* labfile = app.add_subcommand("labfile", "Check a lab file (docs/sessions.md) and print it as JSON");
   std::string lab_path;
   labfile->add_option("file", lab_path, "Lab file")->required()->check(CLI::ExistingFile);
+  // probe: who else is on an address (scripts/lab, before a session starts).
+  CLI::App* probe = app.add_subcommand(
+      "probe", "Listen on an LCM address and print, as JSON, every rmslab session heard there (docs/security.md)");
+  std::string probe_url;
+  double probe_s = 1.2;
+  probe->add_option("--lcm-url", probe_url, "The address")->required();
+  probe->add_option("--seconds", probe_s, "How long to listen")->capture_default_str()->check(CLI::Range(0.1, 60.0));
   CLI11_PARSE(app, argc, argv);
   try {
     if (exporter->parsed()) {
@@ -59,7 +66,11 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (labfile->parsed()) {
-      std::cout << rms::session::LabFileShell(rms::session::LoadLabFile(lab_path));
+      std::cout << rms::session::LabFileJson(rms::session::LoadLabFile(lab_path)).dump(2) << "\n";
+      return 0;
+    }
+    if (probe->parsed()) {
+      std::cout << rms::session::ProbeAddress(probe_url, probe_s).dump(2) << "\n";
       return 0;
     }
     if (manifest->parsed()) {
@@ -85,6 +96,13 @@ int main(int argc, char** argv) {
     std::cout << "frames: operator " << fr["operator_published"] << ", DCP " << fr["dcp_published"]
               << ", ESG " << fr["esg_published"] << ", rendered " << fr["rendered"] << ", PNG "
               << fr["png_written"] << "; dropped " << dropped << "\n";
+    {
+      const auto& r = fr["refused"];
+      if (r.value("other_session", 0) + r.value("late", 0) + r.value("far_ahead", 0) > 0) {
+        std::cout << "refused by the processes: " << r["other_session"] << " of other sessions, " << r["late"]
+                  << " too late to act on (a stall), " << r["far_ahead"] << " with impossible frame numbers\n";
+      }
+    }
     if (j["record"].value("lost", 0) > 0) {
       std::cout << "the record lost " << j["record"]["lost"] << " frames (the recorder fell behind, was stopped or its "
                 << "disk filled):";

@@ -421,6 +421,17 @@ void AddMission(const fs::path& root, const LogScan& s, double rate_hz, nlohmann
   }
 }
 
+// Messages a receiver refused for a reason of its own, not malformed
+// (docs/protocol.md): too late to act on, of another session, beyond the
+// session's clock.
+constexpr const char* kRefusedReasons[] = {"late", "other_session", "far_ahead"};
+
+std::int64_t Malformed(const nlohmann::json& st) {
+  std::int64_t n = SumPrefix(st, "dropped.");
+  for (const char* r : kRefusedReasons) n -= Counter(st, std::string("dropped.") + r);
+  return n;
+}
+
 nlohmann::ordered_json FramesJson(const std::map<std::string, nlohmann::json>& stats) {
   const auto &op = stats.at("operator_station"), &dcp = stats.at("dynamics_proc"), &scene = stats.at("scene_proc"),
              &esg = stats.at("esg_renderer");
@@ -440,14 +451,12 @@ nlohmann::ordered_json FramesJson(const std::map<std::string, nlohmann::json>& s
       {"operator_to_dcp", Counter(dcp, "input.missing")},
       {"dcp_to_scene", Counter(scene, "dcp.missing")},
       {"scene_to_esg", Counter(esg, "esg.missing")},
-      {"malformed_at_dcp", SumPrefix(dcp, "dropped.")},
-      {"malformed_at_scene", SumPrefix(scene, "dropped.")},
-      {"malformed_at_esg", SumPrefix(esg, "dropped.")},
+      {"malformed_at_dcp", Malformed(dcp)},
+      {"malformed_at_scene", Malformed(scene)},
+      {"malformed_at_esg", Malformed(esg)},
   };
-  // Dropped for a reason of their own, not malformed (docs/protocol.md):
-  // too late to act on, of another session, beyond the session's clock.
   nlohmann::ordered_json refused = nlohmann::ordered_json::object();
-  for (const char* reason : {"late", "other_session", "far_ahead"}) {
+  for (const char* reason : kRefusedReasons) {
     refused[reason] = Counter(dcp, std::string("dropped.") + reason) + Counter(scene, std::string("dropped.") + reason) +
                       Counter(esg, std::string("dropped.") + reason);
   }
@@ -481,18 +490,18 @@ nlohmann::ordered_json TimingJson(const std::map<std::string, nlohmann::json>& s
   timing["dynamics_proc"] = {{"dropped_frames", Counter(dcp, "input.missing")},
                              {"late_frames", Counter(dcp, "frames.late")},
                              {"too_late_dropped", Counter(dcp, "dropped.late")},
-                             {"malformed", SumPrefix(dcp, "dropped.")},
+                             {"malformed", Malformed(dcp)},
                              {"latency", Links(dcp)}};
   timing["scene_proc"] = {{"dropped_frames", Counter(scene, "dcp.missing")},
                           {"late_frames", Counter(scene, "frames.late")},
                           {"too_late_dropped", Counter(scene, "dropped.late")},
-                          {"malformed", SumPrefix(scene, "dropped.")},
+                          {"malformed", Malformed(scene)},
                           {"latency", Links(scene)}};
   timing["esg_renderer"] = {{"dropped_frames", Counter(esg, "esg.missing")},
                             {"superseded", Counter(esg, "superseded")},
                             {"late_frames", Counter(esg, "frames.late")},
                             {"too_late_dropped", Counter(esg, "dropped.late")},
-                            {"malformed", SumPrefix(esg, "dropped.")},
+                            {"malformed", Malformed(esg)},
                             {"latency", Links(esg)}};
   return timing;
 }
@@ -632,6 +641,43 @@ nlohmann::ordered_json MakeManifest(const std::string& dir, const ManifestFields
   }
   j["hosts"] = layout;
   if (!command.empty()) j["command"] = command;
+  return j;
+}
+
+nlohmann::ordered_json ProbeAddress(const std::string& url, double seconds) {
+  lcm::LCM lcm(url);
+  if (!lcm.good()) throw TransportError("cannot listen on '" + url + "' (no route for multicast? scripts/lab adds one)");
+  struct Heard {
+    std::map<std::string, std::int64_t> channels;
+    std::set<std::string> senders;
+  };
+  std::map<std::int64_t, Heard> sessions;
+  struct Handler {
+    std::map<std::int64_t, Heard>* out;
+    void On(const lcm::ReceiveBuffer* rb, const std::string& channel) {
+      std::int64_t fp = 0, id = 0;
+      std::int8_t process = 0;
+      std::int32_t pid = 0;
+      const int n = static_cast<int>(rb->data_size);
+      if (!ReadFingerprint(rb->data, n, &fp) || !IsRmslabFingerprint(fp) || !ReadSessionId(rb->data, n, &id)) return;
+      ReadSenderProcess(rb->data, n, &process, &pid);
+      Heard& h = (*out)[id];
+      ++h.channels[channel];
+      h.senders.insert(std::string(ProcessCodeName(process)) + " pid " + std::to_string(pid));
+    }
+  } handler{&sessions};
+  lcm.subscribe("RMS_.*", &Handler::On, &handler);
+  const std::int64_t end = WallTimeUs() + static_cast<std::int64_t>(seconds * 1e6);
+  for (std::int64_t now = WallTimeUs(); now < end; now = WallTimeUs()) {
+    lcm.handleTimeout(static_cast<int>(std::max<std::int64_t>(1, (end - now) / 1000)));
+  }
+  nlohmann::ordered_json j;
+  j["url"] = url;
+  j["seconds"] = seconds;
+  j["sessions"] = nlohmann::ordered_json::array();
+  for (const auto& [id, h] : sessions) {
+    j["sessions"].push_back({{"session_id", FormatSessionId(id)}, {"channels", h.channels}, {"senders", h.senders}});
+  }
   return j;
 }
 

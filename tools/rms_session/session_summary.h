@@ -40,6 +40,13 @@ struct SessionInfo {
 // Throws rms::InputError when SESSION/manifest.json is missing or malformed.
 SessionInfo ReadSessionInfo(const std::string& session_dir);
 
+// Every rmslab session heard on an LCM address within `seconds`:
+// {"url", "seconds", "sessions": [{"session_id", "channels": {name: n},
+// "senders": ["dynamics_proc pid N", ...]}]} -- the launcher's look before it
+// starts a session there (docs/security.md "Stations sharing a network").
+// Throws rms::TransportError when the address cannot be opened.
+nlohmann::ordered_json ProbeAddress(const std::string& url, double seconds);
+
 // A replay's ESG frames against the recorded ones, matched by the DCP frame
 // they were made from: {"recorded", "replayed", "identical", "missing",
 // "first_difference"}.

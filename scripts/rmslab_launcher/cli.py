@@ -1,0 +1,64 @@
+"""scripts/lab: lab sessions (docs/sessions.md).
+
+  scripts/lab demo [--out DIR] [--timeline FILE | --by-hand [--bindings FILE]] [--autopilot-straight]
+                   [--restore CHECKPOINT] [--lab LABFILE] [--config FILE] [--speed X]
+                   [--png-every N] [--width W] [--height H] [--no-video] [--window]
+                   [--gl osmesa|egl] [--visibility priority|depth]
+                   [--lcm-url URL] [--channel-suffix S] [--share-network] [--no-build]
+  scripts/lab replay SESSION [options]       scene and ESG driven from the log: frames, video
+  scripts/lab resim SESSION [--config FILE]  the DCP again on the recorded inputs
+  scripts/lab export SESSION                 every channel to CSV
+  scripts/lab report SESSION                 one self-contained HTML report
+  scripts/lab monitor [--lcm-url URL]        live decoded traffic per channel
+  scripts/lab control [--session DIR] freeze|run|step [N]|checkpoint NAME|restore NAME|FILE [--run]
+
+demo: installs what is missing, builds, checks every file the session will
+use (refusing, with the reason, what is wrong), looks for another session on
+its address, checks the disk, then starts the recorder and the four
+processes over LCM UDP multicast (on this host, TTL 0; or on a lab's hosts,
+--lab), each in a process group of its own, and lets the autopilot fly the
+whole task (acquire, extract, dock) -- or flies a timeline (--timeline), or
+lets you fly by hand (--by-hand: this terminal's keys and status screen, and
+with --window the live window's keys too; Q ends it; --bindings FILE for
+other keys, docs/operator.md). It restarts a process that dies, stops the
+session when the disk fills, writes PNG frames, the video (session.mp4) and
+summary.json, and stops everything at the end, on Ctrl-C, when the terminal
+closes -- and, through its reaper, when it is itself killed. Each other
+command explains itself with --help.
+"""
+import os
+import sys
+
+from . import demo, replay, tools
+from .common import LabError, say
+
+
+def main(argv):
+    cmd = argv[0] if argv else "help"
+    rest = argv[1:]
+    try:
+        if cmd == "demo":
+            return demo.run(rest, "scripts/lab demo " + " ".join(rest))
+        if cmd == "replay":
+            return replay.run(rest)
+        if cmd in ("resim", "export", "report", "monitor", "control"):
+            return getattr(tools, cmd)(rest)
+        if cmd in ("help", "-h", "--help"):
+            print(__doc__.split("\n", 2)[2])
+            return 0
+        say(f"unknown command '{cmd}'")
+        print(__doc__.split("\n", 2)[2], file=sys.stderr)
+        return 2
+    except LabError as e:
+        for line in str(e).splitlines():
+            say(line)
+        return e.code
+    except KeyboardInterrupt:
+        say("interrupted before the session started")
+        return 130
+    except BrokenPipeError:
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,128 @@
+"""What every launcher command shares: paths, messages, the build, the
+multicast route, reading configuration (TOML, with Python's tomllib).
+
+docs/sessions.md "The launcher" describes what scripts/lab does; this
+package is that launcher.
+"""
+import os
+import shutil
+import subprocess
+import sys
+import tomllib
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+BUILD = os.environ.get("RMSLAB_BUILD", os.path.join(ROOT, "build"))
+DEFAULT_URL = "udpm://239.255.76.67:7667?ttl=0"
+DEFAULT_REPLAY_URL = "udpm://239.255.76.67:7669?ttl=0"
+MAX_SPEED = 100.0  # common/rms/process.h kMaxSessionSpeed: the frame checks allow no faster
+
+
+class LabError(Exception):
+    """Bad input or a refusal: the message says what and why; exit code 2."""
+
+    def __init__(self, message, code=2):
+        super().__init__(message)
+        self.code = code
+
+
+def say(*parts):
+    """A line for the person at the terminal (stderr, prefixed "lab:"); a
+    terminal that has gone (closed) is no reason to stop."""
+    try:
+        print("lab: " + " ".join(str(p) for p in parts), file=sys.stderr, flush=True)
+    except OSError:
+        pass
+
+
+def binary(rel):
+    return os.path.join(BUILD, rel)
+
+
+def is_root():
+    return os.geteuid() == 0
+
+
+def sudo_prefix():
+    """[] as root, ["sudo", "-n"] otherwise (when sudo exists)."""
+    if is_root():
+        return []
+    return ["sudo", "-n"] if shutil.which("sudo") else []
+
+
+def install_and_build():
+    """scripts/install-deps, then configure (once) and build, Release."""
+    subprocess.run([os.path.join(ROOT, "scripts", "install-deps")], check=True)
+    if not (os.path.exists(os.path.join(BUILD, "build.ninja")) or os.path.exists(os.path.join(BUILD, "Makefile"))):
+        subprocess.run(["cmake", "-S", ROOT, "-B", BUILD, "-G", "Ninja", "-DCMAKE_BUILD_TYPE=Release"],
+                       check=True, stdout=subprocess.DEVNULL)
+    subprocess.run(["cmake", "--build", BUILD, "--parallel", str(os.cpu_count() or 2)], check=True,
+                   stdout=subprocess.DEVNULL)
+
+
+def require_built(*rels):
+    for rel in rels:
+        if not os.access(binary(rel), os.X_OK):
+            raise LabError(f"{binary(rel)} is not built (drop --no-build, or run scripts/test)")
+
+
+def ensure_multicast_route():
+    """LCM's UDP multicast needs a route to 224.0.0.0/4: added on loopback when missing."""
+    if subprocess.run(["ip", "route", "get", "239.255.76.67"], stdout=subprocess.DEVNULL,
+                      stderr=subprocess.DEVNULL).returncode == 0:
+        return
+    say("this machine has no route for multicast (224.0.0.0/4); adding one on loopback:")
+    say("  ip route add 224.0.0.0/4 dev lo")
+    if subprocess.run(sudo_prefix() + ["ip", "route", "add", "224.0.0.0/4", "dev", "lo"]).returncode != 0:
+        raise LabError("could not add the route (needs root or sudo). Add it by hand, then run again.", 1)
+
+
+def read_toml(path, what):
+    try:
+        with open(path, "rb") as f:
+            return tomllib.load(f)
+    except FileNotFoundError:
+        raise LabError(f"no such file: {path}")
+    except tomllib.TOMLDecodeError as e:
+        raise LabError(f"{path}: not TOML ({e}) -- {what}")
+
+
+def frame_rate_hz(config_path):
+    """session.frame_rate_hz of a configuration (an integer or a float)."""
+    cfg = read_toml(config_path, "the configuration (docs/config.md)")
+    try:
+        rate = float(cfg["session"]["frame_rate_hz"])
+    except (KeyError, TypeError, ValueError):
+        raise LabError(f"{config_path}: key 'session.frame_rate_hz': missing or not a number")
+    if not rate > 0:
+        raise LabError(f"{config_path}: key 'session.frame_rate_hz': must be > 0")
+    return rate
+
+
+def timeline_length_s(path):
+    """The last time in a timeline (docs/timeline.md): its length in seconds."""
+    last = 0.0
+    with open(path, encoding="utf-8", errors="replace") as f:
+        for line in f:
+            line = line.split("#", 1)[0].strip()
+            if not line:
+                continue
+            try:
+                last = max(last, float(line.split()[0]))
+            except ValueError:
+                pass
+    return last
+
+
+def check_suffix(suffix):
+    if suffix and not all(c.isalnum() and c.isascii() or c == "_" for c in suffix):
+        raise LabError(f"--channel-suffix '{suffix}': letters, digits and '_' only")
+
+
+def check_speed(speed):
+    try:
+        s = float(speed)
+    except ValueError:
+        raise LabError(f"--speed '{speed}': not a number")
+    if not (0.01 <= s <= MAX_SPEED):
+        raise LabError(f"--speed {speed}: must be within 0.01 .. {MAX_SPEED:g}")
+    return s

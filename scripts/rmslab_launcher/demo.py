@@ -1,0 +1,381 @@
+"""scripts/lab demo: one session of the four processes and the recorder
+(docs/sessions.md). See `scripts/lab demo --help`."""
+import argparse
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+from . import disk, session
+from .common import (BUILD, DEFAULT_URL, ROOT, LabError, binary, check_speed, check_suffix, ensure_multicast_route,
+                     frame_rate_hz, install_and_build, require_built, say, timeline_length_s)
+from .hosts import Host, check_hosts
+from .supervisor import Spec, Supervisor
+
+PROCESSES = ["operator_station", "dynamics_proc", "scene_proc", "esg_renderer"]
+AUTOPILOT_S = 120.0   # the autopilot's mission, with a margin (docs/operator.md)
+BY_HAND_S = 600.0     # what the disk check allows a person, at least (the watch covers longer)
+
+
+def add_arguments(p):
+    p.add_argument("--out", help="the session folder (default sessions/<UTC time>)")
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--timeline", help="fly this timeline (docs/timeline.md)")
+    g.add_argument("--by-hand", action="store_true", help="fly it yourself: this terminal's keys and status screen")
+    p.add_argument("--bindings", help="by hand: other keys, rates and devices (docs/operator.md)")
+    p.add_argument("--autopilot-straight", action="store_true", help="the autopilot flies straight lines")
+    p.add_argument("--restore", help="start from this checkpoint")
+    p.add_argument("--lab", help="a lab file: which process runs on which host (docs/sessions.md)")
+    p.add_argument("--config", default=os.path.join(ROOT, "config", "rmslab.toml"))
+    p.add_argument("--speed", default="1", help="the same frames, that many times faster (0.01 .. 100)")
+    p.add_argument("--png-every", type=int, default=30, help="a PNG frame every N frames (0: none)")
+    p.add_argument("--width", type=int, default=1024)
+    p.add_argument("--height", type=int, default=768)
+    p.add_argument("--no-video", action="store_true")
+    p.add_argument("--window", action="store_true", help="the ESG's live window (by hand: its keys too)")
+    p.add_argument("--gl", default="osmesa", choices=["osmesa", "egl"])
+    p.add_argument("--visibility", default="priority", choices=["priority", "depth"])
+    p.add_argument("--lcm-url", help=f"the session's LCM address (default {DEFAULT_URL})")
+    p.add_argument("--channel-suffix", default="", help="appended to every channel: stations sharing a network")
+    p.add_argument("--share-network", action="store_true",
+                   help="start even when another session is on this address and channels")
+    p.add_argument("--no-build", action="store_true")
+
+
+class Demo:
+    def __init__(self, a, command_line):
+        self.a = a
+        self.command_line = command_line
+        self.interrupted = None
+        self.notes = []
+
+    # ---- before anything starts ----
+    def validate(self):
+        a = self.a
+        for f in [a.config, a.timeline, a.restore, a.lab, a.bindings]:
+            if f and not os.path.isfile(f):
+                raise LabError(f"no such file: {f}")
+        if a.bindings and not a.by_hand:
+            raise LabError("--bindings is for flying by hand (--by-hand)")
+        self.tty = sys.stdin.isatty()
+        if a.by_hand and not self.tty and not a.window:
+            raise LabError("--by-hand needs a terminal on standard input, or --window to fly from the live window")
+        if a.window and not os.environ.get("DISPLAY"):
+            if a.by_hand and not self.tty:
+                raise LabError("--window: no DISPLAY here, and no terminal: nothing to fly from")
+            self.notes.append("--window: no DISPLAY here; the ESG rendered headless")
+            a.window = False
+        self.speed = check_speed(a.speed)
+        check_suffix(a.channel_suffix)
+        if a.width < 16 or a.height < 16 or a.width % 2 or a.height % 2:
+            raise LabError(f"--width {a.width} --height {a.height}: even sizes, at least 16")
+        if a.png_every < 0:
+            raise LabError("--png-every: 0 (none) or more")
+        self.rate = frame_rate_hz(a.config)
+        self.pilot = "by-hand" if a.by_hand else "timeline" if a.timeline else "autopilot"
+
+    def layout(self):
+        a = self.a
+        self.hosts = {p: Host("localhost") for p in PROCESSES + ["recorder"]}
+        self.remote_bin = BUILD
+        self.url = a.lcm_url or DEFAULT_URL
+        if a.lab:
+            r = subprocess.run([binary("tools/rms_session"), "labfile", a.lab], capture_output=True, text=True)
+            if r.returncode:
+                raise LabError(r.stderr.strip())
+            lab = json.loads(r.stdout)
+            for p, h in lab["hosts"].items():
+                self.hosts[p] = Host(h)
+            if self.hosts["recorder"].remote:
+                raise LabError("the recorder must run here or in a netns (the session folder is here)")
+            if a.by_hand and self.hosts["operator_station"].remote:
+                raise LabError("--by-hand needs operator_station here (it takes this terminal)")
+            if lab["remote_build"]:
+                self.remote_bin = lab["remote_build"]
+            elif lab["remote_root"]:
+                self.remote_bin = os.path.join(lab["remote_root"], "build")
+            if not a.lcm_url:
+                ttl = 0 if lab["all_local"] else lab["ttl"]
+                self.url = f"udpm://{lab['group']}:{lab['port']}?ttl={ttl}"
+            if not lab["all_local"]:
+                check_hosts(self.url, self.remote_bin, list(self.hosts.values()))
+
+    def checks(self):
+        """Every process with its own files, by --check, before anything starts."""
+        a = self.a
+        common = ["--config", a.config, "--channel-suffix", a.channel_suffix]
+        op = [binary("operator_station/operator_station")] + common
+        if self.pilot == "by-hand":
+            op += ["--manual", "--bindings", a.bindings or os.path.join(ROOT, "config", "bindings.toml")]
+        elif self.pilot == "timeline":
+            op += ["--timeline", a.timeline]
+        else:
+            op += ["--autopilot"]
+        if a.restore:
+            op += ["--restore", a.restore]
+        dcp = [binary("dynamics_proc/dynamics_proc")] + common + (["--restore", a.restore] if a.restore else [])
+        esg = [binary("esg_renderer/esg_renderer")] + common + ["--width", str(a.width), "--height", str(a.height),
+                                                                 "--gl", a.gl, "--visibility", a.visibility]
+        session.precheck([("operator_station", op), ("dynamics_proc", dcp),
+                          ("scene_proc", [binary("scene_proc/scene_proc")] + common), ("esg_renderer", esg)])
+
+    def duration_s(self):
+        if self.pilot == "timeline":
+            return timeline_length_s(self.a.timeline) / self.speed + 10
+        if self.pilot == "autopilot":
+            return AUTOPILOT_S / self.speed
+        return BY_HAND_S
+
+    # ---- the session folder ----
+    def make_session(self):
+        a = self.a
+        self.out = session.make_folder(a.out, os.path.join(ROOT, "sessions"))
+        self.name = os.path.basename(self.out)
+        self.bytes_per_s = disk.session_bytes_per_s(self.rate * self.speed, a.width, a.height, a.png_every,
+                                                    not a.no_video and not self.hosts["esg_renderer"].remote)
+        disk.check_room(self.out, self.bytes_per_s, self.duration_s(),
+                        f"{self.pilot}, {a.width}x{a.height}, PNG every {a.png_every}, video "
+                        f"{'no' if a.no_video else 'yes'}")
+        self.remote_run = f"/tmp/rmslab-{self.name}"
+        run = os.path.join(self.out, "run")
+        shutil.copyfile(a.config, os.path.join(self.out, "config.toml"))
+        if a.timeline:
+            shutil.copyfile(a.timeline, os.path.join(self.out, "timeline.tl"))
+        if a.restore:
+            shutil.copyfile(a.restore, os.path.join(run, "restore.json"))
+        if self.pilot == "by-hand":
+            shutil.copyfile(a.bindings or os.path.join(ROOT, "config", "bindings.toml"),
+                            os.path.join(self.out, "bindings.toml"))
+        with open(os.path.join(run, "pilot"), "w") as f:
+            f.write(self.pilot + "\n")
+        with open(os.path.join(run, "launcher.pid"), "w") as f:
+            f.write(f"{os.getpid()}\n")
+        self.session_id = session.new_session_id()
+        fields = [("--pilot", self.pilot), ("--lcm-url", self.url), ("--session-id", self.session_id),
+                  ("--command", self.command_line),
+                  ("--config-sha256", subprocess.run(["sha256sum", os.path.join(self.out, "config.toml")],
+                                                     capture_output=True, text=True).stdout.split()[0])]
+        for p in PROCESSES:
+            fields.append(("--host", f"{p}={self.hosts[p]}"))
+        fields.append(("--host", f"lcm-logger={self.hosts['recorder']}"))
+        if a.channel_suffix:
+            fields.append(("--channel-suffix", a.channel_suffix))
+        if a.timeline:
+            fields.append(("--timeline", a.timeline))
+        if a.restore:
+            fields.append(("--restore", a.restore))
+        session.write_manifest(self.out, fields)
+        say(f"session {self.out}")
+
+    # ---- the processes ----
+    def proc_paths(self, name):
+        """(binary, config, stats, ready file) where `name` runs."""
+        h = self.hosts[name]
+        if h.remote:
+            h.copy_to(os.path.join(self.out, "config.toml"), f"{self.remote_run}/config.toml")
+            return (f"{self.remote_bin}/{name}/{name}", f"{self.remote_run}/config.toml",
+                    f"{self.remote_run}/{name}.json", f"{self.remote_run}/{name}.ready")
+        return (binary(f"{name}/{name}"), os.path.join(self.out, "config.toml"),
+                os.path.join(self.out, "stats", f"{name}.json"), os.path.join(self.out, "run", f"{name}.ready"))
+
+    def spec(self, name, extra, **kw):
+        exe, cfg, stats, ready = self.proc_paths(name)
+        argv = [exe, "--config", cfg, "--lcm-url", self.url, "--stats", stats, "--ready-file", ready]
+        if self.a.channel_suffix:
+            argv += ["--channel-suffix", self.a.channel_suffix]
+        h = self.hosts[name]
+        log = os.path.join(self.out, "logs", f"{name}.log")
+        if h.remote:
+            ready_fn = lambda c: "] ready: " in open(log, errors="replace").read()  # noqa: E731
+        else:
+            ready_fn = lambda c: os.path.exists(ready)  # noqa: E731
+            if os.path.exists(ready):
+                os.remove(ready)
+        return Spec(name, h, argv + extra, log, ready=ready_fn, remote_run=self.remote_run if h.remote else None, **kw)
+
+    def recorder_spec(self):
+        chans = f"RMS_({'|'.join(c[4:] for c in session.CHANNELS)}){self.a.channel_suffix}"
+        def argv(n):
+            return ["lcm-logger", f"--lcm-url={self.url}", "--force", "--quiet", f"--channel={chans}",
+                    os.path.join(self.out, "lcmlog" if n == 0 else f"lcmlog.{n}")]
+        def ready(c):
+            return os.path.exists(argv(c.n)[-1])
+        def may_restart():
+            free = disk.free_bytes(self.out)
+            if free < disk.stop_threshold(self.bytes_per_s):
+                return (f"the recorder stopped: the disk of {self.out} is full ({free / disk.MB:.1f} MB left); "
+                        f"stopping the session, its record ends here")
+            self.notes.append("the recorder died and was restarted: the record has a gap (see summary.json 'record')")
+            return None
+        return Spec("lcm-logger", self.hosts["recorder"], argv(0), os.path.join(self.out, "logs", "lcm-logger.log"),
+                    ready=ready, next_argv=argv, lifeline=False, may_restart=may_restart)
+
+    def esg_args(self):
+        a = self.a
+        args = ["--width", str(a.width), "--height", str(a.height), "--gl", a.gl, "--visibility", a.visibility]
+        if self.hosts["esg_renderer"].remote:
+            say(f"esg_renderer on {self.hosts['esg_renderer'].name}: frames and video stay there, in {self.remote_run}")
+        else:
+            args += ["--png-dir", os.path.join(self.out, "frames"), "--png-every", str(a.png_every)]
+            if not a.no_video:
+                args += ["--video", os.path.join(self.out, "session.mp4")]
+        if a.window:
+            args.append("--window")
+        return args
+
+    def operator_spec(self):
+        a = self.a
+        remote = self.hosts["operator_station"].remote
+        extra = ["--checkpoint-dir", self.remote_run if remote else os.path.join(self.out, "checkpoints")]
+        if a.restore:
+            extra += ["--restore", os.path.join(self.out, "run", "restore.json")]
+        tty = False
+        if self.pilot == "timeline":
+            extra += ["--timeline", os.path.join(self.out, "timeline.tl"), "--speed", str(self.speed)]
+        elif self.pilot == "autopilot":
+            extra += ["--autopilot", "--rate", f"{self.rate * self.speed:.3f}"]
+            if a.autopilot_straight:
+                extra.append("--autopilot-straight")
+        else:
+            extra += ["--manual", "--bindings", os.path.join(self.out, "bindings.toml")]
+            if a.window:
+                extra.append("--window-keys")
+            if self.tty:
+                extra.append("--status")
+            tty = self.tty
+        return self.spec("operator_station", extra, pilot=True, tty=tty)
+
+    # ---- running ----
+    def on_signal(self, signum, frame):
+        self.interrupted = signum
+
+    def start(self):
+        env = {"RMSLAB_SESSION_ID": self.session_id, "RMSLAB_SESSION_EPOCH_US": str(int(time.time() * 1e6))}
+        self.sup = Supervisor(os.path.join(self.out, "run"), env)
+        self.sup.start_reaper(self.out, [binary("tools/rms_session"), "summary", self.out])
+        for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+            signal.signal(sig, self.on_signal)
+        self.sup.add(self.recorder_spec())
+        err = self.sup.wait_ready(["lcm-logger"])
+        if err:
+            raise LabError(err, 1)
+        self.sup.add(self.spec("esg_renderer", self.esg_args()))
+        self.sup.add(self.spec("scene_proc", []))
+        remote = self.hosts["dynamics_proc"].remote
+        dcp = ["--checkpoint-dir", self.remote_run if remote else os.path.join(self.out, "checkpoints")]
+        if not remote:
+            dcp += ["--state-file", os.path.join(self.out, "run", "dcp_state.json")]
+        if self.a.restore:
+            dcp += ["--restore", os.path.join(self.out, "run", "restore.json")]
+        self.sup.add(self.spec("dynamics_proc", dcp))
+        err = self.sup.wait_ready(["esg_renderer", "scene_proc", "dynamics_proc"])
+        if err:
+            raise LabError(err, 2 if "usage or configuration" in err else 1)
+        time.sleep(0.2)
+        flying = {"timeline": f"the timeline {os.path.basename(self.a.timeline or '')}",
+                  "autopilot": "the autopilot",
+                  "by-hand": "you, by hand " + ("(the status screen follows; Q quits)" if self.tty else
+                                               "from the live window (Q in the window quits)")}[self.pilot]
+        lab_hosts = {str(h) for h in self.hosts.values()} != {"localhost"}
+        where = f"the lab's hosts ({os.path.basename(self.a.lab)})" if lab_hosts else "this host"
+        suffix = f" (channel suffix {self.a.channel_suffix})" if self.a.channel_suffix else ""
+        say(f"four processes up on {where}, {self.url}{suffix}; session {self.session_id}; flying: {flying}")
+        self.sup.add(self.operator_spec())
+
+    def watch(self):
+        """Until the pilot ends, a signal comes, or the session must stop."""
+        threshold = disk.stop_threshold(self.bytes_per_s)
+        next_disk = 0.0
+        while not self.sup.pilot_done and self.interrupted is None and self.sup.fatal is None:
+            self.sup.poll()
+            now = time.time()
+            if now >= next_disk:
+                next_disk = now + 1.0
+                free = disk.free_bytes(self.out)
+                if free < threshold:
+                    self.sup.fatal = (f"the disk of {self.out} is nearly full ({free / disk.MB:.1f} MB left): stopping "
+                                      f"the session now, while its record and summary still fit", 1)
+            time.sleep(0.05)
+
+    def stop(self):
+        self.sup.begin_stop()
+        # The station first (by hand it gives the terminal back), then the
+        # pipeline, the recorder last so it records everyone's final report.
+        self.sup.stop(["operator_station"])
+        if self.interrupted is None and self.sup.fatal is None:
+            time.sleep(0.5)  # the last frames through the pipeline
+        self.sup.stop(["esg_renderer", "scene_proc", "dynamics_proc"])
+        time.sleep(0.3)
+        self.sup.stop(["lcm-logger"])
+        self.sup.record_exit_codes()
+        for p in PROCESSES:
+            h = self.hosts[p]
+            if h.remote:
+                h.copy_from(f"{self.remote_run}/{p}.json", os.path.join(self.out, "stats", f"{p}.json"))
+        self.sup.finish_reaper()
+        note = session.join_record_parts(self.out)
+        if note:
+            self.notes.append(note)
+
+    def finish(self):
+        """The summary and the exit code."""
+        lines, where = session.summarize(self.out, self.name)
+        op = self.sup.children.get("operator_station")
+        op_rc = op.exit_code if op and op.exit_code is not None else None
+        if self.sup.fatal:
+            say(self.sup.fatal[0])
+        elif self.interrupted is not None or op_rc == 130:
+            say("interrupted: session stopped")
+        else:
+            say("done; summary:")
+        for l in lines:
+            say("  " + l)
+        for n in self.notes:
+            say("note: " + n)
+        say(f"session folder: {self.out} (manifest.json, lcmlog, logs/, frames/"
+            f"{', session.mp4' if not self.a.no_video else ''}, summary.json)")
+        if where is None:
+            say("no summary could be written anywhere (every disk tried is full)")
+        if self.sup.fatal:
+            return self.sup.fatal[1]
+        if self.interrupted is not None or op_rc == 130:
+            return 130
+        bad = False
+        for n in self.sup.order:
+            c = self.sup.children[n]
+            if n != "operator_station" and c.exit_code not in (0, None):
+                say(f"{n} exited with {c.exit_code} (see {c.spec.log_path})")
+                bad = True
+        if op_rc not in (0, None):
+            say(f"operator_station exited with {op_rc} (see {op.spec.log_path})")
+            return op_rc
+        return 1 if bad else 0
+
+
+def run(argv, command_line):
+    p = argparse.ArgumentParser(prog="scripts/lab demo", description=__doc__)
+    add_arguments(p)
+    a = p.parse_args(argv)
+    d = Demo(a, command_line)
+    d.validate()
+    if not a.no_build:
+        install_and_build()
+    require_built("operator_station/operator_station", "dynamics_proc/dynamics_proc", "scene_proc/scene_proc",
+                  "esg_renderer/esg_renderer", "tools/rms_session")
+    d.layout()
+    ensure_multicast_route()
+    d.checks()
+    session.probe_network(d.hosts["recorder"], d.url, a.channel_suffix, a.share_network)
+    d.make_session()
+    try:
+        d.start()
+        d.watch()
+    except LabError as e:
+        d.sup.fatal = (str(e), e.code)
+    finally:
+        if hasattr(d, "sup"):
+            d.stop()
+    return d.finish()

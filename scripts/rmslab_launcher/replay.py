@@ -1,0 +1,178 @@
+"""scripts/lab replay SESSION: scene_proc and esg_renderer driven from a
+recorded session's log -- lcm-logplayer plays its RMS_DCP_FRAME messages at
+their recorded pace (times --speed) -- make its ESG frames, PNG frames and
+video again into a new session folder (default SESSION/replay-<UTC time>),
+then compares the replayed ESG frames with the recorded ones word for word:
+exit 0 only if all are identical."""
+import argparse
+import json
+import os
+import shutil
+import signal
+import subprocess
+import time
+
+from . import disk, session
+from .common import (DEFAULT_REPLAY_URL, LabError, binary, check_speed, ensure_multicast_route, install_and_build,
+                     require_built, say)
+from .hosts import Host
+from .supervisor import Spec, Supervisor
+
+
+def manifest(path):
+    try:
+        with open(os.path.join(path, "manifest.json")) as f:
+            return json.load(f)
+    except (OSError, ValueError):
+        return {}
+
+
+class Replay:
+    def __init__(self, a):
+        self.a = a
+        self.interrupted = None
+        self.src = os.path.abspath(a.session)
+        m = manifest(self.src)
+        self.suffix = m.get("lcm", {}).get("channel_suffix", "")
+        # The replayed frames carry the recorded session's id: the replay's
+        # processes take them as their own session's.
+        self.session_id = m.get("session_id", "")
+
+    def make(self):
+        a = self.a
+        out = a.out or os.path.join(self.src, "replay-" + time.strftime("%Y%m%dT%H%M%SZ", time.gmtime()))
+        self.out = session.make_folder(out, self.src)
+        shutil.copyfile(os.path.join(self.src, "config.toml"), os.path.join(self.out, "config.toml"))
+        with open(os.path.join(self.out, "run", "pilot"), "w") as f:
+            f.write("replay\n")
+        fields = [("--pilot", "replay"), ("--lcm-url", a.lcm_url), ("--command", f"scripts/lab replay {self.src}")]
+        if self.suffix:
+            fields.append(("--channel-suffix", self.suffix))
+        if self.session_id:
+            fields.append(("--session-id", self.session_id))
+        session.write_manifest(self.out, fields)
+        summary = json.load(open(os.path.join(self.src, "summary.json"))) if os.path.exists(
+            os.path.join(self.src, "summary.json")) else {}
+        self.duration = float(summary.get("duration_s", 0) or 0)
+        rate = 30.0 * self.speed
+        self.bytes_per_s = disk.session_bytes_per_s(rate, a.width, a.height, a.png_every, not a.no_video)
+        disk.check_room(self.out, self.bytes_per_s, (self.duration or 120) / self.speed, "the replay")
+        say(f"replaying {self.src} into {self.out}")
+
+    def spec(self, name, extra):
+        ready = os.path.join(self.out, "run", f"{name}.ready")
+        argv = [binary(f"{name}/{name}"), "--config", os.path.join(self.out, "config.toml"), "--lcm-url",
+                self.a.lcm_url, "--stats", os.path.join(self.out, "stats", f"{name}.json"), "--ready-file", ready]
+        if self.suffix:
+            argv += ["--channel-suffix", self.suffix]
+        return Spec(name, Host("localhost"), argv + extra, os.path.join(self.out, "logs", f"{name}.log"),
+                    ready=lambda c: os.path.exists(ready))
+
+    def run(self):
+        a = self.a
+        env = {"RMSLAB_SESSION_ID": self.session_id} if self.session_id else {}
+        self.sup = Supervisor(os.path.join(self.out, "run"), env)
+        self.sup.start_reaper(self.out, [binary("tools/rms_session"), "summary", self.out])
+        for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+            signal.signal(sig, lambda s, f: setattr(self, "interrupted", s))
+        chans = f"RMS_(DCP_FRAME|ESG_FRAME|STATUS){self.suffix}"
+        log = os.path.join(self.out, "lcmlog")
+        self.sup.add(Spec("lcm-logger", Host("localhost"),
+                          ["lcm-logger", f"--lcm-url={a.lcm_url}", "--force", "--quiet", f"--channel={chans}", log],
+                          os.path.join(self.out, "logs", "lcm-logger.log"), ready=lambda c: os.path.exists(log),
+                          lifeline=False, restart=False))
+        esg = ["--width", str(a.width), "--height", str(a.height), "--png-dir", os.path.join(self.out, "frames"),
+               "--png-every", str(a.png_every)]
+        if not a.no_video:
+            esg += ["--video", os.path.join(self.out, "session.mp4")]
+        self.sup.add(self.spec("esg_renderer", esg))
+        self.sup.add(self.spec("scene_proc", []))
+        err = self.sup.wait_ready(["lcm-logger", "esg_renderer", "scene_proc"])
+        if err:
+            raise LabError(err, 1)
+        time.sleep(0.2)
+        player = ["lcm-logplayer", "-s", str(self.speed), "-e", f"^RMS_DCP_FRAME{self.suffix}$", "-l", a.lcm_url,
+                  os.path.join(self.src, "lcmlog")]
+        self.sup.add(Spec("lcm-logplayer", Host("localhost"), player, os.path.join(self.out, "logs", "lcm-logplayer.log"),
+                          pilot=True, lifeline=False))
+        start = time.time()
+        next_say = start + 2
+        while not self.sup.pilot_done and self.interrupted is None and self.sup.fatal is None:
+            self.sup.poll()
+            if time.time() >= next_say and self.duration:
+                next_say += 2
+                done = min(100.0, 100 * (time.time() - start) * self.speed / self.duration)
+                say(f"replay {done:3.0f}% ({(time.time() - start) * self.speed:.0f} of {self.duration:.0f} s)")
+            time.sleep(0.05)
+        if self.sup.pilot_done:
+            time.sleep(1.0)  # the last frames through the scene and the renderer
+
+    def stop(self):
+        self.sup.begin_stop()
+        self.sup.stop(["lcm-logplayer", "esg_renderer", "scene_proc"])
+        time.sleep(0.3)
+        self.sup.stop(["lcm-logger"])
+        self.sup.record_exit_codes()
+        self.sup.finish_reaper()
+
+    def finish(self):
+        lines, _ = session.summarize(self.out, os.path.basename(self.out))
+        for l in lines:
+            if l.startswith("video:") or l.startswith("the record lost"):
+                say(l)
+        if self.sup.fatal:
+            say(self.sup.fatal[0])
+            return self.sup.fatal[1]
+        if self.interrupted is not None:
+            say("interrupted")
+            return 130
+        player = self.sup.children["lcm-logplayer"]
+        if player.exit_code not in (0, None):
+            say(f"lcm-logplayer failed: {open(player.spec.log_path, errors='replace').read().strip()}")
+            return 1
+        bad = [n for n in ("esg_renderer", "scene_proc", "lcm-logger") if self.sup.children[n].exit_code not in (0, None)]
+        for n in bad:
+            say(f"{n} exited with {self.sup.children[n].exit_code} (see {self.sup.children[n].spec.log_path})")
+        if bad:
+            return 1
+        say(f"replay done: {self.out} (lcmlog, frames/{'' if self.a.no_video else ', session.mp4'})")
+        r = subprocess.run([binary("tools/rms_session"), "compare-esg", self.src, self.out], capture_output=True, text=True)
+        with open(os.path.join(self.out, "replay_comparison.json"), "w") as f:
+            f.write(r.stdout)
+        if r.returncode == 0:
+            c = json.loads(r.stdout)
+            say(f"every ESG frame identical to the recording, word for word (identical: {c['identical']})")
+            return 0
+        say("the replay differs from the recording: " + " ".join(r.stdout.split()))
+        return 1
+
+
+def run(argv):
+    p = argparse.ArgumentParser(prog="scripts/lab replay", description=__doc__)
+    p.add_argument("session")
+    p.add_argument("--out")
+    p.add_argument("--speed", default="1")
+    p.add_argument("--width", type=int, default=1024)
+    p.add_argument("--height", type=int, default=768)
+    p.add_argument("--png-every", type=int, default=30)
+    p.add_argument("--no-video", action="store_true")
+    p.add_argument("--lcm-url", default=DEFAULT_REPLAY_URL)
+    p.add_argument("--no-build", action="store_true")
+    a = p.parse_args(argv)
+    if not os.path.isfile(os.path.join(a.session, "lcmlog")):
+        raise LabError("give a session folder (with an lcmlog)")
+    r = Replay(a)
+    r.speed = check_speed(a.speed)
+    if not a.no_build:
+        install_and_build()
+    require_built("scene_proc/scene_proc", "esg_renderer/esg_renderer", "tools/rms_session")
+    ensure_multicast_route()
+    r.make()
+    try:
+        r.run()
+    except LabError as e:
+        r.sup.fatal = (str(e), e.code)
+    finally:
+        if hasattr(r, "sup"):
+            r.stop()
+    return r.finish()

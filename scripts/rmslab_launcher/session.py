@@ -1,0 +1,117 @@
+"""A session folder and what is done to it before and after its processes
+run: the folder, the id, the manifest, the checks (files, network, disk),
+the record's parts, the summary (docs/sessions.md)."""
+import json
+import os
+import secrets
+import shutil
+import subprocess
+import time
+
+from . import disk
+from .common import LabError, binary, say
+
+CHANNELS = ["RMS_OPERATOR_INPUT", "RMS_OPERATOR_STATE", "RMS_WINDOW_KEYS", "RMS_DCP_FRAME", "RMS_DCP_TELEMETRY",
+            "RMS_ESG_FRAME", "RMS_STATUS", "RMS_CONTROL"]
+
+
+def new_session_id():
+    """A random 63-bit id, never 0 (0 is "no session"), as the manifest writes it."""
+    return f"0x{secrets.randbits(63) | 1:016x}"
+
+
+def make_folder(out, default_parent):
+    if not out:
+        out = os.path.join(default_parent, time.strftime("%Y%m%dT%H%M%SZ", time.gmtime()))
+    if os.path.exists(os.path.join(out, "lcmlog")):
+        raise LabError(f"{out} already holds a session")
+    for sub in ("logs", "stats", "frames", "run", "checkpoints"):
+        os.makedirs(os.path.join(out, sub), exist_ok=True)
+    return os.path.abspath(out)
+
+
+def precheck(checks):
+    """Runs each process with --check before anything starts: a bad file or
+    option is refused here, its message shown (exit 2). checks: [(name, argv)]."""
+    for name, argv in checks:
+        r = subprocess.run(argv + ["--check", "--log-level", "warn"], capture_output=True, text=True)
+        if r.returncode != 0:
+            lines = []
+            for line in (r.stderr + r.stdout).splitlines():
+                # "[time] [process] [level] message" -> "message"
+                parts = line.split("] ", 3)
+                lines.append(parts[-1] if len(parts) == 4 and line.startswith("[") else line)
+            raise LabError(f"{name} refuses to start:\n" + "\n".join("  " + l for l in lines if l.strip()))
+
+
+def probe_network(host, url, suffix, share):
+    """Another session already on this address and channels? Refused unless
+    share (--share-network); one on other channels is only noted."""
+    r = host.run([binary("tools/rms_session"), "probe", "--lcm-url", url, "--seconds", "1.2"], capture_output=True,
+                 text=True)
+    if r.returncode != 0:
+        say(f"could not look for other sessions on {url}: {r.stderr.strip()}")
+        return
+    ours = {c + suffix for c in CHANNELS}
+    for s in json.loads(r.stdout).get("sessions", []):
+        chans = set(s["channels"])
+        who = ", ".join(s["senders"][:4])
+        if chans & ours:
+            msg = (f"another session is running on {url} on this session's channels: session {s['session_id']} "
+                   f"({who}; {', '.join(sorted(chans & ours)[:3])}). Sessions on one address and channels see each "
+                   f"other's traffic (each drops the other's, but they share the link); give this one "
+                   f"--channel-suffix NAME or another --lcm-url, or --share-network to run beside it anyway.")
+            if not share:
+                raise LabError(msg)
+            say("--share-network: " + msg.split(". ")[0])
+        else:
+            say(f"note: another station is on {url}, on other channels (session {s['session_id']}, "
+                f"{', '.join(sorted(chans)[:2])}): not affected")
+
+
+def write_manifest(out, fields):
+    argv = [binary("tools/rms_session"), "manifest", out]
+    for k, v in fields:
+        argv += [k, v]
+    r = subprocess.run(argv, capture_output=True, text=True)
+    if r.returncode != 0:
+        raise LabError(f"cannot write the manifest: {r.stderr.strip()}", 1)
+
+
+def join_record_parts(out):
+    """The recorder, restarted after it died, wrote lcmlog.1, lcmlog.2, ...:
+    appended to lcmlog (an LCM log is a run of events), in order."""
+    parts = []
+    n = 1
+    while os.path.exists(os.path.join(out, f"lcmlog.{n}")):
+        parts.append(os.path.join(out, f"lcmlog.{n}"))
+        n += 1
+    if not parts:
+        return None
+    try:
+        with open(os.path.join(out, "lcmlog"), "ab") as dst:
+            for p in parts:
+                with open(p, "rb") as src:
+                    shutil.copyfileobj(src, dst)
+        for p in parts:
+            os.remove(p)
+        return f"the record was restarted {len(parts)} time(s); its parts are joined into lcmlog"
+    except OSError as e:
+        return f"the record's parts ({', '.join(os.path.basename(p) for p in parts)}) could not be joined ({e}): " \
+               f"lcmlog holds only the first"
+
+
+def summarize(out, fallback_name):
+    """summary.json in the session; when its disk cannot take it, elsewhere
+    (said). Returns (the brief lines, where it went, or None)."""
+    targets = [os.path.join(out, "summary.json")] + [os.path.join(d, f"rmslab-{fallback_name}-summary.json")
+                                                     for d in disk.fallback_dirs()]
+    for t in targets:
+        r = subprocess.run([binary("tools/rms_session"), "summary", out, "--brief", "--out", t], capture_output=True,
+                           text=True)
+        if r.returncode == 0:
+            if t != targets[0]:
+                say(f"the session's folder could not take its summary: written to {t} instead")
+            return r.stdout.splitlines(), t
+        say(f"summary: {r.stderr.strip()}")
+    return [], None

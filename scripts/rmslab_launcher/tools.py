@@ -1,0 +1,115 @@
+"""scripts/lab resim | export | report | monitor | control: the tools over a
+session (docs/sessions.md), each a thin call of its executable."""
+import argparse
+import json
+import os
+import subprocess
+
+from . import replay
+from .common import DEFAULT_URL, ROOT, LabError, binary, install_and_build, say
+
+
+def ensure(rel, no_build=False):
+    if not os.access(binary(rel), os.X_OK):
+        if no_build:
+            raise LabError(f"{binary(rel)} is not built (drop --no-build, or run scripts/test)")
+        install_and_build()
+
+
+def resim(argv):
+    """scripts/lab resim SESSION [--config FILE] [--out DIR] [--video]: the DCP
+    again on the recorded inputs. Without --config, exit 0 only if every
+    output is identical; with it, a new session (default SESSION-resim) with
+    comparison.md; --video replays it to make its video."""
+    p = argparse.ArgumentParser(prog="scripts/lab resim", description=resim.__doc__)
+    p.add_argument("session")
+    p.add_argument("--config")
+    p.add_argument("--out")
+    p.add_argument("--video", action="store_true")
+    p.add_argument("--no-build", action="store_true")
+    a = p.parse_args(argv)
+    if not a.no_build:
+        install_and_build()
+    cmd = [binary("tools/rms_resim"), a.session]
+    if a.config:
+        cmd += ["--config", a.config]
+    if a.out:
+        cmd += ["--out", a.out]
+    rc = subprocess.run(cmd).returncode
+    if rc == 0 and a.video:
+        out = a.out or a.session.rstrip("/") + "-resim"
+        if not os.path.isdir(out):
+            raise LabError("resim --video needs the new session (--config)")
+        replay.run([out, "--out", os.path.join(out, "replay"), "--no-build", "--speed", "4"])
+        video = os.path.join(out, "replay", "session.mp4")
+        if os.path.exists(video):
+            os.replace(video, os.path.join(out, "session.mp4"))
+            say(f"video: {os.path.join(out, 'session.mp4')}")
+    return rc
+
+
+def export(argv):
+    """scripts/lab export SESSION [--out DIR]: every channel of the session's
+    LCM log to CSV, one file each (default SESSION/csv/), in engineering units."""
+    if not argv or argv[0] in ("-h", "--help"):
+        print(export.__doc__)
+        return 0 if argv else 2
+    ensure("tools/rms_session")
+    return subprocess.run([binary("tools/rms_session"), "export"] + argv).returncode
+
+
+def report(argv):
+    """scripts/lab report SESSION [--out FILE]: one self-contained HTML report
+    (default SESSION/report.html) with plots drawn by Chart.js."""
+    if not argv or argv[0] in ("-h", "--help"):
+        print(report.__doc__)
+        return 0 if argv else 2
+    ensure("tools/rms_report")
+    return subprocess.run([binary("tools/rms_report")] + argv).returncode
+
+
+def monitor(argv):
+    """scripts/lab monitor [--lcm-url URL] [--channel-suffix S] [--for SECONDS]:
+    live decoded traffic per channel, and each process's last status report."""
+    ensure("tools/rms_monitor")
+    if "--lcm-url" not in argv:
+        argv = ["--lcm-url", DEFAULT_URL] + argv
+    return subprocess.run([binary("tools/rms_monitor")] + argv).returncode
+
+
+def running_sessions():
+    """Session folders under sessions/ whose launcher is still running."""
+    out = []
+    base = os.path.join(ROOT, "sessions")
+    if not os.path.isdir(base):
+        return out
+    for name in sorted(os.listdir(base)):
+        pidf = os.path.join(base, name, "run", "launcher.pid")
+        try:
+            pid = int(open(pidf).read())
+            os.kill(pid, 0)
+        except (OSError, ValueError):
+            continue
+        if not os.path.exists(os.path.join(base, name, "run", "stopping")):
+            out.append(os.path.join(base, name))
+    return out
+
+
+def control(argv):
+    """scripts/lab control [--session DIR] freeze | run | step [N] | checkpoint NAME | restore NAME|FILE [--run]:
+    commands to a running session (docs/sessions.md "Freeze, run, step,
+    checkpoint"). Without --session (or --lcm-url and --session-id): the one
+    session of this checkout that is running now."""
+    if not argv or argv[0] in ("-h", "--help"):
+        print(control.__doc__)
+        return 0 if argv else 2
+    ensure("tools/rms_control")
+    if not any(a in argv for a in ("--session", "--lcm-url", "--session-id")):
+        live = running_sessions()
+        if len(live) != 1:
+            raise LabError("no session of this checkout is running: give --session DIR" if not live else
+                           "several sessions are running: give --session DIR, one of\n" +
+                           "\n".join("  " + s for s in live))
+        say(f"the running session: {live[0]}")
+        argv = ["--session", live[0]] + argv
+    return subprocess.run([binary("tools/rms_control")] + argv).returncode
