@@ -8,6 +8,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <spdlog/spdlog.h>
 
+#include "rms/channels.h"
 #include "rms/check.h"
 #include "rms/message_io.h"
 
@@ -55,7 +56,7 @@ bool LcmInterface::Admit(const std::string& channel, const void* data, int size)
   // Only rmslab messages carry a sender; anything else goes on to be
   // refused by the decoder (dropped.wrong_type), as before.
   if (!ReadFingerprint(data, size, &fp) || !IsRmslabFingerprint(fp) || !ReadSessionId(data, size, &id)) return true;
-  if (id == sender_.session_id) return true;
+  if (id == sender_.session_id) return AdmitPublisher(channel, data, size);
   ++other_session_dropped_;
   if (other_sessions_[id]++ == 0) {
     std::int8_t process = 0;
@@ -68,6 +69,48 @@ bool LcmInterface::Admit(const std::string& channel, const void* data, int size)
         channel, FormatSessionId(id), ProcessCodeName(process), pid);
   }
   return false;
+}
+
+// One publisher a channel (docs/security.md "One publisher a channel"): on
+// the channels that only one process of a session publishes, a message from
+// another pid is taken only once the current publisher has fallen silent (it
+// ended, and this is its restart); while it still sends, the other is an
+// impostor with the session's id, dropped and counted.
+bool LcmInterface::AdmitPublisher(const std::string& channel, const void* data, int size) {
+  const std::string base = suffix_.empty() || channel.size() < suffix_.size()
+                               ? channel
+                               : channel.substr(0, channel.size() - suffix_.size());
+  if (base != channels::kOperatorInput && base != channels::kDcpFrame && base != channels::kEsgFrame &&
+      base != channels::kDcpTelemetry && base != channels::kOperatorState && base != channels::kWindowKeys) {
+    return true;  // RMS_STATUS and RMS_CONTROL have several publishers
+  }
+  std::int8_t process = 0;
+  std::int32_t pid = 0;
+  if (!ReadSenderProcess(data, size, &process, &pid)) return true;
+  const std::int64_t now = NowUs();
+  Publisher& p = publishers_[channel];
+  if (p.last_us == 0 || (p.pid == pid && p.process == process)) {
+    p.process = process;
+    p.pid = pid;
+    p.last_us = now;
+    return true;
+  }
+  if (now - p.last_us < kPublisherSilenceUs) {
+    ++other_sender_dropped_;
+    if (!p.warned) {
+      p.warned = true;
+      spdlog::warn(
+          "{}: a message of this session from {} pid {} while its publisher ({} pid {}) is sending -- dropped, "
+          "as every one will be while it sends (dropped.other_sender): someone with this session's id is "
+          "impersonating a process (docs/security.md)",
+          channel, ProcessCodeName(process), pid, ProcessCodeName(p.process), p.pid);
+    }
+    return false;
+  }
+  spdlog::info("{}: a new publisher, {} pid {}, after {} ms of silence from pid {} (a restart)", channel,
+               ProcessCodeName(process), pid, (now - p.last_us) / 1000, p.pid);
+  p = Publisher{process, pid, now, false};
+  return true;
 }
 
 // ---------------------------------------------------------------- UdpLcm

@@ -88,6 +88,14 @@ class LcmInterface {
   const Sender& sender() const { return sender_; }
   // Messages of other sessions dropped so far ("dropped.other_session").
   std::int64_t other_session_dropped() const { return other_session_dropped_; }
+  // Messages on a one-publisher channel from a pid other than its
+  // publisher's while that one was still sending ("dropped.other_sender";
+  // docs/security.md "One publisher a channel").
+  std::int64_t other_sender_dropped() const { return other_sender_dropped_; }
+
+  // A one-publisher channel takes another publisher (a restarted process's
+  // new pid) only after the current one has been silent this long.
+  static constexpr std::int64_t kPublisherSilenceUs = 300000;
 
  protected:
   explicit LcmInterface(std::string suffix);
@@ -96,10 +104,20 @@ class LcmInterface {
   bool Admit(const std::string& channel, const void* data, int size);
 
  private:
+  bool AdmitPublisher(const std::string& channel, const void* data, int size);
+  struct Publisher {
+    std::int8_t process = 0;
+    std::int32_t pid = 0;
+    std::int64_t last_us = 0;  // when it was last heard (0: never)
+    bool warned = false;
+  };
+
   std::string suffix_;
   Sender sender_;
   std::int64_t other_session_dropped_ = 0;
+  std::int64_t other_sender_dropped_ = 0;
   std::map<std::int64_t, std::int64_t> other_sessions_;  // id -> messages dropped
+  std::map<std::string, Publisher> publishers_;          // full channel -> its current publisher
 };
 
 // Real LCM. Throws TransportError when LCM is not good() (no multicast route,

@@ -184,6 +184,7 @@ void StatusReporter::Publish(std::int64_t frame, const Counters& counters, bool 
 
 void NoteTransportCounters(const LcmInterface& lcm, Counters* counters) {
   if (const std::int64_t n = lcm.other_session_dropped(); n > 0) counters->Set("dropped.other_session", n);
+  if (const std::int64_t n = lcm.other_sender_dropped(); n > 0) counters->Set("dropped.other_sender", n);
 }
 
 void AddLatencyCounters(const LatencyMap& latencies, Counters* counters) {

@@ -110,7 +110,8 @@ using LatencyMap = std::map<std::string, LatencyHistogram>;
 void AddLatencyCounters(const LatencyMap& latencies, Counters* counters);
 
 // The transport's own counts into the process's counters:
-// "dropped.other_session" (messages of another session, LcmInterface::Admit).
+// "dropped.other_session" (messages of another session) and "dropped.other_sender"
+// (an impostor on a one-publisher channel), LcmInterface::Admit.
 void NoteTransportCounters(const LcmInterface& lcm, Counters* counters);
 
 // The main loop of a subscribing process: waits for messages (at most

@@ -34,6 +34,24 @@ def say(*parts):
         pass
 
 
+_unwritable = set()
+
+
+def write_run_file(path, text, append=True):
+    """One of the session's small bookkeeping files (run/): a full disk is
+    said once a file and is no reason for the launcher to stop stopping
+    the session. Returns False when it could not be written."""
+    try:
+        with open(path, "a" if append else "w") as f:
+            f.write(text)
+        return True
+    except OSError as e:
+        if path not in _unwritable:
+            _unwritable.add(path)
+            say(f"could not write {path} ({e.strerror})")
+        return False
+
+
 def binary(rel):
     return os.path.join(BUILD, rel)
 

@@ -322,7 +322,7 @@ class Demo:
 
     def finish(self):
         """The summary and the exit code."""
-        lines, where = session.summarize(self.out, self.name)
+        lines, where = session.summarize(self.out, f"{self.name}-{self.session_id}")
         op = self.sup.children.get("operator_station")
         op_rc = op.exit_code if op and op.exit_code is not None else None
         if self.sup.fatal:
@@ -335,8 +335,11 @@ class Demo:
             say("  " + l)
         for n in self.notes:
             say("note: " + n)
+        own = where == os.path.join(self.out, "summary.json")
         say(f"session folder: {self.out} (manifest.json, lcmlog, logs/, frames/"
-            f"{', session.mp4' if not self.a.no_video else ''}, summary.json)")
+            f"{', session.mp4' if not self.a.no_video else ''}{', summary.json' if own else ''})")
+        if where is not None and not own:
+            say(f"summary: {where}")
         if where is None:
             say("no summary could be written anywhere (every disk tried is full)")
         if self.sup.fatal:

@@ -16,8 +16,16 @@ import subprocess
 import sys
 import time
 
-from .common import sudo_prefix
+from .common import sudo_prefix, write_run_file
 from .hosts import SSH
+
+
+def log(line):
+    """A line in logs/reaper.log; a full disk does not stop the reaper."""
+    try:
+        print(line, flush=True)
+    except OSError:
+        pass
 
 
 def children(run_dir):
@@ -70,32 +78,30 @@ def signal_child(name, pid, host, sudo, remote_run, sig):
 def stop_all(kids):
     for name, pid, host, sudo, remote_run in kids:
         if alive(pid):
-            print(f"  SIGINT to {name} (pid {pid}, {host})", flush=True)
+            log(f"  SIGINT to {name} (pid {pid}, {host})")
             signal_child(name, pid, host, sudo, remote_run, signal.SIGINT)
     end = time.time() + 5
     while time.time() < end and any(alive(k[1]) for k in kids):
         time.sleep(0.1)
     for name, pid, host, sudo, remote_run in kids:
         if alive(pid):
-            print(f"  SIGKILL to {name} (pid {pid}): it did not stop", flush=True)
+            log(f"  SIGKILL to {name} (pid {pid}): it did not stop")
             signal_child(name, pid, host, sudo, remote_run, signal.SIGKILL)
 
 
 def reap(session, summary_argv):
     run_dir = os.path.join(session, "run")
-    print(f"{time.strftime('%H:%M:%S')} the launcher is gone without stopping the session: stopping it", flush=True)
+    log(f"{time.strftime('%H:%M:%S')} the launcher is gone without stopping the session: stopping it")
     kids = children(run_dir)
     # The pipeline first, the recorder last (it records everyone's last status).
     stop_all([k for k in kids if k[0] != "lcm-logger"])
     time.sleep(0.3)
     stop_all([k for k in kids if k[0] == "lcm-logger"])
-    with open(os.path.join(run_dir, "exit_codes"), "a") as f:
-        f.write("launcher 137\n")
-    with open(os.path.join(run_dir, "launcher_died"), "w") as f:
-        f.write(f"{time.time():.6f}\n")
+    write_run_file(os.path.join(run_dir, "exit_codes"), "launcher 137\n")
+    write_run_file(os.path.join(run_dir, "launcher_died"), f"{time.time():.6f}\n", append=False)
     if summary_argv:
         subprocess.run(summary_argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    print(f"{time.strftime('%H:%M:%S')} stopped; summary written", flush=True)
+    log(f"{time.strftime('%H:%M:%S')} stopped; summary written")
 
 
 def main():

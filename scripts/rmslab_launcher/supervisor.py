@@ -27,7 +27,7 @@ import subprocess
 import sys
 import time
 
-from .common import ROOT, say
+from .common import ROOT, say, write_run_file
 
 MAX_RESTARTS = 5
 RESTART_WINDOW_S = 60.0
@@ -168,10 +168,9 @@ class Supervisor:
             os.close(r)
         c.ready = False
         c.started_at = time.time()
-        with open(os.path.join(self.run_dir, f"{s.name}.pid"), "w") as f:
-            f.write(f"{c.pid}\n")
-        with open(os.path.join(self.run_dir, "children"), "a") as f:
-            f.write(f"{s.name} {c.pid} {s.host.spec} {1 if s.host.via_sudo else 0} {s.remote_run or '-'}\n")
+        write_run_file(os.path.join(self.run_dir, f"{s.name}.pid"), f"{c.pid}\n", append=False)
+        write_run_file(os.path.join(self.run_dir, "children"),
+                       f"{s.name} {c.pid} {s.host.spec} {1 if s.host.via_sudo else 0} {s.remote_run or '-'}\n")
 
     def wait_ready(self, names, timeout_s=READY_TIMEOUT_S):
         """Until each is ready. Returns None, or the message saying which
@@ -216,11 +215,10 @@ class Supervisor:
                 pid = int(json.load(f).get("pid", pid))
         except (OSError, ValueError):
             pass
-        with open(os.path.join(self.run_dir, "pids"), "a") as f:
-            f.write(f"{c.spec.name} {pid}\n")
+        write_run_file(os.path.join(self.run_dir, "pids"), f"{c.spec.name} {pid}\n")
         if c.n > 0:
-            with open(os.path.join(self.run_dir, "restarts"), "a") as f:
-                f.write(f"{c.spec.name} {c.n} {c.last_rc} {c.down_at:.6f} {time.time():.6f}\n")
+            write_run_file(os.path.join(self.run_dir, "restarts"),
+                           f"{c.spec.name} {c.n} {c.last_rc} {c.down_at:.6f} {time.time():.6f}\n")
 
     # ---- watching ----
     def poll(self):
@@ -314,12 +312,9 @@ class Supervisor:
                 c.lifeline_w = None
 
     def record_exit_codes(self):
-        with open(os.path.join(self.run_dir, "exit_codes"), "a") as f:
-            for n in self.order:
-                c = self.children[n]
-                if c.exit_code is not None:
-                    f.write(f"{n} {c.exit_code}\n")
+        lines = [f"{n} {self.children[n].exit_code}\n" for n in self.order if self.children[n].exit_code is not None]
+        write_run_file(os.path.join(self.run_dir, "exit_codes"), "".join(lines))
 
     def begin_stop(self):
         self.stopping = True
-        open(os.path.join(self.run_dir, "stopping"), "w").close()
+        write_run_file(os.path.join(self.run_dir, "stopping"), "", append=False)

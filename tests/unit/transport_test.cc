@@ -3,9 +3,11 @@
 // hostile bytes without throwing.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <lcm/lcm-cpp.hpp>
+#include <thread>
 #include <unistd.h>
 
 #include "rms/channels.h"
@@ -147,6 +149,53 @@ TEST(UdpLcm, MessagesAreStampedWithTheirSenderAndOtherSessionsAreDropped) {
   for (int k = 0; k < 20 && raw == 0; ++k) mine.HandleSubscriptions(20);
   EXPECT_EQ(raw, 1);
   EXPECT_EQ(mine.other_session_dropped(), 10);
+}
+
+// docs/security.md "One publisher a channel": on a channel one process
+// publishes, another pid of the same session is dropped while the
+// publisher sends, and taken once it has been silent (a restart); RMS_STATUS
+// takes every process.
+TEST(SessionSenders, AnImpostorIsDroppedWhileThePublisherSendsAndARestartIsTaken) {
+  LcmOptions o;
+  o.url = "udpm://239.255.76.67:" + std::to_string(7990 + getpid() % 40) + "?ttl=0";
+  UdpLcm real(o), impostor(o), restarted(o), rx(o);
+  real.SetSender({0x1111, sender_t::PROCESS_OPERATOR_STATION, 4242});
+  impostor.SetSender({0x1111, sender_t::PROCESS_OPERATOR_STATION, 9999});
+  restarted.SetSender({0x1111, sender_t::PROCESS_OPERATOR_STATION, 4343});
+  rx.SetSender({0x1111, sender_t::PROCESS_DYNAMICS, 1});
+  std::vector<std::int32_t> inputs, statuses;
+  rx.Subscribe(channels::kOperatorInput, [&](const void* d, int n, std::int64_t) {
+    operator_input_t m;
+    if (SafeDecode(d, n, 1000, &m) == DecodeError::kNone) inputs.push_back(m.sender.pid);
+  });
+  rx.Subscribe(channels::kStatus, [&](const void* d, int n, std::int64_t) {
+    process_status_t m;
+    if (SafeDecode(d, n, 1 << 20, &m) == DecodeError::kNone) statuses.push_back(m.sender.pid);
+  });
+  auto drain = [&](std::size_t want) {
+    for (int k = 0; k < 50 && inputs.size() < want; ++k) rx.HandleSubscriptions(20);
+  };
+  operator_input_t m{};
+  process_status_t st{};
+  st.process = "x";
+  ASSERT_TRUE(PublishMessage(real, channels::kOperatorInput, m));
+  drain(1);
+  for (int i = 0; i < 5; ++i) {
+    ASSERT_TRUE(PublishMessage(impostor, channels::kOperatorInput, m));
+    ASSERT_TRUE(PublishMessage(real, channels::kOperatorInput, m));
+    ASSERT_TRUE(PublishMessage(impostor, channels::kStatus, st));
+  }
+  drain(6);
+  for (int k = 0; k < 5; ++k) rx.HandleSubscriptions(10);
+  EXPECT_EQ(inputs, std::vector<std::int32_t>(6, 4242));
+  EXPECT_EQ(rx.other_sender_dropped(), 5);
+  EXPECT_EQ(statuses.size(), 5u);
+  // The publisher falls silent (it ended); its restart is taken.
+  std::this_thread::sleep_for(std::chrono::microseconds(LcmInterface::kPublisherSilenceUs + 100000));
+  ASSERT_TRUE(PublishMessage(restarted, channels::kOperatorInput, m));
+  drain(7);
+  ASSERT_EQ(inputs.size(), 7u);
+  EXPECT_EQ(inputs.back(), 4343);
 }
 
 TEST(SessionId, ParsedFromDecimalOrHexAndMalformedOnesAreRefused) {

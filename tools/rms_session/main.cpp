@@ -96,11 +96,16 @@ int main(int argc, char** argv) {
     std::cout << "frames: operator " << fr["operator_published"] << ", DCP " << fr["dcp_published"]
               << ", ESG " << fr["esg_published"] << ", rendered " << fr["rendered"] << ", PNG "
               << fr["png_written"] << "; dropped " << dropped << "\n";
+    if (!j["log"]["stats_from_log"].empty()) {
+      std::cout << "counts of " << j["log"]["stats_from_log"].dump() << " from their last status reports in the log "
+                << "(they wrote no stats file at exit: a full disk, a crash): the counts end where the record ends\n";
+    }
     {
       const auto& r = fr["refused"];
-      if (r.value("other_session", 0) + r.value("late", 0) + r.value("far_ahead", 0) > 0) {
-        std::cout << "refused by the processes: " << r["other_session"] << " of other sessions, " << r["late"]
-                  << " too late to act on (a stall), " << r["far_ahead"] << " with impossible frame numbers\n";
+      if (r.value("other_session", 0) + r.value("other_sender", 0) + r.value("late", 0) + r.value("far_ahead", 0) > 0) {
+        std::cout << "refused by the processes: " << r["other_session"] << " of other sessions, " << r["other_sender"]
+                  << " from an impostor with this session's id, " << r["late"] << " too late to act on (a stall), "
+                  << r["far_ahead"] << " with impossible frame numbers\n";
       }
     }
     if (j["record"].value("lost", 0) > 0) {

@@ -116,10 +116,13 @@ namespace {
 struct DcpFrameRecord {
   std::int64_t input_frame = -1;
   ControlWord word;
+  // Two different DCP frames of this number in the log, both with the
+  // session's id and the DCP's pid: one is forged, and neither is believed.
+  bool disputed = false;
 };
 
 // First pass: the session's own DCP frames, by frame number (the first of
-// each number; a repeat is not taken).
+// each number; a repeat that differs marks the number disputed).
 std::map<std::int64_t, DcpFrameRecord> ReadDcpFrames(const fs::path& log_path, SenderCheck check) {
   std::map<std::int64_t, DcpFrameRecord> out;
   lcm::LogFile log(log_path.string(), "r");
@@ -130,7 +133,9 @@ std::map<std::int64_t, DcpFrameRecord> ReadDcpFrames(const fs::path& log_path, S
     dcp_frame_t m;
     if (SafeDecode(ev->data, ev->datalen, 1024, &m) != DecodeError::kNone) continue;
     try {
-      out.emplace(m.frame, DcpFrameRecord{m.input_frame, UnpackControlWord(m.control_word)});
+      const DcpFrameRecord r{m.input_frame, UnpackControlWord(m.control_word)};
+      const auto [it, fresh] = out.emplace(m.frame, r);
+      if (!fresh && (it->second.input_frame != r.input_frame || it->second.word != r.word)) it->second.disputed = true;
     } catch (const InputError&) {
     }
   }
@@ -267,6 +272,7 @@ void ScanTelemetry(const lcm::LogEvent& ev, const std::map<std::int64_t, DcpFram
   // the same (docs/security.md "What the summary trusts").
   const auto it = dcp.find(m.frame);
   if (it == dcp.end()) return check->Count("telemetry_without_its_dcp_frame");
+  if (it->second.disputed) return check->Count("disputed_dcp_frame");
   if (!Agrees(m, it->second)) return check->Count("telemetry_contradicts_its_dcp_frame");
   if (!s->telemetry_frames.insert(m.frame).second) return check->Count("repeated_frame");
   s->telemetry.Observe(m, ev.timestamp, s->first_us);
@@ -353,8 +359,12 @@ std::map<std::string, nlohmann::json> MergedStats(const fs::path& root, const St
     stats[p] = ReadJson(root / "stats" / (std::string(p) + ".json"));
     const auto runs = st.runs.find(p);
     if (runs == st.runs.end()) continue;
+    // No stats file (a full disk at exit, a crash): the last run's counts
+    // are its last RMS_STATUS report in the log (said in "stats_from_log").
+    const bool no_file = !stats[p].contains("counters");
+    if (no_file) stats[p]["from_log"] = true;
     for (const auto& [pid, counters] : runs->second) {
-      if (pid == st.last_pid.at(p)) continue;
+      if (pid == st.last_pid.at(p) && !no_file) continue;
       if (!Plausible(counters, duration_s, rate_hz)) {
         check->Count("implausible_status");
         continue;
@@ -424,7 +434,7 @@ void AddMission(const fs::path& root, const LogScan& s, double rate_hz, nlohmann
 // Messages a receiver refused for a reason of its own, not malformed
 // (docs/protocol.md): too late to act on, of another session, beyond the
 // session's clock.
-constexpr const char* kRefusedReasons[] = {"late", "other_session", "far_ahead"};
+constexpr const char* kRefusedReasons[] = {"late", "other_session", "other_sender", "far_ahead"};
 
 std::int64_t Malformed(const nlohmann::json& st) {
   std::int64_t n = SumPrefix(st, "dropped.");
@@ -457,7 +467,8 @@ nlohmann::ordered_json FramesJson(const std::map<std::string, nlohmann::json>& s
   };
   nlohmann::ordered_json refused = nlohmann::ordered_json::object();
   for (const char* reason : kRefusedReasons) {
-    refused[reason] = Counter(dcp, std::string("dropped.") + reason) + Counter(scene, std::string("dropped.") + reason) +
+    refused[reason] = Counter(op, std::string("dropped.") + reason) + Counter(dcp, std::string("dropped.") + reason) +
+                      Counter(scene, std::string("dropped.") + reason) +
                       Counter(esg, std::string("dropped.") + reason);
   }
   frames["refused"] = refused;
@@ -604,6 +615,10 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
   j["timing"] = TimingJson(stats, rate_hz);
   j["record"] = RecordJson(stats, s);
   j["log"] = LogJson(s);
+  j["log"]["stats_from_log"] = nlohmann::json::array();
+  for (const auto& [p, st] : stats) {
+    if (st.value("from_log", false)) j["log"]["stats_from_log"].push_back(p);
+  }
   j["ignored"] = check.Json();
   return j;
 }
