@@ -10,6 +10,7 @@
 #include <iterator>
 
 #include "rms/check.h"
+#include "rms/text.h"
 
 namespace rms {
 
@@ -83,7 +84,11 @@ void CheckpointFolder::ValidateName(const std::string& name) {
                 ch == '-' || ch == '.');
   }
   if (!ok) {
-    throw InputError("checkpoint name '" + name.substr(0, 80) +
+    std::string shown;  // printable only: a name must not write lines of its own into a log
+    for (char ch : name.substr(0, 80)) {
+      shown += (ch >= 0x20 && ch < 0x7f) ? std::string(1, ch) : Sprintf("\\x%02x", static_cast<unsigned char>(ch));
+    }
+    throw InputError("checkpoint name '" + shown +
                      "' refused: a name (not a path) of 1 to 64 letters, digits, '_', '-' or '.', ending in .json, "
                      "not starting with '.'");
   }
@@ -91,7 +96,10 @@ void CheckpointFolder::ValidateName(const std::string& name) {
 
 int CheckpointFolder::OpenDir() const {
   if (dir_.empty()) throw InputError("no checkpoints folder was given to this process (--checkpoint-dir): refused");
-  const int fd = open(dir_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  // The folder itself, never through a link (one planted in its place while
+  // the session runs would send checkpoints elsewhere).
+  const int fd = open(dir_.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0 && errno == ELOOP) throw InputError("the checkpoints folder '" + dir_ + "' is a symbolic link: refused");
   if (fd < 0) throw InputError("cannot open the checkpoints folder '" + dir_ + "': " + std::strerror(errno));
   return fd;
 }

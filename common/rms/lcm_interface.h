@@ -95,7 +95,7 @@ class LcmInterface {
 
   // A one-publisher channel takes another publisher (a restarted process's
   // new pid) only after the current one has been silent this long.
-  static constexpr std::int64_t kPublisherSilenceUs = 300000;
+  static constexpr std::int64_t kPublisherSilenceUs = 100000;
 
  protected:
   explicit LcmInterface(std::string suffix);

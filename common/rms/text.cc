@@ -1,5 +1,7 @@
 #include "rms/text.h"
 
+#include <sys/stat.h>
+
 #include <vector>
 
 #include <cerrno>
@@ -11,11 +13,28 @@
 namespace rms {
 
 void WriteWholeFile(const std::string& path, const std::string& text) {
-  std::ofstream f(path, std::ios::binary | std::ios::trunc);
-  if (!f) throw InputError("cannot write '" + path + "': " + std::strerror(errno));
-  f << text;
-  f.close();
-  if (!f) throw InputError("could not write all of '" + path + "': " + std::strerror(errno ? errno : EIO));
+  // A regular file (or a new one) is written beside it and renamed over it,
+  // so a failure (a full disk) leaves the old file, or none, never a part;
+  // anything else (a device, a pipe) is written directly.
+  struct stat st {};
+  const bool regular = stat(path.c_str(), &st) != 0 || S_ISREG(st.st_mode);
+  const std::string target = regular ? path + ".tmp" : path;
+  {
+    std::ofstream f(target, std::ios::binary | std::ios::trunc);
+    if (!f) throw InputError("cannot write '" + path + "': " + std::strerror(errno));
+    f << text;
+    f.close();
+    if (!f) {
+      const int err = errno ? errno : EIO;
+      if (regular) std::remove(target.c_str());
+      throw InputError("could not write all of '" + path + "': " + std::strerror(err));
+    }
+  }
+  if (regular && std::rename(target.c_str(), path.c_str()) != 0) {
+    const int err = errno;
+    std::remove(target.c_str());
+    throw InputError("could not write '" + path + "': " + std::strerror(err));
+  }
 }
 
 std::string Sprintf(const char* format, ...) {

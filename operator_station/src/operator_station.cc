@@ -109,6 +109,7 @@ OperatorStation::OperatorStation(const OperatorOptions& options, const LabConfig
       period_ns_(static_cast<std::int64_t>(std::llround(1e9 / rate_hz_))),
       builder_(config.inputs),
       checkpoints_(options.checkpoint_dir) {
+  telemetry_seq_.SetClock(SessionFrameClock(config.session.frame_rate_hz));
   Subscribe();
 }
 
@@ -135,9 +136,23 @@ void OperatorStation::OnTelemetry(const void* data, int size, std::int64_t recv_
     counters_.Add("telemetry.before_reset");  // answers an input from before the last reset or restore
     return;
   }
-  if (telemetry_ && m.frame <= telemetry_->frame && m.frame != 0) {
-    counters_.Add("telemetry.stale");
-    return;
+  switch (telemetry_seq_.Accept(m.frame, recv_us)) {
+    case SequenceTracker::Verdict::kDuplicate:
+    case SequenceTracker::Verdict::kStale:
+      counters_.Add("telemetry.stale");
+      return;
+    case SequenceTracker::Verdict::kFarAhead:
+      if (counters_.Get("dropped.far_ahead") == 0) {
+        spdlog::warn("telemetry frame {} refused: beyond what the session's clock allows (dropped.far_ahead)", m.frame);
+      }
+      counters_.Add("dropped.far_ahead");
+      return;
+    case SequenceTracker::Verdict::kResync:
+      counters_.Add("resyncs");
+      spdlog::warn("the telemetry's numbering moved to frame {}: followed again (resyncs)", m.frame);
+      break;
+    default:
+      break;
   }
   telemetry_ = m;
   telemetry_rate_.Tick(recv_us);
@@ -225,6 +240,9 @@ void OperatorStation::SendControl(std::int8_t command) {
 void OperatorStation::ForgetTelemetry(std::int64_t fresh_from_input_frame) {
   fresh_from_input_frame_ = fresh_from_input_frame;
   telemetry_.reset();
+  const FrameClock clock = SessionFrameClock(config_.session.frame_rate_hz);
+  telemetry_seq_ = SequenceTracker{};
+  telemetry_seq_.SetClock(clock);
   events_.Forget();
 }
 

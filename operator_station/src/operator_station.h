@@ -109,6 +109,10 @@ class OperatorStation {
 
   // What the DCP and the other processes say.
   std::optional<dcp_telemetry_t> telemetry_;
+  // The telemetry's frame numbers: a frame beyond the session's clock is
+  // refused (dropped.far_ahead), so one forged frame far ahead cannot make
+  // every real one after it stale (docs/protocol.md "Frame numbers").
+  SequenceTracker telemetry_seq_;
   std::int64_t fresh_from_input_frame_ = -1;  // telemetry answering an older input is from before a reset / restore
   struct RateMeter {
     void Tick(std::int64_t now_us);

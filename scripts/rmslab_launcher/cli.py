@@ -58,6 +58,10 @@ def main(argv):
         return 130
     except BrokenPipeError:
         return 1
+    except (OSError, UnicodeError) as e:
+        # Nothing the checks foresaw: said plainly, not as a traceback.
+        say(f"error: {e}")
+        return 2
 
 
 if __name__ == "__main__":

@@ -100,8 +100,25 @@ def read_toml(path, what):
             return tomllib.load(f)
     except FileNotFoundError:
         raise LabError(f"no such file: {path}")
-    except tomllib.TOMLDecodeError as e:
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as e:
         raise LabError(f"{path}: not TOML ({e}) -- {what}")
+    except OSError as e:
+        raise LabError(f"cannot read {path} ({e.strerror}) -- {what}")
+
+
+def check_lcm_url(url):
+    """An LCM URL the processes can open: udpm://GROUP:PORT[?options], GROUP
+    an IPv4 multicast address (224.0.0.0 to 239.255.255.255), PORT 1..65535."""
+    import re
+    m = re.fullmatch(r"udpm://(\d{1,3})\.(\d{1,3})\.(\d{1,3})\.(\d{1,3}):(\d{1,5})(\?[A-Za-z0-9_=&.]*)?", url)
+    if not m:
+        raise LabError(f"--lcm-url '{url}': not udpm://GROUP:PORT[?ttl=N] (e.g. {DEFAULT_URL})")
+    octets = [int(m.group(i)) for i in range(1, 5)]
+    if any(o > 255 for o in octets) or not 224 <= octets[0] <= 239:
+        raise LabError(f"--lcm-url '{url}': {'.'.join(map(str, octets))} is not an IPv4 multicast group "
+                       f"(224.0.0.0 to 239.255.255.255; a lab uses 239.x.y.z)")
+    if not 1 <= int(m.group(5)) <= 65535:
+        raise LabError(f"--lcm-url '{url}': port {m.group(5)} is not 1..65535")
 
 
 def frame_rate_hz(config_path):

@@ -11,7 +11,7 @@ import time
 
 from . import disk, session
 from .common import (BUILD, DEFAULT_URL, ROOT, LabError, binary, check_speed, check_suffix, ensure_multicast_route,
-                     frame_rate_hz, install_and_build, require_built, say, timeline_length_s)
+                     frame_rate_hz, check_lcm_url, install_and_build, require_built, say, timeline_length_s)
 from .hosts import Host, check_hosts
 from .supervisor import Spec, Supervisor
 
@@ -56,8 +56,12 @@ class Demo:
     def validate(self):
         a = self.a
         for f in [a.config, a.timeline, a.restore, a.lab, a.bindings]:
-            if f and not os.path.isfile(f):
+            if f and not os.path.exists(f):
                 raise LabError(f"no such file: {f}")
+            if f and not os.path.isfile(f):
+                raise LabError(f"{f}: not a regular file (a folder, a device or a pipe): give a file")
+            if f and not os.access(f, os.R_OK):
+                raise LabError(f"{f}: cannot be read (permissions)")
         if a.bindings and not a.by_hand:
             raise LabError("--bindings is for flying by hand (--by-hand)")
         self.tty = sys.stdin.isatty()
@@ -132,13 +136,14 @@ class Demo:
     # ---- the session folder ----
     def make_session(self):
         a = self.a
-        self.out = session.make_folder(a.out, os.path.join(ROOT, "sessions"))
-        self.name = os.path.basename(self.out)
         self.bytes_per_s = disk.session_bytes_per_s(self.rate * self.speed, a.width, a.height, a.png_every,
                                                     not a.no_video and not self.hosts["esg_renderer"].remote)
-        disk.check_room(self.out, self.bytes_per_s, self.duration_s(),
+        # Before the folder is made: a refused session leaves nothing behind.
+        disk.check_room(a.out or os.path.join(ROOT, "sessions"), self.bytes_per_s, self.duration_s(),
                         f"{self.pilot}, {a.width}x{a.height}, PNG every {a.png_every}, video "
                         f"{'no' if a.no_video else 'yes'}")
+        self.out = session.make_folder(a.out, os.path.join(ROOT, "sessions"))
+        self.name = os.path.basename(self.out)
         self.remote_run = f"/tmp/rmslab-{self.name}"
         run = os.path.join(self.out, "run")
         shutil.copyfile(a.config, os.path.join(self.out, "config.toml"))
@@ -154,6 +159,7 @@ class Demo:
         with open(os.path.join(run, "launcher.pid"), "w") as f:
             f.write(f"{os.getpid()}\n")
         self.session_id = session.new_session_id()
+        session.note_address_holder(self.session_id)
         fields = [("--pilot", self.pilot), ("--lcm-url", self.url), ("--session-id", self.session_id),
                   ("--command", self.command_line),
                   ("--config-sha256", subprocess.run(["sha256sum", os.path.join(self.out, "config.toml")],
@@ -251,6 +257,8 @@ class Demo:
     # ---- running ----
     def on_signal(self, signum, frame):
         self.interrupted = signum
+        if hasattr(self, "sup"):
+            self.sup.interrupted = True
 
     def start(self):
         env = {"RMSLAB_SESSION_ID": self.session_id, "RMSLAB_SESSION_EPOCH_US": str(int(time.time() * 1e6))}
@@ -262,6 +270,8 @@ class Demo:
         err = self.sup.wait_ready(["lcm-logger"])
         if err:
             raise LabError(err, 1)
+        if self.interrupted is not None:
+            return
         self.sup.add(self.spec("esg_renderer", self.esg_args()))
         self.sup.add(self.spec("scene_proc", []))
         remote = self.hosts["dynamics_proc"].remote
@@ -274,6 +284,8 @@ class Demo:
         err = self.sup.wait_ready(["esg_renderer", "scene_proc", "dynamics_proc"])
         if err:
             raise LabError(err, 2 if "usage or configuration" in err else 1)
+        if self.interrupted is not None:
+            return
         time.sleep(0.2)
         flying = {"timeline": f"the timeline {os.path.basename(self.a.timeline or '')}",
                   "autopilot": "the autopilot",
@@ -322,11 +334,13 @@ class Demo:
 
     def finish(self):
         """The summary and the exit code."""
+        if self.sup.fatal:
+            say(self.sup.fatal[0])  # why the session stopped, before anything else
         lines, where = session.summarize(self.out, f"{self.name}-{self.session_id}")
         op = self.sup.children.get("operator_station")
         op_rc = op.exit_code if op and op.exit_code is not None else None
         if self.sup.fatal:
-            say(self.sup.fatal[0])
+            say("the session stopped early; what it recorded:")
         elif self.interrupted is not None or op_rc == 130:
             say("interrupted: session stopped")
         else:
@@ -369,8 +383,10 @@ def run(argv, command_line):
     require_built("operator_station/operator_station", "dynamics_proc/dynamics_proc", "scene_proc/scene_proc",
                   "esg_renderer/esg_renderer", "tools/rms_session")
     d.layout()
+    check_lcm_url(d.url)
     ensure_multicast_route()
     d.checks()
+    session.claim_address(d.url, a.channel_suffix, a.share_network)
     session.probe_network(d.hosts["recorder"], d.url, a.channel_suffix, a.share_network)
     d.make_session()
     try:

@@ -75,7 +75,22 @@ def signal_child(name, pid, host, sudo, remote_run, sig):
             continue
 
 
-def stop_all(kids):
+def ours(pid, session_id, host, sudo):
+    """True if the pid is still a process of this session: a local process
+    must carry the session's id in its environment (RMSLAB_SESSION_ID), so a
+    pid reused by something else since is never signalled. Processes behind
+    sudo (namespace hosts) or ssh are taken by their entry."""
+    if sudo or host != "localhost" or not session_id:
+        return True
+    try:
+        with open(f"/proc/{pid}/environ", "rb") as f:
+            return f"RMSLAB_SESSION_ID={session_id}".encode() in f.read().split(b"\0")
+    except OSError:
+        return False
+
+
+def stop_all(kids, session_id):
+    kids = [k for k in kids if alive(k[1]) and ours(k[1], session_id, k[2], k[3])]
     for name, pid, host, sudo, remote_run in kids:
         if alive(pid):
             log(f"  SIGINT to {name} (pid {pid}, {host})")
@@ -92,15 +107,24 @@ def stop_all(kids):
 def reap(session, summary_argv):
     run_dir = os.path.join(session, "run")
     log(f"{time.strftime('%H:%M:%S')} the launcher is gone without stopping the session: stopping it")
+    session_id = ""
+    try:
+        with open(os.path.join(session, "manifest.json")) as f:
+            session_id = json.load(f).get("session_id", "")
+    except (OSError, ValueError):
+        pass
     kids = children(run_dir)
     # The pipeline first, the recorder last (it records everyone's last status).
-    stop_all([k for k in kids if k[0] != "lcm-logger"])
+    stop_all([k for k in kids if k[0] != "lcm-logger"], session_id)
     time.sleep(0.3)
-    stop_all([k for k in kids if k[0] == "lcm-logger"])
+    stop_all([k for k in kids if k[0] == "lcm-logger"], session_id)
     write_run_file(os.path.join(run_dir, "exit_codes"), "launcher 137\n")
     write_run_file(os.path.join(run_dir, "launcher_died"), f"{time.time():.6f}\n", append=False)
     if summary_argv:
-        subprocess.run(summary_argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        r = subprocess.run(summary_argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        if r.returncode != 0:
+            log(f"{time.strftime('%H:%M:%S')} stopped; the summary could not be written: {r.stderr.strip()}")
+            return
     log(f"{time.strftime('%H:%M:%S')} stopped; summary written")
 
 

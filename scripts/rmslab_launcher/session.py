@@ -3,6 +3,7 @@ run: the folder, the id, the manifest, the checks (files, network, disk),
 the record's parts, the summary (docs/sessions.md)."""
 import json
 import os
+import tempfile
 import secrets
 import shutil
 import subprocess
@@ -25,8 +26,16 @@ def make_folder(out, default_parent):
         out = os.path.join(default_parent, time.strftime("%Y%m%dT%H%M%SZ", time.gmtime()))
     if os.path.exists(os.path.join(out, "lcmlog")):
         raise LabError(f"{out} already holds a session")
-    for sub in ("logs", "stats", "frames", "run", "checkpoints"):
-        os.makedirs(os.path.join(out, sub), exist_ok=True)
+    try:
+        for sub in ("logs", "stats", "frames", "run", "checkpoints"):
+            os.makedirs(os.path.join(out, sub), exist_ok=True)
+        probe = os.path.join(out, "run", ".writable")
+        with open(probe, "w") as f:
+            f.write("")
+        os.remove(probe)
+    except OSError as e:
+        raise LabError(f"--out {out}: cannot make the session's folder there ({e.strerror}: "
+                       f"{e.filename or out}); give --out a folder you can write")
     return os.path.abspath(out)
 
 
@@ -50,8 +59,8 @@ def probe_network(host, url, suffix, share):
     r = host.run([binary("tools/rms_session"), "probe", "--lcm-url", url, "--seconds", "1.2"], capture_output=True,
                  text=True)
     if r.returncode != 0:
-        say(f"could not look for other sessions on {url}: {r.stderr.strip()}")
-        return
+        # The processes could not open it either.
+        raise LabError(f"cannot listen on {url}: {r.stderr.strip()}")
     ours = {c + suffix for c in CHANNELS}
     for s in json.loads(r.stdout).get("sessions", []):
         chans = set(s["channels"])
@@ -67,6 +76,43 @@ def probe_network(host, url, suffix, share):
         else:
             say(f"note: another station is on {url}, on other channels (session {s['session_id']}, "
                 f"{', '.join(sorted(chans)[:2])}): not affected")
+
+
+_address_lock = None  # held for the launcher's life
+
+
+def claim_address(url, suffix, share):
+    """Two launchers on this host started at once on one address and channels
+    would both hear silence in probe_network: a lock file per address and
+    suffix (in the temp folder) makes the second wait its turn and refuse."""
+    global _address_lock
+    import fcntl
+    import hashlib
+    key = hashlib.sha1(f"{url}|{suffix}".encode()).hexdigest()[:16]
+    path = os.path.join(tempfile.gettempdir(), f"rmslab-address-{key}.lock")
+    fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o666)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        holder = os.pread(fd, 200, 0).decode(errors="replace").strip() or "another launcher"
+        os.close(fd)
+        msg = (f"another session is starting or running on {url}{' suffix ' + suffix if suffix else ''} from this "
+               f"host ({holder}). Sessions on one address and channels see each other's traffic; give this one "
+               f"--channel-suffix NAME or another --lcm-url, or --share-network to run beside it anyway.")
+        if not share:
+            raise LabError(msg)
+        say("--share-network: " + msg.split(". ")[0])
+        return
+    os.ftruncate(fd, 0)
+    os.pwrite(fd, f"launcher pid {os.getpid()}".encode(), 0)
+    _address_lock = fd
+
+
+def note_address_holder(session_id):
+    """The session's id in the address's lock file, for the next launcher's message."""
+    if _address_lock is not None:
+        os.ftruncate(_address_lock, 0)
+        os.pwrite(_address_lock, f"session {session_id}, launcher pid {os.getpid()}".encode(), 0)
 
 
 def write_manifest(out, fields):

@@ -107,10 +107,13 @@ class Supervisor:
         self.fatal = None           # (message, code): the session must stop
         self.events = []            # lines said while running
         self.reaper = None
+        self.reaper_argv = None
         self.pilot_done = False
+        self.interrupted = False    # a signal came: stop waiting, stop the session
 
     # ---- the reaper ----
     def start_reaper(self, session_dir, summary_argv):
+        self.reaper_args = (session_dir, summary_argv)
         env = dict(os.environ)
         env["PYTHONPATH"] = os.path.join(ROOT, "scripts") + os.pathsep + env.get("PYTHONPATH", "")
         log = open(os.path.join(session_dir, "logs", "reaper.log"), "ab")
@@ -177,8 +180,8 @@ class Supervisor:
         exited at start or was not ready in time, with its log."""
         end = time.time() + timeout_s
         while time.time() < end:
-            if self.stopping:
-                return "stopped"
+            if self.stopping or self.interrupted:
+                return None
             pending = []
             for n in names:
                 c = self.children[n]
@@ -225,6 +228,11 @@ class Supervisor:
         """One look at every process: restarts what died, notes what is
         ready, sets self.fatal when the session must stop."""
         now = time.time()
+        if self.reaper is not None and self.reaper.poll() is not None and not self.stopping:
+            # Without it a kill -9 of the launcher would leave the session running.
+            self.note(f"the reaper (which stops the session if the launcher is killed) ended with code "
+                      f"{self.reaper.returncode}: starting it again")
+            self.start_reaper(*self.reaper_args)
         for name in self.order:
             c = self.children[name]
             if c.pending_restart_at is not None:

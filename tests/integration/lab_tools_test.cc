@@ -192,8 +192,9 @@ TEST_F(RecordedSession, ItsReportOpensInABrowserWithPlots) {
   const ScriptRun r = Script({SourcePath("scripts/lab"), "report", *dir_, "--out", *tmp_ + "/report.html"}, *tmp_ + "/report.log");
   ASSERT_EQ(r.rc, 0) << r.out;
   const std::string html = ReadFile(*tmp_ + "/report.html");
-  for (const char* want : {"Phase durations", "Collisions", "docking miss distance", "Frame times and latency",
-                           "Mode timeline", "Chart.js v3"}) {
+  for (const char* want : {"Phase durations", "Collisions", "docking miss distance", "Losses",
+                           "lost by the record: RMS_DCP_FRAME", "refused by the processes: late",
+                           "Frame times and latency", "Mode timeline", "Chart.js v3"}) {
     EXPECT_NE(html.find(want), std::string::npos) << want;
   }
   EXPECT_EQ(html.find("<script src="), std::string::npos) << "not self-contained";

@@ -19,10 +19,12 @@
 #include <fstream>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <thread>
 
 #include "live_session.h"
 #include "rms/channels.h"
+#include "rms/control_word.h"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/lcm_interface.h"
@@ -218,6 +220,28 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
     peer.Send(channels::kDcpFrame, d, as_dcp);
     peer.Listen(0.003);
   }
+  // A docked DCP frame and its telemetry far ahead (frame 500000), as the
+  // DCP itself: off the DCP's increasing run, neither believed.
+  for (int i = 0; i < 3; ++i) {
+    dcp_frame_t d = peer.last_dcp();
+    ControlWord w = UnpackControlWord(d.control_word);
+    w.mode = 3;
+    w.acquired = w.docked = true;
+    d.control_word = static_cast<std::int32_t>(PackControlWord(w));
+    d.frame = 500000 + i;
+    d.input_frame = d.frame;
+    d.send_time_us = d.input_send_time_us = WallTimeUs();
+    peer.Send(channels::kDcpFrame, d, as_dcp);
+    dcp_telemetry_t t{};
+    t.frame = t.input_frame = d.frame;
+    t.send_time_us = t.input_send_time_us = WallTimeUs();
+    t.mode = 3;
+    t.acquired = t.docked = true;
+    t.dock_distance_ft = 0.01;
+    for (int k = 0; k < 9; k += 4) t.R_RS2[k] = t.R_RP[k] = 1;
+    peer.Send(channels::kDcpTelemetry, t, as_dcp);
+    peer.Listen(0.003);
+  }
   const int esg_pid = s.pid("esg_renderer");
   peer.ForgeStatus("esg_renderer", 999999, {id, sender_t::PROCESS_ESG, 999999});
   peer.ForgeStatus("esg_renderer", esg_pid, {stranger_id, sender_t::PROCESS_ESG, esg_pid});
@@ -230,6 +254,11 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
   peer.Send(channels::kOperatorInput, far, {id, sender_t::PROCESS_OPERATOR_STATION, op_pid});
 
   ASSERT_TRUE(testing::WaitForFile(cps + "/good.json", 10)) << "a valid checkpoint after the flood was not written";
+  // rms_control says so when it cannot: an existing name.
+  const auto again = Script({testing::BuildPath("tools/rms_control"), "--session", s.out(), "checkpoint", "good"},
+                            tmp + "/control.log", 30);
+  EXPECT_EQ(again.rc, 1) << again.out;
+  EXPECT_NE(again.out.find("exists already"), std::string::npos) << again.out;
   ASSERT_EQ(s.Wait(240), 0) << ReadFile(s.log());
 
   // The checkpoints folder's regular files: the test's big.json, the good
@@ -253,12 +282,17 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
   std::printf("ignored: %s\ndocking: %s\n", sum["ignored"].dump().c_str(), sum["docking"].dump().c_str());
   EXPECT_TRUE(sum["docked"].get<bool>());
   EXPECT_GT(sum["docking"]["distance_ft"].get<double>(), 0.05) << "the forged docking distance was believed";
+  EXPECT_FALSE(sum["docking"]["after_restore"].get<bool>()) << "every restore was refused";
   EXPECT_EQ(sum["mode_changes"].size(), 2u) << sum["mode_changes"].dump();
   EXPECT_GE(Reason(sum, "other_session"), 90 + 1);
   EXPECT_GE(Reason(sum, "not_the_sessions_process"), 90 + 1);
   EXPECT_GE(Reason(sum, "telemetry_contradicts_its_dcp_frame") + Reason(sum, "repeated_frame"), 90);
   EXPECT_GE(Reason(sum, "implausible_status"), 1);
   EXPECT_GE(Reason(sum, "disputed_dcp_frame"), 25);
+  EXPECT_GE(Reason(sum, "dcp_frame_out_of_sequence"), 3);
+  // No record loss made up from the forgeries (those would be 30 or 3 a
+  // channel); the flood of control messages may cost the recorder a datagram.
+  for (const auto& [ch, r] : sum["record"]["by_channel"].items()) EXPECT_LE(r["lost"].get<long>(), 2) << ch;
   bool listed = false;
   for (const auto& o : sum["ignored"]["other_sessions"]) listed |= o.get<std::string>() == FormatSessionId(stranger_id);
   EXPECT_TRUE(listed) << "the stranger's session is not listed";
@@ -286,7 +320,7 @@ TEST(SessionSecurity, ASecondSessionOnTheAddressIsRefusedOrWithShareNetworkBothD
                                "--lcm-url", url, "--png-every", "0", "--no-video"},
                               tmp + "/b/lab.log", 60);
   EXPECT_NE(refused.rc, 0) << refused.out;
-  EXPECT_NE(refused.out.find("another session is running on"), std::string::npos) << refused.out;
+  EXPECT_NE(refused.out.find("another session is"), std::string::npos) << refused.out;
   EXPECT_NE(refused.out.find(FormatSessionId(first.session_id())), std::string::npos) << refused.out;
   EXPECT_NE(refused.out.find("--channel-suffix"), std::string::npos) << refused.out;
   EXPECT_FALSE(fs::exists(tmp + "/b/session/lcmlog"));
@@ -322,6 +356,21 @@ TEST(SessionSecurity, KillingTheLauncherLeavesNoProcessAndASummary) {
   const std::vector<int> kids = s.children();
   ASSERT_GE(kids.size(), 5u) << ReadFile(s.out() + "/run/children");  // four processes and the recorder
   for (int p : kids) ASSERT_TRUE(ProcessAlive(p)) << p;
+  // The reaper killed first: the launcher starts it again.
+  const auto reaper = Script({"/usr/bin/pgrep", "-f", "rmslab_launcher.reaper --session " + s.out()}, tmp + "/pgrep.log", 10);
+  ASSERT_EQ(reaper.rc, 0) << "no reaper running";
+  kill(std::stoi(reaper.out), SIGKILL);
+  const auto end_r = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (ReadFile(s.log()).find("the reaper") == std::string::npos && std::chrono::steady_clock::now() < end_r) Sleep(0.1);
+  ASSERT_NE(ReadFile(s.log()).find("starting it again"), std::string::npos) << ReadFile(s.log());
+  Sleep(0.5);
+  // A pid in run/children that is no longer the session's (reused by another
+  // program): never signalled.
+  testing::Subprocess bystander({"/usr/bin/sleep", "120"}, tmp + "/bystander.log");
+  {
+    std::ofstream children(s.out() + "/run/children", std::ios::app);
+    children << "esg_renderer " << bystander.pid() << " localhost 0 -\n";
+  }
   s.Signal(SIGKILL);
   EXPECT_EQ(s.Wait(10), 128 + SIGKILL);
   const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(20);
@@ -331,6 +380,7 @@ TEST(SessionSecurity, KillingTheLauncherLeavesNoProcessAndASummary) {
     Sleep(0.1);
   }
   EXPECT_TRUE(left.empty()) << left.size() << " of the session's processes still run, e.g. pid " << left.front();
+  EXPECT_TRUE(bystander.Running()) << "the reaper signalled a process that is not the session's";
   ASSERT_TRUE(testing::WaitForFile(s.out() + "/summary.json", 30)) << ReadFile(s.out() + "/logs/reaper.log");
   const nlohmann::json sum = ReadJson(s.out() + "/summary.json");
   EXPECT_GT(sum["log"]["dcp_frames"].get<long>(), 0);
@@ -352,18 +402,28 @@ TEST(SessionSecurity, BadInputIsRefusedBeforeAnythingStartsWithTheReasonShown) {
     std::vector<std::string> args;
     std::string says;
   };
+  {
+    std::ofstream latin1(tmp + "/latin1.toml");
+    latin1 << "\xff\xfe[session]\n";
+    std::ofstream(tmp + "/a_file") << "x";
+  }
   const std::vector<Case> cases = {{{"--config", tmp + "/bad.toml"}, "boom_lenght_ft"},
                                    {{"--width", "0"}, "width"},
-                                   {{"--channel-suffix", "X.*"}, "--channel-suffix"}};
+                                   {{"--channel-suffix", "X.*"}, "--channel-suffix"},
+                                   {{"--config", tmp + "/latin1.toml"}, "not TOML"},
+                                   {{"--lcm-url", "garbage"}, "--lcm-url 'garbage'"},
+                                   {{"--lcm-url", "udpm://10.1.2.3:7667?ttl=0"}, "not an IPv4 multicast group"},
+                                   {{"--out", tmp + "/a_file/session"}, "cannot make the session's folder"}};
   int n = 0;
   for (const auto& c : cases) {
     const std::string out = tmp + "/s" + std::to_string(n++);
     std::vector<std::string> argv = {SourcePath("scripts/lab"), "demo", "--no-build", "--out", out, "--lcm-url",
                                      testing::UniqueLcmUrl(8660)};
-    argv.insert(argv.end(), c.args.begin(), c.args.end());
+    argv.insert(argv.end(), c.args.begin(), c.args.end());  // a later --out or --lcm-url wins
     const auto r = Script(argv, out + ".log", 60);
     EXPECT_EQ(r.rc, 2) << r.out;
     EXPECT_NE(r.out.find(c.says), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("Traceback"), std::string::npos) << r.out;
     EXPECT_FALSE(fs::exists(out + "/lcmlog")) << "something started: " << r.out;
     EXPECT_FALSE(fs::exists(out + "/run/pids")) << r.out;
   }
@@ -515,6 +575,13 @@ TEST(SessionStallsLong, EachProcessAndTheRecorderStoppedIsSurvivedAndReported) {
                              tmp + "/summary.json"},
                             tmp + "/brief.log", 60);
   EXPECT_NE(brief.out.find("the record lost"), std::string::npos) << brief.out;
+  // ... and in the report, apart from the link's losses.
+  const auto report = Script({testing::BuildPath("tools/rms_report"), out, "--out", tmp + "/report.html"},
+                             tmp + "/report.log", 120);
+  ASSERT_EQ(report.rc, 0) << report.out;
+  const std::string html = ReadFile(tmp + "/report.html");
+  EXPECT_TRUE(std::regex_search(html, std::regex("lost by the record: RMS_DCP_FRAME \\(of [0-9]+ published\\)</td><td>[1-9]")))
+      << html.substr(html.find("<h2>Losses"), 1500);
   fs::remove_all(tmp);
 }
 

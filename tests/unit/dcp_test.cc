@@ -7,14 +7,17 @@
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <unistd.h>
 
 #include "dcp_models.h"
 #include "dynamic_collision_program.h"
 #include "mission_plan.h"
 #include "rms/arm_ik.h"
 #include "rms/check.h"
+#include "rms/checkpoint.h"
 #include "rms/config.h"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/word_blocks.h"
@@ -341,3 +344,41 @@ TEST_F(Dcp, ABadCheckpointIsRefusedNamingWhatIsWrong) {
 
 }  // namespace
 }  // namespace rms::dcp
+
+namespace rms {
+namespace {
+
+// docs/security.md "The control channel": a checkpoint is a name, written
+// new only and never through a link, read only from a regular file of at
+// most 1 MiB, and the folder itself is never reached through a link.
+TEST(CheckpointFolderTest, NamesOnlyNewFilesNoLinksAndASizeCap) {
+  namespace fs = std::filesystem;
+  const fs::path root = fs::temp_directory_path() / ("rmslab_cpfolder_" + std::to_string(getpid()));
+  fs::remove_all(root);
+  fs::create_directories(root / "checkpoints");
+  fs::create_directories(root / "elsewhere");
+  const CheckpointFolder folder((root / "checkpoints").string());
+  Checkpoint c;
+  c.dcp = dcp::DynamicCollisionProgram(LoadConfig(std::string(RMSLAB_SOURCE_DIR) + "/config/rmslab.toml")).SaveState();
+  folder.Write("good.json", c);
+  EXPECT_EQ(folder.Read("good.json").dcp, c.dcp);
+  for (const char* bad : {"../x.json", "/tmp/x.json", "a/b.json", ".hidden.json", "x.txt", "x\n.json", ""}) {
+    EXPECT_THROW(folder.Write(bad, c), InputError) << bad;
+    EXPECT_THROW(folder.Read(bad), InputError) << bad;
+  }
+  EXPECT_THROW(folder.Write("good.json", c), InputError) << "over an existing checkpoint";
+  fs::create_symlink(root / "elsewhere" / "t.json", root / "checkpoints" / "link.json");
+  EXPECT_THROW(folder.Write("link.json", c), InputError);
+  EXPECT_FALSE(fs::exists(root / "elsewhere" / "t.json"));
+  std::ofstream(root / "checkpoints" / "big.json") << std::string(kMaxCheckpointBytes + 1, ' ');
+  EXPECT_THROW(folder.Read("big.json"), InputError);
+  // The folder swapped for a link to elsewhere: refused, nothing written there.
+  fs::rename(root / "checkpoints", root / "moved");
+  fs::create_directory_symlink(root / "elsewhere", root / "checkpoints");
+  EXPECT_THROW(folder.Write("other.json", c), InputError);
+  EXPECT_FALSE(fs::exists(root / "elsewhere" / "other.json"));
+  fs::remove_all(root);
+}
+
+}  // namespace
+}  // namespace rms

@@ -12,6 +12,8 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <map>
+#include <functional>
 #include <cstdio>
 #include <filesystem>
 #include <thread>
@@ -22,6 +24,7 @@
 #include "rms/lcm_interface.h"
 #include "rms/message_io.h"
 #include "rms/sender_t.hpp"
+#include "rms/process_status_t.hpp"
 #include "rms/session_control_t.hpp"
 #include "session_summary.h"
 
@@ -102,7 +105,14 @@ int main(int argc, char** argv) {
       folder = (fs::path(session_dir) / "checkpoints").string();
     }
     std::string name;
-    if (checkpoint->parsed()) name = CheckpointName(what);
+    if (checkpoint->parsed()) {
+      name = CheckpointName(what);
+      if (!folder.empty() && fs::exists(fs::path(folder) / name)) {
+        std::fprintf(stderr, "rms_control: checkpoint %s exists already in %s: give another name\n", name.c_str(),
+                     folder.c_str());
+        return 1;
+      }
+    }
     if (restore->parsed()) name = RestoreName(what, folder);
     rms::UdpLcm lcm(lcm_options);
     lcm.SetSender({id, rms::sender_t::PROCESS_CONTROL, static_cast<std::int32_t>(getpid())});
@@ -116,13 +126,34 @@ int main(int argc, char** argv) {
       if (!rms::PublishMessage(lcm, rms::channels::kControl, m)) throw std::runtime_error("cannot publish");
     };
     auto pause = [] { std::this_thread::sleep_for(std::chrono::milliseconds(300)); };
+    // The DCP's own counts, from its status reports (once a second): what a
+    // restore did, confirmed rather than assumed.
+    std::map<std::string, std::int64_t> dcp_counts;
+    int dcp_reports = 0;
+    lcm.Subscribe(rms::channels::kStatus, [&](const void* d, int n, std::int64_t) {
+      rms::process_status_t st;
+      if (rms::SafeDecode(d, n, 1 << 20, &st) != rms::DecodeError::kNone || st.process != "dynamics_proc") return;
+      for (int i = 0; i < st.num_counters; ++i) dcp_counts[st.counter_names[i]] = st.counter_values[i];
+      ++dcp_reports;
+    });
+    auto listen_until = [&](double seconds, const std::function<bool()>& done) {
+      const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+      while (std::chrono::steady_clock::now() < end && !done()) lcm.HandleSubscriptions(50);
+      return done();
+    };
+    auto count = [&](const char* k) { return dcp_counts.count(k) ? dcp_counts[k] : 0; };
     if (freeze->parsed()) send(rms::session_control_t::FREEZE);
     if (run->parsed()) send(rms::session_control_t::RUN);
     if (step->parsed()) {
       for (int i = 0; i < steps; ++i) send(rms::session_control_t::STEP);
     }
     if (checkpoint->parsed()) send(rms::session_control_t::CHECKPOINT, name);
+    std::int64_t restores0 = 0, refused0 = 0, limited0 = 0;
     if (restore->parsed()) {
+      listen_until(1.5, [&] { return dcp_reports > 0; });
+      restores0 = count("control.restores");
+      refused0 = count("control.refused");
+      limited0 = count("control.rate_limited");
       send(rms::session_control_t::FREEZE);
       pause();  // the last frames through the pipeline
       send(rms::session_control_t::RESTORE, name);
@@ -145,6 +176,24 @@ int main(int argc, char** argv) {
       }
       std::printf("saved %s\n", p.c_str());
     }
+    if (restore->parsed() && dcp_reports > 0) {
+      const int seen = dcp_reports;
+      listen_until(3.0, [&] {
+        return dcp_reports > seen && (count("control.restores") > restores0 || count("control.refused") > refused0 ||
+                                      count("control.rate_limited") > limited0);
+      });
+      if (count("control.restores") > restores0) {
+        std::printf("restored from %s (dynamics_proc confirms)%s\n", name.c_str(), then_run ? "" : "; frozen: run resumes");
+        return 0;
+      }
+      std::fprintf(stderr, "rms_control: dynamics_proc did not restore %s (%s; see the session's logs/dynamics_proc.log)\n",
+                   name.c_str(),
+                   count("control.rate_limited") > limited0 ? "too many checkpoint commands a second: try again"
+                   : count("control.refused") > refused0    ? "refused"
+                                                            : "no word from it within 3 s");
+      return 1;
+    }
+    if (restore->parsed()) std::printf("restore sent (not confirmed: no status report from dynamics_proc heard)\n");
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rms_control: %s\n", e.what());

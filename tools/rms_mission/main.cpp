@@ -6,6 +6,7 @@
 
 #include "mission_plan.h"
 #include "rms/check.h"
+#include "rms/text.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"rmslab rms_mission: plan the standard mission (acquire, extract, dock) for a "
@@ -21,9 +22,7 @@ int main(int argc, char** argv) {
     if (out.empty()) {
       std::cout << text;
     } else {
-      std::ofstream f(out);
-      if (!f) throw rms::InputError("cannot write " + out);
-      f << text;
+      rms::WriteWholeFile(out, text);
     }
     return 0;
   } catch (const std::exception& e) {

@@ -112,6 +112,35 @@ Traces ReadTraces(const fs::path& log_path) {
   return t;
 }
 
+// The session's losses, each kind apart (docs/sessions.md "Losses"): frames
+// lost on a link, frames the processes refused, frames the record lost, and
+// logged messages the summary left out as not the session's own.
+std::string LossesSection(const nlohmann::ordered_json& s) {
+  std::ostringstream h;
+  h << "<h2>Losses</h2>\n<table><tr><th>what</th><th>frames or messages</th></tr>";
+  auto row = [&h](const std::string& what, const nlohmann::ordered_json& n) {
+    h << "<tr><td>" << Html(what) << "</td><td>" << (n.is_number() ? n.dump() : std::string("-")) << "</td></tr>";
+  };
+  const auto empty = nlohmann::ordered_json::object();
+  auto part = [&empty](const nlohmann::ordered_json& j, const char* a, const char* b) -> const nlohmann::ordered_json& {
+    if (!j.contains(a) || !j[a].is_object() || !j[a].contains(b) || !j[a][b].is_object()) return empty;
+    return j[a][b];
+  };
+  for (const auto& [k, v] : part(s, "frames", "dropped").items()) {
+    row((k.rfind("malformed", 0) == 0 ? "malformed, dropped: " : "lost on the link: ") + k, v);
+  }
+  for (const auto& [k, v] : part(s, "frames", "refused").items()) row("refused by the processes: " + k, v);
+  for (const auto& [ch, r] : part(s, "record", "by_channel").items()) {
+    row("lost by the record: " + ch + " (of " + r.value("published", nlohmann::ordered_json()).dump() + " published)",
+        r.value("lost", nlohmann::ordered_json()));
+  }
+  for (const auto& [k, v] : part(s, "ignored", "by_reason").items()) {
+    row("left out of this report, not the session's own: " + k, v);
+  }
+  h << "</table>\n";
+  return h.str();
+}
+
 std::string StatsRow(const std::string& name, const std::vector<double>& v) {
   if (v.empty()) return "<tr><td>" + Html(name) + "</td><td colspan=5>none</td></tr>";
   double mean = 0;
@@ -214,6 +243,8 @@ std::string MakeReport(const std::string& session_dir, const std::string& chart_
     h << "</table>\n";
   }
   h << "<p>Frames in which the DCP held the slave arm: " << s.value("held_frames", 0) << ".</p>\n";
+
+  h << LossesSection(s);
 
   // Timing.
   h << "<h2>Frame times and latency</h2>\n<table><tr><th>what</th><th>n</th><th>mean, ms</th><th>p50, ms</th>"

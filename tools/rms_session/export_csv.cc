@@ -62,7 +62,12 @@ class Csv {
   // disk): the export must not end as if it had.
   void Close() {
     f_.close();
-    if (!f_) throw InputError("could not write all of '" + path_.string() + "' (" + std::strerror(errno) + ")");
+    if (!f_) {
+      const int err = errno ? errno : EIO;
+      std::error_code ec;
+      if (fs::is_regular_file(path_, ec)) fs::remove(path_, ec);  // no partial CSV left behind
+      throw InputError("could not write all of '" + path_.string() + "' (" + std::strerror(err) + ")");
+    }
   }
 
  private:

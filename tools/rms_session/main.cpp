@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <fstream>
 #include <iostream>
+#include <map>
 
 #include "rms/text.h"
 #include "export_csv.h"
@@ -146,8 +147,19 @@ int main(int argc, char** argv) {
       std::cout << " (" << j["docking"]["distance_ft"].get<double>() << " ft, "
                 << j["docking"]["angle_deg"].get<double>() << " deg)";
     }
+    if (!j["docking"].is_null() && j["docking"].value("after_restore", false)) std::cout << " after a restore";
     std::cout << "\ncollisions " << j["collisions"].size() << ", frames held " << j["held_frames"]
               << "; LCM log events " << j["log"]["events"] << "\n";
+    if (!j["control"].empty()) {
+      std::map<std::string, int> n;
+      for (const auto& c : j["control"]) ++n[c["command"].get<std::string>()];
+      std::cout << "session control sent:";
+      for (const auto& [what, k] : n) std::cout << " " << what << " " << k;
+      std::cout << "\n";
+    }
+    if (!j["ignored"].value("session_id_checked", true)) {
+      std::cout << "this session has no id (made before session ids): every message in its log was read as its own\n";
+    }
     if (j.contains("restarts") && !j["restarts"].empty()) {
       std::cout << "restarted after a fault:";
       for (const auto& r : j["restarts"]) {

@@ -78,6 +78,16 @@ nlohmann::ordered_json SenderCheck::Json() const {
   for (std::int64_t id : other_sessions_) j["other_sessions"].push_back(FormatSessionId(id));
   j["session_id_checked"] = session_id_ != 0;
   j["pids_checked"] = !pids_.empty();
+  // The processes whose pids were checked; the others (not in run/pids: an
+  // ssh host, a process that never became ready) by the id and publisher only.
+  j["pids_checked_for"] = nlohmann::ordered_json::array();
+  j["pids_not_checked_for"] = nlohmann::ordered_json::array();
+  if (!pids_.empty()) {
+    for (std::int8_t p : {sender_t::PROCESS_OPERATOR_STATION, sender_t::PROCESS_DYNAMICS, sender_t::PROCESS_SCENE,
+                          sender_t::PROCESS_ESG}) {
+      j[pids_.count(p) ? "pids_checked_for" : "pids_not_checked_for"].push_back(ProcessCodeName(p));
+    }
+  }
   return j;
 }
 

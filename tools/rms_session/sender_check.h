@@ -34,7 +34,9 @@ class SenderCheck {
   const char* Ignore(const std::string& base_channel, const void* data, int size);
   // A message left out for a reason of the caller's own (e.g. telemetry no
   // DCP frame confirms): counted with the rest.
-  void Count(const std::string& reason) { ++ignored_[reason]; }
+  void Count(const std::string& reason, std::int64_t n = 1) {
+    if (n > 0) ignored_[reason] += n;
+  }
 
   std::int64_t session_id() const { return session_id_; }
   bool checks_pids() const { return !pids_.empty(); }

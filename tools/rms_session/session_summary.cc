@@ -26,6 +26,7 @@
 #include "rms/lcm_interface.h"
 #include "rms/process.h"
 #include "rms/sender_t.hpp"
+#include "rms/session_control_t.hpp"
 #include "rms/version.h"
 #include "sender_check.h"
 
@@ -121,10 +122,42 @@ struct DcpFrameRecord {
   bool disputed = false;
 };
 
-// First pass: the session's own DCP frames, by frame number (the first of
-// each number; a repeat that differs marks the number disputed).
-std::map<std::int64_t, DcpFrameRecord> ReadDcpFrames(const fs::path& log_path, SenderCheck check) {
-  std::map<std::int64_t, DcpFrameRecord> out;
+// The indices of the longest run of strictly increasing values in v, in
+// order (patience sorting, O(n log n)).
+std::vector<std::size_t> LongestIncreasingRun(const std::vector<std::int64_t>& v) {
+  std::vector<std::size_t> tails;
+  std::vector<std::ptrdiff_t> parent(v.size(), -1);
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const auto it = std::lower_bound(tails.begin(), tails.end(), v[i],
+                                     [&v](std::size_t a, std::int64_t x) { return v[a] < x; });
+    if (it != tails.begin()) parent[i] = static_cast<std::ptrdiff_t>(*(it - 1));
+    if (it == tails.end()) tails.push_back(i);
+    else *it = i;
+  }
+  std::vector<std::size_t> run;
+  for (std::ptrdiff_t i = tails.empty() ? -1 : static_cast<std::ptrdiff_t>(tails.back()); i >= 0; i = parent[i]) {
+    run.push_back(static_cast<std::size_t>(i));
+  }
+  std::reverse(run.begin(), run.end());
+  return run;
+}
+
+// First pass: the session's own DCP frames, by frame number. The DCP
+// numbers its frames upward, across restarts and restores, so the frames
+// believed are the longest run of increasing numbers in the log's order; a
+// frame off it -- a forgery far ahead or behind, with the DCP's own id and
+// pid -- is left out (out_of_sequence), and its telemetry with it. Two
+// different frames of one number mark that number disputed.
+struct DcpFrames {
+  std::map<std::int64_t, DcpFrameRecord> by_frame;
+  std::int64_t out_of_sequence = 0;
+};
+
+DcpFrames ReadDcpFrames(const fs::path& log_path, SenderCheck check) {
+  std::vector<std::int64_t> numbers;
+  std::vector<DcpFrameRecord> records;
+  std::map<std::int64_t, DcpFrameRecord> first;
+  std::set<std::int64_t> disputed;
   lcm::LogFile log(log_path.string(), "r");
   while (const lcm::LogEvent* ev = log.readNextEvent()) {
     if (BaseChannel(ev->channel) != channels::kDcpFrame || check.Ignore(channels::kDcpFrame, ev->data, ev->datalen)) {
@@ -134,10 +167,21 @@ std::map<std::int64_t, DcpFrameRecord> ReadDcpFrames(const fs::path& log_path, S
     if (SafeDecode(ev->data, ev->datalen, 1024, &m) != DecodeError::kNone) continue;
     try {
       const DcpFrameRecord r{m.input_frame, UnpackControlWord(m.control_word)};
-      const auto [it, fresh] = out.emplace(m.frame, r);
-      if (!fresh && (it->second.input_frame != r.input_frame || it->second.word != r.word)) it->second.disputed = true;
+      const auto [it, fresh] = first.emplace(m.frame, r);
+      if (!fresh && (it->second.input_frame != r.input_frame || it->second.word != r.word)) disputed.insert(m.frame);
+      numbers.push_back(m.frame);
+      records.push_back(r);
     } catch (const InputError&) {
     }
+  }
+  DcpFrames out;
+  for (const std::size_t i : LongestIncreasingRun(numbers)) {
+    DcpFrameRecord r = first.at(numbers[i]);
+    r.disputed = disputed.count(numbers[i]) > 0;
+    out.by_frame.emplace(numbers[i], r);
+  }
+  for (const std::int64_t n : numbers) {
+    if (!out.by_frame.count(n)) ++out.out_of_sequence;
   }
   return out;
 }
@@ -253,12 +297,14 @@ struct LogScan {
   std::map<std::string, std::int64_t> by_channel;
   std::int64_t events = 0, first_us = -1, last_us = -1, malformed = 0;
   SequenceTracker input, dcp, esg;  // frame numbers as logged
-  std::set<std::int64_t> telemetry_frames;
+  std::set<std::int64_t> telemetry_frames;  // believed
+  std::set<std::int64_t> telemetry_logged;  // of the DCP's frames, whether believed or not
   int final_mode = 0;
   std::set<int> modes;
   TelemetryLog telemetry;
   HandControlLog hand;
   StatusRuns status;
+  nlohmann::ordered_json control = nlohmann::ordered_json::array();
 };
 
 void ScanTelemetry(const lcm::LogEvent& ev, const std::map<std::int64_t, DcpFrameRecord>& dcp, SenderCheck* check,
@@ -272,6 +318,7 @@ void ScanTelemetry(const lcm::LogEvent& ev, const std::map<std::int64_t, DcpFram
   // the same (docs/security.md "What the summary trusts").
   const auto it = dcp.find(m.frame);
   if (it == dcp.end()) return check->Count("telemetry_without_its_dcp_frame");
+  s->telemetry_logged.insert(m.frame);  // in the record, believed or not
   if (it->second.disputed) return check->Count("disputed_dcp_frame");
   if (!Agrees(m, it->second)) return check->Count("telemetry_contradicts_its_dcp_frame");
   if (!s->telemetry_frames.insert(m.frame).second) return check->Count("repeated_frame");
@@ -290,7 +337,26 @@ void ScanStatus(const lcm::LogEvent& ev, LogScan* s) {
   s->status.last_pid[m.process] = m.pid;
 }
 
-void ScanFrameNumbers(const std::string& base, const lcm::LogEvent& ev, LogScan* s) {
+// Session control as sent (RMS_CONTROL; docs/sessions.md "Freeze, run, step,
+// checkpoint"): what acted is in the processes' control.* counters.
+void ScanControl(const lcm::LogEvent& ev, LogScan* s) {
+  session_control_t m;
+  if (SafeDecode(ev.data, ev.datalen, 1024, &m) != DecodeError::kNone) {
+    ++s->malformed;
+    return;
+  }
+  static const char* const kNames[] = {"?", "freeze", "run", "step", "checkpoint", "restore"};
+  const char* what = m.command >= 1 && m.command <= 5 ? kNames[m.command] : "?";
+  nlohmann::ordered_json e = {{"time_s", (ev.timestamp - s->first_us) * 1e-6},
+                              {"command", what},
+                              {"process", ProcessCodeName(m.sender.process)},
+                              {"pid", m.sender.pid}};
+  if (!m.name.empty()) e["name"] = m.name;
+  s->control.push_back(e);
+}
+
+void ScanFrameNumbers(const std::string& base, const lcm::LogEvent& ev, const std::map<std::int64_t, DcpFrameRecord>& dcp,
+                      LogScan* s) {
   if (base == channels::kOperatorState) {
     operator_state_t m;
     if (SafeDecode(ev.data, ev.datalen, 1024, &m) == DecodeError::kNone) s->hand.Observe(m, (ev.timestamp - s->first_us) * 1e-6);
@@ -300,18 +366,15 @@ void ScanFrameNumbers(const std::string& base, const lcm::LogEvent& ev, LogScan*
     if (SafeDecode(ev.data, ev.datalen, 1024, &m) == DecodeError::kNone) s->input.Accept(m.frame);
     else ++s->malformed;
   } else if (base == channels::kDcpFrame) {
+    // Only the frames of the increasing run (ReadDcpFrames) count.
     dcp_frame_t m;
-    bool ok = SafeDecode(ev.data, ev.datalen, 1024, &m) == DecodeError::kNone;
-    if (ok) {
+    if (SafeDecode(ev.data, ev.datalen, 1024, &m) != DecodeError::kNone) {
+      ++s->malformed;
+    } else if (const auto it = dcp.find(m.frame); it != dcp.end()) {
       s->dcp.Accept(m.frame);
-      try {
-        s->final_mode = UnpackControlWord(m.control_word).mode;
-        s->modes.insert(s->final_mode);
-      } catch (const InputError&) {
-        ok = false;
-      }
+      s->final_mode = it->second.word.mode;
+      s->modes.insert(s->final_mode);
     }
-    if (!ok) ++s->malformed;
   } else if (base == channels::kEsgFrame) {
     esg_frame_t m;
     if (SafeDecode(ev.data, ev.datalen, 1024, &m) == DecodeError::kNone) s->esg.Accept(m.frame);
@@ -331,7 +394,8 @@ LogScan ScanLog(const fs::path& log_path, const std::map<std::int64_t, DcpFrameR
     ++s.by_channel[ev->channel];
     if (base == channels::kDcpTelemetry) ScanTelemetry(*ev, dcp, check, &s);
     else if (base == channels::kStatus) ScanStatus(*ev, &s);
-    else ScanFrameNumbers(base, *ev, &s);
+    else if (base == channels::kControl) ScanControl(*ev, &s);
+    else ScanFrameNumbers(base, *ev, dcp, &s);
   }
   s.telemetry.Finish(s.first_us);
   return s;
@@ -530,7 +594,7 @@ nlohmann::ordered_json RecordJson(const std::map<std::string, nlohmann::json>& s
       {channels::kOperatorInput, Counter(stats.at("operator_station"), "published"), s.input.received()},
       {channels::kDcpFrame, Counter(stats.at("dynamics_proc"), "published"), s.dcp.received()},
       {channels::kDcpTelemetry, Counter(stats.at("dynamics_proc"), "published"),
-       static_cast<std::int64_t>(s.telemetry_frames.size())},
+       static_cast<std::int64_t>(s.telemetry_logged.size())},
       {channels::kEsgFrame, Counter(stats.at("scene_proc"), "published"), s.esg.received()},
   };
   nlohmann::ordered_json r;
@@ -570,8 +634,9 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
     if (!probe.good()) throw InputError("cannot read the session's LCM log '" + log_path.string() + "'");
   }
   SenderCheck check(dir);
-  const auto dcp_frames = ReadDcpFrames(log_path, check);
-  const LogScan s = ScanLog(log_path, dcp_frames, &check);
+  const DcpFrames dcp_frames = ReadDcpFrames(log_path, check);
+  check.Count("dcp_frame_out_of_sequence", dcp_frames.out_of_sequence);
+  const LogScan s = ScanLog(log_path, dcp_frames.by_frame, &check);
   const double rate_hz = FrameRate(root);
   const double duration_s = s.first_us >= 0 ? (s.last_us - s.first_us) * 1e-6 : 0.0;
   const auto stats = MergedStats(root, s.status, duration_s, rate_hz, &check);
@@ -589,6 +654,18 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
   }
   j["restarts"] = Restarts(root);
   j["mode_changes"] = s.telemetry.mode_changes;
+  j["control"] = s.control;
+  if (j["docking"].is_object()) {
+    // A docking a restore may have brought (a checkpoint saved docked):
+    // said, not hidden (docs/security.md "What the summary trusts").
+    bool after_restore = false;
+    const bool restored = Counter(stats.at("dynamics_proc"), "control.restores") > 0;  // one acted
+    for (const auto& c : s.control) {
+      if (!restored) break;
+      after_restore |= c["command"] == "restore" && c["time_s"].get<double>() <= j["docking"]["time_s"].get<double>();
+    }
+    j["docking"]["after_restore"] = after_restore;
+  }
   j["by_hand"] = s.hand.Json();
   if (j["by_hand"].is_object()) {
     // The station's own count has the last key too (a quit ends it before
