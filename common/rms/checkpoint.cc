@@ -99,7 +99,10 @@ int CheckpointFolder::OpenDir() const {
   // The folder itself, never through a link (one planted in its place while
   // the session runs would send checkpoints elsewhere).
   const int fd = open(dir_.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
-  if (fd < 0 && errno == ELOOP) throw InputError("the checkpoints folder '" + dir_ + "' is a symbolic link: refused");
+  struct stat st {};
+  if (fd < 0 && (errno == ELOOP || errno == ENOTDIR) && lstat(dir_.c_str(), &st) == 0 && S_ISLNK(st.st_mode)) {
+    throw InputError("the checkpoints folder '" + dir_ + "' is a symbolic link: refused");
+  }
   if (fd < 0) throw InputError("cannot open the checkpoints folder '" + dir_ + "': " + std::strerror(errno));
   return fd;
 }
@@ -160,7 +163,9 @@ Checkpoint ParseCheckpoint(std::string_view text, const std::string& path) {
     c.inputs.crosshairs = o.value("crosshairs", false);  // absent before the crosshairs switch
     c.dcp = j.at("dcp");
   } catch (const std::exception& e) {
-    throw InputError("checkpoint '" + path + "': " + e.what());
+    std::string why = e.what();  // nlohmann's "[json.exception.out_of_range.403] key 'x' not found" -> the key
+    if (why.rfind("[json.exception.", 0) == 0 && why.find("] ") != std::string::npos) why = why.substr(why.find("] ") + 2);
+    throw InputError("checkpoint '" + path + "': not a valid checkpoint (" + why + ")");
   }
   return c;
 }

@@ -106,6 +106,13 @@ void EsgNode::OnFrame(const void* data, int size, std::int64_t recv_time_us) {
   pending_.emplace(std::move(msg), std::move(data_words));
 }
 
+void EsgNode::FinishVideo() {
+  RenderPending();
+  if (video_ && last_rendered_ >= 0 && frames_.last() > last_rendered_) {
+    video_->Add(output_.data(), static_cast<int>(std::clamp<std::int64_t>(frames_.last() - last_rendered_, 1, 300)));
+  }
+}
+
 bool EsgNode::RenderPending() {
   if (!pending_) return false;
   const auto [msg, frame] = std::move(*pending_);
@@ -208,6 +215,7 @@ int RunEsgRenderer(const LabConfig& config, LcmInterface& lcm, const EsgOptions&
       },
       stats_path, window ? 5 : 100);
   if (video) {
+    node.FinishVideo();
     video->Close();
     node.counters().Set("video.frames", video->frames_written());
     node.counters().Set("video.dropped", video->frames_dropped());

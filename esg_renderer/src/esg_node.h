@@ -46,6 +46,10 @@ class EsgNode {
   void OnFrame(const void* data, int size, std::int64_t recv_time_us);
   // Renders the newest frame received since the last call, if any.
   bool RenderPending();
+  // At the end, for the video: the frame still waiting is drawn, and frames
+  // the renderer saw but did not draw at the very end (too late to act on)
+  // repeat the last image, so the video has one frame per frame number.
+  void FinishVideo();
   // The live window's events: its keys go out on RMS_WINDOW_KEYS at every
   // change and every 100 ms while one is held.
   void PollWindow();

@@ -118,7 +118,7 @@ class Replay:
     def finish(self):
         lines, _ = session.summarize(self.out, os.path.basename(self.out))
         for l in lines:
-            if l.startswith("video:") or l.startswith("the record lost"):
+            if l.startswith(("video:", "renderer:", "the record lost")):
                 say(l)
         if self.sup.fatal:
             say(self.sup.fatal[0])

@@ -71,7 +71,7 @@ def probe_network(host, url, suffix, share):
                    f"other's traffic (each drops the other's, but they share the link); give this one "
                    f"--channel-suffix NAME or another --lcm-url, or --share-network to run beside it anyway.")
             if not share:
-                raise LabError(msg)
+                raise LabError(msg, 1)
             say("--share-network: " + msg.split(". ")[0])
         else:
             say(f"note: another station is on {url}, on other channels (session {s['session_id']}, "
@@ -100,12 +100,22 @@ def claim_address(url, suffix, share):
                f"host ({holder}). Sessions on one address and channels see each other's traffic; give this one "
                f"--channel-suffix NAME or another --lcm-url, or --share-network to run beside it anyway.")
         if not share:
-            raise LabError(msg)
+            raise LabError(msg, 1)
         say("--share-network: " + msg.split(". ")[0])
         return
+    import atexit
+    atexit.register(_release_address, path, fd)
     os.ftruncate(fd, 0)
     os.pwrite(fd, f"launcher pid {os.getpid()}".encode(), 0)
     _address_lock = fd
+
+
+def _release_address(path, fd):
+    try:
+        os.unlink(path)
+        os.close(fd)
+    except OSError:
+        pass
 
 
 def note_address_holder(session_id):

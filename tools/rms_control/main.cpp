@@ -147,7 +147,12 @@ int main(int argc, char** argv) {
     if (step->parsed()) {
       for (int i = 0; i < steps; ++i) send(rms::session_control_t::STEP);
     }
-    if (checkpoint->parsed()) send(rms::session_control_t::CHECKPOINT, name);
+    std::int64_t cp_refused0 = 0;
+    if (checkpoint->parsed()) {
+      listen_until(1.5, [&] { return dcp_reports > 0; });
+      cp_refused0 = count("control.refused") + count("control.rate_limited");
+      send(rms::session_control_t::CHECKPOINT, name);
+    }
     std::int64_t restores0 = 0, refused0 = 0, limited0 = 0;
     if (restore->parsed()) {
       listen_until(1.5, [&] { return dcp_reports > 0; });
@@ -168,7 +173,16 @@ int main(int argc, char** argv) {
     if (checkpoint->parsed() && !folder.empty()) {
       // Confirm it: the DCP writes the file within a frame or two.
       const fs::path p = fs::path(folder) / name;
-      for (int i = 0; i < 30 && !fs::exists(p); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      const int seen = dcp_reports;
+      listen_until(3.0, [&] {
+        return fs::exists(p) ||
+               (dcp_reports > seen && count("control.refused") + count("control.rate_limited") > cp_refused0);
+      });
+      if (!fs::exists(p) && count("control.refused") + count("control.rate_limited") > cp_refused0) {
+        std::fprintf(stderr, "rms_control: dynamics_proc refused checkpoint %s (see the session's logs/dynamics_proc.log)\n",
+                     name.c_str());
+        return 1;
+      }
       if (!fs::exists(p)) {
         std::fprintf(stderr, "rms_control: %s did not appear within 3 s (see the session's logs/dynamics_proc.log)\n",
                      p.c_str());

@@ -117,7 +117,7 @@ Traces ReadTraces(const fs::path& log_path) {
 // logged messages the summary left out as not the session's own.
 std::string LossesSection(const nlohmann::ordered_json& s) {
   std::ostringstream h;
-  h << "<h2>Losses</h2>\n<table><tr><th>what</th><th>frames or messages</th></tr>";
+  h << "<h2>Losses and refusals</h2>\n<table><tr><th>what</th><th>frames or messages</th></tr>";
   auto row = [&h](const std::string& what, const nlohmann::ordered_json& n) {
     h << "<tr><td>" << Html(what) << "</td><td>" << (n.is_number() ? n.dump() : std::string("-")) << "</td></tr>";
   };
@@ -135,7 +135,7 @@ std::string LossesSection(const nlohmann::ordered_json& s) {
         r.value("lost", nlohmann::ordered_json()));
   }
   for (const auto& [k, v] : part(s, "ignored", "by_reason").items()) {
-    row("left out of this report, not the session's own: " + k, v);
+    row("left out of this report (another session's, or not believed): " + k, v);
   }
   h << "</table>\n";
   return h.str();

@@ -118,10 +118,14 @@ int main(int argc, char** argv) {
       std::cout << "\n";
     }
     if (j["ignored"].value("total", 0) > 0) {
-      std::cout << "ignored " << j["ignored"]["total"] << " logged messages not the session's own:";
+      std::cout << "left out " << j["ignored"]["total"] << " logged messages (another session's, or not believed):";
       for (const auto& [why, n] : j["ignored"]["by_reason"].items()) std::cout << " " << why << " " << n;
       if (!j["ignored"]["other_sessions"].empty()) std::cout << " (sessions " << j["ignored"]["other_sessions"].dump() << ")";
       std::cout << "\n";
+    }
+    if (fr.value("superseded", 0) > 0) {
+      std::cout << "renderer: " << fr["superseded"] << " frames overtaken by a newer one before they were drawn "
+                << "(superseded): not drawn; the video repeats the image before them\n";
     }
     if (fr.value("video_dropped", 0) > 0) {
       std::cout << "video: " << fr["video_dropped"] << " frames dropped (the encoder fell behind; the video is "
@@ -132,7 +136,8 @@ int main(int argc, char** argv) {
       std::cout << "operator input to rendered frame: median " << l["p50_ms"].get<double>()
                 << " ms, p99 " << l["p99_ms"].get<double>() << " ms\n";
     }
-    std::cout << "modes 1";
+    if (j["log"].value("dcp_frames", 0) == 0) std::cout << "modes: none (no DCP frame in the log)";
+    else std::cout << "modes 1";
     std::size_t shown = 0;
     for (const auto& mc : j["mode_changes"]) {
       if (++shown > 8) {
