@@ -1,4 +1,8 @@
 #include <gtest/gtest.h>
+#include "session_summary.h"
+#include <algorithm>
+#include <cstdio>
+#include <random>
 
 #include "rms/counters.h"
 #include "rms/frame_receiver.h"
@@ -121,4 +125,47 @@ TEST(SequenceTracker, ReorderedFramesAreCountedMissingThenDroppedAsStale) {
   EXPECT_EQ(t.stale(), 3);
   EXPECT_EQ(t.previous(), 16);
 }
+}  // namespace rms
+
+namespace rms {
+namespace {
+
+// The DCP frames a reader of a log believes (docs/security.md "What the
+// summary trusts"): the longest increasing run, so forgeries far ahead or
+// behind fall off it while gaps (frames lost) and restarts stay on it.
+TEST(LongestIncreasingRun, KeepsTheRealSequenceAndDropsForgeriesAheadAndBehind) {
+  const std::vector<std::int64_t> frames = {0, 1, 2, 500000, 500001, 3, 4, 7, 8, 1, 2, 9, 10, 10, 11};
+  const std::vector<std::size_t> run = session::LongestIncreasingRun(frames);
+  std::vector<std::int64_t> kept;
+  for (std::size_t i : run) kept.push_back(frames[i]);
+  EXPECT_EQ(kept, (std::vector<std::int64_t>{0, 1, 2, 3, 4, 7, 8, 9, 10, 11}));
+  EXPECT_TRUE(session::LongestIncreasingRun({}).empty());
+  // Seeded random sequences: the run is increasing, and no increasing
+  // subsequence found by brute force on short ones is longer.
+  std::mt19937_64 rng(20261201);
+  std::printf("seed 20261201\n");
+  for (int t = 0; t < 200; ++t) {
+    std::vector<std::int64_t> v(1 + rng() % 12);
+    for (auto& x : v) x = static_cast<std::int64_t>(rng() % 20);
+    const auto r = session::LongestIncreasingRun(v);
+    for (std::size_t k = 1; k < r.size(); ++k) ASSERT_LT(v[r[k - 1]], v[r[k]]);
+    for (std::size_t k = 1; k < r.size(); ++k) ASSERT_LT(r[k - 1], r[k]);
+    std::size_t best = 0;
+    for (std::uint32_t mask = 1; mask < (1u << v.size()); ++mask) {
+      std::int64_t last = -1;
+      std::size_t n = 0;
+      bool ok = true;
+      for (std::size_t i = 0; i < v.size() && ok; ++i) {
+        if (!(mask & (1u << i))) continue;
+        ok = v[i] > last;
+        last = v[i];
+        ++n;
+      }
+      if (ok) best = std::max(best, n);
+    }
+    ASSERT_EQ(r.size(), best);
+  }
+}
+
+}  // namespace
 }  // namespace rms

@@ -2,6 +2,7 @@
 
 #include "rms/acquisition_conditions.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstring>
 #include <filesystem>
@@ -82,6 +83,20 @@ Recording ReadRecording(const fs::path& log_path) {
     }
   }
   if (r.dcp_frames.empty()) throw InputError(log_path.string() + ": no RMS_DCP_FRAME recorded: nothing to re-simulate");
+  // Only the DCP's increasing run of frames, as the summary believes them: a
+  // frame forged far ahead or behind is not one the DCP made.
+  std::vector<std::int64_t> numbers;
+  for (const auto& f : r.dcp_frames) numbers.push_back(f.frame);
+  const std::vector<std::size_t> run = session::LongestIncreasingRun(numbers);
+  if (run.size() != r.dcp_frames.size()) {
+    std::vector<dcp_frame_t> kept;
+    for (const std::size_t i : run) kept.push_back(r.dcp_frames[i]);
+    // A control command keeps its place: the number of kept frames before it.
+    for (auto& [before, m] : r.controls) {
+      before = static_cast<std::size_t>(std::lower_bound(run.begin(), run.end(), before) - run.begin());
+    }
+    r.dcp_frames = std::move(kept);
+  }
   return r;
 }
 

@@ -111,19 +111,7 @@ std::string BaseChannel(const std::string& channel) {
   return channel;
 }
 
-namespace {
-
-// A DCP frame as logged: what confirms the telemetry of the same frame.
-struct DcpFrameRecord {
-  std::int64_t input_frame = -1;
-  ControlWord word;
-  // Two different DCP frames of this number in the log, both with the
-  // session's id and the DCP's pid: one is forged, and neither is believed.
-  bool disputed = false;
-};
-
-// The indices of the longest run of strictly increasing values in v, in
-// order (patience sorting, O(n log n)).
+// Declared in session_summary.h.
 std::vector<std::size_t> LongestIncreasingRun(const std::vector<std::int64_t>& v) {
   std::vector<std::size_t> tails;
   std::vector<std::ptrdiff_t> parent(v.size(), -1);
@@ -141,6 +129,17 @@ std::vector<std::size_t> LongestIncreasingRun(const std::vector<std::int64_t>& v
   std::reverse(run.begin(), run.end());
   return run;
 }
+
+namespace {
+
+// A DCP frame as logged: what confirms the telemetry of the same frame.
+struct DcpFrameRecord {
+  std::int64_t input_frame = -1;
+  ControlWord word;
+  // Two different DCP frames of this number in the log, both with the
+  // session's id and the DCP's pid: one is forged, and neither is believed.
+  bool disputed = false;
+};
 
 // First pass: the session's own DCP frames, by frame number. The DCP
 // numbers its frames upward, across restarts and restores, so the frames

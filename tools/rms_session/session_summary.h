@@ -15,6 +15,12 @@ namespace rms::session {
 // the log cannot be read.
 nlohmann::ordered_json Summarize(const std::string& session_dir);
 
+// The indices of the longest run of strictly increasing values in v, in
+// order (patience sorting, O(n log n)): the DCP's frames a reader of a log
+// believes (the DCP numbers its frames upward; a frame off the run is a
+// forgery: docs/security.md "What the summary trusts").
+std::vector<std::size_t> LongestIncreasingRun(const std::vector<std::int64_t>& v);
+
 // A logged channel's name without the session's channel suffix
 // ("RMS_DCP_FRAME_BAY2" -> "RMS_DCP_FRAME"); other names unchanged.
 std::string BaseChannel(const std::string& channel);
