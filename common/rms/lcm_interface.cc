@@ -77,9 +77,8 @@ bool LcmInterface::Admit(const std::string& channel, const void* data, int size)
 // ended, and this is its restart); while it still sends, the other is an
 // impostor with the session's id, dropped and counted.
 bool LcmInterface::AdmitPublisher(const std::string& channel, const void* data, int size) {
-  const std::string base = suffix_.empty() || channel.size() < suffix_.size()
-                               ? channel
-                               : channel.substr(0, channel.size() - suffix_.size());
+  std::string_view base = channel;  // per message: no allocation
+  if (!suffix_.empty() && base.size() >= suffix_.size()) base.remove_suffix(suffix_.size());
   if (base != channels::kOperatorInput && base != channels::kDcpFrame && base != channels::kEsgFrame &&
       base != channels::kDcpTelemetry && base != channels::kOperatorState && base != channels::kWindowKeys) {
     return true;  // RMS_STATUS and RMS_CONTROL have several publishers

@@ -386,15 +386,11 @@ def run(argv, command_line):
     check_lcm_url(d.url)
     ensure_multicast_route()
     d.checks()
-    session.claim_address(d.url, a.channel_suffix, a.share_network)
+    session.claim_address(d.url, a.channel_suffix, a.share_network, str(d.hosts["recorder"]))
     session.probe_network(d.hosts["recorder"], d.url, a.channel_suffix, a.share_network)
     d.make_session()
-    try:
+
+    def fly():
         d.start()
         d.watch()
-    except LabError as e:
-        d.sup.fatal = (str(e), e.code)
-    finally:
-        if hasattr(d, "sup"):
-            d.stop()
-    return d.finish()
+    return session.run_then_stop(d, fly)

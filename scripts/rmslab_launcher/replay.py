@@ -168,11 +168,4 @@ def run(argv):
     require_built("scene_proc/scene_proc", "esg_renderer/esg_renderer", "tools/rms_session")
     ensure_multicast_route()
     r.make()
-    try:
-        r.run()
-    except LabError as e:
-        r.sup.fatal = (str(e), e.code)
-    finally:
-        if hasattr(r, "sup"):
-            r.stop()
-    return r.finish()
+    return session.run_then_stop(r, r.run)

@@ -21,6 +21,22 @@ def new_session_id():
     return f"0x{secrets.randbits(63) | 1:016x}"
 
 
+def run_then_stop(owner, body):
+    """demo and replay alike: body() runs the session; a LabError in it is the
+    session's fatal reason; the session is stopped whatever happened; then
+    owner.finish() says how it went and gives the exit code."""
+    try:
+        body()
+    except LabError as e:
+        if not hasattr(owner, "sup"):
+            raise
+        owner.sup.fatal = (str(e), e.code)
+    finally:
+        if hasattr(owner, "sup"):
+            owner.stop()
+    return owner.finish()
+
+
 def make_folder(out, default_parent):
     if not out:
         out = os.path.join(default_parent, time.strftime("%Y%m%dT%H%M%SZ", time.gmtime()))
@@ -81,14 +97,15 @@ def probe_network(host, url, suffix, share):
 _address_lock = None  # held for the launcher's life
 
 
-def claim_address(url, suffix, share):
+def claim_address(url, suffix, share, network="localhost"):
     """Two launchers on this host started at once on one address and channels
-    would both hear silence in probe_network: a lock file per address and
-    suffix (in the temp folder) makes the second wait its turn and refuse."""
+    would both hear silence in probe_network: a lock file per address, suffix
+    and network (this host's, or the namespace host the recorder listens in:
+    namespace labs are networks of their own) makes the second refuse."""
     global _address_lock
     import fcntl
     import hashlib
-    key = hashlib.sha1(f"{url}|{suffix}".encode()).hexdigest()[:16]
+    key = hashlib.sha1(f"{url}|{suffix}|{network}".encode()).hexdigest()[:16]
     path = os.path.join(tempfile.gettempdir(), f"rmslab-address-{key}.lock")
     fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o666)
     try:

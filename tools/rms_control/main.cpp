@@ -68,6 +68,125 @@ std::string RestoreName(const std::string& what, const std::string& folder) {
 
 }  // namespace
 
+namespace {
+
+// The session's control channel as this tool uses it: commands out, and
+// the DCP's own counts in (from its status reports, once a second), so what
+// a checkpoint or restore did is confirmed rather than assumed.
+class ControlLink {
+ public:
+  ControlLink(const rms::LcmOptions& options, std::int64_t session_id) : lcm_(options) {
+    lcm_.SetSender({session_id, rms::sender_t::PROCESS_CONTROL, static_cast<std::int32_t>(getpid())});
+    lcm_.Subscribe(rms::channels::kStatus, [this](const void* d, int n, std::int64_t) {
+      rms::process_status_t st;
+      if (rms::SafeDecode(d, n, 1 << 20, &st) != rms::DecodeError::kNone || st.process != "dynamics_proc") return;
+      for (int i = 0; i < st.num_counters; ++i) dcp_counts_[st.counter_names[i]] = st.counter_values[i];
+      ++dcp_reports_;
+    });
+  }
+  void Send(std::int8_t command, const std::string& name = "") {
+    rms::session_control_t m;
+    m.send_time_us = lcm_.NowUs();
+    m.sequence = sequence_++;
+    m.command = command;
+    m.name = name;
+    if (!rms::PublishMessage(lcm_, rms::channels::kControl, m)) throw std::runtime_error("cannot publish");
+  }
+  // Handles messages until done() or `seconds` pass; done()'s last answer.
+  bool ListenUntil(double seconds, const std::function<bool()>& done) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    while (std::chrono::steady_clock::now() < end && !done()) lcm_.HandleSubscriptions(50);
+    return done();
+  }
+  // Waits (up to 1.5 s) for a first report of the DCP's counts.
+  void WaitForCounts() {
+    ListenUntil(1.5, [this] { return dcp_reports_ > 0; });
+  }
+  std::int64_t Count(const char* k) const {
+    const auto it = dcp_counts_.find(k);
+    return it == dcp_counts_.end() ? 0 : it->second;
+  }
+  int reports() const { return dcp_reports_; }
+
+ private:
+  rms::UdpLcm lcm_;
+  std::int64_t sequence_ = 0;
+  std::map<std::string, std::int64_t> dcp_counts_;
+  int dcp_reports_ = 0;
+};
+
+void SayWhereSent(const rms::LcmOptions& options, std::int64_t id) {
+  std::printf("sent to %s%s, session %s\n", options.url.c_str(),
+              options.channel_suffix.empty() ? "" : (" (suffix " + options.channel_suffix + ")").c_str(),
+              id ? rms::FormatSessionId(id).c_str() : "none (only processes of no session take it)");
+}
+
+// CHECKPOINT, confirmed when there is a session folder: the DCP writes the
+// file within a frame or two, or its counts say it refused.
+int Checkpoint(ControlLink& link, const std::string& name, const std::string& folder, const rms::LcmOptions& options,
+               std::int64_t id) {
+  link.WaitForCounts();
+  auto refusals = [&link] { return link.Count("control.refused") + link.Count("control.rate_limited"); };
+  const std::int64_t refused0 = refusals();
+  link.Send(rms::session_control_t::CHECKPOINT, name);
+  SayWhereSent(options, id);
+  if (folder.empty()) return 0;
+  const fs::path p = fs::path(folder) / name;
+  const int seen = link.reports();
+  link.ListenUntil(3.0, [&] { return fs::exists(p) || (link.reports() > seen && refusals() > refused0); });
+  if (!fs::exists(p) && refusals() > refused0) {
+    std::fprintf(stderr, "rms_control: dynamics_proc refused checkpoint %s (see the session's logs/dynamics_proc.log)\n",
+                 name.c_str());
+    return 1;
+  }
+  if (!fs::exists(p)) {
+    std::fprintf(stderr, "rms_control: %s did not appear within 3 s (see the session's logs/dynamics_proc.log)\n",
+                 p.c_str());
+    return 1;
+  }
+  std::printf("saved %s\n", p.c_str());
+  return 0;
+}
+
+// FREEZE, RESTORE (and RUN with --run), confirmed by the DCP's counts.
+int Restore(ControlLink& link, const std::string& name, bool then_run, const rms::LcmOptions& options,
+            std::int64_t id) {
+  auto pause = [] { std::this_thread::sleep_for(std::chrono::milliseconds(300)); };
+  link.WaitForCounts();
+  const std::int64_t restores0 = link.Count("control.restores"), refused0 = link.Count("control.refused"),
+                     limited0 = link.Count("control.rate_limited");
+  link.Send(rms::session_control_t::FREEZE);
+  pause();  // the last frames through the pipeline
+  link.Send(rms::session_control_t::RESTORE, name);
+  if (then_run) {
+    pause();
+    link.Send(rms::session_control_t::RUN);
+  }
+  SayWhereSent(options, id);
+  if (link.reports() == 0) {
+    std::printf("restore sent (not confirmed: no status report from dynamics_proc heard)\n");
+    return 0;
+  }
+  const int seen = link.reports();
+  link.ListenUntil(3.0, [&] {
+    return link.reports() > seen && (link.Count("control.restores") > restores0 ||
+                                     link.Count("control.refused") > refused0 ||
+                                     link.Count("control.rate_limited") > limited0);
+  });
+  if (link.Count("control.restores") > restores0) {
+    std::printf("restored from %s (dynamics_proc confirms)%s\n", name.c_str(), then_run ? "" : "; frozen: run resumes");
+    return 0;
+  }
+  std::fprintf(stderr, "rms_control: dynamics_proc did not restore %s (%s; see the session's logs/dynamics_proc.log)\n",
+               name.c_str(),
+               link.Count("control.rate_limited") > limited0 ? "too many checkpoint commands a second: try again"
+               : link.Count("control.refused") > refused0    ? "refused"
+                                                             : "no word from it within 3 s");
+  return 1;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   CLI::App app{"rmslab rms_control: freeze, run, step, checkpoint or restore a running session (RMS_CONTROL)"};
   rms::LcmOptions lcm_options;
@@ -114,100 +233,15 @@ int main(int argc, char** argv) {
       }
     }
     if (restore->parsed()) name = RestoreName(what, folder);
-    rms::UdpLcm lcm(lcm_options);
-    lcm.SetSender({id, rms::sender_t::PROCESS_CONTROL, static_cast<std::int32_t>(getpid())});
-    std::int64_t sequence = 0;
-    auto send = [&](std::int8_t command, const std::string& n = "") {
-      rms::session_control_t m;
-      m.send_time_us = lcm.NowUs();
-      m.sequence = sequence++;
-      m.command = command;
-      m.name = n;
-      if (!rms::PublishMessage(lcm, rms::channels::kControl, m)) throw std::runtime_error("cannot publish");
-    };
-    auto pause = [] { std::this_thread::sleep_for(std::chrono::milliseconds(300)); };
-    // The DCP's own counts, from its status reports (once a second): what a
-    // restore did, confirmed rather than assumed.
-    std::map<std::string, std::int64_t> dcp_counts;
-    int dcp_reports = 0;
-    lcm.Subscribe(rms::channels::kStatus, [&](const void* d, int n, std::int64_t) {
-      rms::process_status_t st;
-      if (rms::SafeDecode(d, n, 1 << 20, &st) != rms::DecodeError::kNone || st.process != "dynamics_proc") return;
-      for (int i = 0; i < st.num_counters; ++i) dcp_counts[st.counter_names[i]] = st.counter_values[i];
-      ++dcp_reports;
-    });
-    auto listen_until = [&](double seconds, const std::function<bool()>& done) {
-      const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-      while (std::chrono::steady_clock::now() < end && !done()) lcm.HandleSubscriptions(50);
-      return done();
-    };
-    auto count = [&](const char* k) { return dcp_counts.count(k) ? dcp_counts[k] : 0; };
-    if (freeze->parsed()) send(rms::session_control_t::FREEZE);
-    if (run->parsed()) send(rms::session_control_t::RUN);
+    ControlLink link(lcm_options, id);
+    if (checkpoint->parsed()) return Checkpoint(link, name, folder, lcm_options, id);
+    if (restore->parsed()) return Restore(link, name, then_run, lcm_options, id);
+    if (freeze->parsed()) link.Send(rms::session_control_t::FREEZE);
+    if (run->parsed()) link.Send(rms::session_control_t::RUN);
     if (step->parsed()) {
-      for (int i = 0; i < steps; ++i) send(rms::session_control_t::STEP);
+      for (int i = 0; i < steps; ++i) link.Send(rms::session_control_t::STEP);
     }
-    std::int64_t cp_refused0 = 0;
-    if (checkpoint->parsed()) {
-      listen_until(1.5, [&] { return dcp_reports > 0; });
-      cp_refused0 = count("control.refused") + count("control.rate_limited");
-      send(rms::session_control_t::CHECKPOINT, name);
-    }
-    std::int64_t restores0 = 0, refused0 = 0, limited0 = 0;
-    if (restore->parsed()) {
-      listen_until(1.5, [&] { return dcp_reports > 0; });
-      restores0 = count("control.restores");
-      refused0 = count("control.refused");
-      limited0 = count("control.rate_limited");
-      send(rms::session_control_t::FREEZE);
-      pause();  // the last frames through the pipeline
-      send(rms::session_control_t::RESTORE, name);
-      if (then_run) {
-        pause();
-        send(rms::session_control_t::RUN);
-      }
-    }
-    std::printf("sent to %s%s, session %s\n", lcm_options.url.c_str(),
-                lcm_options.channel_suffix.empty() ? "" : (" (suffix " + lcm_options.channel_suffix + ")").c_str(),
-                id ? rms::FormatSessionId(id).c_str() : "none (only processes of no session take it)");
-    if (checkpoint->parsed() && !folder.empty()) {
-      // Confirm it: the DCP writes the file within a frame or two.
-      const fs::path p = fs::path(folder) / name;
-      const int seen = dcp_reports;
-      listen_until(3.0, [&] {
-        return fs::exists(p) ||
-               (dcp_reports > seen && count("control.refused") + count("control.rate_limited") > cp_refused0);
-      });
-      if (!fs::exists(p) && count("control.refused") + count("control.rate_limited") > cp_refused0) {
-        std::fprintf(stderr, "rms_control: dynamics_proc refused checkpoint %s (see the session's logs/dynamics_proc.log)\n",
-                     name.c_str());
-        return 1;
-      }
-      if (!fs::exists(p)) {
-        std::fprintf(stderr, "rms_control: %s did not appear within 3 s (see the session's logs/dynamics_proc.log)\n",
-                     p.c_str());
-        return 1;
-      }
-      std::printf("saved %s\n", p.c_str());
-    }
-    if (restore->parsed() && dcp_reports > 0) {
-      const int seen = dcp_reports;
-      listen_until(3.0, [&] {
-        return dcp_reports > seen && (count("control.restores") > restores0 || count("control.refused") > refused0 ||
-                                      count("control.rate_limited") > limited0);
-      });
-      if (count("control.restores") > restores0) {
-        std::printf("restored from %s (dynamics_proc confirms)%s\n", name.c_str(), then_run ? "" : "; frozen: run resumes");
-        return 0;
-      }
-      std::fprintf(stderr, "rms_control: dynamics_proc did not restore %s (%s; see the session's logs/dynamics_proc.log)\n",
-                   name.c_str(),
-                   count("control.rate_limited") > limited0 ? "too many checkpoint commands a second: try again"
-                   : count("control.refused") > refused0    ? "refused"
-                                                            : "no word from it within 3 s");
-      return 1;
-    }
-    if (restore->parsed()) std::printf("restore sent (not confirmed: no status report from dynamics_proc heard)\n");
+    SayWhereSent(lcm_options, id);
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rms_control: %s\n", e.what());
