@@ -12,5 +12,6 @@ inline constexpr const char* kDcpTelemetry = "RMS_DCP_TELEMETRY";    // dynamics
 inline constexpr const char* kControl = "RMS_CONTROL";               // rms_control, operator_station -> every process
 inline constexpr const char* kOperatorState = "RMS_OPERATOR_STATE";  // operator_station -> esg_renderer (window), log
 inline constexpr const char* kWindowKeys = "RMS_WINDOW_KEYS";        // esg_renderer (window) -> operator_station
+inline constexpr const char* kDcpState = "RMS_DCP_STATE";            // dynamics_proc -> log (re-simulation)
 
 }  // namespace rms::channels

@@ -16,6 +16,7 @@ namespace rms {
 
 namespace {
 constexpr const char* kFormat = "rmslab-checkpoint-1";
+}  // namespace
 
 std::string CheckpointText(const Checkpoint& c) {
   nlohmann::ordered_json j;
@@ -33,6 +34,8 @@ std::string CheckpointText(const Checkpoint& c) {
   j["dcp"] = c.dcp;
   return j.dump(2) + "\n";
 }
+
+namespace {
 
 // Reads an open file: a regular one of at most kMaxCheckpointBytes, or refused.
 std::string ReadOpenFile(int fd, const std::string& path) {

@@ -32,6 +32,9 @@ inline constexpr std::int64_t kMaxCheckpointBytes = std::int64_t{1} << 20;
 // Throw rms::InputError naming the file and what is wrong.
 void WriteCheckpoint(const std::string& path, const Checkpoint& c);
 Checkpoint ReadCheckpoint(const std::string& path);
+// The file's text (JSON, doubles exact), as written and as RMS_DCP_STATE
+// carries it.
+std::string CheckpointText(const Checkpoint& c);
 // The same from the file's text (path names it in errors).
 Checkpoint ParseCheckpoint(std::string_view text, const std::string& path);
 

@@ -80,7 +80,8 @@ bool LcmInterface::AdmitPublisher(const std::string& channel, const void* data, 
   std::string_view base = channel;  // per message: no allocation
   if (!suffix_.empty() && base.size() >= suffix_.size()) base.remove_suffix(suffix_.size());
   if (base != channels::kOperatorInput && base != channels::kDcpFrame && base != channels::kEsgFrame &&
-      base != channels::kDcpTelemetry && base != channels::kOperatorState && base != channels::kWindowKeys) {
+      base != channels::kDcpTelemetry && base != channels::kOperatorState && base != channels::kWindowKeys &&
+      base != channels::kDcpState) {
     return true;  // RMS_STATUS and RMS_CONTROL have several publishers
   }
   std::int8_t process = 0;

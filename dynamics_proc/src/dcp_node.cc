@@ -54,6 +54,38 @@ void DcpNode::Restore(const Checkpoint& c, const std::string& what) {
                dcp_.status().mode, dcp_.status().acquired ? ", acquired" : "", dcp_.status().docked ? ", docked" : "");
 }
 
+void DcpNode::PublishState(std::int8_t reason) {
+  dcp_state_t m{};
+  m.send_time_us = lcm_->NowUs();
+  m.reason = reason;
+  m.next_frame = next_frame_;
+  m.input_frame = last_input_frame_;
+  m.resume_pending = resume_.has_value();
+  m.resume_dcp_frame = resume_ ? resume_->first : -1;
+  m.resume_input_frame = resume_ ? resume_->second : -1;
+  m.checkpoint = CheckpointText(MakeCheckpoint());
+  if (PublishMessage(*lcm_, channels::kDcpState, m)) counters_.Add("state.published");
+  else counters_.Add("publish_failed");
+  frames_since_state_ = 0;
+}
+
+void DcpNode::ApplyState(const dcp_state_t& m, bool with_state) {
+  if (with_state) {
+    const Checkpoint c = ParseCheckpoint(m.checkpoint, "RMS_DCP_STATE");
+    try {
+      dcp_.RestoreState(c.dcp);
+    } catch (const std::exception& e) {
+      throw InputError(std::string("RMS_DCP_STATE: ") + e.what());
+    }
+    last_inputs_ = c.inputs;
+  }
+  next_frame_ = m.next_frame;
+  last_input_frame_ = m.input_frame;
+  if (m.resume_pending) resume_ = std::pair{m.resume_dcp_frame, m.resume_input_frame};
+  else resume_.reset();
+  frames_since_state_ = 0;
+}
+
 bool DcpNode::ResumeFromStateFile() {
   if (state_file_.empty() || !std::filesystem::exists(state_file_)) return false;
   const Checkpoint c = ReadCheckpoint(state_file_);
@@ -115,6 +147,7 @@ void DcpNode::OnControl(const void* data, int size) {
     } else {
       Restore(checkpoints_.Read(m.name), checkpoints_.PathOf(m.name));
       counters_.Add("control.restores");
+      PublishState(dcp_state_t::RESTORE);
     }
   } catch (const InputError& e) {
     counters_.Add("control.refused");
@@ -164,6 +197,10 @@ void DcpNode::OnInput(const void* data, int size, std::int64_t recv_time_us) {
   const dcp_telemetry_t tm = MakeTelemetry(dcp_.status(), out);
   if (!PublishMessage(*lcm_, channels::kDcpTelemetry, tm)) counters_.Add("publish_failed");
   Report(dcp_.status(), out.frame);
+  made_a_frame_ = true;
+  if (++frames_since_state_ >= static_cast<std::int64_t>(kStateEverySeconds * config_.session.frame_rate_hz)) {
+    PublishState(dcp_state_t::PERIODIC);
+  }
   if (!state_file_.empty()) {
     const DcpStatus& st = dcp_.status();
     const std::uint32_t key = static_cast<std::uint32_t>(st.mode) | (st.acquired << 4) | (st.docked << 5) |
@@ -257,12 +294,24 @@ int RunDynamicsProc(const LabConfig& config, LcmInterface& lcm, const std::strin
   node.set_checkpoint_folder(CheckpointFolder(checkpoint_dir));
   node.set_state_file(state_file);
   const bool resumed = node.ResumeFromStateFile();
-  if (!restore_path.empty() && !resumed) node.RestoreCheckpoint(restore_path);
+  const bool restored = !restore_path.empty() && !resumed;
+  if (restored) node.RestoreCheckpoint(restore_path);
+  // Its state for the log, until the first frame: the recorder may not
+  // have heard the first one (docs/sessions.md "Re-simulation").
+  const std::int8_t start_reason =
+      resumed ? dcp_state_t::RESUME : restored ? dcp_state_t::RESTORE : dcp_state_t::START;
+  node.PublishState(start_reason);
+  std::int64_t state_sent_us = lcm.NowUs();
+  auto until_first_frame = [&] {
+    if (node.made_a_frame() || lcm.NowUs() - state_sent_us < 500000) return;
+    node.PublishState(start_reason);
+    state_sent_us = lcm.NowUs();
+  };
   if (!ready_path.empty()) WriteReadyFile(ready_path);
   spdlog::info("ready: {} -> {}", lcm.FullChannel(channels::kOperatorInput),
                lcm.FullChannel(channels::kDcpFrame));
   RunNodeLoop(lcm, "dynamics_proc", node.counters(), node.latencies(),
-              [&] { return node.last_frame(); }, nullptr, stats_path);
+              [&] { return node.last_frame(); }, until_first_frame, stats_path);
   node.WriteStateFile();
   spdlog::info("published {} DCP frames; inputs missing {}, late {}, dropped {}; final mode {}",
                node.counters().Get("published"), node.counters().Get("input.missing"),

@@ -10,6 +10,7 @@
 #include "rms/counters.h"
 #include "rms/frame_receiver.h"
 #include "rms/lcm_interface.h"
+#include "rms/dcp_state_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/process.h"
 
@@ -54,6 +55,19 @@ class DcpNode {
   void set_state_file(std::string path) { state_file_ = std::move(path); }
   bool ResumeFromStateFile();
   void WriteStateFile();
+  // RMS_DCP_STATE (docs/protocol.md): the DCP's whole state now, with its
+  // frame numbering, for a reader of the log (dcp_state_t::START, ...).
+  // Sent at start (again every 0.5 s until the first frame), after a
+  // restore or a resume, and every kStateEverySeconds of frames.
+  static constexpr double kStateEverySeconds = 5.0;
+  void PublishState(std::int8_t reason);
+  // Re-simulation (docs/sessions.md "Re-simulation"): takes a logged
+  // RMS_DCP_STATE as the live DCP had it, the state and its numbering; with
+  // with_state false, the numbering only (another design's DCP keeps its
+  // own state). Throws InputError for a checkpoint it cannot read.
+  void ApplyState(const dcp_state_t& m, bool with_state);
+  // Whether the node has made a frame since it started.
+  bool made_a_frame() const { return made_a_frame_; }
   // The first DCP frame number to publish (FirstFrameNumber).
   void set_next_frame(std::int64_t f) { next_frame_ = f; }
   // A live session's receive checks (docs/protocol.md "Frame numbers",
@@ -81,6 +95,8 @@ class DcpNode {
   CheckpointRateLimit checkpoint_rate_;
   std::optional<std::pair<std::int64_t, std::int64_t>> resume_;  // (DCP frame, input frame) of the state resumed
   std::int64_t state_written_us_ = 0;
+  std::int64_t frames_since_state_ = 0;
+  bool made_a_frame_ = false;
   std::uint32_t state_key_ = 0;  // mode, acquired, docked, released: a change writes at once
 };
 

@@ -40,7 +40,7 @@ EsgNode::EsgNode(const LabConfig& config, LcmInterface* lcm, EsgRenderer* render
 
 void EsgNode::OnOperatorState(const void* data, int size) {
   operator_state_t m{};
-  if (const DecodeError e = SafeDecode(data, size, 1024, &m); e != DecodeError::kNone) {
+  if (const DecodeError e = SafeDecode(data, size, 8192, &m); e != DecodeError::kNone) {
     counters_.Add(std::string("dropped.operator_state_") + DecodeErrorName(e));
     return;
   }

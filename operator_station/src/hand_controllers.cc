@@ -31,6 +31,7 @@ void HandControllers::AddDevice(std::unique_ptr<InputDevice> device) {
   spdlog::info("device: {}", device->Describe());
   devices_.push_back(std::move(device));
   reported_gone_.push_back(false);
+  device_actions_.push_back(0);
 }
 
 OperatorInputs HandControllers::Step(double dt_s, const dcp_telemetry_t* telemetry) {
@@ -44,7 +45,9 @@ OperatorInputs HandControllers::Step(double dt_s, const dcp_telemetry_t* telemet
       }
       continue;
     }
+    const int before = cmd.key_actions;
     devices_[i]->Poll(&cmd);
+    device_actions_[i] += cmd.key_actions - before;
   }
   return Apply(cmd, dt_s, telemetry);
 }
@@ -65,7 +68,10 @@ void HandControllers::PollFrozen() {
   step_requests_ = 0;
   DeviceCommands cmd;
   for (std::size_t i = 0; i < devices_.size(); ++i) {
-    if (devices_[i]->connected()) devices_[i]->Poll(&cmd);
+    if (!devices_[i]->connected()) continue;
+    const int before = cmd.key_actions;
+    devices_[i]->Poll(&cmd);
+    device_actions_[i] += cmd.key_actions - before;
   }
   key_actions_ += cmd.key_actions;
   bool ignored = !cmd.hand_presses.empty() || !cmd.input_presses.empty();

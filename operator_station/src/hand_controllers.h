@@ -81,6 +81,9 @@ class HandControllers {
   bool show_guidance() const { return show_guidance_; }
   bool crosshairs() const { return target_.crosshairs; }
   long key_actions() const { return key_actions_; }
+  // Each device's presses so far, in the order added, and its description.
+  const std::vector<long>& device_actions() const { return device_actions_; }
+  std::string device_name(std::size_t i) const { return devices_[i]->Describe(); }
   // "clamped.NAME", "joint_limit.NAME", "control.mode_changes",
   // "control.frame_changes", "control.scale_changes", "device.disconnected", ...
   const Counters& counters() const { return counters_; }
@@ -125,6 +128,7 @@ class HandControllers {
   std::optional<Eigen::Isometry3d> X_ref_;
   Counters counters_;
   long key_actions_ = 0;
+  std::vector<long> device_actions_;
   bool quit_ = false;
   bool freeze_requested_ = false;
   int step_requests_ = 0;

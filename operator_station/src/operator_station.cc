@@ -287,6 +287,13 @@ void OperatorStation::PublishState(std::int64_t frame, const OperatorInputs& in)
     m.sigma_min_ft = s.sigma_min_ft;
     m.show_guidance = h->show_guidance();
     m.key_actions = static_cast<std::int32_t>(h->key_actions());
+    m.rate_limited = s.rate_limited;
+    const std::size_t n = std::min<std::size_t>(h->device_actions().size(), 16);
+    m.num_devices = static_cast<std::int8_t>(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      m.device_names.push_back(h->device_name(i));
+      m.device_actions.push_back(static_cast<std::int32_t>(h->device_actions()[i]));
+    }
   }
   if (const auto g = CurrentGuidance()) {
     const dcp_telemetry_t& t = *telemetry_;

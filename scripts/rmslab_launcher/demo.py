@@ -27,6 +27,8 @@ def add_arguments(p):
     g.add_argument("--by-hand", action="store_true", help="fly it yourself: this terminal's keys and status screen")
     p.add_argument("--bindings", help="by hand: other keys, rates and devices (docs/operator.md)")
     p.add_argument("--autopilot-straight", action="store_true", help="the autopilot flies straight lines")
+    p.add_argument("--subject", default="", help="who flies it, for the manifest and scripts/lab compare")
+    p.add_argument("--note", default="", help="the experimenter's note, for the manifest")
     p.add_argument("--restore", help="start from this checkpoint")
     p.add_argument("--lab", help="a lab file: which process runs on which host (docs/sessions.md)")
     p.add_argument("--config", default=os.path.join(ROOT, "config", "rmslab.toml"))
@@ -173,6 +175,10 @@ class Demo:
             fields.append(("--timeline", a.timeline))
         if a.restore:
             fields.append(("--restore", a.restore))
+        if a.subject:
+            fields.append(("--subject", a.subject))
+        if a.note:
+            fields.append(("--note", a.note))
         session.write_manifest(self.out, fields)
         say(f"session {self.out}")
 

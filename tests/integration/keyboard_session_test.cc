@@ -47,7 +47,7 @@ TEST(KeyboardSession, APressIsOneIncrementAndTheScreenShowsGuidance) {
   });
   lcm.Subscribe(channels::kOperatorState, [&](const void* d, int n, std::int64_t) {
     operator_state_t m;
-    if (SafeDecode(d, n, 1024, &m) == DecodeError::kNone) state = m;
+    if (SafeDecode(d, n, 8192, &m) == DecodeError::kNone) state = m;
   });
   lcm.Subscribe(channels::kEsgFrame, [&](const void* d, int n, std::int64_t) {
     esg_frame_t m;

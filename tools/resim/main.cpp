@@ -32,6 +32,10 @@ int main(int argc, char** argv) {
                 "%.0fx real time in all, %.0fx for the DCP's run\n",
                 r.seconds, r.read_seconds, r.run_seconds, r.recorded_seconds, r.recorded_seconds / std::max(r.seconds, 1e-9),
                 r.recorded_seconds / std::max(r.run_seconds, 1e-9));
+    if (r.states_checked > 0 && r.state_difference.empty()) {
+      std::printf("the DCP's whole state agreed with the %ld states it logged along the way\n", r.states_checked);
+    }
+    if (!r.note.empty()) std::printf("note: %s\n", r.note.c_str());
     if (!r.first_difference.empty()) std::printf("first difference: %s\n", r.first_difference.c_str());
     if (!r.out_dir.empty()) {
       std::printf("new session: %s (summary.json, comparison.md)\n", r.out_dir.c_str());

@@ -14,7 +14,8 @@
 #include <toml++/toml.h>
 
 #include "dcp_node.h"
-#include "sender_check.h"
+#include "rms/checkpoint.h"
+#include "rms/dcp_state_t.hpp"
 #include "rms/channels.h"
 #include "rms/check.h"
 #include "rms/text.h"
@@ -27,6 +28,8 @@
 #include "rms/process.h"
 #include "rms/session_control_t.hpp"
 #include "rms/version.h"
+#include "session_folder.h"
+#include "session_log.h"
 #include "session_summary.h"
 
 namespace fs = std::filesystem;
@@ -40,49 +43,46 @@ struct RecordedInput {
   std::vector<std::uint8_t> bytes;
 };
 
+// An RMS_DCP_STATE as logged, with the number of the DCP's (believed)
+// frames logged before it: its place among them.
+struct LoggedState {
+  std::size_t before = 0;
+  dcp_state_t m;
+};
+
 struct Recording {
   std::string suffix;
   std::map<std::int64_t, RecordedInput> inputs;      // by operator frame
   std::vector<dcp_frame_t> dcp_frames;               // in log order
   std::map<std::int64_t, dcp_telemetry_t> telemetry;  // by DCP frame
-  // Control commands with the number of DCP frames logged before each.
-  std::vector<std::pair<std::size_t, session_control_t>> controls;
+  std::vector<LoggedState> states;                   // in log order
 };
 
-Recording ReadRecording(const fs::path& log_path) {
-  lcm::LogFile log(log_path.string(), "r");
-  if (!log.good()) throw InputError("cannot read the session's LCM log '" + log_path.string() + "'");
+Recording ReadRecording(session::SessionLog& log) {
   Recording r;
-  bool have_suffix = false;
-  // The session's own messages only (docs/security.md "What the summary trusts").
-  session::SenderCheck check(log_path.parent_path().string());
-  while (const lcm::LogEvent* ev = log.readNextEvent()) {
-    const std::string base = session::BaseChannel(ev->channel);
-    if (ev->channel.rfind(base, 0) != 0) continue;
-    if (check.Ignore(base, ev->data, ev->datalen)) continue;
-    if (!have_suffix && base == channels::kOperatorInput) {
-      r.suffix = ev->channel.substr(base.size());  // the session's channel suffix
-      have_suffix = true;
-    }
-    if (base == channels::kOperatorInput) {
-      operator_input_t m;
-      if (SafeDecode(ev->data, ev->datalen, 1024, &m) != DecodeError::kNone) continue;
-      const auto* p = static_cast<const std::uint8_t*>(ev->data);
-      r.inputs[m.frame] = {ev->timestamp, std::vector<std::uint8_t>(p, p + ev->datalen)};
-    } else if (base == channels::kDcpFrame) {
-      dcp_frame_t m;
-      if (SafeDecode(ev->data, ev->datalen, 4096, &m) == DecodeError::kNone) r.dcp_frames.push_back(m);
-    } else if (base == channels::kDcpTelemetry) {
-      dcp_telemetry_t m;
-      if (SafeDecode(ev->data, ev->datalen, 4096, &m) == DecodeError::kNone) r.telemetry[m.frame] = m;
-    } else if (base == channels::kControl) {
-      session_control_t m;
-      if (SafeDecode(ev->data, ev->datalen, 1 << 16, &m) == DecodeError::kNone) {
-        r.controls.emplace_back(r.dcp_frames.size(), m);
-      }
-    }
+  r.suffix = log.suffix();
+  log.Read({channels::kOperatorInput, channels::kDcpFrame, channels::kDcpTelemetry, channels::kDcpState},
+           [&](const session::LogMessage& ev) {
+             if (ev.base == channels::kOperatorInput) {
+               operator_input_t m;
+               if (!log.Decode(ev, &m)) return;
+               const auto* p = static_cast<const std::uint8_t*>(ev.data);
+               r.inputs[m.frame] = {ev.log_us, std::vector<std::uint8_t>(p, p + ev.size)};
+             } else if (ev.base == channels::kDcpFrame) {
+               dcp_frame_t m;
+               if (log.Decode(ev, &m)) r.dcp_frames.push_back(m);
+             } else if (ev.base == channels::kDcpTelemetry) {
+               dcp_telemetry_t m;
+               if (log.Decode(ev, &m)) r.telemetry[m.frame] = m;
+             } else {
+               LoggedState st;
+               st.before = r.dcp_frames.size();
+               if (log.Decode(ev, &st.m)) r.states.push_back(std::move(st));
+             }
+           });
+  if (r.dcp_frames.empty()) {
+    throw InputError(log.log_path() + ": no RMS_DCP_FRAME recorded: nothing to re-simulate");
   }
-  if (r.dcp_frames.empty()) throw InputError(log_path.string() + ": no RMS_DCP_FRAME recorded: nothing to re-simulate");
   // Only the DCP's increasing run of frames, as the summary believes them: a
   // frame forged far ahead or behind is not one the DCP made.
   std::vector<std::int64_t> numbers;
@@ -91,46 +91,116 @@ Recording ReadRecording(const fs::path& log_path) {
   if (run.size() != r.dcp_frames.size()) {
     std::vector<dcp_frame_t> kept;
     for (const std::size_t i : run) kept.push_back(r.dcp_frames[i]);
-    // A control command keeps its place: the number of kept frames before it.
-    for (auto& [before, m] : r.controls) {
-      before = static_cast<std::size_t>(std::lower_bound(run.begin(), run.end(), before) - run.begin());
+    // A state keeps its place: the number of kept frames before it.
+    for (auto& st : r.states) {
+      st.before = static_cast<std::size_t>(std::lower_bound(run.begin(), run.end(), st.before) - run.begin());
     }
     r.dcp_frames = std::move(kept);
   }
   return r;
 }
 
-// The operator frame each DCP frame answered, in DCP frame order, with DCP
-// frames the logger lost filled in where that is unambiguous.
-std::vector<std::int64_t> InputSequence(const Recording& r) {
-  std::map<std::int64_t, std::int64_t> by_frame;  // DCP frame -> input frame
-  for (const auto& f : r.dcp_frames) by_frame[f.frame] = f.input_frame;
-  if (by_frame.begin()->first != 0) {
-    throw InputError("the log starts at DCP frame " + std::to_string(by_frame.begin()->first) +
-                     ": the frames before it, and their inputs, are not in it");
+// What the re-simulation does, step by step: a logged state to take (or,
+// PERIODIC, to check against), then an operator frame to answer.
+struct Step {
+  const dcp_state_t* state = nullptr;
+  std::int64_t input_frame = -1;  // -1: a state only
+  bool first = false;             // the state the re-simulation starts from (taken, whatever its reason)
+};
+
+struct Plan {
+  std::vector<Step> steps;
+  std::size_t first = 0;  // the index of the first recorded DCP frame re-simulated
+  std::string note;       // what the log lacks, when it does not start at the session's start
+};
+
+std::string Frames(std::int64_t a, std::int64_t b) {
+  return a == b ? "DCP frame " + std::to_string(a) : "DCP frames " + std::to_string(a) + ".." + std::to_string(b);
+}
+
+// Where the re-simulation can start: the state logged before the first
+// frame (the DCP sends it at start and until its first frame), or, when the
+// log begins later, the first state logged (every 5 s of frames); a log from
+// frame 0 with no state at all (recorded before RMS_DCP_STATE) starts from
+// the initial state.
+const LoggedState* StartState(const Recording& r, Plan* plan) {
+  const LoggedState* start = nullptr;
+  for (const LoggedState& st : r.states) {
+    if (st.before == 0) start = &st;
   }
-  std::vector<std::int64_t> seq;
+  if (start) return start;
+  const std::int64_t first = r.dcp_frames.front().frame;
+  if (r.states.empty()) {
+    if (first == 0) return nullptr;
+    throw InputError("the log starts at DCP frame " + std::to_string(first) +
+                     " and holds no RMS_DCP_STATE: the DCP's state there is not in it (the log misses the "
+                     "session's start, and was recorded before the DCP logged its state), so nothing can be "
+                     "re-simulated");
+  }
+  start = &r.states.front();
+  if (start->before >= r.dcp_frames.size()) {
+    throw InputError("the log's only RMS_DCP_STATE comes after its last DCP frame: nothing to re-simulate from");
+  }
+  plan->first = start->before;
+  const std::int64_t skipped_to = r.dcp_frames[plan->first].frame - 1;
+  plan->note = Frames(first, skipped_to) + " not re-simulated: the log starts at DCP frame " + std::to_string(first) +
+               " without the DCP's state there; re-simulated from the state it logged before DCP frame " +
+               std::to_string(r.dcp_frames[plan->first].frame);
+  return start;
+}
+
+// The operator frame each DCP frame answered, in DCP frame order, with the
+// logged states in their places, and DCP frames the recorder lost filled in
+// where that is unambiguous.
+Plan MakePlan(const Recording& r) {
+  Plan plan;
+  const LoggedState* start = StartState(r, &plan);
   std::int64_t prev_frame = -1, prev_input = -1;
-  for (const auto& [frame, input] : by_frame) {
-    const std::int64_t lost = frame - prev_frame - 1;
+  bool pending_resume = false;
+  // Where a state leaves the numbering: the next frame's, or (a resumed
+  // process) the first frame after it sets it.
+  auto take = [&](const dcp_state_t& m, bool first) {
+    plan.steps.push_back({&m, -1, first});
+    if (m.reason == dcp_state_t::PERIODIC && !first) return;
+    pending_resume = m.resume_pending;
+    prev_frame = m.next_frame - 1;
+    prev_input = m.input_frame;
+  };
+  if (start) take(start->m, true);
+  std::size_t next_state = start ? static_cast<std::size_t>(start - r.states.data()) + 1 : 0;
+  for (std::size_t k = plan.first; k < r.dcp_frames.size(); ++k) {
+    for (; next_state < r.states.size() && r.states[next_state].before <= k; ++next_state) {
+      if (r.states[next_state].before == k) take(r.states[next_state].m, false);
+    }
+    const dcp_frame_t& f = r.dcp_frames[k];
+    if (pending_resume) {  // the first frame after a resume: nothing between was made
+      prev_frame = f.frame - 1;
+      pending_resume = false;
+    }
+    const std::int64_t lost = f.frame - prev_frame - 1;
     if (lost > 0) {
-      // The DCP answered `lost` inputs between prev_input and input that the
-      // log does not show: unambiguous only if exactly that many were logged.
+      // The DCP answered `lost` inputs between prev_input and this frame's
+      // that the log does not show: unambiguous only if exactly that many
+      // were logged.
       std::vector<std::int64_t> between;
-      for (auto it = r.inputs.upper_bound(prev_input); it != r.inputs.end() && it->first < input; ++it) {
+      for (auto it = r.inputs.upper_bound(prev_input); it != r.inputs.end() && it->first < f.input_frame; ++it) {
         between.push_back(it->first);
       }
       if (static_cast<std::int64_t>(between.size()) != lost) {
-        throw InputError("the log lost DCP frames " + std::to_string(prev_frame + 1) + ".." + std::to_string(frame - 1) +
-                         " and which inputs they answered cannot be told: the re-simulation cannot be exact");
+        throw InputError("the log lost " + Frames(prev_frame + 1, f.frame - 1) +
+                         " and which operator frames they answered cannot be told (" + std::to_string(between.size()) +
+                         " logged between): the re-simulation cannot be exact");
       }
-      seq.insert(seq.end(), between.begin(), between.end());
+      for (const std::int64_t in : between) plan.steps.push_back({nullptr, in, false});
+    } else if (lost < 0) {
+      throw InputError("DCP frame " + std::to_string(f.frame) + " follows " + Frames(prev_frame, prev_frame) +
+                       " with no RMS_DCP_STATE between to say why: the log cannot be re-simulated");
     }
-    seq.push_back(input);
-    prev_frame = frame;
-    prev_input = input;
+    plan.steps.push_back({nullptr, f.input_frame, false});
+    prev_frame = f.frame;
+    prev_input = f.input_frame;
   }
-  return seq;
+  return plan;
 }
 
 bool SameFrame(const dcp_frame_t& a, const dcp_frame_t& b, std::string* what) {
@@ -328,12 +398,30 @@ nlohmann::ordered_json Compare(const Recording& rec, const std::map<std::int64_t
   return j;
 }
 
+// A logged state: a restore, a resume or a start is taken as the live DCP
+// took it (another design keeps its own state at a resume: only the
+// numbering); a periodic one is checked against the re-simulated state
+// (the same design only: another one is expected to differ).
+void TakeState(const dcp_state_t& m, bool first, bool other_design, dcp::DcpNode* node, ResimResult* result) {
+  if (m.reason == dcp_state_t::PERIODIC && !first) {
+    if (other_design || !result->state_difference.empty()) return;
+    ++result->states_checked;
+    const Checkpoint logged = ParseCheckpoint(m.checkpoint, "RMS_DCP_STATE");
+    if (logged.dcp != node->MakeCheckpoint().dcp) {
+      result->state_difference = "the DCP's state before DCP frame " + std::to_string(m.next_frame) +
+                                 " differs from the state it logged there";
+    }
+    return;
+  }
+  node->ApplyState(m, first || !(other_design && m.reason == dcp_state_t::RESUME));
+  ++result->states_taken;
+}
+
 }  // namespace
 
 ResimResult Resimulate(const ResimOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();
   const fs::path session(opt.session);
-  if (!fs::exists(session / "lcmlog")) throw InputError(opt.session + ": not a session folder (no lcmlog)");
   const bool other_design = !opt.config_path.empty();
   const std::string config_path = other_design ? opt.config_path : (session / "config.toml").string();
   const LabConfig config = LoadConfig(config_path);
@@ -341,17 +429,18 @@ ResimResult Resimulate(const ResimOptions& opt) {
     if (opt.progress) opt.progress(f, line);
   };
   progress(0.0, "reading " + (session / "lcmlog").string());
-  const Recording rec = ReadRecording(session / "lcmlog");
-  const std::vector<std::int64_t> seq = InputSequence(rec);
+  session::SessionLog log(opt.session);
+  const Recording rec = ReadRecording(log);
+  const Plan plan = MakePlan(rec);
   const auto t_read = std::chrono::steady_clock::now();
 
   ResimResult result;
+  result.note = plan.note;
+  result.skipped = static_cast<long>(plan.first);
   std::string out_log;
   if (other_design) {
     result.out_dir = opt.out_dir.empty() ? (fs::path(opt.session).lexically_normal().string() + "-resim") : opt.out_dir;
-    if (fs::exists(fs::path(result.out_dir) / "lcmlog")) throw InputError(result.out_dir + " already holds a session");
-    fs::create_directories(fs::path(result.out_dir) / "stats");
-    fs::create_directories(fs::path(result.out_dir) / "run");
+    session::CreateSessionFolder(result.out_dir);
     fs::copy_file(config_path, fs::path(result.out_dir) / "config.toml", fs::copy_options::overwrite_existing);
     WriteWholeFile((fs::path(result.out_dir) / "run" / "pilot").string(), "resim\n");
     out_log = (fs::path(result.out_dir) / "lcmlog").string();
@@ -364,8 +453,8 @@ ResimResult Resimulate(const ResimOptions& opt) {
   // after it.
   std::vector<dcp_frame_t> frames_run;
   std::vector<dcp_telemetry_t> telemetry_run;
-  frames_run.reserve(seq.size());
-  telemetry_run.reserve(seq.size());
+  frames_run.reserve(plan.steps.size());
+  telemetry_run.reserve(plan.steps.size());
   {
     LogLcm lcm("", out_log, rec.suffix);
     dcp::DcpNode node(config, &lcm);
@@ -377,36 +466,25 @@ ResimResult Resimulate(const ResimOptions& opt) {
       telemetry_run.emplace_back();
       if (SafeDecode(d, n, 4096, &telemetry_run.back()) != DecodeError::kNone) telemetry_run.pop_back();
     });
-    std::size_t next_control = 0;
-    CheckpointRateLimit restore_rate;
     const auto t_run = std::chrono::steady_clock::now();
-    for (std::size_t k = 0; k < seq.size(); ++k) {
-      // Restores the live DCP applied before this frame (checkpoints it
-      // saved and freezes change nothing here).
-      while (next_control < rec.controls.size() && rec.controls[next_control].first <= k) {
-        const session_control_t& c = rec.controls[next_control++].second;
-        if (c.command == session_control_t::RESTORE && restore_rate.Allow(c.send_time_us)) {
-          // As the live DCP did: the named checkpoint in the session's
-          // folder, at its rate; one it could not read changed nothing.
-          const CheckpointFolder folder((session / "checkpoints").string());
-          try {
-            node.Restore(folder.Read(c.name), folder.PathOf(c.name));
-          } catch (const InputError& e) {
-            progress(static_cast<double>(k) / seq.size(), std::string("a restore the live DCP refused too: ") + e.what());
-          }
-        }
+    const std::size_t n = plan.steps.size();
+    for (std::size_t k = 0; k < n; ++k) {
+      const Step& step = plan.steps[k];
+      if (step.state) {
+        TakeState(*step.state, step.first, other_design, &node, &result);
+        continue;
       }
-      const auto it = rec.inputs.find(seq[k]);
+      const auto it = rec.inputs.find(step.input_frame);
       if (it == rec.inputs.end()) {
-        throw InputError("operator frame " + std::to_string(seq[k]) + ", which DCP frame " + std::to_string(k) +
-                         " answered, is not in the log: the re-simulation cannot be exact");
+        throw InputError("operator frame " + std::to_string(step.input_frame) +
+                         ", which the DCP answered, is not in the log: the re-simulation cannot be exact");
       }
       lcm.SetNowUs(it->second.timestamp_us);
       lcm.Publish(channels::kOperatorInput, it->second.bytes.data(), static_cast<int>(it->second.bytes.size()));
       lcm.HandleSubscriptions(0);  // the input to the DCP
       lcm.HandleSubscriptions(0);  // its outputs to the comparison
-      if (seq.size() >= 20 && k % (seq.size() / 20) == 0) {
-        progress(static_cast<double>(k) / seq.size(), std::to_string(k) + " of " + std::to_string(seq.size()) + " frames");
+      if (n >= 20 && k % (n / 20) == 0) {
+        progress(static_cast<double>(k) / n, std::to_string(k) + " of " + std::to_string(n) + " steps");
       }
     }
     result.run_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_run).count();
@@ -418,10 +496,11 @@ ResimResult Resimulate(const ResimOptions& opt) {
                      node.counters(), node.latencies());
     }
   }
-  progress(1.0, std::to_string(seq.size()) + " of " + std::to_string(seq.size()) + " frames");
+  progress(1.0, "done");
 
   // Word for word against the recording.
-  for (const dcp_frame_t& r : rec.dcp_frames) {
+  for (std::size_t i = plan.first; i < rec.dcp_frames.size(); ++i) {
+    const dcp_frame_t& r = rec.dcp_frames[i];
     ++result.compared;
     const auto it = frames.find(r.frame);
     std::string what;
@@ -436,6 +515,9 @@ ResimResult Resimulate(const ResimOptions& opt) {
     if (same) ++result.identical;
     else if (result.first_difference.empty()) result.first_difference = "DCP frame " + std::to_string(r.frame) + ": " + what;
   }
+  if (result.first_difference.empty() && !result.state_difference.empty()) {
+    result.first_difference = result.state_difference;
+  }
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   result.read_seconds = std::chrono::duration<double>(t_read - t0).count();
   if (!rec.inputs.empty()) {
@@ -445,12 +527,20 @@ ResimResult Resimulate(const ResimOptions& opt) {
 
   if (other_design) {
     const fs::path out(result.out_dir);
-    nlohmann::ordered_json manifest;
-    manifest["format"] = "rmslab-session-1";
-    manifest["kind"] = "re-simulation";
-    manifest["resimulation_of"] = fs::absolute(session).lexically_normal().string();
-    manifest["config"] = {{"file", "config.toml"}, {"source", fs::absolute(config_path).string()}};
-    manifest["software"] = {{"version", VersionString()}, {"describe", Version().describe}, {"commit", Version().commit}};
+    session::ManifestFields mf;
+    mf.pilot = "resim";
+    mf.kind = "re-simulation";
+    mf.parent = fs::absolute(session).lexically_normal().string();
+    mf.config_source = fs::absolute(config_path).string();
+    if (fs::exists(session / "manifest.json")) {
+      try {  // the subject and the note go with the inputs
+        const auto parent = nlohmann::json::parse(std::ifstream((session / "manifest.json").string()));
+        mf.subject = parent.value("subject", "");
+        mf.note = parent.value("note", "");
+      } catch (const std::exception&) {
+      }
+    }
+    const nlohmann::ordered_json manifest = session::MakeManifest(out.string(), mf);
     WriteWholeFile((out / "manifest.json").string(), manifest.dump(2) + "\n");
     WriteWholeFile((out / "summary.json").string(), session::Summarize(out.string()).dump(2) + "\n");
     result.comparison = Compare(rec, telemetry, config, config.session.frame_rate_hz);

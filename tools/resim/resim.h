@@ -26,6 +26,11 @@ struct ResimResult {
   long compared = 0;           // recorded DCP frames compared
   long identical = 0;          // ... identical word for word (and their telemetry field for field)
   std::string first_difference;  // where they first differ ("" if nowhere)
+  long skipped = 0;            // recorded DCP frames not re-simulated (the log lacks the state before them)
+  std::string note;            // ... said in words ("" if none)
+  long states_taken = 0;       // logged RMS_DCP_STATE taken (start, restores, resumes)
+  long states_checked = 0;     // periodic RMS_DCP_STATE the re-simulated state was checked against
+  std::string state_difference;  // the first of those that differed ("" if none)
   double seconds = 0.0;        // wall time of the re-simulation, all of it
   double read_seconds = 0.0;   // of which reading and decoding the session's log
   double run_seconds = 0.0;    // of which the DCP over its LCM interface, frame by frame

@@ -35,6 +35,10 @@ int main(int argc, char** argv) {
   manifest->add_option("--restore", mf.restore, "The checkpoint the session started from, if any");
   manifest->add_option("--host", mf.hosts, "PROCESS=HOST, one per process (default: all on this host)");
   manifest->add_option("--command", mf.command, "The command line that started the session");
+  manifest->add_option("--subject", mf.subject, "Who flew it (scripts/lab compare groups by it)");
+  manifest->add_option("--note", mf.note, "The experimenter's note");
+  manifest->add_option("--kind", mf.kind, "live, replay or re-simulation")->capture_default_str();
+  manifest->add_option("--parent", mf.parent, "A replay's recorded session");
 
   // compare-esg: replayed ESG frames against recorded ones.
   CLI::App* compare = app.add_subcommand("compare-esg", "Compare a replay's ESG frames with the recorded session's");

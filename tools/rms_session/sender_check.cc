@@ -19,7 +19,9 @@ namespace {
 bool Publishes(const std::string& base, std::int8_t process) {
   using S = sender_t;
   if (base == channels::kOperatorInput || base == channels::kOperatorState) return process == S::PROCESS_OPERATOR_STATION;
-  if (base == channels::kDcpFrame || base == channels::kDcpTelemetry) return process == S::PROCESS_DYNAMICS;
+  if (base == channels::kDcpFrame || base == channels::kDcpTelemetry || base == channels::kDcpState) {
+    return process == S::PROCESS_DYNAMICS;
+  }
   if (base == channels::kEsgFrame) return process == S::PROCESS_SCENE;
   if (base == channels::kWindowKeys) return process == S::PROCESS_ESG;
   if (base == channels::kControl) return process == S::PROCESS_CONTROL || process == S::PROCESS_OPERATOR_STATION;

@@ -28,7 +28,10 @@
 #include "rms/sender_t.hpp"
 #include "rms/session_control_t.hpp"
 #include "rms/version.h"
+#include "attempts.h"
 #include "sender_check.h"
+#include "session_log.h"
+#include "rms/dcp_state_t.hpp"
 
 namespace fs = std::filesystem;
 
@@ -105,7 +108,7 @@ class HandControlLog {
 std::string BaseChannel(const std::string& channel) {
   for (const char* base : {channels::kOperatorInput, channels::kOperatorState, channels::kWindowKeys,
                            channels::kDcpTelemetry, channels::kDcpFrame, channels::kEsgFrame, channels::kStatus,
-                           channels::kControl}) {
+                           channels::kControl, channels::kDcpState}) {
     if (channel.rfind(base, 0) == 0) return base;
   }
   return channel;
@@ -152,18 +155,14 @@ struct DcpFrames {
   std::int64_t out_of_sequence = 0;
 };
 
-DcpFrames ReadDcpFrames(const fs::path& log_path, SenderCheck check) {
+DcpFrames ReadDcpFrames(SessionLog& log) {
   std::vector<std::int64_t> numbers;
   std::vector<DcpFrameRecord> records;
   std::map<std::int64_t, DcpFrameRecord> first;
   std::set<std::int64_t> disputed;
-  lcm::LogFile log(log_path.string(), "r");
-  while (const lcm::LogEvent* ev = log.readNextEvent()) {
-    if (BaseChannel(ev->channel) != channels::kDcpFrame || check.Ignore(channels::kDcpFrame, ev->data, ev->datalen)) {
-      continue;
-    }
+  log.Read({channels::kDcpFrame}, [&](const LogMessage& ev) {
     dcp_frame_t m;
-    if (SafeDecode(ev->data, ev->datalen, 1024, &m) != DecodeError::kNone) continue;
+    if (!log.Decode(ev, &m)) return;
     try {
       const DcpFrameRecord r{m.input_frame, UnpackControlWord(m.control_word)};
       const auto [it, fresh] = first.emplace(m.frame, r);
@@ -172,7 +171,7 @@ DcpFrames ReadDcpFrames(const fs::path& log_path, SenderCheck check) {
       records.push_back(r);
     } catch (const InputError&) {
     }
-  }
+  });
   DcpFrames out;
   for (const std::size_t i : LongestIncreasingRun(numbers)) {
     DcpFrameRecord r = first.at(numbers[i]);
@@ -296,6 +295,7 @@ struct LogScan {
   std::map<std::string, std::int64_t> by_channel;
   std::int64_t events = 0, first_us = -1, last_us = -1, malformed = 0;
   SequenceTracker input, dcp, esg;  // frame numbers as logged
+  double rate_hz = 30.0;
   std::set<std::int64_t> telemetry_frames;  // believed
   std::set<std::int64_t> telemetry_logged;  // of the DCP's frames, whether believed or not
   int final_mode = 0;
@@ -304,12 +304,14 @@ struct LogScan {
   HandControlLog hand;
   StatusRuns status;
   nlohmann::ordered_json control = nlohmann::ordered_json::array();
+  AttemptLog* attempts = nullptr;
+  std::string last_restore_name;
 };
 
-void ScanTelemetry(const lcm::LogEvent& ev, const std::map<std::int64_t, DcpFrameRecord>& dcp, SenderCheck* check,
+void ScanTelemetry(const LogMessage& ev, const std::map<std::int64_t, DcpFrameRecord>& dcp, SenderCheck* check,
                    LogScan* s) {
   dcp_telemetry_t m{};
-  if (SafeDecode(ev.data, ev.datalen, 4096, &m) != DecodeError::kNone) {
+  if (SafeDecode(ev.data, ev.size, 4096, &m) != DecodeError::kNone) {
     ++s->malformed;
     return;
   }
@@ -321,12 +323,13 @@ void ScanTelemetry(const lcm::LogEvent& ev, const std::map<std::int64_t, DcpFram
   if (it->second.disputed) return check->Count("disputed_dcp_frame");
   if (!Agrees(m, it->second)) return check->Count("telemetry_contradicts_its_dcp_frame");
   if (!s->telemetry_frames.insert(m.frame).second) return check->Count("repeated_frame");
-  s->telemetry.Observe(m, ev.timestamp, s->first_us);
+  s->telemetry.Observe(m, ev.log_us, s->first_us);
+  s->attempts->ObserveFrame(m, it->second.word.reset, m.input_frame / s->rate_hz);
 }
 
-void ScanStatus(const lcm::LogEvent& ev, LogScan* s) {
+void ScanStatus(const LogMessage& ev, LogScan* s) {
   process_status_t m;
-  if (SafeDecode(ev.data, ev.datalen, 1 << 20, &m) != DecodeError::kNone) {
+  if (SafeDecode(ev.data, ev.size, 1 << 20, &m) != DecodeError::kNone) {
     ++s->malformed;
     return;
   }
@@ -338,36 +341,41 @@ void ScanStatus(const lcm::LogEvent& ev, LogScan* s) {
 
 // Session control as sent (RMS_CONTROL; docs/sessions.md "Freeze, run, step,
 // checkpoint"): what acted is in the processes' control.* counters.
-void ScanControl(const lcm::LogEvent& ev, LogScan* s) {
+void ScanControl(const LogMessage& ev, LogScan* s) {
   session_control_t m;
-  if (SafeDecode(ev.data, ev.datalen, 1024, &m) != DecodeError::kNone) {
+  if (SafeDecode(ev.data, ev.size, 1024, &m) != DecodeError::kNone) {
     ++s->malformed;
     return;
   }
   static const char* const kNames[] = {"?", "freeze", "run", "step", "checkpoint", "restore"};
   const char* what = m.command >= 1 && m.command <= 5 ? kNames[m.command] : "?";
-  nlohmann::ordered_json e = {{"time_s", (ev.timestamp - s->first_us) * 1e-6},
+  nlohmann::ordered_json e = {{"time_s", (ev.log_us - s->first_us) * 1e-6},
                               {"command", what},
                               {"process", ProcessCodeName(m.sender.process)},
                               {"pid", m.sender.pid}};
   if (!m.name.empty()) e["name"] = m.name;
+  if (m.command == session_control_t::RESTORE) s->last_restore_name = m.name;
   s->control.push_back(e);
 }
 
-void ScanFrameNumbers(const std::string& base, const lcm::LogEvent& ev, const std::map<std::int64_t, DcpFrameRecord>& dcp,
+void ScanFrameNumbers(const std::string& base, const LogMessage& ev, const std::map<std::int64_t, DcpFrameRecord>& dcp,
                       LogScan* s) {
   if (base == channels::kOperatorState) {
     operator_state_t m;
-    if (SafeDecode(ev.data, ev.datalen, 1024, &m) == DecodeError::kNone) s->hand.Observe(m, (ev.timestamp - s->first_us) * 1e-6);
-    else ++s->malformed;
+    if (SafeDecode(ev.data, ev.size, 8192, &m) == DecodeError::kNone) {
+      s->hand.Observe(m, (ev.log_us - s->first_us) * 1e-6);
+      s->attempts->ObserveOperator(m);
+    } else {
+      ++s->malformed;
+    }
   } else if (base == channels::kOperatorInput) {
     operator_input_t m;
-    if (SafeDecode(ev.data, ev.datalen, 1024, &m) == DecodeError::kNone) s->input.Accept(m.frame);
+    if (SafeDecode(ev.data, ev.size, 1024, &m) == DecodeError::kNone) s->input.Accept(m.frame);
     else ++s->malformed;
   } else if (base == channels::kDcpFrame) {
     // Only the frames of the increasing run (ReadDcpFrames) count.
     dcp_frame_t m;
-    if (SafeDecode(ev.data, ev.datalen, 1024, &m) != DecodeError::kNone) {
+    if (SafeDecode(ev.data, ev.size, 1024, &m) != DecodeError::kNone) {
       ++s->malformed;
     } else if (const auto it = dcp.find(m.frame); it != dcp.end()) {
       s->dcp.Accept(m.frame);
@@ -376,26 +384,39 @@ void ScanFrameNumbers(const std::string& base, const lcm::LogEvent& ev, const st
     }
   } else if (base == channels::kEsgFrame) {
     esg_frame_t m;
-    if (SafeDecode(ev.data, ev.datalen, 1024, &m) == DecodeError::kNone) s->esg.Accept(m.frame);
+    if (SafeDecode(ev.data, ev.size, 1024, &m) == DecodeError::kNone) s->esg.Accept(m.frame);
     else ++s->malformed;
   }
 }
 
-LogScan ScanLog(const fs::path& log_path, const std::map<std::int64_t, DcpFrameRecord>& dcp, SenderCheck* check) {
-  lcm::LogFile log(log_path.string(), "r");
-  LogScan s;
-  while (const lcm::LogEvent* ev = log.readNextEvent()) {
-    ++s.events;
-    if (s.first_us < 0) s.first_us = ev->timestamp;
-    s.last_us = ev->timestamp;
-    const std::string base = BaseChannel(ev->channel);
-    if (check->Ignore(base, ev->data, ev->datalen)) continue;
-    ++s.by_channel[ev->channel];
-    if (base == channels::kDcpTelemetry) ScanTelemetry(*ev, dcp, check, &s);
-    else if (base == channels::kStatus) ScanStatus(*ev, &s);
-    else if (base == channels::kControl) ScanControl(*ev, &s);
-    else ScanFrameNumbers(base, *ev, dcp, &s);
+// A restore the DCP made (RMS_DCP_STATE RESTORE) starts an attempt.
+void ScanState(const LogMessage& ev, LogScan* s) {
+  dcp_state_t m;
+  if (SafeDecode(ev.data, ev.size, SessionLog::kMaxMessageBytes, &m) != DecodeError::kNone) {
+    ++s->malformed;
+    return;
   }
+  if (m.reason == dcp_state_t::RESTORE) s->attempts->ObserveRestore(s->last_restore_name);
+}
+
+LogScan ScanLog(SessionLog& log, const std::map<std::int64_t, DcpFrameRecord>& dcp, AttemptLog* attempts) {
+  LogScan s;
+  s.attempts = attempts;
+  s.rate_hz = log.frame_rate_hz();
+  SenderCheck* check = &log.check();
+  log.Read({}, [&](const LogMessage& ev) {
+    if (s.first_us < 0) s.first_us = log.first_us();
+    ++s.by_channel[std::string(ev.channel)];
+    if (ev.base == channels::kDcpTelemetry) ScanTelemetry(ev, dcp, check, &s);
+    else if (ev.base == channels::kStatus) ScanStatus(ev, &s);
+    else if (ev.base == channels::kControl) ScanControl(ev, &s);
+    else if (ev.base == channels::kDcpState) ScanState(ev, &s);
+    else ScanFrameNumbers(std::string(ev.base), ev, dcp, &s);
+  });
+  s.events = log.events();
+  s.first_us = log.first_us();
+  s.last_us = log.last_us();
+  s.malformed += log.malformed();
   s.telemetry.Finish(s.first_us);
   return s;
 }
@@ -465,33 +486,12 @@ nlohmann::ordered_json Restarts(const fs::path& root) {
   return restarts;
 }
 
-void AddMission(const fs::path& root, const LogScan& s, double rate_hz, nlohmann::ordered_json* out) {
+void AddMission(const LogScan& s, nlohmann::ordered_json* out) {
   nlohmann::ordered_json& j = *out;
-  const TelemetryLog& t = s.telemetry;
   j["final_mode"] = s.final_mode;
   j["modes_seen"] = std::vector<int>(s.modes.begin(), s.modes.end());
-  j["acquired"] = t.acquired;
-  j["docked"] = t.docked;
-  j["docking"] = t.docking;
-  // Phase durations in session time (DCP frames over the frame rate), so
-  // they do not depend on how fast the session ran.
-  auto span = [&](std::int64_t a, std::int64_t b) -> nlohmann::ordered_json {
-    if (a < 0 || b < 0) return nullptr;
-    return static_cast<double>(b - a) / rate_hz;
-  };
-  const std::int64_t envelope = t.f_envelope >= 0 ? t.f_envelope : t.f_docked;
-  j["phase_durations_s"] = {{"acquisition", span(t.f_start, t.f_acquired)},
-                            {"extraction", span(t.f_acquired, t.f_clear)},
-                            {"maneuvering", span(t.f_clear, envelope)},
-                            {"docking", span(envelope, t.f_docked)}};
-  if (t.docked && t.docking.is_object()) {
-    try {
-      const LabConfig c = LoadConfig((root / "config.toml").string());
-      j["docking"]["within_tolerance"] = t.docking["distance_ft"].get<double>() <= c.dcp.dock_distance_ft &&
-                                         t.docking["angle_deg"].get<double>() <= c.dcp.dock_angle_deg;
-    } catch (const std::exception&) {
-    }
-  }
+  j["acquired"] = s.telemetry.acquired;
+  j["docked"] = s.telemetry.docked;
 }
 
 // Messages a receiver refused for a reason of its own, not malformed
@@ -627,15 +627,19 @@ nlohmann::ordered_json LogJson(const LogScan& s) {
 
 nlohmann::ordered_json Summarize(const std::string& dir) {
   const fs::path root(dir);
-  const fs::path log_path = root / "lcmlog";
-  {
-    lcm::LogFile probe(log_path.string(), "r");
-    if (!probe.good()) throw InputError("cannot read the session's LCM log '" + log_path.string() + "'");
-  }
-  SenderCheck check(dir);
-  const DcpFrames dcp_frames = ReadDcpFrames(log_path, check);
+  SessionLog first_pass(dir);
+  const DcpFrames dcp_frames = ReadDcpFrames(first_pass);
+  SessionLog log(dir);
+  SenderCheck& check = log.check();
   check.Count("dcp_frame_out_of_sequence", dcp_frames.out_of_sequence);
-  const LogScan s = ScanLog(log_path, dcp_frames.by_frame, &check);
+  LabConfig config;
+  try {
+    config = LoadConfig((root / "config.toml").string());
+  } catch (const std::exception&) {
+    config = LoadConfig(DefaultConfigPath());
+  }
+  AttemptLog attempts(config);
+  const LogScan s = ScanLog(log, dcp_frames.by_frame, &attempts);
   const double rate_hz = FrameRate(root);
   const double duration_s = s.first_us >= 0 ? (s.last_us - s.first_us) * 1e-6 : 0.0;
   const auto stats = MergedStats(root, s.status, duration_s, rate_hz, &check);
@@ -645,25 +649,36 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
   if (j["session"].get<std::string>().empty()) j["session"] = fs::absolute(root).parent_path().filename().string();
   if (check.session_id() != 0) j["session_id"] = FormatSessionId(check.session_id());
   j["duration_s"] = duration_s;
-  AddMission(root, s, rate_hz, &j);
+  AddMission(s, &j);
   {
     std::ifstream pilot((root / "run" / "pilot").string());
     std::string who;
     if (pilot >> who) j["pilot"] = who;
   }
   j["restarts"] = Restarts(root);
+  for (std::size_t i = 0; i < j["restarts"].size(); ++i) attempts.ObserveRestart();
+  {
+    nlohmann::ordered_json a = attempts.Json();
+    j["attempts"] = std::move(a["attempts"]);
+    j["totals"] = std::move(a["totals"]);
+  }
   j["mode_changes"] = s.telemetry.mode_changes;
   j["control"] = s.control;
-  if (j["docking"].is_object()) {
-    // A docking a restore may have brought (a checkpoint saved docked):
-    // said, not hidden (docs/security.md "What the summary trusts").
-    bool after_restore = false;
-    const bool restored = Counter(stats.at("dynamics_proc"), "control.restores") > 0;  // one acted
-    for (const auto& c : s.control) {
-      if (!restored) break;
-      after_restore |= c["command"] == "restore" && c["time_s"].get<double>() <= j["docking"]["time_s"].get<double>();
+  // The session's result (docs/sessions.md "summary.json"): its last
+  // attempt that docked, or else its last attempt.
+  {
+    nlohmann::ordered_json result = nullptr;
+    for (const auto& a : j["attempts"]) {
+      if (a["outcome"] == "docked" || result.is_null() || !(result["outcome"] == "docked")) result = a;
     }
-    j["docking"]["after_restore"] = after_restore;
+    if (result.is_object()) {
+      j["result_attempt"] = result["index"];
+      j["phase_durations_s"] = result["phase_durations_s"];
+      j["docking"] = result["docking"];
+      // A docking a restore brought (a checkpoint saved just before it): said,
+      // not hidden (docs/security.md "What the summary trusts").
+      if (j["docking"].is_object()) j["docking"]["after_restore"] = result["started_by"] == "restore";
+    }
   }
   j["by_hand"] = s.hand.Json();
   if (j["by_hand"].is_object()) {
@@ -714,15 +729,20 @@ nlohmann::ordered_json MakeManifest(const std::string& dir, const ManifestFields
   j["started_utc"] = utc;
   j["started_us"] = now;
   j["pilot"] = pilot;
+  j["kind"] = f.kind;
+  if (!f.parent.empty()) j[f.kind == "re-simulation" ? "resimulation_of" : "replay_of"] = f.parent;
+  if (!f.subject.empty()) j["subject"] = f.subject;
+  if (!f.note.empty()) j["note"] = f.note;
   if (!timeline.empty()) j["timeline"] = {{"file", "timeline.tl"}, {"source", timeline}};
   if (!restore.empty()) j["restored_from"] = restore;
   j["config"] = {{"file", "config.toml"}, {"sha256", config_sha256}};
+  if (!f.config_source.empty()) j["config"]["source"] = f.config_source;
   j["software"] = {{"version", VersionString()}, {"project", Version().project}, {"describe", Version().describe},
                    {"commit", Version().commit}, {"build_type", Version().build_type}, {"compiler", Version().compiler}};
   char host[256] = {};
   gethostname(host, sizeof host - 1);
   j["lab_host"] = host;
-  j["lcm"] = {{"url", url}, {"channel_suffix", suffix}};
+  if (!url.empty()) j["lcm"] = {{"url", url}, {"channel_suffix", suffix}};
   nlohmann::ordered_json layout = nlohmann::ordered_json::object();
   for (const char* p : {"operator_station", "dynamics_proc", "scene_proc", "esg_renderer", "lcm-logger"}) layout[p] = "localhost";
   for (const std::string& h : hosts) {

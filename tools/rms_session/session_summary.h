@@ -33,6 +33,10 @@ struct ManifestFields {
   std::string pilot, url, suffix, config_sha256, timeline, restore, command;
   std::string session_id;           // "0x..." (the launcher's random id; every message carries it)
   std::vector<std::string> hosts;   // PROCESS=HOST
+  std::string subject, note;        // who flew it and the experimenter's note (scripts/lab demo --subject --note)
+  std::string kind = "live";        // "live", "replay" or "re-simulation"
+  std::string parent;               // a replay's or re-simulation's recorded session (absolute path)
+  std::string config_source;        // where config.toml came from
 };
 nlohmann::ordered_json MakeManifest(const std::string& session_dir, const ManifestFields& f);
 
