@@ -14,6 +14,7 @@
 //
 //   build/bench/rms_dcp_bench [--md FILE] [--reps N] [--trajectories N] [--seed S]
 #include <CLI/CLI.hpp>
+#include "rms/command_line.h"
 #include <spdlog/spdlog.h>
 #include <benchmark/benchmark.h>
 
@@ -253,7 +254,7 @@ int main(int argc, char** argv) {
   app.add_option("--trajectories", trajectories, "Colliding trajectories for the tunnelling table")
       ->capture_default_str();
   app.add_option("--seed", seed, "Seed of the random samples")->capture_default_str();
-  CLI11_PARSE(app, argc, argv);
+  if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   spdlog::set_level(spdlog::level::warn);
   std::fprintf(stderr, "rms_dcp_bench: seed %llu\n", static_cast<unsigned long long>(seed));
   std::ostringstream md;

@@ -8,6 +8,7 @@
 //
 //   build/bench/rms_render_bench [--width 1024 --height 768] [--every 1] [--json out.json]
 #include <CLI/CLI.hpp>
+#include "rms/command_line.h"
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -65,7 +66,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> sizes;
   app.add_option("--md", md_path, "Write the tables as markdown to this file");
   app.add_option("--sizes", sizes, "Also time the ESG's default renderer and the depth buffer at these sizes (WxH)");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   try {
     using rms::esg::Visibility;
     const rms::LabConfig config = rms::LoadConfig(config_path);

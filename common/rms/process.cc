@@ -1,5 +1,7 @@
 #include "rms/process.h"
 
+#include "rms/command_line.h"
+
 #include <cerrno>
 #include <cstdio>
 #include <thread>
@@ -55,11 +57,7 @@ int ProcessMain(CLI::App& app, int argc, char** argv, const std::string& process
                 const std::function<int(const LabConfig&, LcmInterface&)>& body,
                 const std::function<void(const LabConfig&)>& check) {
   AddCommonOptions(app, common);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e);
-  }
+  if (const auto rc = ParseCommandLine(app, argc, argv)) return *rc;
   SetUpLogging(process, common->log_level);
   InstallStopHandlers();
   WatchLifeline();

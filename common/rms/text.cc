@@ -1,3 +1,4 @@
+#include <cmath>
 #include "rms/text.h"
 
 #include <sys/stat.h>
@@ -48,6 +49,18 @@ std::string Sprintf(const char* format, ...) {
   if (n > 0) std::vsnprintf(out.data(), out.size() + 1, format, ap);
   va_end(ap);
   return out;
+}
+
+std::string HumanNumber(double v, int decimals) {
+  if (!std::isfinite(v)) return std::isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf");
+  if (v != 0 && std::abs(v) < std::pow(10.0, -decimals)) return Sprintf("%.2g", v);
+  std::string s = Sprintf("%.*f", decimals, v);
+  if (s.find('.') != std::string::npos) {
+    while (s.back() == '0') s.pop_back();
+    if (s.back() == '.') s.pop_back();
+  }
+  if (s == "-0") s = "0";
+  return s;
 }
 
 }  // namespace rms

@@ -38,21 +38,15 @@ def run_then_stop(owner, body):
 
 
 def make_folder(out, default_parent):
+    """A new session folder, made by the one writer of them (rms_session
+    folder: docs/sessions.md "The session folder"); its absolute path."""
     if not out:
         out = os.path.join(default_parent, time.strftime("%Y%m%dT%H%M%SZ", time.gmtime()))
-    if os.path.exists(os.path.join(out, "lcmlog")):
-        raise LabError(f"{out} already holds a session")
-    try:
-        for sub in ("logs", "stats", "frames", "run", "checkpoints"):
-            os.makedirs(os.path.join(out, sub), exist_ok=True)
-        probe = os.path.join(out, "run", ".writable")
-        with open(probe, "w") as f:
-            f.write("")
-        os.remove(probe)
-    except OSError as e:
-        raise LabError(f"--out {out}: cannot make the session's folder there ({e.strerror}: "
-                       f"{e.filename or out}); give --out a folder you can write")
-    return os.path.abspath(out)
+    r = subprocess.run([binary("tools/rms_session"), "folder", out], capture_output=True, text=True)
+    if r.returncode != 0:
+        msg = r.stderr.strip().removeprefix("rms_session: ")
+        raise LabError(f"--out {msg}" if "already holds" not in msg else msg)
+    return r.stdout.strip()
 
 
 def precheck(checks):

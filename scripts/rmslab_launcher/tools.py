@@ -49,13 +49,47 @@ def resim(argv):
 
 
 def export(argv):
-    """scripts/lab export SESSION [--out DIR]: every channel of the session's
-    LCM log to CSV, one file each (default SESSION/csv/), in engineering units."""
-    if not argv or argv[0] in ("-h", "--help"):
-        print(export.__doc__)
-        return 0 if argv else 2
-    ensure("tools/rms_session")
-    return subprocess.run([binary("tools/rms_session"), "export"] + argv).returncode
+    """scripts/lab export SESSION [--out DIR] | --mcap [--out FILE]: every
+    channel of the session's LCM log to CSV, one file each (default
+    SESSION/csv/), in engineering units, each row with its session time; or,
+    with --mcap, the whole log as one MCAP file (default SESSION/session.mcap)
+    that Foxglove Studio and PlotJuggler open: JSON messages, a JSON Schema
+    for every channel made from the LCM types."""
+    p = argparse.ArgumentParser(prog="scripts/lab export", description=export.__doc__)
+    p.add_argument("session")
+    p.add_argument("--out")
+    p.add_argument("--mcap", action="store_true", help="one MCAP file instead of CSV")
+    p.add_argument("--no-build", action="store_true")
+    a = p.parse_args(argv)
+    if not os.path.isfile(os.path.join(a.session, "lcmlog")):
+        raise LabError(f"{a.session}: not a session folder (no lcmlog)", 2)
+    ensure("tools/rms_session", a.no_build)
+    if not a.mcap:
+        cmd = [binary("tools/rms_session"), "export", a.session] + (["--out", a.out] if a.out else [])
+        return subprocess.run(cmd).returncode
+    return export_mcap(a.session, a.out or os.path.join(a.session, "session.mcap"))
+
+
+def export_mcap(session, out):
+    """The log as JSON lines (rms_session export --jsonl) into the MCAP
+    writer (tools/rms_mcap/write_mcap.mjs, @mcap/core from npm)."""
+    mcap = os.path.join(ROOT, "tools", "rms_mcap")
+    schemas = binary("lcmtypes/schemas")
+    if not os.path.isdir(os.path.join(mcap, "node_modules", "@mcap", "core")):
+        raise LabError("the MCAP writer's packages are not installed: run scripts/install-deps", 1)
+    if not os.path.isdir(schemas):
+        raise LabError(f"no JSON schemas in {schemas}: build first (drop --no-build)", 1)
+    reader = subprocess.Popen([binary("tools/rms_session"), "export", session, "--jsonl"], stdout=subprocess.PIPE)
+    writer = subprocess.run(["node", os.path.join(mcap, "write_mcap.mjs"), "--schemas", schemas, "--out", out],
+                            stdin=reader.stdout)
+    reader.stdout.close()
+    rc = reader.wait()
+    if rc != 0 or writer.returncode != 0:
+        if os.path.exists(out) and writer.returncode == 0:
+            os.remove(out)  # a partial log: not left as if whole
+        raise LabError(f"the MCAP export failed (reader exit {rc}, writer exit {writer.returncode})", 1)
+    say(f"MCAP: {out} (opens in Foxglove Studio and PlotJuggler)")
+    return 0
 
 
 def report(argv):

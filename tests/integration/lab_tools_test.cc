@@ -83,7 +83,7 @@ TEST_F(RecordedSession, ItReSimulatesBitForBit) {
                            std::to_string(s["frames"]["dcp_published"].get<int>()) +
                            " recorded frames identical, word for word";
   EXPECT_NE(r.out.find(want), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("resim: 100%"), std::string::npos) << "no progress shown";
+  EXPECT_EQ(r.out.find("resim: "), std::string::npos) << "progress lines with no terminal to show them";
 }
 
 TEST_F(RecordedSession, ALongerArmFaresOtherwiseAndTheComparisonSaysWhy) {

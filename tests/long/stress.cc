@@ -25,6 +25,7 @@
 //    collision, every plane sent separating its pair.
 // Exit status 0 when every check holds.
 #include <CLI/CLI.hpp>
+#include "rms/command_line.h"
 #include <spdlog/spdlog.h>
 
 #include <chrono>
@@ -338,7 +339,7 @@ int main(int argc, char** argv) {
   app.add_option("--seed", seed, "Seed")->capture_default_str();
   app.add_option("--config", config_path, "Configuration file")->capture_default_str();
   app.add_option("--md", md_path, "Write the results as markdown to this file");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   spdlog::set_level(spdlog::level::err);
   std::printf("rms_stress: seed %llu, %ld pairs, %ld poses, %ld soak frames\n", static_cast<unsigned long long>(seed),
               pairs, poses, frames);

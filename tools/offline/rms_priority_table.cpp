@@ -1,5 +1,6 @@
 // rms_priority_table: prints the priority table (docs/priority-table.md).
 #include <CLI/CLI.hpp>
+#include "rms/command_line.h"
 #include <cstdio>
 
 #include "priority_table.h"
@@ -11,7 +12,7 @@ int main(int argc, char** argv) {
   std::string timeline = std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl";
   app.add_option("--config", config_path, "Configuration file")->capture_default_str();
   app.add_option("--timeline", timeline, "Timeline whose first frame places the planes")->capture_default_str();
-  CLI11_PARSE(app, argc, argv);
+  if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   try {
     std::fputs(rms::offline::PriorityTableMarkdown(rms::LoadConfig(config_path), timeline).c_str(), stdout);
     return 0;

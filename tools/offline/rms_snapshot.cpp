@@ -8,6 +8,7 @@
 // the crosshairs on and the live window's guidance panel drawn as the
 // operator station would fill it (docs/operator.md's pictures).
 #include <CLI/CLI.hpp>
+#include "rms/command_line.h"
 #include <algorithm>
 #include <array>
 #include <cstdio>
@@ -121,7 +122,7 @@ int main(int argc, char** argv) {
   app.add_option("--guidance-frame", guidance_frame, "The guidance panel's command frame: end_effector, orbiter, payload")
       ->capture_default_str()
       ->check(CLI::IsMember({"end_effector", "orbiter", "payload"}));
-  CLI11_PARSE(app, argc, argv);
+  if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   try {
     const rms::LabConfig config = rms::LoadConfig(config_path);
     const rms::op::Timeline tl = rms::op::Timeline::Load(timeline, config.inputs);

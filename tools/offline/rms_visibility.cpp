@@ -2,6 +2,7 @@
 // against the depth-buffer reference over a whole scripted mission, from
 // every camera station: the pixels on which the two disagree, per camera.
 #include <CLI/CLI.hpp>
+#include "rms/command_line.h"
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -60,7 +61,7 @@ int main(int argc, char** argv) {
   app.add_option("--json", json_out, "Also write the figures as JSON to this file");
   app.add_option("--gl", gl_name, "GL backend: osmesa or egl")->capture_default_str();
   app.add_flag("--explain", explain, "List the cluster pairs (priority / depth) on the differing pixels");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   try {
     const rms::LabConfig config = rms::LoadConfig(config_path);
     rms::offline::OfflineSession session(config, rms::op::Timeline::Load(timeline, config.inputs));

@@ -3,7 +3,9 @@
 //   rms_resim SESSION                      exit 0 only if identical, word for word
 //   rms_resim SESSION --config FILE [--out DIR]   the same inputs, another design
 #include <CLI/CLI.hpp>
+#include "rms/command_line.h"
 #include <cstdio>
+#include <unistd.h>
 
 #include "resim.h"
 
@@ -16,9 +18,9 @@ int main(int argc, char** argv) {
   app.add_option("session", opt.session, "Session folder")->required()->check(CLI::ExistingDirectory);
   app.add_option("--config", opt.config_path, "Another configuration (a different design)")->check(CLI::ExistingFile);
   app.add_option("--out", opt.out_dir, "With --config: the new session folder (default SESSION-resim)");
-  app.add_flag("--quiet", quiet, "No progress lines");
-  CLI11_PARSE(app, argc, argv);
-  if (!quiet) {
+  app.add_flag("--quiet", quiet, "No progress lines (they go only to a terminal anyway)");
+  if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
+  if (!quiet && isatty(STDERR_FILENO)) {  // progress only to a person at a terminal
     opt.progress = [](double f, const std::string& line) {
       std::fprintf(stderr, "resim: %3.0f%% %s\n", 100 * f, line.c_str());
     };

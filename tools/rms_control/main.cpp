@@ -9,6 +9,7 @@
 // session first (so no frame is in flight), restores the DCP's state and the
 // operator station's inputs, and leaves the session frozen unless --run.
 #include <CLI/CLI.hpp>
+#include "rms/command_line.h"
 #include <unistd.h>
 
 #include <chrono>
@@ -211,7 +212,7 @@ int main(int argc, char** argv) {
       "restore", "Freeze, then restore the DCP's state (and the operator's inputs) from a checkpoint NAME, or a FILE");
   restore->add_option("checkpoint", what, "A checkpoint's name in the session, or a checkpoint file")->required();
   restore->add_flag("--run", then_run, "Run again after restoring");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   try {
     std::string folder;
     std::int64_t id = session_id.empty() ? 0 : rms::ParseSessionId(session_id, "--session-id");

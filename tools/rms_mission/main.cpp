@@ -1,6 +1,7 @@
 // rms_mission: writes the standard mission (acquire, extract, dock) as a
 // timeline for the given configuration (docs/timeline.md).
 #include <CLI/CLI.hpp>
+#include "rms/command_line.h"
 #include <fstream>
 #include <iostream>
 
@@ -14,7 +15,7 @@ int main(int argc, char** argv) {
   std::string config_path = rms::DefaultConfigPath(), out;
   app.add_option("--config", config_path, "Configuration file")->capture_default_str();
   app.add_option("--out", out, "Timeline file to write (default: standard output)");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   try {
     const rms::LabConfig config = rms::LoadConfig(config_path);
     const std::string text = rms::mission::FormatTimeline(

@@ -3,6 +3,7 @@
 //   rms_monitor [--lcm-url URL] [--channel-suffix S]        redraws twice a second
 //   rms_monitor --for SECONDS                                one plain snapshot, then exit
 #include <CLI/CLI.hpp>
+#include "rms/command_line.h"
 #include <chrono>
 #include <cmath>
 #include <cstdarg>
@@ -66,7 +67,7 @@ int main(int argc, char** argv) {
   app.add_option("--channel-suffix", lcm_options.channel_suffix, "The session's channel suffix");
   app.add_option("--for", for_s, "Listen this many seconds, print one snapshot and exit (0: live, until Ctrl-C)")
       ->check(CLI::NonNegativeNumber);
-  CLI11_PARSE(app, argc, argv);
+  if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   rms::InstallStopHandlers();
   try {
     rms::UdpLcm lcm(lcm_options);

@@ -1,6 +1,9 @@
 // rms_report: a session's report as one self-contained HTML file.
 #include <CLI/CLI.hpp>
+#include "rms/command_line.h"
 #include <fstream>
+#include <functional>
+#include <unistd.h>
 #include <iostream>
 
 #include "rms/text.h"
@@ -13,11 +16,12 @@ int main(int argc, char** argv) {
   app.add_option("session", session, "Session folder")->required()->check(CLI::ExistingDirectory);
   app.add_option("--out", out, "The HTML file (default SESSION/report.html)");
   app.add_option("--chart-js", chart_js, "Chart.js to embed")->capture_default_str();
-  CLI11_PARSE(app, argc, argv);
+  if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   try {
     if (out.empty()) out = session + "/report.html";
-    const std::string html =
-        rms::report::MakeReport(session, chart_js, [](const std::string& line) { std::cerr << line << "\n"; });
+    std::function<void(const std::string&)> progress;  // only to a person at a terminal
+    if (isatty(STDERR_FILENO)) progress = [](const std::string& line) { std::cerr << line << "\n"; };
+    const std::string html = rms::report::MakeReport(session, chart_js, progress, out);
     rms::WriteWholeFile(out, html);
     std::cout << out << "\n";
     return 0;

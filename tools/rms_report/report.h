@@ -11,7 +11,11 @@ namespace rms::report {
 
 std::string DefaultChartJsPath();
 // Throws rms::InputError for an unreadable session or a missing Chart.js.
+// out_path: where the report goes (links to the session's video are made
+// relative to it).
 std::string MakeReport(const std::string& session_dir, const std::string& chart_js_path,
-                       const std::function<void(const std::string&)>& progress = {});
+                       const std::function<void(const std::string&)>& progress = {}, const std::string& out_path = "");
+// The report's scripts (report_charts.js, compare_charts.js) in the source tree.
+std::string ChartsScriptPath(const std::string& name);
 
 }  // namespace rms::report

@@ -22,7 +22,7 @@
 #include "rms/message_io.h"
 #include "rms/operator_input_t.hpp"
 #include "rms/process_status_t.hpp"
-#include "sender_check.h"
+#include "session_log.h"
 #include "rms/session_control_t.hpp"
 #include "rms/word_blocks.h"
 #include "session_summary.h"
@@ -121,13 +121,13 @@ std::vector<std::pair<std::string, long>> ExportCsv(const std::string& session_d
   fs::create_directories(out);
 
   // Columns, by channel.
-  std::vector<std::string> in_cols = {"log_time [us]", "frame", "send_time [us]"};
+  std::vector<std::string> in_cols = {"log_time [us]", "session_time [s]", "frame", "send_time [us]"};
   for (int i = 0; i < kNumAnalogInputs; ++i) {
     in_cols.push_back(std::string(kAnalogInputNames[i]) + " [" + config.inputs[i].unit + "]");
   }
   Add(&in_cols, {"camera_station", "reset", "overlay"});
 
-  std::vector<std::string> dcp_cols = {"log_time [us]", "frame", "send_time [us]", "input_frame", "input_send_time [us]"};
+  std::vector<std::string> dcp_cols = {"log_time [us]", "session_time [s]", "frame", "send_time [us]", "input_frame", "input_send_time [us]"};
   dcp_cols.insert(dcp_cols.end(), kAngle, kAngle + 6);
   for (const auto& c : ControlColumns("")) dcp_cols.push_back(c);
   for (int k = 1; k <= 3; ++k) {
@@ -138,7 +138,7 @@ std::vector<std::pair<std::string, long>> ExportCsv(const std::string& session_d
   for (const auto& c : Vec3Columns("p_RoPo_R", "ft")) dcp_cols.push_back(c);
   for (const auto& c : MatColumns("R_RP")) dcp_cols.push_back(c);
 
-  std::vector<std::string> esg_cols = {"log_time [us]", "frame", "send_time [us]", "dcp_frame", "input_frame",
+  std::vector<std::string> esg_cols = {"log_time [us]", "session_time [s]", "frame", "send_time [us]", "dcp_frame", "input_frame",
                                        "input_send_time [us]", "num_words", "frame_count"};
   for (const auto& c : ControlColumns("")) esg_cols.push_back(c);
   Add(&esg_cols, {"priority_dynamic", "priority_fixed"});
@@ -151,7 +151,7 @@ std::vector<std::pair<std::string, long>> ExportCsv(const std::string& session_d
   for (const auto& c : MatColumns("R_RP")) esg_cols.push_back(c);
   for (int w = 0; w < esg_words::kPriorityCount; ++w) esg_cols.push_back("priority_word_" + std::to_string(w) + " [hex]");
 
-  std::vector<std::string> tm_cols = {"log_time [us]", "frame", "send_time [us]", "input_frame", "input_send_time [us]",
+  std::vector<std::string> tm_cols = {"log_time [us]", "session_time [s]", "frame", "send_time [us]", "input_frame", "input_send_time [us]",
                                       "mode", "acquired", "docked", "held", "finger_held", "collisions [bits]",
                                       "slave_collisions [bits]"};
   for (int i = 1; i <= 6; ++i) tm_cols.push_back("acquisition_condition_" + std::to_string(i));
@@ -173,45 +173,32 @@ std::vector<std::pair<std::string, long>> ExportCsv(const std::string& session_d
   Csv dcp_csv(out / "dcp_frame.csv", dcp_cols);
   Csv esg_csv(out / "esg_frame.csv", esg_cols);
   Csv tm_csv(out / "dcp_telemetry.csv", tm_cols);
-  Csv st_csv(out / "status.csv", {"log_time [us]", "send_time [us]", "process", "host", "pid", "frame", "final",
+  Csv st_csv(out / "status.csv", {"log_time [us]", "session_time [s]", "send_time [us]", "process", "host", "pid", "frame", "final",
                                   "counter", "value"});
-  Csv ctl_csv(out / "control.csv", {"log_time [us]", "send_time [us]", "sequence", "command", "name"});
+  Csv ctl_csv(out / "control.csv", {"log_time [us]", "session_time [s]", "send_time [us]", "sequence", "command", "name"});
   long skipped = 0;
-  SenderCheck check(session_dir);  // only the session's own messages (docs/security.md)
-
-  lcm::LogFile log((root / "lcmlog").string(), "r");
-  if (!log.good()) throw InputError("cannot read the session's LCM log '" + (root / "lcmlog").string() + "'");
-  const auto size = fs::file_size(root / "lcmlog");
+  SessionLog log(session_dir);  // only the session's own messages (docs/security.md)
   long events = 0;
-  int last_pct = -1;
-  while (const lcm::LogEvent* ev = log.readNextEvent()) {
-    ++events;
-    if (progress && size > 0) {
-      const int pct = static_cast<int>(100.0 * std::ftell(log.getFilePtr()) / static_cast<double>(size));
-      if (pct / 10 != last_pct / 10) {
-        last_pct = pct;
-        progress("export: " + std::to_string(pct) + "% (" + std::to_string(events) + " events)");
-      }
-    }
-    const std::string base = BaseChannel(ev->channel);
-    if (check.Ignore(base, ev->data, ev->datalen)) continue;
-    const std::string t = I(ev->timestamp);
+  log.Read({}, [&](const LogMessage& msg) {
+    const std::string_view base = msg.base;
+    const std::string t = I(msg.log_us), st = N(msg.session_time_s);
+    if (progress && ++events % 100000 == 0) progress("export: " + std::to_string(events) + " messages");
     try {
       if (base == channels::kOperatorInput) {
-        operator_input_t m;
-        if (SafeDecode(ev->data, ev->datalen, 1024, &m) != DecodeError::kNone) throw InputError("malformed");
+        operator_input_t m{};
+        if (SafeDecode(msg.data, msg.size, 1024, &m) != DecodeError::kNone) throw InputError("malformed");
         std::array<std::int32_t, kInputWords> words{};
         std::copy(m.words, m.words + kInputWords, words.begin());
         const OperatorInputs in = DecodeInputs(words, config.inputs, nullptr);
-        std::vector<std::string> row = {t, I(m.frame), I(m.send_time_us)};
+        std::vector<std::string> row = {t, st, I(m.frame), I(m.send_time_us)};
         for (int i = 0; i < kNumAnalogInputs; ++i) row.push_back(N(in.value[i]));
         Add(&row, {I(in.camera_station), B(in.reset), B(in.overlay)});
         in_csv.Row(row);
       } else if (base == channels::kDcpFrame) {
-        dcp_frame_t m;
-        if (SafeDecode(ev->data, ev->datalen, 4096, &m) != DecodeError::kNone) throw InputError("malformed");
+        dcp_frame_t m{};
+        if (SafeDecode(msg.data, msg.size, 4096, &m) != DecodeError::kNone) throw InputError("malformed");
         const DcpFrameData d = UnpackDcpFrame(m);
-        std::vector<std::string> row = {t, I(m.frame), I(m.send_time_us), I(m.input_frame), I(m.input_send_time_us)};
+        std::vector<std::string> row = {t, st, I(m.frame), I(m.send_time_us), I(m.input_frame), I(m.input_send_time_us)};
         for (int i = 0; i < 6; ++i) row.push_back(N(Deg(d.arm[i])));
         ControlCells(&row, d.control);
         for (int k = 0; k < 3; ++k) {
@@ -226,10 +213,10 @@ std::vector<std::pair<std::string, long>> ExportCsv(const std::string& session_d
         }
         dcp_csv.Row(row);
       } else if (base == channels::kEsgFrame) {
-        esg_frame_t m;
-        if (SafeDecode(ev->data, ev->datalen, 4096, &m) != DecodeError::kNone) throw InputError("malformed");
+        esg_frame_t m{};
+        if (SafeDecode(msg.data, msg.size, 4096, &m) != DecodeError::kNone) throw InputError("malformed");
         const EsgFrameData d = UnpackEsgWords(m.words);
-        std::vector<std::string> row = {t, I(m.frame), I(m.send_time_us), I(m.dcp_frame), I(m.input_frame),
+        std::vector<std::string> row = {t, st, I(m.frame), I(m.send_time_us), I(m.dcp_frame), I(m.input_frame),
                                         I(m.input_send_time_us), I(m.num_words), I(d.frame_count)};
         ControlCells(&row, d.control);
         Add(&row, {I(d.control.priority_dynamic), I(d.control.priority_fixed)});
@@ -251,9 +238,9 @@ std::vector<std::pair<std::string, long>> ExportCsv(const std::string& session_d
         }
         esg_csv.Row(row);
       } else if (base == channels::kDcpTelemetry) {
-        dcp_telemetry_t m;
-        if (SafeDecode(ev->data, ev->datalen, 4096, &m) != DecodeError::kNone) throw InputError("malformed");
-        std::vector<std::string> row = {t, I(m.frame), I(m.send_time_us), I(m.input_frame), I(m.input_send_time_us),
+        dcp_telemetry_t m{};
+        if (SafeDecode(msg.data, msg.size, 4096, &m) != DecodeError::kNone) throw InputError("malformed");
+        std::vector<std::string> row = {t, st, I(m.frame), I(m.send_time_us), I(m.input_frame), I(m.input_send_time_us),
                                         I(m.mode), B(m.acquired), B(m.docked), B(m.held), B(m.finger_held),
                                         I(m.collisions), I(m.slave_collisions)};
         for (int i = 0; i < 6; ++i) row.push_back(B(m.acquisition_conditions[i]));
@@ -273,29 +260,29 @@ std::vector<std::pair<std::string, long>> ExportCsv(const std::string& session_d
         tm_csv.Row(row);
       } else if (base == channels::kStatus) {
         process_status_t m;
-        if (SafeDecode(ev->data, ev->datalen, 1 << 20, &m) != DecodeError::kNone) throw InputError("malformed");
+        if (SafeDecode(msg.data, msg.size, 1 << 20, &m) != DecodeError::kNone) throw InputError("malformed");
         for (int i = 0; i < m.num_counters; ++i) {
-          st_csv.Row({t, I(m.send_time_us), m.process, m.host, I(m.pid), I(m.frame), B(m.final), m.counter_names[i],
+          st_csv.Row({t, st, I(m.send_time_us), m.process, m.host, I(m.pid), I(m.frame), B(m.final), m.counter_names[i],
                       I(m.counter_values[i])});
         }
       } else if (base == channels::kControl) {
         session_control_t m;
-        if (SafeDecode(ev->data, ev->datalen, 1 << 16, &m) != DecodeError::kNone) throw InputError("malformed");
+        if (SafeDecode(msg.data, msg.size, 1 << 16, &m) != DecodeError::kNone) throw InputError("malformed");
         static const char* kNames[] = {"?", "freeze", "run", "step", "checkpoint", "restore"};
-        ctl_csv.Row({t, I(m.send_time_us), I(m.sequence), m.command >= 1 && m.command <= 5 ? kNames[m.command] : "?",
+        ctl_csv.Row({t, st, I(m.send_time_us), I(m.sequence), m.command >= 1 && m.command <= 5 ? kNames[m.command] : "?",
                      m.name});
       }
     } catch (const std::exception&) {
       ++skipped;  // a malformed message: counted, not exported
     }
-  }
+  });
   std::vector<std::pair<std::string, long>> files;
   for (Csv* c : {&in_csv, &dcp_csv, &esg_csv, &tm_csv, &st_csv, &ctl_csv}) {
     c->Close();
     files.emplace_back(c->path().string(), c->rows());
   }
   files.emplace_back("skipped (malformed)", skipped);
-  files.emplace_back("not exported (not the session's own: other sessions, other senders)", static_cast<long>(check.ignored_total()));
+  files.emplace_back("not exported (not the session's own: other sessions, other senders)", static_cast<long>(log.check().ignored_total()));
   return files;
 }
 

@@ -1,13 +1,17 @@
 // rms_session: tools over a lab session folder (docs/sessions.md).
 //   rms_session summary SESSION   writes SESSION/summary.json
 #include <CLI/CLI.hpp>
+#include "rms/command_line.h"
 #include <fstream>
+#include <functional>
+#include <unistd.h>
 #include <iostream>
 #include <map>
 
 #include "rms/text.h"
 #include "export_csv.h"
 #include "lab_file.h"
+#include "session_folder.h"
 #include "session_summary.h"
 
 int main(int argc, char** argv) {
@@ -50,6 +54,12 @@ int main(int argc, char** argv) {
   std::string e_dir, e_out;
   exporter->add_option("session", e_dir, "Session folder")->required()->check(CLI::ExistingDirectory);
   exporter->add_option("--out", e_out, "Folder for the CSV files (default SESSION/csv)");
+  bool e_jsonl = false;
+  exporter->add_flag("--jsonl", e_jsonl, "Instead: every message as a JSON line on stdout (for the MCAP writer)");
+  // folder: a new session folder (the one writer of them; scripts/lab demo and replay).
+  CLI::App* folder = app.add_subcommand("folder", "Make a new session folder and print its absolute path");
+  std::string f_dir;
+  folder->add_option("dir", f_dir, "The folder")->required();
 
   // labfile: a lab's host layout, checked, as JSON for scripts/lab.
   CLI::App* labfile = app.add_subcommand("labfile", "Check a lab file (docs/sessions.md) and print it as JSON");
@@ -62,11 +72,28 @@ int main(int argc, char** argv) {
   double probe_s = 1.2;
   probe->add_option("--lcm-url", probe_url, "The address")->required();
   probe->add_option("--seconds", probe_s, "How long to listen")->capture_default_str()->check(CLI::Range(0.1, 60.0));
-  CLI11_PARSE(app, argc, argv);
+  if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   try {
+    if (folder->parsed()) {
+      std::cout << rms::session::CreateSessionFolder(f_dir) << "\n";
+      return 0;
+    }
+    if (exporter->parsed() && e_jsonl) {
+      std::ios::sync_with_stdio(false);
+      long malformed = 0;
+      const long n = rms::session::ExportJsonLines(e_dir, std::cout, &malformed);
+      std::cout.flush();
+      std::cerr << "rms_session export: " << n << " messages";
+      if (malformed > 0) std::cerr << " (" << malformed << " malformed, left out)";
+      std::cerr << "\n";
+      return std::cout ? 0 : 1;
+    }
     if (exporter->parsed()) {
       if (e_out.empty()) e_out = e_dir + "/csv";
-      const auto files = rms::session::ExportCsv(e_dir, e_out, [](const std::string& line) { std::cerr << line << "\n"; });
+      // Progress only to a person at a terminal (docs/sessions.md "Command lines").
+      std::function<void(const std::string&)> progress;
+      if (isatty(STDERR_FILENO)) progress = [](const std::string& line) { std::cerr << line << "\n"; };
+      const auto files = rms::session::ExportCsv(e_dir, e_out, progress);
       for (const auto& [f, n] : files) std::cout << f << ": " << n << " rows\n";
       return 0;
     }
@@ -148,17 +175,26 @@ int main(int argc, char** argv) {
         std::cout << " ... (" << j["mode_changes"].size() - 8 << " more mode changes)";
         break;
       }
-      std::cout << " -> " << mc["to"] << " (" << mc["time_s"].get<double>() << " s)";
+      std::cout << " -> " << mc["to"] << " (" << rms::HumanNumber(mc["time_s"].get<double>(), 1) << " s)";
     }
     std::cout << "; acquired " << (j["acquired"].get<bool>() ? "yes" : "no") << ", docked "
               << (j["docked"].get<bool>() ? "yes" : "no");
     if (!j["docking"].is_null()) {
-      std::cout << " (" << j["docking"]["distance_ft"].get<double>() << " ft, "
-                << j["docking"]["angle_deg"].get<double>() << " deg)";
+      std::cout << " (" << rms::HumanNumber(j["docking"]["distance_ft"].get<double>()) << " ft, "
+                << rms::HumanNumber(j["docking"]["angle_deg"].get<double>(), 2) << " deg)";
     }
     if (!j["docking"].is_null() && j["docking"].value("after_restore", false)) std::cout << " after a restore";
     std::cout << "\ncollisions " << j["collisions"].size() << ", frames held " << j["held_frames"]
               << "; LCM log events " << j["log"]["events"] << "\n";
+    if (j["attempts"].size() > 1) {
+      std::cout << "attempts: " << j["attempts"].size() << " (";
+      for (std::size_t i = 0; i < j["attempts"].size(); ++i) {
+        const auto& a = j["attempts"][i];
+        std::cout << (i ? "; " : "") << a["index"] << " from the " << a["started_by"].get<std::string>() << " at "
+                  << rms::HumanNumber(a["start_s"].get<double>()) << " s: " << a["outcome"].get<std::string>();
+      }
+      std::cout << ")\n";
+    }
     if (!j["control"].empty()) {
       std::map<std::string, int> n;
       for (const auto& c : j["control"]) ++n[c["command"].get<std::string>()];

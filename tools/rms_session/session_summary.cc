@@ -1,5 +1,6 @@
 #include "session_summary.h"
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <lcm/lcm-cpp.hpp>
@@ -27,6 +28,7 @@
 #include "rms/process.h"
 #include "rms/sender_t.hpp"
 #include "rms/session_control_t.hpp"
+#include "rms/text.h"
 #include "rms/version.h"
 #include "attempts.h"
 #include "sender_check.h"
@@ -195,7 +197,7 @@ bool Agrees(const dcp_telemetry_t& t, const DcpFrameRecord& f) {
 // docking and the phases' boundaries (DCP frame numbers; -1: not reached).
 class TelemetryLog {
  public:
-  TelemetryLog() {
+  explicit TelemetryLog(double rate_hz = 30.0) : rate_hz_(rate_hz) {
     for (const char* name : kCollisionNames) totals_[name] = {0, 0, 0};
   }
   void Observe(const dcp_telemetry_t& m, std::int64_t t_us, std::int64_t first_us) {
@@ -213,7 +215,10 @@ class TelemetryLog {
     if (m.mode == 3 && m.probe_in_envelope && f_envelope < 0) f_envelope = m.frame;
     if (m.docked && f_docked < 0) f_docked = m.frame;
     if (m.mode != last_mode_) {
-      if (last_mode_ != 0) mode_changes.push_back({{"frame", m.frame}, {"time_s", t_s}, {"from", last_mode_}, {"to", m.mode}});
+      if (last_mode_ != 0) {
+        mode_changes.push_back({{"frame", m.frame}, {"time_s", m.input_frame / rate_hz_}, {"log_time_s", t_s},
+                                {"from", last_mode_}, {"to", m.mode}});
+      }
       last_mode_ = m.mode;
     }
     acquired = acquired || m.acquired;
@@ -280,6 +285,7 @@ class TelemetryLog {
   std::uint32_t last_bits_ = 0;
   int last_mode_ = 0;
   std::int64_t frames_ = 0, prev_us_ = 0;
+  double rate_hz_;
 };
 
 // Each process's runs (a restart after a fault is a new pid): the last
@@ -403,6 +409,7 @@ LogScan ScanLog(SessionLog& log, const std::map<std::int64_t, DcpFrameRecord>& d
   LogScan s;
   s.attempts = attempts;
   s.rate_hz = log.frame_rate_hz();
+  s.telemetry = TelemetryLog(s.rate_hz);
   SenderCheck* check = &log.check();
   log.Read({}, [&](const LogMessage& ev) {
     if (s.first_us < 0) s.first_us = log.first_us();
@@ -625,6 +632,20 @@ nlohmann::ordered_json LogJson(const LogScan& s) {
 
 }  // namespace
 
+// Every number to 9 significant digits, so the summary reads 20.9 and not
+// 20.899999999999999 (its times are whole microseconds; docs/sessions.md
+// "summary.json").
+static void ForPeople(nlohmann::ordered_json* j) {
+  if (j->is_number_float()) {
+    const double v = j->get<double>();
+    if (std::isfinite(v)) *j = std::strtod(Sprintf("%.9g", v).c_str(), nullptr);
+    return;
+  }
+  if (j->is_structured()) {
+    for (auto& child : *j) ForPeople(&child);
+  }
+}
+
 nlohmann::ordered_json Summarize(const std::string& dir) {
   const fs::path root(dir);
   SessionLog first_pass(dir);
@@ -711,6 +732,7 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
     if (st.value("from_log", false)) j["log"]["stats_from_log"].push_back(p);
   }
   j["ignored"] = check.Json();
+  ForPeople(&j);
   return j;
 }
 
