@@ -200,6 +200,7 @@ void OperatorStation::OnControl(const void* data, int size, std::int64_t) {
     case session_control_t::RUN:
       if (frozen_) spdlog::info("running again");
       frozen_ = false;
+      counters_.Add("control.runs");
       steps_pending_ = 0;
       break;
     case session_control_t::STEP:

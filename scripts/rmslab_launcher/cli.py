@@ -1,14 +1,16 @@
 """scripts/lab: lab sessions (docs/sessions.md).
 
   scripts/lab demo [--out DIR] [--timeline FILE | --by-hand [--bindings FILE]] [--autopilot-straight]
+                   [--subject NAME] [--note TEXT]
                    [--restore CHECKPOINT] [--lab LABFILE] [--config FILE] [--speed X]
                    [--png-every N] [--width W] [--height H] [--no-video] [--window]
                    [--gl osmesa|egl] [--visibility priority|depth]
                    [--lcm-url URL] [--channel-suffix S] [--share-network] [--no-build]
   scripts/lab replay SESSION [options]       scene and ESG driven from the log: frames, video
   scripts/lab resim SESSION [--config FILE]  the DCP again on the recorded inputs
-  scripts/lab export SESSION                 every channel to CSV
+  scripts/lab export SESSION [--mcap]        every channel to CSV, or the log as MCAP
   scripts/lab report SESSION                 one self-contained HTML report
+  scripts/lab compare SESSION...             scorecards side by side, learning curves
   scripts/lab monitor [--lcm-url URL]        live decoded traffic per channel
   scripts/lab control [--session DIR] freeze|run|step [N]|checkpoint NAME|restore NAME|FILE [--run]
 
@@ -41,7 +43,7 @@ def main(argv):
             return demo.run(rest, "scripts/lab demo " + " ".join(rest))
         if cmd == "replay":
             return replay.run(rest)
-        if cmd in ("resim", "export", "report", "monitor", "control"):
+        if cmd in ("resim", "export", "report", "compare", "monitor", "control"):
             return getattr(tools, cmd)(rest)
         if cmd in ("help", "-h", "--help"):
             print(__doc__.split("\n", 2)[2])

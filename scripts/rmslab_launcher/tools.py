@@ -4,6 +4,7 @@ import argparse
 import json
 import os
 import subprocess
+import time
 
 from . import replay
 from .common import DEFAULT_URL, ROOT, LabError, binary, install_and_build, say
@@ -100,6 +101,26 @@ def report(argv):
         return 0 if argv else 2
     ensure("tools/rms_report")
     return subprocess.run([binary("tools/rms_report")] + argv).returncode
+
+
+def compare(argv):
+    """scripts/lab compare SESSION... [--out DIR]: the scorecard of each
+    session side by side, and each subject's learning curve across the
+    sessions it flew (scripts/lab demo --subject NAME), as DIR/compare.html
+    (self-contained, plots by Chart.js) and DIR/compare.csv (a row an
+    attempt); default DIR: sessions/compare-<UTC time>. Re-simulations
+    (scripts/lab resim --config) are sessions of their own in it."""
+    p = argparse.ArgumentParser(prog="scripts/lab compare", description=compare.__doc__)
+    p.add_argument("sessions", nargs="+")
+    p.add_argument("--out")
+    p.add_argument("--no-build", action="store_true")
+    a = p.parse_args(argv)
+    for s in a.sessions:
+        if not os.path.isfile(os.path.join(s, "lcmlog")):
+            raise LabError(f"{s}: not a session folder (no lcmlog)", 2)
+    ensure("tools/rms_compare", a.no_build)
+    out = a.out or os.path.join(ROOT, "sessions", "compare-" + time.strftime("%Y%m%dT%H%M%SZ", time.gmtime()))
+    return subprocess.run([binary("tools/rms_compare")] + a.sessions + ["--out", out]).returncode
 
 
 def monitor(argv):

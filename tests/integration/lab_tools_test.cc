@@ -45,7 +45,7 @@ class RecordedSession : public ::testing::Test {
     tmp_ = new std::string(testing::MakeTempDir("recorded"));
     dir_ = new std::string(*tmp_ + "/session");
     const ScriptRun r = Script({SourcePath("scripts/lab"), "demo", "--no-build", "--out", *dir_, "--speed", "4", "--lcm-url",
-                          testing::UniqueLcmUrl(9100), "--png-every", "0", "--width", "160", "--height", "120"},
+                          testing::UniqueLcmUrl(9100), "--png-every", "200", "--width", "160", "--height", "120"},
                          *tmp_ + "/lab.log");
     ASSERT_EQ(r.rc, 0) << r.out;
   }
@@ -192,19 +192,22 @@ TEST_F(RecordedSession, ItsReportOpensInABrowserWithPlots) {
   const ScriptRun r = Script({SourcePath("scripts/lab"), "report", *dir_, "--out", *tmp_ + "/report.html"}, *tmp_ + "/report.log");
   ASSERT_EQ(r.rc, 0) << r.out;
   const std::string html = ReadFile(*tmp_ + "/report.html");
-  for (const char* want : {"Phase durations", "Collisions", "docking miss distance", "Losses",
+  for (const char* want : {"<h2>Attempts</h2>", "The operator's scorecard", "docked at, ft", "Losses",
                            "lost by the record: RMS_DCP_FRAME", "refused by the processes: late",
-                           "Frame times and latency", "Mode timeline", "Chart.js v3"}) {
+                           "Frame times and latency", "The configuration's tolerances", "Chart.js v3",
+                           "data:image/png;base64,"}) {
     EXPECT_NE(html.find(want), std::string::npos) << want;
   }
   EXPECT_EQ(html.find("<script src="), std::string::npos) << "not self-contained";
-  // A real browser: headless Chromium draws the four charts.
+  EXPECT_EQ(html.find("<pre>"), std::string::npos) << "raw JSON in the report";
+  // A real browser: headless Chromium draws the charts (path top and side,
+  // joints, distance to goal, timeline; no inputs plot for the autopilot).
   Subprocess chrome({"/usr/bin/chromium", "--headless=new", "--no-sandbox", "--disable-gpu", "--virtual-time-budget=5000",
                      "--dump-dom", "file://" + *tmp_ + "/report.html"},
                     *tmp_ + "/dom.html");
   ASSERT_EQ(chrome.Wait(120), 0) << ReadFile(*tmp_ + "/dom.html").substr(0, 2000);
   const std::string dom = ReadFile(*tmp_ + "/dom.html");
-  EXPECT_NE(dom.find("data-charts-rendered=\"4\""), std::string::npos)
+  EXPECT_NE(dom.find("data-charts-rendered=\"5\""), std::string::npos)
       << "charts not drawn: " << dom.substr(dom.find("<body"), 200);
 }
 

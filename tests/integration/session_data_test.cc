@@ -13,6 +13,8 @@
 #include <fstream>
 #include <lcm/lcm-cpp.hpp>
 #include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
 #include <thread>
 
 #include "lab_processes.h"
@@ -200,6 +202,153 @@ TEST_F(HandFlownSession, ALogWithoutTheDcpsStateSaysWhatIsMissing) {
   const ScriptRun r = Script({SourcePath("scripts/lab"), "resim", bare, "--no-build"}, *tmp_ + "/bare.log", 120);
   EXPECT_NE(r.rc, 0) << r.out;
   EXPECT_NE(r.out.find("holds no RMS_DCP_STATE"), std::string::npos) << r.out;
+}
+
+// The DOM a real browser (headless Chromium) makes of a page, its scripts run.
+std::string BrowserDom(const std::string& page, const std::string& out) {
+  Subprocess chrome({"/usr/bin/chromium", "--headless=new", "--no-sandbox", "--disable-gpu",
+                     "--virtual-time-budget=8000", "--dump-dom", "file://" + page},
+                    out);
+  EXPECT_EQ(chrome.Wait(120), 0);
+  return ReadFile(out);
+}
+
+int ChartsRendered(const std::string& dom) {
+  const auto at = dom.find("data-charts-rendered=\"");
+  return at == std::string::npos ? -1 : std::atoi(dom.c_str() + at + 22);
+}
+
+// The report's embedded data (window.RMS_REPORT = {...};).
+nlohmann::json ReportData(const std::string& html) {
+  const std::string key = "window.RMS_REPORT = ";
+  const auto a = html.find(key);
+  if (a == std::string::npos) return nullptr;
+  const auto b = html.find(";\n</script>", a);
+  std::string j = html.substr(a + key.size(), b - a - key.size());
+  for (std::size_t p = j.find("<\\/"); p != std::string::npos; p = j.find("<\\/", p)) j.replace(p, 3, "</");
+  return nlohmann::json::parse(j);
+}
+
+TEST_F(HandFlownSession, ItsReportShowsEveryAttemptThePathAndTheTimeline) {
+  const std::string page = *tmp_ + "/report.html";
+  const ScriptRun r = Script({SourcePath("scripts/lab"), "report", *out_, "--out", page}, *tmp_ + "/report.log", 120);
+  ASSERT_EQ(r.rc, 0) << r.out;
+  const std::string html = ReadFile(page);
+  for (const char* want : {"<h2>Attempts</h2>", "The operator's scorecard", "The configuration's tolerances",
+                           "<td>reset</td>", "<td>restore", "ann", "first try", "Frames", "Losses and refusals"}) {
+    EXPECT_NE(html.find(want), std::string::npos) << want;
+  }
+  EXPECT_EQ(html.find("<pre>"), std::string::npos) << "raw JSON in the report";
+  EXPECT_EQ(html.find("<script src="), std::string::npos) << "not self-contained";
+  const nlohmann::json d = ReportData(html);
+  ASSERT_TRUE(d.is_object());
+  const auto& goal = d["series"]["distance_to_goal_ft"];
+  ASSERT_GT(goal.size(), 10u);
+  for (const auto& g : goal) ASSERT_GE(g.get<double>(), 0.0) << "a signed distance";
+  ASSERT_EQ(d["series"]["p_ft"].size(), goal.size());
+  EXPECT_TRUE(d["series"]["inputs"].is_object()) << "by hand: the inputs are plotted";
+  std::set<std::string> kinds;
+  for (const auto& e : d["events"]) kinds.insert(e["kind"].get<std::string>());
+  for (const char* k : {"reset", "restore", "freeze", "restart"}) EXPECT_TRUE(kinds.count(k)) << k << " not in the timeline";
+  EXPECT_GE(d["attempts"].size(), 3u);
+  const std::string dom = BrowserDom(page, *tmp_ + "/report_dom.html");
+  EXPECT_GE(ChartsRendered(dom), 6) << dom.substr(0, 1500);
+  for (const char* want : {"End effector path", "Joint angles", "Operator inputs", "Event timeline"}) {
+    EXPECT_NE(dom.find(want), std::string::npos) << want;
+  }
+}
+
+TEST_F(HandFlownSession, CompareShowsTheSubjectsLearningCurveAndAReSimulationApart) {
+  // A second session of the same subject (a timeline), and the first flown
+  // again with another design (a re-simulation: a session of its own).
+  const std::string second = *tmp_ + "/second";
+  const ScriptRun s2 = Script({SourcePath("scripts/lab"), "demo", "--no-build", "--out", second, "--timeline",
+                               SourcePath("scripts/timelines/short.tl"), "--lcm-url", testing::UniqueLcmUrl(9750),
+                               "--png-every", "0", "--no-video", "--width", "160", "--height", "120", "--subject", "ann"},
+                              *tmp_ + "/second.log", 120);
+  ASSERT_EQ(s2.rc, 0) << s2.out;
+  const std::string wide = *tmp_ + "/wide.toml";
+  {
+    std::string cfg = ReadFile(*out_ + "/config.toml");
+    const auto at = cfg.find("dock_distance_ft");
+    ASSERT_NE(at, std::string::npos);
+    cfg.replace(at, cfg.find('\n', at) - at, "dock_distance_ft = 0.5");
+    std::ofstream(wide) << cfg;
+  }
+  const ScriptRun rs = Script({SourcePath("scripts/lab"), "resim", *out_, "--no-build", "--config", wide, "--out",
+                               *tmp_ + "/wide"}, *tmp_ + "/wide.log", 120);
+  ASSERT_EQ(rs.rc, 0) << rs.out;
+  const ScriptRun c = Script({SourcePath("scripts/lab"), "compare", *out_, second, *tmp_ + "/wide", "--no-build",
+                              "--out", *tmp_ + "/compare"}, *tmp_ + "/compare.log", 120);
+  ASSERT_EQ(c.rc, 0) << c.out;
+  const std::string csv = ReadFile(*tmp_ + "/compare/compare.csv");
+  std::istringstream rows(csv);
+  std::string line;
+  std::getline(rows, line);
+  EXPECT_NE(line.find("task_time_s"), std::string::npos) << line;
+  int hand_rows = 0, second_rows = 0, resim_rows = 0;
+  while (std::getline(rows, line)) {
+    hand_rows += line.rfind("session,", 0) == 0;
+    second_rows += line.rfind("second,", 0) == 0;
+    resim_rows += line.rfind("wide,", 0) == 0 && line.find("re-simulation") != std::string::npos;
+  }
+  const auto summary = nlohmann::json::parse(ReadFile(*out_ + "/summary.json"));
+  EXPECT_EQ(hand_rows, static_cast<int>(summary["attempts"].size())) << csv;  // a row an attempt
+  EXPECT_EQ(second_rows, 1) << csv;
+  EXPECT_EQ(resim_rows, hand_rows) << csv;
+  const std::string html = ReadFile(*tmp_ + "/compare/compare.html");
+  const auto a = html.find("window.RMS_COMPARE = ");
+  ASSERT_NE(a, std::string::npos);
+  const auto data = nlohmann::json::parse(html.substr(a + 21, html.find(";\n</script>", a) - a - 21));
+  ASSERT_TRUE(data["subjects"].contains("ann")) << data["subjects"].dump();
+  EXPECT_EQ(data["subjects"]["ann"].size(), 2u) << "the subject's two sessions, not the re-simulation";
+  const std::string dom = BrowserDom(*tmp_ + "/compare/compare.html", *tmp_ + "/compare_dom.html");
+  EXPECT_GE(ChartsRendered(dom), 2) << dom.substr(0, 1500);
+}
+
+TEST_F(HandFlownSession, ItsMcapExportHoldsEveryMessageAndEachMatchesItsSchema) {
+  const std::string mcap = *tmp_ + "/session.mcap";
+  const ScriptRun r = Script({SourcePath("scripts/lab"), "export", *out_, "--mcap", "--out", mcap, "--no-build"},
+                             *tmp_ + "/mcap.log", 120);
+  ASSERT_EQ(r.rc, 0) << r.out;
+  // Read back with the MCAP library, every message validated against its
+  // channel's JSON schema (tools/rms_mcap/check_mcap.mjs: @mcap/core, ajv).
+  Subprocess check({"/usr/bin/node", SourcePath("tools/rms_mcap/check_mcap.mjs"), mcap}, *tmp_ + "/mcap_check.log");
+  ASSERT_EQ(check.Wait(120), 0) << ReadFile(*tmp_ + "/mcap_check.log");
+  const std::string out = ReadFile(*tmp_ + "/mcap_check.log");
+  const auto j = nlohmann::json::parse(out.substr(out.find('{'), out.rfind('}') - out.find('{') + 1));
+  EXPECT_EQ(j["invalid"], 0);
+  const auto summary = nlohmann::json::parse(ReadFile(*out_ + "/summary.json"));
+  for (const char* ch : {"RMS_OPERATOR_INPUT", "RMS_OPERATOR_STATE", "RMS_DCP_FRAME", "RMS_DCP_TELEMETRY",
+                         "RMS_DCP_STATE", "RMS_ESG_FRAME", "RMS_STATUS", "RMS_CONTROL"}) {
+    ASSERT_TRUE(j["channels"].contains(ch)) << ch << ": " << out;
+    EXPECT_EQ(j["channels"][ch], summary["log"]["by_channel"][ch]) << ch;
+  }
+}
+
+TEST(CommandLines, UsageErrorsExitTwoAndAControlCommandNobodyAnswersFails) {
+  const std::string tmp = testing::MakeTempDir("cli");
+  for (const std::vector<std::string>& cmd :
+       {std::vector<std::string>{testing::BuildPath("tools/rms_resim"), "--bogus"},
+        {testing::BuildPath("tools/rms_session"), "bogus"},
+        {testing::BuildPath("tools/rms_report")},
+        {testing::BuildPath("tools/rms_compare")},
+        {testing::BuildPath("tools/rms_control"), "--bogus", "freeze"},
+        {testing::BuildPath("dynamics_proc/dynamics_proc"), "--bogus"},
+        {SourcePath("scripts/lab"), "export"},
+        {SourcePath("scripts/lab"), "compare"},
+        {SourcePath("scripts/lab"), "resim"},
+        {SourcePath("scripts/lab"), "nonsense"}}) {
+    const ScriptRun r = Script(cmd, tmp + "/usage.log", 60);
+    EXPECT_EQ(r.rc, 2) << cmd[0] << " " << cmd[1 % cmd.size()] << ": " << r.out;
+  }
+  const ScriptRun h = Script({testing::BuildPath("tools/rms_resim"), "--help"}, tmp + "/help.log", 60);
+  EXPECT_EQ(h.rc, 0);
+  const ScriptRun c = Script({SourcePath("scripts/lab"), "control", "--lcm-url", testing::UniqueLcmUrl(9790),
+                              "--session-id", "0x0000000000000777", "freeze"}, tmp + "/nobody.log", 60);
+  EXPECT_EQ(c.rc, 1) << c.out;
+  EXPECT_NE(c.out.find("no operator station of session"), std::string::npos) << c.out;
+  fs::remove_all(tmp);
 }
 
 }  // namespace

@@ -415,6 +415,9 @@ void TakeState(const dcp_state_t& m, bool first, bool other_design, dcp::DcpNode
   }
   node->ApplyState(m, first || !(other_design && m.reason == dcp_state_t::RESUME));
   ++result->states_taken;
+  // Into the new session's log too, so it can be re-simulated and its
+  // summary sees the same restores (its attempts).
+  node->PublishState(m.reason == dcp_state_t::PERIODIC ? dcp_state_t::START : m.reason);
 }
 
 }  // namespace

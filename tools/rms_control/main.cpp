@@ -80,9 +80,10 @@ class ControlLink {
     lcm_.SetSender({session_id, rms::sender_t::PROCESS_CONTROL, static_cast<std::int32_t>(getpid())});
     lcm_.Subscribe(rms::channels::kStatus, [this](const void* d, int n, std::int64_t) {
       rms::process_status_t st;
-      if (rms::SafeDecode(d, n, 1 << 20, &st) != rms::DecodeError::kNone || st.process != "dynamics_proc") return;
-      for (int i = 0; i < st.num_counters; ++i) dcp_counts_[st.counter_names[i]] = st.counter_values[i];
-      ++dcp_reports_;
+      if (rms::SafeDecode(d, n, 1 << 20, &st) != rms::DecodeError::kNone) return;
+      auto& counts = counts_[st.process];
+      for (int i = 0; i < st.num_counters; ++i) counts[st.counter_names[i]] = st.counter_values[i];
+      ++reports_[st.process];
     });
   }
   void Send(std::int8_t command, const std::string& name = "") {
@@ -99,22 +100,63 @@ class ControlLink {
     while (std::chrono::steady_clock::now() < end && !done()) lcm_.HandleSubscriptions(50);
     return done();
   }
-  // Waits (up to 1.5 s) for a first report of the DCP's counts.
-  void WaitForCounts() {
-    ListenUntil(1.5, [this] { return dcp_reports_ > 0; });
+  // Waits (up to 2.5 s: they report once a second) for a first report of
+  // `process`'s counts; false if none came (nobody there to answer).
+  bool WaitForCounts(const std::string& process = "dynamics_proc") {
+    return ListenUntil(2.5, [&] { return reports(process) > 0; });
   }
-  std::int64_t Count(const char* k) const {
-    const auto it = dcp_counts_.find(k);
-    return it == dcp_counts_.end() ? 0 : it->second;
+  std::int64_t Count(const char* k, const std::string& process = "dynamics_proc") const {
+    const auto p = counts_.find(process);
+    if (p == counts_.end()) return 0;
+    const auto it = p->second.find(k);
+    return it == p->second.end() ? 0 : it->second;
   }
-  int reports() const { return dcp_reports_; }
+  int reports(const std::string& process = "dynamics_proc") const {
+    const auto it = reports_.find(process);
+    return it == reports_.end() ? 0 : it->second;
+  }
 
  private:
   rms::UdpLcm lcm_;
   std::int64_t sequence_ = 0;
-  std::map<std::string, std::int64_t> dcp_counts_;
-  int dcp_reports_ = 0;
+  std::map<std::string, std::map<std::string, std::int64_t>> counts_;  // by process
+  std::map<std::string, int> reports_;
 };
+
+void SayWhereSent(const rms::LcmOptions& options, std::int64_t id);
+
+// Nobody answered: said, and a failure (docs/sessions.md "Command lines").
+int NobodyThere(const rms::LcmOptions& options, std::int64_t id, const char* process) {
+  std::fprintf(stderr,
+               "rms_control: no %s of session %s is running on %s%s (no status report heard in 2.5 s): nothing "
+               "was sent\n",
+               process, id ? rms::FormatSessionId(id).c_str() : "(none)", options.url.c_str(),
+               options.channel_suffix.empty() ? "" : (" with suffix " + options.channel_suffix).c_str());
+  return 1;
+}
+
+// FREEZE, RUN, STEP: confirmed by the operator station's counts (it is the
+// session's clock).
+int Clock(ControlLink& link, std::int8_t command, int steps, const rms::LcmOptions& options, std::int64_t id) {
+  const char* what = command == rms::session_control_t::FREEZE ? "control.freezes"
+                     : command == rms::session_control_t::RUN  ? "control.runs"
+                                                               : "control.steps";
+  if (!link.WaitForCounts("operator_station")) return NobodyThere(options, id, "operator station");
+  const std::int64_t before = link.Count(what, "operator_station");
+  for (int i = 0; i < steps; ++i) link.Send(command);
+  SayWhereSent(options, id);
+  const int seen = link.reports("operator_station");
+  const bool done = link.ListenUntil(3.0, [&] {
+    return link.reports("operator_station") > seen && link.Count(what, "operator_station") >= before + steps;
+  });
+  if (!done) {
+    std::fprintf(stderr, "rms_control: the operator station did not confirm the command within 3 s (see the "
+                         "session's logs/operator_station.log)\n");
+    return 1;
+  }
+  std::printf("done (the operator station confirms)\n");
+  return 0;
+}
 
 void SayWhereSent(const rms::LcmOptions& options, std::int64_t id) {
   std::printf("sent to %s%s, session %s\n", options.url.c_str(),
@@ -126,12 +168,23 @@ void SayWhereSent(const rms::LcmOptions& options, std::int64_t id) {
 // file within a frame or two, or its counts say it refused.
 int Checkpoint(ControlLink& link, const std::string& name, const std::string& folder, const rms::LcmOptions& options,
                std::int64_t id) {
-  link.WaitForCounts();
+  if (!link.WaitForCounts()) return NobodyThere(options, id, "dynamics_proc");
+  const std::int64_t saved0 = link.Count("control.checkpoints");
   auto refusals = [&link] { return link.Count("control.refused") + link.Count("control.rate_limited"); };
   const std::int64_t refused0 = refusals();
   link.Send(rms::session_control_t::CHECKPOINT, name);
   SayWhereSent(options, id);
-  if (folder.empty()) return 0;
+  if (folder.empty()) {  // no folder to look in: the DCP's counts say
+    const int seen0 = link.reports();
+    link.ListenUntil(3.0, [&] { return link.reports() > seen0 && link.Count("control.checkpoints") + refusals() > saved0 + refused0; });
+    if (link.Count("control.checkpoints") > saved0) {
+      std::printf("saved %s (dynamics_proc confirms)\n", name.c_str());
+      return 0;
+    }
+    std::fprintf(stderr, "rms_control: dynamics_proc did not save checkpoint %s (%s)\n", name.c_str(),
+                 refusals() > refused0 ? "refused" : "no word from it within 3 s");
+    return 1;
+  }
   const fs::path p = fs::path(folder) / name;
   const int seen = link.reports();
   link.ListenUntil(3.0, [&] { return fs::exists(p) || (link.reports() > seen && refusals() > refused0); });
@@ -153,7 +206,7 @@ int Checkpoint(ControlLink& link, const std::string& name, const std::string& fo
 int Restore(ControlLink& link, const std::string& name, bool then_run, const rms::LcmOptions& options,
             std::int64_t id) {
   auto pause = [] { std::this_thread::sleep_for(std::chrono::milliseconds(300)); };
-  link.WaitForCounts();
+  if (!link.WaitForCounts()) return NobodyThere(options, id, "dynamics_proc");
   const std::int64_t restores0 = link.Count("control.restores"), refused0 = link.Count("control.refused"),
                      limited0 = link.Count("control.rate_limited");
   link.Send(rms::session_control_t::FREEZE);
@@ -164,10 +217,6 @@ int Restore(ControlLink& link, const std::string& name, bool then_run, const rms
     link.Send(rms::session_control_t::RUN);
   }
   SayWhereSent(options, id);
-  if (link.reports() == 0) {
-    std::printf("restore sent (not confirmed: no status report from dynamics_proc heard)\n");
-    return 0;
-  }
   const int seen = link.reports();
   link.ListenUntil(3.0, [&] {
     return link.reports() > seen && (link.Count("control.restores") > restores0 ||
@@ -237,13 +286,9 @@ int main(int argc, char** argv) {
     ControlLink link(lcm_options, id);
     if (checkpoint->parsed()) return Checkpoint(link, name, folder, lcm_options, id);
     if (restore->parsed()) return Restore(link, name, then_run, lcm_options, id);
-    if (freeze->parsed()) link.Send(rms::session_control_t::FREEZE);
-    if (run->parsed()) link.Send(rms::session_control_t::RUN);
-    if (step->parsed()) {
-      for (int i = 0; i < steps; ++i) link.Send(rms::session_control_t::STEP);
-    }
-    SayWhereSent(lcm_options, id);
-    return 0;
+    if (freeze->parsed()) return Clock(link, rms::session_control_t::FREEZE, 1, lcm_options, id);
+    if (run->parsed()) return Clock(link, rms::session_control_t::RUN, 1, lcm_options, id);
+    return Clock(link, rms::session_control_t::STEP, steps, lcm_options, id);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rms_control: %s\n", e.what());
     return 2;
