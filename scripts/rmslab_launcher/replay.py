@@ -45,7 +45,8 @@ class Replay:
         shutil.copyfile(os.path.join(self.src, "config.toml"), os.path.join(self.out, "config.toml"))
         with open(os.path.join(self.out, "run", "pilot"), "w") as f:
             f.write("replay\n")
-        fields = [("--pilot", "replay"), ("--lcm-url", a.lcm_url), ("--command", f"scripts/lab replay {self.src}")]
+        fields = [("--pilot", "replay"), ("--lcm-url", a.lcm_url), ("--command", f"scripts/lab replay {self.src}"),
+                  ("--kind", "replay"), ("--parent", os.path.abspath(self.src))]
         if self.suffix:
             fields.append(("--channel-suffix", self.suffix))
         if self.session_id:

@@ -32,47 +32,51 @@
   // Tick label: the name, with a second line when the session never docked.
   const labelOf = (i) => (taskTime(sessions[i]) === null ? [nameOf(i), '(not docked)'] : nameOf(i));
 
-  // {subject: [session indices]}: the contract's map, else grouped by each session's subject.
+  // {subject: [session indices]} for the learning curves: the contract's map, else by each session's subject.
   function subjects() {
     const out = {};
     const given = C.subjects && typeof C.subjects === 'object' ? C.subjects : null;
-    if (given) {
-      Object.keys(given).forEach((k) => {
-        const idx = arr(given[k]).filter((i) => Number.isInteger(i) && i >= 0 && i < sessions.length);
-        if (idx.length) out[k] = idx;
-      });
-    }
-    const covered = new Set([].concat(...Object.values(out)));
+    Object.keys(given || {}).forEach((k) => {
+      const idx = arr(given[k]).filter((i) => Number.isInteger(i) && i >= 0 && i < sessions.length);
+      if (idx.length) out[k] = idx;
+    });
+    if (given) return out;
     sessions.forEach((s, i) => {
-      if (covered.has(i)) return;
-      const k = given ? '(no subject)' : String(s.subject || '(no subject)');
+      const k = String(s.subject || '(no subject)');
       (out[k] = out[k] || []).push(i);
     });
     return out;
   }
 
-  function section(title, height) {
-    const div = document.createElement('div');
-    div.className = 'rms-chart';
-    const h = document.createElement('h3');
-    h.textContent = title;
-    div.appendChild(h);
-    const box = document.createElement('div');
-    box.style.position = 'relative';
-    box.style.height = height + 'px';
-    const canvas = document.createElement('canvas');
-    box.appendChild(canvas);
-    div.appendChild(box);
-    document.getElementById('rms-charts').appendChild(div);
-    return canvas;
+  // The overall chart's groups: the subjects, then the sessions in none (re-simulations apart).
+  function groups(subs) {
+    const out = Object.assign({}, subs);
+    const covered = new Set([].concat(...Object.values(subs)));
+    sessions.forEach((s, i) => {
+      if (covered.has(i)) return;
+      const k = s.kind === 're-simulation' ? 're-simulations' : '(no subject)';
+      (out[k] = out[k] || []).push(i);
+    });
+    return out;
   }
 
-  function note(text) {
-    const p = document.createElement('p');
-    p.className = 'rms-chart-note';
-    p.textContent = text;
-    document.getElementById('rms-charts').appendChild(p);
+  // A new element with the given properties, appended to parent.
+  function el(tag, props, parent) {
+    const e = Object.assign(document.createElement(tag), props);
+    parent.appendChild(e);
+    return e;
   }
+
+  // A titled section holding a canvas of the given height.
+  function section(title, height) {
+    const div = el('div', { className: 'rms-chart' }, document.getElementById('rms-charts'));
+    el('h3', { textContent: title }, div);
+    const box = el('div', {}, div);
+    box.style.cssText = 'position:relative;height:' + height + 'px';
+    return el('canvas', {}, box);
+  }
+
+  const note = (text) => el('p', { className: 'rms-chart-note', textContent: text }, document.getElementById('rms-charts'));
 
   // Tooltip footer lines describing session i.
   function about(i) {
@@ -82,7 +86,7 @@
     if (s.subject) lines.push('subject: ' + s.subject);
     if (s.note) lines.push('note: ' + s.note);
     if (s.started_utc) lines.push('started: ' + s.started_utc + (s.kind ? ' (' + s.kind + ')' : ''));
-    lines.push('attempts: ' + arr(s.attempts).length + (b.outcome ? ', best: ' + b.outcome : ''));
+    lines.push('attempts: ' + arr(s.attempts).length + (b.outcome ? ', outcome: ' + b.outcome : ''));
     if (num(b.dock_distance_ft)) lines.push('dock miss: ' + b.dock_distance_ft.toFixed(3) + ' ft');
     if (num(b.dock_angle_deg)) lines.push('dock angle: ' + b.dock_angle_deg.toFixed(2) + ' deg');
     if (taskTime(s) === null) lines.push('not docked');
@@ -95,7 +99,7 @@
       interaction: { mode: 'index', intersect: false },
       scales: {
         x: { title: { display: true, text: 'session, in start order' } },
-        y: { beginAtZero: true, title: { display: true, text: 'task time, s' } },
+        y: { beginAtZero: true, grace: '8%', title: { display: true, text: 'task time, s' } },
       },
       plugins: {
         title: { display: true, text: title },
@@ -110,7 +114,7 @@
     const times = idx.map((i) => taskTime(sessions[i]));
     const cols = idx.map((i) => collisions(sessions[i]));
     const o = baseOptions(subject + ': task time of the best attempt per session (missing point = not docked)');
-    o.scales.y1 = { position: 'right', beginAtZero: true, display: 'auto', grid: { drawOnChartArea: false },
+    o.scales.y1 = { position: 'right', beginAtZero: true, grace: '8%', display: 'auto', grid: { drawOnChartArea: false },
       ticks: { precision: 0 }, title: { display: true, text: 'collisions' } };
     o.plugins.tooltip.callbacks.footer = (items) => (items.length ? about(idx[items[0].dataIndex]) : []);
     o.plugins.tooltip.callbacks.label = (c) => c.dataset.label.split(' (')[0] + ': ' +
@@ -135,6 +139,7 @@
     const o = baseOptions('Task time per session, coloured by subject (no bar = not docked)');
     o.interaction = { mode: 'nearest', intersect: true };
     o.plugins.tooltip.callbacks.footer = (items) => (items.length ? about(items[0].dataIndex) : []);
+    o.plugins.tooltip.callbacks.label = (c) => c.dataset.label + ': ' + c.raw + ' s';
     const ds = keys.map((k, n) => {
       const mine = new Set(subs[k]);
       return {
@@ -149,11 +154,7 @@
   }
 
   function main() {
-    if (!document.getElementById('rms-charts')) {
-      const div = document.createElement('div');
-      div.id = 'rms-charts';
-      document.body.appendChild(div);
-    }
+    if (!document.getElementById('rms-charts')) el('div', { id: 'rms-charts' }, document.body);
     const draw = (f) => {
       try { f(); } catch (e) { errors.push(String(e)); console.error('rms compare chart:', e); }
     };
@@ -162,7 +163,7 @@
     else {
       const subs = subjects();
       Object.keys(subs).forEach((k, n) => draw(() => learningCurve(k, subs[k], PALETTE[n % PALETTE.length])));
-      draw(() => overall(subs));
+      draw(() => overall(groups(subs)));
     }
     document.body.dataset.chartsRendered = String(made.length);
     if (errors.length) document.body.dataset.chartsError = errors.join('; ');

@@ -688,6 +688,9 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
   // The session's result (docs/sessions.md "summary.json"): its last
   // attempt that docked, or else its last attempt.
   {
+    j["result_attempt"] = nullptr;
+    j["phase_durations_s"] = nullptr;
+    j["docking"] = nullptr;
     nlohmann::ordered_json result = nullptr;
     for (const auto& a : j["attempts"]) {
       if (a["outcome"] == "docked" || result.is_null() || !(result["outcome"] == "docked")) result = a;
@@ -836,19 +839,17 @@ SessionInfo ReadSessionInfo(const std::string& dir) {
 }
 
 nlohmann::ordered_json CompareEsgFrames(const std::string& original_dir, const std::string& replay_dir) {
-  auto read = [](const fs::path& log_path) {
+  auto read = [](const std::string& dir) {
     std::map<std::int64_t, esg_frame_t> by_dcp;
-    lcm::LogFile log(log_path.string(), "r");
-    if (!log.good()) throw InputError("cannot read '" + log_path.string() + "'");
-    while (const lcm::LogEvent* ev = log.readNextEvent()) {
-      if (BaseChannel(ev->channel) != channels::kEsgFrame) continue;
+    SessionLog log(dir);  // each session's own ESG frames
+    log.Read({channels::kEsgFrame}, [&](const LogMessage& ev) {
       esg_frame_t m;
-      if (SafeDecode(ev->data, ev->datalen, 4096, &m) == DecodeError::kNone) by_dcp[m.dcp_frame] = m;
-    }
+      if (log.Decode(ev, &m)) by_dcp[m.dcp_frame] = m;
+    });
     return by_dcp;
   };
-  const auto a = read(fs::path(original_dir) / "lcmlog");
-  const auto b = read(fs::path(replay_dir) / "lcmlog");
+  const auto a = read(original_dir);
+  const auto b = read(replay_dir);
   std::int64_t identical = 0, missing = 0;
   std::string first;
   for (const auto& [dcp_frame, m] : a) {
