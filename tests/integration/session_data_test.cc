@@ -41,13 +41,16 @@ class CpuLoad {
     const long cores = std::max(1L, sysconf(_SC_NPROCESSORS_ONLN));
     for (long i = 0; i < cores; ++i) {
       busy_.push_back(std::make_unique<Subprocess>(
-          std::vector<std::string>{"/usr/bin/timeout", "600", "/bin/sh", "-c", "while :; do :; done"}, dir + "/busy.log"));
+          std::vector<std::string>{"/usr/bin/timeout", "300", "/bin/sh", "-c", "while :; do :; done"}, dir + "/busy.log"));
     }
     std::printf("CPU load: %ld busy processes\n", cores);
   }
+  // SIGTERM, which timeout passes on to its busy loop (a SIGKILL would end
+  // timeout alone and leave the loop running); timeout ends it anyway after
+  // 300 s if this process dies first.
   ~CpuLoad() {
     for (auto& b : busy_) {
-      b->Signal(SIGKILL);
+      b->Signal(SIGTERM);
       b->Wait(5);
     }
   }

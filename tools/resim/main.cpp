@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 #include "rms/command_line.h"
 #include <cstdio>
+#include <spdlog/spdlog.h>
 #include <unistd.h>
 
 #include "resim.h"
@@ -19,7 +20,11 @@ int main(int argc, char** argv) {
   app.add_option("--config", opt.config_path, "Another configuration (a different design)")->check(CLI::ExistingFile);
   app.add_option("--out", opt.out_dir, "With --config: the new session folder (default SESSION-resim)");
   app.add_flag("--quiet", quiet, "No progress lines (they go only to a terminal anyway)");
+  bool verbose = false;
+  app.add_flag("--verbose", verbose, "Also the DCP's own log lines (mode changes, collisions) as it re-flies");
   if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
+  // The re-flown DCP's log lines only when asked for: the result is the output.
+  spdlog::set_level(verbose ? spdlog::level::info : spdlog::level::warn);
   if (!quiet && isatty(STDERR_FILENO)) {  // progress only to a person at a terminal
     opt.progress = [](double f, const std::string& line) {
       std::fprintf(stderr, "resim: %3.0f%% %s\n", 100 * f, line.c_str());
