@@ -95,12 +95,21 @@ def export_mcap(session, out):
 
 def report(argv):
     """scripts/lab report SESSION [--out FILE]: one self-contained HTML report
-    (default SESSION/report.html) with plots drawn by Chart.js."""
-    if not argv or argv[0] in ("-h", "--help"):
-        print(report.__doc__)
-        return 0 if argv else 2
-    ensure("tools/rms_report")
-    return subprocess.run([binary("tools/rms_report")] + argv).returncode
+    (default SESSION/report.html): the session, its tolerances, every
+    attempt and the operator's scorecard, the end effector's path, joints,
+    inputs, an event timeline, frames and the video's link, losses and
+    timing; plots drawn by Chart.js, embedded."""
+    p = argparse.ArgumentParser(prog="scripts/lab report", description=report.__doc__)
+    p.add_argument("session")
+    p.add_argument("--out")
+    p.add_argument("--no-build", action="store_true")
+    a = p.parse_args(argv)
+    if not os.path.isfile(os.path.join(a.session, "lcmlog")):
+        raise LabError(f"{a.session}: not a session folder (no lcmlog)", 2)
+    if a.out and not os.path.isdir(os.path.dirname(os.path.abspath(a.out))):
+        raise LabError(f"--out {a.out}: its folder does not exist", 2)
+    ensure("tools/rms_report", a.no_build)
+    return subprocess.run([binary("tools/rms_report"), a.session] + (["--out", a.out] if a.out else [])).returncode
 
 
 def compare(argv):

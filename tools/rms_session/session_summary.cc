@@ -832,8 +832,10 @@ SessionInfo ReadSessionInfo(const std::string& dir) {
     if (j.contains("session_id")) s.session_id = ParseSessionId(j.at("session_id").get<std::string>(), p.string() + " session_id");
   } catch (const InputError&) {
     throw;
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(p.string() + ": not valid JSON (at byte " + std::to_string(e.byte) + "): not a session's manifest");
   } catch (const std::exception& e) {
-    throw InputError(p.string() + ": " + e.what());
+    throw InputError(p.string() + ": not a session's manifest (" + std::string(e.what()).substr(std::string(e.what()).find(']') + 1) + ")");
   }
   return s;
 }
