@@ -35,7 +35,7 @@ int main(int argc, char** argv) {
     std::printf("re-simulated %ld DCP frames in %.2f s (%.0f frames/s); %ld of %ld recorded frames identical%s\n",
                 r.frames, r.seconds, r.frames / std::max(r.seconds, 1e-9), r.identical, r.compared,
                 r.first_difference.empty() ? ", word for word" : "");
-    std::printf("timing: %.4f s in all (%.4f s reading the log, %.4f s running the DCP); the session lasted %.1f s: "
+    std::printf("timing: %.4f s in all (%.4f s reading the log, %.4f s running the DCP); the session lasted %.1f s of wall time: "
                 "%.0fx real time in all, %.0fx for the DCP's run\n",
                 r.seconds, r.read_seconds, r.run_seconds, r.recorded_seconds, r.recorded_seconds / std::max(r.seconds, 1e-9),
                 r.recorded_seconds / std::max(r.run_seconds, 1e-9));
@@ -43,6 +43,7 @@ int main(int argc, char** argv) {
       std::printf("the DCP's whole state agreed with the %ld states it logged along the way\n", r.states_checked);
     }
     if (!r.note.empty()) std::printf("note: %s\n", r.note.c_str());
+    if (!r.log_note.empty()) std::printf("note: %s\n", r.log_note.c_str());
     if (!r.first_difference.empty()) std::printf("first difference: %s\n", r.first_difference.c_str());
     if (!r.out_dir.empty()) {
       std::printf("new session: %s (summary.json, comparison.md)\n", r.out_dir.c_str());

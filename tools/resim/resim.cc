@@ -252,6 +252,8 @@ void Flatten(const toml::node& n, const std::string& prefix, std::map<std::strin
       os << *a;
       (*out)[prefix] = os.str();
     }
+  } else if (const auto* d = n.as_floating_point()) {
+    (*out)[prefix] = HumanNumber(d->get(), 9);  // 0.6, not 0.59999999999999998
   } else {
     std::ostringstream os;
     n.visit([&](auto&& v) { os << v; });
@@ -425,6 +427,7 @@ void TakeState(const dcp_state_t& m, bool first, bool other_design, dcp::DcpNode
 ResimResult Resimulate(const ResimOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();
   const fs::path session(opt.session);
+  if (!fs::exists(session / "lcmlog")) throw InputError(opt.session + ": not a session folder (no lcmlog)");
   const bool other_design = !opt.config_path.empty();
   const std::string config_path = other_design ? opt.config_path : (session / "config.toml").string();
   const LabConfig config = LoadConfig(config_path);
@@ -438,6 +441,10 @@ ResimResult Resimulate(const ResimOptions& opt) {
   const auto t_read = std::chrono::steady_clock::now();
 
   ResimResult result;
+  if (log.unread_bytes() > 0) {
+    result.log_note = "the log ends in " + std::to_string(log.unread_bytes()) +
+                      " bytes that are no whole event (it was cut short or damaged there): re-simulated up to them";
+  }
   result.note = plan.note;
   result.skipped = static_cast<long>(plan.first);
   std::string out_log;

@@ -28,6 +28,7 @@ struct ResimResult {
   std::string first_difference;  // where they first differ ("" if nowhere)
   long skipped = 0;            // recorded DCP frames not re-simulated (the log lacks the state before them)
   std::string note;            // ... said in words ("" if none)
+  std::string log_note;        // the log's end is no whole event ("" if it is)
   long states_taken = 0;       // logged RMS_DCP_STATE taken (start, restores, resumes)
   long states_checked = 0;     // periodic RMS_DCP_STATE the re-simulated state was checked against
   std::string state_difference;  // the first of those that differed ("" if none)

@@ -40,8 +40,11 @@ Session Load(const std::string& dir) {
       s.started_utc = m.value("started_utc", "");
       s.started_us = m.value("started_us", std::int64_t{0});
       s.parent = m.value("resimulation_of", "");
+    } catch (const nlohmann::json::parse_error& e) {
+      throw InputError(dir + "/manifest.json: not valid JSON (at byte " + std::to_string(e.byte) +
+                       "): not a session's manifest");
     } catch (const std::exception& e) {
-      throw InputError(dir + "/manifest.json: " + e.what());
+      throw InputError(dir + "/manifest.json: not a session's manifest");
     }
   }
   s.summary = session::Summarize(dir);

@@ -6,6 +6,7 @@
 
 #include "compare.h"
 #include "report.h"
+#include "rms/check.h"
 #include "rms/command_line.h"
 #include "rms/text.h"
 
@@ -25,6 +26,9 @@ int main(int argc, char** argv) {
     rms::WriteWholeFile(out + "/compare.csv", c.csv);
     std::cout << out << "/compare.html\n" << out << "/compare.csv\n";
     return 0;
+  } catch (const rms::InputError& e) {  // a folder that is no session, a bad manifest
+    std::cerr << "rms_compare: " << e.what() << "\n";
+    return 2;
   } catch (const std::exception& e) {
     std::cerr << "rms_compare: " << e.what() << "\n";
     return 1;

@@ -23,7 +23,7 @@
 #include "rms/text.h"
 #include "session_log.h"
 #include "session_summary.h"
-#include <Eigen/Core>
+#include <Eigen/Dense>
 #include <array>
 #include <functional>
 #include <set>
@@ -111,10 +111,15 @@ struct TraceReader {
     }
     return n;
   }
-  // The unsigned distance to the mode's goal: Mode 1 point A to the grasp
-  // (the BAR's face c centre, over TPOB), Modes 2-3 the probe's tip to the port.
+  // The unsigned distance to the mode's goal: Mode 1 point A to the BAR's
+  // centre (where the grasp is), Modes 2-3 the probe's tip to the port.
   double Goal(const dcp_telemetry_t& m) const {
-    return m.mode == 1 ? std::abs(m.palm_to_bar_ft) : std::abs(m.dock_distance_ft);
+    if (m.mode != 1) return std::abs(m.dock_distance_ft);
+    Eigen::Matrix3d R_RP;
+    for (int i = 0; i < 9; ++i) R_RP(i / 3, i % 3) = m.R_RP[i];
+    const Eigen::Vector3d bar = Eigen::Vector3d(m.p_RoPo_R_ft[0], m.p_RoPo_R_ft[1], m.p_RoPo_R_ft[2]) +
+                                R_RP * config.payload.p_PoBar_P_ft;
+    return (Eigen::Vector3d(m.p_RoA_R_ft[0], m.p_RoA_R_ft[1], m.p_RoA_R_ft[2]) - bar).norm();
   }
   void Telemetry(const dcp_telemetry_t& m, double t_s) {
     ++t.frames;
@@ -317,7 +322,7 @@ std::string SessionSection(const nlohmann::ordered_json& m, const nlohmann::orde
     for (const auto& [p, host] : m["hosts"].items()) hosts += (hosts.empty() ? "" : ", ") + p + " on " + host.get<std::string>();
     field("hosts", hosts);
   }
-  field("wall time", s.value("duration_s", nlohmann::ordered_json()));
+  if (s.contains("duration_s")) h << Row("wall time", {Cell(s["duration_s"], " s", 1)});
   h << "</table>\n";
   return h.str();
 }

@@ -1,6 +1,7 @@
 #include "session_log.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <lcm/lcm-cpp.hpp>
 
@@ -50,7 +51,9 @@ void SessionLog::Read(std::initializer_list<std::string_view> channels,
   events_ = 0;
   first_us_ = last_us_ = -1;
   std::int64_t input_frame = -1;
+  long good_end = 0;  // where the last whole event ends
   while (const lcm::LogEvent* ev = log.readNextEvent()) {
+    good_end = std::ftell(log.getFilePtr());
     ++events_;
     if (first_us_ < 0) first_us_ = ev->timestamp;
     last_us_ = ev->timestamp;
@@ -79,6 +82,10 @@ void SessionLog::Read(std::initializer_list<std::string_view> channels,
     m.size = ev->datalen;
     visit(m);
   }
+  const long at = good_end;
+  std::error_code ec;
+  const auto size = fs::file_size(log_path_, ec);
+  unread_bytes_ = (at >= 0 && !ec && static_cast<std::int64_t>(size) > at) ? static_cast<std::int64_t>(size) - at : 0;
 }
 
 }  // namespace rms::session

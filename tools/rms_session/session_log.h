@@ -62,13 +62,16 @@ class SessionLog {
   std::int64_t first_us() const { return first_us_; }
   std::int64_t last_us() const { return last_us_; }
   std::int64_t malformed() const { return malformed_; }
+  // Of the last Read: bytes at the log's end that are no whole event (a log
+  // cut short, or garbage after it): left out, and said by its readers.
+  std::int64_t unread_bytes() const { return unread_bytes_; }
   SenderCheck& check() { return check_; }
 
  private:
   std::string dir_, log_path_, suffix_;
   double rate_hz_ = 30.0;
   SenderCheck check_;
-  std::int64_t events_ = 0, first_us_ = -1, last_us_ = -1, malformed_ = 0;
+  std::int64_t events_ = 0, first_us_ = -1, last_us_ = -1, malformed_ = 0, unread_bytes_ = 0;
 };
 
 }  // namespace rms::session

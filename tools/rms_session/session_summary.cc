@@ -730,6 +730,7 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
   j["timing"] = TimingJson(stats, rate_hz);
   j["record"] = RecordJson(stats, s);
   j["log"] = LogJson(s);
+  j["log"]["unread_bytes"] = log.unread_bytes();  // a log cut short or damaged at its end
   j["log"]["stats_from_log"] = nlohmann::json::array();
   for (const auto& [p, st] : stats) {
     if (st.value("from_log", false)) j["log"]["stats_from_log"].push_back(p);
