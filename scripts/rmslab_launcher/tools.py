@@ -75,6 +75,9 @@ def export_mcap(session, out):
     """The log as JSON lines (rms_session export --jsonl) into the MCAP
     writer (tools/rms_mcap/write_mcap.mjs, @mcap/core from npm)."""
     mcap = os.path.join(ROOT, "tools", "rms_mcap")
+    folder = os.path.dirname(os.path.abspath(out))
+    if not os.path.isdir(folder) or not os.access(folder, os.W_OK):
+        raise LabError(f"--out {out}: cannot write there (its folder {folder} is missing or not writable)", 2)
     schemas = binary("lcmtypes/schemas")
     if not os.path.isdir(os.path.join(mcap, "node_modules", "@mcap", "core")):
         raise LabError("the MCAP writer's packages are not installed: run scripts/install-deps", 1)
@@ -88,7 +91,9 @@ def export_mcap(session, out):
     if rc != 0 or writer.returncode != 0:
         if os.path.exists(out) and writer.returncode == 0:
             os.remove(out)  # a partial log: not left as if whole
-        raise LabError(f"the MCAP export failed (reader exit {rc}, writer exit {writer.returncode})", 1)
+        why = ("the MCAP writer failed (said above)" if writer.returncode != 0 else
+               f"reading the session's log failed (rms_session exit {rc})")
+        raise LabError(f"the MCAP export failed: {why}; no file written", 1)
     say(f"MCAP: {out} (opens in Foxglove Studio and PlotJuggler)")
     return 0
 
