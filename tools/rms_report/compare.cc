@@ -199,8 +199,7 @@ Comparison CompareSessions(const std::vector<std::string>& dirs, const std::stri
   std::stringstream chart_js, charts;
   chart_js << js.rdbuf();
   charts << cs.rdbuf();
-  std::string json = data.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
-  for (std::size_t p = json.find("</"); p != std::string::npos; p = json.find("</", p + 2)) json.replace(p, 2, "<\\/");
+  const std::string json = ScriptJson(data);
   std::ostringstream h;
   h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>rmslab: " << sessions.size()
     << " sessions compared</title>\n<style>body{font-family:sans-serif;max-width:1300px;margin:1em auto;color:#222}"

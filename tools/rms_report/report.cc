@@ -555,17 +555,6 @@ std::string ReadText(const std::string& path, const char* what) {
   return ss.str();
 }
 
-// JSON inside a <script>: "</" written so it cannot end the script.
-std::string ScriptJson(const nlohmann::json& j) {
-  std::string s = j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-  std::string out;
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    if (s[i] == '<' && i + 1 < s.size() && s[i + 1] == '/') out += "<\\";
-    else out += s[i];
-  }
-  return out;
-}
-
 LabConfig SessionConfig(const fs::path& root) {
   try {
     return LoadConfig((root / "config.toml").string());
@@ -581,6 +570,16 @@ const char* kStyle =
     "figure{margin:4px}figure img{width:240px}</style>\n";
 
 }  // namespace
+
+std::string ScriptJson(const nlohmann::json& j) {
+  std::string s = j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  std::string out;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s[i] == '<' && i + 1 < s.size() && s[i + 1] == '/') out += "<\\";
+    else out += s[i];
+  }
+  return out;
+}
 
 std::string ChartsScriptPath(const std::string& name) {
   return std::string(RMSLAB_SOURCE_DIR) + "/tools/rms_report/" + name;

@@ -7,6 +7,8 @@
 #include <functional>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 namespace rms::report {
 
 std::string DefaultChartJsPath();
@@ -15,6 +17,9 @@ std::string DefaultChartJsPath();
 // relative to it).
 std::string MakeReport(const std::string& session_dir, const std::string& chart_js_path,
                        const std::function<void(const std::string&)>& progress = {}, const std::string& out_path = "");
+// JSON to embed in a <script> (the report's and the comparison's data):
+// "</" written "<\/" so it cannot end the script.
+std::string ScriptJson(const nlohmann::json& j);
 // The report's scripts (report_charts.js, compare_charts.js) in the source tree.
 std::string ChartsScriptPath(const std::string& name);
 

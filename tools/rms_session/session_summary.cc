@@ -203,17 +203,7 @@ class TelemetryLog {
   void Observe(const dcp_telemetry_t& m, std::int64_t t_us, std::int64_t first_us) {
     ++frames_;
     const double t_s = (t_us - first_us) * 1e-6;
-    // The last start of Mode 1 (the session's start or a reset), acquisition
-    // (1 -> 2), clear of the bay (2 -> 3), the probe first in the docking
-    // envelope, docked.
-    if (f_start < 0 || (m.mode == 1 && last_mode_ != 1)) {
-      f_start = m.frame;
-      f_acquired = f_clear = f_envelope = f_docked = -1;
-    }
-    if (m.mode == 2 && last_mode_ == 1) f_acquired = m.frame;
-    if (m.mode == 3 && last_mode_ == 2) f_clear = m.frame;
-    if (m.mode == 3 && m.probe_in_envelope && f_envelope < 0) f_envelope = m.frame;
-    if (m.docked && f_docked < 0) f_docked = m.frame;
+    // (Phases and docking are each attempt's: AttemptLog.)
     if (m.mode != last_mode_) {
       if (last_mode_ != 0) {
         mode_changes.push_back({{"frame", m.frame}, {"time_s", m.input_frame / rate_hz_}, {"log_time_s", t_s},
@@ -222,9 +212,6 @@ class TelemetryLog {
       last_mode_ = m.mode;
     }
     acquired = acquired || m.acquired;
-    if (m.docked && !docked) {
-      docking = {{"frame", m.frame}, {"time_s", t_s}, {"distance_ft", m.dock_distance_ft}, {"angle_deg", m.dock_angle_deg}};
-    }
     docked = docked || m.docked;
     held_frames += m.held;
     const auto bits = static_cast<std::uint32_t>(m.collisions);
@@ -261,10 +248,8 @@ class TelemetryLog {
 
   nlohmann::ordered_json mode_changes = nlohmann::ordered_json::array();
   nlohmann::ordered_json collisions = nlohmann::ordered_json::array();
-  nlohmann::ordered_json docking = nullptr;
   bool acquired = false, docked = false;
   std::int64_t held_frames = 0;
-  std::int64_t f_start = -1, f_acquired = -1, f_clear = -1, f_envelope = -1, f_docked = -1;
 
  private:
   void EndRun(int b, std::int64_t first_us, bool open) {
