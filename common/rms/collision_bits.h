@@ -13,17 +13,19 @@ inline constexpr std::uint32_t kEffHexRecpt = 1u << 0;     // bits 0-2: EFF HEX 
 inline constexpr std::uint32_t kEffHexPayload = 1u << 3;   // bits 3-5: EFF HEX 1, 2, 3 with the payload body
 inline constexpr std::uint32_t kBayFace = 1u << 6;         // bits 6-11: a payload vertex beyond bay face a..f
 inline constexpr std::uint32_t kPayloadCae = 1u << 12;     // a payload vertex inside the CAE's front half
-inline constexpr std::uint32_t kRecptMask = 0x7u;          // essential in the acquisition relationship
+inline constexpr std::uint32_t kEffHexBarPost = 1u << 13;  // EFF HEX 1, 2 or 3 with a post under the bar
+inline constexpr std::uint32_t kNonFinite = 1u << 14;      // the command's models are not finite: refused
+inline constexpr std::uint32_t kRecptMask = 0x7u;          // the end effector with the BAR (the essential contact: bit 2 alone, the movable finger closing)
 inline constexpr std::uint32_t kEePayloadMask = 0x7u << 3;
 inline constexpr std::uint32_t kBayMask = 0x3Fu << 6;
-inline constexpr int kCount = 13;
+inline constexpr int kCount = 15;
 }  // namespace collision_bits
 
 // "eff_hex_2-recpt", "payload-bay_b", ... for logs, counters and summaries.
 inline constexpr std::array<const char*, collision_bits::kCount> kCollisionNames = {
     "eff_hex_1-recpt",   "eff_hex_2-recpt",   "eff_hex_3-recpt", "eff_hex_1-payload", "eff_hex_2-payload",
     "eff_hex_3-payload", "payload-bay_a",     "payload-bay_b",   "payload-bay_c",     "payload-bay_d",
-    "payload-bay_e",     "payload-bay_f",     "payload-cae"};
+    "payload-bay_e",     "payload-bay_f",     "payload-cae",     "eff_hex-bar_post",  "non-finite"};
 inline const char* CollisionName(int bit) {
   return bit >= 0 && bit < collision_bits::kCount ? kCollisionNames[bit] : "?";
 }

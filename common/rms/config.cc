@@ -9,6 +9,7 @@
 #include "rms/toml_reader.h"
 
 #include "rms/check.h"
+#include "rms/text.h"
 
 #ifndef RMSLAB_DEFAULT_CONFIG
 #error "RMSLAB_DEFAULT_CONFIG must be defined by the build"
@@ -127,6 +128,21 @@ LabConfig ParseConfig(std::string_view text, const std::string& source) {
     c.dcp.dock_angle_deg = r.Number("dock_angle_deg", 0.0, 90.0, true);
     if (c.dcp.d3y_ft <= c.end_effector.finger_gap_closed_ft) {
       r.Fail("d3y_ft", "must be greater than end_effector.finger_gap_closed_ft, or no gap could satisfy it");
+    }
+    // The finger must close onto the bar within D3Y, and open past it to let go.
+    const double bar_width = c.payload.bar_size_P_ft.y();
+    if (c.dcp.d3y_ft <= bar_width) {
+      r.Fail("d3y_ft", "must be greater than the bar's width (payload.bar_size_ft[1] = " + HumanNumber(bar_width) +
+                           " ft), or the finger could never close onto the bar within D3Y: acquisition impossible");
+    }
+    if (c.dcp.d3y_ft + kReleaseOpeningFt > c.end_effector.finger_gap_open_ft) {
+      r.Fail("d3y_ft", "must be at most end_effector.finger_gap_open_ft - 0.05 ft (" +
+                           HumanNumber(c.end_effector.finger_gap_open_ft - kReleaseOpeningFt) +
+                           "), or opening the finger could not let the payload go");
+    }
+    if (c.end_effector.finger_gap_closed_ft >= bar_width) {
+      r.Fail("d3y_ft", "needs end_effector.finger_gap_closed_ft below the bar's width (payload.bar_size_ft[1] = " +
+                           HumanNumber(bar_width) + " ft), or the finger could not close onto the bar");
     }
     r.Finish();
   }

@@ -85,6 +85,11 @@ struct CaeConfig {
   double port_diameter_ft = 0;
 };
 
+// Opening the finger this far past its gap at acquisition lets the payload
+// go (docs/collision.md "The finger after acquisition"); D3Y must leave room
+// for it below the open gap.
+inline constexpr double kReleaseOpeningFt = 0.05;
+
 // [dcp]: the Dynamic Collision Program's selected values (report IV.A.3).
 struct DcpConfig {
   double d3y_ft = 0;            // D3Y: acquisition needs the finger gap below this

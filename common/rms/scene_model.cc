@@ -27,6 +27,24 @@ Eigen::Vector3d GrappleTargetCentre_P(const PayloadConfig& p) {
           p.p_PoBar_P_ft.z() - 0.5 * p.bar_size_P_ft.z() - 0.1};
 }
 
+double PayloadTopFlat_P(const PayloadConfig& p) { return 0.5 * p.diameter_ft * std::cos(M_PI / 16); }
+
+BarPostBoxes BarPosts_P(const PayloadConfig& p) {
+  BarPostBoxes b;
+  const Eigen::Vector3d& bc = p.p_PoBar_P_ft;
+  const Eigen::Vector3d& bs = p.bar_size_P_ft;
+  const double post = std::min(0.3, 0.4 * bs.x());
+  const double z0 = PayloadTopFlat_P(p), z1 = bc.z() - 0.5 * bs.z();
+  if (!(z1 - z0 > 2 * kClusterClearanceFt)) return b;
+  b.count = 2;
+  b.half_P = Eigen::Vector3d(0.5 * post, 0.5 * post, 0.5 * (z1 - z0));
+  for (int k = 0; k < 2; ++k) {
+    const double x = bc.x() + (k ? 1.0 : -1.0) * (0.5 * bs.x() - 0.5 * post);
+    b.centre_P[k] = Eigen::Vector3d(x, bc.y(), 0.5 * (z0 + z1));
+  }
+  return b;
+}
+
 double MovingFingerCentreY2(const EndEffectorConfig& ee, double gap) {
   // Face b of EFF HEX 2 is at Y2 = W - t; face e of EFF HEX 3 is `gap` below it.
   const double t = ee.finger_thickness_ft;
@@ -236,7 +254,6 @@ void BuildPayload(const PayloadConfig& p, std::array<Cluster, kNumClusters>* c) 
   (*c)[kPayloadBody].mesh.AddCylinder(V(0, -hl, 0), V(0, hl, 0), r, 16, kGold, true, phase);
   const V bc = F(p.p_PoBar_P_ft), bs = F(p.bar_size_P_ft);
   (*c)[kBar].mesh.AddBox(bc - 0.5f * bs, bc + 0.5f * bs, kBarRgb);
-  const float top = r * std::cos(phase);
   // The grapple target (docs/scene.md "Targets"): a white plate with a black
   // cross standing off the body beside the bar's end, over a black disc with
   // a white rim on the body: from the wrist camera at the grasp the cross
@@ -267,15 +284,12 @@ void BuildPayload(const PayloadConfig& p, std::array<Cluster, kNumClusters>* c) 
     Disc(&body, on + 2 * kDecalOffset * n, n, 0.35f, 16, kTargetBlack);
     body.SetDecal(false);
   }
-  const float post = std::min(0.3f, 0.4f * bs.x());
-  for (int k = 0; k < 2; ++k) {
-    const float x = bc.x() + (k ? 1.0f : -1.0f) * (0.5f * bs.x() - 0.5f * post);
-    const float z1 = bc.z() - 0.5f * bs.z();
-    const float z0 = top + kGap;
-    if (z1 - kGap > z0) {
-      (*c)[k ? kBarPostB : kBarPostA].mesh.AddBox(V(x - 0.5f * post, bc.y() - 0.5f * post, z0),
-                                                   V(x + 0.5f * post, bc.y() + 0.5f * post, z1 - kGap), kBarRgb);
-    }
+  // The posts, drawn clear of the body's flat and of the bar by the clusters' clearance.
+  const BarPostBoxes posts = BarPosts_P(p);
+  for (int k = 0; k < posts.count; ++k) {
+    const V lo = F(posts.centre_P[k] - posts.half_P), hi = F(posts.centre_P[k] + posts.half_P);
+    (*c)[k ? kBarPostB : kBarPostA].mesh.AddBox(V(lo.x(), lo.y(), lo.z() + kGap), V(hi.x(), hi.y(), hi.z() - kGap),
+                                                 kBarRgb);
   }
   const float pr = static_cast<float>(p.probe_diameter_ft / 2);
   (*c)[kProbe].mesh.AddFrustum(V(0, hl + kGap, 0), V(0, hl + static_cast<float>(p.probe_length_ft), 0), pr, 0.6f * pr, 10,

@@ -96,6 +96,20 @@ inline constexpr double kWristClearanceFt = 0.75;  // lower boom's end to W
 // face, centred here in the payload frame P, beyond the bar's end on the
 // side the wrist camera looks from at the grasp.
 Eigen::Vector3d GrappleTargetCentre_P(const PayloadConfig& p);
+// The bar's two posts (docs/scene.md, docs/collision.md "The models"): boxes
+// in the payload frame P under the bar's ends, from the body's top flat up
+// to the bar's bottom face. Drawn by the scene (kBarPostA, kBarPostB) and
+// tested by the DCP in Mode 1 (collision bit eff_hex-bar_post). `count` is 0
+// when the bar sits on the body (no room for posts).
+struct BarPostBoxes {
+  int count = 0;
+  std::array<Eigen::Vector3d, 2> centre_P{};
+  Eigen::Vector3d half_P = Eigen::Vector3d::Zero();
+};
+BarPostBoxes BarPosts_P(const PayloadConfig& p);
+// The payload body's top flat (the drawn 16-sided body has a flat on top at
+// this height above its axis, r cos(pi/16)), payload frame z_P, ft.
+double PayloadTopFlat_P(const PayloadConfig& p);
 // The docking target beside the CAE's port (docs/scene.md "Targets"): this
 // far from the port's centre along z_C, its cross this far out from face c.
 inline constexpr double kDockTargetAlongFt = 3.5;

@@ -28,6 +28,38 @@ struct PlaneCandidate {
   Eigen::Vector3d apex, q0, q1;
 };
 
+// The distance between the segments p + s u (0 <= s <= 1) and q + t v
+// (0 <= t <= 1), ft, at any angle, parallel included (Ericson, Real-Time
+// Collision Detection, 5.1.9), computed about p so that it is accurate far
+// from the origin.
+double SegmentDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& u, const Eigen::Vector3d& q,
+                       const Eigen::Vector3d& v) {
+  const Eigen::Vector3d r = p - q;
+  const double a = u.squaredNorm(), e = v.squaredNorm(), f = v.dot(r);
+  double s = 0.0, t = 0.0;
+  if (a <= 0.0 && e <= 0.0) return r.norm();
+  if (a <= 0.0) {
+    t = std::clamp(f / e, 0.0, 1.0);
+  } else {
+    const double c = u.dot(r);
+    if (e <= 0.0) {
+      s = std::clamp(-c / a, 0.0, 1.0);
+    } else {
+      const double b = u.dot(v), denom = a * e - b * b;
+      s = denom > 0.0 ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
+      t = (b * s + f) / e;
+      if (t < 0.0) {
+        t = 0.0;
+        s = std::clamp(-c / a, 0.0, 1.0);
+      } else if (t > 1.0) {
+        t = 1.0;
+        s = std::clamp((b - c) / a, 0.0, 1.0);
+      }
+    }
+  }
+  return (r + s * u - t * v).norm();
+}
+
 // Section IV.A.1's edge test for the edge (i, k) of P against the faces of Q,
 // given the two vertices' location words against Q. Returns the face of Q the
 // edge pierces, or -1.
@@ -61,9 +93,12 @@ int EdgePiercesFace(const Hexahedron& P, int i, int k, LocationWord wi, Location
       const Eigen::Vector3d e = Q.vertex(b1) - q0;
       const double t = Q.handedness * (q0 - apex).cross(e).dot(dir);
       ++*products;
-      // T_j / (|edge| |V|) is how far the edge passes outside the bounding
-      // edge (docs/collision.md); within tau it still touches.
-      if (t > tau * e.norm() * dir_len) {
+      // T_j > 0: the edge passes outside the bounding edge. It still touches
+      // when it comes within tau of it (docs/collision.md "Tolerance rule").
+      // T_j / (|e| |V|) is at most the distance between the two lines, so
+      // above tau the edge is clear; below, near-parallel edges can be far
+      // apart with a small T_j, and the segments' distance decides.
+      if (t > 0 && (t > tau * e.norm() * dir_len || SegmentDistance(apex, dir, q0, e) > tau)) {
         inside = false;
         if (!cand->have) *cand = {true, apex, q0, Q.vertex(b1)};
         break;
@@ -153,10 +188,14 @@ double MidGapOffset(const Hexahedron& a, const Hexahedron& b, const Eigen::Vecto
   return 0.5 * (ahi + blo);
 }
 
+double ToleranceFt(const Hexahedron& a, const Hexahedron& b, double relative_tolerance) {
+  return relative_tolerance * std::max(a.scale, b.scale) + kRoundingPerFt * std::max(a.magnitude, b.magnitude);
+}
+
 CollisionResult Collide(const Hexahedron& a, const Hexahedron& b, const CollideOptions& options) {
   CollisionResult r;
   if (!a.valid || !b.valid) return r;  // kInvalid, kNonFinite
-  const double tau = options.relative_tolerance * std::max(a.scale, b.scale);
+  const double tau = ToleranceFt(a, b, options.relative_tolerance);
 
   if (options.sphere_reject) {
     const double dx = b.cx - a.cx, dy = b.cy - a.cy, dz = b.cz - a.cz;
@@ -194,7 +233,9 @@ CollisionResult Collide(const Hexahedron& a, const Hexahedron& b, const CollideO
       return r;
     }
   }
-  if (options.hint && PlaneSeparates(a, b, options.hint->n, options.hint->d, tau)) {
+  // The hint decides only a pair it separates by more than tau on each side
+  // (so touching pairs, which collide, always go to the report's test).
+  if (options.hint && PlaneSeparates(a, b, options.hint->n, options.hint->d, -tau)) {
     r.verdict = Verdict::kSeparate;
     r.decider = Decider::kHintPlane;
     if (options.want_plane) SetPlane(&r, options.hint->n, options.hint->d);

@@ -21,11 +21,12 @@
 // normal to that axis; then, when a
 // hint is given, the previous frame's plane if it still separates.
 //
-// Touching counts as collision: a vertex within tau = relative_tolerance x
-// scale of a face's plane is on the FALSE side, and an edge within that
-// distance of a face's boundary pierces it (scale = the larger bounding-box
-// diagonal of the pair). Non-finite input is an error (kInvalid), never a
-// verdict.
+// Touching counts as collision: a vertex within tau of a face's plane is on
+// the FALSE side, and an edge within tau of a face's boundary pierces it
+// (ToleranceFt: tau = relative_tolerance x scale + kRoundingPerFt x
+// magnitude, scale the larger bounding-box diagonal of the pair, magnitude
+// its largest coordinate; docs/collision.md "Tolerance rule"). Invalid or
+// non-finite input is an error (kInvalid), never a verdict.
 #include <array>
 #include <cstdint>
 
@@ -69,8 +70,10 @@ struct CollideOptions {
   // spheres; the same verdict, a plane normal to the axis that parts them).
   bool aabb_reject = true;
   // Frame coherence: a plane to try first (the pair's separating plane of
-  // the previous frame); when it still separates the pair (within tau), the
-  // verdict is separate with this plane. Null: none.
+  // the previous frame); when it still separates the pair with more than
+  // tau to spare on each side, the verdict is separate with this plane (it
+  // cannot change a verdict: a pair within tau of it goes to the report's
+  // test). Null: none.
   const SeparatingPlaneHint* hint = nullptr;
 };
 
@@ -96,6 +99,9 @@ struct CollisionResult {
 };
 
 CollisionResult Collide(const Hexahedron& a, const Hexahedron& b, const CollideOptions& options = {});
+
+// The pair's tolerance tau, ft: a distance (docs/collision.md "Tolerance rule").
+double ToleranceFt(const Hexahedron& a, const Hexahedron& b, double relative_tolerance = 1e-12);
 
 // Does every vertex of A lie at or below the plane (n . p <= d + tol) and
 // every vertex of B at or above it (n . p >= d - tol)?

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "rms/scene_model.h"
+
 namespace rms::dcp {
 
 EndEffectorModel MakeEndEffector(const EndEffectorConfig& ee, const Eigen::Isometry3d& X_RS2,
@@ -26,6 +28,17 @@ Hexahedron MakeBar(const PayloadConfig& p, const Eigen::Isometry3d& X_RP) {
   const Eigen::Vector3d centre = X_RP * p.p_PoBar_P_ft;
   const Eigen::Vector3d& size = p.bar_size_P_ft;
   return MakeBox(centre - 0.5 * size.x() * u, u, v, w, size.x(), 0.5 * size.y(), 0.5 * size.z());
+}
+
+int MakeBarPosts(const PayloadConfig& p, const Eigen::Isometry3d& X_RP, std::array<Hexahedron, 2>* posts) {
+  const BarPostBoxes b = BarPosts_P(p);
+  const Eigen::Matrix3d& R = X_RP.linear();
+  for (int k = 0; k < b.count; ++k) {
+    const Eigen::Vector3d centre = X_RP * b.centre_P[k];
+    (*posts)[k] = MakeBox(centre - b.half_P.x() * R.col(0), R.col(0), R.col(1), R.col(2), 2 * b.half_P.x(),
+                          b.half_P.y(), b.half_P.z());
+  }
+  return b.count;
 }
 
 PayloadModel MakePayload(const PayloadConfig& p, const Eigen::Isometry3d& X_RP) {

@@ -26,6 +26,10 @@ EndEffectorModel MakeEndEffector(const EndEffectorConfig& ee, const Eigen::Isome
 // (faces a and d are its ends), v = -y_P, w = -z_P (face c its top).
 Hexahedron MakeBar(const PayloadConfig& p, const Eigen::Isometry3d& X_RP);
 
+// The BAR's two posts in Reference coordinates: rms::BarPosts_P (the boxes
+// the scene draws), x_P, y_P, z_P as u, v, w. Returns how many (0 or 2).
+int MakeBarPosts(const PayloadConfig& p, const Eigen::Isometry3d& X_RP, std::array<Hexahedron, 2>* posts);
+
 // The payload model of the report's Figure 8 (reconstructed): three groups of
 // vertices from the payload's diameter and length and the probe's diameter
 // (and length): V11-V18 the body (a square prism round the cylinder),

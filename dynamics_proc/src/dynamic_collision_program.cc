@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <spdlog/spdlog.h>
 
 #include "rms/check.h"
+#include "rms/scene_model.h"
 
 #include "rms/word_codec.h"
 
@@ -41,26 +43,108 @@ std::string Names(std::uint32_t bits) {
 DynamicCollisionProgram::DynamicCollisionProgram(const LabConfig& config, const DcpOptions& options)
     : config_(config), options_(options) {
   X_RP_bay_ = MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft);
-  bar_bay_ = MakeBar(config.payload, X_RP_bay_);
-  payload_bay_ = MakePayload(config.payload, X_RP_bay_);
   bay_ = MakeCargoBay(config.shuttle);
   cae_ = MakeCaeFrontHalf(config.cae);
-  Reset();
+  PlacePayload(X_RP_bay_);
+  // The substep: at most kMaxSubstepTravelFt, and under half the thinnest
+  // solid tested against another (the fingers, the BAR, its posts), so no
+  // solid can step through another between two tested poses.
+  const auto& ee = config.end_effector;
+  double thinnest = std::min({ee.finger_thickness_ft, 2 * ee.palm_half_width_ft, 2 * ee.palm_half_height_ft,
+                              ee.palm_length_ft, ee.finger_length_ft, config.payload.bar_size_P_ft.minCoeff()});
+  if (post_count_ > 0) thinnest = std::min(thinnest, 2 * BarPosts_P(config.payload).half_P.minCoeff());
+  substep_ft_ = std::min(kMaxSubstepTravelFt, 0.45 * thinnest);
+  // The slave starts at the initial inputs' pose, which must be free.
+  const OperatorInputs initial = InitialInputs(config.inputs);
+  ArmCommand start;
+  for (int i = 0; i < 6; ++i) start.angles_deg[i] = initial.value[i];
+  start.shoulder_height_ft = initial.value[kShoulderHeight];
+  start.finger = initial.value[kFinger];
+  Evaluate(start, nullptr, slave_);
+  if (slave_->collisions) {
+    throw InputError("inputs.*.initial: the arm's initial pose collides (" + Names(slave_->collisions) +
+                     "); the DCP needs a collision-free pose to start from");
+  }
+  status_.master = status_.slave = start;
+  status_.X_RS2 = slave_->pose.X_RS2;
+  status_.X_RP = slave_->X_RP;
+  status_.finger_gap_ft = slave_->finger_gap_ft;
 }
 
-void DynamicCollisionProgram::Reset() {
-  released_ = false;
-  status_.released = false;
+void DynamicCollisionProgram::PlacePayload(const Eigen::Isometry3d& X_RP) {
+  X_RP_free_ = X_RP;
+  bar_ = MakeBar(config_.payload, X_RP);
+  payload_ = MakePayload(config_.payload, X_RP);
+  post_count_ = MakeBarPosts(config_.payload, X_RP, &posts_);
+}
+
+bool DynamicCollisionProgram::Reset() {
+  // The reset scene: Mode 1, the payload in the bay. The arm stays; where it
+  // is must be free there, or the reset is refused.
+  const Eigen::Isometry3d X_RP_free = X_RP_free_;
+  const int mode = status_.mode;
+  const bool acquired = status_.acquired, docked = status_.docked, released = released_;
+  PlacePayload(X_RP_bay_);
   status_.mode = 1;
-  status_.acquired = false;
-  status_.docked = false;
+  status_.acquired = status_.docked = false;
+  released_ = false;
+  Evaluate(slave_->cmd, slave_, spare_);
+  if (spare_->collisions) {
+    spdlog::warn("reset refused: the arm where it is would collide with the payload in the bay ({}); "
+                 "move the arm clear and reset again", Names(spare_->collisions));
+    PlacePayload(X_RP_free);
+    status_.mode = mode;
+    status_.acquired = acquired;
+    status_.docked = docked;
+    released_ = released;
+    return false;
+  }
+  AcceptSpare();
+  status_.released = false;
   status_.X_RP = X_RP_bay_;
-  have_slave_ = false;
+  return true;
 }
 
 double DynamicCollisionProgram::FingerGapFt(double lever) const {
   const auto& e = config_.end_effector;
   return e.finger_gap_open_ft - lever * (e.finger_gap_open_ft - e.finger_gap_closed_ft);
+}
+
+namespace {
+
+bool Finite(const ArmCommand& c) {
+  double zero = c.shoulder_height_ft * 0.0 + c.finger * 0.0;
+  for (double a : c.angles_deg) zero += a * 0.0;
+  return zero == 0.0;
+}
+
+bool Finite(const PayloadModel& p) {
+  double zero = 0.0;
+  for (const Eigen::Vector3d& v : p.v) zero += (v.x() + v.y() + v.z()) * 0.0;
+  return zero == 0.0 && p.body.valid;
+}
+
+// TestMotion's answer for a motion beyond kMaxSubsteps: not a collision bit.
+constexpr std::uint32_t kTooFast = 1u << 31;
+
+ArmCommand Lerp(const ArmCommand& a, const ArmCommand& b, double t) {
+  ArmCommand c;
+  for (int i = 0; i < 6; ++i) c.angles_deg[i] = a.angles_deg[i] + t * (b.angles_deg[i] - a.angles_deg[i]);
+  c.shoulder_height_ft = a.shoulder_height_ft + t * (b.shoulder_height_ft - a.shoulder_height_ft);
+  c.finger = a.finger + t * (b.finger - a.finger);
+  return c;
+}
+
+}  // namespace
+
+std::uint32_t DynamicCollisionProgram::BayCollisions(const PayloadModel& p) const {
+  const double tau = tau_rel_ * bay_.scale;
+  std::uint32_t bits = 0;
+  for (const Eigen::Vector3d& v : p.v) {
+    const LocationWord w = bay_.Word(v, tau);
+    if (!(w & FaceBit(kFaceC))) bits |= static_cast<std::uint32_t>(w) << 6;
+  }
+  return bits;
 }
 
 void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* prev, Evaluation* out) const {
@@ -94,25 +178,31 @@ void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* 
   namespace cb = collision_bits;
   switch (status_.mode) {
     case 1: {
-      // EFF HEX 1-3 against the BAR and against the payload's body.
+      // EFF HEX 1-3 against the BAR, the payload's body and the BAR's posts.
       e.ee = MakeEndEffector(config_.end_effector, e.pose.X_RS2, e.finger_gap_ft);
-      e.X_RP = X_RP_bay_;
-      e.payload = payload_bay_;
+      e.X_RP = X_RP_free_;
+      e.payload = payload_;
+      CollideOptions plain;
+      plain.relative_tolerance = tau_rel_;
+      plain.sphere_reject = plain.aabb_reject = options_.bounding_reject;
+      plain.want_plane = false;
       for (int k = 0; k < 3; ++k) {
-        e.ee_bar[k] = Collide(e.ee.hex[k], bar_bay_, opts(prev ? &prev->ee_bar[k] : nullptr, &hints[0][k]));
+        if (!e.ee.hex[k].valid) e.collisions |= cb::kNonFinite;
+        e.ee_bar[k] = Collide(e.ee.hex[k], bar_, opts(prev ? &prev->ee_bar[k] : nullptr, &hints[0][k]));
         if (e.ee_bar[k].verdict != Verdict::kSeparate) e.collisions |= cb::kEffHexRecpt << k;
         // The body's plane serves only as the next frame's hint.
         CollideOptions body = opts(prev ? &prev->ee_body[k] : nullptr, &hints[1][k]);
         body.want_plane = options_.frame_coherence;
-        e.ee_body[k] = Collide(e.ee.hex[k], payload_bay_.body, body);
+        e.ee_body[k] = Collide(e.ee.hex[k], payload_.body, body);
         if (e.ee_body[k].verdict != Verdict::kSeparate) e.collisions |= cb::kEffHexPayload << k;
+        for (int j = 0; j < post_count_; ++j) {
+          if (Collide(e.ee.hex[k], posts_[j], plain).verdict != Verdict::kSeparate) e.collisions |= cb::kEffHexBarPost;
+        }
       }
       if (!options_.mode_pairs_only) {
         // The pairs of Modes 2 and 3, computed and discarded.
-        CollideOptions o;
-        o.sphere_reject = o.aabb_reject = options_.bounding_reject;
-        e.extra_collisions |= Collide(payload_bay_.body, bay_, o).verdict != Verdict::kSeparate;
-        e.extra_collisions |= Collide(payload_bay_.body, cae_, o).verdict != Verdict::kSeparate;
+        e.extra_collisions |= Collide(payload_.body, bay_, plain).verdict != Verdict::kSeparate;
+        e.extra_collisions |= Collide(payload_.body, cae_, plain).verdict != Verdict::kSeparate;
       }
       break;
     }
@@ -121,11 +211,7 @@ void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* 
       // bottom: a vertex below face c that is beyond a wall collides with it.
       e.X_RP = e.pose.X_RS2 * X_S2P_;
       e.payload = MakePayload(config_.payload, e.X_RP);
-      const double tau = tau_rel_ * bay_.scale;
-      for (const Eigen::Vector3d& v : e.payload.v) {
-        const LocationWord w = bay_.Word(v, tau);
-        if (!(w & FaceBit(kFaceC))) e.collisions |= static_cast<std::uint32_t>(w) << 6;
-      }
+      e.collisions |= BayCollisions(e.payload);
       break;
     }
     default: {
@@ -134,16 +220,22 @@ void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* 
         e.payload = MakePayload(config_.payload, e.X_RP);
         break;
       }
-      // The payload's and probe's vertices against the CAE's front half.
+      // The payload's and probe's vertices against the CAE's front half, and
+      // still against the bay's walls while any is below face c (lowered
+      // back toward the bay, it cannot pass through them).
       e.X_RP = e.pose.X_RS2 * X_S2P_;
       e.payload = MakePayload(config_.payload, e.X_RP);
       const double tau = tau_rel_ * cae_.scale;
       for (const Eigen::Vector3d& v : e.payload.v) {
         if (cae_.Word(v, tau) == 0) e.collisions |= cb::kPayloadCae;
       }
+      e.collisions |= BayCollisions(e.payload);
       break;
     }
   }
+  // Non-finite models (a pose from non-finite words or a restored state)
+  // are refused as a collision, never read as "no collision".
+  if (!Finite(e.payload) || !e.pose.X_RS2.matrix().allFinite()) e.collisions |= cb::kNonFinite;
   if (!options_.mode_pairs_only && status_.mode >= 2) {
     // Every other pair, computed and discarded: the end effector against the
     // BAR and the payload where they are now, the payload against the bay
@@ -161,9 +253,127 @@ void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* 
   }
 }
 
-void DynamicCollisionProgram::AcceptSpare() {
-  std::swap(slave_, spare_);
-  have_slave_ = true;
+void DynamicCollisionProgram::AcceptSpare() { std::swap(slave_, spare_); }
+
+double DynamicCollisionProgram::ReachFt() const {
+  const auto& a = config_.arm;
+  const auto& ee = config_.end_effector;
+  const double hand = ee.palm_length_ft + ee.finger_length_ft +
+                      std::hypot(ee.palm_half_width_ft, ee.palm_half_height_ft);
+  return a.upper_boom_ft + a.lower_boom_ft + a.wrist_to_palm_ft + std::max(hand, payload_reach_ft_);
+}
+
+int DynamicCollisionProgram::Substeps(const ArmCommand& from, const ArmCommand& to) const {
+  // A bound on any model vertex's travel: each joint turns every vertex
+  // beyond it by at most its angle (rad) times the reach; the shoulder's
+  // height moves all alike; the finger moves the movable finger alone.
+  double travel = std::abs(to.shoulder_height_ft - from.shoulder_height_ft);
+  const double reach = ReachFt();
+  for (int i = 0; i < 6; ++i) travel += std::abs(to.angles_deg[i] - from.angles_deg[i]) * (M_PI / 180.0) * reach;
+  travel += std::abs(FingerGapFt(to.finger) - FingerGapFt(from.finger));
+  const double n = std::ceil(travel / substep_ft_);
+  if (!(n <= kMaxSubsteps)) return -1;
+  return std::max(1, static_cast<int>(n));
+}
+
+std::uint32_t DynamicCollisionProgram::TestMotion(const ArmCommand& from, const ArmCommand& to, Evaluation* out) {
+  Evaluate(to, slave_, out);  // the end pose first: most collisions show there
+  status_.substeps = 1;
+  if (out->collisions) return out->collisions;
+  const int n = Substeps(from, to);
+  if (n < 0) {
+    status_.too_fast = true;
+    return kTooFast;
+  }
+  for (int k = 1; k < n; ++k) {
+    Evaluate(Lerp(from, to, static_cast<double>(k) / n), slave_, scratch_);
+    if (scratch_->collisions) {
+      status_.substeps = k + 1;
+      status_.motion_collision = true;
+      return scratch_->collisions;
+    }
+  }
+  status_.substeps = n;
+  return 0;
+}
+
+std::uint32_t DynamicCollisionProgram::MoveFinger(double finger) {
+  // From the slave's finger toward `finger`, the arm where the slave is: in
+  // steps of at most substep_ft_ of gap to the first colliding position, then
+  // bisection to within 1e-5 ft of gap.
+  const ArmCommand from = slave_->cmd;
+  const double f0 = from.finger;
+  const double span_ft = std::abs(FingerGapFt(finger) - FingerGapFt(f0));
+  const int n = std::max(1, static_cast<int>(std::ceil(span_ft / substep_ft_)));
+  ArmCommand c = from;
+  double free_f = f0, hit_f = f0;
+  std::uint32_t bits = 0;
+  for (int k = 1; k <= n && !bits; ++k) {
+    c.finger = f0 + (finger - f0) * k / n;
+    Evaluate(c, slave_, scratch_);
+    if (scratch_->collisions) {
+      bits = scratch_->collisions;
+      hit_f = c.finger;
+    } else {
+      free_f = c.finger;
+    }
+  }
+  while (bits && std::abs(FingerGapFt(hit_f) - FingerGapFt(free_f)) > 1e-5) {
+    c.finger = 0.5 * (free_f + hit_f);
+    Evaluate(c, slave_, scratch_);
+    (scratch_->collisions ? hit_f : free_f) = c.finger;
+  }
+  if (free_f != f0) {
+    c.finger = free_f;
+    Evaluate(c, slave_, spare_);
+    AcceptSpare();
+  }
+  return bits;
+}
+
+void DynamicCollisionProgram::Respond(const ArmCommand& command) {
+  namespace cb = collision_bits;
+  const std::uint32_t hit = TestMotion(slave_->cmd, command, spare_);
+  status_.collisions = hit & ~kTooFast;
+  if (!hit) return AcceptSpare();
+  if (status_.too_fast) {
+    status_.held = true;
+    return;
+  }
+  if (status_.mode == 1 && command.finger != slave_->cmd.finger) {
+    // The finger is what collides: let the arm follow, and move the finger
+    // as far as it goes (onto the bar: the essential contact).
+    ArmCommand arm_only = command;
+    arm_only.finger = slave_->cmd.finger;
+    const bool closing = FingerGapFt(command.finger) < FingerGapFt(slave_->cmd.finger);
+    const int substeps = status_.substeps;
+    if (TestMotion(slave_->cmd, arm_only, spare_) == 0) {
+      AcceptSpare();
+      status_.finger_held = true;
+      const std::uint32_t contact = MoveFinger(command.finger);
+      status_.substeps += substeps;
+      // Only the movable finger closing onto the BAR is essential; the palm
+      // or a finger striking it, or the finger against anything else, is
+      // detrimental (report II: "a finger ... contacts the end effector
+      // receptacle in the physical relationship required").
+      status_.essential_contact = closing && contact == (cb::kEffHexRecpt << 2);
+      status_.collisions = contact ? contact : status_.collisions;
+      return;
+    }
+  }
+  status_.held = true;
+}
+
+void DynamicCollisionProgram::LetGo() {
+  spdlog::info("the finger opened: the payload is let go where it is (Mode 1)");
+  PlacePayload(slave_->X_RP);
+  status_.mode = 1;
+  status_.acquired = false;
+  status_.let_go = true;
+  payload_reach_ft_ = 0.0;
+  // The slave's evaluation in the new mode (the arm where it is).
+  Evaluate(slave_->cmd, slave_, spare_);
+  AcceptSpare();
 }
 
 DcpFrameData DynamicCollisionProgram::Step(const OperatorInputs& in) {
@@ -171,18 +381,24 @@ DcpFrameData DynamicCollisionProgram::Step(const OperatorInputs& in) {
   for (int i = 0; i < 6; ++i) master.angles_deg[i] = in.value[i];
   master.shoulder_height_ft = in.value[kShoulderHeight];
   master.finger = in.value[kFinger];
-  if (in.reset) {
-    Reset();
-    spdlog::info("reset: Mode 1, payload in the cargo bay");
+  status_.input_refused = !Finite(master);
+  if (status_.input_refused) master = status_.master;  // hold the last command
+  status_.reset_refused = false;
+  status_.let_go = false;
+  if (in.reset && !reset_pressed_) {
+    if (Reset()) spdlog::info("reset: Mode 1, payload in the cargo bay");
+    else status_.reset_refused = true;
   }
+  reset_pressed_ = in.reset;
   status_.master = master;
-  status_.held = false;
-  status_.finger_held = false;
+  status_.held = status_.finger_held = status_.essential_contact = false;
+  status_.motion_collision = status_.too_fast = false;
+  status_.substeps = 0;
 
-  // A docked payload is captured at the port: the arm that holds it keeps
-  // its pose and only the finger moves, until opening the finger releases it.
   ArmCommand command = master;
-  if (status_.docked && !released_ && have_slave_) {
+  if (status_.docked && !released_) {
+    // A docked payload is captured at the port: the arm that holds it keeps
+    // its pose and only the finger moves, until opening it releases it.
     if (slave_->finger_gap_ft >= acquisition_gap_ft_ + kReleaseOpeningFt) {
       released_ = true;
       spdlog::info("released: the finger let go of the docked payload; the arm is free");
@@ -190,30 +406,28 @@ DcpFrameData DynamicCollisionProgram::Step(const OperatorInputs& in) {
       command.angles_deg = slave_->cmd.angles_deg;
       command.shoulder_height_ft = slave_->cmd.shoulder_height_ft;
     }
+  } else if (status_.mode >= 2 && !status_.docked &&
+             FingerGapFt(master.finger) >= acquisition_gap_ft_ + kReleaseOpeningFt) {
+    // The grasp lasts only while the finger stays closed.
+    LetGo();
   }
-  Evaluate(command, have_slave_ ? slave_ : nullptr, spare_);
-  const std::uint32_t collisions = spare_->collisions;
-  status_.collisions = collisions;
-  if (!have_slave_) {
-    // The first frame after start or reset: the slave takes the command.
-    AcceptSpare();
-    if (collisions) spdlog::warn("starting in collision: {}", Names(collisions));
-  } else if (collisions == 0) {
-    AcceptSpare();
+  if (started_) {
+    Respond(command);
   } else {
-    bool moved = false;
-    if (status_.mode == 1 && master.finger != slave_->cmd.finger) {
-      // The finger is what collides: let the arm follow and hold the finger.
-      ArmCommand arm_only = master;
-      arm_only.finger = slave_->cmd.finger;
-      Evaluate(arm_only, slave_, spare_);
-      if (spare_->collisions == 0) {
-        AcceptSpare();
-        status_.finger_held = true;
-        moved = true;
-      }
+    // The first frame after start: nothing to move from but the initial
+    // pose, which the command need not be near. Its pose is tested where it
+    // is, and taken only when free.
+    Evaluate(command, nullptr, spare_);
+    status_.collisions = spare_->collisions;
+    status_.substeps = 1;
+    if (spare_->collisions == 0) {
+      AcceptSpare();
+    } else {
+      status_.held = true;
+      spdlog::warn("the first command collides ({}): not taken; the arm stays at its initial pose",
+                   Names(spare_->collisions));
     }
-    status_.held = !moved;
+    started_ = true;
   }
   status_.released = released_;
   status_.slave_collisions = slave_->collisions;
@@ -236,8 +450,10 @@ DcpFrameData DynamicCollisionProgram::Step(const OperatorInputs& in) {
   out.control.overlay = in.overlay;
   out.control.crosshairs = in.crosshairs;
   out.control.mode = status_.mode;
-  out.control.collision = (status_.collisions & ~collision_bits::kRecptMask) != 0;
-  out.control.receptacle_collision = (status_.collisions & collision_bits::kRecptMask) != 0;
+  // COLLISION: a detrimental collision; RECPT: the essential contact.
+  const std::uint32_t essential = status_.essential_contact ? collision_bits::kEffHexRecpt << 2 : 0u;
+  out.control.collision = (status_.collisions & ~essential) != 0;
+  out.control.receptacle_collision = status_.essential_contact;
   out.control.acquired = status_.acquired;
   out.control.docked = status_.docked;
   out.shoulder_height_ft = slave_->cmd.shoulder_height_ft;
@@ -264,14 +480,13 @@ void DynamicCollisionProgram::UpdatePlanes() {
     const CollisionResult& r = slave_->ee_bar[k];
     if (r.verdict == Verdict::kSeparate && r.plane_valid) {
       // Centred in the gap, to survive rounding to the plane words.
-      status_.planes[k] = {r.n, MidGapOffset(slave_->ee.hex[k], bar_bay_, r.n)};
+      status_.planes[k] = {r.n, MidGapOffset(slave_->ee.hex[k], bar_, r.n)};
       status_.plane_valid |= 1u << k;
     }
   }
 }
 
 void DynamicCollisionProgram::RefreshMeasures() {
-  if (!have_slave_) return;
   UpdatePlanes();
   const DockingCheck d = CheckDocking(config_.dcp, config_.cae, cae_, slave_->payload, tau_rel_);
   status_.probe_in_envelope = d.in_envelope;
@@ -283,10 +498,11 @@ void DynamicCollisionProgram::RefreshMeasures() {
   status_.acquisition_margin_ft = {};
   status_.palm_to_bar_ft = 0.0;
   if (status_.mode == 1) {
-    const AcquisitionCheck c = CheckAcquisition(config_.dcp, slave_->ee, bar_bay_, slave_->finger_gap_ft, tau_rel_);
+    const AcquisitionCheck c = CheckAcquisition(config_.dcp, slave_->ee, bar_, slave_->finger_gap_ft, tau_rel_);
     status_.acquisition = c.holds;
     status_.acquisition_margin_ft = c.margin_ft;
     status_.palm_to_bar_ft = c.palm_to_bar_ft;
+    status_.finger_contact = c.margin_ft[2] <= kFingerContactToleranceFt;
   }
 }
 
@@ -340,6 +556,12 @@ AcquisitionCheck CheckAcquisition(const DcpConfig& dcp, const EndEffectorModel& 
                        -bar.Beyond(kFaceD, h1.x[i], h1.y[i], h1.z[i])});
   }
   c.margin_ft[5] = inside;
+  // Condition 3 at the essential contact: the movable finger on the bar. A
+  // bar slightly askew touches face e at one corner while its far corner,
+  // beyond the finger's edge, may lie a hair behind the face's plane: within
+  // the contact tolerance it counts as on the face (docs/collision.md "The
+  // essential contact").
+  c.holds[2] = c.holds[2] || c.margin_ft[2] > -kFingerContactToleranceFt;
   return c;
 }
 
@@ -366,31 +588,31 @@ DockingCheck CheckDocking(const DcpConfig& dcp, const CaeConfig& cae, const Hexa
 }
 
 void DynamicCollisionProgram::UpdateAcquisition() {
-  // Report IV.A.3: the six conditions, on the slave's (collision-free) pose.
-  const AcquisitionCheck c =
-      CheckAcquisition(config_.dcp, slave_->ee, bar_bay_, slave_->finger_gap_ft, tau_rel_);
+  // Report IV.A.3: the six conditions, on the slave's (collision-free) pose,
+  // and the essential contact: the movable finger on the bar (face e of EFF
+  // HEX 3 within kFingerContactToleranceFt of it; docs/collision.md).
+  const AcquisitionCheck c = CheckAcquisition(config_.dcp, slave_->ee, bar_, slave_->finger_gap_ft, tau_rel_);
   status_.acquisition = c.holds;
   status_.acquisition_margin_ft = c.margin_ft;
   status_.palm_to_bar_ft = c.palm_to_bar_ft;
   status_.bay_clearance_ft = BayClearance(slave_->payload);
-  if (c.all()) {
-    status_.mode = 2;
-    status_.acquired = true;
-    X_S2P_ = slave_->pose.X_RS2.inverse() * X_RP_bay_;
-    // The gap at which face e of EFF HEX 3 would touch the bar: from face b
-    // of EFF HEX 2 (at Y2 = W - t) to the bar's nearest vertex along -Y2.
-    const Hexahedron& bar = bar_bay_;
-    double y_min = 1e30;
-    for (int i = 0; i < kNumVertices; ++i) {
-      y_min = std::min(y_min, slave_->pose.X_RS2.linear().col(1).dot(bar.vertex(i) - slave_->pose.X_RS2.translation()));
-    }
-    const auto& ee = config_.end_effector;
-    acquisition_gap_ft_ = slave_->finger_gap_ft;
-    contact_gap_ft_ = std::clamp(ee.palm_half_width_ft - ee.finger_thickness_ft - y_min + kFingerContactClearanceFt,
-                                 0.0, acquisition_gap_ft_);
-    spdlog::info("acquisition: Mode 1 -> Mode 2 (finger gap {:.3f} ft, palm to bar {:.3f} ft)",
-                 c.finger_gap_ft, c.palm_to_bar_ft);
-  }
+  status_.finger_contact = c.margin_ft[2] <= kFingerContactToleranceFt;
+  if (!(c.all() && status_.finger_contact)) return;
+  status_.mode = 2;
+  status_.acquired = true;
+  X_S2P_ = slave_->pose.X_RS2.inverse() * X_RP_free_;
+  // The gap at which face e of EFF HEX 3 would touch the bar: from face b
+  // of EFF HEX 2 (at Y2 = W - t) to the bar's nearest vertex along -Y2.
+  const Eigen::Isometry3d& X_RS2 = slave_->pose.X_RS2;
+  double y_min = 1e30;
+  for (int i = 0; i < kNumVertices; ++i) y_min = std::min(y_min, X_RS2.linear().col(1).dot(bar_.vertex(i) - X_RS2.translation()));
+  const auto& ee = config_.end_effector;
+  acquisition_gap_ft_ = slave_->finger_gap_ft;
+  contact_gap_ft_ = std::clamp(ee.palm_half_width_ft - ee.finger_thickness_ft - y_min + kFingerContactClearanceFt,
+                               0.0, acquisition_gap_ft_);
+  payload_reach_ft_ = PayloadReachFt(X_S2P_);  // bounds the held payload's travel
+  spdlog::info("acquisition: Mode 1 -> Mode 2 (finger gap {:.3f} ft, palm to bar {:.3f} ft)", c.finger_gap_ft,
+               c.palm_to_bar_ft);
 }
 
 void DynamicCollisionProgram::UpdateExtraction() {
@@ -479,14 +701,16 @@ nlohmann::ordered_json DynamicCollisionProgram::SaveState() const {
   j["acquired"] = status_.acquired;
   j["docked"] = status_.docked;
   j["released"] = released_;
-  j["have_slave"] = have_slave_;
+  j["have_slave"] = started_;
   j["slave"] = CommandJson(slave_->cmd);
   j["slave_collisions"] = slave_->collisions;
   j["master"] = CommandJson(status_.master);
   j["X_S2P"] = PoseJson(X_S2P_);
   j["X_RP_docked"] = PoseJson(X_RP_docked_);
+  j["X_RP_free"] = PoseJson(X_RP_free_);
   j["contact_gap_ft"] = contact_gap_ft_;
   j["acquisition_gap_ft"] = acquisition_gap_ft_;
+  j["reset_pressed"] = reset_pressed_;
   // The slave's separating planes, the next frame's hints (frame coherence).
   nlohmann::json bar = nlohmann::json::array(), body = nlohmann::json::array();
   for (int k = 0; k < 3; ++k) {
@@ -499,47 +723,90 @@ nlohmann::ordered_json DynamicCollisionProgram::SaveState() const {
 }
 
 void DynamicCollisionProgram::RestoreState(const nlohmann::json& j) {
+  // Read every key first; change the state only when all of them are good
+  // (a refused checkpoint changes nothing). Keys added after the format's
+  // first version (X_RP_free, reset_pressed) default to the payload in the
+  // bay and the button up.
+  struct Parsed {
+    int mode = 1;
+    bool acquired = false, docked = false, released = false, have_slave = false, reset_pressed = false;
+    Eigen::Isometry3d X_S2P, X_RP_docked, X_RP_free;
+    double contact_gap_ft = 0, acquisition_gap_ft = 0;
+    ArmCommand master, slave;
+    std::uint32_t slave_collisions = 0;
+    Evaluation hints;  // only its planes
+  };
+  auto p = std::make_unique<Parsed>();
   try {
     if (j.at("format").get<std::string>() != kCheckpointFormat) {
       throw InputError("checkpoint: format '" + j.at("format").get<std::string>() + "', expected '" +
                        kCheckpointFormat + "'");
     }
-    const int mode = j.at("mode").get<int>();
-    if (mode < 1 || mode > 3) throw InputError("checkpoint: mode must be 1, 2 or 3");
-    status_.mode = mode;
-    status_.acquired = j.at("acquired").get<bool>();
-    status_.docked = j.at("docked").get<bool>();
-    released_ = j.at("released").get<bool>();
-    status_.released = released_;
-    X_S2P_ = PoseFrom(j.at("X_S2P"), "X_S2P");
-    X_RP_docked_ = PoseFrom(j.at("X_RP_docked"), "X_RP_docked");
-    contact_gap_ft_ = j.at("contact_gap_ft").get<double>();
-    acquisition_gap_ft_ = j.at("acquisition_gap_ft").get<double>();
-    status_.master = CommandFrom(j.at("master"));
-    have_slave_ = j.at("have_slave").get<bool>();
-    if (have_slave_) {
-      // The slave's evaluation follows from its command and the state above.
-      // The saved planes are the hints, as they were for the saved frame.
-      Evaluation prev;
+    p->mode = j.at("mode").get<int>();
+    if (p->mode < 1 || p->mode > 3) throw InputError("checkpoint: mode must be 1, 2 or 3");
+    p->acquired = j.at("acquired").get<bool>();
+    p->docked = j.at("docked").get<bool>();
+    p->released = j.at("released").get<bool>();
+    p->X_S2P = PoseFrom(j.at("X_S2P"), "X_S2P");
+    p->X_RP_docked = PoseFrom(j.at("X_RP_docked"), "X_RP_docked");
+    p->X_RP_free = j.contains("X_RP_free") ? PoseFrom(j.at("X_RP_free"), "X_RP_free") : X_RP_bay_;
+    p->contact_gap_ft = j.at("contact_gap_ft").get<double>();
+    p->acquisition_gap_ft = j.at("acquisition_gap_ft").get<double>();
+    p->reset_pressed = j.contains("reset_pressed") ? j.at("reset_pressed").get<bool>() : false;
+    p->master = CommandFrom(j.at("master"));
+    p->have_slave = j.at("have_slave").get<bool>();
+    if (p->have_slave) {
+      p->slave = CommandFrom(j.at("slave"));
+      p->slave_collisions = j.at("slave_collisions").get<std::uint32_t>();
       if (j.contains("planes_ee_bar")) {
         for (int k = 0; k < 3; ++k) {
-          PlaneFrom(j.at("planes_ee_bar").at(k), &prev.ee_bar[k]);
-          PlaneFrom(j.at("planes_ee_body").at(k), &prev.ee_body[k]);
+          PlaneFrom(j.at("planes_ee_bar").at(k), &p->hints.ee_bar[k]);
+          PlaneFrom(j.at("planes_ee_body").at(k), &p->hints.ee_body[k]);
         }
       }
-      Evaluate(CommandFrom(j.at("slave")), &prev, slave_);
-      slave_->collisions = j.at("slave_collisions").get<std::uint32_t>();
-      status_.slave = slave_->cmd;
-      status_.X_RS2 = slave_->pose.X_RS2;
-      status_.X_RP = slave_->X_RP;
-      status_.finger_gap_ft = slave_->finger_gap_ft;
-      RefreshMeasures();  // nothing of the frames before the restore
-    } else {
-      status_.X_RP = X_RP_bay_;
     }
   } catch (const nlohmann::json::exception& e) {
     throw InputError(std::string("checkpoint: ") + e.what());
   }
+  if (!Finite(p->master) || (p->have_slave && !Finite(p->slave)) || !p->X_S2P.matrix().allFinite() ||
+      !p->X_RP_free.matrix().allFinite() || !p->X_RP_docked.matrix().allFinite() ||
+      !std::isfinite(p->contact_gap_ft) || !std::isfinite(p->acquisition_gap_ft)) {
+    throw InputError("checkpoint: a number is not finite");
+  }
+  // All read: now the state.
+  status_.mode = p->mode;
+  status_.acquired = p->acquired;
+  status_.docked = p->docked;
+  released_ = status_.released = p->released;
+  X_S2P_ = p->X_S2P;
+  X_RP_docked_ = p->X_RP_docked;
+  contact_gap_ft_ = p->contact_gap_ft;
+  acquisition_gap_ft_ = p->acquisition_gap_ft;
+  reset_pressed_ = p->reset_pressed;
+  started_ = p->have_slave;
+  status_.master = p->master;
+  PlacePayload(p->X_RP_free);
+  payload_reach_ft_ = p->acquired ? PayloadReachFt(p->X_S2P) : 0.0;
+  // The slave's evaluation follows from its command and the state above (a
+  // checkpoint saved before the first frame: the initial pose). The saved
+  // planes are the hints, as they were for the saved frame.
+  const ArmCommand slave = p->have_slave ? p->slave : slave_->cmd;
+  Evaluate(slave, &p->hints, spare_);
+  AcceptSpare();
+  if (p->have_slave) slave_->collisions = p->slave_collisions;
+  status_.slave = slave_->cmd;
+  status_.X_RS2 = slave_->pose.X_RS2;
+  status_.X_RP = slave_->X_RP;
+  status_.finger_gap_ft = slave_->finger_gap_ft;
+  RefreshMeasures();  // nothing of the frames before the restore
+}
+
+double DynamicCollisionProgram::PayloadReachFt(const Eigen::Isometry3d& X_S2P) const {
+  // The payload in System Two: its vertices' distances from point A.
+  const PayloadModel m = MakePayload(config_.payload, X_S2P);
+  double reach = 0.0;
+  for (const Eigen::Vector3d& v : m.v) reach = std::max(reach, v.norm());
+  return reach;
 }
 
 }  // namespace rms::dcp

@@ -40,8 +40,19 @@ namespace rms::dcp {
 // The finger stops this far short of touching the bar once acquired (above
 // the finger gap word's resolution, so the bar and finger never overlap).
 inline constexpr double kFingerContactClearanceFt = 0.01;
-// Opening the finger this far past the acquisition gap releases a docked payload.
-inline constexpr double kReleaseOpeningFt = 0.05;
+// Opening the finger kReleaseOpeningFt (rms/config.h) past the acquisition
+// gap lets the payload go: at the dock, or anywhere before it.
+using rms::kReleaseOpeningFt;
+// The motion test between frames (docs/collision.md "Nothing passes
+// through"): no model vertex moves more than this in one substep (less, when
+// the thinnest tested solid is thinner than twice it).
+inline constexpr double kMaxSubstepTravelFt = 0.05;
+// A command whose motion would need more substeps than this is held and
+// reported (a jump no arm could make in a frame).
+inline constexpr int kMaxSubsteps = 4096;
+// The essential contact: acquisition needs the movable finger's face e
+// within this of the bar (docs/collision.md "The essential contact").
+inline constexpr double kFingerContactToleranceFt = 0.01;
 
 // The collision bits of the telemetry: rms/collision_bits.h (in namespace rms).
 
@@ -98,6 +109,14 @@ struct DcpStatus {
   bool released = false;               // docked and let go by the finger: the arm is free
   bool held = false;
   bool finger_held = false;
+  bool essential_contact = false;      // the movable finger closing onto the bar stopped on it (RECPT)
+  bool motion_collision = false;       // the command's pose is free but its motion from the slave's is not
+  bool too_fast = false;               // the motion needed more than kMaxSubsteps substeps: held
+  int substeps = 0;                    // poses tested for the motion this frame (1: the end pose alone)
+  bool reset_refused = false;          // a reset whose arm pose would collide with the reset scene: not taken
+  bool input_refused = false;          // a non-finite input: the frame holds the last command
+  bool let_go = false;                 // the finger opened and let the payload go before docking (Mode 1 again)
+  bool finger_contact = false;         // Mode 1: face e of EFF HEX 3 within kFingerContactToleranceFt of the BAR
   std::uint32_t collisions = 0;        // of the master's command
   std::uint32_t slave_collisions = 0;  // of the pose the slave holds
   std::array<bool, 6> acquisition{};   // the six conditions, report order (Mode 1; false after)
@@ -136,23 +155,30 @@ struct DcpOptions {
 class DynamicCollisionProgram {
  public:
   explicit DynamicCollisionProgram(const LabConfig& config, const DcpOptions& options = {});
+  // Throws rms::InputError when the initial inputs' pose collides.
   DynamicCollisionProgram(const DynamicCollisionProgram&) = delete;  // holds pointers into itself
   DynamicCollisionProgram& operator=(const DynamicCollisionProgram&) = delete;
 
   // One frame. The returned block's frame / time fields are the caller's.
+  // The master's command is tested as a motion from the slave's pose
+  // (docs/collision.md "Collision response"); a non-finite input holds.
   DcpFrameData Step(const OperatorInputs& in);
 
   // Back to the Acquisition Phase (Mode 1) and the initial state: payload in
-  // the cargo bay, nothing acquired or docked; the slave takes the next
-  // command as it is.
-  void Reset();
+  // the cargo bay, nothing acquired or docked; the arm stays where it is.
+  // Refused (returns false, nothing changed) when the arm where it is would
+  // collide with the payload back in the bay. Step acts on the reset
+  // button's press, not on each frame it is held.
+  bool Reset();
 
   // A checkpoint (docs/sessions.md "Freeze, run, step, checkpoint"): the
   // program's whole state -- mode, acquired, docked, released, the slave
-  // arm's pose, the payload's attachment and docked pose, the finger's
-  // limits -- as JSON, doubles exact. Restore() refuses a document of
-  // another format with rms::InputError naming what is wrong; after it the
-  // program continues as it would have from the saved frame.
+  // arm's pose, the payload's attachment, free and docked poses, the
+  // finger's limits, the reset button -- as JSON, doubles exact.
+  // RestoreState refuses a document of another format, or missing or
+  // malformed keys, with rms::InputError naming what is wrong, and then
+  // changes nothing; after it the program continues as it would have from
+  // the saved frame.
   nlohmann::ordered_json SaveState() const;
   void RestoreState(const nlohmann::json& state);
 
@@ -181,6 +207,27 @@ class DynamicCollisionProgram {
   // the hints (frame coherence); null: none. e->ee is left as it was outside
   // Mode 1 (only Mode 1 reads it).
   void Evaluate(const ArmCommand& cmd, const Evaluation* prev, Evaluation* e) const;
+  // The payload's and probe's vertices against the bay's walls and bottom
+  // (a vertex below face c beyond one), Modes 2 and 3.
+  std::uint32_t BayCollisions(const PayloadModel& p) const;
+  // The motion from `from` to `to` (joint angles, height and finger linear
+  // in between): the end pose into *out, then substeps so that no model
+  // vertex moves more than substep_ft_ between two tested poses. Returns the
+  // first collision bits found (0: the whole motion is free).
+  std::uint32_t TestMotion(const ArmCommand& from, const ArmCommand& to, Evaluation* out);
+  // The number of poses the motion needs (1: the end pose alone), or -1
+  // beyond kMaxSubsteps.
+  int Substeps(const ArmCommand& from, const ArmCommand& to) const;
+  // The command with the arm where the slave is and the finger closed (or
+  // opened) toward `finger` as far as it goes free, to within 1e-5 ft of
+  // the first contact. Returns the contact's collision bits (0: none).
+  std::uint32_t MoveFinger(double finger);
+  // What the slave does with the command: follows, holds, or holds the finger.
+  void Respond(const ArmCommand& command);
+  // Opening the finger before docking: the payload stays where it is (Mode 1).
+  void LetGo();
+  // The payload not held (Mode 1): its pose and models.
+  void PlacePayload(const Eigen::Isometry3d& X_RP);
   // The spare evaluation becomes the slave's (two buffers, no copy).
   void AcceptSpare();
   void UpdateAcquisition();
@@ -191,22 +238,37 @@ class DynamicCollisionProgram {
   void RefreshMeasures();
   void UpdatePlanes();
   double BayClearance(const PayloadModel& p) const;
+  // The largest distance of a moving model vertex from the shoulder, ft:
+  // bounds a vertex's travel per radian of any joint.
+  double ReachFt() const;
+  // A held payload's farthest vertex from point A, ft.
+  double PayloadReachFt(const Eigen::Isometry3d& X_S2P) const;
 
   const LabConfig& config_;
   DcpOptions options_;
   double tau_rel_ = 1e-12;
-  // Fixed models: the payload in the bay (Mode 1), the bay, the CAE.
+  // Fixed models: the payload in the bay (its pose at start and reset), the
+  // bay, the CAE.
   Eigen::Isometry3d X_RP_bay_;
-  Hexahedron bar_bay_;
-  PayloadModel payload_bay_;
   Hexahedron bay_;
   Hexahedron cae_;
-  // State.
-  bool have_slave_ = false;
-  std::array<Evaluation, 2> evaluations_;
+  double substep_ft_ = kMaxSubstepTravelFt;
+  // The payload where it rests when not held (Mode 1): in the bay, or where
+  // the finger let it go. Its BAR, body and the BAR's posts.
+  Eigen::Isometry3d X_RP_free_;
+  Hexahedron bar_;
+  PayloadModel payload_;
+  std::array<Hexahedron, 2> posts_{};
+  int post_count_ = 0;
+  // State. The slave starts at the initial inputs' pose (config [inputs]).
+  bool reset_pressed_ = false;  // the reset button as last seen (Step acts on its press)
+  bool started_ = false;        // a frame has been made: commands are motions from the slave's pose
+  std::array<Evaluation, 3> evaluations_;
   Evaluation* slave_ = &evaluations_[0];  // the slave's (collision-free) evaluation
   Evaluation* spare_ = &evaluations_[1];  // this frame's candidate
+  Evaluation* scratch_ = &evaluations_[2];  // substeps
   Eigen::Isometry3d X_S2P_ = Eigen::Isometry3d::Identity();       // payload in System Two, from acquisition
+  double payload_reach_ft_ = 0.0;  // held payload's farthest vertex from point A (travel bound)
   // Once acquired, the finger holds the bar: its gap stays between the gap at
   // which it touches the bar and the gap at acquisition.
   double contact_gap_ft_ = 0.0;

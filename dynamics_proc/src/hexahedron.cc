@@ -11,6 +11,21 @@ namespace rms::dcp {
 
 char FaceLetter(int f) { return static_cast<char>('a' + f); }
 
+const char* HexProblemName(HexProblem p) {
+  switch (p) {
+    case HexProblem::kNone: return "valid";
+    case HexProblem::kNonFinite: return "a coordinate is not finite";
+    case HexProblem::kOverflow: return "a coordinate beyond 1e100 ft (its products would overflow)";
+    case HexProblem::kTooSmall: return "smaller than 1e-100 ft (its products would underflow)";
+    case HexProblem::kBadDimension: return "a length or half-width not positive";
+    case HexProblem::kDegenerateFace: return "a face has no area";
+    case HexProblem::kFlat: return "flat: thinner than the rounding tolerance at its coordinates";
+    case HexProblem::kTwisted: return "twisted: its faces disagree on the outward side";
+    case HexProblem::kNonConvex: return "not convex: a vertex beyond a face's plane";
+  }
+  return "?";
+}
+
 LocationWord Hexahedron::Word(double px, double py, double pz, double tau) const {
   LocationWord w = 0;
   for (int f = 0; f < kNumFaces; ++f) {
@@ -160,8 +175,9 @@ void SetFace(Hexahedron* h, int f, const Eigen::Vector3d& n, double d) {
   h->d[f] = d;
 }
 
-// Edge lengths, scale and the finiteness check, common to both builders.
-bool Finish(Hexahedron* h) {
+// Scale, bounds, magnitude and the finiteness and range checks, common to
+// both builders.
+HexProblem Finish(Hexahedron* h) {
   double lo[3] = {h->x[0], h->y[0], h->z[0]}, hi[3] = {h->x[0], h->y[0], h->z[0]};
   // Finite: x * 0 is 0 for a finite x and NaN otherwise; one sum, no branch.
   double zero = 0.0;
@@ -175,6 +191,8 @@ bool Finish(Hexahedron* h) {
   }
   for (int f = 0; f < kNumFaces; ++f) zero += (h->nx[f] + h->ny[f] + h->nz[f] + h->d[f]) * 0.0;
   const bool finite = zero == 0.0;
+  h->magnitude = 0.0;
+  for (int k = 0; k < 3; ++k) h->magnitude = std::max({h->magnitude, std::abs(lo[k]), std::abs(hi[k])});
   h->scale = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                        (hi[2] - lo[2]) * (hi[2] - lo[2]));
   h->cx = 0.5 * (lo[0] + hi[0]);
@@ -189,7 +207,18 @@ bool Finish(Hexahedron* h) {
   h->hx = 0.5 * (hi[0] - lo[0]);
   h->hy = 0.5 * (hi[1] - lo[1]);
   h->hz = 0.5 * (hi[2] - lo[2]);
-  return finite && std::isfinite(h->scale) && h->scale > 0.0;
+  if (!finite) return HexProblem::kNonFinite;
+  if (!(h->magnitude <= kMaxCoordinateFt) || !std::isfinite(h->scale)) return HexProblem::kOverflow;
+  if (!(h->scale >= kMinScaleFt)) return HexProblem::kTooSmall;
+  return HexProblem::kNone;
+}
+
+// The rounding tolerance of the builders' checks, ft (docs/collision.md).
+double ShapeTolerance(const Hexahedron& h) { return 1e-9 * h.scale + kRoundingPerFt * h.magnitude; }
+
+void SetValidity(Hexahedron* h, HexProblem p) {
+  h->problem = p;
+  h->valid = p == HexProblem::kNone;
 }
 
 }  // namespace
@@ -219,54 +248,81 @@ Hexahedron MakeBox(const Eigen::Vector3d& p_A, const Eigen::Vector3d& U, const E
   SetFace(&h, kFaceF, W, wa + half_w);
   h.handedness = U.dot(V.cross(W)) >= 0 ? 1.0 : -1.0;
   h.parallel_opposites = true;  // the normals above are exact negatives
-  h.valid = Finish(&h) && length > 0 && half_v > 0 && half_w > 0;
+  HexProblem problem = Finish(&h);
+  if (problem == HexProblem::kNone) {
+    if (!(length > 0 && half_v > 0 && half_w > 0)) problem = HexProblem::kBadDimension;
+    else if (std::min({length, 2 * half_v, 2 * half_w}) <= ShapeTolerance(h)) problem = HexProblem::kFlat;
+  }
+  SetValidity(&h, problem);
   return h;
 }
 
 Hexahedron FromVertices(const std::array<Eigen::Vector3d, 8>& v) {
   Hexahedron h;
   for (int i = 0; i < kNumVertices; ++i) SetVertex(&h, i, v[i]);
+  HexProblem problem = Finish(&h);
+  if (problem != HexProblem::kNone) {
+    SetValidity(&h, problem);
+    return h;
+  }
+  // Faces from differences of vertices (accurate at any distance from the
+  // origin), about the first vertex.
+  const Eigen::Vector3d o = v[0];
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (const auto& p : v) centroid += p;
+  for (const auto& p : v) centroid += p - o;
   centroid /= 8.0;
   int inward = 0;
-  bool ok = true;
+  double volume6 = 0.0, largest_area2 = 0.0;  // six times the volume; twice the largest face's area
+  std::array<double, 6> d_o{};                // each face's offset about o
   for (int f = 0; f < kNumFaces; ++f) {
     const auto& fv = kFaceVertices[f];
     Eigen::Vector3d n = (v[fv[2]] - v[fv[0]]).cross(v[fv[3]] - v[fv[1]]);
     const double len = n.norm();
     if (!(len > 0) || !std::isfinite(len)) {
-      ok = false;
-      n = Eigen::Vector3d::UnitZ();
-    } else {
-      n /= len;
+      SetValidity(&h, HexProblem::kDegenerateFace);
+      return h;
     }
-    const Eigen::Vector3d mid = 0.25 * (v[fv[0]] + v[fv[1]] + v[fv[2]] + v[fv[3]]);
+    n /= len;
+    const Eigen::Vector3d mid = 0.25 * ((v[fv[0]] - o) + (v[fv[1]] - o) + (v[fv[2]] - o) + (v[fv[3]] - o));
     if (n.dot(mid - centroid) < 0) {
       n = -n;
       ++inward;
     }
-    SetFace(&h, f, n, n.dot(mid));
+    // The pyramid from the centroid over the face: its height times twice
+    // the face's area (a quadrilateral's area is half its diagonals' cross
+    // product); the six summed are six times the volume.
+    volume6 += n.dot(mid - centroid) * len;
+    d_o[f] = n.dot(mid);
+    largest_area2 = std::max(largest_area2, len);
+    SetFace(&h, f, n, n.dot(mid) + n.dot(o));
   }
   // Every face's diagonal normal points inward for a mirrored hexahedron,
   // none for a right-handed one; a mixture is a twisted, invalid solid.
-  if (inward != 0 && inward != kNumFaces) ok = false;
+  if (inward != 0 && inward != kNumFaces) {
+    SetValidity(&h, HexProblem::kTwisted);
+    return h;
+  }
   h.handedness = inward == kNumFaces ? -1.0 : 1.0;
-  ok = Finish(&h) && ok;
+  const double tol = ShapeTolerance(h);
+  // Flat: the volume over the largest face's area is the solid's thickness
+  // (exactly, for a box), = volume6 / (3 largest_area2).
+  if (!(volume6 / (3.0 * largest_area2) > tol)) {
+    SetValidity(&h, HexProblem::kFlat);
+    return h;
+  }
   // Convex: every vertex on the FALSE side of (or on) every face's plane,
-  // within the rounding of non-planar faces.
-  if (ok) {
-    const double tol = 1e-9 * h.scale;
-    for (int f = 0; f < kNumFaces && ok; ++f) {
-      for (int i = 0; i < kNumVertices; ++i) {
-        if (h.Beyond(f, h.x[i], h.y[i], h.z[i]) > tol) {
-          ok = false;
-          break;
-        }
+  // within the rounding of non-planar faces and of the coordinates.
+  for (int f = 0; f < kNumFaces; ++f) {
+    for (int i = 0; i < kNumVertices; ++i) {
+      const double beyond = h.nx[f] * (h.x[i] - o.x()) + h.ny[f] * (h.y[i] - o.y()) + h.nz[f] * (h.z[i] - o.z()) -
+                            d_o[f];
+      if (beyond > tol) {
+        SetValidity(&h, HexProblem::kNonConvex);
+        return h;
       }
     }
   }
-  h.valid = ok;
+  SetValidity(&h, HexProblem::kNone);
   return h;
 }
 

@@ -29,6 +29,27 @@ inline constexpr int kNumFaces = 6;
 inline constexpr int kNumVertices = 8;
 inline constexpr int kNumEdges = 12;
 
+// Why a hexahedron is refused (docs/collision.md "Tolerance rule"): a test on
+// it is an error, never a verdict. kNone: valid.
+enum class HexProblem : std::uint8_t {
+  kNone,
+  kNonFinite,       // a coordinate is NaN or infinite
+  kOverflow,        // a coordinate beyond kMaxCoordinateFt: its products would overflow
+  kTooSmall,        // smaller than kMinScaleFt: its products would underflow
+  kBadDimension,    // MakeBox: a length or half-width not positive
+  kDegenerateFace,  // a face with no area (its diagonals parallel)
+  kFlat,            // thinner than the rounding tolerance at its coordinates
+  kTwisted,         // the faces disagree on which side is outward
+  kNonConvex,       // a vertex beyond a face's plane by more than the rounding tolerance
+};
+const char* HexProblemName(HexProblem p);
+inline constexpr double kMaxCoordinateFt = 1e100;
+inline constexpr double kMinScaleFt = 1e-100;
+// The rounding tolerance of a solid at coordinates of magnitude M ft is
+// kRoundingPerFt x M: what double rounding of the vertices, the face planes
+// and one projection can do there (32 units of 2^-52; docs/collision.md).
+inline constexpr double kRoundingPerFt = 32.0 * 2.220446049250313e-16;
+
 // Six bits, bit f for face f (bit 0 = a ... bit 5 = f).
 using LocationWord = std::uint8_t;
 // The eight location words from six face masks (bit i of masks[f]: vertex i
@@ -71,6 +92,9 @@ struct Hexahedron {
   std::array<double, 6> nx{}, ny{}, nz{}, d{};
   // The bounding box's diagonal, ft: the hexahedron's scale for tolerances.
   double scale = 0.0;
+  // The largest absolute coordinate of a vertex, ft: the magnitude at which
+  // its numbers are rounded (tolerances, docs/collision.md).
+  double magnitude = 0.0;
   // A bounding sphere (centre of the bounding box, radius to the farthest
   // vertex), ft: for rejecting pairs far apart before the report's test.
   double cx = 0.0, cy = 0.0, cz = 0.0, radius = 0.0;
@@ -83,8 +107,9 @@ struct Hexahedron {
   // exactly): one dot product a vertex serves both faces of a pair.
   bool parallel_opposites = false;
   // Every number above finite, the solid well-formed. A collision test on an
-  // invalid hexahedron is an error, never a verdict.
+  // invalid hexahedron is an error, never a verdict; `problem` says why.
   bool valid = false;
+  HexProblem problem = HexProblem::kNonFinite;
 
   Eigen::Vector3d vertex(int i) const { return {x[i], y[i], z[i]}; }
   Eigen::Vector3d normal(int f) const { return {nx[f], ny[f], nz[f]}; }
@@ -114,8 +139,12 @@ Hexahedron MakeBox(const Eigen::Vector3d& p_A, const Eigen::Vector3d& U, const E
 
 // A general convex hexahedron from its eight vertices in the standard
 // numbering (frusta, skewed boxes, the CAE's front half). Each face's normal
-// comes from its diagonals; the result is invalid (valid == false) when a
-// coordinate is not finite, a face is degenerate, or the solid is not convex.
+// comes from its diagonals; the result is invalid (valid == false, problem
+// says why) when a coordinate is not finite or too large, a face is
+// degenerate, the solid is flat, twisted or not convex. Flatness and
+// convexity are judged against the rounding tolerance at the solid's
+// coordinates (1e-9 x scale + kRoundingPerFt x magnitude), so a small solid
+// far from the origin is answered like the same solid at the origin.
 Hexahedron FromVertices(const std::array<Eigen::Vector3d, 8>& v);
 
 }  // namespace rms::dcp

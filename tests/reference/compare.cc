@@ -41,7 +41,24 @@ CompareStats Compare(std::uint64_t seed, long count, double band_rel, int exact_
     // Every third block of 8 draws from all ten kinds (three of them general
     // hexahedra), the rest from the seven box kinds: 10% general in all.
     const bool boxes_only = (n / 8) % 3 != 2;
-    const Pair p = gen.Next(scale, boxes_only);
+    // Every 7th pair: two boxes with nearly parallel edges, gap or overlap
+    // from just outside the band to 100x it (or inside it, one in 8). Every
+    // 5th pair of scale <= 1 ft is moved 1 to 1e4 ft from the origin.
+    Pair p;
+    if (n % 7 == 3) {
+      std::uniform_real_distribution<double> lg(0.0, 2.0);
+      std::uniform_int_distribution<int> sg(0, 15);
+      const int k = sg(gen.rng());
+      const double mag = (k < 2 ? 0.5 : 1.01) * band_rel * std::pow(10.0, k < 2 ? -lg(gen.rng()) : lg(gen.rng()));
+      p = gen.NearParallelEdges(scale, k % 2 ? mag : -mag);
+    } else {
+      p = gen.Next(scale, boxes_only);
+    }
+    if (n % 5 == 1 && scale <= 1.0) {
+      std::uniform_real_distribution<double> lg(0.0, 4.0);
+      const Eigen::Vector3d dir = RandomRotation(gen.rng()).col(0);
+      p = Translated(p, std::pow(10.0, lg(gen.rng())) * dir);
+    }
     ++st.pairs;
     ++st.pairs_by_kind[p.kind];
 
@@ -51,7 +68,7 @@ CompareStats Compare(std::uint64_t seed, long count, double band_rel, int exact_
     bool ref_hit;
     if (p.a.is_box && p.b.is_box) {
       ref_hit = BoxesIntersect(p.a.box, p.b.box);
-      if (exact_every > 0 && n % exact_every == 0) {
+      if ((exact_every > 0 && n % exact_every == 0) || p.kind.rfind("near-parallel", 0) == 0) {
         ++st.exact_checked;
         const bool exact = ExactHullsIntersect(p.a.v, p.b.v);
         if (exact != ref_hit) ref_hit = exact;  // near contact the long double test may differ; exact wins
@@ -65,9 +82,15 @@ CompareStats Compare(std::uint64_t seed, long count, double band_rel, int exact_
     st.ref_seconds += std::chrono::duration<double>(t2 - t1).count();
     ++st.deciders[DeciderName(r.decider)];
     st.collide += ref_hit;
+    // The band (docs/collision.md "Tolerance rule"): 1000 x tau.
+    const double band = 1000.0 * dcp::ToleranceFt(p.a.hex, p.b.hex, band_rel / 1000.0);
     const double s = std::max(p.a.hex.scale, p.b.hex.scale);
     if (r.verdict == dcp::Verdict::kInvalid) {
       ++st.invalid;
+      if (st.examples.size() < 10) {
+        st.examples.push_back("pair " + std::to_string(n) + " (" + p.kind + ", scale " + std::to_string(scale) +
+                              "): invalid: " + dcp::HexProblemName(p.a.hex.valid ? p.b.hex.problem : p.a.hex.problem));
+      }
       continue;
     }
     const bool dcp_hit = r.verdict == dcp::Verdict::kCollide;
@@ -79,7 +102,7 @@ CompareStats Compare(std::uint64_t seed, long count, double band_rel, int exact_
     };
     if (dcp_hit != ref_hit) {
       const double sep = separation();
-      if (std::abs(sep) <= band_rel * s) {
+      if (std::abs(sep) <= band) {
         ++st.disagree_in_band;
         ++st.in_band_by_kind[p.kind];
       } else {
@@ -89,17 +112,17 @@ CompareStats Compare(std::uint64_t seed, long count, double band_rel, int exact_
           os.precision(17);
           os << "pair " << n << " (" << p.kind << ", scale " << scale << "): dcp " << (dcp_hit ? "collide" : "separate")
              << " by '" << DeciderName(r.decider) << "', reference " << (ref_hit ? "intersect" : "disjoint")
-             << ", separation " << sep << " = " << sep / s << " x scale";
+             << ", separation " << sep << " = " << sep / s << " x scale (band " << band / s << " x scale)";
           st.examples.push_back(os.str());
         }
       }
     } else if (!dcp_hit) {
       // Separate: the plane must separate the solids (within the band).
       if (!r.plane_valid) {
-        if (separation() > band_rel * s) ++st.plane_missing;
+        if (separation() > band) ++st.plane_missing;
       } else {
         dcp::Hexahedron a = p.a.hex, b = p.b.hex;
-        if (!dcp::PlaneSeparates(a, b, r.n, r.d, band_rel * s)) ++st.plane_wrong;
+        if (!dcp::PlaneSeparates(a, b, r.n, r.d, band)) ++st.plane_wrong;
       }
     }
   }

@@ -90,6 +90,29 @@ inline Eigen::Matrix3d RandomShear(std::mt19937_64& rng, double amount) {
   return RandomRotation(rng) * S;
 }
 
+// The same pair moved by `offset` ft (a small solid far from the origin:
+// its coordinates rounded at the offset's magnitude). Boxes are rebuilt the
+// report's way at the new centre; general hexahedra from the moved vertices.
+inline Pair Translated(const Pair& p, const Eigen::Vector3d& offset) {
+  auto move = [&](const Solid& s) {
+    if (s.is_box) {
+      Eigen::Matrix3d R;
+      Eigen::Vector3d half;
+      for (int k = 0; k < 3; ++k) {
+        R.col(k) = s.box.axis[k].cast<double>();
+        half[k] = static_cast<double>(s.box.half[k]);
+      }
+      Solid t = Box(s.box.centre.cast<double>() + offset, R, half);
+      return t;
+    }
+    Solid t = s;
+    for (auto& v : t.v) v += offset;
+    t.hex = dcp::FromVertices(t.v);
+    return t;
+  };
+  return {move(p.a), move(p.b), p.kind + ", far out"};
+}
+
 // The mix of cases, at `scale` ft. kind selects the family; the generator
 // picks one of them per call in a fixed rotation.
 class PairGenerator {
@@ -114,6 +137,38 @@ class PairGenerator {
   }
 
   std::mt19937_64& rng() { return rng_; }
+
+  // Two boxes whose closest features are an edge of each, the edges at an
+  // angle of 1e-7 to 1e-2 rad (either sign) and `gap` apart along their
+  // common normal (gap < 0: overlapping by about -gap). The edge of B along
+  // its x axis at (y, z) = (+hb.y, +hb.z); the common normal n = (y + z)/sqrt 2;
+  // A's edge crosses over B's at the middle of both, A lying beyond n from
+  // it with its two faces at the edge at 45 deg to n, so the boxes' distance
+  // is exactly `gap` when gap > 0.
+  Pair NearParallelEdges(double s, double gap_rel) {
+    std::uniform_real_distribution<double> lg(-7.0, -2.0), u(-0.7, 0.7);
+    std::uniform_int_distribution<int> sg(0, 1);
+    const double theta = (sg(rng_) ? 1 : -1) * std::pow(10.0, lg(rng_));
+    const Eigen::Vector3d ha = RandomHalf(s), hb = RandomHalf(s);
+    const Eigen::Vector3d n = Eigen::Vector3d(0, 1, 1).normalized();
+    const Eigen::Vector3d m = n.cross(Eigen::Vector3d::UnitX());
+    const Eigen::Vector3d w = std::cos(theta) * Eigen::Vector3d::UnitX() + std::sin(theta) * m;
+    const Eigen::Vector3d q = w.cross(n);
+    Eigen::Matrix3d Ra;
+    Ra.col(0) = w;
+    Ra.col(1) = (n - q) / std::sqrt(2.0);
+    Ra.col(2) = (n + q) / std::sqrt(2.0);
+    // Gap relative to the pair's largest possible bounding-box diagonal
+    // (2 sqrt 3 |half|), so |gap_rel| >= band means outside the band.
+    const double diag = 2 * std::sqrt(3.0) * std::max(ha.norm(), hb.norm());
+    const double gap = gap_rel * diag;
+    const Eigen::Vector3d on_b(u(rng_) * hb.x(), hb.y(), hb.z());
+    const Eigen::Vector3d edge_a = on_b + gap * n;
+    const Eigen::Vector3d ca = edge_a + ha.y() * Ra.col(1) + ha.z() * Ra.col(2);
+    const Eigen::Matrix3d R = RandomRotation(rng_);
+    const Eigen::Vector3d cb = RandomPos(s);
+    return {Box(cb + R * ca, R * Ra, ha), Box(cb, R, hb), "near-parallel edges"};
+  }
 
  private:
   Eigen::Vector3d RandomHalf(double scale) {

@@ -161,6 +161,98 @@ TEST(Collide, NonFiniteInputIsAnErrorNotAVerdict) {
   }
 }
 
+TEST(Collide, NearParallelEdgesJustOutsideTheBandGetTheExactVerdict) {
+  // Edges at 1e-7 .. 1e-2 rad, 1.5 to 3 band widths apart or overlapping.
+  // The old tolerance (T_j against tau |e| |V|) grew as 1/sin(angle) and
+  // called about 5% of the apart ones collisions.
+  const std::uint64_t seed = 20261202;
+  std::printf("seed %llu\n", static_cast<unsigned long long>(seed));
+  ref::PairGenerator gen(seed);
+  std::uniform_real_distribution<double> k(1.5, 3.0);
+  int wrong = 0, pairs = 0;
+  for (double scale : {1e-3, 1.0, 1e4}) {
+    for (int i = 0; i < 2000; ++i) {
+      const bool apart = i % 2 == 0;
+      const ref::Pair p = gen.NearParallelEdges(scale, (apart ? 1 : -1) * k(gen.rng()) * 1e-9);
+      const CollisionResult r = Collide(p.a.hex, p.b.hex);
+      ASSERT_NE(r.verdict, Verdict::kInvalid);
+      ++pairs;
+      if ((r.verdict == Verdict::kCollide) == apart) {
+        if (++wrong < 5) ADD_FAILURE() << "scale " << scale << " pair " << i << (apart ? " apart" : " overlapping");
+      }
+    }
+  }
+  EXPECT_EQ(wrong, 0) << "of " << pairs;
+}
+
+TEST(Hexahedron, SmallSolidsFarFromTheOriginAreAnsweredAndDegenerateOnesRefusedWithTheReason) {
+  // 0.001 ft solids at 1e4 ft: a bolt far out in the Reference frame.
+  const std::uint64_t seed = 977;
+  std::printf("seed %llu\n", static_cast<unsigned long long>(seed));
+  std::mt19937_64 rng(seed);
+  for (int i = 0; i < 500; ++i) {
+    const Vector3d at = 1e4 * ref::RandomRotation(rng).col(0);
+    const ref::Solid g = ref::General(at, ref::RandomShear(rng, 0.5), Vector3d(5e-4, 3e-4, 4e-4), 0.7);
+    ASSERT_TRUE(g.hex.valid) << i << ": " << HexProblemName(g.hex.problem);
+    const ref::Solid b = ref::Box(at, ref::RandomRotation(rng), Vector3d(5e-4, 2e-4, 3e-4));
+    ASSERT_TRUE(b.hex.valid) << i << ": " << HexProblemName(b.hex.problem);
+    // A copy moved by 2 x its size is separate; by a tenth of it, collides.
+    const ref::Solid far = ref::Box(at + Vector3d(2e-3, 0, 0), ref::RandomRotation(rng), Vector3d(5e-4, 2e-4, 3e-4));
+    const ref::Solid near = ref::Box(at + Vector3d(1e-4, 0, 0), ref::RandomRotation(rng), Vector3d(5e-4, 2e-4, 3e-4));
+    EXPECT_EQ(Collide(b.hex, far.hex).verdict, Verdict::kSeparate);
+    EXPECT_EQ(Collide(b.hex, near.hex).verdict, Verdict::kCollide);
+  }
+  // Degenerate solids, near and far, each refused with its reason.
+  for (const Vector3d& at : {Vector3d(0, 0, 0), Vector3d(1e4, -1e4, 1e4)}) {
+    std::array<Vector3d, 8> cube;
+    for (int i = 0; i < 8; ++i)
+      cube[i] = at + 1e-3 * Vector3d(ref::kVertexSigns[i][0], ref::kVertexSigns[i][1], ref::kVertexSigns[i][2]);
+    EXPECT_EQ(FromVertices(cube).problem, HexProblem::kNone);
+    auto flat = cube;
+    for (auto& v : flat) v.z() = at.z();
+    EXPECT_EQ(FromVertices(flat).problem, HexProblem::kDegenerateFace);
+    auto thin = cube;  // 1e-18 thick: below what rounding resolves at 1e4 ft (and 1e-9 x scale at 0)
+    for (int i = 0; i < 8; ++i) thin[i].z() = at.z() + (ref::kVertexSigns[i][2] > 0 ? 1e-18 * std::max(1.0, at.norm()) : 0.0);
+    const HexProblem tp = FromVertices(thin).problem;
+    EXPECT_TRUE(tp == HexProblem::kFlat || tp == HexProblem::kDegenerateFace) << HexProblemName(tp);
+    auto twisted = cube;
+    std::swap(twisted[0], twisted[2]);
+    EXPECT_NE(FromVertices(twisted).problem, HexProblem::kNone);
+    auto dented = cube;  // v1 pushed in along the diagonal: faces a, b, c bend inward
+    dented[0] = at + 0.2e-3 * Vector3d(-1, -1, -1);
+    EXPECT_EQ(FromVertices(dented).problem, HexProblem::kNonConvex);
+    auto nan = cube;
+    nan[3].y() = std::nan("");
+    EXPECT_EQ(FromVertices(nan).problem, HexProblem::kNonFinite);
+    auto huge = cube;
+    huge[5] = Vector3d(1e200, 0, 0);
+    EXPECT_EQ(FromVertices(huge).problem, HexProblem::kOverflow);
+  }
+  EXPECT_STREQ(HexProblemName(HexProblem::kNonConvex), "not convex: a vertex beyond a face's plane");
+  EXPECT_EQ(MakeBox(Vector3d::Zero(), Vector3d::UnitX(), Vector3d::UnitY(), Vector3d::UnitZ(), 0.0, 1, 1).problem,
+            HexProblem::kBadDimension);
+  EXPECT_EQ(MakeBox(Vector3d(1e4, 0, 0), Vector3d::UnitX(), Vector3d::UnitY(), Vector3d::UnitZ(), 1e-14, 1, 1).problem,
+            HexProblem::kFlat);
+}
+
+TEST(Collide, TheHintCannotChangeAVerdict) {
+  // Exactly touching faces collide; their common plane as the hint must not
+  // call them separate.
+  const Hexahedron a = AxisBox(Vector3d(0, 0, 0), Vector3d(1, 1, 1));
+  const Hexahedron b = AxisBox(Vector3d(1, 0, 0), Vector3d(2, 1, 1));
+  SeparatingPlaneHint hint{Vector3d::UnitX(), 1.0};
+  CollideOptions o;
+  o.hint = &hint;
+  o.sphere_reject = o.aabb_reject = false;  // the hint first
+  const CollisionResult r = Collide(a, b, o);
+  EXPECT_EQ(r.verdict, Verdict::kCollide);
+  EXPECT_NE(r.decider, Decider::kHintPlane);
+  // Apart by 1e-6, the hint decides.
+  const Hexahedron c = AxisBox(Vector3d(1 + 1e-6, 0, 0), Vector3d(2, 1, 1));
+  hint.d = 1 + 5e-7;
+  EXPECT_EQ(Collide(a, c, o).decider, Decider::kHintPlane);
+}
+
 TEST(Collide, TheCompiledFaceListsCoverEveryCombination) {
   for (int m = 0; m < 64; ++m) {
     int bits = 0;

@@ -110,7 +110,9 @@ TEST_F(Dcp, EachConditionsMarginAgreesWithItAndIsADistance) {
     const AcquisitionCheck c = Check(X, gap);
     for (int i = 0; i < 6; ++i) {
       if (std::abs(c.margin_ft[i]) < 1e-9) continue;
-      EXPECT_EQ(c.holds[i], c.margin_ft[i] > 0) << "pose " << k << " condition " << i + 1 << " margin " << c.margin_ft[i];
+      // Condition 3 allows the bar within the contact tolerance behind face e.
+      const double threshold = i == 2 ? -kFingerContactToleranceFt : 0.0;
+      EXPECT_EQ(c.holds[i], c.margin_ft[i] > threshold) << "pose " << k << " condition " << i + 1 << " margin " << c.margin_ft[i];
       ++checked;
     }
   }
