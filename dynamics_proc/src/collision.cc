@@ -181,6 +181,13 @@ bool PlaneSeparates(const Hexahedron& a, const Hexahedron& b, const Eigen::Vecto
   return ahi <= d + tol && blo >= d - tol;
 }
 
+double GapAlong(const Hexahedron& a, const Hexahedron& b, const Eigen::Vector3d& n) {
+  double alo, ahi, blo, bhi;
+  ProjectionRange(a, n, &alo, &ahi);
+  ProjectionRange(b, n, &blo, &bhi);
+  return blo - ahi;
+}
+
 double MidGapOffset(const Hexahedron& a, const Hexahedron& b, const Eigen::Vector3d& n) {
   double alo, ahi, blo, bhi;
   ProjectionRange(a, n, &alo, &ahi);

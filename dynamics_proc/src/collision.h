@@ -108,6 +108,11 @@ double ToleranceFt(const Hexahedron& a, const Hexahedron& b, double relative_tol
 bool PlaneSeparates(const Hexahedron& a, const Hexahedron& b, const Eigen::Vector3d& n, double d,
                     double tol);
 
+// The gap between A (below) and B (above) along the unit normal n: min over
+// B of n . p less max over A: a lower bound on the distance between the
+// solids when positive (docs/collision.md "Nothing passes through").
+double GapAlong(const Hexahedron& a, const Hexahedron& b, const Eigen::Vector3d& n);
+
 // The offset d that puts the plane n . p = d midway in the gap between A
 // (below) and B (above) along n: (max over A + min over B) / 2. The DCP
 // sends its planes centred so that rounding to the 24-bit plane words

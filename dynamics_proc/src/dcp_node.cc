@@ -216,6 +216,13 @@ void DcpNode::Report(const DcpStatus& st, std::int64_t frame) {
   counters_.Set("mode", st.mode);
   if (st.held) counters_.Add("frames.held");
   if (st.finger_held) counters_.Add("frames.finger_held");
+  // docs/collision.md "Collision response": what the DCP refused.
+  if (st.motion_collision) counters_.Add("frames.motion_held");
+  if (st.too_fast) counters_.Add("frames.too_fast");
+  if (st.essential_contact) counters_.Add("frames.essential_contact");
+  if (st.input_refused) counters_.Add("inputs.non_finite");
+  if (st.reset_refused) counters_.Add("resets.refused");
+  if (st.let_go) counters_.Add("grasps.let_go");
   for (int b = 0; b < collision_bits::kCount; ++b) {
     if (st.collisions & (1u << b)) counters_.Add(std::string("collision_frames.") + CollisionName(b));
   }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <spdlog/spdlog.h>
 
@@ -137,15 +138,30 @@ ArmCommand Lerp(const ArmCommand& a, const ArmCommand& b, double t) {
 
 }  // namespace
 
-std::uint32_t DynamicCollisionProgram::BayCollisions(const PayloadModel& p) const {
+std::uint32_t DynamicCollisionProgram::BayCollisions(const PayloadModel& p, double* clearance_ft) const {
   const double tau = tau_rel_ * bay_.scale;
   std::uint32_t bits = 0;
   for (const Eigen::Vector3d& v : p.v) {
     const LocationWord w = bay_.Word(v, tau);
     if (!(w & FaceBit(kFaceC))) bits |= static_cast<std::uint32_t>(w) << 6;
+    // The distance to "below face c and beyond a wall or the bottom" is at
+    // least, for the nearest wall, the larger of the height above c and the
+    // depth inside that wall.
+    const double above = bay_.Beyond(kFaceC, v.x(), v.y(), v.z());
+    for (int f : {kFaceA, kFaceB, kFaceD, kFaceE, kFaceF}) {
+      *clearance_ft = std::min(*clearance_ft, std::max(above, -bay_.Beyond(f, v.x(), v.y(), v.z())));
+    }
   }
   return bits;
 }
+
+namespace {
+// A pair's gap lower bound from its separating plane (0: colliding or none).
+double PairGap(const CollisionResult& r, const Hexahedron& a, const Hexahedron& b) {
+  if (r.verdict != Verdict::kSeparate || !r.plane_valid) return 0.0;
+  return std::max(0.0, GapAlong(a, b, r.n));
+}
+}  // namespace
 
 void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* prev, Evaluation* out) const {
   RMS_DASSERT(out != prev);
@@ -185,22 +201,24 @@ void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* 
       CollideOptions plain;
       plain.relative_tolerance = tau_rel_;
       plain.sphere_reject = plain.aabb_reject = options_.bounding_reject;
-      plain.want_plane = false;
+      e.clearance_ft = std::numeric_limits<double>::infinity();
       for (int k = 0; k < 3; ++k) {
-        if (!e.ee.hex[k].valid) e.collisions |= cb::kNonFinite;
-        e.ee_bar[k] = Collide(e.ee.hex[k], bar_, opts(prev ? &prev->ee_bar[k] : nullptr, &hints[0][k]));
+        const Hexahedron& h = e.ee.hex[k];
+        if (!h.valid) e.collisions |= cb::kNonFinite;
+        e.ee_bar[k] = Collide(h, bar_, opts(prev ? &prev->ee_bar[k] : nullptr, &hints[0][k]));
         if (e.ee_bar[k].verdict != Verdict::kSeparate) e.collisions |= cb::kEffHexRecpt << k;
-        // The body's plane serves only as the next frame's hint.
-        CollideOptions body = opts(prev ? &prev->ee_body[k] : nullptr, &hints[1][k]);
-        body.want_plane = options_.frame_coherence;
-        e.ee_body[k] = Collide(e.ee.hex[k], payload_.body, body);
+        e.ee_body[k] = Collide(h, payload_.body, opts(prev ? &prev->ee_body[k] : nullptr, &hints[1][k]));
         if (e.ee_body[k].verdict != Verdict::kSeparate) e.collisions |= cb::kEffHexPayload << k;
+        e.clearance_ft = std::min({e.clearance_ft, PairGap(e.ee_bar[k], h, bar_), PairGap(e.ee_body[k], h, payload_.body)});
         for (int j = 0; j < post_count_; ++j) {
-          if (Collide(e.ee.hex[k], posts_[j], plain).verdict != Verdict::kSeparate) e.collisions |= cb::kEffHexBarPost;
+          const CollisionResult r = Collide(h, posts_[j], plain);
+          if (r.verdict != Verdict::kSeparate) e.collisions |= cb::kEffHexBarPost;
+          e.clearance_ft = std::min(e.clearance_ft, PairGap(r, h, posts_[j]));
         }
       }
       if (!options_.mode_pairs_only) {
         // The pairs of Modes 2 and 3, computed and discarded.
+        plain.want_plane = false;
         e.extra_collisions |= Collide(payload_.body, bay_, plain).verdict != Verdict::kSeparate;
         e.extra_collisions |= Collide(payload_.body, cae_, plain).verdict != Verdict::kSeparate;
       }
@@ -211,13 +229,15 @@ void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* 
       // bottom: a vertex below face c that is beyond a wall collides with it.
       e.X_RP = e.pose.X_RS2 * X_S2P_;
       e.payload = MakePayload(config_.payload, e.X_RP);
-      e.collisions |= BayCollisions(e.payload);
+      e.clearance_ft = std::numeric_limits<double>::infinity();
+      e.collisions |= BayCollisions(e.payload, &e.clearance_ft);
       break;
     }
     default: {
       if (status_.docked) {
         e.X_RP = X_RP_docked_;  // captured by the CAE; the arm is free
         e.payload = MakePayload(config_.payload, e.X_RP);
+        e.clearance_ft = std::numeric_limits<double>::infinity();
         break;
       }
       // The payload's and probe's vertices against the CAE's front half, and
@@ -226,16 +246,23 @@ void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* 
       e.X_RP = e.pose.X_RS2 * X_S2P_;
       e.payload = MakePayload(config_.payload, e.X_RP);
       const double tau = tau_rel_ * cae_.scale;
+      e.clearance_ft = std::numeric_limits<double>::infinity();
       for (const Eigen::Vector3d& v : e.payload.v) {
         if (cae_.Word(v, tau) == 0) e.collisions |= cb::kPayloadCae;
+        // Outside a convex solid, the farthest face plane is a lower bound on the distance to it.
+        double out = -std::numeric_limits<double>::infinity();
+        for (int f = 0; f < kNumFaces; ++f) out = std::max(out, cae_.Beyond(f, v.x(), v.y(), v.z()));
+        e.clearance_ft = std::min(e.clearance_ft, std::max(0.0, out));
       }
-      e.collisions |= BayCollisions(e.payload);
+      e.collisions |= BayCollisions(e.payload, &e.clearance_ft);
       break;
     }
   }
   // Non-finite models (a pose from non-finite words or a restored state)
   // are refused as a collision, never read as "no collision".
   if (!Finite(e.payload) || !e.pose.X_RS2.matrix().allFinite()) e.collisions |= cb::kNonFinite;
+  if (e.collisions) e.clearance_ft = 0.0;
+  e.mode = status_.mode;
   if (!options_.mode_pairs_only && status_.mode >= 2) {
     // Every other pair, computed and discarded: the end effector against the
     // BAR and the payload where they are now, the payload against the bay
@@ -285,16 +312,41 @@ std::uint32_t DynamicCollisionProgram::TestMotion(const ArmCommand& from, const 
     status_.too_fast = true;
     return kTooFast;
   }
-  for (int k = 1; k < n; ++k) {
-    Evaluate(Lerp(from, to, static_cast<double>(k) / n), slave_, scratch_);
-    if (scratch_->collisions) {
-      status_.substeps = k + 1;
-      status_.motion_collision = true;
-      return scratch_->collisions;
+  const double step_ft = substep_ft_;
+  // The slave's clearance, when it was evaluated in this mode (else unknown).
+  double c_prev = slave_->mode == status_.mode ? slave_->clearance_ft : 0.0;
+  for (int k = 1; k <= n; ++k) {
+    double c = out->clearance_ft;
+    if (k < n) {
+      Evaluate(Lerp(from, to, static_cast<double>(k) / n), slave_, scratch_);
+      ++status_.substeps;
+      if (scratch_->collisions) {
+        status_.motion_collision = true;
+        return scratch_->collisions;
+      }
+      c = scratch_->clearance_ft;
     }
+    const std::uint32_t bits =
+        Refine(from, to, static_cast<double>(k - 1) / n, static_cast<double>(k) / n, c_prev, c, step_ft, 0);
+    if (bits) {
+      status_.motion_collision = true;
+      return bits;
+    }
+    c_prev = c;
   }
-  status_.substeps = n;
   return 0;
+}
+
+std::uint32_t DynamicCollisionProgram::Refine(const ArmCommand& from, const ArmCommand& to, double s0, double s1,
+                                              double c0, double c1, double travel_ft, int depth) {
+  if (c0 + c1 > travel_ft || depth >= kRefineDepth) return 0;
+  const double sm = 0.5 * (s0 + s1);
+  Evaluate(Lerp(from, to, sm), slave_, probe_);
+  ++status_.substeps;
+  if (probe_->collisions) return probe_->collisions;
+  const double cm = probe_->clearance_ft;
+  if (const std::uint32_t bits = Refine(from, to, s0, sm, c0, cm, 0.5 * travel_ft, depth + 1)) return bits;
+  return Refine(from, to, sm, s1, cm, c1, 0.5 * travel_ft, depth + 1);
 }
 
 std::uint32_t DynamicCollisionProgram::MoveFinger(double finger) {

@@ -50,6 +50,10 @@ inline constexpr double kMaxSubstepTravelFt = 0.05;
 // A command whose motion would need more substeps than this is held and
 // reported (a jump no arm could make in a frame).
 inline constexpr int kMaxSubsteps = 4096;
+// Between two substeps whose clearances do not cover the travel, the
+// motion is halved this many times at most (to 1/64 of a substep's travel:
+// a graze shallower than that may go unseen; docs/collision.md).
+inline constexpr int kRefineDepth = 6;
 // The essential contact: acquisition needs the movable finger's face e
 // within this of the bar (docs/collision.md "The essential contact").
 inline constexpr double kFingerContactToleranceFt = 0.01;
@@ -202,6 +206,12 @@ class DynamicCollisionProgram {
     Eigen::Isometry3d X_RP = Eigen::Isometry3d::Identity();
     PayloadModel payload{};
     std::uint32_t collisions = 0;
+    // A lower bound on the distance from the moving models to what they are
+    // tested against, ft (0 when colliding or unknown; infinite when nothing
+    // is tested): between two free poses whose clearances add up to more
+    // than any vertex's travel, nothing can touch.
+    double clearance_ft = 0.0;
+    int mode = 0;  // the mode it was evaluated in
   };
   // Into *e (not prev). prev: the last accepted evaluation, whose planes are
   // the hints (frame coherence); null: none. e->ee is left as it was outside
@@ -209,12 +219,19 @@ class DynamicCollisionProgram {
   void Evaluate(const ArmCommand& cmd, const Evaluation* prev, Evaluation* e) const;
   // The payload's and probe's vertices against the bay's walls and bottom
   // (a vertex below face c beyond one), Modes 2 and 3.
-  std::uint32_t BayCollisions(const PayloadModel& p) const;
+  // *clearance_ft is lowered to a bound on the vertices' distance from it.
+  std::uint32_t BayCollisions(const PayloadModel& p, double* clearance_ft) const;
   // The motion from `from` to `to` (joint angles, height and finger linear
   // in between): the end pose into *out, then substeps so that no model
   // vertex moves more than substep_ft_ between two tested poses. Returns the
   // first collision bits found (0: the whole motion is free).
   std::uint32_t TestMotion(const ArmCommand& from, const ArmCommand& to, Evaluation* out);
+  // Between two free poses of the motion (parameters s0 < s1, clearances c0,
+  // c1, any vertex's travel between them at most travel_ft): when c0 + c1
+  // cannot cover the travel, the midpoint is tested, and each half in turn,
+  // down to kRefineDepth halvings. Returns the first collision bits found.
+  std::uint32_t Refine(const ArmCommand& from, const ArmCommand& to, double s0, double s1, double c0, double c1,
+                       double travel_ft, int depth);
   // The number of poses the motion needs (1: the end pose alone), or -1
   // beyond kMaxSubsteps.
   int Substeps(const ArmCommand& from, const ArmCommand& to) const;
@@ -263,10 +280,11 @@ class DynamicCollisionProgram {
   // State. The slave starts at the initial inputs' pose (config [inputs]).
   bool reset_pressed_ = false;  // the reset button as last seen (Step acts on its press)
   bool started_ = false;        // a frame has been made: commands are motions from the slave's pose
-  std::array<Evaluation, 3> evaluations_;
+  std::array<Evaluation, 4> evaluations_;
   Evaluation* slave_ = &evaluations_[0];  // the slave's (collision-free) evaluation
   Evaluation* spare_ = &evaluations_[1];  // this frame's candidate
   Evaluation* scratch_ = &evaluations_[2];  // substeps
+  Evaluation* probe_ = &evaluations_[3];    // refinement between substeps
   Eigen::Isometry3d X_S2P_ = Eigen::Isometry3d::Identity();       // payload in System Two, from acquisition
   double payload_reach_ft_ = 0.0;  // held payload's farthest vertex from point A (travel bound)
   // Once acquired, the finger holds the bar: its gap stays between the gap at

@@ -69,6 +69,10 @@ TEST(Config, EveryProblemNamesTheKeyAndTheReason) {
       {R"(\[\[cameras\]\]\nname = "external")", "[[camera]]\nname = \"external\"", "cameras", "exactly 8"},
       {R"(d3y_ft = 0.6)", "d3y_ft = 0.3", "dcp.d3y_ft", "greater than end_effector.finger_gap_closed_ft"},
       {R"(dock_distance_ft = 0.25)", "", "dcp.dock_distance_ft", "missing"},
+      // D3Y against the bar and the finger's gaps (docs/config.md).
+      {R"(d3y_ft = 0.6)", "d3y_ft = 0.38", "dcp.d3y_ft", "bar's width (payload.bar_size_ft[1] = 0.4 ft)"},
+      {R"(d3y_ft = 0.6)", "d3y_ft = 1.28", "dcp.d3y_ft", "could not let the payload go"},
+      {R"(finger_gap_closed_ft = 0.35)", "finger_gap_closed_ft = 0.45", "dcp.d3y_ft", "finger could not close onto the bar"},
   };
   for (const Case& c : cases) {
     const std::string err = ErrorOf(Edit(c.pattern, c.replacement));
