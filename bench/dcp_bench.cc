@@ -221,14 +221,18 @@ rms::SinCos PolySinCosDeg(double deg) {
 
 struct TunnelScene {
   const rms::LabConfig* c;
-  Hexahedron bar, body;
+  Hexahedron bar;
+  std::array<Hexahedron, kBodyStrips> body;
   // Any of EFF HEX 1-3 against the BAR or the payload's body.
   bool Collides(const ArmSample& s, long* tests) const {
     const EndEffectorModel ee = EndEffectorFor(*c, rms::SinCosFromDegrees(s.deg), s);
     for (int k = 0; k < 3; ++k) {
-      *tests += 2;
+      ++*tests;
       if (Collide(ee.hex[k], bar, {.want_plane = false}).verdict != Verdict::kSeparate) return true;
-      if (Collide(ee.hex[k], body, {.want_plane = false}).verdict != Verdict::kSeparate) return true;
+      for (const Hexahedron& strip : body) {
+        ++*tests;
+        if (Collide(ee.hex[k], strip, {.want_plane = false}).verdict != Verdict::kSeparate) return true;
+      }
     }
     return false;
   }
@@ -407,7 +411,8 @@ int main(int argc, char** argv) {
         const EndEffectorModel a = EndEffectorFor(config, sc, s), b = EndEffectorFor(config, Quantize(sc, how), s);
         for (int k = 0; k < 3; ++k) {
           changed += Collide(a.hex[k], bar).verdict != Collide(b.hex[k], bar).verdict;
-          changed += Collide(a.hex[k], payload.body).verdict != Collide(b.hex[k], payload.body).verdict;
+          for (const Hexahedron& strip : payload.body)
+            changed += Collide(a.hex[k], strip).verdict != Collide(b.hex[k], strip).verdict;
         }
       }
       const rms::ArmSinCos sc0 = rms::SinCosFromDegrees(rs[0].deg);
@@ -562,7 +567,7 @@ int main(int argc, char** argv) {
         }
       };
       extents(bar);
-      extents(payload.body);
+      for (const Hexahedron& strip : payload.body) extents(strip);
       {
         const EndEffectorModel ee = EndEffectorFor(config, rms::SinCosFromDegrees(near[0].deg), near[0]);
         for (int k = 0; k < 3; ++k) extents(ee.hex[k]);

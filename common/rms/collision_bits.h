@@ -21,6 +21,15 @@ inline constexpr std::uint32_t kBayMask = 0x3Fu << 6;
 inline constexpr int kCount = 15;
 }  // namespace collision_bits
 
+// The collision bits less the essential contact (docs/collision.md "The
+// essential contact"): the movable finger closing onto the BAR, seen in the
+// telemetry as bit 2 alone while the finger is held and the arm is not. The
+// rest are detrimental (the control word's COLLISION and RECPT say the same).
+inline std::uint32_t DetrimentalCollisions(std::uint32_t collisions, bool finger_held, bool held) {
+  const bool essential = finger_held && !held && collisions == (collision_bits::kEffHexRecpt << 2);
+  return essential ? 0u : collisions;
+}
+
 // "eff_hex_2-recpt", "payload-bay_b", ... for logs, counters and summaries.
 inline constexpr std::array<const char*, collision_bits::kCount> kCollisionNames = {
     "eff_hex_1-recpt",   "eff_hex_2-recpt",   "eff_hex_3-recpt", "eff_hex_1-payload", "eff_hex_2-payload",

@@ -1,6 +1,7 @@
 #include "dcp_models.h"
 
 #include <cmath>
+#include <cstdio>
 
 #include "rms/scene_model.h"
 
@@ -47,8 +48,35 @@ PayloadModel MakePayload(const PayloadConfig& p, const Eigen::Isometry3d& X_RP) 
   const Eigen::Vector3d centre = X_RP.translation();
   const double half_len = 0.5 * p.length_ft, r = 0.5 * p.diameter_ft, pr = 0.5 * p.probe_diameter_ft;
   PayloadModel m;
-  m.body = MakeBox(centre - half_len * yP, yP, xP, -zP, p.length_ft, r, r);
-  for (int i = 0; i < 8; ++i) m.v[i] = m.body.vertex(i);
+  // The 16-gon's vertex levels from the top: level j at angle (2j + 1) pi/16
+  // from +z_P, z = r cos, half-width r sin (scene_model.cc draws the same).
+  std::array<double, 9> z{}, hx{};
+  for (int j = 0; j < 8; ++j) {
+    const double a = (2 * j + 1) * M_PI / kBodySides;
+    z[j] = r * std::cos(a);
+    hx[j] = r * std::sin(a);
+  }
+  auto at = [&](double x, double y, double zz) { return Eigen::Vector3d(centre + x * xP + y * yP + zz * zP); };
+  // The rings: vertex k of a ring at angle (2k + 1) pi/16 round y_P from +z_P toward +x_P.
+  for (int end = 0; end < 2; ++end) {
+    const double y = end ? half_len : -half_len;
+    for (int k = 0; k < kBodySides; ++k) {
+      const double a = (2 * k + 1) * M_PI / kBodySides;
+      m.v[end * kBodySides + k] = at(r * std::sin(a), y, r * std::cos(a));
+    }
+  }
+  // The strips, each from its eight vertices in the standard numbering
+  // (generators' signs: u from a to d, v from b to e, w from c to f).
+  static constexpr int kSigns[8][3] = {{-1, -1, -1}, {-1, -1, 1}, {1, -1, -1}, {-1, 1, 1},
+                                       {-1, 1, -1},  {1, -1, 1},  {1, 1, 1},   {1, 1, -1}};
+  for (int j = 0; j < kBodyStrips; ++j) {
+    std::array<Eigen::Vector3d, 8> v;
+    for (int i = 0; i < 8; ++i) {
+      const int level = kSigns[i][2] < 0 ? j : j + 1;  // w = -z_P: the c side is the top
+      v[i] = at(kSigns[i][1] * hx[level], kSigns[i][0] * half_len, z[level]);
+    }
+    m.body[j] = FromVertices(v);
+  }
   const Eigen::Vector3d root = centre + half_len * yP;
   const Eigen::Vector3d tip = root + p.probe_length_ft * yP;
   int k = kProbeFirst;
@@ -63,11 +91,12 @@ PayloadModel MakePayload(const PayloadConfig& p, const Eigen::Isometry3d& X_RP) 
   return m;
 }
 
-const char* PayloadVertexName(int i) {
-  static const char* kNames[kPayloadVertices] = {"V11", "V12", "V13", "V14", "V15", "V16",
-                                                 "V17", "V18", "V21", "V22", "V23", "V24",
-                                                 "V31", "V32", "V33", "V34", "V35", "V36"};
-  return i >= 0 && i < kPayloadVertices ? kNames[i] : "?";
+std::string PayloadVertexName(int i) {
+  char name[8] = "?";
+  if (i >= 0 && i < kBodyVertices) std::snprintf(name, sizeof name, "B%d", i + 1);
+  else if (i >= kProbeFirst && i < kProbeTipFirst) std::snprintf(name, sizeof name, "V2%d", i - kProbeFirst + 1);
+  else if (i >= kProbeTipFirst && i < kPayloadVertices) std::snprintf(name, sizeof name, "V3%d", i - kProbeTipFirst + 1);
+  return name;
 }
 
 Hexahedron MakeCargoBay(const ShuttleConfig& s) {

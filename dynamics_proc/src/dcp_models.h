@@ -4,6 +4,7 @@
 // System-Two unit vectors (or the payload's, the bay's, the CAE's) scaled by
 // the dimensions of the configuration. docs/collision.md has the figures.
 #include <array>
+#include <string>
 
 #include <Eigen/Geometry>
 
@@ -30,22 +31,30 @@ Hexahedron MakeBar(const PayloadConfig& p, const Eigen::Isometry3d& X_RP);
 // the scene draws), x_P, y_P, z_P as u, v, w. Returns how many (0 or 2).
 int MakeBarPosts(const PayloadConfig& p, const Eigen::Isometry3d& X_RP, std::array<Hexahedron, 2>* posts);
 
-// The payload model of the report's Figure 8 (reconstructed): three groups of
-// vertices from the payload's diameter and length and the probe's diameter
-// (and length): V11-V18 the body (a square prism round the cylinder),
-// V21-V24 the probe's root, V31-V36 the probe's tip.
-inline constexpr int kPayloadVertices = 18;
-inline constexpr int kProbeFirst = 8;     // V21
-inline constexpr int kProbeTipFirst = 12; // V31
+// The payload model (the report's Figure 8, reconstructed; docs/collision.md
+// "The payload"): the body is the drawn 16-sided prism round the cylinder
+// (a flat on top, r cos(pi/16) above the axis, as the scene draws it), so
+// contact shows where it is drawn. Its 32 vertices take the place of the
+// report's V11-V18; Mode 1 tests it as seven hexahedra, horizontal strips of
+// the 16-gon (each a trapezoid prism). V21-V24 the probe's root, V31-V36 the
+// probe's tip.
+inline constexpr int kBodySides = 16;
+inline constexpr int kBodyStrips = 7;
+inline constexpr int kBodyVertices = 2 * kBodySides;
+inline constexpr int kProbeFirst = kBodyVertices;      // V21
+inline constexpr int kProbeTipFirst = kProbeFirst + 4;  // V31
+inline constexpr int kPayloadVertices = kProbeTipFirst + 6;
 struct PayloadModel {
-  Hexahedron body;  // V11-V18 as a hexahedron: u = y_P (face d at the probe end), v = x_P, w = -z_P (c top)
-  std::array<Eigen::Vector3d, kPayloadVertices> v;  // V11..V18, V21..V24, V31..V36
+  // Strip j between the 16-gon's vertex levels j and j + 1 from the top:
+  // u = y_P (face d at the probe end), v = x_P, w = -z_P (c the strip's top).
+  std::array<Hexahedron, kBodyStrips> body;
+  std::array<Eigen::Vector3d, kPayloadVertices> v;  // body (aft ring, then fore ring), V21..V24, V31..V36
   Eigen::Vector3d probe_tip_centre;                 // centre of V31-V36
   Eigen::Vector3d probe_axis;                       // y_P, the probe's y-axis
 };
 PayloadModel MakePayload(const PayloadConfig& p, const Eigen::Isometry3d& X_RP);
-// The payload vertex names, "V11" .. "V36".
-const char* PayloadVertexName(int i);
+// The payload vertex names: "B1" .. "B32" (the body), "V21" .. "V36".
+std::string PayloadVertexName(int i);
 
 // The cargo bay (Figure 8): u = X_R (a forward bulkhead, d aft bulkhead),
 // v = -Y_R (b starboard wall, e port wall), w = -Z_R (c the top, the bay's

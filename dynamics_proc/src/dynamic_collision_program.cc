@@ -79,6 +79,15 @@ void DynamicCollisionProgram::PlacePayload(const Eigen::Isometry3d& X_RP) {
   post_count_ = MakeBarPosts(config_.payload, X_RP, &posts_);
 }
 
+ArmCommand DynamicCollisionProgram::SlaveAsItIs() const {
+  // In Modes 2 and 3 the finger's gap is clamped to the bar; the lever that
+  // gives that gap unclamped, so the slave evaluated in Mode 1 is where it is.
+  ArmCommand c = slave_->cmd;
+  const auto& e = config_.end_effector;
+  c.finger = (e.finger_gap_open_ft - slave_->finger_gap_ft) / (e.finger_gap_open_ft - e.finger_gap_closed_ft);
+  return c;
+}
+
 bool DynamicCollisionProgram::Reset() {
   // The reset scene: Mode 1, the payload in the bay. The arm stays; where it
   // is must be free there, or the reset is refused.
@@ -89,7 +98,7 @@ bool DynamicCollisionProgram::Reset() {
   status_.mode = 1;
   status_.acquired = status_.docked = false;
   released_ = false;
-  Evaluate(slave_->cmd, slave_, spare_);
+  Evaluate(SlaveAsItIs(), slave_, spare_);
   if (spare_->collisions) {
     spdlog::warn("reset refused: the arm where it is would collide with the payload in the bay ({}); "
                  "move the arm clear and reset again", Names(spare_->collisions));
@@ -122,7 +131,8 @@ bool Finite(const ArmCommand& c) {
 bool Finite(const PayloadModel& p) {
   double zero = 0.0;
   for (const Eigen::Vector3d& v : p.v) zero += (v.x() + v.y() + v.z()) * 0.0;
-  return zero == 0.0 && p.body.valid;
+  for (const Hexahedron& h : p.body) zero += h.valid ? 0.0 : NAN;
+  return zero == 0.0;
 }
 
 // TestMotion's answer for a motion beyond kMaxSubsteps: not a collision bit.
@@ -171,7 +181,7 @@ void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* 
   e.ee_bar = {};
   e.ee_body = {};
   // A pair's options: sphere rejection, and its previous plane as the hint.
-  SeparatingPlaneHint hints[2][3];
+  SeparatingPlaneHint hints[1 + kBodyStrips][3];
   auto opts = [&](const CollisionResult* last, SeparatingPlaneHint* hint) {
     CollideOptions o;
     o.relative_tolerance = tau_rel_;
@@ -207,9 +217,13 @@ void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* 
         if (!h.valid) e.collisions |= cb::kNonFinite;
         e.ee_bar[k] = Collide(h, bar_, opts(prev ? &prev->ee_bar[k] : nullptr, &hints[0][k]));
         if (e.ee_bar[k].verdict != Verdict::kSeparate) e.collisions |= cb::kEffHexRecpt << k;
-        e.ee_body[k] = Collide(h, payload_.body, opts(prev ? &prev->ee_body[k] : nullptr, &hints[1][k]));
-        if (e.ee_body[k].verdict != Verdict::kSeparate) e.collisions |= cb::kEffHexPayload << k;
-        e.clearance_ft = std::min({e.clearance_ft, PairGap(e.ee_bar[k], h, bar_), PairGap(e.ee_body[k], h, payload_.body)});
+        e.clearance_ft = std::min(e.clearance_ft, PairGap(e.ee_bar[k], h, bar_));
+        for (int j = 0; j < kBodyStrips; ++j) {
+          const int i = k * kBodyStrips + j;
+          e.ee_body[i] = Collide(h, payload_.body[j], opts(prev ? &prev->ee_body[i] : nullptr, &hints[1 + j][k]));
+          if (e.ee_body[i].verdict != Verdict::kSeparate) e.collisions |= cb::kEffHexPayload << k;
+          e.clearance_ft = std::min(e.clearance_ft, PairGap(e.ee_body[i], h, payload_.body[j]));
+        }
         for (int j = 0; j < post_count_; ++j) {
           const CollisionResult r = Collide(h, posts_[j], plain);
           if (r.verdict != Verdict::kSeparate) e.collisions |= cb::kEffHexBarPost;
@@ -219,8 +233,10 @@ void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* 
       if (!options_.mode_pairs_only) {
         // The pairs of Modes 2 and 3, computed and discarded.
         plain.want_plane = false;
-        e.extra_collisions |= Collide(payload_.body, bay_, plain).verdict != Verdict::kSeparate;
-        e.extra_collisions |= Collide(payload_.body, cae_, plain).verdict != Verdict::kSeparate;
+        for (const Hexahedron& strip : payload_.body) {
+          e.extra_collisions |= Collide(strip, bay_, plain).verdict != Verdict::kSeparate;
+          e.extra_collisions |= Collide(strip, cae_, plain).verdict != Verdict::kSeparate;
+        }
       }
       break;
     }
@@ -273,10 +289,13 @@ void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* 
     const Hexahedron bar = MakeBar(config_.payload, e.X_RP);
     for (int k = 0; k < 3; ++k) {
       e.extra_collisions |= Collide(ee.hex[k], bar, o).verdict != Verdict::kSeparate;
-      e.extra_collisions |= Collide(ee.hex[k], e.payload.body, o).verdict != Verdict::kSeparate;
+      for (const Hexahedron& strip : e.payload.body)
+        e.extra_collisions |= Collide(ee.hex[k], strip, o).verdict != Verdict::kSeparate;
     }
-    e.extra_collisions |= Collide(e.payload.body, bay_, o).verdict != Verdict::kSeparate;
-    e.extra_collisions |= Collide(e.payload.body, cae_, o).verdict != Verdict::kSeparate;
+    for (const Hexahedron& strip : e.payload.body) {
+      e.extra_collisions |= Collide(strip, bay_, o).verdict != Verdict::kSeparate;
+      e.extra_collisions |= Collide(strip, cae_, o).verdict != Verdict::kSeparate;
+    }
   }
 }
 
@@ -424,7 +443,7 @@ void DynamicCollisionProgram::LetGo() {
   status_.let_go = true;
   payload_reach_ft_ = 0.0;
   // The slave's evaluation in the new mode (the arm where it is).
-  Evaluate(slave_->cmd, slave_, spare_);
+  Evaluate(SlaveAsItIs(), slave_, spare_);
   AcceptSpare();
 }
 
@@ -765,10 +784,8 @@ nlohmann::ordered_json DynamicCollisionProgram::SaveState() const {
   j["reset_pressed"] = reset_pressed_;
   // The slave's separating planes, the next frame's hints (frame coherence).
   nlohmann::json bar = nlohmann::json::array(), body = nlohmann::json::array();
-  for (int k = 0; k < 3; ++k) {
-    bar.push_back(PlaneJson(slave_->ee_bar[k]));
-    body.push_back(PlaneJson(slave_->ee_body[k]));
-  }
+  for (int k = 0; k < 3; ++k) bar.push_back(PlaneJson(slave_->ee_bar[k]));
+  for (const CollisionResult& r : slave_->ee_body) body.push_back(PlaneJson(r));
   j["planes_ee_bar"] = bar;
   j["planes_ee_body"] = body;
   return j;
@@ -811,10 +828,14 @@ void DynamicCollisionProgram::RestoreState(const nlohmann::json& j) {
       p->slave = CommandFrom(j.at("slave"));
       p->slave_collisions = j.at("slave_collisions").get<std::uint32_t>();
       if (j.contains("planes_ee_bar")) {
-        for (int k = 0; k < 3; ++k) {
-          PlaneFrom(j.at("planes_ee_bar").at(k), &p->hints.ee_bar[k]);
-          PlaneFrom(j.at("planes_ee_body").at(k), &p->hints.ee_body[k]);
+        for (int k = 0; k < 3; ++k) PlaneFrom(j.at("planes_ee_bar").at(k), &p->hints.ee_bar[k]);
+        // One plane per end-effector hexahedron and body strip (an older
+        // checkpoint has three, one per hexahedron: hints for strip 0).
+        const nlohmann::json& body = j.at("planes_ee_body");
+        if (!body.is_array() || body.size() > p->hints.ee_body.size()) {
+          throw InputError("checkpoint: 'planes_ee_body' must be at most 21 planes");
         }
+        for (std::size_t i = 0; i < body.size(); ++i) PlaneFrom(body.at(i), &p->hints.ee_body[i]);
       }
     }
   } catch (const nlohmann::json::exception& e) {

@@ -201,7 +201,8 @@ class DynamicCollisionProgram {
     double finger_gap_ft = 0.0;
     EndEffectorModel ee{};
     std::array<CollisionResult, 3> ee_bar{};   // EFF HEX k against the BAR (Mode 1)
-    std::array<CollisionResult, 3> ee_body{};  // EFF HEX k against the payload's body (Mode 1)
+    // EFF HEX k against the payload body's strip j, at [k * kBodyStrips + j] (Mode 1)
+    std::array<CollisionResult, 3 * kBodyStrips> ee_body{};
     std::uint32_t extra_collisions = 0;        // pairs outside the mode (mode_pairs_only false); unused
     Eigen::Isometry3d X_RP = Eigen::Isometry3d::Identity();
     PayloadModel payload{};
@@ -241,6 +242,8 @@ class DynamicCollisionProgram {
   std::uint32_t MoveFinger(double finger);
   // What the slave does with the command: follows, holds, or holds the finger.
   void Respond(const ArmCommand& command);
+  // The slave's command with the finger lever of its actual (clamped) gap.
+  ArmCommand SlaveAsItIs() const;
   // Opening the finger before docking: the payload stays where it is (Mode 1).
   void LetGo();
   // The payload not held (Mode 1): its pose and models.

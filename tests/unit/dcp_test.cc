@@ -20,6 +20,7 @@
 #include "rms/checkpoint.h"
 #include "rms/config.h"
 #include "rms/dcp_frame_t.hpp"
+#include "rms/scene_model.h"
 #include "rms/word_blocks.h"
 #include "timeline.h"
 
@@ -194,7 +195,7 @@ TEST_F(Dcp, ACollisionHoldsTheSlaveAtContactAndReleasesIt) {
   DynamicCollisionProgram dcp(config);
   // Over the payload's body, well away from the bar, palm down.
   const Isometry3d above = Shifted(geo.X_RS2_grasp, Vector3d(-6.0, 0, 3.0));
-  const Hexahedron body = MakePayload(config.payload, X_RP_bay()).body;
+  const PayloadModel payload = MakePayload(config.payload, X_RP_bay());
   int held = 0;
   double lowest = 1e9;
   // Down 5 ft over 3 s (through the body's top), then back up.
@@ -210,13 +211,14 @@ TEST_F(Dcp, ACollisionHoldsTheSlaveAtContactAndReleasesIt) {
     }
     // The slave's end effector never penetrates the body.
     const EndEffectorModel ee = MakeEndEffector(config.end_effector, st.X_RS2, st.finger_gap_ft);
-    for (const Hexahedron& h : ee.hex) ASSERT_NE(Collide(h, body).verdict, Verdict::kCollide) << "frame " << f;
+    for (const Hexahedron& h : ee.hex)
+      for (const Hexahedron& strip : payload.body) ASSERT_NE(Collide(h, strip).verdict, Verdict::kCollide) << "frame " << f;
     lowest = std::min(lowest, st.X_RS2.translation().z());
   }
   EXPECT_GT(held, 30);
   // Contact: the fingers' tips stopped within one frame's travel of the body's top.
   const double finger_tip = lowest - config.end_effector.palm_length_ft - config.end_effector.finger_length_ft;
-  const double body_top = config.payload.p_RoPo_R_ft.z() + 0.5 * config.payload.diameter_ft;
+  const double body_top = config.payload.p_RoPo_R_ft.z() + PayloadTopFlat_P(config.payload);  // the 16-gon's top flat
   EXPECT_GT(finger_tip, body_top);
   EXPECT_LT(finger_tip, body_top + 5.0 / 90 + 1e-6);
   // Released: back above, the slave follows the master exactly.
@@ -263,7 +265,7 @@ TEST_F(Dcp, InMode2APayloadVertexBeyondABayWallHoldsTheArm) {
     }
   }
   EXPECT_GT(held, 10);
-  EXPECT_LT(dcp.status().X_RP.translation().y() + 0.5 * config.payload.diameter_ft,
+  EXPECT_LT(dcp.status().X_RP.translation().y() + PayloadTopFlat_P(config.payload),  // the 16-gon's side flat
             0.5 * config.shuttle.bay_width_ft + 1e-9);
   EXPECT_EQ(dcp.mode(), 2);
 }

@@ -31,8 +31,10 @@ std::string PriorityTableMarkdown(const LabConfig& config, const std::string& ti
       "  finger EFF HEX 2; the elbow and the lower boom); the plane is found once, in A's frame, and moves\n"
       "  with it.\n"
       "- **DCP**: the Dynamic Collision Program's dynamic separating plane between an end-effector\n"
-      "  hexahedron and the BAR (report IV.A.1, control word bits 14-16); when the DCP has none (a\n"
-      "  collision) the pair falls back to dynamic.\n"
+      "  hexahedron and the BAR (report IV.A.1, control word bits 14-16). The DCP sends them in Mode 1\n"
+      "  while the pair is separate; when it has none (the pair in contact, or Modes 2 and 3, where the\n"
+      "  finger holds the bar and no plane parts them) the pair falls back to dynamic (`docs/collision.md`\n"
+      "  \"The three dynamic separating planes\").\n"
       "- **dynamic**: the clusters move relative to each other; scene_proc finds a plane every frame,\n"
       "  trying the last frame's first.\n\n";
   char line[256];
@@ -58,7 +60,7 @@ std::string PriorityTableMarkdown(const LabConfig& config, const std::string& ti
                     z(pl.n.z(), 5e-5), z(pl.d, 5e-4));
       plane = buf;
     } else if (src == PlaneSource::kDcp) {
-      plane = "the DCP's, every frame";
+      plane = "the DCP's in Mode 1 while separate; else found every frame";
     } else {
       plane = "found every frame";
     }

@@ -106,7 +106,8 @@ void AttemptLog::ObserveFrame(const dcp_telemetry_t& m, bool reset, double t_s) 
     a.best_dock_distance_ft = m.dock_distance_ft;
     a.best_dock_angle_deg = m.dock_angle_deg;
   }
-  const auto bits = static_cast<std::uint32_t>(m.collisions);
+  // Detrimental collisions only: the finger resting on the bar is the essential contact.
+  const auto bits = DetrimentalCollisions(static_cast<std::uint32_t>(m.collisions), m.finger_held, m.held);
   for (int b = 0; b < collision_bits::kCount; ++b) {
     if (!(bits & (1u << b))) continue;
     ++a.collisions[b].frames;

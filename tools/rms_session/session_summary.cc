@@ -214,7 +214,8 @@ class TelemetryLog {
     acquired = acquired || m.acquired;
     docked = docked || m.docked;
     held_frames += m.held;
-    const auto bits = static_cast<std::uint32_t>(m.collisions);
+    // Detrimental collisions only: the finger resting on the bar is the essential contact.
+    const auto bits = DetrimentalCollisions(static_cast<std::uint32_t>(m.collisions), m.finger_held, m.held);
     for (int b = 0; b < kCollisionBits; ++b) {
       const bool on = bits & (1u << b), was = last_bits_ & (1u << b);
       if (on && !was) {
