@@ -19,6 +19,7 @@
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/message_io.h"
+#include "rms/scene_model.h"
 #include "subprocess.h"
 
 namespace rms {
@@ -155,7 +156,7 @@ TEST(DcpSession, ACollisionHoldsThenReleasesAndResetReturnsToMode1) {
       // Never below the body's top: the fingers' tips stay above it.
       const double tip = s.telemetry[i].p_RoA_R_ft[2] - config.end_effector.palm_length_ft -
                          config.end_effector.finger_length_ft;
-      EXPECT_GT(tip, config.payload.p_RoPo_R_ft.z() + 0.5 * config.payload.diameter_ft);
+      EXPECT_GT(tip, config.payload.p_RoPo_R_ft.z() + PayloadTopFlat_P(config.payload));  // the 16-gon's top flat
     }
   }
   ASSERT_GT(held, 10);
