@@ -23,10 +23,11 @@ inline constexpr int kCount = 15;
 
 // The collision bits less the essential contact (docs/collision.md "The
 // essential contact"): the movable finger closing onto the BAR, seen in the
-// telemetry as bit 2 alone while the finger is held and the arm is not. The
-// rest are detrimental (the control word's COLLISION and RECPT say the same).
-inline std::uint32_t DetrimentalCollisions(std::uint32_t collisions, bool finger_held, bool held) {
-  const bool essential = finger_held && !held && collisions == (collision_bits::kEffHexRecpt << 2);
+// telemetry as bit 2 alone while the finger is held, the arm is not, and the
+// master's finger lever is beyond the slave's (closing). The rest are
+// detrimental (the control word's COLLISION and RECPT say the same).
+inline std::uint32_t DetrimentalCollisions(std::uint32_t collisions, bool finger_held, bool held, bool closing) {
+  const bool essential = closing && finger_held && !held && collisions == (collision_bits::kEffHexRecpt << 2);
   return essential ? 0u : collisions;
 }
 

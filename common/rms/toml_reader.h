@@ -150,6 +150,10 @@ class TomlReader {
     if (std::abs(y.norm() - 1.0) > 1e-6) Fail(y_key, "must be a unit vector");
     if (std::abs(z.norm() - 1.0) > 1e-6) Fail(z_key, "must be a unit vector");
     if (std::abs(y.dot(z)) > 1e-6) Fail(z_key, "must be perpendicular to " + Key(y_key));
+    // Within 1e-6 of a rotation: made exactly orthonormal (y kept in its
+    // direction), so the models built on it have exactly planar faces.
+    y.normalize();
+    z = (z - z.dot(y) * y).normalized();
     Eigen::Matrix3d r;
     r.col(0) = y.cross(z);
     r.col(1) = y;

@@ -66,6 +66,7 @@ DynamicCollisionProgram::DynamicCollisionProgram(const LabConfig& config, const 
     throw InputError("inputs.*.initial: the arm's initial pose collides (" + Names(slave_->collisions) +
                      "); the DCP needs a collision-free pose to start from");
   }
+  initial_ = start;
   status_.master = status_.slave = start;
   status_.X_RS2 = slave_->pose.X_RS2;
   status_.X_RP = slave_->X_RP;
@@ -94,10 +95,12 @@ bool DynamicCollisionProgram::Reset() {
   const Eigen::Isometry3d X_RP_free = X_RP_free_;
   const int mode = status_.mode;
   const bool acquired = status_.acquired, docked = status_.docked, released = released_;
+  const double reach = payload_reach_ft_;
   PlacePayload(X_RP_bay_);
   status_.mode = 1;
   status_.acquired = status_.docked = false;
   released_ = false;
+  payload_reach_ft_ = 0.0;
   Evaluate(SlaveAsItIs(), slave_, spare_);
   if (spare_->collisions) {
     spdlog::warn("reset refused: the arm where it is would collide with the payload in the bay ({}); "
@@ -107,6 +110,7 @@ bool DynamicCollisionProgram::Reset() {
     status_.acquired = acquired;
     status_.docked = docked;
     released_ = released;
+    payload_reach_ft_ = reach;
     return false;
   }
   AcceptSpare();
@@ -148,23 +152,6 @@ ArmCommand Lerp(const ArmCommand& a, const ArmCommand& b, double t) {
 
 }  // namespace
 
-std::uint32_t DynamicCollisionProgram::BayCollisions(const PayloadModel& p, double* clearance_ft) const {
-  const double tau = tau_rel_ * bay_.scale;
-  std::uint32_t bits = 0;
-  for (const Eigen::Vector3d& v : p.v) {
-    const LocationWord w = bay_.Word(v, tau);
-    if (!(w & FaceBit(kFaceC))) bits |= static_cast<std::uint32_t>(w) << 6;
-    // The distance to "below face c and beyond a wall or the bottom" is at
-    // least, for the nearest wall, the larger of the height above c and the
-    // depth inside that wall.
-    const double above = bay_.Beyond(kFaceC, v.x(), v.y(), v.z());
-    for (int f : {kFaceA, kFaceB, kFaceD, kFaceE, kFaceF}) {
-      *clearance_ft = std::min(*clearance_ft, std::max(above, -bay_.Beyond(f, v.x(), v.y(), v.z())));
-    }
-  }
-  return bits;
-}
-
 namespace {
 // A pair's gap lower bound from its separating plane (0: colliding or none).
 double PairGap(const CollisionResult& r, const Hexahedron& a, const Hexahedron& b) {
@@ -173,14 +160,31 @@ double PairGap(const CollisionResult& r, const Hexahedron& a, const Hexahedron& 
 }
 }  // namespace
 
-void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* prev, Evaluation* out) const {
-  RMS_DASSERT(out != prev);
+std::uint32_t DynamicCollisionProgram::BayCollisions(const PayloadModel& p, double* clearance_ft) const {
+  // The payload lives inside the bay: a vertex not above face c (by more
+  // than tau) that is on or beyond a wall or the bottom (within tau:
+  // touching counts) collides with it.
+  const double tau = ToleranceFt(bay_, bay_, tau_rel_);
+  std::uint32_t bits = 0;
+  for (const Eigen::Vector3d& v : p.v) {
+    const double above = bay_.Beyond(kFaceC, v.x(), v.y(), v.z());
+    for (int f : {kFaceA, kFaceB, kFaceD, kFaceE, kFaceF}) {
+      const double beyond = bay_.Beyond(f, v.x(), v.y(), v.z());
+      if (above <= tau && beyond >= -tau) bits |= static_cast<std::uint32_t>(FaceBit(f)) << 6;
+      // The distance to "below face c and beyond this wall" is at least the
+      // larger of the height above c and the depth inside the wall.
+      *clearance_ft = std::min(*clearance_ft, std::max(above, -beyond));
+    }
+  }
+  return bits;
+}
+
+void DynamicCollisionProgram::TestHandAgainstPayload(const Evaluation* prev, Evaluation* out) const {
+  // EFF HEX 1-3 against the resting payload's BAR, body (seven strips) and
+  // the BAR's posts, with each pair's clearance.
+  namespace cb = collision_bits;
   Evaluation& e = *out;
-  e.collisions = 0;
-  e.extra_collisions = 0;
-  e.ee_bar = {};
-  e.ee_body = {};
-  // A pair's options: sphere rejection, and its previous plane as the hint.
+  // A pair's options: bounding rejection, and its previous plane as the hint.
   SeparatingPlaneHint hints[1 + kBodyStrips][3];
   auto opts = [&](const CollisionResult* last, SeparatingPlaneHint* hint) {
     CollideOptions o;
@@ -193,11 +197,42 @@ void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* 
     }
     return o;
   };
+  CollideOptions plain;
+  plain.relative_tolerance = tau_rel_;
+  plain.sphere_reject = plain.aabb_reject = options_.bounding_reject;
+  e.clearance_ft = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 3; ++k) {
+    const Hexahedron& h = e.ee.hex[k];
+    if (!h.valid) e.collisions |= cb::kNonFinite;
+    e.ee_bar[k] = Collide(h, bar_, opts(prev ? &prev->ee_bar[k] : nullptr, &hints[0][k]));
+    if (e.ee_bar[k].verdict != Verdict::kSeparate) e.collisions |= cb::kEffHexRecpt << k;
+    e.clearance_ft = std::min(e.clearance_ft, PairGap(e.ee_bar[k], h, bar_));
+    for (int j = 0; j < kBodyStrips; ++j) {
+      const int i = k * kBodyStrips + j;
+      e.ee_body[i] = Collide(h, payload_.body[j], opts(prev ? &prev->ee_body[i] : nullptr, &hints[1 + j][k]));
+      if (e.ee_body[i].verdict != Verdict::kSeparate) e.collisions |= cb::kEffHexPayload << k;
+      e.clearance_ft = std::min(e.clearance_ft, PairGap(e.ee_body[i], h, payload_.body[j]));
+    }
+    for (int j = 0; j < post_count_; ++j) {
+      const CollisionResult r = Collide(h, posts_[j], plain);
+      if (r.verdict != Verdict::kSeparate) e.collisions |= cb::kEffHexBarPost;
+      e.clearance_ft = std::min(e.clearance_ft, PairGap(r, h, posts_[j]));
+    }
+  }
+}
+
+void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* prev, Evaluation* out) const {
+  RMS_DASSERT(out != prev);
+  Evaluation& e = *out;
+  e.collisions = 0;
+  e.extra_collisions = 0;
+  e.ee_bar = {};
+  e.ee_body = {};
   e.cmd = cmd;
   e.words = TransmittedArmWords(cmd.angles_deg);
   e.pose = ComputeArmPose(config_.arm, e.words, cmd.shoulder_height_ft);
   e.finger_gap_ft = FingerGapFt(cmd.finger);
-  if (status_.mode >= 2) {
+  if (status_.mode >= 2 && !(status_.docked && released_)) {
     const double widest = status_.docked ? config_.end_effector.finger_gap_open_ft : acquisition_gap_ft_;
     e.finger_gap_ft = std::clamp(e.finger_gap_ft, contact_gap_ft_, widest);
   }
@@ -208,30 +243,11 @@ void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* 
       e.ee = MakeEndEffector(config_.end_effector, e.pose.X_RS2, e.finger_gap_ft);
       e.X_RP = X_RP_free_;
       e.payload = payload_;
-      CollideOptions plain;
-      plain.relative_tolerance = tau_rel_;
-      plain.sphere_reject = plain.aabb_reject = options_.bounding_reject;
-      e.clearance_ft = std::numeric_limits<double>::infinity();
-      for (int k = 0; k < 3; ++k) {
-        const Hexahedron& h = e.ee.hex[k];
-        if (!h.valid) e.collisions |= cb::kNonFinite;
-        e.ee_bar[k] = Collide(h, bar_, opts(prev ? &prev->ee_bar[k] : nullptr, &hints[0][k]));
-        if (e.ee_bar[k].verdict != Verdict::kSeparate) e.collisions |= cb::kEffHexRecpt << k;
-        e.clearance_ft = std::min(e.clearance_ft, PairGap(e.ee_bar[k], h, bar_));
-        for (int j = 0; j < kBodyStrips; ++j) {
-          const int i = k * kBodyStrips + j;
-          e.ee_body[i] = Collide(h, payload_.body[j], opts(prev ? &prev->ee_body[i] : nullptr, &hints[1 + j][k]));
-          if (e.ee_body[i].verdict != Verdict::kSeparate) e.collisions |= cb::kEffHexPayload << k;
-          e.clearance_ft = std::min(e.clearance_ft, PairGap(e.ee_body[i], h, payload_.body[j]));
-        }
-        for (int j = 0; j < post_count_; ++j) {
-          const CollisionResult r = Collide(h, posts_[j], plain);
-          if (r.verdict != Verdict::kSeparate) e.collisions |= cb::kEffHexBarPost;
-          e.clearance_ft = std::min(e.clearance_ft, PairGap(r, h, posts_[j]));
-        }
-      }
+      TestHandAgainstPayload(prev, &e);
       if (!options_.mode_pairs_only) {
         // The pairs of Modes 2 and 3, computed and discarded.
+        CollideOptions plain;
+        plain.sphere_reject = plain.aabb_reject = options_.bounding_reject;
         plain.want_plane = false;
         for (const Hexahedron& strip : payload_.body) {
           e.extra_collisions |= Collide(strip, bay_, plain).verdict != Verdict::kSeparate;
@@ -251,9 +267,15 @@ void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* 
     }
     default: {
       if (status_.docked) {
-        e.X_RP = X_RP_docked_;  // captured by the CAE; the arm is free
-        e.payload = MakePayload(config_.payload, e.X_RP);
+        e.X_RP = X_RP_docked_;  // captured by the CAE
+        e.payload = payload_;   // placed at the dock
         e.clearance_ft = std::numeric_limits<double>::infinity();
+        if (released_) {
+          // Let go, the arm is free: the hand is tested against the docked
+          // payload as in Mode 1 (it cannot pass back through the bar).
+          e.ee = MakeEndEffector(config_.end_effector, e.pose.X_RS2, e.finger_gap_ft);
+          TestHandAgainstPayload(prev, &e);
+        }
         break;
       }
       // The payload's and probe's vertices against the CAE's front half, and
@@ -261,7 +283,7 @@ void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* 
       // back toward the bay, it cannot pass through them).
       e.X_RP = e.pose.X_RS2 * X_S2P_;
       e.payload = MakePayload(config_.payload, e.X_RP);
-      const double tau = tau_rel_ * cae_.scale;
+      const double tau = ToleranceFt(cae_, cae_, tau_rel_);
       e.clearance_ft = std::numeric_limits<double>::infinity();
       for (const Eigen::Vector3d& v : e.payload.v) {
         if (cae_.Word(v, tau) == 0) e.collisions |= cb::kPayloadCae;
@@ -301,23 +323,40 @@ void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* 
 
 void DynamicCollisionProgram::AcceptSpare() { std::swap(slave_, spare_); }
 
-double DynamicCollisionProgram::ReachFt() const {
+std::array<double, 6> DynamicCollisionProgram::JointReachFt() const {
+  // Joint i turns only what lies beyond it; a moving vertex is at most this
+  // far from its axis (the links from the joint out, then the hand: the end
+  // effector's farthest vertex from point A, or the held payload's).
   const auto& a = config_.arm;
   const auto& ee = config_.end_effector;
-  const double hand = ee.palm_length_ft + ee.finger_length_ft +
-                      std::hypot(ee.palm_half_width_ft, ee.palm_half_height_ft);
-  return a.upper_boom_ft + a.lower_boom_ft + a.wrist_to_palm_ft + std::max(hand, payload_reach_ft_);
+  const double hand = std::max(ee.palm_length_ft + ee.finger_length_ft +
+                                   std::hypot(ee.palm_half_width_ft, ee.palm_half_height_ft),
+                               payload_reach_ft_);
+  const double at_w = a.wrist_to_palm_ft + hand, at_e = a.lower_boom_ft + at_w, at_s = a.upper_boom_ft + at_e;
+  return {at_s, at_s, at_e, at_w, at_w, at_w};
 }
 
-int DynamicCollisionProgram::Substeps(const ArmCommand& from, const ArmCommand& to) const {
-  // A bound on any model vertex's travel: each joint turns every vertex
-  // beyond it by at most its angle (rad) times the reach; the shoulder's
-  // height moves all alike; the finger moves the movable finger alone.
+double DynamicCollisionProgram::TravelFt(const ArmCommand& from, const ArmCommand& to) const {
+  // A bound on any model vertex's travel along the motion: each joint's
+  // angle (rad) times its reach; the shoulder's height moves all alike; the
+  // finger moves the movable finger alone.
+  const std::array<double, 6> reach = JointReachFt();
   double travel = std::abs(to.shoulder_height_ft - from.shoulder_height_ft);
-  const double reach = ReachFt();
-  for (int i = 0; i < 6; ++i) travel += std::abs(to.angles_deg[i] - from.angles_deg[i]) * (M_PI / 180.0) * reach;
-  travel += std::abs(FingerGapFt(to.finger) - FingerGapFt(from.finger));
-  const double n = std::ceil(travel / substep_ft_);
+  for (int i = 0; i < 6; ++i) travel += std::abs(to.angles_deg[i] - from.angles_deg[i]) * (M_PI / 180.0) * reach[i];
+  return travel + std::abs(FingerGapFt(to.finger) - FingerGapFt(from.finger));
+}
+
+double DynamicCollisionProgram::WordSlackFt() const {
+  // The arm words' rounding (SC22, 2^-22) moves each tested pose off the
+  // straight interpolation by at most this; two poses, twice.
+  const std::array<double, 6> reach = JointReachFt();
+  double slack = 0.0;
+  for (double r : reach) slack += 2.0 * std::ldexp(1.0, -22) * r;
+  return 2.0 * slack;
+}
+
+int DynamicCollisionProgram::Substeps(double travel_ft) const {
+  const double n = std::ceil(travel_ft / substep_ft_);
   if (!(n <= kMaxSubsteps)) return -1;
   return std::max(1, static_cast<int>(n));
 }
@@ -326,12 +365,14 @@ std::uint32_t DynamicCollisionProgram::TestMotion(const ArmCommand& from, const 
   Evaluate(to, slave_, out);  // the end pose first: most collisions show there
   status_.substeps = 1;
   if (out->collisions) return out->collisions;
-  const int n = Substeps(from, to);
+  const double travel = TravelFt(from, to);
+  const int n = Substeps(travel);
   if (n < 0) {
     status_.too_fast = true;
     return kTooFast;
   }
-  const double step_ft = substep_ft_;
+  if (travel <= 0.0) return 0;  // nothing moves
+  const double step_ft = travel / n, slack_ft = WordSlackFt();
   // The slave's clearance, when it was evaluated in this mode (else unknown).
   double c_prev = slave_->mode == status_.mode ? slave_->clearance_ft : 0.0;
   for (int k = 1; k <= n; ++k) {
@@ -345,8 +386,9 @@ std::uint32_t DynamicCollisionProgram::TestMotion(const ArmCommand& from, const 
       }
       c = scratch_->clearance_ft;
     }
-    const std::uint32_t bits =
-        Refine(from, to, static_cast<double>(k - 1) / n, static_cast<double>(k) / n, c_prev, c, step_ft, 0);
+    double hit_s = 0.0;
+    const std::uint32_t bits = Refine(from, to, static_cast<double>(k - 1) / n, static_cast<double>(k) / n, c_prev,
+                                      c, step_ft, slack_ft, 0, &hit_s);
     if (bits) {
       status_.motion_collision = true;
       return bits;
@@ -357,46 +399,59 @@ std::uint32_t DynamicCollisionProgram::TestMotion(const ArmCommand& from, const 
 }
 
 std::uint32_t DynamicCollisionProgram::Refine(const ArmCommand& from, const ArmCommand& to, double s0, double s1,
-                                              double c0, double c1, double travel_ft, int depth) {
-  if (c0 + c1 > travel_ft || depth >= kRefineDepth) return 0;
+                                              double c0, double c1, double travel_ft, double slack_ft, int depth,
+                                              double* hit_s) {
+  if (c0 + c1 > travel_ft + slack_ft || depth >= kRefineDepth) return 0;
   const double sm = 0.5 * (s0 + s1);
   Evaluate(Lerp(from, to, sm), slave_, probe_);
   ++status_.substeps;
-  if (probe_->collisions) return probe_->collisions;
+  if (probe_->collisions) {
+    *hit_s = sm;
+    return probe_->collisions;
+  }
   const double cm = probe_->clearance_ft;
-  if (const std::uint32_t bits = Refine(from, to, s0, sm, c0, cm, 0.5 * travel_ft, depth + 1)) return bits;
-  return Refine(from, to, sm, s1, cm, c1, 0.5 * travel_ft, depth + 1);
+  if (const std::uint32_t bits = Refine(from, to, s0, sm, c0, cm, 0.5 * travel_ft, slack_ft, depth + 1, hit_s)) {
+    return bits;
+  }
+  return Refine(from, to, sm, s1, cm, c1, 0.5 * travel_ft, slack_ft, depth + 1, hit_s);
 }
 
 std::uint32_t DynamicCollisionProgram::MoveFinger(double finger) {
   // From the slave's finger toward `finger`, the arm where the slave is: in
-  // steps of at most substep_ft_ of gap to the first colliding position, then
-  // bisection to within 1e-5 ft of gap.
+  // substeps (refined between them as any motion) to the first colliding
+  // position, then bisection to within 1e-5 ft of gap.
   const ArmCommand from = slave_->cmd;
   const double f0 = from.finger;
+  ArmCommand to = from;
+  to.finger = finger;
   const double span_ft = std::abs(FingerGapFt(finger) - FingerGapFt(f0));
-  const int n = std::max(1, static_cast<int>(std::ceil(span_ft / substep_ft_)));
-  ArmCommand c = from;
-  double free_f = f0, hit_f = f0;
+  const int n = Substeps(span_ft);
+  if (n < 0 || !(span_ft > 0)) return 0;
+  const double slack_ft = WordSlackFt();
+  double free_s = 0.0, hit_s = 0.0, c_prev = slave_->clearance_ft;
   std::uint32_t bits = 0;
   for (int k = 1; k <= n && !bits; ++k) {
-    c.finger = f0 + (finger - f0) * k / n;
-    Evaluate(c, slave_, scratch_);
+    const double s = static_cast<double>(k) / n;
+    Evaluate(Lerp(from, to, s), slave_, scratch_);
     if (scratch_->collisions) {
       bits = scratch_->collisions;
-      hit_f = c.finger;
-    } else {
-      free_f = c.finger;
+      hit_s = s;
+      break;
+    }
+    const double c_k = scratch_->clearance_ft;
+    bits = Refine(from, to, free_s, s, c_prev, c_k, span_ft / n, slack_ft, 0, &hit_s);
+    if (!bits) {
+      free_s = s;
+      c_prev = c_k;
     }
   }
-  while (bits && std::abs(FingerGapFt(hit_f) - FingerGapFt(free_f)) > 1e-5) {
-    c.finger = 0.5 * (free_f + hit_f);
-    Evaluate(c, slave_, scratch_);
-    (scratch_->collisions ? hit_f : free_f) = c.finger;
+  while (bits && (hit_s - free_s) * span_ft > 1e-5) {
+    const double mid = 0.5 * (free_s + hit_s);
+    Evaluate(Lerp(from, to, mid), slave_, scratch_);
+    (scratch_->collisions ? hit_s : free_s) = mid;
   }
-  if (free_f != f0) {
-    c.finger = free_f;
-    Evaluate(c, slave_, spare_);
+  if (free_s > 0.0) {
+    Evaluate(Lerp(from, to, free_s), slave_, spare_);
     AcceptSpare();
   }
   return bits;
@@ -436,14 +491,26 @@ void DynamicCollisionProgram::Respond(const ArmCommand& command) {
 }
 
 void DynamicCollisionProgram::LetGo() {
-  spdlog::info("the finger opened: the payload is let go where it is (Mode 1)");
+  // The payload where it is, Mode 1; the arm where it is must be free of it
+  // (it is, but for rounding through X_S2P), else the grasp is kept.
+  const Eigen::Isometry3d X_RP_free = X_RP_free_;
   PlacePayload(slave_->X_RP);
   status_.mode = 1;
   status_.acquired = false;
-  status_.let_go = true;
+  const double reach = payload_reach_ft_;
   payload_reach_ft_ = 0.0;
-  // The slave's evaluation in the new mode (the arm where it is).
   Evaluate(SlaveAsItIs(), slave_, spare_);
+  if (spare_->collisions) {
+    spdlog::warn("the finger opened but the hand would be in collision with the payload let go ({}): grasp kept",
+                 Names(spare_->collisions));
+    PlacePayload(X_RP_free);
+    status_.mode = slave_->mode;
+    status_.acquired = true;
+    payload_reach_ft_ = reach;
+    return;
+  }
+  spdlog::info("the finger opened: the payload is let go where it is (Mode 1)");
+  status_.let_go = true;
   AcceptSpare();
 }
 
@@ -463,6 +530,7 @@ DcpFrameData DynamicCollisionProgram::Step(const OperatorInputs& in) {
   reset_pressed_ = in.reset;
   status_.master = master;
   status_.held = status_.finger_held = status_.essential_contact = false;
+  status_.finger_contact = false;  // Mode 1's, set by UpdateAcquisition
   status_.motion_collision = status_.too_fast = false;
   status_.substeps = 0;
 
@@ -472,6 +540,7 @@ DcpFrameData DynamicCollisionProgram::Step(const OperatorInputs& in) {
     // its pose and only the finger moves, until opening it releases it.
     if (slave_->finger_gap_ft >= acquisition_gap_ft_ + kReleaseOpeningFt) {
       released_ = true;
+      PlacePayload(X_RP_docked_);  // the hand is tested against it from now on
       spdlog::info("released: the finger let go of the docked payload; the arm is free");
     } else {
       command.angles_deg = slave_->cmd.angles_deg;
@@ -568,6 +637,7 @@ void DynamicCollisionProgram::RefreshMeasures() {
   status_.acquisition = {};
   status_.acquisition_margin_ft = {};
   status_.palm_to_bar_ft = 0.0;
+  status_.finger_contact = false;
   if (status_.mode == 1) {
     const AcquisitionCheck c = CheckAcquisition(config_.dcp, slave_->ee, bar_, slave_->finger_gap_ft, tau_rel_);
     status_.acquisition = c.holds;
@@ -593,7 +663,7 @@ AcquisitionCheck CheckAcquisition(const DcpConfig& dcp, const EndEffectorModel& 
   const Hexahedron& h1 = ee.hex[0];
   const Hexahedron& h2 = ee.hex[1];
   const Hexahedron& h3 = ee.hex[2];
-  const double tau = relative_tolerance * std::max(h1.scale, bar.scale);
+  const double tau = ToleranceFt(h1, bar, relative_tolerance);
   AcquisitionCheck c;
   c.finger_gap_ft = finger_gap_ft;
   c.holds[0] = AllHave(h1.Words(bar, tau), kFaceD);
@@ -639,7 +709,7 @@ AcquisitionCheck CheckAcquisition(const DcpConfig& dcp, const EndEffectorModel& 
 DockingCheck CheckDocking(const DcpConfig& dcp, const CaeConfig& cae, const Hexahedron& front,
                           const PayloadModel& p, double relative_tolerance) {
   DockingCheck d;
-  const double tau = relative_tolerance * front.scale;
+  const double tau = ToleranceFt(front, front, relative_tolerance);
   const LocationWord sides = FaceBit(kFaceA) | FaceBit(kFaceB) | FaceBit(kFaceD) | FaceBit(kFaceE);
   d.in_envelope = true;
   d.envelope_margin_ft = 1e30;
@@ -682,8 +752,27 @@ void DynamicCollisionProgram::UpdateAcquisition() {
   contact_gap_ft_ = std::clamp(ee.palm_half_width_ft - ee.finger_thickness_ft - y_min + kFingerContactClearanceFt,
                                0.0, acquisition_gap_ft_);
   payload_reach_ft_ = PayloadReachFt(X_S2P_);  // bounds the held payload's travel
+  if (!ReevaluateSlave()) {
+    status_.mode = 1;
+    status_.acquired = false;
+    payload_reach_ft_ = 0.0;
+    return;
+  }
   spdlog::info("acquisition: Mode 1 -> Mode 2 (finger gap {:.3f} ft, palm to bar {:.3f} ft)", c.finger_gap_ft,
                c.palm_to_bar_ft);
+}
+
+bool DynamicCollisionProgram::ReevaluateSlave() {
+  // The slave where it is, tested in the mode just entered: a pose that
+  // collides there keeps the mode it was in (reported, never shown).
+  Evaluate(slave_->cmd, slave_, spare_);
+  if (spare_->collisions) {
+    spdlog::warn("Mode {} not entered: the arm where it is would collide there ({})", status_.mode,
+                 Names(spare_->collisions));
+    return false;
+  }
+  AcceptSpare();
+  return true;
 }
 
 void DynamicCollisionProgram::UpdateExtraction() {
@@ -693,11 +782,15 @@ void DynamicCollisionProgram::UpdateExtraction() {
   status_.acquisition_margin_ft = {};
   status_.palm_to_bar_ft = 0.0;
   status_.bay_clearance_ft = BayClearance(slave_->payload);
-  const double tau = tau_rel_ * bay_.scale;
+  const double tau = ToleranceFt(bay_, bay_, tau_rel_);
   for (const Eigen::Vector3d& v : slave_->payload.v) {
     if (!(bay_.Word(v, tau) & FaceBit(kFaceC))) return;
   }
   status_.mode = 3;
+  if (!ReevaluateSlave()) {
+    status_.mode = 2;
+    return;
+  }
   spdlog::info("clear of the cargo bay: Mode 2 -> Mode 3");
 }
 
@@ -710,6 +803,7 @@ void DynamicCollisionProgram::UpdateDocking() {
   if (status_.mode == 3 && !status_.docked && d.docked) {
     status_.docked = true;
     X_RP_docked_ = slave_->X_RP;
+    PlacePayload(X_RP_docked_);
     spdlog::info("docked: distance {:.3f} ft, angle {:.3f} deg", d.distance_ft, d.angle_deg);
   }
 }
@@ -841,11 +935,26 @@ void DynamicCollisionProgram::RestoreState(const nlohmann::json& j) {
   } catch (const nlohmann::json::exception& e) {
     throw InputError(std::string("checkpoint: ") + e.what());
   }
-  if (!Finite(p->master) || (p->have_slave && !Finite(p->slave)) || !p->X_S2P.matrix().allFinite() ||
-      !p->X_RP_free.matrix().allFinite() || !p->X_RP_docked.matrix().allFinite() ||
-      !std::isfinite(p->contact_gap_ft) || !std::isfinite(p->acquisition_gap_ft)) {
-    throw InputError("checkpoint: a number is not finite");
+  CheckRestored(p->mode, p->acquired, p->docked, p->released, p->contact_gap_ft, p->acquisition_gap_ft);
+  if (!Finite(p->master) || (p->have_slave && !Finite(p->slave))) throw InputError("checkpoint: a command is not finite");
+  for (const ArmCommand* c : {&p->master, &p->slave}) {
+    if (!(std::abs(c->finger) <= 10.0)) throw InputError("checkpoint: a finger lever is out of range");
   }
+  for (const auto& [X, key] : {std::pair{&p->X_S2P, "X_S2P"}, {&p->X_RP_free, "X_RP_free"}, {&p->X_RP_docked, "X_RP_docked"}}) {
+    const Eigen::Matrix3d R = X->linear();
+    if (!X->matrix().allFinite() || !((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= 1e-9)) {
+      throw InputError(std::string("checkpoint: '") + key + "' is not a rigid pose");
+    }
+  }
+  for (const CollisionResult& r : p->hints.ee_bar) {
+    if (r.plane_valid && !(std::abs(r.n.norm() - 1.0) <= 1e-9)) throw InputError("checkpoint: a plane's normal is not a unit vector");
+  }
+  for (const CollisionResult& r : p->hints.ee_body) {
+    if (r.plane_valid && !(std::abs(r.n.norm() - 1.0) <= 1e-9)) throw InputError("checkpoint: a plane's normal is not a unit vector");
+  }
+  // The slave must be free where the checkpoint puts it: tried on the state
+  // it describes, and the old state put back if not.
+  const nlohmann::ordered_json before = SaveState();
   // All read: now the state.
   status_.mode = p->mode;
   status_.acquired = p->acquired;
@@ -858,20 +967,41 @@ void DynamicCollisionProgram::RestoreState(const nlohmann::json& j) {
   reset_pressed_ = p->reset_pressed;
   started_ = p->have_slave;
   status_.master = p->master;
-  PlacePayload(p->X_RP_free);
+  PlacePayload(p->docked ? p->X_RP_docked : p->X_RP_free);
   payload_reach_ft_ = p->acquired ? PayloadReachFt(p->X_S2P) : 0.0;
   // The slave's evaluation follows from its command and the state above (a
   // checkpoint saved before the first frame: the initial pose). The saved
   // planes are the hints, as they were for the saved frame.
-  const ArmCommand slave = p->have_slave ? p->slave : slave_->cmd;
+  const ArmCommand slave = p->have_slave ? p->slave : initial_;
   Evaluate(slave, &p->hints, spare_);
+  if (spare_->collisions) {
+    const std::string pairs = Names(spare_->collisions);
+    RestoreState(before);
+    throw InputError("checkpoint: its arm pose collides (" + pairs + ")");
+  }
   AcceptSpare();
-  if (p->have_slave) slave_->collisions = p->slave_collisions;
   status_.slave = slave_->cmd;
   status_.X_RS2 = slave_->pose.X_RS2;
   status_.X_RP = slave_->X_RP;
   status_.finger_gap_ft = slave_->finger_gap_ft;
   RefreshMeasures();  // nothing of the frames before the restore
+}
+
+void DynamicCollisionProgram::CheckRestored(int mode, bool acquired, bool docked, bool released, double contact_gap_ft,
+                                            double acquisition_gap_ft) const {
+  // A state the program could have reached (docs/sessions.md "checkpoint").
+  if (acquired != (mode >= 2)) throw InputError("checkpoint: 'acquired' must be true exactly in Modes 2 and 3");
+  if (docked && mode != 3) throw InputError("checkpoint: 'docked' needs Mode 3");
+  if (released && !docked) throw InputError("checkpoint: 'released' needs 'docked'");
+  if (!std::isfinite(contact_gap_ft) || !std::isfinite(acquisition_gap_ft)) {
+    throw InputError("checkpoint: a finger gap is not finite");
+  }
+  const auto& e = config_.end_effector;
+  if (acquired && !(contact_gap_ft >= 0.0 && contact_gap_ft <= acquisition_gap_ft &&
+                    acquisition_gap_ft <= e.finger_gap_open_ft)) {
+    throw InputError("checkpoint: the finger gaps must satisfy 0 <= contact_gap_ft <= acquisition_gap_ft <= "
+                     "the open gap");
+  }
 }
 
 double DynamicCollisionProgram::PayloadReachFt(const Eigen::Isometry3d& X_S2P) const {

@@ -46,14 +46,14 @@ using rms::kReleaseOpeningFt;
 // The motion test between frames (docs/collision.md "Nothing passes
 // through"): no model vertex moves more than this in one substep (less, when
 // the thinnest tested solid is thinner than twice it).
-inline constexpr double kMaxSubstepTravelFt = 0.05;
+inline constexpr double kMaxSubstepTravelFt = 0.1;
 // A command whose motion would need more substeps than this is held and
 // reported (a jump no arm could make in a frame).
 inline constexpr int kMaxSubsteps = 4096;
 // Between two substeps whose clearances do not cover the travel, the
-// motion is halved this many times at most (to 1/64 of a substep's travel:
+// motion is halved this many times at most (to 1/128 of a substep's travel:
 // a graze shallower than that may go unseen; docs/collision.md).
-inline constexpr int kRefineDepth = 6;
+inline constexpr int kRefineDepth = 7;
 // The essential contact: acquisition needs the movable finger's face e
 // within this of the bar (docs/collision.md "The essential contact").
 inline constexpr double kFingerContactToleranceFt = 0.01;
@@ -220,22 +220,33 @@ class DynamicCollisionProgram {
   void Evaluate(const ArmCommand& cmd, const Evaluation* prev, Evaluation* e) const;
   // The payload's and probe's vertices against the bay's walls and bottom
   // (a vertex below face c beyond one), Modes 2 and 3.
+  // EFF HEX 1-3 (out->ee) against the resting payload: collision bits,
+  // results and clearance into *out.
+  void TestHandAgainstPayload(const Evaluation* prev, Evaluation* out) const;
   // *clearance_ft is lowered to a bound on the vertices' distance from it.
   std::uint32_t BayCollisions(const PayloadModel& p, double* clearance_ft) const;
   // The motion from `from` to `to` (joint angles, height and finger linear
   // in between): the end pose into *out, then substeps so that no model
-  // vertex moves more than substep_ft_ between two tested poses. Returns the
-  // first collision bits found (0: the whole motion is free).
+  // vertex moves more than substep_ft_ between two tested poses, refined
+  // where the clearances do not cover the travel. Returns the first
+  // collision bits found (0: the whole motion is free).
   std::uint32_t TestMotion(const ArmCommand& from, const ArmCommand& to, Evaluation* out);
   // Between two free poses of the motion (parameters s0 < s1, clearances c0,
-  // c1, any vertex's travel between them at most travel_ft): when c0 + c1
-  // cannot cover the travel, the midpoint is tested, and each half in turn,
-  // down to kRefineDepth halvings. Returns the first collision bits found.
+  // c1, any vertex's travel between them at most travel_ft, plus slack_ft
+  // for the words' rounding): when c0 + c1 cannot cover it, the midpoint is
+  // tested, and each half in turn, down to kRefineDepth halvings. Returns the
+  // first collision bits found, and where (*hit_s).
   std::uint32_t Refine(const ArmCommand& from, const ArmCommand& to, double s0, double s1, double c0, double c1,
-                       double travel_ft, int depth);
-  // The number of poses the motion needs (1: the end pose alone), or -1
-  // beyond kMaxSubsteps.
-  int Substeps(const ArmCommand& from, const ArmCommand& to) const;
+                       double travel_ft, double slack_ft, int depth, double* hit_s);
+  // The bound on any model vertex's travel along the motion, ft.
+  double TravelFt(const ArmCommand& from, const ArmCommand& to) const;
+  // Each joint's reach: the farthest a moving vertex can be from its axis, ft.
+  std::array<double, 6> JointReachFt() const;
+  // What the arm words' rounding can move a tested pose, twice, ft.
+  double WordSlackFt() const;
+  // The number of poses a motion of this travel needs (1: the end pose
+  // alone), or -1 beyond kMaxSubsteps.
+  int Substeps(double travel_ft) const;
   // The command with the arm where the slave is and the finger closed (or
   // opened) toward `finger` as far as it goes free, to within 1e-5 ft of
   // the first contact. Returns the contact's collision bits (0: none).
@@ -252,15 +263,18 @@ class DynamicCollisionProgram {
   void AcceptSpare();
   void UpdateAcquisition();
   void UpdateExtraction();
+  // After a mode change: the slave re-evaluated in the new mode; false (and
+  // nothing accepted) when it would collide there.
+  bool ReevaluateSlave();
   void UpdateDocking();
   // The status's measures of the slave's pose (planes, conditions, bay
   // clearance, docking), without changing the mode: after a restore.
   void RefreshMeasures();
   void UpdatePlanes();
   double BayClearance(const PayloadModel& p) const;
-  // The largest distance of a moving model vertex from the shoulder, ft:
-  // bounds a vertex's travel per radian of any joint.
-  double ReachFt() const;
+  // Refuses (rms::InputError) a restored state the program could not reach.
+  void CheckRestored(int mode, bool acquired, bool docked, bool released, double contact_gap_ft,
+                     double acquisition_gap_ft) const;
   // A held payload's farthest vertex from point A, ft.
   double PayloadReachFt(const Eigen::Isometry3d& X_S2P) const;
 
@@ -283,6 +297,7 @@ class DynamicCollisionProgram {
   // State. The slave starts at the initial inputs' pose (config [inputs]).
   bool reset_pressed_ = false;  // the reset button as last seen (Step acts on its press)
   bool started_ = false;        // a frame has been made: commands are motions from the slave's pose
+  ArmCommand initial_;          // the initial inputs' pose, where the slave starts
   std::array<Evaluation, 4> evaluations_;
   Evaluation* slave_ = &evaluations_[0];  // the slave's (collision-free) evaluation
   Evaluation* spare_ = &evaluations_[1];  // this frame's candidate

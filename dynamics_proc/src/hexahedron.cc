@@ -15,9 +15,10 @@ const char* HexProblemName(HexProblem p) {
   switch (p) {
     case HexProblem::kNone: return "valid";
     case HexProblem::kNonFinite: return "a coordinate is not finite";
-    case HexProblem::kOverflow: return "a coordinate beyond 1e100 ft (its products would overflow)";
-    case HexProblem::kTooSmall: return "smaller than 1e-100 ft (its products would underflow)";
+    case HexProblem::kOverflow: return "a coordinate beyond 1e75 ft (its products would overflow)";
+    case HexProblem::kTooSmall: return "smaller than 1e-75 ft (its products would underflow)";
     case HexProblem::kBadDimension: return "a length or half-width not positive";
+    case HexProblem::kSkewedAxes: return "its axes U, V, W are not orthonormal";
     case HexProblem::kDegenerateFace: return "a face has no area";
     case HexProblem::kFlat: return "flat: thinner than the rounding tolerance at its coordinates";
     case HexProblem::kTwisted: return "twisted: its faces disagree on the outward side";
@@ -250,7 +251,10 @@ Hexahedron MakeBox(const Eigen::Vector3d& p_A, const Eigen::Vector3d& U, const E
   h.parallel_opposites = true;  // the normals above are exact negatives
   HexProblem problem = Finish(&h);
   if (problem == HexProblem::kNone) {
+    const double skew = std::max({std::abs(U.squaredNorm() - 1), std::abs(V.squaredNorm() - 1), std::abs(W.squaredNorm() - 1),
+                                  std::abs(U.dot(V)), std::abs(V.dot(W)), std::abs(W.dot(U))});
     if (!(length > 0 && half_v > 0 && half_w > 0)) problem = HexProblem::kBadDimension;
+    else if (!(skew <= 1e-9)) problem = HexProblem::kSkewedAxes;
     else if (std::min({length, 2 * half_v, 2 * half_w}) <= ShapeTolerance(h)) problem = HexProblem::kFlat;
   }
   SetValidity(&h, problem);

@@ -37,14 +37,17 @@ enum class HexProblem : std::uint8_t {
   kOverflow,        // a coordinate beyond kMaxCoordinateFt: its products would overflow
   kTooSmall,        // smaller than kMinScaleFt: its products would underflow
   kBadDimension,    // MakeBox: a length or half-width not positive
+  kSkewedAxes,      // MakeBox: U, V, W not orthonormal (to 1e-9)
   kDegenerateFace,  // a face with no area (its diagonals parallel)
   kFlat,            // thinner than the rounding tolerance at its coordinates
   kTwisted,         // the faces disagree on which side is outward
   kNonConvex,       // a vertex beyond a face's plane by more than the rounding tolerance
 };
 const char* HexProblemName(HexProblem p);
-inline constexpr double kMaxCoordinateFt = 1e100;
-inline constexpr double kMinScaleFt = 1e-100;
+// Face normals come from cross products of edges (fourth powers of length
+// in their norms): beyond these the products would overflow or underflow.
+inline constexpr double kMaxCoordinateFt = 1e75;
+inline constexpr double kMinScaleFt = 1e-75;
 // The rounding tolerance of a solid at coordinates of magnitude M ft is
 // kRoundingPerFt x M: what double rounding of the vertices, the face planes
 // and one projection can do there (32 units of 2^-52; docs/collision.md).

@@ -155,7 +155,9 @@ TEST_F(DcpEdges, InMode3ThePayloadCannotBeLoweredBackThroughTheBayWalls) {
   // No payload vertex beyond the wall is below the sill.
   const PayloadModel p = MakePayload(config.payload, dcp.X_RP());
   for (const Vector3d& v : p.v) {
-    if (v.y() > 0.5 * config.shuttle.bay_width_ft) EXPECT_GT(v.z(), -1e-9) << v.transpose();
+    if (v.y() > 0.5 * config.shuttle.bay_width_ft) {
+      EXPECT_GT(v.z(), -1e-9) << v.transpose();
+    }
   }
 }
 
@@ -297,6 +299,26 @@ TEST_F(DcpEdges, ACheckpointMissingItsLastKeyLeavesTheStateUnchanged) {
   cp["contact_gap_ft"] = nullptr;
   EXPECT_THROW(other.RestoreState(cp), InputError);
   EXPECT_EQ(other.SaveState().dump(), before);
+  // States the program could not reach: refused, nothing changed.
+  const nlohmann::json good = nlohmann::json::parse(saved.SaveState().dump());
+  std::vector<nlohmann::json> bad(5, good);
+  bad[0]["acquired"] = false;                              // Mode 2 without acquisition
+  bad[1]["contact_gap_ft"] = 2.0;                          // above the gap at acquisition
+  bad[2]["X_S2P"][0] = 2.0;                                // not a rigid pose
+  bad[3]["slave"]["angles_deg"][1] = good["slave"]["angles_deg"][1].get<double>() - 30.0;  // the palm in the bay
+  bad[4]["released"] = true;                               // released, not docked
+  for (std::size_t i = 0; i < bad.size(); ++i) {
+    try {
+      other.RestoreState(bad[i]);
+      ADD_FAILURE() << "case " << i << " restored";
+    } catch (const InputError& e) {
+      std::printf("case %zu refused: %s\n", i, e.what());
+    }
+    EXPECT_EQ(other.SaveState().dump(), before) << "case " << i;
+  }
+  // The good one restores.
+  other.RestoreState(good);
+  EXPECT_EQ(other.mode(), 2);
 }
 
 }  // namespace

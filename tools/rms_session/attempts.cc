@@ -107,7 +107,8 @@ void AttemptLog::ObserveFrame(const dcp_telemetry_t& m, bool reset, double t_s) 
     a.best_dock_angle_deg = m.dock_angle_deg;
   }
   // Detrimental collisions only: the finger resting on the bar is the essential contact.
-  const auto bits = DetrimentalCollisions(static_cast<std::uint32_t>(m.collisions), m.finger_held, m.held);
+  const auto bits = DetrimentalCollisions(static_cast<std::uint32_t>(m.collisions), m.finger_held, m.held,
+                                                m.master_finger > m.slave_finger);
   for (int b = 0; b < collision_bits::kCount; ++b) {
     if (!(bits & (1u << b))) continue;
     ++a.collisions[b].frames;

@@ -215,7 +215,8 @@ class TelemetryLog {
     docked = docked || m.docked;
     held_frames += m.held;
     // Detrimental collisions only: the finger resting on the bar is the essential contact.
-    const auto bits = DetrimentalCollisions(static_cast<std::uint32_t>(m.collisions), m.finger_held, m.held);
+    const auto bits = DetrimentalCollisions(static_cast<std::uint32_t>(m.collisions), m.finger_held, m.held,
+                                                m.master_finger > m.slave_finger);
     for (int b = 0; b < kCollisionBits; ++b) {
       const bool on = bits & (1u << b), was = last_bits_ & (1u << b);
       if (on && !was) {
