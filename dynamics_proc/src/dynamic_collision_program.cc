@@ -494,11 +494,15 @@ void DynamicCollisionProgram::LetGo() {
   // The payload where it is, Mode 1; the arm where it is must be free of it
   // (it is, but for rounding through X_S2P), else the grasp is kept.
   const Eigen::Isometry3d X_RP_free = X_RP_free_;
-  PlacePayload(slave_->X_RP);
   status_.mode = 1;
   status_.acquired = false;
   const double reach = payload_reach_ft_;
   payload_reach_ft_ = 0.0;
+  // Re-orthonormalized: a payload let go and grasped again many times must
+  // not accumulate rounding in its rotation.
+  Eigen::Isometry3d X_RP = slave_->X_RP;
+  X_RP.linear() = Eigen::Quaterniond(X_RP.linear()).normalized().toRotationMatrix();
+  PlacePayload(X_RP);
   Evaluate(SlaveAsItIs(), slave_, spare_);
   if (spare_->collisions) {
     spdlog::warn("the finger opened but the hand would be in collision with the payload let go ({}): grasp kept",
