@@ -375,6 +375,9 @@ std::uint32_t DynamicCollisionProgram::TestMotion(const ArmCommand& from, const 
   const double step_ft = travel / n, slack_ft = WordSlackFt();
   // The slave's clearance, when it was evaluated in this mode (else unknown).
   double c_prev = slave_->mode == status_.mode ? slave_->clearance_ft : 0.0;
+  // The two ends' clearances cover the whole travel: nothing can touch
+  // between them (conservative advancement); the usual frame costs one test.
+  if (c_prev + out->clearance_ft > travel + slack_ft) return 0;
   for (int k = 1; k <= n; ++k) {
     double c = out->clearance_ft;
     if (k < n) {
