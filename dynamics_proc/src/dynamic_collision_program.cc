@@ -875,7 +875,7 @@ nlohmann::ordered_json DynamicCollisionProgram::SaveState() const {
   j["released"] = released_;
   j["have_slave"] = started_;
   j["slave"] = CommandJson(slave_->cmd);
-  j["slave_collisions"] = slave_->collisions;
+  j["slave_collisions"] = slave_->collisions;  // always 0 (a restore re-tests the slave); kept for older readers
   j["master"] = CommandJson(status_.master);
   j["X_S2P"] = PoseJson(X_S2P_);
   j["X_RP_docked"] = PoseJson(X_RP_docked_);
@@ -903,7 +903,6 @@ void DynamicCollisionProgram::RestoreState(const nlohmann::json& j) {
     Eigen::Isometry3d X_S2P, X_RP_docked, X_RP_free;
     double contact_gap_ft = 0, acquisition_gap_ft = 0;
     ArmCommand master, slave;
-    std::uint32_t slave_collisions = 0;
     Evaluation hints;  // only its planes
   };
   auto p = std::make_unique<Parsed>();
@@ -927,7 +926,6 @@ void DynamicCollisionProgram::RestoreState(const nlohmann::json& j) {
     p->have_slave = j.at("have_slave").get<bool>();
     if (p->have_slave) {
       p->slave = CommandFrom(j.at("slave"));
-      p->slave_collisions = j.at("slave_collisions").get<std::uint32_t>();
       if (j.contains("planes_ee_bar")) {
         for (int k = 0; k < 3; ++k) PlaneFrom(j.at("planes_ee_bar").at(k), &p->hints.ee_bar[k]);
         // One plane per end-effector hexahedron and body strip (an older

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "dcp_fixture.h"
 #include "dcp_models.h"
 #include "dynamic_collision_program.h"
 #include "mission_plan.h"
@@ -23,25 +24,8 @@ namespace {
 using Eigen::Isometry3d;
 using Eigen::Vector3d;
 
-class DcpEdges : public ::testing::Test {
+class DcpEdges : public testing::DcpFixture {
  protected:
-  LabConfig config = LoadConfig(DefaultConfigPath());
-  mission::MissionGeometry geo = mission::PlanGeometry(config);
-
-  Isometry3d X_RP_bay() const { return MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft); }
-  OperatorInputs Inputs(const Isometry3d& X_RS2, double finger) const {
-    OperatorInputs in = InitialInputs(config.inputs);
-    const auto s = SolveArmIk(config.arm, X_RS2, geo.shoulder_height_ft);
-    EXPECT_TRUE(s.has_value());
-    for (int i = 0; i < 6; ++i) in.value[i] = s->angles_deg[i];
-    in.value[kShoulderHeight] = geo.shoulder_height_ft;
-    in.value[kFinger] = finger;
-    return in;
-  }
-  static Isometry3d Shifted(Isometry3d X, const Vector3d& d) {
-    X.translation() += d;
-    return X;
-  }
   double Lever(double gap_ft) const {
     const auto& e = config.end_effector;
     return (e.finger_gap_open_ft - gap_ft) / (e.finger_gap_open_ft - e.finger_gap_closed_ft);

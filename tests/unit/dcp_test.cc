@@ -12,6 +12,7 @@
 #include <sstream>
 #include <unistd.h>
 
+#include "dcp_fixture.h"
 #include "dcp_models.h"
 #include "dynamic_collision_program.h"
 #include "mission_plan.h"
@@ -30,31 +31,8 @@ namespace {
 using Eigen::Isometry3d;
 using Eigen::Vector3d;
 
-class Dcp : public ::testing::Test {
+class Dcp : public testing::DcpFixture {
  protected:
-  LabConfig config = LoadConfig(DefaultConfigPath());
-  mission::MissionGeometry geo = mission::PlanGeometry(config);
-
-  Isometry3d X_RP_bay() const {
-    Isometry3d X = Isometry3d::Identity();
-    X.linear() = config.payload.R_RP;
-    X.translation() = config.payload.p_RoPo_R_ft;
-    return X;
-  }
-  OperatorInputs Inputs(const Isometry3d& X_RS2, double finger, double height = -1) const {
-    if (height < 0) height = geo.shoulder_height_ft;
-    OperatorInputs in = InitialInputs(config.inputs);
-    const auto s = SolveArmIk(config.arm, X_RS2, height);
-    EXPECT_TRUE(s.has_value());
-    for (int i = 0; i < 6; ++i) in.value[i] = s->angles_deg[i];
-    in.value[kShoulderHeight] = height;
-    in.value[kFinger] = finger;
-    return in;
-  }
-  static Isometry3d Shifted(Isometry3d X, const Vector3d& d) {
-    X.translation() += d;
-    return X;
-  }
   // The acquisition check for System Two at X_RS2 and a finger gap.
   AcquisitionCheck Check(const Isometry3d& X_RS2, double gap) const {
     return CheckAcquisition(config.dcp, MakeEndEffector(config.end_effector, X_RS2, gap),

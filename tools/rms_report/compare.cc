@@ -193,12 +193,11 @@ Comparison CompareSessions(const std::vector<std::string>& dirs, const std::stri
     if (s.kind != "re-simulation") subjects[s.subject.empty() ? "(no subject)" : s.subject].push_back(i);
   }
   data["subjects"] = subjects;
-  std::ifstream js(chart_js_path), cs(ChartsScriptPath("compare_charts.js"));
+  std::ifstream js(chart_js_path);
   if (!js) throw InputError("cannot read Chart.js at '" + chart_js_path + "' (libjs-chart.js; scripts/install-deps)");
-  if (!cs) throw InputError("cannot read " + ChartsScriptPath("compare_charts.js"));
-  std::stringstream chart_js, charts;
+  std::stringstream chart_js;
   chart_js << js.rdbuf();
-  charts << cs.rdbuf();
+  const std::string charts = ChartsScript("compare_charts.js");
   const std::string json = ScriptJson(data);
   std::ostringstream h;
   h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>rmslab: " << sessions.size()
@@ -209,7 +208,7 @@ Comparison CompareSessions(const std::vector<std::string>& dirs, const std::stri
     << "<p>Made by <code>scripts/lab compare</code> from the session folders alone; the figures are each session's "
        "summary (docs/sessions.md). compare.csv beside this page has a row an attempt.</p>\n"
     << Table(sessions) << "<h2>Learning curves</h2>\n<div id=\"rms-charts\"></div>\n<script>\nwindow.RMS_COMPARE = "
-    << json << ";\n</script>\n<script>\n" << charts.str() << "\n</script>\n</body></html>\n";
+    << json << ";\n</script>\n<script>\n" << charts << "\n</script>\n</body></html>\n";
   return {h.str(), Csv(sessions)};
 }
 

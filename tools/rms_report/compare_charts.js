@@ -60,21 +60,9 @@
     return out;
   }
 
-  // A new element with the given properties, appended to parent.
-  function el(tag, props, parent) {
-    const e = Object.assign(document.createElement(tag), props);
-    parent.appendChild(e);
-    return e;
-  }
-
-  // A titled section holding a canvas of the given height.
-  function section(title, height) {
-    const div = el('div', { className: 'rms-chart' }, document.getElementById('rms-charts'));
-    el('h3', { textContent: title }, div);
-    const box = el('div', {}, div);
-    box.style.cssText = 'position:relative;height:' + height + 'px';
-    return el('canvas', {}, box);
-  }
+  const { el } = window.RmsCharts;  // chart_page.js
+  // A titled section's canvas, of the given height.
+  const section = (title, height) => window.RmsCharts.section(title, height).canvas;
 
   const note = (text) => el('p', { className: 'rms-chart-note', textContent: text }, document.getElementById('rms-charts'));
 

@@ -581,8 +581,9 @@ std::string ScriptJson(const nlohmann::json& j) {
   return out;
 }
 
-std::string ChartsScriptPath(const std::string& name) {
-  return std::string(RMSLAB_SOURCE_DIR) + "/tools/rms_report/" + name;
+std::string ChartsScript(const std::string& name) {
+  const std::string dir = std::string(RMSLAB_SOURCE_DIR) + "/tools/rms_report/";
+  return ReadText(dir + "chart_page.js", "the charts' page helpers") + "\n" + ReadText(dir + name, "the page's charts");
 }
 
 std::string MakeReport(const std::string& session_dir, const std::string& chart_js_path,
@@ -595,7 +596,7 @@ std::string MakeReport(const std::string& session_dir, const std::string& chart_
   const nlohmann::ordered_json s = session::Summarize(session_dir);
   const nlohmann::ordered_json manifest = ReadManifest(root);
   const std::string chart_js = ReadText(chart_js_path, "Chart.js (Debian package libjs-chart.js; scripts/install-deps)");
-  const std::string charts = ReadText(ChartsScriptPath("report_charts.js"), "the report's charts");
+  const std::string charts = ChartsScript("report_charts.js");
   const LabConfig config = SessionConfig(root);
   say("report: reading the log");
   const Traces t = ReadTraces(session_dir, config, s);

@@ -20,7 +20,9 @@ std::string MakeReport(const std::string& session_dir, const std::string& chart_
 // JSON to embed in a <script> (the report's and the comparison's data):
 // "</" written "<\/" so it cannot end the script.
 std::string ScriptJson(const nlohmann::json& j);
-// The report's scripts (report_charts.js, compare_charts.js) in the source tree.
-std::string ChartsScriptPath(const std::string& name);
+// A page's chart script from the source tree (report_charts.js,
+// compare_charts.js), after the helpers they share (chart_page.js): the text
+// to embed in one <script>. Throws rms::InputError when one cannot be read.
+std::string ChartsScript(const std::string& name);
 
 }  // namespace rms::report

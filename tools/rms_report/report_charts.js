@@ -58,21 +58,7 @@
     return [0, 1, 2, 3].filter((m) => seen.has(m));
   }
 
-  // A new element with the given properties, appended to parent.
-  function el(tag, props, parent) {
-    const e = Object.assign(document.createElement(tag), props);
-    parent.appendChild(e);
-    return e;
-  }
-
-  // A titled section holding a canvas (fixed height, or fixed aspect ratio when height is null).
-  function section(title, height) {
-    const div = el('div', { className: 'rms-chart' }, document.getElementById('rms-charts'));
-    el('h3', { textContent: title }, div);
-    const box = el('div', {}, div);
-    box.style.cssText = 'position:relative' + (height ? ';height:' + height + 'px' : '');
-    return { div, box, canvas: el('canvas', {}, box) };
-  }
+  const { el, section } = window.RmsCharts;  // chart_page.js
 
   function note(sec, text) {
     sec.box.remove();

@@ -1,0 +1,41 @@
+#pragma once
+// The DCP unit tests' common ground: the default configuration, the planned
+// mission's geometry, and operator inputs that put System Two at a pose.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include "mission_plan.h"
+#include "rms/arm_ik.h"
+#include "rms/arm_kinematics.h"
+#include "rms/config.h"
+#include "rms/input_block.h"
+
+namespace rms::dcp::testing {
+
+class DcpFixture : public ::testing::Test {
+ protected:
+  LabConfig config = LoadConfig(DefaultConfigPath());
+  mission::MissionGeometry geo = mission::PlanGeometry(config);
+
+  // The payload in the bay (Mode 1).
+  Eigen::Isometry3d X_RP_bay() const { return MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft); }
+  // Inputs that put System Two at X_RS2 (inverse kinematics) with the finger
+  // lever, at the mission's shoulder height unless one is given.
+  OperatorInputs Inputs(const Eigen::Isometry3d& X_RS2, double finger, double height = -1) const {
+    if (height < 0) height = geo.shoulder_height_ft;
+    OperatorInputs in = InitialInputs(config.inputs);
+    const auto s = SolveArmIk(config.arm, X_RS2, height);
+    EXPECT_TRUE(s.has_value());
+    for (int i = 0; i < 6; ++i) in.value[i] = s->angles_deg[i];
+    in.value[kShoulderHeight] = height;
+    in.value[kFinger] = finger;
+    return in;
+  }
+  static Eigen::Isometry3d Shifted(Eigen::Isometry3d X, const Eigen::Vector3d& d) {
+    X.translation() += d;
+    return X;
+  }
+};
+
+}  // namespace rms::dcp::testing
