@@ -22,17 +22,17 @@
 #include <string>
 #include <vector>
 
-#include "collision.h"
-#include "exact_hull.h"
-#include "generators.h"
+#include "rms/dynamics_proc/collision.h"
+#include "rms/reference/exact_hull.h"
+#include "rms/reference/generators.h"
 #include "peers.h"
 
 namespace {
 
-using rms::ref::Pair;
+using rms::reference::Pair;
 using Hull = std::array<Eigen::Vector3d, 8>;
 
-rms::bench::BoxShape Shape(const rms::ref::Solid& s) {
+rms::bench::BoxShape Shape(const rms::reference::Solid& s) {
   rms::bench::BoxShape b;
   b.centre = s.box.centre.cast<double>();
   for (int k = 0; k < 3; ++k) {
@@ -43,7 +43,7 @@ rms::bench::BoxShape Shape(const rms::ref::Solid& s) {
 }
 
 struct Sets {
-  std::vector<std::pair<rms::dcp::Hexahedron, rms::dcp::Hexahedron>> hex_boxes, hex_general;
+  std::vector<std::pair<rms::dynamics_proc::Hexahedron, rms::dynamics_proc::Hexahedron>> hex_boxes, hex_general;
   std::vector<std::pair<rms::bench::BoxShape, rms::bench::BoxShape>> boxes;
   std::vector<std::pair<Hull, Hull>> hulls_boxes, hulls_general;
   std::vector<std::unique_ptr<rms::bench::FclPair>> fcl_boxes, fcl_general;
@@ -51,7 +51,7 @@ struct Sets {
 
 Sets MakeSets() {
   Sets s;
-  rms::ref::PairGenerator gen(12345);
+  rms::reference::PairGenerator gen(12345);
   while (s.boxes.size() < 4096) {
     const Pair p = gen.Next(1.0, true);
     if (p.kind != "random boxes") continue;
@@ -119,25 +119,25 @@ int main(int argc, char** argv) {
     std::size_t i = 0;
     for (auto _ : st) benchmark::DoNotOptimize(f(i++ & 4095));
   };
-  rms::dcp::CollideOptions verdict_only;
+  rms::dynamics_proc::CollideOptions verdict_only;
   verdict_only.want_plane = false;
-  rms::dcp::CollideOptions report_only = verdict_only;
+  rms::dynamics_proc::CollideOptions report_only = verdict_only;
   report_only.sphere_reject = false;
   report_only.aabb_reject = false;
-  rms::dcp::CollideOptions spheres_only = verdict_only;
+  rms::dynamics_proc::CollideOptions spheres_only = verdict_only;
   spheres_only.aabb_reject = false;
   // Boxes.
   benchmark::RegisterBenchmark("boxes/DCP, verdict", [&](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) { return rms::dcp::Collide(sets.hex_boxes[i].first, sets.hex_boxes[i].second, verdict_only).verdict; });
+    cycle(st, [&](std::size_t i) { return rms::dynamics_proc::Collide(sets.hex_boxes[i].first, sets.hex_boxes[i].second, verdict_only).verdict; });
   });
   benchmark::RegisterBenchmark("boxes/DCP, verdict, no bounding-volume rejection", [&](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) { return rms::dcp::Collide(sets.hex_boxes[i].first, sets.hex_boxes[i].second, report_only).verdict; });
+    cycle(st, [&](std::size_t i) { return rms::dynamics_proc::Collide(sets.hex_boxes[i].first, sets.hex_boxes[i].second, report_only).verdict; });
   });
   benchmark::RegisterBenchmark("boxes/DCP, verdict, spheres but no box rejection", [&](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) { return rms::dcp::Collide(sets.hex_boxes[i].first, sets.hex_boxes[i].second, spheres_only).verdict; });
+    cycle(st, [&](std::size_t i) { return rms::dynamics_proc::Collide(sets.hex_boxes[i].first, sets.hex_boxes[i].second, spheres_only).verdict; });
   });
   benchmark::RegisterBenchmark("boxes/DCP, verdict and separating plane", [&](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) { return rms::dcp::Collide(sets.hex_boxes[i].first, sets.hex_boxes[i].second).verdict; });
+    cycle(st, [&](std::size_t i) { return rms::dynamics_proc::Collide(sets.hex_boxes[i].first, sets.hex_boxes[i].second).verdict; });
   });
   benchmark::RegisterBenchmark("boxes/separating axes, 15 (double)", [&](benchmark::State& st) {
     cycle(st, [&](std::size_t i) { return rms::bench::SatBoxesIntersect(sets.boxes[i].first, sets.boxes[i].second); });
@@ -152,14 +152,14 @@ int main(int argc, char** argv) {
     cycle(st, [&](std::size_t i) { return rms::bench::CcdMprBoxes(sets.boxes[i].first, sets.boxes[i].second); });
   });
   benchmark::RegisterBenchmark("boxes/exact (CGAL)", [&](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) { return rms::ref::ExactHullsIntersect(sets.hulls_boxes[i].first, sets.hulls_boxes[i].second); });
+    cycle(st, [&](std::size_t i) { return rms::reference::ExactHullsIntersect(sets.hulls_boxes[i].first, sets.hulls_boxes[i].second); });
   });
   // General hexahedra.
   benchmark::RegisterBenchmark("general/DCP, verdict", [&](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) { return rms::dcp::Collide(sets.hex_general[i].first, sets.hex_general[i].second, verdict_only).verdict; });
+    cycle(st, [&](std::size_t i) { return rms::dynamics_proc::Collide(sets.hex_general[i].first, sets.hex_general[i].second, verdict_only).verdict; });
   });
   benchmark::RegisterBenchmark("general/DCP, verdict and separating plane", [&](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) { return rms::dcp::Collide(sets.hex_general[i].first, sets.hex_general[i].second).verdict; });
+    cycle(st, [&](std::size_t i) { return rms::dynamics_proc::Collide(sets.hex_general[i].first, sets.hex_general[i].second).verdict; });
   });
   benchmark::RegisterBenchmark("general/libccd MPR", [&](benchmark::State& st) {
     cycle(st, [&](std::size_t i) { return rms::bench::CcdMprHulls(sets.hulls_general[i].first, sets.hulls_general[i].second); });
@@ -168,7 +168,7 @@ int main(int argc, char** argv) {
     cycle(st, [&](std::size_t i) { return sets.fcl_general[i]->Collide(); });
   });
   benchmark::RegisterBenchmark("general/exact (CGAL)", [&](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) { return rms::ref::ExactHullsIntersect(sets.hulls_general[i].first, sets.hulls_general[i].second); });
+    cycle(st, [&](std::size_t i) { return rms::reference::ExactHullsIntersect(sets.hulls_general[i].first, sets.hulls_general[i].second); });
   });
   Collector collector;
   benchmark::RunSpecifiedBenchmarks(&collector);
@@ -179,13 +179,13 @@ int main(int argc, char** argv) {
   std::fprintf(stderr, "agreement: %ld pairs a family, seed %llu\n", agreement_pairs, static_cast<unsigned long long>(seed));
   Agreement box_agree, gen_agree;
   {
-    rms::ref::PairGenerator gen(seed);
+    rms::reference::PairGenerator gen(seed);
     for (long n = 0; n < 7 * (agreement_pairs / 7); ++n) {
       const Pair p = gen.Next(1.0, true);
-      const bool exact = rms::ref::ExactHullsIntersect(p.a.v, p.b.v);
+      const bool exact = rms::reference::ExactHullsIntersect(p.a.v, p.b.v);
       const auto a = Shape(p.a), b = Shape(p.b);
       const std::map<std::string, bool> says = {
-          {"DCP", rms::dcp::Collide(p.a.hex, p.b.hex, verdict_only).verdict == rms::dcp::Verdict::kCollide},
+          {"DCP", rms::dynamics_proc::Collide(p.a.hex, p.b.hex, verdict_only).verdict == rms::dynamics_proc::Verdict::kCollide},
           {"separating axes, 15", rms::bench::SatBoxesIntersect(a, b)},
           {"ODE dBoxTouchesBox", rms::bench::OdeBoxesTouch(a, b)},
           {"FCL boxes", rms::bench::FclPair::Boxes(a, b)->Collide()},
@@ -202,9 +202,9 @@ int main(int argc, char** argv) {
     while (gen_agree.pairs < agreement_pairs / 2) {
       const Pair p = gen.Next(1.0, false);
       if (p.a.is_box || p.b.is_box) continue;
-      const bool exact = rms::ref::ExactHullsIntersect(p.a.v, p.b.v);
+      const bool exact = rms::reference::ExactHullsIntersect(p.a.v, p.b.v);
       const std::map<std::string, bool> says = {
-          {"DCP", rms::dcp::Collide(p.a.hex, p.b.hex, verdict_only).verdict == rms::dcp::Verdict::kCollide},
+          {"DCP", rms::dynamics_proc::Collide(p.a.hex, p.b.hex, verdict_only).verdict == rms::dynamics_proc::Verdict::kCollide},
           {"libccd MPR", rms::bench::CcdMprHulls(p.a.v, p.b.v)},
           {"FCL convex", rms::bench::FclPair::Hulls(p.a.v, p.b.v)->Collide()}};
       ++gen_agree.pairs;

@@ -14,7 +14,7 @@
 //
 //   build/bench/rms_dcp_bench [--md FILE] [--reps N] [--trajectories N] [--seed S]
 #include <CLI/CLI.hpp>
-#include "rms/command_line.h"
+#include "rms/base/command_line.h"
 #include <spdlog/spdlog.h>
 #include <benchmark/benchmark.h>
 
@@ -28,25 +28,25 @@
 #include <sstream>
 
 #include "bench_stats.h"
-#include "closed_loop.h"
-#include "random_operator.h"
-#include "dynamic_collision_program.h"
-#include "rms/text.h"
-#include "rms/word_codec.h"
+#include "rms/sim/closed_loop.h"
+#include "rms/sim/random_operator.h"
+#include "rms/dynamics_proc/dynamic_collision_program.h"
+#include "rms/base/text.h"
+#include "rms/wire/word_codec.h"
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
 using rms::bench::Percentile;
 using rms::Sprintf;
-using namespace rms::dcp;
+using namespace rms::dynamics_proc;
 
 
 // ---------------------------------------------------------------- 1. frame
 
 struct Flight {
   std::string name;
-  std::vector<rms::OperatorInputs> inputs;
+  std::vector<rms::wire::OperatorInputs> inputs;
 };
 
 struct FrameVariant {
@@ -77,16 +77,16 @@ void RunFrames(const rms::LabConfig& config, const std::vector<Flight>& flights,
       for (int r = 0; r < reps; ++r) {
         DynamicCollisionProgram dcp(config, v.options);
         std::vector<Decision> decisions;
-        for (const rms::OperatorInputs& in : flights[fi].inputs) {
+        for (const rms::wire::OperatorInputs& in : flights[fi].inputs) {
           const int mode = dcp.mode();
           const auto t0 = Clock::now();
-          rms::DcpFrameData out = dcp.Step(in);
+          rms::wire::DcpFrameData out = dcp.Step(in);
           benchmark::DoNotOptimize(out);
           const double ns = std::chrono::duration<double, std::nano>(Clock::now() - t0).count();
           v.ns.push_back(ns);
           v.ns_mode[mode].push_back(ns);
           if (r == 0) {
-            decisions.push_back({rms::PackControlWord(out.control), dcp.status().collisions, dcp.mode(),
+            decisions.push_back({rms::wire::PackControlWord(out.control), dcp.status().collisions, dcp.mode(),
                                  dcp.status().X_RS2.translation()});
           }
         }
@@ -114,9 +114,9 @@ double ClockOverheadNs() {
 
 // ---------------------------------------------------------------- shared
 
-rms::ArmSinCos Quantize(const rms::ArmSinCos& sc, int how) {  // 0 double, 1 float, 2 SC22
-  rms::ArmSinCos q = sc;
-  for (rms::SinCos& a : q) {
+rms::arm::ArmSinCos Quantize(const rms::arm::ArmSinCos& sc, int how) {  // 0 double, 1 float, 2 SC22
+  rms::arm::ArmSinCos q = sc;
+  for (rms::arm::SinCos& a : q) {
     if (how == 1) {
       a.s = static_cast<float>(a.s);
       a.c = static_cast<float>(a.c);
@@ -147,8 +147,8 @@ struct ArmSample {
 };
 
 // The end effector (EFF HEX 1-3) for a pose.
-EndEffectorModel EndEffectorFor(const rms::LabConfig& c, const rms::ArmSinCos& sc, const ArmSample& s) {
-  const rms::ArmPose pose = rms::ComputeArmPose(c.arm, sc, s.height_ft);
+EndEffectorModel EndEffectorFor(const rms::LabConfig& c, const rms::arm::ArmSinCos& sc, const ArmSample& s) {
+  const rms::arm::ArmPose pose = rms::arm::ComputeArmPose(c.arm, sc, s.height_ft);
   return MakeEndEffector(c.end_effector, pose.X_RS2, s.gap_ft);
 }
 
@@ -174,7 +174,7 @@ class SineTable {
     const double f = x - i;
     return t_[i] + f * (t_[i + 1] - t_[i]);
   }
-  rms::SinCos SinCosDeg(double deg) const {
+  rms::arm::SinCos SinCosDeg(double deg) const {
     double turns = deg / 360.0;
     turns -= std::floor(turns);
     double tc = turns + 0.25;
@@ -190,7 +190,7 @@ class SineTable {
 // Octant reduction and odd/even Taylor polynomials on [-pi/4, pi/4] (Hastings-
 // style; degree 2k+1 for sin, 2k for cos).
 template <int kTerms>
-rms::SinCos PolySinCosDeg(double deg) {
+rms::arm::SinCos PolySinCosDeg(double deg) {
   const double q = std::nearbyint(deg / 90.0);  // quadrant
   const double x = (deg - 90.0 * q) * (M_PI / 180.0);
   const double x2 = x * x;
@@ -225,7 +225,7 @@ struct TunnelScene {
   std::array<Hexahedron, kBodyStrips> body;
   // Any of EFF HEX 1-3 against the BAR or the payload's body.
   bool Collides(const ArmSample& s, long* tests) const {
-    const EndEffectorModel ee = EndEffectorFor(*c, rms::SinCosFromDegrees(s.deg), s);
+    const EndEffectorModel ee = EndEffectorFor(*c, rms::arm::SinCosFromDegrees(s.deg), s);
     for (int k = 0; k < 3; ++k) {
       ++*tests;
       if (Collide(ee.hex[k], bar, {.want_plane = false}).verdict != Verdict::kSeparate) return true;
@@ -273,11 +273,11 @@ int main(int argc, char** argv) {
     flights[2].name = "random operator";
     {
       // The random operator: its inputs through the words, as on the wire.
-      rms::offline::RandomOperator op(config.inputs, seed);
+      rms::sim::RandomOperator op(config.inputs, seed);
       rms::Counters counters;
       for (int f = 0; f < 4000; ++f) {
-        const auto words = rms::EncodeInputs(op.Next(), config.inputs, &counters);
-        flights[2].inputs.push_back(rms::DecodeInputs(words, config.inputs, &counters));
+        const auto words = rms::wire::EncodeInputs(op.Next(), config.inputs, &counters);
+        flights[2].inputs.push_back(rms::wire::DecodeInputs(words, config.inputs, &counters));
       }
     }
     std::array<long, 3> held{};
@@ -289,10 +289,10 @@ int main(int argc, char** argv) {
       }
     }
     {
-      rms::op::AutopilotOptions planned, straight;
+      rms::operator_station::AutopilotOptions planned, straight;
       straight.plan_clear_paths = false;
-      const auto r0 = rms::offline::FlyAutopilot(config, planned, 20000, 1, &flights[0].inputs);
-      const auto r1 = rms::offline::FlyAutopilot(config, straight, 20000, 1, &flights[1].inputs);
+      const auto r0 = rms::sim::FlyAutopilot(config, planned, 20000, 1, &flights[0].inputs);
+      const auto r1 = rms::sim::FlyAutopilot(config, straight, 20000, 1, &flights[1].inputs);
       std::fprintf(stderr, "flights: %zu frames (docked %d), %zu frames (docked %d, %d held)\n",
                    flights[0].inputs.size(), r0.docked, flights[1].inputs.size(), r1.docked, r1.held_frames);
     }
@@ -382,9 +382,9 @@ int main(int argc, char** argv) {
         }
       }
     }
-    const Hexahedron bar = MakeBar(config.payload, rms::MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft));
+    const Hexahedron bar = MakeBar(config.payload, rms::arm::MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft));
     const PayloadModel payload =
-        MakePayload(config.payload, rms::MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft));
+        MakePayload(config.payload, rms::arm::MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft));
     const int kRandom = 200000;
     md << "## Run time against error: word precision\n\n"
        << Sprintf("Arm words: the six angles' sin/cos held as each representation, the kinematics in double "
@@ -400,14 +400,14 @@ int main(int argc, char** argv) {
     for (int how = 0; how < 3; ++how) {
       double maxe = 0, sum2 = 0;
       for (const ArmSample& s : rs) {
-        const rms::ArmSinCos sc = rms::SinCosFromDegrees(s.deg);
+        const rms::arm::ArmSinCos sc = rms::arm::SinCosFromDegrees(s.deg);
         const double e = MaxVertexDistance(EndEffectorFor(config, Quantize(sc, how), s), EndEffectorFor(config, sc, s));
         maxe = std::max(maxe, e);
         sum2 += e * e;
       }
       long changed = 0;
       for (const ArmSample& s : near) {
-        const rms::ArmSinCos sc = rms::SinCosFromDegrees(s.deg);
+        const rms::arm::ArmSinCos sc = rms::arm::SinCosFromDegrees(s.deg);
         const EndEffectorModel a = EndEffectorFor(config, sc, s), b = EndEffectorFor(config, Quantize(sc, how), s);
         for (int k = 0; k < 3; ++k) {
           changed += Collide(a.hex[k], bar).verdict != Collide(b.hex[k], bar).verdict;
@@ -415,11 +415,11 @@ int main(int argc, char** argv) {
             changed += Collide(a.hex[k], strip).verdict != Collide(b.hex[k], strip).verdict;
         }
       }
-      const rms::ArmSinCos sc0 = rms::SinCosFromDegrees(rs[0].deg);
+      const rms::arm::ArmSinCos sc0 = rms::arm::SinCosFromDegrees(rs[0].deg);
       const auto t0 = Clock::now();
       const int kQ = 200000;
       for (int i = 0; i < kQ; ++i) {
-        rms::ArmSinCos q = Quantize(sc0, how);
+        rms::arm::ArmSinCos q = Quantize(sc0, how);
         benchmark::DoNotOptimize(q);
       }
       const double qns = std::chrono::duration<double, std::nano>(Clock::now() - t0).count() / kQ;
@@ -435,7 +435,7 @@ int main(int argc, char** argv) {
       for (const Flight& f : flights) {
         DynamicCollisionProgram d(config);
         for (const auto& in : f.inputs) {
-          const rms::DcpFrameData out = d.Step(in);
+          const rms::wire::DcpFrameData out = d.Step(in);
           const EndEffectorModel ee = MakeEndEffector(config.end_effector, d.status().X_RS2, d.status().finger_gap_ft);
           for (int k = 0; k < 3; ++k) {
             if (!(out.plane_valid & (1u << k))) continue;
@@ -493,10 +493,10 @@ int main(int argc, char** argv) {
       const SineTable t4096(4096), t65536(65536);
       struct Method {
         const char* name;
-        std::function<rms::SinCos(double)> f;
+        std::function<rms::arm::SinCos(double)> f;
       };
       std::vector<Method> methods = {
-          {"C library sin, cos (double)", [](double d) { const double r = d * M_PI / 180; return rms::SinCos{std::sin(r), std::cos(r)}; }},
+          {"C library sin, cos (double)", [](double d) { const double r = d * M_PI / 180; return rms::arm::SinCos{std::sin(r), std::cos(r)}; }},
           {"table, 4096 entries a turn, linear interpolation", [&](double d) { return t4096.SinCosDeg(d); }},
           {"table, 65536 entries a turn, linear interpolation", [&](double d) { return t65536.SinCosDeg(d); }},
           {"polynomial, octant reduction, degree 7 / 6", PolySinCosDeg<4>},
@@ -507,12 +507,12 @@ int main(int argc, char** argv) {
         long words_differ = 0;
         for (int i = 0; i < kRandom; ++i) {
           const ArmSample& s = rs[i];
-          rms::ArmSinCos lib = rms::SinCosFromDegrees(s.deg), mine;
+          rms::arm::ArmSinCos lib = rms::arm::SinCosFromDegrees(s.deg), mine;
           for (int j = 0; j < 6; ++j) {
             mine[j] = m.f(s.deg[j]);
             maxe = std::max({maxe, std::abs(mine[j].s - lib[j].s), std::abs(mine[j].c - lib[j].c)});
           }
-          const rms::ArmSinCos a = Quantize(lib, 2), b = Quantize(mine, 2);
+          const rms::arm::ArmSinCos a = Quantize(lib, 2), b = Quantize(mine, 2);
           for (int j = 0; j < 6; ++j) words_differ += (a[j].s != b[j].s) + (a[j].c != b[j].c);
           if (i < 20000) eff = std::max(eff, MaxVertexDistance(EndEffectorFor(config, mine, s), EndEffectorFor(config, lib, s)));
         }
@@ -521,7 +521,7 @@ int main(int argc, char** argv) {
         for (int i = 0; i < kT; ++i) {
           const ArmSample& s = rs[i % kRandom];
           for (int j = 0; j < 6; ++j) {
-            rms::SinCos v = m.f(s.deg[j]);
+            rms::arm::SinCos v = m.f(s.deg[j]);
             benchmark::DoNotOptimize(v);
           }
         }
@@ -545,7 +545,7 @@ int main(int argc, char** argv) {
       double reach = 0;
       for (int i = 0; i < 2000; ++i) {
         const ArmSample& s = near[pick(rng)];
-        const rms::ArmPose pose = rms::ComputeArmPose(config.arm, rms::SinCosFromDegrees(s.deg), s.height_ft);
+        const rms::arm::ArmPose pose = rms::arm::ComputeArmPose(config.arm, rms::arm::SinCosFromDegrees(s.deg), s.height_ft);
         const EndEffectorModel ee = MakeEndEffector(config.end_effector, pose.X_RS2, s.gap_ft);
         for (int k = 0; k < 3; ++k)
           for (int v = 0; v < 8; ++v) reach = std::max(reach, (ee.hex[k].vertex(v) - pose.p_RoS_R).norm());
@@ -569,7 +569,7 @@ int main(int argc, char** argv) {
       extents(bar);
       for (const Hexahedron& strip : payload.body) extents(strip);
       {
-        const EndEffectorModel ee = EndEffectorFor(config, rms::SinCosFromDegrees(near[0].deg), near[0]);
+        const EndEffectorModel ee = EndEffectorFor(config, rms::arm::SinCosFromDegrees(near[0].deg), near[0]);
         for (int k = 0; k < 3; ++k) extents(ee.hex[k]);
       }
       const double step_ft = 0.5 * thin;
@@ -598,8 +598,8 @@ int main(int argc, char** argv) {
       for (const Traj& t : colliding) {
         ArmSample s1 = t.start;
         for (int j = 0; j < 6; ++j) s1.deg[j] += t.rate_deg_s[j] * 1e-3;
-        const EndEffectorModel a = EndEffectorFor(config, rms::SinCosFromDegrees(t.start.deg), t.start);
-        const EndEffectorModel b = EndEffectorFor(config, rms::SinCosFromDegrees(s1.deg), s1);
+        const EndEffectorModel a = EndEffectorFor(config, rms::arm::SinCosFromDegrees(t.start.deg), t.start);
+        const EndEffectorModel b = EndEffectorFor(config, rms::arm::SinCosFromDegrees(s1.deg), s1);
         speeds.push_back((b.hex[0].vertex(0) - a.hex[0].vertex(0)).norm() / 1e-3);
       }
       md << "## Frame rate against tunnelling\n\n"
@@ -649,7 +649,7 @@ int main(int argc, char** argv) {
         for (const Traj& t : colliding) {
           DynamicCollisionProgram dcp(config);
           auto inputs_for = [&](const ArmSample& a) {
-            rms::OperatorInputs in = rms::InitialInputs(config.inputs);
+            rms::wire::OperatorInputs in = rms::wire::InitialInputs(config.inputs);
             for (int j = 0; j < 6; ++j) in.value[j] = a.deg[j];
             in.value[rms::kShoulderHeight] = a.height_ft;
             const auto& ee = config.end_effector;
@@ -662,7 +662,7 @@ int main(int argc, char** argv) {
           for (int f = 1; f <= nf && !seen; ++f) {
             ArmSample cur = t.start;
             for (int j = 0; j < 6; ++j) cur.deg[j] += t.rate_deg_s[j] * f / hz;
-            const rms::OperatorInputs in = inputs_for(cur);
+            const rms::wire::OperatorInputs in = inputs_for(cur);
             const auto t0 = Clock::now();
             dcp.Step(in);
             t_dcp += std::chrono::duration<double, std::micro>(Clock::now() - t0).count();

@@ -8,7 +8,7 @@
 //
 //   build/bench/rms_render_bench [--width 1024 --height 768] [--every 1] [--json out.json]
 #include <CLI/CLI.hpp>
-#include "rms/command_line.h"
+#include "rms/base/command_line.h"
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -18,15 +18,15 @@
 #include <fstream>
 #include <sstream>
 
-#include "rms/check.h"
-#include "rms/text.h"
+#include "rms/base/check.h"
+#include "rms/base/text.h"
 
 #include "bench_stats.h"
-#include "gl_context.h"
-#include "offline_session.h"
-#include "overlay.h"
-#include "png_io.h"
-#include "renderer.h"
+#include "rms/esg_renderer/gl_context.h"
+#include "rms/sim/offline_session.h"
+#include "rms/esg_renderer/overlay.h"
+#include "rms/esg_renderer/png_io.h"
+#include "rms/esg_renderer/renderer.h"
 
 namespace {
 
@@ -37,9 +37,9 @@ double Ms(Clock::duration d) { return std::chrono::duration<double, std::milli>(
 
 struct Variant {
   std::string name;
-  rms::esg::RenderOptions options;
-  std::unique_ptr<rms::esg::GlContext> gl;
-  std::unique_ptr<rms::esg::EsgRenderer> renderer;
+  rms::esg_renderer::RenderOptions options;
+  std::unique_ptr<rms::esg_renderer::GlContext> gl;
+  std::unique_ptr<rms::esg_renderer::FrameRenderer> renderer;
   std::vector<double> ms;
   long clusters = 0, triangles = 0, differing = 0, frames_differing = 0, worst = 0;
 };
@@ -68,9 +68,9 @@ int main(int argc, char** argv) {
   app.add_option("--sizes", sizes, "Also time the ESG's default renderer and the depth buffer at these sizes (WxH)");
   if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   try {
-    using rms::esg::Visibility;
+    using rms::esg_renderer::Visibility;
     const rms::LabConfig config = rms::LoadConfig(config_path);
-    rms::offline::OfflineSession session(config, rms::op::Timeline::Load(timeline, config.inputs));
+    rms::sim::OfflineSession session(config, rms::operator_station::Timeline::Load(timeline, config.inputs));
     std::vector<Variant> v;
     auto add = [&](std::string name, Visibility vis, bool frustum, bool backface) {
       Variant x;
@@ -85,14 +85,14 @@ int main(int argc, char** argv) {
     add("priority, no back-face cull", Visibility::kPriority, true, false);
     add("depth buffer, no culls", Visibility::kDepth, false, false);
     for (Variant& x : v) {
-      x.gl = rms::esg::CreateGlContext(rms::esg::ParseGlBackend(gl_name), width, height);
-      x.renderer = std::make_unique<rms::esg::EsgRenderer>(config, x.gl.get(), x.options);
+      x.gl = rms::esg_renderer::CreateGlContext(rms::esg_renderer::ParseGlBackend(gl_name), width, height);
+      x.renderer = std::make_unique<rms::esg_renderer::FrameRenderer>(config, x.gl.get(), x.options);
     }
     const std::size_t n = static_cast<std::size_t>(width) * height;
     std::vector<std::uint8_t> ref(n * 4), out(n * 4);
     std::vector<std::string> names;
     for (const auto& c : config.cameras) names.push_back(c.name);
-    const rms::esg::OverlayModel overlay = rms::esg::MakeOverlayModel(config);
+    const rms::esg_renderer::OverlayModel overlay = rms::esg_renderer::MakeOverlayModel(config);
 
     std::vector<double> all_stations_ms, overlay_ms;
     long frames = 0, unchanged = 0;
@@ -100,13 +100,13 @@ int main(int argc, char** argv) {
     while (session.Next()) {
       // Unchanged frames: the selected station's words but for the frame
       // counter (word 0) equal the previous frame's, as esg_renderer tests.
-      const std::vector<std::int32_t> words = rms::PackEsgWords(session.esg(), nullptr);
+      const std::vector<std::int32_t> words = rms::wire::PackEsgWords(session.esg(), nullptr);
       const bool same = !prev_words.empty() && std::equal(words.begin() + 1, words.end(), prev_words.begin() + 1);
       prev_words = words;
       ++frames;
       unchanged += same;
       if (session.frame() % every) continue;
-      const rms::EsgFrameData& f = session.esg();
+      const rms::wire::EsgFrameData& f = session.esg();
       for (std::size_t k = 0; k < v.size(); ++k) {
         Variant& x = v[k];
         const auto t0 = Clock::now();
@@ -122,8 +122,8 @@ int main(int argc, char** argv) {
           for (std::size_t i = 0; i < n; ++i) d += std::memcmp(px + 4 * i, &ref[4 * i], 3) != 0;
           if (d > x.worst && !dump_dir.empty()) {  // the worst frame so far
             const std::string stem = dump_dir + "/variant" + std::to_string(k) + "_worst_";
-            rms::esg::WritePng(stem + "variant.png", width, height, px);
-            rms::esg::WritePng(stem + "reference.png", width, height, ref.data());
+            rms::esg_renderer::WritePng(stem + "variant.png", width, height, px);
+            rms::esg_renderer::WritePng(stem + "reference.png", width, height, ref.data());
             x.worst = d;
           }
           x.differing += d;
@@ -144,7 +144,7 @@ int main(int argc, char** argv) {
       {
         const auto t0 = Clock::now();
         std::memcpy(out.data(), ref.data(), n * 4);
-        rms::esg::DrawOverlay(out.data(), width, height, f, overlay);
+        rms::esg_renderer::DrawOverlay(out.data(), width, height, f, overlay);
         overlay_ms.push_back(Ms(Clock::now() - t0));
       }
     }
@@ -219,13 +219,13 @@ int main(int argc, char** argv) {
         if (std::sscanf(wh.c_str(), "%dx%d", &w, &h) != 2 || w <= 0 || h <= 0) {
           throw rms::InputError("--sizes: '" + wh + "' is not WIDTHxHEIGHT");
         }
-        rms::offline::OfflineSession sz(config, rms::op::Timeline::Load(timeline, config.inputs));
+        rms::sim::OfflineSession sz(config, rms::operator_station::Timeline::Load(timeline, config.inputs));
         std::vector<double> ms[2];
-        std::unique_ptr<rms::esg::GlContext> gl[2];
-        std::unique_ptr<rms::esg::EsgRenderer> r[2];
+        std::unique_ptr<rms::esg_renderer::GlContext> gl[2];
+        std::unique_ptr<rms::esg_renderer::FrameRenderer> r[2];
         for (int k = 0; k < 2; ++k) {
-          gl[k] = rms::esg::CreateGlContext(rms::esg::ParseGlBackend(gl_name), w, h);
-          r[k] = std::make_unique<rms::esg::EsgRenderer>(config, gl[k].get(), k ? v[0].options : v[1].options);
+          gl[k] = rms::esg_renderer::CreateGlContext(rms::esg_renderer::ParseGlBackend(gl_name), w, h);
+          r[k] = std::make_unique<rms::esg_renderer::FrameRenderer>(config, gl[k].get(), k ? v[0].options : v[1].options);
         }
         while (sz.Next()) {
           if (sz.frame() % 10) continue;

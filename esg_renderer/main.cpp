@@ -4,15 +4,15 @@
 #include <cstdlib>
 #include <filesystem>
 
-#include "esg_node.h"
-#include "rms/process.h"
+#include "rms/esg_renderer/esg_renderer.h"
+#include "rms/transport/process.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"rmslab esg_renderer: the Electronic Scene Generator. Renders each ESG frame "
                "(RMS_ESG_FRAME) from its words and the static models, headless (OSMesa or EGL), "
                "with visibility by separating-plane priority, to PNG, video and a live window."};
-  rms::CommonOptions common;
-  rms::esg::EsgOptions opt;
+  rms::transport::CommonOptions common;
+  rms::esg_renderer::EsgOptions opt;
   app.add_option("--width", opt.width, "Image width, pixels")->capture_default_str()->check(CLI::Range(16, 8192));
   app.add_option("--height", opt.height, "Image height, pixels")->capture_default_str()->check(CLI::Range(16, 8192));
   app.add_option("--png-dir", opt.png_dir, "Directory for PNG frames (frame_NNNNNN.png)");
@@ -33,8 +33,8 @@ int main(int argc, char** argv) {
   app.add_flag("--no-skip-unchanged", no_skip, "Re-render frames whose words did not change");
   app.add_flag("--no-frustum-cull", no_frustum, "Draw clusters outside the view volume too");
   app.add_flag("--no-backface-cull", no_backface, "Draw faces turned away too");
-  return rms::ProcessMain(app, argc, argv, "esg_renderer", &common,
-                          [&](const rms::LabConfig& config, rms::LcmInterface& lcm) {
+  return rms::transport::ProcessMain(app, argc, argv, "esg_renderer", &common,
+                          [&](const rms::LabConfig& config, rms::transport::LcmInterface& lcm) {
                             // Restarted by the launcher after a fault (RMSLAB_RESTART=N): the
                             // video so far is kept; this run's goes beside it, NAME.restartN.mp4.
                             if (const char* r = std::getenv("RMSLAB_RESTART"); r && *r && std::string(r) != "0" &&
@@ -46,7 +46,7 @@ int main(int argc, char** argv) {
                             opt.skip_unchanged = !no_skip;
                             opt.frustum_cull = !no_frustum;
                             opt.backface_cull = !no_backface;
-                            return rms::esg::RunEsgRenderer(config, lcm, opt, common.stats_path,
+                            return rms::esg_renderer::RunEsgRenderer(config, lcm, opt, common.stats_path,
                                                             common.ready_path);
                           });
 }

@@ -8,8 +8,8 @@
 
 #include <spdlog/spdlog.h>
 
-#include "rms/config.h"
-#include "rms/lcm_interface.h"
+#include "rms/base/config.h"
+#include "rms/transport/lcm_interface.h"
 
 namespace rms::fuzz {
 

@@ -5,12 +5,12 @@
 // refuse it with rms::InputError; anything else escaping is a finding.
 #include <string_view>
 
-#include "dynamic_collision_program.h"
+#include "rms/dynamics_proc/dynamic_collision_program.h"
 #include "fuzz_common.h"
-#include "lab_file.h"
-#include "rms/check.h"
-#include "rms/checkpoint.h"
-#include "timeline.h"
+#include "rms/session/lab_file.h"
+#include "rms/base/check.h"
+#include "rms/wire/checkpoint.h"
+#include "rms/operator_station/timeline.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static const rms::LabConfig& config = rms::fuzz::Config();
@@ -19,11 +19,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     switch (data[0] % 4) {
       case 0: (void)rms::ParseConfig(text, "fuzz.toml"); break;
-      case 1: (void)rms::op::Timeline::Parse(text, "fuzz.tl", config.inputs); break;
+      case 1: (void)rms::operator_station::Timeline::Parse(text, "fuzz.tl", config.inputs); break;
       case 2: (void)rms::session::ParseLabFile(text, "fuzz-lab.toml"); break;
       default: {
-        const rms::Checkpoint c = rms::ParseCheckpoint(text, "fuzz.json");
-        rms::dcp::DynamicCollisionProgram dcp(config);
+        const rms::wire::Checkpoint c = rms::wire::ParseCheckpoint(text, "fuzz.json");
+        rms::dynamics_proc::DynamicCollisionProgram dcp(config);
         dcp.RestoreState(c.dcp);
         dcp.Step(c.inputs);
         break;

@@ -2,15 +2,15 @@
 // A thin main over operator_station/src; see docs/operator.md.
 #include <CLI/CLI.hpp>
 
-#include "operator_station.h"
-#include "rms/process.h"
+#include "rms/operator_station/operator_station.h"
+#include "rms/transport/process.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"rmslab operator station: publishes the operator's input block (Table I) on "
                "RMS_OPERATOR_INPUT at the frame rate, from a timeline file, the operator's hand controllers "
                "(keyboard, live window, gamepad, 3D mouse) or the autopilot, with a live status screen."};
-  rms::CommonOptions common;
-  rms::op::OperatorOptions opt;
+  rms::transport::CommonOptions common;
+  rms::operator_station::OperatorOptions opt;
   app.add_option("--timeline", opt.timeline_path, "Fly a timeline file (docs/timeline.md)")->check(CLI::ExistingFile);
   app.add_flag("--keyboard", opt.keyboard, "Fly by hand from this terminal's keyboard (and any gamepad or 3D mouse)");
   app.add_flag("--manual", opt.manual, "Fly by hand with whatever devices are found (keyboard, gamepad, 3D mouse)");
@@ -39,13 +39,13 @@ int main(int argc, char** argv) {
   app.add_option("--checkpoint-dir", opt.checkpoint_dir,
                  "The session's checkpoints folder: RMS_CONTROL's RESTORE names a file in it and nowhere else "
                  "(docs/security.md)");
-  return rms::ProcessMain(app, argc, argv, "operator_station", &common,
-                          [&](const rms::LabConfig& config, rms::LcmInterface& lcm) {
+  return rms::transport::ProcessMain(app, argc, argv, "operator_station", &common,
+                          [&](const rms::LabConfig& config, rms::transport::LcmInterface& lcm) {
                             opt.gamepad = !no_gamepad;
                             opt.spacemouse = !no_spacemouse;
                             opt.status = status_on ? 1 : status_off ? 0 : -1;
-                            rms::op::OperatorStation station(opt, config, lcm, rms::op::MakeSource(opt, config));
+                            rms::operator_station::OperatorStation station(opt, config, lcm, rms::operator_station::MakeSource(opt, config));
                             return station.Run(common.stats_path, common.ready_path);
                           },
-                          [&](const rms::LabConfig& config) { rms::op::CheckSourceFiles(opt, config); });
+                          [&](const rms::LabConfig& config) { rms::operator_station::CheckSourceFiles(opt, config); });
 }

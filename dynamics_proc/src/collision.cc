@@ -1,11 +1,11 @@
-#include "collision.h"
+#include "rms/dynamics_proc/collision.h"
 
 #include <algorithm>
 #include <bit>
 #include <cmath>
 #include <limits>
 
-namespace rms::dcp {
+namespace rms::dynamics_proc {
 
 namespace {
 
@@ -320,4 +320,4 @@ CollisionResult Collide(const Hexahedron& a, const Hexahedron& b, const CollideO
   return r;
 }
 
-}  // namespace rms::dcp
+}  // namespace rms::dynamics_proc

@@ -1,11 +1,11 @@
-#include "dcp_models.h"
+#include "rms/dynamics_proc/dcp_models.h"
 
 #include <cmath>
 #include <cstdio>
 
-#include "rms/scene_model.h"
+#include "rms/scene_model/scene_model.h"
 
-namespace rms::dcp {
+namespace rms::dynamics_proc {
 
 EndEffectorModel MakeEndEffector(const EndEffectorConfig& ee, const Eigen::Isometry3d& X_RS2,
                                  double gap) {
@@ -32,7 +32,7 @@ Hexahedron MakeBar(const PayloadConfig& p, const Eigen::Isometry3d& X_RP) {
 }
 
 int MakeBarPosts(const PayloadConfig& p, const Eigen::Isometry3d& X_RP, std::array<Hexahedron, 2>* posts) {
-  const BarPostBoxes b = BarPosts_P(p);
+  const scene_model::BarPostBoxes b = scene_model::BarPosts_P(p);
   const Eigen::Matrix3d& R = X_RP.linear();
   for (int k = 0; k < b.count; ++k) {
     const Eigen::Vector3d centre = X_RP * b.centre_P[k];
@@ -117,4 +117,4 @@ Hexahedron MakeCaeFrontHalf(const CaeConfig& c) {
   return FromVertices(v);
 }
 
-}  // namespace rms::dcp
+}  // namespace rms::dynamics_proc

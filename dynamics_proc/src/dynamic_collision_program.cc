@@ -1,4 +1,4 @@
-#include "dynamic_collision_program.h"
+#include "rms/dynamics_proc/dynamic_collision_program.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,16 +6,16 @@
 #include <memory>
 #include <spdlog/spdlog.h>
 
-#include "rms/check.h"
-#include "rms/scene_model.h"
+#include "rms/base/check.h"
+#include "rms/scene_model/scene_model.h"
 
-#include "rms/word_codec.h"
+#include "rms/wire/word_codec.h"
 
-namespace rms::dcp {
+namespace rms::dynamics_proc {
 
-ArmSinCos TransmittedArmWords(const std::array<double, 6>& angles_deg) {
-  ArmSinCos sc = SinCosFromDegrees(angles_deg);
-  for (SinCos& a : sc) {
+arm::ArmSinCos TransmittedArmWords(const std::array<double, 6>& angles_deg) {
+  arm::ArmSinCos sc = arm::SinCosFromDegrees(angles_deg);
+  for (arm::SinCos& a : sc) {
     a.s = wire::RoundTrip(wire::kSC22, a.s);
     a.c = wire::RoundTrip(wire::kSC22, a.c);
   }
@@ -33,8 +33,8 @@ bool AllHave(const std::array<LocationWord, 8>& words, int face) {
 
 std::string Names(std::uint32_t bits) {
   std::string s;
-  for (int b = 0; b < collision_bits::kCount; ++b) {
-    if (bits & (1u << b)) s += std::string(s.empty() ? "" : ", ") + CollisionName(b);
+  for (int b = 0; b < wire::collision_bits::kCount; ++b) {
+    if (bits & (1u << b)) s += std::string(s.empty() ? "" : ", ") + wire::CollisionName(b);
   }
   return s.empty() ? "none" : s;
 }
@@ -43,7 +43,7 @@ std::string Names(std::uint32_t bits) {
 
 DynamicCollisionProgram::DynamicCollisionProgram(const LabConfig& config, const DcpOptions& options)
     : config_(config), options_(options) {
-  X_RP_bay_ = MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft);
+  X_RP_bay_ = arm::MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft);
   bay_ = MakeCargoBay(config.shuttle);
   cae_ = MakeCaeFrontHalf(config.cae);
   PlacePayload(X_RP_bay_);
@@ -53,10 +53,10 @@ DynamicCollisionProgram::DynamicCollisionProgram(const LabConfig& config, const 
   const auto& ee = config.end_effector;
   double thinnest = std::min({ee.finger_thickness_ft, 2 * ee.palm_half_width_ft, 2 * ee.palm_half_height_ft,
                               ee.palm_length_ft, ee.finger_length_ft, config.payload.bar_size_P_ft.minCoeff()});
-  if (post_count_ > 0) thinnest = std::min(thinnest, 2 * BarPosts_P(config.payload).half_P.minCoeff());
+  if (post_count_ > 0) thinnest = std::min(thinnest, 2 * scene_model::BarPosts_P(config.payload).half_P.minCoeff());
   substep_ft_ = std::min(kMaxSubstepTravelFt, 0.45 * thinnest);
   // The slave starts at the initial inputs' pose, which must be free.
-  const OperatorInputs initial = InitialInputs(config.inputs);
+  const wire::OperatorInputs initial = wire::InitialInputs(config.inputs);
   ArmCommand start;
   for (int i = 0; i < 6; ++i) start.angles_deg[i] = initial.value[i];
   start.shoulder_height_ft = initial.value[kShoulderHeight];
@@ -182,7 +182,7 @@ std::uint32_t DynamicCollisionProgram::BayCollisions(const PayloadModel& p, doub
 void DynamicCollisionProgram::TestHandAgainstPayload(const Evaluation* prev, Evaluation* out) const {
   // EFF HEX 1-3 against the resting payload's BAR, body (seven strips) and
   // the BAR's posts, with each pair's clearance.
-  namespace cb = collision_bits;
+  namespace cb = wire::collision_bits;
   Evaluation& e = *out;
   // A pair's options: bounding rejection, and its previous plane as the hint.
   SeparatingPlaneHint hints[1 + kBodyStrips][3];
@@ -230,13 +230,13 @@ void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* 
   e.ee_body = {};
   e.cmd = cmd;
   e.words = TransmittedArmWords(cmd.angles_deg);
-  e.pose = ComputeArmPose(config_.arm, e.words, cmd.shoulder_height_ft);
+  e.pose = arm::ComputeArmPose(config_.arm, e.words, cmd.shoulder_height_ft);
   e.finger_gap_ft = FingerGapFt(cmd.finger);
   if (status_.mode >= 2 && !(status_.docked && released_)) {
     const double widest = status_.docked ? config_.end_effector.finger_gap_open_ft : acquisition_gap_ft_;
     e.finger_gap_ft = std::clamp(e.finger_gap_ft, contact_gap_ft_, widest);
   }
-  namespace cb = collision_bits;
+  namespace cb = wire::collision_bits;
   switch (status_.mode) {
     case 1: {
       // EFF HEX 1-3 against the BAR, the payload's body and the BAR's posts.
@@ -461,7 +461,7 @@ std::uint32_t DynamicCollisionProgram::MoveFinger(double finger) {
 }
 
 void DynamicCollisionProgram::Respond(const ArmCommand& command) {
-  namespace cb = collision_bits;
+  namespace cb = wire::collision_bits;
   const std::uint32_t hit = TestMotion(slave_->cmd, command, spare_);
   status_.collisions = hit & ~kTooFast;
   if (!hit) return AcceptSpare();
@@ -521,7 +521,7 @@ void DynamicCollisionProgram::LetGo() {
   AcceptSpare();
 }
 
-DcpFrameData DynamicCollisionProgram::Step(const OperatorInputs& in) {
+wire::DcpFrameData DynamicCollisionProgram::Step(const wire::OperatorInputs& in) {
   ArmCommand master;
   for (int i = 0; i < 6; ++i) master.angles_deg[i] = in.value[i];
   master.shoulder_height_ft = in.value[kShoulderHeight];
@@ -590,7 +590,7 @@ DcpFrameData DynamicCollisionProgram::Step(const OperatorInputs& in) {
   else if (mode_before == 2) UpdateExtraction();
   else status_.bay_clearance_ft = BayClearance(slave_->payload);
 
-  DcpFrameData out;
+  wire::DcpFrameData out;
   out.arm = slave_->words;
   out.control.camera_station = in.camera_station;
   out.control.reset = in.reset;
@@ -598,7 +598,7 @@ DcpFrameData DynamicCollisionProgram::Step(const OperatorInputs& in) {
   out.control.crosshairs = in.crosshairs;
   out.control.mode = status_.mode;
   // COLLISION: a detrimental collision; RECPT: the essential contact.
-  const std::uint32_t essential = status_.essential_contact ? collision_bits::kEffHexRecpt << 2 : 0u;
+  const std::uint32_t essential = status_.essential_contact ? wire::collision_bits::kEffHexRecpt << 2 : 0u;
   out.control.collision = (status_.collisions & ~essential) != 0;
   out.control.receptacle_collision = status_.essential_contact;
   out.control.acquired = status_.acquired;
@@ -1017,4 +1017,4 @@ double DynamicCollisionProgram::PayloadReachFt(const Eigen::Isometry3d& X_S2P) c
   return reach;
 }
 
-}  // namespace rms::dcp
+}  // namespace rms::dynamics_proc

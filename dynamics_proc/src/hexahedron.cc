@@ -1,4 +1,4 @@
-#include "hexahedron.h"
+#include "rms/dynamics_proc/hexahedron.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <immintrin.h>
 #endif
 
-namespace rms::dcp {
+namespace rms::dynamics_proc {
 
 char FaceLetter(int f) { return static_cast<char>('a' + f); }
 
@@ -330,4 +330,4 @@ Hexahedron FromVertices(const std::array<Eigen::Vector3d, 8>& v) {
   return h;
 }
 
-}  // namespace rms::dcp
+}  // namespace rms::dynamics_proc

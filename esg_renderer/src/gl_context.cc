@@ -1,4 +1,4 @@
-#include "gl_context.h"
+#include "rms/esg_renderer/gl_context.h"
 
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
@@ -8,9 +8,9 @@
 #include <cstring>
 #include <stdexcept>
 
-#include "rms/check.h"
+#include "rms/base/check.h"
 
-namespace rms::esg {
+namespace rms::esg_renderer {
 
 GlBackend ParseGlBackend(const std::string& name) {
   if (name == "osmesa") return GlBackend::kOsMesa;
@@ -191,4 +191,4 @@ std::unique_ptr<GlContext> CreateGlContext(GlBackend backend, int width, int hei
   return std::make_unique<OsMesaContext>(width, height);
 }
 
-}  // namespace rms::esg
+}  // namespace rms::esg_renderer

@@ -1,4 +1,4 @@
-#include "overlay.h"
+#include "rms/esg_renderer/overlay.h"
 
 #include <algorithm>
 #include <array>
@@ -6,11 +6,11 @@
 #include <cmath>
 #include <cstdio>
 
-#include "rms/arm_kinematics.h"
-#include "rms/mission_geometry.h"
-#include "rms/scene_model.h"
+#include "rms/arm/kinematics.h"
+#include "rms/mission/mission_geometry.h"
+#include "rms/scene_model/scene_model.h"
 
-namespace rms::esg {
+namespace rms::esg_renderer {
 
 namespace {
 
@@ -67,7 +67,7 @@ const std::uint8_t* Glyph(char ch) {
 
 }  // namespace
 
-void FillRect(std::uint8_t* rgba, int w, int h, int x0, int y0, int x1, int y1, const Rgb& c) {
+void FillRect(std::uint8_t* rgba, int w, int h, int x0, int y0, int x1, int y1, const scene_model::Rgb& c) {
   x0 = std::max(x0, 0); y0 = std::max(y0, 0); x1 = std::min(x1, w); y1 = std::min(y1, h);
   for (int y = y0; y < y1; ++y) {
     std::uint8_t* p = rgba + (static_cast<std::size_t>(y) * w + x0) * 4;
@@ -77,7 +77,7 @@ void FillRect(std::uint8_t* rgba, int w, int h, int x0, int y0, int x1, int y1, 
   }
 }
 
-void DrawText(std::uint8_t* rgba, int w, int h, int x, int y, std::string_view text, const Rgb& colour, int scale) {
+void DrawText(std::uint8_t* rgba, int w, int h, int x, int y, std::string_view text, const scene_model::Rgb& colour, int scale) {
   for (char ch : text) {
     const std::uint8_t* g = Glyph(ch);
     for (int row = 0; row < 7; ++row) {
@@ -97,14 +97,14 @@ OverlayModel MakeOverlayModel(const LabConfig& config) {
     m.camera_names.push_back(cam.name);
     m.mounts.push_back(cam.mount);
   }
-  m.p_S2oT_S2 = mission::PlanGeometry(config).X_S2P * GrappleTargetCentre_P(config.payload);
+  m.p_S2oT_S2 = mission::PlanGeometry(config).X_S2P * scene_model::GrappleTargetCentre_P(config.payload);
   m.p_RoPort_R = config.cae.p_RoCo_R_ft;
   m.y_port_R = config.cae.R_RC.col(1);
   m.arm = config.arm;
   return m;
 }
 
-bool ProjectToImage(const EsgFrameData& f, int w, int h, const Eigen::Vector3d& p_R, double* x, double* y) {
+bool ProjectToImage(const wire::EsgFrameData& f, int w, int h, const Eigen::Vector3d& p_R, double* x, double* y) {
   const Eigen::Vector3d d = f.R_RE.transpose() * (p_R - f.p_RoEye_R_ft);
   if (d.x() < 0.05) return false;
   const double focal = 0.5 * h / std::tan(0.5 * f.fov_deg * M_PI / 180.0);
@@ -113,7 +113,7 @@ bool ProjectToImage(const EsgFrameData& f, int w, int h, const Eigen::Vector3d& 
   return true;
 }
 
-void DrawLine(std::uint8_t* rgba, int w, int h, int x0, int y0, int x1, int y1, const Rgb& c, int thick) {
+void DrawLine(std::uint8_t* rgba, int w, int h, int x0, int y0, int x1, int y1, const scene_model::Rgb& c, int thick) {
   const int n = std::max({std::abs(x1 - x0), std::abs(y1 - y0), 1});
   if (n > 4 * (w + h)) return;  // far off the image: nothing to draw
   for (int i = 0; i <= n; ++i) {
@@ -122,15 +122,15 @@ void DrawLine(std::uint8_t* rgba, int w, int h, int x0, int y0, int x1, int y1, 
   }
 }
 
-void DrawCrosshairs(std::uint8_t* rgba, int w, int h, const EsgFrameData& f, const OverlayModel& m) {
+void DrawCrosshairs(std::uint8_t* rgba, int w, int h, const wire::EsgFrameData& f, const OverlayModel& m) {
   const int st = f.control.camera_station;
   if (st < 1 || st > static_cast<int>(m.mounts.size())) return;
   const int t = std::max(1, h / 400);
-  const Rgb green{60, 240, 110};
+  const scene_model::Rgb green{60, 240, 110};
   double x = 0, y = 0;
   if (m.mounts[st - 1] == CameraMount::kWrist) {
     // Fixed in System Two: where the grapple target's cross is at the grasp.
-    const ArmPose arm = ComputeArmPose(m.arm, f.arm, f.shoulder_height_ft);
+    const arm::ArmPose arm = arm::ComputeArmPose(m.arm, f.arm, f.shoulder_height_ft);
     if (!ProjectToImage(f, w, h, arm.X_RS2 * m.p_S2oT_S2, &x, &y)) return;
     const int cx = static_cast<int>(std::lround(x)), cy = static_cast<int>(std::lround(y));
     const int arm_px = h / 10, gap = h / 60;
@@ -168,13 +168,13 @@ void DrawCrosshairs(std::uint8_t* rgba, int w, int h, const EsgFrameData& f, con
   }
 }
 
-void DrawOverlay(std::uint8_t* rgba, int w, int h, const EsgFrameData& f, const OverlayModel& model) {
+void DrawOverlay(std::uint8_t* rgba, int w, int h, const wire::EsgFrameData& f, const OverlayModel& model) {
   if (f.control.crosshairs) DrawCrosshairs(rgba, w, h, f, model);
   const std::vector<std::string>& names = model.camera_names;
   if (!f.control.overlay) return;
   const int s = std::max(1, h / 300);
   const int line = 9 * s, margin = 4 * s;
-  const Rgb text{230, 230, 120}, dim{90, 90, 90}, black{0, 0, 0};
+  const scene_model::Rgb text{230, 230, 120}, dim{90, 90, 90}, black{0, 0, 0};
   char buf[64];
   std::snprintf(buf, sizeof buf, "FRAME %06u", f.frame_count);
   DrawText(rgba, w, h, margin, margin, buf, text, s);
@@ -189,7 +189,7 @@ void DrawOverlay(std::uint8_t* rgba, int w, int h, const EsgFrameData& f, const 
   struct Lamp {
     const char* label;
     bool on;
-    Rgb colour;
+    scene_model::Rgb colour;
   };
   const Lamp lamps[] = {{"DOCK", f.control.docked, {60, 200, 80}},
                         {"ACQ", f.control.acquired, {60, 200, 80}},
@@ -260,4 +260,4 @@ void DrawGuidance(std::uint8_t* rgba, int w, int h, const operator_state_t& st) 
   }
 }
 
-}  // namespace rms::esg
+}  // namespace rms::esg_renderer

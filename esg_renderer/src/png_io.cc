@@ -1,11 +1,11 @@
-#include "png_io.h"
+#include "rms/esg_renderer/png_io.h"
 
 #include <cstdio>
 #include <memory>
 #include <png.h>
 #include <stdexcept>
 
-namespace rms::esg {
+namespace rms::esg_renderer {
 
 namespace {
 struct FileCloser {
@@ -58,4 +58,4 @@ Image ReadPng(const std::string& path) {
   return out;
 }
 
-}  // namespace rms::esg
+}  // namespace rms::esg_renderer

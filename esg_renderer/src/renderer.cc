@@ -1,25 +1,26 @@
-#include "renderer.h"
+#include "rms/esg_renderer/renderer.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "rms/check.h"
+#include "rms/base/check.h"
+#include "rms/wire/priority_words.h"
 
-namespace rms::esg {
+namespace rms::esg_renderer {
 
-Rgb IdColor(int i) {
+scene_model::Rgb IdColor(int i) {
   return {static_cast<std::uint8_t>(20 + 7 * i), static_cast<std::uint8_t>(250 - 7 * i),
           static_cast<std::uint8_t>(40 + (i * 53) % 200)};
 }
 
 int ClusterOfColor(const std::uint8_t* rgb) {
   const int i = (rgb[0] - 20) / 7;
-  if (i < 0 || i >= kNumClusters) return -1;
-  const Rgb c = IdColor(i);
+  if (i < 0 || i >= scene_model::kNumClusters) return -1;
+  const scene_model::Rgb c = IdColor(i);
   return (c[0] == rgb[0] && c[1] == rgb[1] && c[2] == rgb[2]) ? i : -1;
 }
 
-Eigen::Matrix4d ViewMatrix(const EsgFrameData& f) {
+Eigen::Matrix4d ViewMatrix(const wire::EsgFrameData& f) {
   // Eye frame E (X line of sight, Y right, Z down) to GL eye coordinates
   // (x right, y up, z toward the viewer).
   Eigen::Matrix3d M;
@@ -42,11 +43,11 @@ Eigen::Matrix4d ProjectionMatrix(double fov_deg, double aspect, double n, double
   return P;
 }
 
-EsgRenderer::EsgRenderer(const LabConfig& config, GlContext* context, RenderOptions options)
-    : config_(config), context_(context), gl_(context->gl()), options_(options), model_(BuildSceneModel(config)) {
+FrameRenderer::FrameRenderer(const LabConfig& config, GlContext* context, RenderOptions options)
+    : config_(config), context_(context), gl_(context->gl()), options_(options), model_(scene_model::BuildSceneModel(config)) {
   sun_R_ = Eigen::Vector3f(-0.35f, 0.45f, 1.0f).normalized();
   context_->MakeCurrent();
-  for (const Cluster& c : model_.clusters) {
+  for (const scene_model::Cluster& c : model_.clusters) {
     GpuCluster g;
     g.id = c.id;
     // The cluster's edges as pairs of its points, for near-plane clipping.
@@ -59,7 +60,7 @@ EsgRenderer::EsgRenderer(const LabConfig& config, GlContext* context, RenderOpti
       }
       return best;
     };
-    for (const Triangle& t : c.mesh.triangles()) {
+    for (const scene_model::Triangle& t : c.mesh.triangles()) {
       const int ia = index_of(t.a), ib = index_of(t.b), ic = index_of(t.c);
       for (auto e : {std::pair{ia, ib}, std::pair{ib, ic}, std::pair{ic, ia}}) {
         if (e.first > e.second) std::swap(e.first, e.second);
@@ -67,7 +68,7 @@ EsgRenderer::EsgRenderer(const LabConfig& config, GlContext* context, RenderOpti
       }
     }
     for (bool decals : {false, true}) {  // base faces first, decals after
-      for (const Triangle& t : c.mesh.triangles()) {
+      for (const scene_model::Triangle& t : c.mesh.triangles()) {
         if (t.decal != decals) continue;
         for (const Eigen::Vector3f* v : {&t.a, &t.b, &t.c}) g.xyz.insert(g.xyz.end(), {v->x(), v->y(), v->z()});
         g.n.push_back(t.n);
@@ -86,13 +87,13 @@ EsgRenderer::EsgRenderer(const LabConfig& config, GlContext* context, RenderOpti
   gl_.EnableClientState(GL_COLOR_ARRAY);
 }
 
-std::size_t EsgRenderer::triangle_count() const {
+std::size_t FrameRenderer::triangle_count() const {
   std::size_t n = 0;
   for (const GpuCluster& c : gpu_) n += c.n.size();
   return n;
 }
 
-void EsgRenderer::DrawCluster(GpuCluster& c, const Eigen::Affine3d& X, const Eigen::Matrix4d& view) {
+void FrameRenderer::DrawCluster(GpuCluster& c, const Eigen::Affine3d& X, const Eigen::Matrix4d& view) {
   // Flat shading: one lit colour a triangle from its Reference normal.
   const Eigen::Matrix3f R = X.linear().inverse().transpose().cast<float>();
   constexpr float kAmbient = 0.30f, kDiffuse = 0.70f;
@@ -112,22 +113,22 @@ void EsgRenderer::DrawCluster(GpuCluster& c, const Eigen::Affine3d& X, const Eig
   stats_.triangles_submitted += static_cast<int>(c.n.size());
 }
 
-void EsgRenderer::Render(const EsgFrameData& f) {
+void FrameRenderer::Render(const wire::EsgFrameData& f) {
   stats_ = {};
   context_->MakeCurrent();
   const int w = context_->width(), h = context_->height();
   const Eigen::Matrix4d P = ProjectionMatrix(f.fov_deg, static_cast<double>(w) / h, kNearFt, kFarFt);
   const Eigen::Matrix4d view = ViewMatrix(f);
-  const ClusterPoses poses = ComputeClusterPoses(config_, f);
+  const scene_model::ClusterPoses poses = scene_model::ComputeClusterPoses(config_, f.scene_pose());
 
   // Each cluster's silhouette: what of it lies in front of the near plane,
   // projected (its vertices there and where its edges cross the near plane);
   // culled when all of it lies beyond one plane of the view volume, or when
   // it is a flat, one-sided cluster seen from behind.
-  std::array<ScreenBox, kNumClusters> boxes{};
-  for (int c = 0; c < kNumClusters; ++c) {
+  std::array<ScreenBox, scene_model::kNumClusters> boxes{};
+  for (int c = 0; c < scene_model::kNumClusters; ++c) {
     if (!poses.present[c]) continue;
-    const Cluster& model = model_[c];
+    const scene_model::Cluster& model = model_[c];
     const Eigen::Matrix4d VM = view * poses.X_RC[c].matrix();
     if (options_.backface_cull && model.flat) {
       const Eigen::Vector3d n_R = (poses.X_RC[c].linear().inverse().transpose() * model.normals[0]).normalized();
@@ -196,7 +197,7 @@ void EsgRenderer::Render(const EsgFrameData& f) {
   // no depth buffer; the reference draws them in the same order with the
   // depth test on, so faces that touch resolve the same way in both and
   // every pixel the depth test changes is a priority error.
-  const PriorityBits bits = UnpackPriority(f.control, f.priority_words);
+  const scene_model::PriorityBits bits = wire::UnpackPriority(f.control, f.priority_words);
   order_ = DrawOrder(bits, boxes, &stats_.cycles_broken, 1e-6f);
   if (options_.visibility == Visibility::kDepth) {
     gl_.Enable(GL_DEPTH_TEST);
@@ -215,4 +216,4 @@ void EsgRenderer::Render(const EsgFrameData& f) {
   }
 }
 
-}  // namespace rms::esg
+}  // namespace rms::esg_renderer

@@ -1,4 +1,4 @@
-#include "video.h"
+#include "rms/esg_renderer/video.h"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -12,7 +12,7 @@
 
 extern char** environ;
 
-namespace rms::esg {
+namespace rms::esg_renderer {
 
 VideoWriter::VideoWriter(const std::string& path, int width, int height, double fps)
     : width_(width), height_(height) {
@@ -101,4 +101,4 @@ void VideoWriter::Close() {
   }
 }
 
-}  // namespace rms::esg
+}  // namespace rms::esg_renderer

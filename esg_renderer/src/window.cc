@@ -1,12 +1,12 @@
-#include "window.h"
+#include "rms/esg_renderer/window.h"
 
 #include <SDL2/SDL.h>
 
 #include <stdexcept>
 
-#include "rms/key_codes.h"
+#include "rms/wire/key_codes.h"
 
-namespace rms::esg {
+namespace rms::esg_renderer {
 
 struct LiveWindow::Impl {
   SDL_Window* window = nullptr;
@@ -14,15 +14,15 @@ struct LiveWindow::Impl {
 
 int KeyCodeFromSdl(int sym, int mod) {
   switch (sym) {
-    case SDLK_UP: return kKeyUp;
-    case SDLK_DOWN: return kKeyDown;
-    case SDLK_LEFT: return kKeyLeft;
-    case SDLK_RIGHT: return kKeyRight;
-    case SDLK_PAGEUP: return kKeyPageUp;
-    case SDLK_PAGEDOWN: return kKeyPageDown;
-    case SDLK_BACKSPACE: return kKeyBackspace;
-    case SDLK_TAB: return kKeyTab;
-    case SDLK_RETURN: case SDLK_KP_ENTER: return kKeyEnter;
+    case SDLK_UP: return wire::kKeyUp;
+    case SDLK_DOWN: return wire::kKeyDown;
+    case SDLK_LEFT: return wire::kKeyLeft;
+    case SDLK_RIGHT: return wire::kKeyRight;
+    case SDLK_PAGEUP: return wire::kKeyPageUp;
+    case SDLK_PAGEDOWN: return wire::kKeyPageDown;
+    case SDLK_BACKSPACE: return wire::kKeyBackspace;
+    case SDLK_TAB: return wire::kKeyTab;
+    case SDLK_RETURN: case SDLK_KP_ENTER: return wire::kKeyEnter;
     case SDLK_KP_PLUS: return '+';
     case SDLK_KP_MINUS: return '-';
     default: break;
@@ -107,4 +107,4 @@ bool LiveWindow::Show(const std::uint8_t* rgba) {
   return true;
 }
 
-}  // namespace rms::esg
+}  // namespace rms::esg_renderer

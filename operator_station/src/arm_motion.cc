@@ -1,14 +1,14 @@
-#include "arm_motion.h"
+#include "rms/operator_station/arm_motion.h"
 
 #include <algorithm>
 #include <cmath>
 
 #include <Eigen/SVD>
 
-#include "rms/arm_ik.h"
-#include "rms/arm_kinematics.h"
+#include "rms/mission/arm_ik.h"
+#include "rms/arm/kinematics.h"
 
-namespace rms::op {
+namespace rms::operator_station {
 
 namespace {
 constexpr double kDeg = M_PI / 180.0;
@@ -31,11 +31,11 @@ JointLimits LimitsFromConfig(const LabConfig& config, double rate_deg_s) {
 }
 
 Eigen::Isometry3d ForwardPose(const ArmGeometry& arm, const JointAngles& q, double h) {
-  return ComputeArmPose(arm, SinCosFromDegrees(q), h).X_RS2;
+  return arm::ComputeArmPose(arm, arm::SinCosFromDegrees(q), h).X_RS2;
 }
 
 Matrix6d ArmJacobian(const ArmGeometry& arm, const JointAngles& q, double h, const Eigen::Vector3d& p_S2oQ_S2) {
-  const ArmPose pose = ComputeArmPose(arm, SinCosFromDegrees(q), h);
+  const arm::ArmPose pose = arm::ComputeArmPose(arm, arm::SinCosFromDegrees(q), h);
   const Eigen::Vector3d Q = pose.X_RS2 * p_S2oQ_S2;
   // docs/kinematics.md: yaw about +Z (R) at S; the pitches about -Y of the
   // frame before, at S, E and W; wrist yaw about +Z of F4 and wrist roll
@@ -184,7 +184,7 @@ bool StepJointsToward(JointAngles* q, const JointAngles& target, const JointAngl
 
 std::optional<JointAngles> SolveWithinLimits(const ArmGeometry& arm, const JointLimits& limits,
                                              const Eigen::Isometry3d& X_RS2, double h) {
-  const auto s = SolveArmIk(arm, X_RS2, h, Elbow::kUp);
+  const auto s = mission::SolveArmIk(arm, X_RS2, h, mission::Elbow::kUp);
   if (!s) return std::nullopt;
   for (int i = 0; i < 6; ++i) {
     if (s->angles_deg[i] < limits.min_deg[i] || s->angles_deg[i] > limits.max_deg[i]) return std::nullopt;
@@ -209,4 +209,4 @@ Eigen::Vector3d RotationVector(const Eigen::Matrix3d& R) {
   return aa.angle() * aa.axis();
 }
 
-}  // namespace rms::op
+}  // namespace rms::operator_station

@@ -1,14 +1,14 @@
-#include "autopilot.h"
+#include "rms/operator_station/autopilot.h"
 
 #include <algorithm>
 #include <cmath>
 #include <spdlog/spdlog.h>
 
-#include "guidance.h"
-#include "rms/arm_kinematics.h"
-#include "rms/collision_bits.h"
+#include "rms/operator_station/guidance.h"
+#include "rms/arm/kinematics.h"
+#include "rms/wire/collision_bits.h"
 
-namespace rms::op {
+namespace rms::operator_station {
 
 const char* AutopilotPhaseName(AutopilotPhase p) {
   switch (p) {
@@ -42,9 +42,9 @@ Autopilot::Autopilot(const LabConfig& config, AutopilotOptions options)
     : config_(config),
       opt_(options),
       limits_(LimitsFromConfig(config, options.joint_rate_deg_s)),
-      model_(BuildSceneModel(config)),
+      model_(scene_model::BuildSceneModel(config)),
       dt_s_(1.0 / config.session.frame_rate_hz) {
-  cmd_ = InitialInputs(config.inputs);
+  cmd_ = wire::InitialInputs(config.inputs);
   cmd_.camera_station = 8;
   cmd_.overlay = true;
   // System Two at the grasp, in the payload's frame (body-fixed; the payload
@@ -303,8 +303,8 @@ void Autopilot::Relieve(const dcp_telemetry_t& tm) {
   ++collisions_;
   counters_.Add("autopilot.collisions_relieved");
   std::string kinds;
-  for (int b = 0; b < collision_bits::kCount; ++b) {
-    if (tm.collisions & (1 << b)) kinds += std::string(kinds.empty() ? "" : ", ") + CollisionName(b);
+  for (int b = 0; b < wire::collision_bits::kCount; ++b) {
+    if (tm.collisions & (1 << b)) kinds += std::string(kinds.empty() ? "" : ", ") + wire::CollisionName(b);
   }
   spdlog::info("autopilot: collision ({}) in {}: back to the pose the slave holds, then away", kinds,
                AutopilotPhaseName(phase_));
@@ -342,7 +342,7 @@ void Autopilot::Relieve(const dcp_telemetry_t& tm) {
   Enter(AutopilotPhase::kRelieve);
 }
 
-void Autopilot::Resync(const OperatorInputs& restored) {
+void Autopilot::Resync(const wire::OperatorInputs& restored) {
   const int camera = cmd_.camera_station;
   cmd_ = restored;
   cmd_.reset = false;
@@ -354,7 +354,7 @@ void Autopilot::Resync(const OperatorInputs& restored) {
   Enter(AutopilotPhase::kResync);
 }
 
-OperatorInputs Autopilot::Step(const dcp_telemetry_t* tm_ptr) {
+wire::OperatorInputs Autopilot::Step(const dcp_telemetry_t* tm_ptr) {
   t_s_ += dt_s_;
   cmd_.reset = false;
   if (phase_ == AutopilotPhase::kFailed) return cmd_;
@@ -526,4 +526,4 @@ OperatorInputs Autopilot::Step(const dcp_telemetry_t* tm_ptr) {
   return cmd_;
 }
 
-}  // namespace rms::op
+}  // namespace rms::operator_station

@@ -1,4 +1,4 @@
-#include "bindings.h"
+#include "rms/operator_station/bindings.h"
 
 #include <SDL2/SDL_gamecontroller.h>
 
@@ -7,14 +7,14 @@
 #include <set>
 #include <sstream>
 
-#include "rms/check.h"
-#include "rms/toml_reader.h"
+#include "rms/base/check.h"
+#include "rms/base/toml_reader.h"
 
 #ifndef RMSLAB_DEFAULT_BINDINGS
 #error "RMSLAB_DEFAULT_BINDINGS must be defined by the build"
 #endif
 
-namespace rms::op {
+namespace rms::operator_station {
 
 std::string DefaultBindingsPath() { return RMSLAB_DEFAULT_BINDINGS; }
 
@@ -184,7 +184,7 @@ void ReadKeyboard(TomlReader& top, Bindings* b) {
   TomlReader k = r.Sub("keys");
   for (auto&& [key, node] : k.table()) {
     const std::string name(key.str());
-    const int code = KeyCode(name);
+    const int code = wire::KeyCode(name);
     if (code < 0) {
       k.Fail(name, "is not a key (a printable character, space, up, down, left, right, pageup, pagedown, "
                    "backspace, tab, enter, plus, minus)");
@@ -290,4 +290,4 @@ Bindings ParseBindings(std::string_view text, const std::string& source) {
 
 Bindings LoadBindings(const std::string& path) { return ParseBindings(ReadTextFile(path, "the bindings file"), path); }
 
-}  // namespace rms::op
+}  // namespace rms::operator_station

@@ -1,6 +1,6 @@
-#include "control_modes.h"
+#include "rms/operator_station/control_modes.h"
 
-namespace rms::op {
+namespace rms::operator_station {
 
 std::string_view ControlModeName(ControlMode m) {
   switch (m) {
@@ -39,4 +39,4 @@ int HandAxisIndex(std::string_view name) {
   return -1;
 }
 
-}  // namespace rms::op
+}  // namespace rms::operator_station

@@ -1,4 +1,4 @@
-#include "devices.h"
+#include "rms/operator_station/devices.h"
 
 #include <SDL2/SDL.h>
 
@@ -10,7 +10,7 @@
 #include <spnav.h>
 #endif
 
-namespace rms::op {
+namespace rms::operator_station {
 
 double ApplyDeadband(double x, double band) {
   const double a = std::abs(x);
@@ -74,7 +74,7 @@ void KeyboardDevice::Poll(DeviceCommands* out) {
     const auto it = b_.keys.find(k);
     if (it == b_.keys.end()) {
       // Said once a key, so a person knows the press did nothing.
-      if (unbound_seen_.insert(k).second) spdlog::info("key '{}' is not bound to anything ({})", KeyName(k), b_.source);
+      if (unbound_seen_.insert(k).second) spdlog::info("key '{}' is not bound to anything ({})", wire::KeyName(k), b_.source);
       ++unbound_;
       continue;
     }
@@ -95,19 +95,19 @@ WindowKeyboardDevice::WindowKeyboardDevice(const Bindings& bindings, std::int64_
 bool WindowKeyboardDevice::Receive(const Message& m, std::int64_t now_us) {
   if (m.sender_pid != 0 && sender_pid_ != 0 && m.sender_pid != sender_pid_) {
     // A new window (esg_renderer restarted): its own numbering, from 0.
-    sequence_ = SequenceTracker{};
+    sequence_ = wire::SequenceTracker{};
     held_.clear();
     ++new_windows_;
     spdlog::warn("window keys: a new live window (esg_renderer pid {}, was {}); its keys are taken from now on",
                  m.sender_pid, sender_pid_);
   }
   if (m.sender_pid != 0) sender_pid_ = m.sender_pid;
-  const SequenceTracker::Verdict v = sequence_.Accept(m.sequence);
-  if (v == SequenceTracker::Verdict::kDuplicate || v == SequenceTracker::Verdict::kStale ||
-      v == SequenceTracker::Verdict::kFarAhead) {
+  const wire::SequenceTracker::Verdict v = sequence_.Accept(m.sequence);
+  if (v == wire::SequenceTracker::Verdict::kDuplicate || v == wire::SequenceTracker::Verdict::kStale ||
+      v == wire::SequenceTracker::Verdict::kFarAhead) {
     return false;
   }
-  if (v == SequenceTracker::Verdict::kResync) {
+  if (v == wire::SequenceTracker::Verdict::kResync) {
     spdlog::warn("window keys: sequence numbers resynchronised at {} (the window restarted, or {} was not real)",
                  m.sequence, last_sequence_);
   }
@@ -235,4 +235,4 @@ SpaceMouseDevice::~SpaceMouseDevice() = default;
 void SpaceMouseDevice::Poll(DeviceCommands*) {}
 #endif
 
-}  // namespace rms::op
+}  // namespace rms::operator_station

@@ -1,12 +1,12 @@
-#include "guidance.h"
+#include "rms/operator_station/guidance.h"
 
 #include <cmath>
 
-#include "arm_motion.h"
-#include "rms/arm_kinematics.h"
-#include "rms/mission_geometry.h"
+#include "rms/operator_station/arm_motion.h"
+#include "rms/arm/kinematics.h"
+#include "rms/mission/mission_geometry.h"
 
-namespace rms::op {
+namespace rms::operator_station {
 
 namespace {
 
@@ -38,7 +38,7 @@ Eigen::Isometry3d TelemetryPose(const double p[3], const double R_rowmajor[9]) {
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) R(i, j) = R_rowmajor[3 * i + j];
   }
-  return MakeIsometry(R, Eigen::Vector3d(p[0], p[1], p[2]));
+  return arm::MakeIsometry(R, Eigen::Vector3d(p[0], p[1], p[2]));
 }
 
 GuidanceGeometry MakeGuidanceGeometry(const LabConfig& c) {
@@ -132,4 +132,4 @@ Guidance ComputeGuidance(const GuidanceGeometry& g, const ArmState& s, CommandFr
   return out;
 }
 
-}  // namespace rms::op
+}  // namespace rms::operator_station

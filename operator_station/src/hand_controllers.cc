@@ -1,12 +1,12 @@
-#include "hand_controllers.h"
+#include "rms/operator_station/hand_controllers.h"
 
 #include <algorithm>
 #include <cmath>
 #include <spdlog/spdlog.h>
 
-#include "rms/arm_kinematics.h"
+#include "rms/arm/kinematics.h"
 
-namespace rms::op {
+namespace rms::operator_station {
 
 namespace {
 constexpr double kDeg = M_PI / 180.0;
@@ -18,7 +18,7 @@ HandControllers::HandControllers(const LabConfig& config, const Bindings& bindin
       b_(bindings),
       geometry_(MakeGuidanceGeometry(config)),
       limits_(LimitsFromConfig(config, 0.0)),
-      target_(InitialInputs(config.inputs)),
+      target_(wire::InitialInputs(config.inputs)),
       out_(target_) {
   for (int i = 0; i < 6; ++i) limits_.rate_deg_s[i] = bindings.max_rate[i];
   status_.mode = bindings.initial_mode;
@@ -34,7 +34,7 @@ void HandControllers::AddDevice(std::unique_ptr<InputDevice> device) {
   device_actions_.push_back(0);
 }
 
-OperatorInputs HandControllers::Step(double dt_s, const dcp_telemetry_t* telemetry) {
+wire::OperatorInputs HandControllers::Step(double dt_s, const dcp_telemetry_t* telemetry) {
   DeviceCommands cmd;
   for (std::size_t i = 0; i < devices_.size(); ++i) {
     if (!devices_[i]->connected()) {
@@ -52,7 +52,7 @@ OperatorInputs HandControllers::Step(double dt_s, const dcp_telemetry_t* telemet
   return Apply(cmd, dt_s, telemetry);
 }
 
-void HandControllers::SetInputs(const OperatorInputs& in) {
+void HandControllers::SetInputs(const wire::OperatorInputs& in) {
   const bool crosshairs = target_.crosshairs;
   target_ = in;
   target_.reset = false;
@@ -364,7 +364,7 @@ void HandControllers::DirectInputs(const DeviceCommands& cmd, double dt_s) {
   }
 }
 
-OperatorInputs HandControllers::Apply(const DeviceCommands& cmd, double dt_s, const dcp_telemetry_t* tm) {
+wire::OperatorInputs HandControllers::Apply(const DeviceCommands& cmd, double dt_s, const dcp_telemetry_t* tm) {
   out_.reset = false;
   freeze_requested_ = false;
   step_requests_ = 0;
@@ -406,4 +406,4 @@ OperatorInputs HandControllers::Apply(const DeviceCommands& cmd, double dt_s, co
   return out_;
 }
 
-}  // namespace rms::op
+}  // namespace rms::operator_station

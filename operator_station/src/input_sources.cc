@@ -1,11 +1,11 @@
-#include "input_sources.h"
+#include "rms/operator_station/input_sources.h"
 
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
-#include "rms/check.h"
+#include "rms/base/check.h"
 
-namespace rms::op {
+namespace rms::operator_station {
 
 // ---- timeline ----
 
@@ -16,11 +16,11 @@ TimelineSource::TimelineSource(const std::string& path, const LabConfig& config,
                config.session.frame_rate_hz, speed);
 }
 
-std::optional<OperatorInputs> TimelineSource::Next(const Frame& f) {
+std::optional<wire::OperatorInputs> TimelineSource::Next(const Frame& f) {
   // Timeline time is the frame count over the rate: jitter-free and reproducible.
   const double t = speed_ * static_cast<double>(f.count) * f.dt_s;
   if (t > timeline_.end_time() + 1e-9 && !hold_) return std::nullopt;
-  OperatorInputs in = timeline_.Sample(t);
+  wire::OperatorInputs in = timeline_.Sample(t);
   in.reset = timeline_.ResetIn(prev_t_, t);
   prev_t_ = t;
   return in;
@@ -35,7 +35,7 @@ std::string KeyHelp(const Bindings& b) {
   for (const auto& [code, a] : b.keys) {
     std::string& k = by_action[ActionName(a)];
     if (!k.empty()) k += ",";
-    k += KeyName(code);
+    k += wire::KeyName(code);
   }
   std::string s = "keys:";
   auto pair = [&](const std::string& plus, const std::string& minus, const char* what) {
@@ -102,9 +102,9 @@ HandSource::HandSource(const LabConfig& config, const HandOptions& o)
   help_ = KeyHelp(bindings_);
 }
 
-std::optional<OperatorInputs> HandSource::Next(const Frame& f) {
+std::optional<wire::OperatorInputs> HandSource::Next(const Frame& f) {
   if (window_) window_->SetNow(f.now_us);
-  const OperatorInputs in = hands_->Step(f.dt_s, f.telemetry);
+  const wire::OperatorInputs in = hands_->Step(f.dt_s, f.telemetry);
   requests_ = {hands_->quit(), hands_->freeze_requested(), hands_->step_requests()};
   if (hands_->quit()) return std::nullopt;
   return in;
@@ -120,12 +120,12 @@ std::map<std::string, std::string> HandSource::key_hints() const {
   for (const auto& [code, a] : bindings_.keys) {
     std::string& k = m[ActionName(a)];
     if (!k.empty()) k += ",";
-    k += KeyName(code);
+    k += wire::KeyName(code);
   }
   return m;
 }
 
-void HandSource::Resume(const OperatorInputs& in, bool) { hands_->SetInputs(in); }
+void HandSource::Resume(const wire::OperatorInputs& in, bool) { hands_->SetInputs(in); }
 
 void HandSource::AddCounters(Counters* c) const {
   for (const auto& [k, v] : hands_->counters().values()) c->Add(k, v);
@@ -143,18 +143,18 @@ std::string AutopilotSource::Describe() const {
   return std::string("autopilot: ") + AutopilotPhaseName(autopilot_.phase());
 }
 
-void AutopilotSource::Resume(const OperatorInputs& in, bool from_checkpoint) {
+void AutopilotSource::Resume(const wire::OperatorInputs& in, bool from_checkpoint) {
   autopilot_.Resync(in);
   if (from_checkpoint) resume_from_telemetry_ = false;
 }
 
-std::optional<OperatorInputs> AutopilotSource::Next(const Frame& f) {
+std::optional<wire::OperatorInputs> AutopilotSource::Next(const Frame& f) {
   if (resume_from_telemetry_ && f.telemetry) {
     // Restarted mid-session by the launcher: carry on from the command the
     // DCP last answered, and let the autopilot pick up the task where the
     // telemetry says it is (no reset).
     const dcp_telemetry_t& t = *f.telemetry;
-    OperatorInputs from = InitialInputs(config_.inputs);
+    wire::OperatorInputs from = wire::InitialInputs(config_.inputs);
     for (int i = 0; i < 6; ++i) from.value[i] = t.master_angles_deg[i];
     from.value[kShoulderHeight] = t.master_shoulder_height_ft;
     from.value[kFinger] = t.master_finger;
@@ -163,7 +163,7 @@ std::optional<OperatorInputs> AutopilotSource::Next(const Frame& f) {
     spdlog::warn("restarted: the autopilot resumes from the DCP's telemetry (Mode {}, frame {})",
                  static_cast<int>(t.mode), t.frame);
   }
-  const OperatorInputs in = autopilot_.Step(f.telemetry);
+  const wire::OperatorInputs in = autopilot_.Step(f.telemetry);
   if (autopilot_.failed() && !hold_) return std::nullopt;
   // Docked: hold two seconds of session time (the scene shows it), then stop.
   if (autopilot_.docked() && ++docked_frames_ > 2 * config_.session.frame_rate_hz && !hold_) return std::nullopt;
@@ -179,4 +179,4 @@ void AutopilotSource::AddCounters(Counters* c) const {
   else if (autopilot_.docked()) spdlog::info("autopilot: docked {:.1f} s into the session", autopilot_.docked_at_s());
 }
 
-}  // namespace rms::op
+}  // namespace rms::operator_station

@@ -1,14 +1,14 @@
-#include "keyboard.h"
+#include "rms/operator_station/keyboard.h"
 
-#include "bindings.h"
+#include "rms/operator_station/bindings.h"
 
 #include <termios.h>
 #include <unistd.h>
 #include <fcntl.h>
 
-#include "rms/check.h"
+#include "rms/base/check.h"
 
-namespace rms::op {
+namespace rms::operator_station {
 
 struct TerminalKeys::Saved {
   termios tio;
@@ -43,21 +43,21 @@ int TerminalKeys::ReadByte() {
 
 int TerminalKeys::Next() {
   const int c = ReadByte();
-  if (c == 127 || c == 8) return kKeyBackspace;
-  if (c == '\t') return kKeyTab;
-  if (c == '\r' || c == '\n') return kKeyEnter;
+  if (c == 127 || c == 8) return wire::kKeyBackspace;
+  if (c == '\t') return wire::kKeyTab;
+  if (c == '\r' || c == '\n') return wire::kKeyEnter;
   if (c != 27) return c;
   const int b = ReadByte();
   if (b != '[') return 27;
   switch (ReadByte()) {
-    case 'A': return kKeyUp;
-    case 'B': return kKeyDown;
-    case 'C': return kKeyRight;
-    case 'D': return kKeyLeft;
-    case '5': return ReadByte() == '~' ? kKeyPageUp : -1;
-    case '6': return ReadByte() == '~' ? kKeyPageDown : -1;
+    case 'A': return wire::kKeyUp;
+    case 'B': return wire::kKeyDown;
+    case 'C': return wire::kKeyRight;
+    case 'D': return wire::kKeyLeft;
+    case '5': return ReadByte() == '~' ? wire::kKeyPageUp : -1;
+    case '6': return ReadByte() == '~' ? wire::kKeyPageDown : -1;
     default: return -1;
   }
 }
 
-}  // namespace rms::op
+}  // namespace rms::operator_station

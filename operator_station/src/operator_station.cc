@@ -1,4 +1,4 @@
-#include "operator_station.h"
+#include "rms/operator_station/operator_station.h"
 
 #include <cerrno>
 #include <cmath>
@@ -6,24 +6,24 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "rms/channels.h"
-#include "rms/check.h"
-#include "rms/checkpoint.h"
-#include "rms/message_io.h"
+#include "rms/wire/channels.h"
+#include "rms/base/check.h"
+#include "rms/wire/checkpoint.h"
+#include "rms/wire/message_io.h"
 #include "rms/operator_state_t.hpp"
 #include "rms/process_status_t.hpp"
 #include "rms/session_control_t.hpp"
-#include "rms/telemetry_check.h"
+#include "rms/operator_station/telemetry_check.h"
 #include "rms/window_keys_t.hpp"
 
-namespace rms::op {
+namespace rms::operator_station {
 
-operator_input_t InputBlockBuilder::Build(const OperatorInputs& in, std::int64_t send_time_us,
+operator_input_t InputBlockBuilder::Build(const wire::OperatorInputs& in, std::int64_t send_time_us,
                                           Counters* counters) {
   operator_input_t m;
   m.frame = next_frame_++;
   m.send_time_us = send_time_us;
-  const auto words = EncodeInputs(in, cal_, counters);
+  const auto words = wire::EncodeInputs(in, cal_, counters);
   std::copy(words.begin(), words.end(), m.words);
   return m;
 }
@@ -41,7 +41,7 @@ void SleepUntilNs(std::int64_t t_ns) {
   ts.tv_sec = t_ns / 1000000000;
   ts.tv_nsec = t_ns % 1000000000;
   while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
-    if (StopRequested()) return;
+    if (transport::StopRequested()) return;
   }
 }
 
@@ -49,9 +49,9 @@ void SleepUntilNs(std::int64_t t_ns) {
 constexpr int kMaxTelemetrySize = 4096;
 constexpr int kMaxStatusSize = 1 << 20;
 constexpr int kMaxControlSize = 1 << 16;
-constexpr int kMaxWindowKeysSize = 8 + kSenderBytes + 16 + 2 + 2 * 512 + 2 + 2 * 512 + 1;
+constexpr int kMaxWindowKeysSize = 8 + wire::kSenderBytes + 16 + 2 + 2 * 512 + 2 + 2 * 512 + 1;
 
-bool Restarted() { return RestartedByLauncher(); }
+bool Restarted() { return transport::RestartedByLauncher(); }
 
 }  // namespace
 
@@ -82,7 +82,7 @@ void CheckSourceFiles(const OperatorOptions& o, const LabConfig& config) {
   if (o.keyboard || o.manual || !o.bindings_path.empty()) {
     (void)LoadBindings(o.bindings_path.empty() ? DefaultBindingsPath() : o.bindings_path);
   }
-  if (!o.restore_path.empty()) (void)ReadCheckpoint(o.restore_path);
+  if (!o.restore_path.empty()) (void)wire::ReadCheckpoint(o.restore_path);
 }
 
 void OperatorStation::RateMeter::Tick(std::int64_t now_us) {
@@ -98,7 +98,7 @@ void OperatorStation::RateMeter::Tick(std::int64_t now_us) {
   }
 }
 
-OperatorStation::OperatorStation(const OperatorOptions& options, const LabConfig& config, LcmInterface& lcm,
+OperatorStation::OperatorStation(const OperatorOptions& options, const LabConfig& config, transport::LcmInterface& lcm,
                                  std::unique_ptr<InputSource> source)
     : options_(options),
       config_(config),
@@ -109,23 +109,23 @@ OperatorStation::OperatorStation(const OperatorOptions& options, const LabConfig
       period_ns_(static_cast<std::int64_t>(std::llround(1e9 / rate_hz_))),
       builder_(config.inputs),
       checkpoints_(options.checkpoint_dir) {
-  telemetry_seq_.SetClock(SessionFrameClock(config.session.frame_rate_hz));
+  telemetry_seq_.SetClock(transport::SessionFrameClock(config.session.frame_rate_hz));
   Subscribe();
 }
 
 void OperatorStation::Subscribe() {
-  lcm_.Subscribe(channels::kDcpTelemetry, [this](const void* d, int n, std::int64_t t) { OnTelemetry(d, n, t); });
-  lcm_.Subscribe(channels::kStatus, [this](const void* d, int n, std::int64_t t) { OnStatus(d, n, t); });
-  lcm_.Subscribe(channels::kControl, [this](const void* d, int n, std::int64_t t) { OnControl(d, n, t); });
+  lcm_.Subscribe(wire::channels::kDcpTelemetry, [this](const void* d, int n, std::int64_t t) { OnTelemetry(d, n, t); });
+  lcm_.Subscribe(wire::channels::kStatus, [this](const void* d, int n, std::int64_t t) { OnStatus(d, n, t); });
+  lcm_.Subscribe(wire::channels::kControl, [this](const void* d, int n, std::int64_t t) { OnControl(d, n, t); });
   if (source_->window_keyboard()) {
-    lcm_.Subscribe(channels::kWindowKeys, [this](const void* d, int n, std::int64_t t) { OnWindowKeys(d, n, t); });
+    lcm_.Subscribe(wire::channels::kWindowKeys, [this](const void* d, int n, std::int64_t t) { OnWindowKeys(d, n, t); });
   }
 }
 
 void OperatorStation::OnTelemetry(const void* data, int size, std::int64_t recv_us) {
   dcp_telemetry_t m{};
-  if (const DecodeError e = SafeDecode(data, size, kMaxTelemetrySize, &m); e != DecodeError::kNone) {
-    counters_.Add(std::string("dropped.telemetry_") + DecodeErrorName(e));
+  if (const wire::DecodeError e = wire::SafeDecode(data, size, kMaxTelemetrySize, &m); e != wire::DecodeError::kNone) {
+    counters_.Add(std::string("dropped.telemetry_") + wire::DecodeErrorName(e));
     return;
   }
   if (const auto why = TelemetryProblem(m)) {
@@ -137,17 +137,17 @@ void OperatorStation::OnTelemetry(const void* data, int size, std::int64_t recv_
     return;
   }
   switch (telemetry_seq_.Accept(m.frame, recv_us)) {
-    case SequenceTracker::Verdict::kDuplicate:
-    case SequenceTracker::Verdict::kStale:
+    case wire::SequenceTracker::Verdict::kDuplicate:
+    case wire::SequenceTracker::Verdict::kStale:
       counters_.Add("telemetry.stale");
       return;
-    case SequenceTracker::Verdict::kFarAhead:
+    case wire::SequenceTracker::Verdict::kFarAhead:
       if (counters_.Get("dropped.far_ahead") == 0) {
         spdlog::warn("telemetry frame {} refused: beyond what the session's clock allows (dropped.far_ahead)", m.frame);
       }
       counters_.Add("dropped.far_ahead");
       return;
-    case SequenceTracker::Verdict::kResync:
+    case wire::SequenceTracker::Verdict::kResync:
       counters_.Add("resyncs");
       spdlog::warn("the telemetry's numbering moved to frame {}: followed again (resyncs)", m.frame);
       break;
@@ -162,7 +162,7 @@ void OperatorStation::OnTelemetry(const void* data, int size, std::int64_t recv_
 
 void OperatorStation::OnStatus(const void* data, int size, std::int64_t recv_us) {
   process_status_t m;
-  if (SafeDecode(data, size, kMaxStatusSize, &m) != DecodeError::kNone) {
+  if (wire::SafeDecode(data, size, kMaxStatusSize, &m) != wire::DecodeError::kNone) {
     counters_.Add("dropped.status_malformed");
     return;
   }
@@ -187,7 +187,7 @@ void OperatorStation::OnStatus(const void* data, int size, std::int64_t recv_us)
 // publishes nothing, so every process holds its frame and nothing is lost.
 void OperatorStation::OnControl(const void* data, int size, std::int64_t) {
   session_control_t m;
-  if (SafeDecode(data, size, kMaxControlSize, &m) != DecodeError::kNone) {
+  if (wire::SafeDecode(data, size, kMaxControlSize, &m) != wire::DecodeError::kNone) {
     counters_.Add("dropped.control_malformed");
     return;
   }
@@ -217,8 +217,8 @@ void OperatorStation::OnControl(const void* data, int size, std::int64_t) {
 
 void OperatorStation::OnWindowKeys(const void* data, int size, std::int64_t recv_us) {
   window_keys_t m;
-  if (const DecodeError e = SafeDecode(data, size, kMaxWindowKeysSize, &m); e != DecodeError::kNone) {
-    counters_.Add(std::string("dropped.window_keys_") + DecodeErrorName(e));
+  if (const wire::DecodeError e = wire::SafeDecode(data, size, kMaxWindowKeysSize, &m); e != wire::DecodeError::kNone) {
+    counters_.Add(std::string("dropped.window_keys_") + wire::DecodeErrorName(e));
     return;
   }
   WindowKeyboardDevice::Message k;
@@ -235,14 +235,14 @@ void OperatorStation::SendControl(std::int8_t command) {
   m.send_time_us = lcm_.NowUs();
   m.sequence = control_sequence_++;
   m.command = command;
-  if (!PublishMessage(lcm_, channels::kControl, m)) counters_.Add("publish_failed");
+  if (!transport::PublishMessage(lcm_, wire::channels::kControl, m)) counters_.Add("publish_failed");
 }
 
 void OperatorStation::ForgetTelemetry(std::int64_t fresh_from_input_frame) {
   fresh_from_input_frame_ = fresh_from_input_frame;
   telemetry_.reset();
-  const FrameClock clock = SessionFrameClock(config_.session.frame_rate_hz);
-  telemetry_seq_ = SequenceTracker{};
+  const wire::FrameClock clock = transport::SessionFrameClock(config_.session.frame_rate_hz);
+  telemetry_seq_ = wire::SequenceTracker{};
   telemetry_seq_.SetClock(clock);
   events_.Forget();
 }
@@ -251,7 +251,7 @@ void OperatorStation::ApplyRestore() {
   // Carry on from the checkpoint's inputs, so the first frame after it
   // commands the arm where the DCP now has it.
   try {
-    const Checkpoint c = checkpoints_.Read(*restored_from_);
+    const wire::Checkpoint c = checkpoints_.Read(*restored_from_);
     source_->Resume(c.inputs, true);
     ForgetTelemetry(builder_.next_frame());
     spdlog::info("RESTORED the checkpoint {}: carrying on from its inputs", checkpoints_.PathOf(*restored_from_));
@@ -271,7 +271,7 @@ std::optional<Guidance> OperatorStation::CurrentGuidance() const {
   return ComputeGuidance(geometry_, s, f);
 }
 
-void OperatorStation::PublishState(std::int64_t frame, const OperatorInputs& in) {
+void OperatorStation::PublishState(std::int64_t frame, const wire::OperatorInputs& in) {
   operator_state_t m{};
   m.frame = frame;
   m.send_time_us = lcm_.NowUs();
@@ -319,10 +319,10 @@ void OperatorStation::PublishState(std::int64_t frame, const OperatorInputs& in)
     m.dock_angle_deg = t.dock_angle_deg;
   }
   (void)in;
-  if (!PublishMessage(lcm_, channels::kOperatorState, m)) counters_.Add("publish_failed");
+  if (!transport::PublishMessage(lcm_, wire::channels::kOperatorState, m)) counters_.Add("publish_failed");
 }
 
-void OperatorStation::DrawScreen(std::int64_t frame, const OperatorInputs& in, bool frozen) {
+void OperatorStation::DrawScreen(std::int64_t frame, const wire::OperatorInputs& in, bool frozen) {
   if (!screen_) return;
   StatusSnapshot s;
   s.source = source_->Describe() +
@@ -364,7 +364,7 @@ bool OperatorStation::RunFrozen() {
 
 int OperatorStation::Run(const std::string& stats_path, const std::string& ready_path) {
   if (!options_.restore_path.empty()) {
-    const Checkpoint c = ReadCheckpoint(options_.restore_path);
+    const wire::Checkpoint c = wire::ReadCheckpoint(options_.restore_path);
     spdlog::info("starting from the checkpoint {} (DCP frame {})", options_.restore_path, c.dcp_frame);
     source_->Resume(c.inputs, true);
   }
@@ -377,16 +377,16 @@ int OperatorStation::Run(const std::string& stats_path, const std::string& ready
   if (options_.status == 1 || (options_.status == -1 && by_hand && isatty(STDOUT_FILENO))) {
     screen_ = std::make_unique<StatusScreen>(config_);
   }
-  StatusReporter status(&lcm_, "operator_station");
-  builder_.set_next_frame(FirstFrameNumber(config_.session.frame_rate_hz));
-  if (!ready_path.empty()) WriteReadyFile(ready_path);
+  transport::StatusReporter status(&lcm_, "operator_station");
+  builder_.set_next_frame(transport::FirstFrameNumber(config_.session.frame_rate_hz));
+  if (!ready_path.empty()) transport::WriteReadyFile(ready_path);
 
   std::int64_t next_ns = MonotonicNs();
-  last_ = InitialInputs(config_.inputs);
-  while (!StopRequested()) {
+  last_ = wire::InitialInputs(config_.inputs);
+  while (!transport::StopRequested()) {
     if (options_.max_frames >= 0 && frames_ >= options_.max_frames) break;
     if (lcm_.HandleSubscriptions(0) < 0) counters_.Add("transport_errors");
-    NoteTransportCounters(lcm_, &counters_);
+    transport::NoteTransportCounters(lcm_, &counters_);
     if (restored_from_) ApplyRestore();
     if (frozen_ && steps_pending_ == 0) {
       if (!RunFrozen()) break;
@@ -398,7 +398,7 @@ int OperatorStation::Run(const std::string& stats_path, const std::string& ready
     if (steps_pending_ > 0) --steps_pending_;
     if (resume_from_telemetry && telemetry_) {
       const dcp_telemetry_t& t = *telemetry_;
-      OperatorInputs from = last_;
+      wire::OperatorInputs from = last_;
       for (int i = 0; i < 6; ++i) from.value[i] = t.master_angles_deg[i];
       from.value[kShoulderHeight] = t.master_shoulder_height_ft;
       from.value[kFinger] = t.master_finger;
@@ -412,7 +412,7 @@ int OperatorStation::Run(const std::string& stats_path, const std::string& ready
     f.dt_s = 1.0 / config_.session.frame_rate_hz;
     f.telemetry = telemetry_ ? &*telemetry_ : nullptr;
     f.now_us = lcm_.NowUs();
-    const std::optional<OperatorInputs> in = source_->Next(f);
+    const std::optional<wire::OperatorInputs> in = source_->Next(f);
     if (source_->requests().freeze) SendControl(session_control_t::FREEZE);
     if (!in) break;
     last_ = *in;
@@ -421,7 +421,7 @@ int OperatorStation::Run(const std::string& stats_path, const std::string& ready
       ForgetTelemetry(builder_.next_frame());
     }
     const operator_input_t block = builder_.Build(*in, lcm_.NowUs(), &counters_);
-    if (PublishMessage(lcm_, channels::kOperatorInput, block)) counters_.Add("published");
+    if (transport::PublishMessage(lcm_, wire::channels::kOperatorInput, block)) counters_.Add("published");
     else counters_.Add("publish_failed");
     PublishState(block.frame, *in);
     publish_rate_.Tick(lcm_.NowUs());
@@ -440,17 +440,17 @@ int OperatorStation::Run(const std::string& stats_path, const std::string& ready
   }
   screen_.reset();  // the terminal back, the captured log written out
   source_->AddCounters(&counters_);
-  NoteTransportCounters(lcm_, &counters_);
+  transport::NoteTransportCounters(lcm_, &counters_);
   counters_.Set("frames.total", frames_);
   status.Final(builder_.next_frame() - 1, counters_);
-  if (!stats_path.empty()) WriteStatsJson(stats_path, "operator_station", counters_, {});
+  if (!stats_path.empty()) transport::WriteStatsJson(stats_path, "operator_station", counters_, {});
   spdlog::info("published {} input blocks ({} late, {} clamped inputs)", counters_.Get("published"),
                counters_.Get("frames.late"), counters_.SumPrefix("clamped."));
-  if (StopRequested()) {
+  if (transport::StopRequested()) {
     spdlog::info("stopped by a signal at frame {}", builder_.next_frame() - 1);
     return kExitInterrupted;
   }
   return source_->exit_code();
 }
 
-}  // namespace rms::op
+}  // namespace rms::operator_station

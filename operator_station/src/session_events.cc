@@ -1,10 +1,10 @@
-#include "session_events.h"
+#include "rms/operator_station/session_events.h"
 
 #include <spdlog/spdlog.h>
 
-#include "rms/collision_bits.h"
+#include "rms/wire/collision_bits.h"
 
-namespace rms::op {
+namespace rms::operator_station {
 
 void TelemetryEvents::Observe(const dcp_telemetry_t& t) {
   if (!last_) {
@@ -34,10 +34,10 @@ void TelemetryEvents::Observe(const dcp_telemetry_t& t) {
     event(fmt::format("DOCKED: distance {:.3f} ft, angle {:.2f} deg", t.dock_distance_ft, t.dock_angle_deg));
   }
   const auto now = static_cast<std::uint32_t>(t.collisions), before = static_cast<std::uint32_t>(p.collisions);
-  for (int b = 0; b < collision_bits::kCount; ++b) {
+  for (int b = 0; b < wire::collision_bits::kCount; ++b) {
     const std::uint32_t bit = 1u << b;
-    if ((now & bit) && !(before & bit)) event(fmt::format("COLLISION {} begins", CollisionName(b)));
-    if (!(now & bit) && (before & bit)) event(fmt::format("collision {} ends", CollisionName(b)));
+    if ((now & bit) && !(before & bit)) event(fmt::format("COLLISION {} begins", wire::CollisionName(b)));
+    if (!(now & bit) && (before & bit)) event(fmt::format("collision {} ends", wire::CollisionName(b)));
   }
   if (t.held && !p.held) event("HELD: the DCP holds the arm (the command collides): move away from the contact");
   if (!t.held && p.held) event("the arm follows again");
@@ -45,4 +45,4 @@ void TelemetryEvents::Observe(const dcp_telemetry_t& t) {
   last_ = t;
 }
 
-}  // namespace rms::op
+}  // namespace rms::operator_station

@@ -1,4 +1,4 @@
-#include "status_screen.h"
+#include "rms/operator_station/status_screen.h"
 
 #include <spdlog/sinks/base_sink.h>
 #include <spdlog/spdlog.h>
@@ -11,11 +11,11 @@
 #include <mutex>
 #include <sstream>
 
-#include "rms/acquisition_conditions.h"
-#include "rms/collision_bits.h"
-#include "rms/text.h"
+#include "rms/wire/acquisition_conditions.h"
+#include "rms/wire/collision_bits.h"
+#include "rms/base/text.h"
 
-namespace rms::op {
+namespace rms::operator_station {
 
 namespace {
 
@@ -155,8 +155,8 @@ void ModeLines(const StatusSnapshot& s, Flow& flow) {
 void CollisionLines(const StatusSnapshot& s, Flow& flow) {
   const dcp_telemetry_t& t = *s.telemetry;
   std::string coll;
-  for (int b = 0; b < collision_bits::kCount; ++b) {
-    if (t.collisions & (1 << b)) coll += std::string(coll.empty() ? "" : ", ") + CollisionName(b);
+  for (int b = 0; b < wire::collision_bits::kCount; ++b) {
+    if (t.collisions & (1 << b)) coll += std::string(coll.empty() ? "" : ", ") + wire::CollisionName(b);
   }
   flow.Line("collisions: " + (coll.empty() ? std::string("none") : coll));
 }
@@ -167,10 +167,10 @@ void ConditionLines(const StatusSnapshot& s, const LabConfig& config, int width,
     flow.Line("ACQUISITION (each condition's margin):");
     // Two a line, named in full on a wide screen; three, by tag, on a narrow one.
     const bool wide = width >= 110;
-    for (int i = 0; i < kNumAcquisitionConditions; ++i) {
+    for (int i = 0; i < wire::kNumAcquisitionConditions; ++i) {
       if (i % (wide ? 2 : 3) == 0) flow.Line(" ");
       flow.Field(Sprintf(wide ? "[%c] %d %-24s %-20s" : "[%c] %d %s: %s", t.acquisition_conditions[i] ? 'x' : ' ', i + 1,
-                         wide ? kAcquisitionConditionNames[i].brief : kAcquisitionConditionNames[i].tag,
+                         wide ? wire::kAcquisitionConditionNames[i].brief : wire::kAcquisitionConditionNames[i].tag,
                          Margin(t.acquisition_margin_ft[i]).c_str()));
     }
     flow.Line(Sprintf("  finger gap %.3f ft (D3Y %.3f)", t.finger_gap_ft, config.dcp.d3y_ft))
@@ -251,7 +251,7 @@ std::string RenderStatusScreen(const StatusSnapshot& s, const LabConfig& config,
     Flow flow = section(1);
     ConditionLines(s, config, width, flow);
   }
-  const OperatorInputs& in = s.inputs;
+  const wire::OperatorInputs& in = s.inputs;
   {
     Flow flow = section(2);
     const int st = in.camera_station;
@@ -425,4 +425,4 @@ void StatusScreen::Draw(StatusSnapshot s) {
   std::fflush(stdout);
 }
 
-}  // namespace rms::op
+}  // namespace rms::operator_station

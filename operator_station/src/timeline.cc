@@ -1,4 +1,4 @@
-#include "timeline.h"
+#include "rms/operator_station/timeline.h"
 
 #include <algorithm>
 #include <charconv>
@@ -6,9 +6,9 @@
 #include <fstream>
 #include <sstream>
 
-#include "rms/check.h"
+#include "rms/base/check.h"
 
-namespace rms::op {
+namespace rms::operator_station {
 
 namespace {
 
@@ -45,7 +45,7 @@ std::string KnownKeys() {
 Timeline Timeline::Parse(std::string_view text, const std::string& source,
                          const InputCalibrations& cal) {
   Timeline tl;
-  tl.initial_ = InitialInputs(cal);
+  tl.initial_ = wire::InitialInputs(cal);
   double prev_t = 0.0;
   bool have_end = false;
   int line_no = 0;
@@ -137,8 +137,8 @@ Timeline Timeline::Load(const std::string& path, const InputCalibrations& cal) {
   return Parse(ss.str(), path, cal);
 }
 
-OperatorInputs Timeline::Sample(double t) const {
-  OperatorInputs in = initial_;
+wire::OperatorInputs Timeline::Sample(double t) const {
+  wire::OperatorInputs in = initial_;
   for (int i = 0; i < kNumAnalogInputs; ++i) {
     const auto& keys = analog_[i];
     RMS_DASSERT(!keys.empty());
@@ -175,4 +175,4 @@ bool Timeline::ResetIn(double t0, double t1) const {
   return false;
 }
 
-}  // namespace rms::op
+}  // namespace rms::operator_station

@@ -1,18 +1,18 @@
-#include "camera_stations.h"
+#include "rms/scene_proc/camera_stations.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "rms/check.h"
+#include "rms/base/check.h"
 
-namespace rms::scene {
+namespace rms::scene_proc {
 
-Eigen::Isometry3d MountPose(CameraMount mount, const ArmPose& arm, const CaeConfig& cae) {
+Eigen::Isometry3d MountPose(CameraMount mount, const arm::ArmPose& arm, const CaeConfig& cae) {
   switch (mount) {
     case CameraMount::kShuttle: return Eigen::Isometry3d::Identity();
     case CameraMount::kElbow: return arm.X_RF3;
     case CameraMount::kWrist: return arm.X_RS2;
-    case CameraMount::kCae: return MakeIsometry(cae.R_RC, cae.p_RoCo_R_ft);
+    case CameraMount::kCae: return arm::MakeIsometry(cae.R_RC, cae.p_RoCo_R_ft);
   }
   RMS_CHECK(false);
   return {};
@@ -41,7 +41,7 @@ void ClampPanTilt(const CameraStationConfig& cam, double* pan_deg, double* tilt_
 }
 
 CameraView ComputeCameraView(const LabConfig& config, int station, double pan_deg,
-                             double tilt_deg, double zoom, const ArmPose& arm,
+                             double tilt_deg, double zoom, const arm::ArmPose& arm,
                              Counters* counters) {
   RMS_CHECK(station >= 1 && station <= kNumCameraStations);
   const CameraStationConfig& cam = config.cameras[station - 1];
@@ -62,4 +62,4 @@ CameraView ComputeCameraView(const LabConfig& config, int station, double pan_de
   return v;
 }
 
-}  // namespace rms::scene
+}  // namespace rms::scene_proc

@@ -14,7 +14,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 BUILD = os.environ.get("RMSLAB_BUILD", os.path.join(ROOT, "build"))
 DEFAULT_URL = "udpm://239.255.76.67:7667?ttl=0"
 DEFAULT_REPLAY_URL = "udpm://239.255.76.67:7669?ttl=0"
-MAX_SPEED = 100.0  # common/rms/process.h kMaxSessionSpeed: the frame checks allow no faster
+MAX_SPEED = 100.0  # transport/include/rms/transport/process.h kMaxSessionSpeed: the frame checks allow no faster
 
 
 class LabError(Exception):

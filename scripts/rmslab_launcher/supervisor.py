@@ -6,7 +6,7 @@ signal to the launcher's terminal does not reach it and it is stopped as a
 group. Nothing outlives the launcher, even when it is killed with SIGKILL:
 - each process's standard input is a pipe whose other end only the launcher
   holds (its "lifeline"): rmslab's processes stop when it closes
-  (RMSLAB_LIFELINE=stdin, common/rms/process.h WatchLifeline);
+  (RMSLAB_LIFELINE=stdin, transport/include/rms/transport/process.h WatchLifeline);
 - each gets the parent-death signal SIGTERM (prctl), for lcm-logger and
   ffmpeg's parent;
 - a reaper, a small process of its own session started first, holds a

@@ -73,8 +73,8 @@ def export(argv):
 
 def export_mcap(session, out):
     """The log as JSON lines (rms_session export --jsonl) into the MCAP
-    writer (tools/rms_mcap/write_mcap.mjs, @mcap/core from npm)."""
-    mcap = os.path.join(ROOT, "tools", "rms_mcap")
+    writer (tools/mcap/write_mcap.mjs, @mcap/core from npm)."""
+    mcap = os.path.join(ROOT, "tools", "mcap")
     folder = os.path.dirname(os.path.abspath(out))
     if not os.path.isdir(folder) or not os.access(folder, os.W_OK):
         raise LabError(f"--out {out}: cannot write there (its folder {folder} is missing or not writable)", 2)

@@ -11,15 +11,15 @@
 #include <lcm/lcm-cpp.hpp>
 #include <nlohmann/json.hpp>
 
-#include "mission_plan.h"
-#include "rms/arm_ik.h"
-#include "rms/channels.h"
-#include "rms/config.h"
-#include "rms/control_word.h"
+#include "rms/mission/mission_plan.h"
+#include "rms/mission/arm_ik.h"
+#include "rms/wire/channels.h"
+#include "rms/base/config.h"
+#include "rms/wire/control_word.h"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
-#include "rms/message_io.h"
-#include "rms/scene_model.h"
+#include "rms/wire/message_io.h"
+#include "rms/scene_model/scene_model.h"
 #include "subprocess.h"
 
 namespace rms {
@@ -57,13 +57,13 @@ Session RunLab(const std::string& timeline, double speed, const std::string& tag
   s.summary = nlohmann::json::parse(testing::ReadFile(s.dir + "/summary.json"));
   lcm::LogFile f(s.dir + "/lcmlog", "r");
   while (const lcm::LogEvent* ev = f.readNextEvent()) {
-    if (ev->channel == channels::kDcpTelemetry) {
+    if (ev->channel == wire::channels::kDcpTelemetry) {
       dcp_telemetry_t m;
-      EXPECT_EQ(SafeDecode(ev->data, ev->datalen, 4096, &m), DecodeError::kNone);
+      EXPECT_EQ(wire::SafeDecode(ev->data, ev->datalen, 4096, &m), wire::DecodeError::kNone);
       s.telemetry.push_back(m);
-    } else if (ev->channel == channels::kDcpFrame) {
+    } else if (ev->channel == wire::channels::kDcpFrame) {
       dcp_frame_t m;
-      EXPECT_EQ(SafeDecode(ev->data, ev->datalen, 4096, &m), DecodeError::kNone);
+      EXPECT_EQ(wire::SafeDecode(ev->data, ev->datalen, 4096, &m), wire::DecodeError::kNone);
       s.dcp_frames.push_back(m);
     }
   }
@@ -88,7 +88,7 @@ TEST(DcpSession, TheMissionAcquiresExtractsAndDocks) {
   EXPECT_EQ(s.summary["held_frames"], 0);  // the planned path never collides
   // The ESG's control words carry it too: the last DCP frames say Mode 3, docked.
   ASSERT_FALSE(s.dcp_frames.empty());
-  const ControlWord last = UnpackControlWord(s.dcp_frames.back().control_word);
+  const wire::ControlWord last = wire::UnpackControlWord(s.dcp_frames.back().control_word);
   EXPECT_EQ(last.mode, 3);
   EXPECT_TRUE(last.docked);
   EXPECT_TRUE(last.acquired);
@@ -110,7 +110,7 @@ TEST(DcpSession, ACollisionHoldsThenReleasesAndResetReturnsToMode1) {
   };
   std::vector<mission::Keyframe> keys;
   auto key = [&](double t, const Eigen::Isometry3d& X, double finger, const std::string& note) {
-    const auto s = SolveArmIk(config.arm, X, g.shoulder_height_ft);
+    const auto s = mission::SolveArmIk(config.arm, X, g.shoulder_height_ft);
     ASSERT_TRUE(s.has_value()) << note;
     keys.push_back({t, s->angles_deg, g.shoulder_height_ft, finger, t == 0 ? 8 : 0, note, ""});
   };
@@ -156,7 +156,7 @@ TEST(DcpSession, ACollisionHoldsThenReleasesAndResetReturnsToMode1) {
       // Never below the body's top: the fingers' tips stay above it.
       const double tip = s.telemetry[i].p_RoA_R_ft[2] - config.end_effector.palm_length_ft -
                          config.end_effector.finger_length_ft;
-      EXPECT_GT(tip, config.payload.p_RoPo_R_ft.z() + PayloadTopFlat_P(config.payload));  // the 16-gon's top flat
+      EXPECT_GT(tip, config.payload.p_RoPo_R_ft.z() + scene_model::PayloadTopFlat_P(config.payload));  // the 16-gon's top flat
     }
   }
   ASSERT_GT(held, 10);

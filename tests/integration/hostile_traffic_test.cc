@@ -17,13 +17,13 @@
 #include <thread>
 
 #include "lab_processes.h"
-#include "rms/channels.h"
+#include "rms/wire/channels.h"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/esg_frame_t.hpp"
-#include "rms/input_block.h"
-#include "rms/lcm_interface.h"
-#include "rms/message_io.h"
+#include "rms/wire/input_block.h"
+#include "rms/transport/lcm_interface.h"
+#include "rms/wire/message_io.h"
 #include "rms/operator_input_t.hpp"
 #include "rms/process_status_t.hpp"
 #include "rms/session_control_t.hpp"
@@ -42,31 +42,31 @@ nlohmann::json Counters(const std::string& path) {
 std::int64_t Get(const nlohmann::json& c, const std::string& k) { return c.value(k, std::int64_t{0}); }
 
 struct Attacker {
-  UdpLcm* lcm = nullptr;
+  transport::UdpLcm* lcm = nullptr;
   std::mt19937_64 rng{19721122};
   std::atomic<long> sent{0};
   std::optional<dcp_frame_t> seen_dcp;
   std::optional<esg_frame_t> seen_esg;
   void Listen() {
-    lcm->Subscribe(channels::kDcpFrame, [this](const void* d, int n, std::int64_t) {
+    lcm->Subscribe(wire::channels::kDcpFrame, [this](const void* d, int n, std::int64_t) {
       dcp_frame_t m;
-      if (SafeDecode(d, n, 4096, &m) == DecodeError::kNone && m.frame > 0) seen_dcp = m;
+      if (wire::SafeDecode(d, n, 4096, &m) == wire::DecodeError::kNone && m.frame > 0) seen_dcp = m;
     });
-    lcm->Subscribe(channels::kEsgFrame, [this](const void* d, int n, std::int64_t) {
+    lcm->Subscribe(wire::channels::kEsgFrame, [this](const void* d, int n, std::int64_t) {
       esg_frame_t m;
-      if (SafeDecode(d, n, 4096, &m) == DecodeError::kNone && m.frame > 0) seen_esg = m;
+      if (wire::SafeDecode(d, n, 4096, &m) == wire::DecodeError::kNone && m.frame > 0) seen_esg = m;
     });
   }
 
   template <class Msg>
   void Send(const char* channel, const Msg& m) {
-    const auto bytes = EncodeMessage(m);
+    const auto bytes = wire::EncodeMessage(m);
     lcm->Publish(channel, bytes.data(), static_cast<int>(bytes.size()));
     ++sent;
   }
   template <class Msg>
   void SendTruncated(const char* channel, const Msg& m) {
-    const auto bytes = EncodeMessage(m);
+    const auto bytes = wire::EncodeMessage(m);
     lcm->Publish(channel, bytes.data(), static_cast<int>(bytes.size() / 2));
     ++sent;
   }
@@ -78,19 +78,19 @@ struct Attacker {
   static operator_input_t Input(std::int64_t frame) {
     operator_input_t m{};
     m.frame = frame;
-    m.send_time_us = WallTimeUs();
+    m.send_time_us = transport::WallTimeUs();
     return m;
   }
   static dcp_frame_t Dcp(std::int64_t frame) {
     dcp_frame_t m{};
     m.frame = frame;
-    m.send_time_us = m.input_send_time_us = WallTimeUs();
+    m.send_time_us = m.input_send_time_us = transport::WallTimeUs();
     return m;
   }
   static esg_frame_t Esg(std::int64_t frame) {
     esg_frame_t m{};
     m.frame = frame;
-    m.send_time_us = m.input_send_time_us = WallTimeUs();
+    m.send_time_us = m.input_send_time_us = transport::WallTimeUs();
     m.num_words = 10;
     m.words.assign(10, 0);
     return m;
@@ -98,7 +98,7 @@ struct Attacker {
   static dcp_telemetry_t Telemetry(std::int64_t frame) {
     dcp_telemetry_t m{};
     m.frame = frame;
-    m.send_time_us = m.input_send_time_us = WallTimeUs();
+    m.send_time_us = m.input_send_time_us = transport::WallTimeUs();
     m.mode = 1;
     for (int i = 0; i < 9; i += 4) m.R_RS2[i] = m.R_RP[i] = 1;
     return m;
@@ -106,7 +106,7 @@ struct Attacker {
 
   // One round of every kind on every channel.
   void Round() {
-    using namespace channels;
+    using namespace wire::channels;
     // Wrong type: a well-formed message of another type on each channel.
     Send(kOperatorInput, Esg(1));
     Send(kDcpFrame, Input(1));
@@ -144,7 +144,7 @@ struct Attacker {
     t.mode = 7;
     Send(kDcpTelemetry, t);
     operator_input_t r = Input(0);
-    r.words[kInputWords - 1] = 0xFFFFE0;  // reserved discrete bits
+    r.words[wire::kInputWords - 1] = 0xFFFFE0;  // reserved discrete bits
     Send(kOperatorInput, r);
     esg_frame_t big = Esg(0);
     big.num_words = 200;
@@ -173,7 +173,7 @@ struct Attacker {
   }
 
   void Flood(int n) {
-    using namespace channels;
+    using namespace wire::channels;
     const char* chs[] = {kOperatorInput, kDcpFrame, kEsgFrame, kDcpTelemetry, kStatus, kControl};
     for (int i = 0; i < n; ++i) {
       std::vector<std::uint8_t> junk(8 + rng() % 200);
@@ -192,11 +192,11 @@ TEST(HostileTraffic, EveryProcessCountsWhatItDroppedAndKeepsItsFrameRate) {
   std::string error;
   ASSERT_TRUE(lab.Start(&error)) << error;
 
-  LcmOptions o;
+  transport::LcmOptions o;
   o.url = url;
-  UdpLcm listen(o), attack_lcm(o);
+  transport::UdpLcm listen(o), attack_lcm(o);
   long esg_frames = 0;
-  listen.Subscribe(channels::kEsgFrame, [&](const void*, int, std::int64_t) { ++esg_frames; });
+  listen.Subscribe(wire::channels::kEsgFrame, [&](const void*, int, std::int64_t) { ++esg_frames; });
 
   Attacker attacker;
   attacker.lcm = &attack_lcm;

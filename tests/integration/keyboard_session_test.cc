@@ -14,12 +14,12 @@
 #include <nlohmann/json.hpp>
 
 #include "lab_processes.h"
-#include "rms/channels.h"
-#include "rms/control_word.h"
+#include "rms/wire/channels.h"
+#include "rms/wire/control_word.h"
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/esg_frame_t.hpp"
-#include "rms/lcm_interface.h"
-#include "rms/message_io.h"
+#include "rms/transport/lcm_interface.h"
+#include "rms/wire/message_io.h"
 #include "rms/operator_state_t.hpp"
 #include "subprocess.h"
 #include "tmux.h"
@@ -35,24 +35,24 @@ TEST(KeyboardSession, APressIsOneIncrementAndTheScreenShowsGuidance) {
   testing::LabProcesses lab(dir, testing::UniqueLcmUrl(8900));
   std::string error;
   ASSERT_TRUE(lab.Start(&error)) << error;
-  LcmOptions o;
+  transport::LcmOptions o;
   o.url = lab.url();
-  UdpLcm lcm(o);
+  transport::UdpLcm lcm(o);
   std::optional<dcp_telemetry_t> tm;
   std::optional<operator_state_t> state;
   int camera_in_esg = 0;
-  lcm.Subscribe(channels::kDcpTelemetry, [&](const void* d, int n, std::int64_t) {
+  lcm.Subscribe(wire::channels::kDcpTelemetry, [&](const void* d, int n, std::int64_t) {
     dcp_telemetry_t m;
-    if (SafeDecode(d, n, 4096, &m) == DecodeError::kNone) tm = m;
+    if (wire::SafeDecode(d, n, 4096, &m) == wire::DecodeError::kNone) tm = m;
   });
-  lcm.Subscribe(channels::kOperatorState, [&](const void* d, int n, std::int64_t) {
+  lcm.Subscribe(wire::channels::kOperatorState, [&](const void* d, int n, std::int64_t) {
     operator_state_t m;
-    if (SafeDecode(d, n, 8192, &m) == DecodeError::kNone) state = m;
+    if (wire::SafeDecode(d, n, 8192, &m) == wire::DecodeError::kNone) state = m;
   });
-  lcm.Subscribe(channels::kEsgFrame, [&](const void* d, int n, std::int64_t) {
+  lcm.Subscribe(wire::channels::kEsgFrame, [&](const void* d, int n, std::int64_t) {
     esg_frame_t m;
-    if (SafeDecode(d, n, 4096, &m) == DecodeError::kNone && m.num_words > 1) {
-      camera_in_esg = UnpackControlWord(m.words[1]).camera_station;
+    if (wire::SafeDecode(d, n, 4096, &m) == wire::DecodeError::kNone && m.num_words > 1) {
+      camera_in_esg = wire::UnpackControlWord(m.words[1]).camera_station;
     }
   });
   auto pump = [&](double seconds) {

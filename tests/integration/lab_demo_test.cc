@@ -8,10 +8,10 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
-#include "rms/channels.h"
+#include "rms/wire/channels.h"
 #include "rms/esg_frame_t.hpp"
-#include "rms/lcm_interface.h"
-#include "rms/message_io.h"
+#include "rms/transport/lcm_interface.h"
+#include "rms/wire/message_io.h"
 #include "subprocess.h"
 
 namespace rms {
@@ -59,10 +59,10 @@ TEST(LabDemo, TheSessionFolderHoldsLogVideoFramesProcessLogsAndSummary) {
     ASSERT_TRUE(log.good());
     while (const lcm::LogEvent* ev = log.readNextEvent()) ++by_channel[ev->channel];
   }
-  EXPECT_GE(by_channel[channels::kOperatorInput], 85);
-  EXPECT_GE(by_channel[channels::kDcpFrame], 85);
-  EXPECT_GE(by_channel[channels::kEsgFrame], 85);
-  EXPECT_GE(by_channel[channels::kStatus], 4);  // at least every process's final report
+  EXPECT_GE(by_channel[wire::channels::kOperatorInput], 85);
+  EXPECT_GE(by_channel[wire::channels::kDcpFrame], 85);
+  EXPECT_GE(by_channel[wire::channels::kEsgFrame], 85);
+  EXPECT_GE(by_channel[wire::channels::kStatus], 4);  // at least every process's final report
 
   // summary.json
   const auto s = nlohmann::json::parse(testing::ReadFile(out + "/summary.json"));
@@ -74,26 +74,26 @@ TEST(LabDemo, TheSessionFolderHoldsLogVideoFramesProcessLogsAndSummary) {
   EXPECT_EQ(s["frames"]["video_dropped"], 0);
   EXPECT_EQ(s["frames"]["scenes_drawn"].get<int>() + s["frames"]["skipped_unchanged"].get<int>(),
             s["frames"]["rendered"].get<int>());
-  EXPECT_EQ(s["log"]["esg_frames"], by_channel[channels::kEsgFrame]);
+  EXPECT_EQ(s["log"]["esg_frames"], by_channel[wire::channels::kEsgFrame]);
   EXPECT_TRUE(s["frames"]["dropped"].contains("scene_to_esg"));
   EXPECT_TRUE(s["latency"].contains("input_to_render"));
   EXPECT_EQ(s["log"]["final_status_from"].size(), 4u);
 
   // lcm-logplayer plays the log: a listener on another port receives the ESG frames.
   const std::string play_url = testing::UniqueLcmUrl(8100);
-  LcmOptions o;
+  transport::LcmOptions o;
   o.url = play_url;
-  UdpLcm lcm(o);
+  transport::UdpLcm lcm(o);
   int esg_frames = 0;
-  lcm.Subscribe(channels::kEsgFrame, [&](const void* d, int n, std::int64_t) {
+  lcm.Subscribe(wire::channels::kEsgFrame, [&](const void* d, int n, std::int64_t) {
     esg_frame_t m;
-    esg_frames += SafeDecode(d, n, 400, &m) == DecodeError::kNone;
+    esg_frames += wire::SafeDecode(d, n, 400, &m) == wire::DecodeError::kNone;
   });
   Subprocess player({"/usr/bin/lcm-logplayer", "-s", "10", "-l", play_url, out + "/lcmlog"}, tmp + "/player.log");
   while (player.Running()) lcm.HandleSubscriptions(20);
   for (int i = 0; i < 10; ++i) lcm.HandleSubscriptions(20);
   EXPECT_EQ(player.Wait(1), 0) << testing::ReadFile(tmp + "/player.log");
-  EXPECT_GE(esg_frames, by_channel[channels::kEsgFrame] - 2);
+  EXPECT_GE(esg_frames, by_channel[wire::channels::kEsgFrame] - 2);
   fs::remove_all(tmp);
 }
 

@@ -17,13 +17,13 @@
 #include <regex>
 
 #include "lab_processes.h"
-#include "rms/channels.h"
-#include "rms/config.h"
+#include "rms/wire/channels.h"
+#include "rms/base/config.h"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/esg_frame_t.hpp"
-#include "rms/lcm_interface.h"
-#include "rms/message_io.h"
+#include "rms/transport/lcm_interface.h"
+#include "rms/wire/message_io.h"
 #include "subprocess.h"
 
 namespace rms {
@@ -214,27 +214,27 @@ TEST_F(RecordedSession, ItsReportOpensInABrowserWithPlots) {
 // A short timeline run live (3 s), listening on LCM.
 struct Listener {
   explicit Listener(const std::string& url) {
-    LcmOptions o;
+    transport::LcmOptions o;
     o.url = url;
-    lcm = std::make_unique<UdpLcm>(o);
-    lcm->Subscribe(channels::kDcpFrame, [this](const void* d, int n, std::int64_t) {
+    lcm = std::make_unique<transport::UdpLcm>(o);
+    lcm->Subscribe(wire::channels::kDcpFrame, [this](const void* d, int n, std::int64_t) {
       dcp_frame_t m;
-      if (SafeDecode(d, n, 4096, &m) == DecodeError::kNone) dcp.push_back(m);
+      if (wire::SafeDecode(d, n, 4096, &m) == wire::DecodeError::kNone) dcp.push_back(m);
     });
-    lcm->Subscribe(channels::kEsgFrame, [this](const void* d, int n, std::int64_t) {
+    lcm->Subscribe(wire::channels::kEsgFrame, [this](const void* d, int n, std::int64_t) {
       esg_frame_t m;
-      if (SafeDecode(d, n, 4096, &m) == DecodeError::kNone) esg.push_back(m.frame);
+      if (wire::SafeDecode(d, n, 4096, &m) == wire::DecodeError::kNone) esg.push_back(m.frame);
     });
-    lcm->Subscribe(channels::kDcpTelemetry, [this](const void* d, int n, std::int64_t) {
+    lcm->Subscribe(wire::channels::kDcpTelemetry, [this](const void* d, int n, std::int64_t) {
       dcp_telemetry_t m{};
-      if (SafeDecode(d, n, 4096, &m) == DecodeError::kNone) telemetry = m;
+      if (wire::SafeDecode(d, n, 4096, &m) == wire::DecodeError::kNone) telemetry = m;
     });
   }
   void Pump(double seconds) {
     const std::int64_t until = lcm->NowUs() + static_cast<std::int64_t>(seconds * 1e6);
     while (lcm->NowUs() < until) lcm->HandleSubscriptions(20);
   }
-  std::unique_ptr<UdpLcm> lcm;
+  std::unique_ptr<transport::UdpLcm> lcm;
   std::vector<dcp_frame_t> dcp;
   std::vector<std::int64_t> esg;
   std::optional<dcp_telemetry_t> telemetry;

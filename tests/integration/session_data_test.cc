@@ -315,8 +315,8 @@ TEST_F(HandFlownSession, ItsMcapExportHoldsEveryMessageAndEachMatchesItsSchema) 
                              *tmp_ + "/mcap.log", 120);
   ASSERT_EQ(r.rc, 0) << r.out;
   // Read back with the MCAP library, every message validated against its
-  // channel's JSON schema (tools/rms_mcap/check_mcap.mjs: @mcap/core, ajv).
-  Subprocess check({"/usr/bin/node", SourcePath("tools/rms_mcap/check_mcap.mjs"), mcap}, *tmp_ + "/mcap_check.log");
+  // channel's JSON schema (tools/mcap/check_mcap.mjs: @mcap/core, ajv).
+  Subprocess check({"/usr/bin/node", SourcePath("tools/mcap/check_mcap.mjs"), mcap}, *tmp_ + "/mcap_check.log");
   ASSERT_EQ(check.Wait(120), 0) << ReadFile(*tmp_ + "/mcap_check.log");
   const std::string out = ReadFile(*tmp_ + "/mcap_check.log");
   const auto j = nlohmann::json::parse(out.substr(out.find('{'), out.rfind('}') - out.find('{') + 1));

@@ -23,12 +23,13 @@
 #include <thread>
 
 #include "live_session.h"
-#include "rms/channels.h"
-#include "rms/control_word.h"
+#include "session_files.h"
+#include "rms/wire/channels.h"
+#include "rms/wire/control_word.h"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
-#include "rms/lcm_interface.h"
-#include "rms/message_io.h"
+#include "rms/transport/lcm_interface.h"
+#include "rms/wire/message_io.h"
 #include "rms/operator_input_t.hpp"
 #include "rms/process_status_t.hpp"
 #include "rms/sender_t.hpp"
@@ -43,19 +44,9 @@ using testing::LiveSession;
 using testing::ReadFile;
 using testing::Script;
 using testing::SourcePath;
+using testing::Counter;
+using testing::ReadJson;
 
-nlohmann::json ReadJson(const std::string& path) {
-  std::ifstream f(path);
-  if (!f) return nlohmann::json::object();
-  try {
-    return nlohmann::json::parse(f);
-  } catch (const std::exception&) {
-    return nlohmann::json::object();
-  }
-}
-std::int64_t Counter(const std::string& session, const std::string& process, const std::string& name) {
-  return ReadJson(session + "/stats/" + process + ".json").value("counters", nlohmann::json::object()).value(name, 0L);
-}
 std::int64_t Reason(const nlohmann::json& summary, const std::string& reason) {
   return summary["ignored"]["by_reason"].value(reason, 0L);
 }
@@ -71,10 +62,10 @@ void Sleep(double s) { std::this_thread::sleep_for(std::chrono::duration<double>
 // takes all) and publishes whatever it likes, with whatever sender.
 class Peer {
  public:
-  explicit Peer(const std::string& url) : lcm_(LcmOptions{url, "", 1000}) {
-    lcm_.Subscribe(channels::kDcpFrame, [this](const void* d, int n, std::int64_t) {
+  explicit Peer(const std::string& url) : lcm_(transport::LcmOptions{url, "", 1000}) {
+    lcm_.Subscribe(wire::channels::kDcpFrame, [this](const void* d, int n, std::int64_t) {
       dcp_frame_t m;
-      if (SafeDecode(d, n, 1024, &m) == DecodeError::kNone && m.frame > dcp_frame_) {
+      if (wire::SafeDecode(d, n, 1024, &m) == wire::DecodeError::kNone && m.frame > dcp_frame_) {
         dcp_frame_ = m.frame;
         last_dcp_ = m;
       }
@@ -88,38 +79,38 @@ class Peer {
   }
   const dcp_frame_t& last_dcp() const { return last_dcp_; }
   template <class Msg>
-  void Send(const char* channel, Msg m, const Sender& as) {
+  void Send(const char* channel, Msg m, const transport::Sender& as) {
     m.sender.session_id = as.session_id;
     m.sender.process = as.process;
     m.sender.pid = as.pid;
-    const auto bytes = EncodeMessage(m);
+    const auto bytes = wire::EncodeMessage(m);
     ASSERT_FALSE(bytes.empty());
     lcm_.Publish(channel, bytes.data(), static_cast<int>(bytes.size()));
   }
-  void Control(std::int8_t command, const std::string& name, const Sender& as) {
+  void Control(std::int8_t command, const std::string& name, const transport::Sender& as) {
     session_control_t c{};
-    c.send_time_us = WallTimeUs();
+    c.send_time_us = transport::WallTimeUs();
     c.sequence = sequence_++;
     c.command = command;
     c.name = name;
-    Send(channels::kControl, c, as);
+    Send(wire::channels::kControl, c, as);
   }
   // Telemetry that says docked at 0.01 ft, its mode cycling (every message
   // a "mode change").
-  void ForgeTelemetry(std::int64_t frame, const Sender& as) {
+  void ForgeTelemetry(std::int64_t frame, const transport::Sender& as) {
     dcp_telemetry_t t{};
     t.frame = frame;
     t.input_frame = frame;
-    t.send_time_us = t.input_send_time_us = WallTimeUs();
+    t.send_time_us = t.input_send_time_us = transport::WallTimeUs();
     t.mode = static_cast<std::int8_t>(1 + frame % 3);
     t.acquired = t.docked = true;
     t.dock_distance_ft = 0.01;
     for (int i = 0; i < 9; i += 4) t.R_RS2[i] = t.R_RP[i] = 1;
-    Send(channels::kDcpTelemetry, t, as);
+    Send(wire::channels::kDcpTelemetry, t, as);
   }
-  void ForgeStatus(const std::string& process, int pid, const Sender& as) {
+  void ForgeStatus(const std::string& process, int pid, const transport::Sender& as) {
     process_status_t st{};
-    st.send_time_us = WallTimeUs();
+    st.send_time_us = transport::WallTimeUs();
     st.process = process;
     st.host = "forger";
     st.pid = pid;
@@ -127,11 +118,11 @@ class Peer {
     st.counter_names = {"published", "rendered", "received"};
     st.counter_values = {1000000000000, -999220, 1000000000000};
     st.num_counters = 3;
-    Send(channels::kStatus, st, as);
+    Send(wire::channels::kStatus, st, as);
   }
 
  private:
-  UdpLcm lcm_;
+  transport::UdpLcm lcm_;
   std::int64_t dcp_frame_ = 0;
   dcp_frame_t last_dcp_{};
   std::int64_t sequence_ = 0;
@@ -151,12 +142,12 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
   const int dcp_pid = s.pid("dynamics_proc"), op_pid = s.pid("operator_station");
   ASSERT_GT(dcp_pid, 0);
   ASSERT_GT(op_pid, 0);
-  std::printf("session %s, dynamics_proc pid %d, attacker's stranger id %s\n", FormatSessionId(id).c_str(), dcp_pid,
-              FormatSessionId(stranger_id).c_str());
+  std::printf("session %s, dynamics_proc pid %d, attacker's stranger id %s\n", wire::FormatSessionId(id).c_str(), dcp_pid,
+              wire::FormatSessionId(stranger_id).c_str());
   const std::string cps = s.out() + "/checkpoints";
   Peer peer(s.url());
-  const Sender stranger{stranger_id, sender_t::PROCESS_CONTROL, 4242};
-  const Sender insider{id, sender_t::PROCESS_CONTROL, static_cast<std::int32_t>(getpid())};
+  const transport::Sender stranger{stranger_id, sender_t::PROCESS_CONTROL, 4242};
+  const transport::Sender insider{id, sender_t::PROCESS_CONTROL, static_cast<std::int32_t>(getpid())};
 
   // A stranger's freeze is ignored: the DCP's frames go on.
   const std::int64_t before = peer.Listen(0.5);
@@ -201,9 +192,9 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
   // processes has, and as the DCP itself (its id and pid) for frames it has
   // already sent. A forged status with absurd counts, as the ESG.
   const std::int64_t now = peer.Listen(0.2);
-  const Sender as_stranger_dcp{stranger_id, sender_t::PROCESS_DYNAMICS, dcp_pid};
-  const Sender as_fake_pid{id, sender_t::PROCESS_DYNAMICS, 1};
-  const Sender as_dcp{id, sender_t::PROCESS_DYNAMICS, dcp_pid};
+  const transport::Sender as_stranger_dcp{stranger_id, sender_t::PROCESS_DYNAMICS, dcp_pid};
+  const transport::Sender as_fake_pid{id, sender_t::PROCESS_DYNAMICS, 1};
+  const transport::Sender as_dcp{id, sender_t::PROCESS_DYNAMICS, dcp_pid};
   for (int i = 0; i < 90; ++i) {
     peer.ForgeTelemetry(now + 2 + i, as_stranger_dcp);
     peer.ForgeTelemetry(now + 2 + i, as_fake_pid);
@@ -216,30 +207,30 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
     dcp_frame_t d = peer.last_dcp();  // well-formed words, as the DCP sends them
     d.frame = std::max<std::int64_t>(1, now - 300) + i;
     d.input_frame = d.frame + 7;
-    d.send_time_us = d.input_send_time_us = WallTimeUs();
-    peer.Send(channels::kDcpFrame, d, as_dcp);
+    d.send_time_us = d.input_send_time_us = transport::WallTimeUs();
+    peer.Send(wire::channels::kDcpFrame, d, as_dcp);
     peer.Listen(0.003);
   }
   // A docked DCP frame and its telemetry far ahead (frame 500000), as the
   // DCP itself: off the DCP's increasing run, neither believed.
   for (int i = 0; i < 3; ++i) {
     dcp_frame_t d = peer.last_dcp();
-    ControlWord w = UnpackControlWord(d.control_word);
+    wire::ControlWord w = wire::UnpackControlWord(d.control_word);
     w.mode = 3;
     w.acquired = w.docked = true;
-    d.control_word = static_cast<std::int32_t>(PackControlWord(w));
+    d.control_word = static_cast<std::int32_t>(wire::PackControlWord(w));
     d.frame = 500000 + i;
     d.input_frame = d.frame;
-    d.send_time_us = d.input_send_time_us = WallTimeUs();
-    peer.Send(channels::kDcpFrame, d, as_dcp);
+    d.send_time_us = d.input_send_time_us = transport::WallTimeUs();
+    peer.Send(wire::channels::kDcpFrame, d, as_dcp);
     dcp_telemetry_t t{};
     t.frame = t.input_frame = d.frame;
-    t.send_time_us = t.input_send_time_us = WallTimeUs();
+    t.send_time_us = t.input_send_time_us = transport::WallTimeUs();
     t.mode = 3;
     t.acquired = t.docked = true;
     t.dock_distance_ft = 0.01;
     for (int k = 0; k < 9; k += 4) t.R_RS2[k] = t.R_RP[k] = 1;
-    peer.Send(channels::kDcpTelemetry, t, as_dcp);
+    peer.Send(wire::channels::kDcpTelemetry, t, as_dcp);
     peer.Listen(0.003);
   }
   const int esg_pid = s.pid("esg_renderer");
@@ -250,8 +241,8 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
   // One operator input from the far future (2^47), as the station itself.
   operator_input_t far{};
   far.frame = std::int64_t{1} << 47;
-  far.send_time_us = WallTimeUs();
-  peer.Send(channels::kOperatorInput, far, {id, sender_t::PROCESS_OPERATOR_STATION, op_pid});
+  far.send_time_us = transport::WallTimeUs();
+  peer.Send(wire::channels::kOperatorInput, far, {id, sender_t::PROCESS_OPERATOR_STATION, op_pid});
 
   ASSERT_TRUE(testing::WaitForFile(cps + "/good.json", 10)) << "a valid checkpoint after the flood was not written";
   // rms_control says so when it cannot: an existing name.
@@ -294,7 +285,7 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
   // channel); the flood of control messages may cost the recorder a datagram.
   for (const auto& [ch, r] : sum["record"]["by_channel"].items()) EXPECT_LE(r["lost"].get<long>(), 2) << ch;
   bool listed = false;
-  for (const auto& o : sum["ignored"]["other_sessions"]) listed |= o.get<std::string>() == FormatSessionId(stranger_id);
+  for (const auto& o : sum["ignored"]["other_sessions"]) listed |= o.get<std::string>() == wire::FormatSessionId(stranger_id);
   EXPECT_TRUE(listed) << "the stranger's session is not listed";
   const auto& fr = sum["frames"];
   EXPECT_GE(fr["rendered"].get<long>(), 0);
@@ -321,7 +312,7 @@ TEST(SessionSecurity, ASecondSessionOnTheAddressIsRefusedOrWithShareNetworkBothD
                               tmp + "/b/lab.log", 60);
   EXPECT_NE(refused.rc, 0) << refused.out;
   EXPECT_NE(refused.out.find("another session is"), std::string::npos) << refused.out;
-  EXPECT_NE(refused.out.find(FormatSessionId(first.session_id())), std::string::npos) << refused.out;
+  EXPECT_NE(refused.out.find(wire::FormatSessionId(first.session_id())), std::string::npos) << refused.out;
   EXPECT_NE(refused.out.find("--channel-suffix"), std::string::npos) << refused.out;
   EXPECT_FALSE(fs::exists(tmp + "/b/session/lcmlog"));
 
@@ -337,7 +328,7 @@ TEST(SessionSecurity, ASecondSessionOnTheAddressIsRefusedOrWithShareNetworkBothD
                 sum["docking"].dump().c_str(), sum["ignored"].dump().c_str());
     EXPECT_TRUE(sum.value("docked", false));
     EXPECT_EQ(sum["mode_changes"].size(), 2u);
-    EXPECT_EQ(sum["session_id"].get<std::string>(), FormatSessionId(x->session_id()));
+    EXPECT_EQ(sum["session_id"].get<std::string>(), wire::FormatSessionId(x->session_id()));
     EXPECT_GT(Counter(x->out(), "dynamics_proc", "dropped.other_session"), 0);
   }
   // The second's traffic is in the first's record, and left out by its
@@ -525,63 +516,6 @@ TEST(SessionSecurity, ToolsExitNonZeroWhenTheirOutputCannotBeWritten) {
   const auto exp = Script({tool, "export", s.out(), "--out", tmp + "/csv"}, tmp + "/t2.log", 60);
   EXPECT_NE(exp.rc, 0) << exp.out;
   EXPECT_NE(exp.out.find("dcp_telemetry.csv"), std::string::npos) << exp.out;
-  fs::remove_all(tmp);
-}
-
-}  // namespace
-}  // namespace rms
-
-namespace rms {
-namespace {
-
-// Stalls (long label: scripts/test leaves it out; ctest -L long runs it):
-// each process and the recorder stopped (SIGSTOP) for 4 s in turn while
-// the autopilot flies. A stopped receiver wakes to frames that waited
-// beyond the link's delay and drops them, counted (dropped.late), instead
-// of acting on them in a burst; the recorder's gap is reported as a loss
-// of the record, per channel; the autopilot still docks.
-TEST(SessionStallsLong, EachProcessAndTheRecorderStoppedIsSurvivedAndReported) {
-  const std::string tmp = testing::MakeTempDir("stalls");
-  LiveSession s(tmp, testing::UniqueLcmUrl(8720));
-  ASSERT_TRUE(s.WaitRunning(60)) << ReadFile(s.log());
-  Sleep(2);
-  for (const char* p : {"dynamics_proc", "scene_proc", "esg_renderer", "lcm-logger", "operator_station"}) {
-    const int pid = s.pid(p);
-    ASSERT_GT(pid, 0) << p;
-    std::printf("SIGSTOP %s (pid %d) for 4 s\n", p, pid);
-    kill(pid, SIGSTOP);
-    Sleep(4);
-    kill(pid, SIGCONT);
-    Sleep(3);
-  }
-  ASSERT_EQ(s.Wait(300), 0) << ReadFile(s.log());
-  const std::string out = s.out();
-  const nlohmann::json sum = ReadJson(out + "/summary.json");
-  std::printf("refused %s\nrecord %s\n", sum["frames"]["refused"].dump().c_str(), sum["record"].dump().c_str());
-  EXPECT_TRUE(sum.value("docked", false));
-  // The DCP stopped 4 s: what waited for it was dropped, not run in a burst
-  // (a burst would overflow the receivers downstream: their gaps stay small).
-  EXPECT_GT(Counter(out, "dynamics_proc", "dropped.late"), 30);
-  EXPECT_GT(Counter(out, "scene_proc", "dropped.late"), 30);
-  EXPECT_GT(Counter(out, "esg_renderer", "dropped.late"), 30);
-  EXPECT_GT(sum["frames"]["refused"]["late"].get<long>(), 90);
-  // The recorder stopped 4 s: the record's loss, per channel, said.
-  EXPECT_GT(sum["record"]["lost"].get<long>(), 0);
-  for (const char* ch : {"RMS_OPERATOR_INPUT", "RMS_DCP_FRAME"}) {
-    const auto& r = sum["record"]["by_channel"][ch];
-    EXPECT_EQ(r["published"].get<long>() - r["logged"].get<long>(), r["lost"].get<long>()) << ch;
-  }
-  const auto brief = Script({testing::BuildPath("tools/rms_session"), "summary", out, "--brief", "--out",
-                             tmp + "/summary.json"},
-                            tmp + "/brief.log", 60);
-  EXPECT_NE(brief.out.find("the record lost"), std::string::npos) << brief.out;
-  // ... and in the report, apart from the link's losses.
-  const auto report = Script({testing::BuildPath("tools/rms_report"), out, "--out", tmp + "/report.html"},
-                             tmp + "/report.log", 120);
-  ASSERT_EQ(report.rc, 0) << report.out;
-  const std::string html = ReadFile(tmp + "/report.html");
-  EXPECT_TRUE(std::regex_search(html, std::regex("lost by the record: RMS_DCP_FRAME \\(of [0-9]+ published\\)</td><td>[1-9]")))
-      << html.substr(html.find("<h2>Losses"), 1500);
   fs::remove_all(tmp);
 }
 

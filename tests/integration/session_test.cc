@@ -10,16 +10,16 @@
 #include <fstream>
 #include <map>
 
-#include "renderer.h"
-#include "png_io.h"
-#include "rms/arm_kinematics.h"
-#include "rms/channels.h"
+#include "rms/esg_renderer/renderer.h"
+#include "rms/esg_renderer/png_io.h"
+#include "rms/arm/kinematics.h"
+#include "rms/wire/channels.h"
 #include "pinhole.h"
-#include "rms/config.h"
+#include "rms/base/config.h"
 #include "rms/esg_frame_t.hpp"
-#include "rms/lcm_interface.h"
-#include "rms/message_io.h"
-#include "rms/word_blocks.h"
+#include "rms/transport/lcm_interface.h"
+#include "rms/wire/message_io.h"
+#include "rms/wire/word_blocks.h"
 #include "subprocess.h"
 
 namespace rms {
@@ -61,14 +61,14 @@ TEST_F(Session, FourProcessesOverLcmRenderTheArmWhereTheKinematicsPutIt) {
   }
 
   // This test listens to the ESG frames too, over the same real LCM.
-  LcmOptions o;
+  transport::LcmOptions o;
   o.url = url;
-  UdpLcm lcm(o);
+  transport::UdpLcm lcm(o);
   std::vector<esg_frame_t> frames;
   int malformed = 0;
-  lcm.Subscribe(channels::kEsgFrame, [&](const void* d, int n, std::int64_t) {
+  lcm.Subscribe(wire::channels::kEsgFrame, [&](const void* d, int n, std::int64_t) {
     esg_frame_t m;
-    if (SafeDecode(d, n, 400, &m) == DecodeError::kNone) {
+    if (wire::SafeDecode(d, n, 400, &m) == wire::DecodeError::kNone) {
       frames.push_back(std::move(m));
     } else {
       ++malformed;
@@ -91,7 +91,7 @@ TEST_F(Session, FourProcessesOverLcmRenderTheArmWhereTheKinematicsPutIt) {
   // in practice; allow a few rather than fail on a hiccup.
   EXPECT_EQ(malformed, 0);
   ASSERT_GE(frames.size(), 85u);
-  std::map<std::int64_t, EsgFrameData> by_frame;
+  std::map<std::int64_t, wire::EsgFrameData> by_frame;
   for (std::size_t i = 0; i < frames.size(); ++i) {
     const esg_frame_t& m = frames[i];
     if (i > 0) {
@@ -101,7 +101,7 @@ TEST_F(Session, FourProcessesOverLcmRenderTheArmWhereTheKinematicsPutIt) {
     ASSERT_LE(m.num_words, 64);
     ASSERT_EQ(static_cast<std::size_t>(m.num_words), m.words.size());
     for (std::int32_t w : m.words) ASSERT_EQ(static_cast<std::uint32_t>(w) >> 24, 0u);
-    by_frame[m.frame] = UnpackEsgWords(m.words);
+    by_frame[m.frame] = wire::UnpackEsgWords(m.words);
   }
 
   // Every PNG: the booms' midpoints, projected from the frame's own words,
@@ -113,21 +113,21 @@ TEST_F(Session, FourProcessesOverLcmRenderTheArmWhereTheKinematicsPutIt) {
     const std::int64_t frame = std::stoll(name.substr(6, 6));
     auto it = by_frame.find(frame);
     if (it == by_frame.end()) continue;  // this test missed that frame on the wire
-    const EsgFrameData& f = it->second;
-    const esg::Image img = esg::ReadPng(entry.path().string());
+    const wire::EsgFrameData& f = it->second;
+    const esg_renderer::Image img = esg_renderer::ReadPng(entry.path().string());
     ASSERT_EQ(img.width, kW);
     ASSERT_EQ(img.height, kH);
-    const ArmPose arm = ComputeArmPose(config.arm, f.arm, f.shoulder_height_ft);
-    for (const auto& [p, id] : {std::pair{0.5 * (arm.p_RoS_R + arm.p_RoE_R), kUpperBoom},
-                                std::pair{0.5 * (arm.p_RoE_R + arm.p_RoW_R), kLowerBoom}}) {
+    const arm::ArmPose arm = arm::ComputeArmPose(config.arm, f.arm, f.shoulder_height_ft);
+    for (const auto& [p, id] : {std::pair{0.5 * (arm.p_RoS_R + arm.p_RoE_R), scene_model::kUpperBoom},
+                                std::pair{0.5 * (arm.p_RoE_R + arm.p_RoW_R), scene_model::kLowerBoom}}) {
       int x = 0, y = 0;
       ASSERT_TRUE(Project(f, p, kW, kH, &x, &y)) << name;
       const std::uint8_t* px = img.at(x, y);
-      const Rgb want = esg::IdColor(id);
+      const scene_model::Rgb want = esg_renderer::IdColor(id);
       EXPECT_TRUE(px[0] == want[0] && px[1] == want[1] && px[2] == want[2])
-          << name << ": " << ClusterName(id) << " expected at (" << x << ", " << y << "), found rgb "
+          << name << ": " << scene_model::ClusterName(id) << " expected at (" << x << ", " << y << "), found rgb "
           << int(px[0]) << "," << int(px[1]) << "," << int(px[2]);
-      if (id == kLowerBoom) boom_pixels.emplace_back(x, y);
+      if (id == scene_model::kLowerBoom) boom_pixels.emplace_back(x, y);
     }
     ++checked;
   }

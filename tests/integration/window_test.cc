@@ -13,10 +13,10 @@
 #include <nlohmann/json.hpp>
 
 #include "lab_processes.h"
-#include "rms/channels.h"
+#include "rms/wire/channels.h"
 #include "rms/dcp_telemetry_t.hpp"
-#include "rms/lcm_interface.h"
-#include "rms/message_io.h"
+#include "rms/transport/lcm_interface.h"
+#include "rms/wire/message_io.h"
 #include "rms/operator_input_t.hpp"
 #include "rms/window_keys_t.hpp"
 #include "subprocess.h"
@@ -73,9 +73,9 @@ TEST(LiveWindow, OpensUnderXvfbAndShowsTheRenderedFrame) {
   lab.set_esg_env({"DISPLAY=" + x.display()});
   std::string error;
   ASSERT_TRUE(lab.Start(&error)) << error;
-  LcmOptions o;
+  transport::LcmOptions o;
   o.url = lab.url();
-  UdpLcm lcm(o);
+  transport::UdpLcm lcm(o);
   ASSERT_EQ(lab.Fly(lcm, testing::SourcePath("scripts/timelines/short.tl")), 0);
 
   // The window, by its title, read from the X server while it still shows
@@ -123,9 +123,9 @@ TEST(LiveWindow, AKeyHeldInTheWindowMovesTheArmAndItStopsWithinAFrameOfTheReleas
   lab.set_esg_env({"DISPLAY=" + x.display()});
   std::string error;
   ASSERT_TRUE(lab.Start(&error)) << error;
-  LcmOptions o;
+  transport::LcmOptions o;
   o.url = lab.url();
-  UdpLcm lcm(o);
+  transport::UdpLcm lcm(o);
   // What went out: each operator block's arm words (did the command move?)
   // and the window's key messages, in the order they were heard.
   struct Input {
@@ -137,24 +137,24 @@ TEST(LiveWindow, AKeyHeldInTheWindowMovesTheArmAndItStopsWithinAFrameOfTheReleas
   std::int64_t release_seen_at_input = -1, hold_seen_at_input = -1;
   std::int64_t latest_input = -1;
   std::optional<dcp_telemetry_t> tm;
-  lcm.Subscribe(channels::kOperatorInput, [&](const void* d, int n, std::int64_t) {
+  lcm.Subscribe(wire::channels::kOperatorInput, [&](const void* d, int n, std::int64_t) {
     operator_input_t m;
-    if (SafeDecode(d, n, 1024, &m) != DecodeError::kNone) return;
+    if (wire::SafeDecode(d, n, 1024, &m) != wire::DecodeError::kNone) return;
     const std::vector<std::int32_t> words(m.words, m.words + 6);
     inputs.push_back({m.frame, !last_words.empty() && words != last_words});
     last_words = words;
     latest_input = m.frame;
   });
-  lcm.Subscribe(channels::kWindowKeys, [&](const void* d, int n, std::int64_t) {
+  lcm.Subscribe(wire::channels::kWindowKeys, [&](const void* d, int n, std::int64_t) {
     window_keys_t m;
-    if (SafeDecode(d, n, 4096, &m) != DecodeError::kNone) return;
+    if (wire::SafeDecode(d, n, 4096, &m) != wire::DecodeError::kNone) return;
     const bool r_held = std::find(m.held.begin(), m.held.end(), 'r') != m.held.end();
     if (r_held && hold_seen_at_input < 0) hold_seen_at_input = latest_input;
     if (!r_held && hold_seen_at_input >= 0 && release_seen_at_input < 0) release_seen_at_input = latest_input;
   });
-  lcm.Subscribe(channels::kDcpTelemetry, [&](const void* d, int n, std::int64_t) {
+  lcm.Subscribe(wire::channels::kDcpTelemetry, [&](const void* d, int n, std::int64_t) {
     dcp_telemetry_t m;
-    if (SafeDecode(d, n, 4096, &m) == DecodeError::kNone) tm = m;
+    if (wire::SafeDecode(d, n, 4096, &m) == wire::DecodeError::kNone) tm = m;
   });
   auto pump = [&](double seconds) {
     const std::int64_t until = lcm.NowUs() + static_cast<std::int64_t>(seconds * 1e6);

@@ -5,13 +5,13 @@
 
 #include <Eigen/Geometry>
 
-#include "mission_plan.h"
-#include "rms/arm_ik.h"
-#include "rms/arm_kinematics.h"
-#include "rms/config.h"
-#include "rms/input_block.h"
+#include "rms/mission/mission_plan.h"
+#include "rms/mission/arm_ik.h"
+#include "rms/arm/kinematics.h"
+#include "rms/base/config.h"
+#include "rms/wire/input_block.h"
 
-namespace rms::dcp::testing {
+namespace rms::dynamics_proc::testing {
 
 class DcpFixture : public ::testing::Test {
  protected:
@@ -19,13 +19,13 @@ class DcpFixture : public ::testing::Test {
   mission::MissionGeometry geo = mission::PlanGeometry(config);
 
   // The payload in the bay (Mode 1).
-  Eigen::Isometry3d X_RP_bay() const { return MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft); }
+  Eigen::Isometry3d X_RP_bay() const { return arm::MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft); }
   // Inputs that put System Two at X_RS2 (inverse kinematics) with the finger
   // lever, at the mission's shoulder height unless one is given.
-  OperatorInputs Inputs(const Eigen::Isometry3d& X_RS2, double finger, double height = -1) const {
+  wire::OperatorInputs Inputs(const Eigen::Isometry3d& X_RS2, double finger, double height = -1) const {
     if (height < 0) height = geo.shoulder_height_ft;
-    OperatorInputs in = InitialInputs(config.inputs);
-    const auto s = SolveArmIk(config.arm, X_RS2, height);
+    wire::OperatorInputs in = wire::InitialInputs(config.inputs);
+    const auto s = mission::SolveArmIk(config.arm, X_RS2, height);
     EXPECT_TRUE(s.has_value());
     for (int i = 0; i < 6; ++i) in.value[i] = s->angles_deg[i];
     in.value[kShoulderHeight] = height;
@@ -38,4 +38,4 @@ class DcpFixture : public ::testing::Test {
   }
 };
 
-}  // namespace rms::dcp::testing
+}  // namespace rms::dynamics_proc::testing

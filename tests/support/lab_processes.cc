@@ -32,7 +32,7 @@ bool LabProcesses::Start(std::string* error) {
   return true;
 }
 
-int LabProcesses::Fly(UdpLcm& lcm, const std::string& timeline, const std::vector<std::string>& extra) {
+int LabProcesses::Fly(transport::UdpLcm& lcm, const std::string& timeline, const std::vector<std::string>& extra) {
   lcm.HandleSubscriptions(0);
   std::vector<std::string> argv = {BuildPath("operator_station/operator_station"), "--lcm-url", url_,
                                    "--timeline", timeline, "--stats", dir_ + "/operator_station.json"};

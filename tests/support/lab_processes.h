@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "rms/lcm_interface.h"
+#include "rms/transport/lcm_interface.h"
 #include "subprocess.h"
 
 namespace rms::testing {
@@ -24,7 +24,7 @@ class LabProcesses {
   bool Start(std::string* error);
   // Runs operator_station on `timeline` (extra args appended) to its end,
   // calling lcm.HandleSubscriptions all along; returns its exit code.
-  int Fly(UdpLcm& lcm, const std::string& timeline, const std::vector<std::string>& extra = {});
+  int Fly(transport::UdpLcm& lcm, const std::string& timeline, const std::vector<std::string>& extra = {});
   // SIGINT to the three; returns true when all exit 0 (logs in `error` if not).
   bool Stop(std::string* error);
 

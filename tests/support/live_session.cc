@@ -7,7 +7,7 @@
 #include <sstream>
 #include <thread>
 
-#include "rms/lcm_interface.h"
+#include "rms/transport/lcm_interface.h"
 
 namespace rms::testing {
 
@@ -34,7 +34,7 @@ bool LiveSession::WaitRunning(double timeout_s) {
 std::int64_t LiveSession::session_id() const {
   std::ifstream f(out_ + "/manifest.json");
   const auto j = nlohmann::json::parse(f);
-  return ParseSessionId(j.at("session_id").get<std::string>(), "manifest session_id");
+  return transport::ParseSessionId(j.at("session_id").get<std::string>(), "manifest session_id");
 }
 
 int LiveSession::pid(const std::string& process) const {

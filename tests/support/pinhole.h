@@ -6,13 +6,13 @@
 
 #include <Eigen/Core>
 
-#include "rms/word_blocks.h"
+#include "rms/wire/word_blocks.h"
 
 namespace rms::testing {
 
 // The pixel of point p_R for the frame's view in a w x h image; false when the
 // point is behind the eye (or within 1 ft of it) or outside the image.
-inline bool Project(const EsgFrameData& f, const Eigen::Vector3d& p_R, int w, int h, int* px, int* py) {
+inline bool Project(const wire::EsgFrameData& f, const Eigen::Vector3d& p_R, int w, int h, int* px, int* py) {
   const Eigen::Vector3d e = f.R_RE.transpose() * (p_R - f.p_RoEye_R_ft);
   if (e.x() < 1.0) return false;
   const double focal = 0.5 * h / std::tan(0.5 * f.fov_deg * M_PI / 180.0);

@@ -8,11 +8,11 @@
 #include <cstdio>
 #include <random>
 
-#include "arm_motion.h"
-#include "rms/arm_kinematics.h"
-#include "rms/config.h"
+#include "rms/operator_station/arm_motion.h"
+#include "rms/arm/kinematics.h"
+#include "rms/base/config.h"
 
-namespace rms::op {
+namespace rms::operator_station {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
@@ -155,4 +155,4 @@ TEST_F(ArmMotion, JointMovesArriveTogetherAtTheirRates) {
 }
 
 }  // namespace
-}  // namespace rms::op
+}  // namespace rms::operator_station

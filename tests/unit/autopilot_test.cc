@@ -7,17 +7,17 @@
 #include <cstdio>
 #include <random>
 
-#include "closed_loop.h"
-#include "rms/arm_kinematics.h"
-#include "rms/mission_geometry.h"
-#include "rms/config.h"
+#include "rms/sim/closed_loop.h"
+#include "rms/arm/kinematics.h"
+#include "rms/mission/mission_geometry.h"
+#include "rms/base/config.h"
 
 namespace rms {
 namespace {
 
 constexpr int kMaxFrames = 30 * 400;  // 400 s of session time
 
-void ExpectDocked(const offline::ClosedLoopResult& r, const LabConfig& c) {
+void ExpectDocked(const sim::ClosedLoopResult& r, const LabConfig& c) {
   EXPECT_TRUE(r.docked) << r.failure << " (mode " << int(r.last.mode) << ")";
   EXPECT_LE(r.dock_distance_ft, c.dcp.dock_distance_ft);
   EXPECT_LE(r.dock_angle_deg, c.dcp.dock_angle_deg);
@@ -27,7 +27,7 @@ void ExpectDocked(const offline::ClosedLoopResult& r, const LabConfig& c) {
 
 TEST(Autopilot, DocksFromTheDefaultState) {
   const LabConfig c = LoadConfig(DefaultConfigPath());
-  const auto r = offline::FlyAutopilot(c, {}, kMaxFrames);
+  const auto r = sim::FlyAutopilot(c, {}, kMaxFrames);
   ExpectDocked(r, c);
   std::printf("docked after %.1f s: distance %.4f ft, angle %.4f deg; modes 2 at %.1f s, 3 at %.1f s\n", r.time_s,
               r.dock_distance_ft, r.dock_angle_deg, r.modes_entered[2] / 30.0, r.modes_entered[3] / 30.0);
@@ -38,7 +38,7 @@ TEST(Autopilot, DocksFromTheDefaultState) {
 void OffsetPayload(LabConfig* c, const Eigen::Vector3d& d_ft, double yaw_deg) {
   c->payload.p_RoPo_R_ft += d_ft;
   const double a = yaw_deg * M_PI / 180.0;
-  c->payload.R_RP = RotZ({std::sin(a), std::cos(a)}) * c->payload.R_RP;
+  c->payload.R_RP = arm::RotZ({std::sin(a), std::cos(a)}) * c->payload.R_RP;
 }
 
 // Does the payload (body and probe) lie inside the cargo bay's walls?
@@ -64,7 +64,7 @@ TEST(Autopilot, DocksWithThePayloadElsewhereInTheBay) {
   LabConfig c = LoadConfig(DefaultConfigPath());
   OffsetPayload(&c, {6.0, -0.8, 0.0}, 4.0);
   ASSERT_TRUE(PayloadFitsTheBay(c));
-  ExpectDocked(offline::FlyAutopilot(c, {}, kMaxFrames), c);
+  ExpectDocked(sim::FlyAutopilot(c, {}, kMaxFrames), c);
 }
 
 TEST(Autopilot, DocksFromOtherShoulderHeights) {
@@ -72,21 +72,21 @@ TEST(Autopilot, DocksFromOtherShoulderHeights) {
     LabConfig c = LoadConfig(DefaultConfigPath());
     c.inputs[kShoulderHeight].initial = h;
     SCOPED_TRACE("shoulder height " + std::to_string(h));
-    ExpectDocked(offline::FlyAutopilot(c, {}, kMaxFrames), c);
+    ExpectDocked(sim::FlyAutopilot(c, {}, kMaxFrames), c);
   }
 }
 
 TEST(Autopilot, OpensAClosedFingerFirst) {
   LabConfig c = LoadConfig(DefaultConfigPath());
   c.inputs[kFinger].initial = 1.0;
-  ExpectDocked(offline::FlyAutopilot(c, {}, kMaxFrames), c);
+  ExpectDocked(sim::FlyAutopilot(c, {}, kMaxFrames), c);
 }
 
 TEST(Autopilot, DocksFromAnArmThatIsNotStowed) {
   LabConfig c = LoadConfig(DefaultConfigPath());
   const double q[6] = {40.0, 35.0, -50.0, -20.0, 10.0, 30.0};
   for (int i = 0; i < 6; ++i) c.inputs[i].initial = q[i];
-  ExpectDocked(offline::FlyAutopilot(c, {}, kMaxFrames), c);
+  ExpectDocked(sim::FlyAutopilot(c, {}, kMaxFrames), c);
 }
 
 TEST(Autopilot, DocksFromRandomPerturbations) {
@@ -108,7 +108,7 @@ TEST(Autopilot, DocksFromRandomPerturbations) {
     std::snprintf(what, sizeof what, "case %d: payload moved (%.2f, %.2f) ft, yaw %.1f deg; shoulder %.2f ft; finger %.2f",
                   k, d.x(), d.y(), yaw, h, finger);
     SCOPED_TRACE(what);
-    const auto r = offline::FlyAutopilot(c, {}, kMaxFrames);
+    const auto r = sim::FlyAutopilot(c, {}, kMaxFrames);
     ExpectDocked(r, c);
     std::printf("%s: %s after %.1f s (%.3f ft, %.3f deg)\n", what, r.docked ? "docked" : r.failure.c_str(), r.time_s,
                 r.dock_distance_ft, r.dock_angle_deg);
@@ -126,9 +126,9 @@ constexpr double kStraightIntoPayload[6] = {4.2, 17.9, -37.2, -39.9, -7.4, -44.0
 TEST(Autopilot, RelievesTheCollisionsItRunsIntoAndStillDocks) {
   LabConfig c = LoadConfig(DefaultConfigPath());
   for (int i = 0; i < 6; ++i) c.inputs[i].initial = kStraightIntoPayload[i];
-  op::AutopilotOptions o;
+  operator_station::AutopilotOptions o;
   o.plan_clear_paths = false;  // fly straight, like a novice: the DCP stops the arm
-  const auto r = offline::FlyAutopilot(c, o, kMaxFrames);
+  const auto r = sim::FlyAutopilot(c, o, kMaxFrames);
   EXPECT_GT(r.held_frames, 0) << "the DCP never held the arm: no collision to relieve";
   EXPECT_GE(r.autopilot.Get("autopilot.collisions_relieved"), 1);
   ExpectDocked(r, c);
@@ -137,7 +137,7 @@ TEST(Autopilot, RelievesTheCollisionsItRunsIntoAndStillDocks) {
 TEST(Autopilot, PlansAroundWhatItWouldHit) {
   LabConfig c = LoadConfig(DefaultConfigPath());
   for (int i = 0; i < 6; ++i) c.inputs[i].initial = kNearPayload[i];
-  const auto r = offline::FlyAutopilot(c, {}, kMaxFrames);
+  const auto r = sim::FlyAutopilot(c, {}, kMaxFrames);
   EXPECT_EQ(r.held_frames, 0);
   EXPECT_EQ(r.autopilot.Get("autopilot.collisions_relieved"), 0);
   EXPECT_GE(r.autopilot.Get("autopilot.via_points"), 1);
@@ -150,7 +150,7 @@ TEST(Autopilot, DocksWithoutACollisionFromRandomArmStarts) {
   std::mt19937 rng(kSeed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const LabConfig c0 = LoadConfig(DefaultConfigPath());
-  const SceneModel model = BuildSceneModel(c0);
+  const scene_model::SceneModel model = scene_model::BuildSceneModel(c0);
   int flown = 0;
   for (int k = 0; k < 200 && flown < 20; ++k) {
     LabConfig c = c0;
@@ -159,7 +159,7 @@ TEST(Autopilot, DocksWithoutACollisionFromRandomArmStarts) {
     for (int i = 0; i < 6; ++i) c.inputs[i].initial = q[i];
     // Only starts that are physically possible: nothing of the arm in the payload or the orbiter.
     if (!mission::Interpenetration(c, model, q, c.inputs[kShoulderHeight].initial, c.end_effector.finger_gap_open_ft,
-                                   MakeIsometry(c.payload.R_RP, c.payload.p_RoPo_R_ft), mission::PayloadState::kInBay)
+                                   arm::MakeIsometry(c.payload.R_RP, c.payload.p_RoPo_R_ft), mission::PayloadState::kInBay)
              .empty()) {
       continue;
     }
@@ -167,7 +167,7 @@ TEST(Autopilot, DocksWithoutACollisionFromRandomArmStarts) {
     char what[128];
     std::snprintf(what, sizeof what, "start %.1f %.1f %.1f %.1f %.1f %.1f", q[0], q[1], q[2], q[3], q[4], q[5]);
     SCOPED_TRACE(what);
-    const auto r = offline::FlyAutopilot(c, {}, kMaxFrames);
+    const auto r = sim::FlyAutopilot(c, {}, kMaxFrames);
     ExpectDocked(r, c);
     EXPECT_EQ(r.held_frames, 0);
   }

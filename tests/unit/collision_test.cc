@@ -6,11 +6,11 @@
 #include <cstdio>
 #include <limits>
 
-#include "collision.h"
-#include "compare.h"
-#include "generators.h"
+#include "rms/dynamics_proc/collision.h"
+#include "rms/reference/compare.h"
+#include "rms/reference/generators.h"
 
-namespace rms::dcp {
+namespace rms::dynamics_proc {
 namespace {
 
 using Eigen::Matrix3d;
@@ -167,13 +167,13 @@ TEST(Collide, NearParallelEdgesJustOutsideTheBandGetTheExactVerdict) {
   // called about 5% of the apart ones collisions.
   const std::uint64_t seed = 20261202;
   std::printf("seed %llu\n", static_cast<unsigned long long>(seed));
-  ref::PairGenerator gen(seed);
+  reference::PairGenerator gen(seed);
   std::uniform_real_distribution<double> k(1.5, 3.0);
   int wrong = 0, pairs = 0;
   for (double scale : {1e-3, 1.0, 1e4}) {
     for (int i = 0; i < 2000; ++i) {
       const bool apart = i % 2 == 0;
-      const ref::Pair p = gen.NearParallelEdges(scale, (apart ? 1 : -1) * k(gen.rng()) * 1e-9);
+      const reference::Pair p = gen.NearParallelEdges(scale, (apart ? 1 : -1) * k(gen.rng()) * 1e-9);
       const CollisionResult r = Collide(p.a.hex, p.b.hex);
       ASSERT_NE(r.verdict, Verdict::kInvalid);
       ++pairs;
@@ -191,14 +191,14 @@ TEST(Hexahedron, SmallSolidsFarFromTheOriginAreAnsweredAndDegenerateOnesRefusedW
   std::printf("seed %llu\n", static_cast<unsigned long long>(seed));
   std::mt19937_64 rng(seed);
   for (int i = 0; i < 500; ++i) {
-    const Vector3d at = 1e4 * ref::RandomRotation(rng).col(0);
-    const ref::Solid g = ref::General(at, ref::RandomShear(rng, 0.5), Vector3d(5e-4, 3e-4, 4e-4), 0.7);
+    const Vector3d at = 1e4 * reference::RandomRotation(rng).col(0);
+    const reference::Solid g = reference::General(at, reference::RandomShear(rng, 0.5), Vector3d(5e-4, 3e-4, 4e-4), 0.7);
     ASSERT_TRUE(g.hex.valid) << i << ": " << HexProblemName(g.hex.problem);
-    const ref::Solid b = ref::Box(at, ref::RandomRotation(rng), Vector3d(5e-4, 2e-4, 3e-4));
+    const reference::Solid b = reference::Box(at, reference::RandomRotation(rng), Vector3d(5e-4, 2e-4, 3e-4));
     ASSERT_TRUE(b.hex.valid) << i << ": " << HexProblemName(b.hex.problem);
     // A copy moved by 2 x its size is separate; by a tenth of it, collides.
-    const ref::Solid far = ref::Box(at + Vector3d(2e-3, 0, 0), ref::RandomRotation(rng), Vector3d(5e-4, 2e-4, 3e-4));
-    const ref::Solid near = ref::Box(at + Vector3d(1e-4, 0, 0), ref::RandomRotation(rng), Vector3d(5e-4, 2e-4, 3e-4));
+    const reference::Solid far = reference::Box(at + Vector3d(2e-3, 0, 0), reference::RandomRotation(rng), Vector3d(5e-4, 2e-4, 3e-4));
+    const reference::Solid near = reference::Box(at + Vector3d(1e-4, 0, 0), reference::RandomRotation(rng), Vector3d(5e-4, 2e-4, 3e-4));
     EXPECT_EQ(Collide(b.hex, far.hex).verdict, Verdict::kSeparate);
     EXPECT_EQ(Collide(b.hex, near.hex).verdict, Verdict::kCollide);
   }
@@ -206,13 +206,13 @@ TEST(Hexahedron, SmallSolidsFarFromTheOriginAreAnsweredAndDegenerateOnesRefusedW
   for (const Vector3d& at : {Vector3d(0, 0, 0), Vector3d(1e4, -1e4, 1e4)}) {
     std::array<Vector3d, 8> cube;
     for (int i = 0; i < 8; ++i)
-      cube[i] = at + 1e-3 * Vector3d(ref::kVertexSigns[i][0], ref::kVertexSigns[i][1], ref::kVertexSigns[i][2]);
+      cube[i] = at + 1e-3 * Vector3d(reference::kVertexSigns[i][0], reference::kVertexSigns[i][1], reference::kVertexSigns[i][2]);
     EXPECT_EQ(FromVertices(cube).problem, HexProblem::kNone);
     auto flat = cube;
     for (auto& v : flat) v.z() = at.z();
     EXPECT_EQ(FromVertices(flat).problem, HexProblem::kDegenerateFace);
     auto thin = cube;  // 1e-18 thick: below what rounding resolves at 1e4 ft (and 1e-9 x scale at 0)
-    for (int i = 0; i < 8; ++i) thin[i].z() = at.z() + (ref::kVertexSigns[i][2] > 0 ? 1e-18 * std::max(1.0, at.norm()) : 0.0);
+    for (int i = 0; i < 8; ++i) thin[i].z() = at.z() + (reference::kVertexSigns[i][2] > 0 ? 1e-18 * std::max(1.0, at.norm()) : 0.0);
     const HexProblem tp = FromVertices(thin).problem;
     EXPECT_TRUE(tp == HexProblem::kFlat || tp == HexProblem::kDegenerateFace) << HexProblemName(tp);
     auto twisted = cube;
@@ -266,8 +266,8 @@ TEST(CollideVsReference, AgreesOutsideTheBandOnGeneratedPairs) {
   const std::uint64_t seed = 20261122;
   const long count = 40000;
   std::printf("seed %llu, %ld pairs\n", static_cast<unsigned long long>(seed), count);
-  const ref::CompareStats st = ref::Compare(seed, count, 1e-9, /*exact_every=*/20);
-  std::printf("%s", ref::Describe(st).c_str());
+  const reference::CompareStats st = reference::Compare(seed, count, 1e-9, /*exact_every=*/20);
+  std::printf("%s", reference::Describe(st).c_str());
   EXPECT_EQ(st.disagree_outside, 0);
   EXPECT_EQ(st.invalid, 0);
   EXPECT_EQ(st.plane_wrong, 0);
@@ -282,4 +282,4 @@ TEST(CollideVsReference, AgreesOutsideTheBandOnGeneratedPairs) {
 }
 
 }  // namespace
-}  // namespace rms::dcp
+}  // namespace rms::dynamics_proc

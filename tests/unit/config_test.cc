@@ -5,8 +5,8 @@
 #include <regex>
 #include <sstream>
 
-#include "rms/check.h"
-#include "rms/config.h"
+#include "rms/base/check.h"
+#include "rms/base/config.h"
 
 namespace rms {
 namespace {

@@ -1,23 +1,23 @@
 #include <gtest/gtest.h>
-#include "session_summary.h"
+#include "rms/session/session_summary.h"
 #include <algorithm>
 #include <cstdio>
 #include <random>
 
-#include "rms/counters.h"
-#include "rms/frame_receiver.h"
+#include "rms/base/counters.h"
+#include "rms/wire/frame_receiver.h"
 
 namespace rms {
 namespace {
 
 TEST(SequenceTracker, GapsDuplicatesAndStaleFrames) {
-  SequenceTracker t;
-  EXPECT_EQ(t.Accept(5), SequenceTracker::Verdict::kFirst);
-  EXPECT_EQ(t.Accept(6), SequenceTracker::Verdict::kNext);
-  EXPECT_EQ(t.Accept(9), SequenceTracker::Verdict::kGap);
+  wire::SequenceTracker t;
+  EXPECT_EQ(t.Accept(5), wire::SequenceTracker::Verdict::kFirst);
+  EXPECT_EQ(t.Accept(6), wire::SequenceTracker::Verdict::kNext);
+  EXPECT_EQ(t.Accept(9), wire::SequenceTracker::Verdict::kGap);
   EXPECT_EQ(t.missing(), 2);
-  EXPECT_EQ(t.Accept(9), SequenceTracker::Verdict::kDuplicate);
-  EXPECT_EQ(t.Accept(7), SequenceTracker::Verdict::kStale);
+  EXPECT_EQ(t.Accept(9), wire::SequenceTracker::Verdict::kDuplicate);
+  EXPECT_EQ(t.Accept(7), wire::SequenceTracker::Verdict::kStale);
   EXPECT_EQ(t.received(), 3);
   EXPECT_EQ(t.duplicates(), 1);
   EXPECT_EQ(t.stale(), 1);
@@ -28,12 +28,12 @@ TEST(SequenceTracker, GapsDuplicatesAndStaleFrames) {
 // the session's clock it is refused outright; with none it may be taken,
 // and then the real stream is followed again after kResyncAfter refusals.
 TEST(SequenceTracker, AFarFutureFrameCannotLockTheStream) {
-  using V = SequenceTracker::Verdict;
+  using V = wire::SequenceTracker::Verdict;
   const std::int64_t forged = std::int64_t{1} << 47;
-  FrameClock clock;
+  wire::FrameClock clock;
   clock.epoch_us = 1'000'000'000'000;
   clock.max_rate_hz = 30 * 100;
-  SequenceTracker with_clock;
+  wire::SequenceTracker with_clock;
   with_clock.SetClock(clock);
   const std::int64_t t0 = clock.epoch_us + 5'000'000;  // 5 s into the session
   EXPECT_EQ(with_clock.Accept(100, t0), V::kFirst);
@@ -44,19 +44,19 @@ TEST(SequenceTracker, AFarFutureFrameCannotLockTheStream) {
   // A restarted sender's jump within the clock is a gap, as before.
   EXPECT_EQ(with_clock.Accept(400, t0 + 10'000'000), V::kGap);
 
-  SequenceTracker none;
+  wire::SequenceTracker none;
   EXPECT_EQ(none.Accept(forged), V::kFirst);  // nothing to tell it by yet
   std::int64_t f = 200;
-  for (int i = 1; i < SequenceTracker::kResyncAfter; ++i) EXPECT_EQ(none.Accept(f++), V::kStale) << i;
+  for (int i = 1; i < wire::SequenceTracker::kResyncAfter; ++i) EXPECT_EQ(none.Accept(f++), V::kStale) << i;
   EXPECT_EQ(none.Accept(f), V::kResync);
   EXPECT_EQ(none.last(), f);
   EXPECT_EQ(none.Accept(f + 1), V::kNext);
   EXPECT_EQ(none.resyncs(), 1);
   // Far ahead of the last without a clock: refused, and followed only as a run.
-  EXPECT_EQ(none.Accept(f + 2 + SequenceTracker::kMaxJump), V::kFarAhead);
+  EXPECT_EQ(none.Accept(f + 2 + wire::SequenceTracker::kMaxJump), V::kFarAhead);
   EXPECT_EQ(none.Accept(f + 2), V::kNext);
   // Refusals that are not one run (stale frames of a reordering) never resync.
-  SequenceTracker reorder;
+  wire::SequenceTracker reorder;
   reorder.Accept(1000);
   for (int i = 0; i < 100; ++i) EXPECT_EQ(reorder.Accept(999 - (i % 2)), V::kStale);
   EXPECT_EQ(reorder.resyncs(), 0);
@@ -65,9 +65,9 @@ TEST(SequenceTracker, AFarFutureFrameCannotLockTheStream) {
 // A woken process's queue of old frames is dropped, not executed: a frame
 // is late when its age exceeds the link's own delay by the limit.
 TEST(LateFrameFilter, DropsWhatWaitedBeyondTheLinksDelayAndFollowsAClockOffset) {
-  LateFrameFilter off;
+  wire::LateFrameFilter off;
   EXPECT_FALSE(off.TooLate(0, 10'000'000));
-  LateFrameFilter late(30.0);
+  wire::LateFrameFilter late(30.0);
   EXPECT_EQ(late.limit_us(), 100000);
   const std::int64_t offset = 2'500'000;  // the sender's clock 2.5 s behind: ages read 2.5 s more
   std::int64_t now = 50'000'000;
@@ -114,10 +114,10 @@ TEST(Counters, SumByPrefix) {
 // exact.
 namespace rms {
 TEST(SequenceTracker, ReorderedFramesAreCountedMissingThenDroppedAsStale) {
-  SequenceTracker t;
-  std::vector<SequenceTracker::Verdict> v;
+  wire::SequenceTracker t;
+  std::vector<wire::SequenceTracker::Verdict> v;
   for (std::int64_t f : {10, 11, 13, 12, 14, 16, 15, 15, 17}) v.push_back(t.Accept(f));
-  using V = SequenceTracker::Verdict;
+  using V = wire::SequenceTracker::Verdict;
   EXPECT_EQ(v, (std::vector<V>{V::kFirst, V::kNext, V::kGap, V::kStale, V::kNext, V::kGap, V::kStale, V::kStale,
                                V::kNext}));
   EXPECT_EQ(t.received(), 6);  // 10 11 13 14 16 17

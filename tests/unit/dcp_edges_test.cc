@@ -10,15 +10,15 @@
 #include <sstream>
 
 #include "dcp_fixture.h"
-#include "dcp_models.h"
-#include "dynamic_collision_program.h"
-#include "mission_plan.h"
-#include "rms/arm_ik.h"
-#include "rms/check.h"
-#include "rms/config.h"
-#include "rms/scene_model.h"
+#include "rms/dynamics_proc/dcp_models.h"
+#include "rms/dynamics_proc/dynamic_collision_program.h"
+#include "rms/mission/mission_plan.h"
+#include "rms/mission/arm_ik.h"
+#include "rms/base/check.h"
+#include "rms/base/config.h"
+#include "rms/scene_model/scene_model.h"
 
-namespace rms::dcp {
+namespace rms::dynamics_proc {
 namespace {
 
 using Eigen::Isometry3d;
@@ -39,7 +39,7 @@ class DcpEdges : public testing::DcpFixture {
     for (int f = 1; f <= n; ++f) dcp->Step(Inputs(Shifted(geo.X_RS2_grasp, d * f / n), 1.0));
     ASSERT_FALSE(dcp->status().held);
   }
-  std::uint32_t CollisionsAt(const OperatorInputs& in) const {
+  std::uint32_t CollisionsAt(const wire::OperatorInputs& in) const {
     // A fresh DCP's first command is tested where it is: its collisions.
     DynamicCollisionProgram fresh(config);
     fresh.Step(in);
@@ -51,18 +51,18 @@ TEST_F(DcpEdges, AFastCommandThroughTheBarBetweenTwoFramesIsHeld) {
   // The jaw beside the bar, then in one frame to the other side: both poses
   // are free, the motion between them passes the fingers through the bar.
   const Vector3d Y2 = geo.X_RS2_grasp.linear().col(1);
-  const OperatorInputs left = Inputs(Shifted(geo.X_RS2_grasp, -2.0 * Y2), 0.0);
-  const OperatorInputs right = Inputs(Shifted(geo.X_RS2_grasp, 2.0 * Y2), 0.0);
+  const wire::OperatorInputs left = Inputs(Shifted(geo.X_RS2_grasp, -2.0 * Y2), 0.0);
+  const wire::OperatorInputs right = Inputs(Shifted(geo.X_RS2_grasp, 2.0 * Y2), 0.0);
   ASSERT_EQ(CollisionsAt(left), 0u);
   ASSERT_EQ(CollisionsAt(right), 0u);
   DynamicCollisionProgram dcp(config);
   dcp.Step(left);
   ASSERT_FALSE(dcp.status().held);
-  const DcpFrameData out = dcp.Step(right);
+  const wire::DcpFrameData out = dcp.Step(right);
   EXPECT_TRUE(dcp.status().held);
   EXPECT_TRUE(dcp.status().motion_collision);
   EXPECT_GT(dcp.status().substeps, 1);
-  EXPECT_TRUE(dcp.status().collisions & (collision_bits::kRecptMask | collision_bits::kEffHexBarPost));
+  EXPECT_TRUE(dcp.status().collisions & (wire::collision_bits::kRecptMask | wire::collision_bits::kEffHexBarPost));
   EXPECT_TRUE(out.control.collision);  // a finger striking the bar is detrimental
   for (int i = 0; i < 6; ++i) EXPECT_EQ(dcp.status().slave.angles_deg[i], left.value[i]);
 }
@@ -79,7 +79,7 @@ TEST_F(DcpEdges, TheBarsPostsAreCollisionModels) {
   toml.replace(toml.find(from), from.size(), "bar_center_ft = [0.0, 0.0, 8.0]");
   config = ParseConfig(toml, "tall-posts.toml");
   geo = mission::PlanGeometry(config);
-  const BarPostBoxes posts = BarPosts_P(config.payload);
+  const scene_model::BarPostBoxes posts = scene_model::BarPosts_P(config.payload);
   ASSERT_EQ(posts.count, 2);
   const Vector3d X2 = geo.X_RS2_grasp.linear().col(0);
   const Vector3d along = X_RP_bay().linear().col(0);  // the bar's axis, x_P
@@ -90,10 +90,10 @@ TEST_F(DcpEdges, TheBarsPostsAreCollisionModels) {
   bool post_hit = false;
   for (int k = 1; k <= 60 && !post_hit; ++k) {
     dcp.Step(Inputs(Shifted(beside, -1.0 * along * k / 60), 0.0));
-    post_hit = dcp.status().collisions & collision_bits::kEffHexBarPost;
+    post_hit = dcp.status().collisions & wire::collision_bits::kEffHexBarPost;
   }
   EXPECT_TRUE(post_hit);
-  EXPECT_FALSE(dcp.status().collisions & collision_bits::kRecptMask) << "the bar itself is not touched";
+  EXPECT_FALSE(dcp.status().collisions & wire::collision_bits::kRecptMask) << "the bar itself is not touched";
   EXPECT_TRUE(dcp.status().held);
 }
 
@@ -113,7 +113,7 @@ TEST_F(DcpEdges, AFastCommandThroughABayWallBetweenTwoFramesIsHeld) {
   dcp.Step(Inputs(Shifted(geo.X_RS2_grasp, Vector3d(0, out_y + 1.0, lift + 1.0)), 1.0));
   EXPECT_TRUE(dcp.status().held);
   EXPECT_TRUE(dcp.status().motion_collision);
-  EXPECT_TRUE(dcp.status().collisions & (collision_bits::kBayFace << kFaceB));
+  EXPECT_TRUE(dcp.status().collisions & (wire::collision_bits::kBayFace << kFaceB));
   EXPECT_EQ(dcp.mode(), 2);
 }
 
@@ -121,7 +121,7 @@ TEST_F(DcpEdges, InMode3ThePayloadCannotBeLoweredBackThroughTheBayWalls) {
   // Lifted clear (Mode 3), moved 2 ft outboard of the starboard wall,
   // lowered 6 ft: the vertices over the wall stop at the sill.
   DynamicCollisionProgram dcp(config);
-  const double r = PayloadTopFlat_P(config.payload);  // the 16-gon's flats from its axis
+  const double r = scene_model::PayloadTopFlat_P(config.payload);  // the 16-gon's flats from its axis
   const double lift = -(config.payload.p_RoPo_R_ft.z() - r) + 0.5;
   AcquireAndMove(&dcp, Vector3d(0, 0, lift));
   ASSERT_EQ(dcp.mode(), 3);
@@ -134,7 +134,7 @@ TEST_F(DcpEdges, InMode3ThePayloadCannotBeLoweredBackThroughTheBayWalls) {
     held += dcp.status().held;
   }
   EXPECT_GT(held, 15);
-  EXPECT_TRUE(dcp.status().collisions & (collision_bits::kBayFace << kFaceB));
+  EXPECT_TRUE(dcp.status().collisions & (wire::collision_bits::kBayFace << kFaceB));
   EXPECT_EQ(dcp.mode(), 3);
   // No payload vertex beyond the wall is below the sill.
   const PayloadModel p = MakePayload(config.payload, dcp.X_RP());
@@ -152,13 +152,13 @@ TEST_F(DcpEdges, AResetHeldDownDoesNotDisableTheCollisionResponse) {
   const Isometry3d above = Shifted(geo.X_RS2_grasp, Vector3d(-6.0, 0, 3.0));
   int held = 0;
   for (int f = 0; f <= 90; ++f) {
-    OperatorInputs in = Inputs(Shifted(above, Vector3d(0, 0, -5.0 * f / 90)), 0.0);
+    wire::OperatorInputs in = Inputs(Shifted(above, Vector3d(0, 0, -5.0 * f / 90)), 0.0);
     in.reset = true;
     dcp.Step(in);
     held += dcp.status().held;
   }
   EXPECT_GT(held, 30);
-  EXPECT_TRUE(dcp.status().collisions & collision_bits::kEePayloadMask);
+  EXPECT_TRUE(dcp.status().collisions & wire::collision_bits::kEePayloadMask);
 }
 
 TEST_F(DcpEdges, AResetWhoseArmPoseWouldCollideIsRefused) {
@@ -167,7 +167,7 @@ TEST_F(DcpEdges, AResetWhoseArmPoseWouldCollideIsRefused) {
   DynamicCollisionProgram dcp(config);
   AcquireAndMove(&dcp, Vector3d(0, 0, -0.4));
   const std::string before = dcp.SaveState().dump();
-  OperatorInputs in = Inputs(Shifted(geo.X_RS2_grasp, Vector3d(0, 0, -0.4)), 1.0);
+  wire::OperatorInputs in = Inputs(Shifted(geo.X_RS2_grasp, Vector3d(0, 0, -0.4)), 1.0);
   in.reset = true;
   dcp.Step(in);
   EXPECT_TRUE(dcp.status().reset_refused);
@@ -210,7 +210,7 @@ TEST_F(DcpEdges, TheFingerClosingOnTheBarIsEssentialAndThePalmStrikingItIsDetrim
   const Isometry3d centred = Shifted(geo.X_RS2_grasp, 0.3 * Y2);
   bool essential = false;
   for (int f = 0; f <= 90; ++f) {
-    const DcpFrameData out = dcp.Step(Inputs(centred, f / 90.0));
+    const wire::DcpFrameData out = dcp.Step(Inputs(centred, f / 90.0));
     if (dcp.status().essential_contact) {
       essential = true;
       EXPECT_TRUE(out.control.receptacle_collision);
@@ -224,8 +224,8 @@ TEST_F(DcpEdges, TheFingerClosingOnTheBarIsEssentialAndThePalmStrikingItIsDetrim
   DynamicCollisionProgram palm(config);
   bool struck = false;
   for (int f = 0; f <= 30 && !struck; ++f) {
-    const DcpFrameData out = palm.Step(Inputs(Shifted(geo.X_RS2_grasp, 0.3 * X2 * f / 30), 0.0));
-    if (palm.status().collisions & collision_bits::kEffHexRecpt) {
+    const wire::DcpFrameData out = palm.Step(Inputs(Shifted(geo.X_RS2_grasp, 0.3 * X2 * f / 30), 0.0));
+    if (palm.status().collisions & wire::collision_bits::kEffHexRecpt) {
       struck = true;
       EXPECT_TRUE(out.control.collision);
       EXPECT_FALSE(out.control.receptacle_collision);
@@ -255,10 +255,10 @@ TEST_F(DcpEdges, NonFiniteInputsAndAFirstCommandThatCollidesAreNotTaken) {
   EXPECT_TRUE(dcp.status().held);
   EXPECT_NE(dcp.status().collisions, 0u);
   EXPECT_EQ(dcp.status().slave_collisions, 0u);
-  const OperatorInputs initial = InitialInputs(config.inputs);
+  const wire::OperatorInputs initial = wire::InitialInputs(config.inputs);
   for (int i = 0; i < 6; ++i) EXPECT_EQ(dcp.status().slave.angles_deg[i], initial.value[i]);
   // A NaN angle: the frame holds the last command.
-  OperatorInputs in = Inputs(geo.X_RS2_grasp, 0.0);
+  wire::OperatorInputs in = Inputs(geo.X_RS2_grasp, 0.0);
   in.value[2] = std::nan("");
   dcp.Step(in);
   EXPECT_TRUE(dcp.status().input_refused);
@@ -306,9 +306,9 @@ TEST_F(DcpEdges, ACheckpointMissingItsLastKeyLeavesTheStateUnchanged) {
 }
 
 }  // namespace
-}  // namespace rms::dcp
+}  // namespace rms::dynamics_proc
 
-namespace rms::dcp {
+namespace rms::dynamics_proc {
 namespace {
 
 // The distance of p from a convex hexahedron's surface, ft, signed (> 0
@@ -324,7 +324,7 @@ TEST(DcpModels, WhatIsTestedIsWhatIsDrawn) {
   // DCP's models built at the identity) lies on the tested models' surface,
   // within 0.05 ft (measured: the worst is printed).
   const LabConfig config = LoadConfig(DefaultConfigPath());
-  const SceneModel scene = BuildSceneModel(config);
+  const scene_model::SceneModel scene = scene_model::BuildSceneModel(config);
   const Eigen::Isometry3d I = Eigen::Isometry3d::Identity();
   const PayloadModel payload = MakePayload(config.payload, I);
   const Hexahedron bar = MakeBar(config.payload, I);
@@ -334,11 +334,11 @@ TEST(DcpModels, WhatIsTestedIsWhatIsDrawn) {
     int cluster;
     std::vector<const Hexahedron*> tested;
   };
-  std::vector<Part> parts = {{kPayloadBody, {}}, {kBar, {&bar}}, {kBarPostA, {&posts[0]}}, {kBarPostB, {&posts[1]}}};
+  std::vector<Part> parts = {{scene_model::kPayloadBody, {}}, {scene_model::kBar, {&bar}}, {scene_model::kBarPostA, {&posts[0]}}, {scene_model::kBarPostB, {&posts[1]}}};
   for (const Hexahedron& s : payload.body) parts[0].tested.push_back(&s);
   for (const Part& part : parts) {
     double worst = 0;
-    for (const Triangle& t : scene[part.cluster].mesh.triangles()) {
+    for (const scene_model::Triangle& t : scene[part.cluster].mesh.triangles()) {
       for (const Eigen::Vector3f* v : {&t.a, &t.b, &t.c}) {
         // The union's surface: outside all (distance to the nearest) or inside one.
         double d = 1e30;
@@ -346,10 +346,10 @@ TEST(DcpModels, WhatIsTestedIsWhatIsDrawn) {
         worst = std::max(worst, std::abs(d));
       }
     }
-    std::printf("%s: drawn vs tested, worst %.2g ft\n", std::string(ClusterName(part.cluster)).c_str(), worst);
-    EXPECT_LE(worst, 0.05) << ClusterName(part.cluster);
+    std::printf("%s: drawn vs tested, worst %.2g ft\n", std::string(scene_model::ClusterName(part.cluster)).c_str(), worst);
+    EXPECT_LE(worst, 0.05) << scene_model::ClusterName(part.cluster);
   }
 }
 
 }  // namespace
-}  // namespace rms::dcp
+}  // namespace rms::dynamics_proc

@@ -13,19 +13,19 @@
 #include <unistd.h>
 
 #include "dcp_fixture.h"
-#include "dcp_models.h"
-#include "dynamic_collision_program.h"
-#include "mission_plan.h"
-#include "rms/arm_ik.h"
-#include "rms/check.h"
-#include "rms/checkpoint.h"
-#include "rms/config.h"
+#include "rms/dynamics_proc/dcp_models.h"
+#include "rms/dynamics_proc/dynamic_collision_program.h"
+#include "rms/mission/mission_plan.h"
+#include "rms/mission/arm_ik.h"
+#include "rms/base/check.h"
+#include "rms/wire/checkpoint.h"
+#include "rms/base/config.h"
 #include "rms/dcp_frame_t.hpp"
-#include "rms/scene_model.h"
-#include "rms/word_blocks.h"
-#include "timeline.h"
+#include "rms/scene_model/scene_model.h"
+#include "rms/wire/word_blocks.h"
+#include "rms/operator_station/timeline.h"
 
-namespace rms::dcp {
+namespace rms::dynamics_proc {
 namespace {
 
 using Eigen::Isometry3d;
@@ -153,12 +153,12 @@ TEST_F(Dcp, TheShippedMissionTimelineIsThePlannersForTheDefaultConfig) {
 
 TEST_F(Dcp, TheMissionTimelineAcquiresExtractsAndDocks) {
   const std::string text = mission::FormatTimeline(mission::PlanMission(config), "");
-  const op::Timeline tl = op::Timeline::Parse(text, "mission", config.inputs);
+  const operator_station::Timeline tl = operator_station::Timeline::Parse(text, "mission", config.inputs);
   DynamicCollisionProgram dcp(config);
   std::vector<int> modes;
   int frames = 0;
   for (double t = 0; t <= tl.end_time(); t += 1.0 / 30.0, ++frames) {
-    const DcpFrameData out = dcp.Step(tl.Sample(t));
+    const wire::DcpFrameData out = dcp.Step(tl.Sample(t));
     if (modes.empty() || modes.back() != out.control.mode) modes.push_back(out.control.mode);
     EXPECT_EQ(dcp.status().slave_collisions, 0u) << "the slave never stands in collision, t = " << t;
     EXPECT_EQ(dcp.status().collisions, 0u) << "the planned mission never collides, t = " << t;
@@ -179,12 +179,12 @@ TEST_F(Dcp, ACollisionHoldsTheSlaveAtContactAndReleasesIt) {
   // Down 5 ft over 3 s (through the body's top), then back up.
   for (int f = 0; f <= 180; ++f) {
     const double down = f <= 90 ? 5.0 * f / 90 : 5.0 * (180 - f) / 90;
-    const OperatorInputs in = Inputs(Shifted(above, Vector3d(0, 0, -down)), 0.0);
-    const DcpFrameData out = dcp.Step(in);
+    const wire::OperatorInputs in = Inputs(Shifted(above, Vector3d(0, 0, -down)), 0.0);
+    const wire::DcpFrameData out = dcp.Step(in);
     const DcpStatus& st = dcp.status();
     if (st.held) {
       ++held;
-      EXPECT_TRUE(st.collisions & collision_bits::kEePayloadMask);
+      EXPECT_TRUE(st.collisions & wire::collision_bits::kEePayloadMask);
       EXPECT_TRUE(out.control.collision);
     }
     // The slave's end effector never penetrates the body.
@@ -196,7 +196,7 @@ TEST_F(Dcp, ACollisionHoldsTheSlaveAtContactAndReleasesIt) {
   EXPECT_GT(held, 30);
   // Contact: the fingers' tips stopped within one frame's travel of the body's top.
   const double finger_tip = lowest - config.end_effector.palm_length_ft - config.end_effector.finger_length_ft;
-  const double body_top = config.payload.p_RoPo_R_ft.z() + PayloadTopFlat_P(config.payload);  // the 16-gon's top flat
+  const double body_top = config.payload.p_RoPo_R_ft.z() + scene_model::PayloadTopFlat_P(config.payload);  // the 16-gon's top flat
   EXPECT_GT(finger_tip, body_top);
   EXPECT_LT(finger_tip, body_top + 5.0 / 90 + 1e-6);
   // Released: back above, the slave follows the master exactly.
@@ -216,7 +216,7 @@ TEST_F(Dcp, TheFingerStopsOnTheBarWhileTheArmFollows) {
     dcp.Step(Inputs(centred, f / 90.0));
     if (dcp.status().finger_held) {
       finger_held = true;
-      EXPECT_TRUE(dcp.status().collisions & collision_bits::kRecptMask);
+      EXPECT_TRUE(dcp.status().collisions & wire::collision_bits::kRecptMask);
     }
   }
   EXPECT_TRUE(finger_held);
@@ -239,11 +239,11 @@ TEST_F(Dcp, InMode2APayloadVertexBeyondABayWallHoldsTheArm) {
     if (dcp.status().held) {
       ++held;
       // The starboard wall is bay face b (v = -Y_R): bit 6 + 1.
-      EXPECT_TRUE(dcp.status().collisions & (collision_bits::kBayFace << kFaceB));
+      EXPECT_TRUE(dcp.status().collisions & (wire::collision_bits::kBayFace << kFaceB));
     }
   }
   EXPECT_GT(held, 10);
-  EXPECT_LT(dcp.status().X_RP.translation().y() + PayloadTopFlat_P(config.payload),  // the 16-gon's side flat
+  EXPECT_LT(dcp.status().X_RP.translation().y() + scene_model::PayloadTopFlat_P(config.payload),  // the 16-gon's side flat
             0.5 * config.shuttle.bay_width_ft + 1e-9);
   EXPECT_EQ(dcp.mode(), 2);
 }
@@ -254,9 +254,9 @@ TEST_F(Dcp, ResetReturnsToMode1AndTheInitialState) {
   ASSERT_EQ(dcp.mode(), 2);
   for (int f = 1; f <= 30; ++f) dcp.Step(Inputs(Shifted(geo.X_RS2_grasp, Vector3d(0, 0, 0.2 * f)), 1.0));
   ASSERT_GT(dcp.X_RP().translation().z(), config.payload.p_RoPo_R_ft.z() + 5.0);
-  OperatorInputs in = Inputs(Shifted(geo.X_RS2_grasp, Vector3d(0, 0, 6)), 0.0);
+  wire::OperatorInputs in = Inputs(Shifted(geo.X_RS2_grasp, Vector3d(0, 0, 6)), 0.0);
   in.reset = true;
-  const DcpFrameData out = dcp.Step(in);
+  const wire::DcpFrameData out = dcp.Step(in);
   EXPECT_EQ(dcp.mode(), 1);
   EXPECT_EQ(out.control.mode, 1);
   EXPECT_TRUE(out.control.reset);
@@ -268,8 +268,8 @@ TEST_F(Dcp, ACheckpointRestoresTheStateExactly) {
   // At every phase of the mission: save, go on; restore into a fresh DCP and
   // go on with the same inputs: the same outputs, word for word.
   const std::string text = mission::FormatTimeline(mission::PlanMission(config), "");
-  const op::Timeline tl = op::Timeline::Parse(text, "mission", config.inputs);
-  std::vector<OperatorInputs> inputs;
+  const operator_station::Timeline tl = operator_station::Timeline::Parse(text, "mission", config.inputs);
+  std::vector<wire::OperatorInputs> inputs;
   for (double t = 0; t <= tl.end_time(); t += 1.0 / 30.0) inputs.push_back(tl.Sample(t));
   for (std::size_t at : {std::size_t{100}, std::size_t{500}, std::size_t{800}, std::size_t{1300}}) {
     DynamicCollisionProgram live(config);
@@ -292,10 +292,10 @@ TEST_F(Dcp, ACheckpointRestoresTheStateExactly) {
       for (int i = 0; i < 6; ++i) EXPECT_FALSE(live.status().acquisition[i]) << "not evaluated after acquisition";
     }
     for (std::size_t k = at; k < inputs.size(); ++k) {
-      const DcpFrameData a = live.Step(inputs[k]), b = restored.Step(inputs[k]);
+      const wire::DcpFrameData a = live.Step(inputs[k]), b = restored.Step(inputs[k]);
       dcp_frame_t wa, wb;
-      PackDcpFrame(a, &wa, nullptr);
-      PackDcpFrame(b, &wb, nullptr);
+      wire::PackDcpFrame(a, &wa, nullptr);
+      wire::PackDcpFrame(b, &wb, nullptr);
       ASSERT_EQ(std::memcmp(wa.arm_words, wb.arm_words, sizeof wa.arm_words), 0) << at << "+" << k;
       ASSERT_EQ(wa.control_word, wb.control_word) << at << "+" << k;
       ASSERT_EQ(std::memcmp(wa.state_words, wb.state_words, sizeof wa.state_words), 0) << at << "+" << k;
@@ -325,7 +325,7 @@ TEST_F(Dcp, ABadCheckpointIsRefusedNamingWhatIsWrong) {
 }
 
 }  // namespace
-}  // namespace rms::dcp
+}  // namespace rms::dynamics_proc
 
 namespace rms {
 namespace {
@@ -339,9 +339,9 @@ TEST(CheckpointFolderTest, NamesOnlyNewFilesNoLinksAndASizeCap) {
   fs::remove_all(root);
   fs::create_directories(root / "checkpoints");
   fs::create_directories(root / "elsewhere");
-  const CheckpointFolder folder((root / "checkpoints").string());
-  Checkpoint c;
-  c.dcp = dcp::DynamicCollisionProgram(LoadConfig(std::string(RMSLAB_SOURCE_DIR) + "/config/rmslab.toml")).SaveState();
+  const wire::CheckpointFolder folder((root / "checkpoints").string());
+  wire::Checkpoint c;
+  c.dcp = dynamics_proc::DynamicCollisionProgram(LoadConfig(std::string(RMSLAB_SOURCE_DIR) + "/config/rmslab.toml")).SaveState();
   folder.Write("good.json", c);
   EXPECT_EQ(folder.Read("good.json").dcp, c.dcp);
   for (const char* bad : {"../x.json", "/tmp/x.json", "a/b.json", ".hidden.json", "x.txt", "x\n.json", ""}) {
@@ -352,7 +352,7 @@ TEST(CheckpointFolderTest, NamesOnlyNewFilesNoLinksAndASizeCap) {
   fs::create_symlink(root / "elsewhere" / "t.json", root / "checkpoints" / "link.json");
   EXPECT_THROW(folder.Write("link.json", c), InputError);
   EXPECT_FALSE(fs::exists(root / "elsewhere" / "t.json"));
-  std::ofstream(root / "checkpoints" / "big.json") << std::string(kMaxCheckpointBytes + 1, ' ');
+  std::ofstream(root / "checkpoints" / "big.json") << std::string(wire::kMaxCheckpointBytes + 1, ' ');
   EXPECT_THROW(folder.Read("big.json"), InputError);
   // The folder swapped for a link to elsewhere: refused, nothing written there.
   fs::rename(root / "checkpoints", root / "moved");

@@ -18,17 +18,17 @@
 #include <sstream>
 #include <thread>
 
-#include "bindings.h"
-#include "devices.h"
-#include "guidance.h"
-#include "hand_controllers.h"
-#include "rms/arm_kinematics.h"
-#include "rms/check.h"
-#include "rms/config.h"
-#include "rms/mission_geometry.h"
-#include "status_screen.h"
+#include "rms/operator_station/bindings.h"
+#include "rms/operator_station/devices.h"
+#include "rms/operator_station/guidance.h"
+#include "rms/operator_station/hand_controllers.h"
+#include "rms/arm/kinematics.h"
+#include "rms/base/check.h"
+#include "rms/base/config.h"
+#include "rms/mission/mission_geometry.h"
+#include "rms/operator_station/status_screen.h"
 
-namespace rms::op {
+namespace rms::operator_station {
 namespace {
 
 constexpr double kDt = 1.0 / 30;
@@ -41,27 +41,27 @@ class Devices : public ::testing::Test {
   GuidanceGeometry geometry = MakeGuidanceGeometry(config);
 
   // A pose in the middle of the workspace, over the bay.
-  OperatorInputs MidPose() const {
-    OperatorInputs in = InitialInputs(config.inputs);
+  wire::OperatorInputs MidPose() const {
+    wire::OperatorInputs in = wire::InitialInputs(config.inputs);
     const double q[6] = {15, 60, -75, -60, 5, -70};
     for (int i = 0; i < 6; ++i) in.value[i] = q[i];
     return in;
   }
-  static JointAngles Angles(const OperatorInputs& in) {
+  static JointAngles Angles(const wire::OperatorInputs& in) {
     JointAngles q{};
     for (int i = 0; i < 6; ++i) q[i] = in.value[i];
     return q;
   }
-  Eigen::Isometry3d X_RS2(const OperatorInputs& in) const {
+  Eigen::Isometry3d X_RS2(const wire::OperatorInputs& in) const {
     return ForwardPose(config.arm, Angles(in), in.value[kShoulderHeight]);
   }
   // Telemetry as the DCP would send it for these inputs: Mode 1, or the
   // payload held (Mode 2) at the grasp's attachment.
-  dcp_telemetry_t Telemetry(const OperatorInputs& in, int mode) const {
+  dcp_telemetry_t Telemetry(const wire::OperatorInputs& in, int mode) const {
     dcp_telemetry_t t{};
     t.mode = static_cast<std::int8_t>(mode);
     const Eigen::Isometry3d X = X_RS2(in);
-    const Eigen::Isometry3d P = mode == 1 ? MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft)
+    const Eigen::Isometry3d P = mode == 1 ? arm::MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft)
                                           : X * mission::PlanGeometry(config).X_S2P;
     for (int i = 0; i < 3; ++i) {
       t.p_RoA_R_ft[i] = X.translation()[i];
@@ -109,9 +109,9 @@ TEST_F(Devices, TheBindingsFileIsReadAndBadOnesAreRefusedNamingTheKey) {
   EXPECT_EQ(bindings.keys.at('i').index, kRhcPitch);
   EXPECT_EQ(bindings.keys.at('i').sign, -1.0);
   EXPECT_EQ(bindings.keys.at(' ').kind, ActionKind::kStop);
-  EXPECT_EQ(bindings.keys.at(kKeyBackspace).kind, ActionKind::kReset);
+  EXPECT_EQ(bindings.keys.at(wire::kKeyBackspace).kind, ActionKind::kReset);
   EXPECT_EQ(bindings.keys.at('Q').kind, ActionKind::kQuit);
-  EXPECT_EQ(bindings.keys.at(kKeyUp).index, kCameraTilt);
+  EXPECT_EQ(bindings.keys.at(wire::kKeyUp).index, kCameraTilt);
   EXPECT_EQ(bindings.keys.at('5').camera, 5);
   EXPECT_EQ(bindings.gamepad_axes.at("lefty").sign, -1.0);
   EXPECT_EQ(bindings.initial_mode, ControlMode::kManualAugmented);
@@ -164,12 +164,12 @@ TEST_F(Devices, ManualAugmentedMovesThePointOfResolutionAlongEachFramesAxes) {
       Bindings b = bindings;
       b.initial_frame = c.frame;
       HandControllers hc(config, b);
-      const OperatorInputs in0 = MidPose();
+      const wire::OperatorInputs in0 = MidPose();
       hc.SetInputs(in0);
       const dcp_telemetry_t t = Telemetry(in0, c.mode);
       DeviceCommands cmd;
       cmd.hand[axis] = 1.0;
-      const OperatorInputs in1 = hc.Apply(cmd, kDt, &t);
+      const wire::OperatorInputs in1 = hc.Apply(cmd, kDt, &t);
       ArmState s = ArmStateFrom(t);
       const Eigen::Matrix3d R_RF = CommandAxes(geometry, c.frame, s);
       const Eigen::Vector3d por = PointOfResolution(geometry, s);
@@ -201,14 +201,14 @@ TEST_F(Devices, ATerminalPressIsOneIncrementMergedNeverQueuedAndStopHaltsIt) {
   HandControllers hc(config, bindings);
   TypedKeys typed;
   hc.AddDevice(std::make_unique<KeyboardDevice>(bindings, typed.Source()));
-  const OperatorInputs in0 = MidPose();
+  const wire::OperatorInputs in0 = MidPose();
   hc.SetInputs(in0);
   const dcp_telemetry_t t = Telemetry(in0, 1);
-  auto por = [&](const OperatorInputs& in) { return X_RS2(in) * geometry.p_S2oG_S2; };
+  auto por = [&](const wire::OperatorInputs& in) { return X_RS2(in) * geometry.p_S2oG_S2; };
   const Eigen::Vector3d p0 = por(in0);
   // Ten presses of 'w' in one frame: one coarse increment (2 ft) forward.
   for (int i = 0; i < 10; ++i) typed.keys.push_back('w');
-  OperatorInputs in = hc.Step(kDt, &t);
+  wire::OperatorInputs in = hc.Step(kDt, &t);
   int frames = 1;
   while (hc.status().rate[kThcX] != 0.0 && frames < 1000) {
     in = hc.Step(kDt, &t);
@@ -243,7 +243,7 @@ TEST_F(Devices, ATerminalPressIsOneIncrementMergedNeverQueuedAndStopHaltsIt) {
   in = hc.Step(kDt, &t);
   EXPECT_EQ(hc.status().rate[kThcY], 0.0);
   EXPECT_EQ(hc.status().pending[kThcY], 0.0);
-  const OperatorInputs still = hc.Step(kDt, &t);
+  const wire::OperatorInputs still = hc.Step(kDt, &t);
   for (int i = 0; i < 6; ++i) EXPECT_EQ(still.value[i], in.value[i]);
   typed.keys = {'f'};
   hc.Step(kDt, &t);
@@ -265,7 +265,7 @@ TEST_F(Devices, OneFramesKeysActInTheOrderTheyCame) {
   HandControllers hc(config, bindings);
   TypedKeys typed;
   hc.AddDevice(std::make_unique<KeyboardDevice>(bindings, typed.Source()));
-  const OperatorInputs in0 = MidPose();
+  const wire::OperatorInputs in0 = MidPose();
   hc.SetInputs(in0);
   const dcp_telemetry_t t = Telemetry(in0, 1);
   typed.keys = {'w'};
@@ -287,12 +287,12 @@ TEST_F(Devices, TheLiveWindowsHeldKeysMoveAndReleasedOnesStopAtOnce) {
   auto dev = std::make_unique<WindowKeyboardDevice>(bindings, 300000);
   WindowKeyboardDevice* window = dev.get();
   hc.AddDevice(std::move(dev));
-  const OperatorInputs in0 = MidPose();
+  const wire::OperatorInputs in0 = MidPose();
   hc.SetInputs(in0);
   const dcp_telemetry_t t = Telemetry(in0, 1);
   std::int64_t now = 1000000;
   window->Receive({0, {'w'}, {'w'}, true}, now);
-  OperatorInputs in = in0;
+  wire::OperatorInputs in = in0;
   std::int64_t seq = 0;
   for (int f = 0; f < 30; ++f) {
     window->SetNow(now += 33333);
@@ -305,7 +305,7 @@ TEST_F(Devices, TheLiveWindowsHeldKeysMoveAndReleasedOnesStopAtOnce) {
   // Released: the very next frame commands no motion.
   window->Receive({++seq, {}, {}, true}, now);
   window->SetNow(now += 33333);
-  const OperatorInputs after = hc.Step(kDt, &t);
+  const wire::OperatorInputs after = hc.Step(kDt, &t);
   for (int i = 0; i < 6; ++i) EXPECT_EQ(after.value[i], in.value[i]);
   // A stale message is refused; a window that goes silent with a key held
   // is let go of after the timeout.
@@ -343,7 +343,7 @@ TEST_F(Devices, StopHoldsUntilReleasedDockedHoldsAndFrozenTakesStopAndSteps) {
   TypedKeys typed;
   hc.AddDevice(std::move(dev));
   hc.AddDevice(std::make_unique<KeyboardDevice>(bindings, typed.Source()));
-  const OperatorInputs in0 = MidPose();
+  const wire::OperatorInputs in0 = MidPose();
   hc.SetInputs(in0);
   dcp_telemetry_t t = Telemetry(in0, 1);
   std::int64_t now = 1000000, seq = 0;
@@ -353,12 +353,12 @@ TEST_F(Devices, StopHoldsUntilReleasedDockedHoldsAndFrozenTakesStopAndSteps) {
     return hc.Step(kDt, &t);
   };
   frame({'w'}, {'w'});
-  OperatorInputs in = frame({'w'});
+  wire::OperatorInputs in = frame({'w'});
   EXPECT_GT(hc.status().rate[kThcX], 0.0);
   typed.keys = {' '};  // stop, from the terminal, while the window's key stays down
   in = frame({'w'});
   for (int f = 0; f < 10; ++f) {
-    const OperatorInputs next = frame({'w'});
+    const wire::OperatorInputs next = frame({'w'});
     for (int i = 0; i < 6; ++i) EXPECT_EQ(next.value[i], in.value[i]) << "a held key acts after the stop";
   }
   frame({});  // let go, press again: it moves
@@ -374,7 +374,7 @@ TEST_F(Devices, StopHoldsUntilReleasedDockedHoldsAndFrozenTakesStopAndSteps) {
   EXPECT_EQ(hc.status().pending[kThcY], 0.0);
   EXPECT_EQ(hc.status().rate[kThcY], 0.0);
   // Docked, the finger not yet open: the hand controllers follow the held arm.
-  OperatorInputs closed = in;
+  wire::OperatorInputs closed = in;
   closed.value[kFinger] = 1.0;
   hc.SetInputs(closed);
   t.docked = true;
@@ -403,7 +403,7 @@ TEST_F(Devices, SingleJointDrivesTheSelectedJointAtARateWithinItsLimit) {
   Bindings b = bindings;
   b.initial_mode = ControlMode::kSingleJoint;
   HandControllers hc(config, b);
-  const OperatorInputs in0 = MidPose();
+  const wire::OperatorInputs in0 = MidPose();
   hc.SetInputs(in0);
   DeviceCommands select;
   select.events.push_back(ParseAction("joint_next"));  // shoulder yaw -> shoulder pitch
@@ -412,7 +412,7 @@ TEST_F(Devices, SingleJointDrivesTheSelectedJointAtARateWithinItsLimit) {
   DeviceCommands push;
   push.hand[kThcX] = 1.0;
   push.hand[kThcY] = 1.0;  // not used in single joint
-  OperatorInputs in = hc.Apply(push, 1.0, nullptr);
+  wire::OperatorInputs in = hc.Apply(push, 1.0, nullptr);
   EXPECT_NEAR(in.value[1] - in0.value[1], b.rates.joint_coarse_deg_s, 1e-9);
   for (int i : {0, 2, 3, 4, 5}) EXPECT_EQ(in.value[i], in0.value[i]);
   // Driven past its limit it stops on it, reported once.
@@ -429,7 +429,7 @@ TEST_F(Devices, SingleJointDrivesTheSelectedJointAtARateWithinItsLimit) {
 
 TEST_F(Devices, ThePayloadFrameIsOfferedOnlyOnceThePayloadIsHeld) {
   HandControllers hc(config, bindings);
-  const OperatorInputs in0 = MidPose();
+  const wire::OperatorInputs in0 = MidPose();
   hc.SetInputs(in0);
   DeviceCommands frame;
   frame.events.push_back(ParseAction("frame"));
@@ -467,7 +467,7 @@ TEST_F(Devices, OutOfRangeCommandsAreClampedAndReportedOnce) {
   HandControllers h2(config, bindings);
   DeviceCommands press;
   press.input_presses.push_back({kFinger, 1.0});
-  OperatorInputs in = h2.Apply(press, kDt, nullptr);
+  wire::OperatorInputs in = h2.Apply(press, kDt, nullptr);
   EXPECT_NEAR(in.value[kFinger], bindings.max_rate[kFinger] * kDt, 1e-12);
   for (int i = 0; i < 10; ++i) in = h2.Apply({}, kDt, nullptr);
   DeviceCommands stop;
@@ -596,10 +596,10 @@ TEST_F(Devices, A3DMouseIsBothHandControllers) {
   // Through the hand controllers: the point of resolution moves forward
   // and the end effector turns, in one frame.
   HandControllers hc(config, bindings);
-  const OperatorInputs in0 = MidPose();
+  const wire::OperatorInputs in0 = MidPose();
   hc.SetInputs(in0);
   const dcp_telemetry_t t = Telemetry(in0, 1);
-  const OperatorInputs in1 = hc.Apply(c, kDt, &t);
+  const wire::OperatorInputs in1 = hc.Apply(c, kDt, &t);
   const Eigen::Isometry3d X0 = X_RS2(in0), X1 = X_RS2(in1);
   const Eigen::Matrix3d R_RF = CommandAxes(geometry, CommandFrame::kEndEffector, ArmStateFrom(t));
   const Eigen::Vector3d v = (X1 * geometry.p_S2oG_S2 - X0 * geometry.p_S2oG_S2) / kDt;
@@ -622,7 +622,7 @@ TEST_F(Devices, TheStatusScreenShowsGuidanceMarginsAndFollowsTheWidth) {
   StatusSnapshot s;
   s.source = "by hand";
   s.frame = 1234;
-  s.inputs = InitialInputs(config.inputs);
+  s.inputs = wire::InitialInputs(config.inputs);
   s.inputs.camera_station = 4;
   s.inputs.value[kCameraZoom] = 0.3;
   dcp_telemetry_t t{};
@@ -642,7 +642,7 @@ TEST_F(Devices, TheStatusScreenShowsGuidanceMarginsAndFollowsTheWidth) {
   g.distance_ft = 3.44;
   s.guidance = g;
   s.hand = HandStatus{};
-  for (const auto& [code, a] : bindings.keys) s.keys[ActionName(a)] = KeyName(code);
+  for (const auto& [code, a] : bindings.keys) s.keys[ActionName(a)] = wire::KeyName(code);
   s.publish_hz = 30.0;
   s.telemetry_hz = 29.9;
   s.input_to_dcp_ms = 1.2;
@@ -686,4 +686,4 @@ TEST_F(Devices, TheStatusScreenShowsGuidanceMarginsAndFollowsTheWidth) {
 }
 
 }  // namespace
-}  // namespace rms::op
+}  // namespace rms::operator_station

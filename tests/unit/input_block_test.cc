@@ -3,10 +3,10 @@
 #include <cmath>
 #include <random>
 
-#include "rms/check.h"
-#include "rms/config.h"
-#include "rms/input_block.h"
-#include "rms/word_codec.h"
+#include "rms/base/check.h"
+#include "rms/base/config.h"
+#include "rms/wire/input_block.h"
+#include "rms/wire/word_codec.h"
 
 namespace rms {
 namespace {
@@ -21,7 +21,7 @@ TEST_F(InputBlock, RandomInputsRoundTripWithinHalfACount) {
   std::printf("seed %llu\n", static_cast<unsigned long long>(seed));
   std::mt19937_64 rng(seed);
   for (int n = 0; n < 20000; ++n) {
-    OperatorInputs in;
+    wire::OperatorInputs in;
     for (int i = 0; i < kNumAnalogInputs; ++i) {
       std::uniform_real_distribution<double> d(config.inputs[i].min, config.inputs[i].max);
       in.value[i] = d(rng);
@@ -30,9 +30,9 @@ TEST_F(InputBlock, RandomInputsRoundTripWithinHalfACount) {
     in.reset = rng() & 1;
     in.overlay = rng() & 1;
     Counters c;
-    const auto words = EncodeInputs(in, config.inputs, &c);
+    const auto words = wire::EncodeInputs(in, config.inputs, &c);
     for (std::int32_t w : words) ASSERT_TRUE(wire::IsValidWord(w));
-    const OperatorInputs out = DecodeInputs(words, config.inputs, &c);
+    const wire::OperatorInputs out = wire::DecodeInputs(words, config.inputs, &c);
     for (int i = 0; i < kNumAnalogInputs; ++i) {
       ASSERT_LE(std::abs(out.value[i] - in.value[i]), 0.5 * std::abs(config.inputs[i].units_per_count) + 1e-12)
           << kAnalogInputNames[i];
@@ -45,27 +45,27 @@ TEST_F(InputBlock, RandomInputsRoundTripWithinHalfACount) {
 }
 
 TEST_F(InputBlock, OutOfRangeInputsAreClampedAndReported) {
-  OperatorInputs in = InitialInputs(config.inputs);
+  wire::OperatorInputs in = wire::InitialInputs(config.inputs);
   in.value[kShoulderHeight] = 55.0;  // max 20 ft
   in.value[kFinger] = -3.0;          // min 0
   in.camera_station = 11;
   Counters c;
-  const auto words = EncodeInputs(in, config.inputs, &c);
+  const auto words = wire::EncodeInputs(in, config.inputs, &c);
   EXPECT_EQ(c.Get("clamped.shoulder_height"), 1);
   EXPECT_EQ(c.Get("clamped.finger"), 1);
   EXPECT_EQ(c.Get("clamped.camera_station"), 1);
-  const OperatorInputs out = DecodeInputs(words, config.inputs, &c);
+  const wire::OperatorInputs out = wire::DecodeInputs(words, config.inputs, &c);
   EXPECT_NEAR(out.value[kShoulderHeight], 20.0, 1e-3);
   EXPECT_NEAR(out.value[kFinger], 0.0, 1e-4);
   EXPECT_EQ(out.camera_station, 8);
 }
 
 TEST_F(InputBlock, CountsBeyondTheConverterAndBeyondTheRangeAreClampedAtTheDcp) {
-  std::array<std::int32_t, kInputWords> w{};
+  std::array<std::int32_t, wire::kInputWords> w{};
   w[kShoulderHeight] = static_cast<std::int32_t>(wire::FromSigned(100000));  // beyond ADC16
   w[kFinger] = static_cast<std::int32_t>(wire::FromSigned(-5000));          // finger < 0
   Counters c;
-  const OperatorInputs in = DecodeInputs(w, config.inputs, &c);
+  const wire::OperatorInputs in = wire::DecodeInputs(w, config.inputs, &c);
   EXPECT_EQ(c.Get("clamped.adc.shoulder_height"), 1);
   EXPECT_EQ(c.Get("clamped.shoulder_height"), 1);  // 32.767 ft > 20 ft
   EXPECT_EQ(c.Get("clamped.finger"), 1);
@@ -74,23 +74,23 @@ TEST_F(InputBlock, CountsBeyondTheConverterAndBeyondTheRangeAreClampedAtTheDcp) 
 }
 
 TEST_F(InputBlock, MalformedBlocksAreRefusedWithTheWordNamed) {
-  std::array<std::int32_t, kInputWords> w{};
+  std::array<std::int32_t, wire::kInputWords> w{};
   w[3] = 0x1000000;
   try {
-    DecodeInputs(w, config.inputs, nullptr);
+    wire::DecodeInputs(w, config.inputs, nullptr);
     FAIL();
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("input word 3"), std::string::npos) << e.what();
   }
   w[3] = 0;
-  w[kDiscreteWordIndex] = 1 << 7;  // reserved bit
-  EXPECT_THROW(DecodeInputs(w, config.inputs, nullptr), InputError);
+  w[wire::kDiscreteWordIndex] = 1 << 7;  // reserved bit
+  EXPECT_THROW(wire::DecodeInputs(w, config.inputs, nullptr), InputError);
 }
 
 TEST_F(InputBlock, NonFiniteOperatorValuesAreAnError) {
-  OperatorInputs in = InitialInputs(config.inputs);
+  wire::OperatorInputs in = wire::InitialInputs(config.inputs);
   in.value[kElbowPitch] = std::nan("");
-  EXPECT_THROW(EncodeInputs(in, config.inputs, nullptr), InputError);
+  EXPECT_THROW(wire::EncodeInputs(in, config.inputs, nullptr), InputError);
 }
 
 }  // namespace

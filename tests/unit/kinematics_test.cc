@@ -3,8 +3,8 @@
 
 #include <random>
 
-#include "rms/arm_kinematics.h"
-#include "rms/config.h"
+#include "rms/arm/kinematics.h"
+#include "rms/base/config.h"
 
 namespace rms {
 namespace {
@@ -19,8 +19,8 @@ class Kinematics : public ::testing::Test {
     arm.lower_boom_ft = 25.0;
     arm.wrist_to_palm_ft = 5.0;
   }
-  ArmPose Pose(std::array<double, 6> deg, double h = 3.0) {
-    return ComputeArmPose(arm, SinCosFromDegrees(deg), h);
+  arm::ArmPose Pose(std::array<double, 6> deg, double h = 3.0) {
+    return arm::ComputeArmPose(arm, arm::SinCosFromDegrees(deg), h);
   }
   ArmGeometry arm;
 };
@@ -28,7 +28,7 @@ class Kinematics : public ::testing::Test {
 #define EXPECT_VEC_NEAR(a, b, tol) EXPECT_LT(((a) - (b)).norm(), tol) << (a).transpose() << " vs " << (b).transpose()
 
 TEST_F(Kinematics, ZeroAnglesLayTheArmAftAlongXr) {
-  const ArmPose p = Pose({0, 0, 0, 0, 0, 0}, 3.0);
+  const arm::ArmPose p = Pose({0, 0, 0, 0, 0, 0}, 3.0);
   const Vector3d S(1.5, -9.0, 3.0);
   EXPECT_VEC_NEAR(p.p_RoS_R, S, 1e-12);
   EXPECT_VEC_NEAR(p.p_RoE_R, S + Vector3d(20, 0, 0), 1e-12);
@@ -38,7 +38,7 @@ TEST_F(Kinematics, ZeroAnglesLayTheArmAftAlongXr) {
 }
 
 TEST_F(Kinematics, ShoulderYawTurnsTheArmTowardPlusY) {
-  const ArmPose p = Pose({90, 0, 0, 0, 0, 0});
+  const arm::ArmPose p = Pose({90, 0, 0, 0, 0, 0});
   const Vector3d S(1.5, -9.0, 3.0);
   EXPECT_VEC_NEAR(p.X_RS2.translation(), S + Vector3d(0, 50, 0), 1e-12);
   EXPECT_VEC_NEAR(p.X_RS2.linear().col(0), Vector3d(0, 1, 0), 1e-12);   // X2
@@ -47,7 +47,7 @@ TEST_F(Kinematics, ShoulderYawTurnsTheArmTowardPlusY) {
 }
 
 TEST_F(Kinematics, PositiveShoulderPitchRaisesTheArm) {
-  const ArmPose p = Pose({0, 90, 0, 0, 0, 0});
+  const arm::ArmPose p = Pose({0, 90, 0, 0, 0, 0});
   const Vector3d S(1.5, -9.0, 3.0);
   EXPECT_VEC_NEAR(p.p_RoE_R, S + Vector3d(0, 0, 20), 1e-12);
   EXPECT_VEC_NEAR(p.X_RS2.translation(), S + Vector3d(0, 0, 50), 1e-12);
@@ -56,7 +56,7 @@ TEST_F(Kinematics, PositiveShoulderPitchRaisesTheArm) {
 }
 
 TEST_F(Kinematics, ElbowDownFromAVerticalUpperBoom) {
-  const ArmPose p = Pose({0, 90, -90, 0, 0, 0});
+  const arm::ArmPose p = Pose({0, 90, -90, 0, 0, 0});
   const Vector3d S(1.5, -9.0, 3.0);
   EXPECT_VEC_NEAR(p.p_RoE_R, S + Vector3d(0, 0, 20), 1e-12);
   EXPECT_VEC_NEAR(p.p_RoW_R, S + Vector3d(25, 0, 20), 1e-12);
@@ -66,16 +66,16 @@ TEST_F(Kinematics, ElbowDownFromAVerticalUpperBoom) {
 TEST_F(Kinematics, WristPitchYawAndRoll) {
   const Vector3d W = Vector3d(1.5, -9.0, 3.0) + Vector3d(45, 0, 0);
   {  // wrist pitch -90: X2 points down
-    const ArmPose p = Pose({0, 0, 0, -90, 0, 0});
+    const arm::ArmPose p = Pose({0, 0, 0, -90, 0, 0});
     EXPECT_VEC_NEAR(p.X_RS2.translation(), W + Vector3d(0, 0, -5), 1e-12);
     EXPECT_VEC_NEAR(p.X_RS2.linear().col(0), Vector3d(0, 0, -1), 1e-12);
   }
   {  // wrist yaw +90: X2 along +Y
-    const ArmPose p = Pose({0, 0, 0, 0, 90, 0});
+    const arm::ArmPose p = Pose({0, 0, 0, 0, 90, 0});
     EXPECT_VEC_NEAR(p.X_RS2.translation(), W + Vector3d(0, 5, 0), 1e-12);
   }
   {  // wrist roll +90 about X2: Y2 -> +Z, Z2 -> -Y
-    const ArmPose p = Pose({0, 0, 0, 0, 0, 90});
+    const arm::ArmPose p = Pose({0, 0, 0, 0, 0, 90});
     EXPECT_VEC_NEAR(p.X_RS2.translation(), W + Vector3d(5, 0, 0), 1e-12);
     EXPECT_VEC_NEAR(p.X_RS2.linear().col(1), Vector3d(0, 0, 1), 1e-12);
     EXPECT_VEC_NEAR(p.X_RS2.linear().col(2), Vector3d(0, -1, 0), 1e-12);
@@ -90,8 +90,8 @@ TEST_F(Kinematics, TheDemoGraspPoseComputedByHand) {
   def.upper_boom_ft = 20.9;
   def.lower_boom_ft = 23.2;
   def.wrist_to_palm_ft = 6.15;
-  const ArmPose p =
-      ComputeArmPose(def, SinCosFromDegrees({16.19, 52.93, -84.89, -58.04, 0, -73.81}), 3.0);
+  const arm::ArmPose p =
+      arm::ComputeArmPose(def, arm::SinCosFromDegrees({16.19, 52.93, -84.89, -58.04, 0, -73.81}), 3.0);
   EXPECT_VEC_NEAR(p.p_RoW_R, Vector3d(32.50, 0.0, 7.39), 0.02);
   EXPECT_VEC_NEAR(p.X_RS2.translation(), Vector3d(32.50, 0.0, 1.24), 0.02);
   EXPECT_VEC_NEAR(p.X_RS2.linear().col(0), Vector3d(0, 0, -1), 1e-3);
@@ -102,8 +102,8 @@ TEST_F(Kinematics, TheDemoGraspPoseComputedByHand) {
 }
 
 TEST_F(Kinematics, ShoulderHeightMovesEverythingUp) {
-  const ArmPose a = Pose({10, 20, -30, 40, 50, 60}, 2.0);
-  const ArmPose b = Pose({10, 20, -30, 40, 50, 60}, 7.5);
+  const arm::ArmPose a = Pose({10, 20, -30, 40, 50, 60}, 2.0);
+  const arm::ArmPose b = Pose({10, 20, -30, 40, 50, 60}, 7.5);
   EXPECT_VEC_NEAR(b.X_RS2.translation() - a.X_RS2.translation(), Vector3d(0, 0, 5.5), 1e-12);
 }
 
@@ -115,19 +115,19 @@ TEST_F(Kinematics, RandomPosesAreRigidAndIgnoreThePairsScale) {
   for (int i = 0; i < 10000; ++i) {
     std::array<double, 6> deg{};
     for (double& d : deg) d = ang(rng);
-    ArmSinCos sc = SinCosFromDegrees(deg);
-    const ArmPose p = ComputeArmPose(arm, sc, 3.0);
+    arm::ArmSinCos sc = arm::SinCosFromDegrees(deg);
+    const arm::ArmPose p = arm::ComputeArmPose(arm, sc, 3.0);
     const Eigen::Matrix3d R = p.X_RS2.linear();
     ASSERT_LT((R.transpose() * R - Eigen::Matrix3d::Identity()).norm(), 1e-12);
     ASSERT_NEAR(R.determinant(), 1.0, 1e-12);
     ASSERT_NEAR((p.p_RoE_R - p.p_RoS_R).norm(), 20.0, 1e-9);
     ASSERT_NEAR((p.p_RoW_R - p.p_RoE_R).norm(), 25.0, 1e-9);
-    for (SinCos& a : sc) {
+    for (arm::SinCos& a : sc) {
       const double k = scale(rng);
       a.s *= k;
       a.c *= k;
     }
-    const ArmPose q = ComputeArmPose(arm, sc, 3.0);
+    const arm::ArmPose q = arm::ComputeArmPose(arm, sc, 3.0);
     ASSERT_LT((q.X_RS2.translation() - p.X_RS2.translation()).norm(), 1e-9);
   }
 }
@@ -135,7 +135,7 @@ TEST_F(Kinematics, RandomPosesAreRigidAndIgnoreThePairsScale) {
 }  // namespace
 }  // namespace rms
 
-#include "rms/arm_ik.h"
+#include "rms/mission/arm_ik.h"
 
 namespace rms {
 namespace {
@@ -151,11 +151,11 @@ TEST(ArmIk, ForwardOfInverseIsTheTargetPose) {
     // A reachable target: forward kinematics of random angles.
     const std::array<double, 6> deg = {ang(rng), ang(rng), ang(rng), ang(rng), wy(rng), ang(rng)};
     const double height = h(rng);
-    const ArmPose p = ComputeArmPose(config.arm, SinCosFromDegrees(deg), height);
-    for (Elbow elbow : {Elbow::kUp, Elbow::kDown}) {
-      const auto s = SolveArmIk(config.arm, p.X_RS2, height, elbow);
+    const arm::ArmPose p = arm::ComputeArmPose(config.arm, arm::SinCosFromDegrees(deg), height);
+    for (mission::Elbow elbow : {mission::Elbow::kUp, mission::Elbow::kDown}) {
+      const auto s = mission::SolveArmIk(config.arm, p.X_RS2, height, elbow);
       ASSERT_TRUE(s.has_value());
-      const ArmPose q = ComputeArmPose(config.arm, SinCosFromDegrees(s->angles_deg), height);
+      const arm::ArmPose q = arm::ComputeArmPose(config.arm, arm::SinCosFromDegrees(s->angles_deg), height);
       ASSERT_LT((q.X_RS2.translation() - p.X_RS2.translation()).norm(), 1e-7);
       ASSERT_LT((q.X_RS2.linear() - p.X_RS2.linear()).norm(), 1e-7);
       ++solved;
@@ -166,8 +166,8 @@ TEST(ArmIk, ForwardOfInverseIsTheTargetPose) {
 
 TEST(ArmIk, OutOfReachHasNoSolution) {
   const LabConfig config = LoadConfig(DefaultConfigPath());
-  const auto X = EndEffectorPose(Eigen::Vector3d(200, 0, 0), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY());
-  EXPECT_FALSE(SolveArmIk(config.arm, X, 3.0).has_value());
+  const auto X = mission::EndEffectorPose(Eigen::Vector3d(200, 0, 0), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY());
+  EXPECT_FALSE(mission::SolveArmIk(config.arm, X, 3.0).has_value());
 }
 
 }  // namespace

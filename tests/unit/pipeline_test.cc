@@ -3,14 +3,14 @@
 // order, carrying the kinematics; malformed blocks are counted and dropped.
 #include <gtest/gtest.h>
 
-#include "camera_stations.h"
-#include "dcp_node.h"
-#include "rms/channels.h"
-#include "rms/config.h"
+#include "rms/scene_proc/camera_stations.h"
+#include "rms/dynamics_proc/dynamics_proc.h"
+#include "rms/wire/channels.h"
+#include "rms/base/config.h"
 #include "rms/esg_frame_t.hpp"
-#include "rms/message_io.h"
+#include "rms/wire/message_io.h"
 #include "rms/operator_input_t.hpp"
-#include "visual_scene.h"
+#include "rms/scene_proc/scene_proc.h"
 
 namespace rms {
 namespace {
@@ -18,34 +18,34 @@ namespace {
 class Pipeline : public ::testing::Test {
  protected:
   Pipeline() : lcm("", ""), dcp(config, &lcm), scene(config, &lcm) {
-    lcm.Subscribe(channels::kEsgFrame, [this](const void* d, int n, std::int64_t) {
+    lcm.Subscribe(wire::channels::kEsgFrame, [this](const void* d, int n, std::int64_t) {
       esg_frame_t m;
-      ASSERT_EQ(SafeDecode(d, n, 1000, &m), DecodeError::kNone);
+      ASSERT_EQ(wire::SafeDecode(d, n, 1000, &m), wire::DecodeError::kNone);
       esg.push_back(m);
     });
   }
   void Send(const operator_input_t& m) {
-    PublishMessage(lcm, channels::kOperatorInput, m);
+    transport::PublishMessage(lcm, wire::channels::kOperatorInput, m);
     while (lcm.HandleSubscriptions(0) > 0) {
     }
   }
-  operator_input_t Block(std::int64_t frame, const OperatorInputs& in) {
+  operator_input_t Block(std::int64_t frame, const wire::OperatorInputs& in) {
     operator_input_t m{};
     m.frame = frame;
     m.send_time_us = 1000 * frame;
-    const auto w = EncodeInputs(in, config.inputs, nullptr);
+    const auto w = wire::EncodeInputs(in, config.inputs, nullptr);
     std::copy(w.begin(), w.end(), m.words);
     return m;
   }
   LabConfig config = LoadConfig(DefaultConfigPath());
-  LogLcm lcm;
-  dcp::DcpNode dcp;
-  scene::SceneNode scene;
+  transport::LogLcm lcm;
+  dynamics_proc::DynamicsProc dcp;
+  scene_proc::SceneProc scene;
   std::vector<esg_frame_t> esg;
 };
 
 TEST_F(Pipeline, OneEsgFramePerInputBlockCarryingTheKinematics) {
-  OperatorInputs in = InitialInputs(config.inputs);
+  wire::OperatorInputs in = wire::InitialInputs(config.inputs);
   for (int f = 0; f < 30; ++f) {
     in.value[kShoulderYaw] = f;
     in.value[kShoulderPitch] = 2.0 * f;
@@ -58,7 +58,7 @@ TEST_F(Pipeline, OneEsgFramePerInputBlockCarryingTheKinematics) {
     EXPECT_EQ(esg[f].frame, f);
     EXPECT_EQ(esg[f].input_frame, f);
     ASSERT_LE(esg[f].num_words, 64);
-    const EsgFrameData d = UnpackEsgWords(esg[f].words);
+    const wire::EsgFrameData d = wire::UnpackEsgWords(esg[f].words);
     EXPECT_EQ(d.control.camera_station, 1 + f % 8);
     EXPECT_EQ(d.control.mode, 1);
     EXPECT_NEAR(std::atan2(d.arm[0].s, d.arm[0].c) * 180 / M_PI, f, 0.006);
@@ -72,11 +72,11 @@ TEST_F(Pipeline, OneEsgFramePerInputBlockCarryingTheKinematics) {
 }
 
 TEST_F(Pipeline, ViewFollowsTheSelectedCameraStation) {
-  OperatorInputs in = InitialInputs(config.inputs);
+  wire::OperatorInputs in = wire::InitialInputs(config.inputs);
   in.camera_station = 8;
   Send(Block(0, in));
   ASSERT_EQ(esg.size(), 1u);
-  const EsgFrameData d = UnpackEsgWords(esg[0].words);
+  const wire::EsgFrameData d = wire::UnpackEsgWords(esg[0].words);
   const auto& cam = config.cameras[7];
   EXPECT_LT((d.p_RoEye_R_ft - cam.p_MoCam_M_ft).norm(), 1e-3);
   const Eigen::Vector3d look = (cam.p_MoAim_M_ft - cam.p_MoCam_M_ft).normalized();
@@ -85,7 +85,7 @@ TEST_F(Pipeline, ViewFollowsTheSelectedCameraStation) {
 }
 
 TEST_F(Pipeline, MalformedDuplicateAndStaleBlocksAreCountedAndDropped) {
-  OperatorInputs in = InitialInputs(config.inputs);
+  wire::OperatorInputs in = wire::InitialInputs(config.inputs);
   Send(Block(0, in));
   operator_input_t bad = Block(1, in);
   bad.words[2] = 0x7000000;  // bits above 23
@@ -94,7 +94,7 @@ TEST_F(Pipeline, MalformedDuplicateAndStaleBlocksAreCountedAndDropped) {
   Send(Block(1, in));  // duplicate
   Send(Block(0, in));  // stale
   const char junk[5] = {1, 2, 3, 4, 5};
-  lcm.Publish(channels::kOperatorInput, junk, 5);
+  lcm.Publish(wire::channels::kOperatorInput, junk, 5);
   while (lcm.HandleSubscriptions(0) > 0) {
   }
   Send(Block(4, in));  // frames 2 and 3 lost
@@ -107,11 +107,11 @@ TEST_F(Pipeline, MalformedDuplicateAndStaleBlocksAreCountedAndDropped) {
 }
 
 TEST_F(Pipeline, ResetReturnsToMode1AndSetsTheResetBit) {
-  OperatorInputs in = InitialInputs(config.inputs);
+  wire::OperatorInputs in = wire::InitialInputs(config.inputs);
   in.reset = true;
   Send(Block(0, in));
   ASSERT_EQ(esg.size(), 1u);
-  const EsgFrameData d = UnpackEsgWords(esg[0].words);
+  const wire::EsgFrameData d = wire::UnpackEsgWords(esg[0].words);
   EXPECT_TRUE(d.control.reset);
   EXPECT_EQ(d.control.mode, 1);
 }

@@ -12,11 +12,11 @@
 #include <map>
 #include <set>
 
-#include "gl_context.h"
-#include "offline_session.h"
-#include "priority_table.h"
-#include "renderer.h"
-#include "rms/config.h"
+#include "rms/esg_renderer/gl_context.h"
+#include "rms/sim/offline_session.h"
+#include "rms/sim/priority_table.h"
+#include "rms/esg_renderer/renderer.h"
+#include "rms/base/config.h"
 
 namespace rms {
 namespace {
@@ -26,25 +26,25 @@ constexpr int kW = 320, kH = 240;
 class Scene : public ::testing::Test {
  protected:
   Scene()
-      : gl(esg::CreateGlContext(esg::GlBackend::kOsMesa, kW, kH)),
+      : gl(esg_renderer::CreateGlContext(esg_renderer::GlBackend::kOsMesa, kW, kH)),
         renderer(config, gl.get(), {.id_colors = true}) {}
 
   // Pixels of each cluster in a frame's object-id render.
-  std::map<int, int> Seen(const EsgFrameData& f) {
+  std::map<int, int> Seen(const wire::EsgFrameData& f) {
     renderer.Render(f);
     const std::uint8_t* px = renderer.pixels();
     std::map<int, int> n;
     for (int i = 0; i < kW * kH; ++i) {
-      const int c = esg::ClusterOfColor(px + 4 * i);
+      const int c = esg_renderer::ClusterOfColor(px + 4 * i);
       if (c >= 0) ++n[c];
     }
     return n;
   }
   // The mission's frames at these times (s), from every station.
-  std::map<double, std::array<EsgFrameData, kNumCameraStations>> AtTimes(std::set<double> times) {
-    offline::OfflineSession s(config, op::Timeline::Load(std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl",
+  std::map<double, std::array<wire::EsgFrameData, kNumCameraStations>> AtTimes(std::set<double> times) {
+    sim::OfflineSession s(config, operator_station::Timeline::Load(std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl",
                                                          config.inputs));
-    std::map<double, std::array<EsgFrameData, kNumCameraStations>> out;
+    std::map<double, std::array<wire::EsgFrameData, kNumCameraStations>> out;
     while (s.Next()) {
       for (double t : times) {
         if (std::abs(s.t_s() - t) < 1e-6) {
@@ -56,8 +56,8 @@ class Scene : public ::testing::Test {
   }
 
   LabConfig config = LoadConfig(DefaultConfigPath());
-  std::unique_ptr<esg::GlContext> gl;
-  esg::EsgRenderer renderer;
+  std::unique_ptr<esg_renderer::GlContext> gl;
+  esg_renderer::FrameRenderer renderer;
 };
 
 TEST_F(Scene, EachStationShowsWhatItShould) {
@@ -69,24 +69,24 @@ TEST_F(Scene, EachStationShowsWhatItShould) {
     std::vector<int> hides;
   };
   const std::vector<Expect> expects = {
-      {11, 1, {kFloor, kPayloadBody, kEffHex1, kWrist}, {kCaeModule}},                 // aft flight deck, overhead
-      {11, 2, {kFloor, kPayloadBody, kTail}, {}},                                       // aft flight deck, port aft
-      {11, 3, {kLowerBoom, kPayloadBody}, {kUpperBoom}},                                // elbow, looking along the lower boom
-      {11, 4, {kEffHex1, kEffHex2, kEffHex3, kBar, kPayloadBody}, {kCaeModule}},      // wrist: fingers about the bar
-      {11, 5, {kPayloadBody, kBulkheadAft, kEffHex1}, {kBulkheadFwd}},                 // bay, forward bulkhead, looking aft
-      {11, 6, {kPayloadBody, kProbe, kBulkheadFwd, kCabin}, {kBulkheadAft}},           // bay, aft bulkhead, looking forward
-      {24, 8, {kCaeModule, kTail, kPayloadBody, kWingStbd, kDoorStbd}, {}},            // external
-      {41, 7, {kProbe, kPayloadBody}, {}},                                              // CAE port: the probe docked
-      {41, 1, {kFloor}, {kPayloadBody}},                                                // the payload has left the bay
-      {41, 3, {kLowerBoom, kPayloadBody, kCaeModule}, {}},
+      {11, 1, {scene_model::kFloor, scene_model::kPayloadBody, scene_model::kEffHex1, scene_model::kWrist}, {scene_model::kCaeModule}},                 // aft flight deck, overhead
+      {11, 2, {scene_model::kFloor, scene_model::kPayloadBody, scene_model::kTail}, {}},                                       // aft flight deck, port aft
+      {11, 3, {scene_model::kLowerBoom, scene_model::kPayloadBody}, {scene_model::kUpperBoom}},                                // elbow, looking along the lower boom
+      {11, 4, {scene_model::kEffHex1, scene_model::kEffHex2, scene_model::kEffHex3, scene_model::kBar, scene_model::kPayloadBody}, {scene_model::kCaeModule}},      // wrist: fingers about the bar
+      {11, 5, {scene_model::kPayloadBody, scene_model::kBulkheadAft, scene_model::kEffHex1}, {scene_model::kBulkheadFwd}},                 // bay, forward bulkhead, looking aft
+      {11, 6, {scene_model::kPayloadBody, scene_model::kProbe, scene_model::kBulkheadFwd, scene_model::kCabin}, {scene_model::kBulkheadAft}},           // bay, aft bulkhead, looking forward
+      {24, 8, {scene_model::kCaeModule, scene_model::kTail, scene_model::kPayloadBody, scene_model::kWingStbd, scene_model::kDoorStbd}, {}},            // external
+      {41, 7, {scene_model::kProbe, scene_model::kPayloadBody}, {}},                                              // CAE port: the probe docked
+      {41, 1, {scene_model::kFloor}, {scene_model::kPayloadBody}},                                                // the payload has left the bay
+      {41, 3, {scene_model::kLowerBoom, scene_model::kPayloadBody, scene_model::kCaeModule}, {}},
   };
   for (const Expect& e : expects) {
     const auto seen = Seen(frames.at(e.t)[e.station - 1]);
     for (int c : e.shows) {
-      EXPECT_GT(seen.count(c) ? seen.at(c) : 0, 20) << "t " << e.t << " station " << e.station << " should show " << ClusterName(c);
+      EXPECT_GT(seen.count(c) ? seen.at(c) : 0, 20) << "t " << e.t << " station " << e.station << " should show " << scene_model::ClusterName(c);
     }
     for (int c : e.hides) {
-      EXPECT_EQ(seen.count(c), 0u) << "t " << e.t << " station " << e.station << " should not show " << ClusterName(c);
+      EXPECT_EQ(seen.count(c), 0u) << "t " << e.t << " station " << e.station << " should not show " << scene_model::ClusterName(c);
     }
   }
 }
@@ -100,25 +100,25 @@ struct Blob {
 
 TEST_F(Scene, PanTiltAndZoomMoveTheImageTheRightWay) {
   const auto frames = AtTimes({11.0});
-  offline::OfflineSession s(config, op::Timeline::Load(std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl",
+  sim::OfflineSession s(config, operator_station::Timeline::Load(std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl",
                                                        config.inputs));
   while (s.Next() && s.t_s() < 11.0 - 1e-9) {
   }
   auto look = [&](double pan, double tilt, double zoom) {
-    scene::VisualScene vs(config);
-    DcpFrameData d = s.dcp();
+    scene_proc::VisualSceneProgram vs(config);
+    wire::DcpFrameData d = s.dcp();
     d.control.camera_station = 8;
     d.camera_pan_deg = pan;
     d.camera_tilt_deg = tilt;
     d.camera_zoom = zoom;
-    EsgFrameData e;
+    wire::EsgFrameData e;
     for (int i = 0; i < 150; ++i) e = vs.Step(d, 0, nullptr);  // 5 s: every drive has arrived
-    renderer.Render(UnpackEsgWords(PackEsgWords(e, nullptr)));
+    renderer.Render(wire::UnpackEsgWords(wire::PackEsgWords(e, nullptr)));
     const std::uint8_t* px = renderer.pixels();
     Blob b;
     for (int y = 0; y < kH; ++y)
       for (int x = 0; x < kW; ++x) {
-        if (esg::ClusterOfColor(px + 4 * (y * kW + x)) == kCabin) {
+        if (esg_renderer::ClusterOfColor(px + 4 * (y * kW + x)) == scene_model::kCabin) {
           b.x += x;
           b.y += y;
           ++b.pixels;
@@ -141,9 +141,9 @@ TEST_F(Scene, PanTiltAndZoomMoveTheImageTheRightWay) {
 }
 
 TEST_F(Scene, CameraDrivesSlewAtTheirRates) {
-  scene::VisualScene vs(config);
-  DcpFrameData d;
-  d.arm = SinCosFromDegrees({0, 0, 0, 0, 0, 0});
+  scene_proc::VisualSceneProgram vs(config);
+  wire::DcpFrameData d;
+  d.arm = arm::SinCosFromDegrees({0, 0, 0, 0, 0, 0});
   d.control.camera_station = 1;
   d.shoulder_height_ft = 3;
   d.camera_pan_deg = 60;
@@ -168,9 +168,9 @@ TEST_F(Scene, CameraDrivesSlewAtTheirRates) {
 TEST_F(Scene, PriorityDrawsWhatTheDepthBufferDrawsOverTheMissionFromEveryStation) {
   // Every 15th frame of the mission from all eight stations at 320 x 240;
   // build/tools/rms_visibility measures every frame at 1024 x 768.
-  auto gd = esg::CreateGlContext(esg::GlBackend::kOsMesa, kW, kH);
-  esg::EsgRenderer depth(config, gd.get(), {.visibility = esg::Visibility::kDepth, .id_colors = true});
-  offline::OfflineSession s(config, op::Timeline::Load(std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl",
+  auto gd = esg_renderer::CreateGlContext(esg_renderer::GlBackend::kOsMesa, kW, kH);
+  esg_renderer::FrameRenderer depth(config, gd.get(), {.visibility = esg_renderer::Visibility::kDepth, .id_colors = true});
+  sim::OfflineSession s(config, operator_station::Timeline::Load(std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl",
                                                        config.inputs));
   std::array<long, kNumCameraStations> differing{};
   long frames = 0, cycles = 0;
@@ -196,7 +196,7 @@ TEST_F(Scene, APlaneSeparatesEveryPairOfClustersThroughoutTheMission) {
   // A pair with no separating plane interpenetrates (the arm through the
   // orbiter, say): visual priority can then not be right, and the mission
   // flies through something solid.
-  offline::OfflineSession s(config, op::Timeline::Load(std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl",
+  sim::OfflineSession s(config, operator_station::Timeline::Load(std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl",
                                                        config.inputs));
   long frames = 0;
   while (s.Next()) ++frames;
@@ -209,26 +209,26 @@ TEST_F(Scene, NoCameraEverSitsInsideASolid) {
   // away) and would see its inside if back faces were drawn: a modelling
   // error that back-face culling hides. Every 5th frame of the mission, every
   // station, every solid cluster.
-  const SceneModel model = BuildSceneModel(config);
-  offline::OfflineSession s(config, op::Timeline::Load(std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl",
+  const scene_model::SceneModel model = scene_model::BuildSceneModel(config);
+  sim::OfflineSession s(config, operator_station::Timeline::Load(std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl",
                                                        config.inputs));
   long checked = 0;
   while (s.Next()) {
     if (s.frame() % 5) continue;
     for (int st = 1; st <= kNumCameraStations; ++st) {
-      const EsgFrameData& f = s.esg(st);
-      const ClusterPoses poses = ComputeClusterPoses(config, f);
-      for (int c = 0; c < kNumClusters; ++c) {
+      const wire::EsgFrameData& f = s.esg(st);
+      const scene_model::ClusterPoses poses = scene_model::ComputeClusterPoses(config, f.scene_pose());
+      for (int c = 0; c < scene_model::kNumClusters; ++c) {
         if (!poses.present[c] || model[c].flat) continue;
         ++checked;
         // The eye in the cluster's frame; inside when behind every face.
         const Eigen::Vector3f p = (poses.X_RC[c].inverse() * f.p_RoEye_R_ft).cast<float>();
         float max_out_ft = -1e9f;
-        for (const Triangle& t : model[c].mesh.triangles()) {
+        for (const scene_model::Triangle& t : model[c].mesh.triangles()) {
           if (!t.decal) max_out_ft = std::max(max_out_ft, t.n.dot(p - t.a));
         }
         EXPECT_GT(max_out_ft, 0.0f) << "station " << st << " (" << config.cameras[st - 1].name << ") is inside "
-                                    << ClusterName(c) << " at frame " << s.frame();
+                                    << scene_model::ClusterName(c) << " at frame " << s.frame();
       }
     }
   }
@@ -239,7 +239,7 @@ TEST_F(Scene, ThePriorityTableInTheDocsIsWhatTheCodeComputes) {
   std::ifstream in(std::string(RMSLAB_SOURCE_DIR) + "/docs/priority-table.md");
   std::stringstream shipped;
   shipped << in.rdbuf();
-  EXPECT_EQ(shipped.str(), offline::PriorityTableMarkdown(
+  EXPECT_EQ(shipped.str(), sim::PriorityTableMarkdown(
                                config, std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl"))
       << "regenerate: build/tools/rms_priority_table > docs/priority-table.md";
 }

@@ -1,10 +1,10 @@
 #include <gtest/gtest.h>
 
-#include "rms/check.h"
-#include "rms/config.h"
-#include "timeline.h"
+#include "rms/base/check.h"
+#include "rms/base/config.h"
+#include "rms/operator_station/timeline.h"
 
-namespace rms::op {
+namespace rms::operator_station {
 namespace {
 
 class TimelineTest : public ::testing::Test {
@@ -76,4 +76,4 @@ TEST_F(TimelineTest, TheShippedTimelinesParse) {
 }
 
 }  // namespace
-}  // namespace rms::op
+}  // namespace rms::operator_station

@@ -2,9 +2,9 @@
 
 #include <random>
 
-#include "rms/check.h"
+#include "rms/base/check.h"
 #include "rms/dcp_frame_t.hpp"
-#include "rms/word_blocks.h"
+#include "rms/wire/word_blocks.h"
 
 namespace rms {
 namespace {
@@ -14,14 +14,14 @@ Eigen::Matrix3d RandomRotation(std::mt19937_64& rng) {
   return Eigen::Quaterniond(n(rng), n(rng), n(rng), n(rng)).normalized().toRotationMatrix();
 }
 
-EsgFrameData RandomEsg(std::mt19937_64& rng) {
+wire::EsgFrameData RandomEsg(std::mt19937_64& rng) {
   std::uniform_real_distribution<double> pos(-500, 500), ang(-180, 180), u(0, 1);
-  EsgFrameData e;
+  wire::EsgFrameData e;
   e.frame_count = static_cast<std::uint32_t>(rng() & 0xFFFFFF);
   e.control.camera_station = 1 + static_cast<int>(rng() % 8);
   e.control.mode = 1 + static_cast<int>(rng() % 3);
   e.control.priority_fixed = static_cast<std::uint32_t>(rng() % 128);
-  e.arm = SinCosFromDegrees({ang(rng), ang(rng), ang(rng), ang(rng), ang(rng), ang(rng)});
+  e.arm = arm::SinCosFromDegrees({ang(rng), ang(rng), ang(rng), ang(rng), ang(rng), ang(rng)});
   e.shoulder_height_ft = 20 * u(rng);
   e.finger_gap_ft = u(rng);
   e.p_RoEye_R_ft = {pos(rng), pos(rng), pos(rng)};
@@ -38,13 +38,13 @@ TEST(EsgFrame, PackedFramesFitTheIeuAndRoundTripWithinOneLsb) {
   std::mt19937_64 rng(seed);
   const double ft = wire::kFT12.lsb(), sc = wire::kSC22.lsb();
   for (int i = 0; i < 20000; ++i) {
-    const EsgFrameData e = RandomEsg(rng);
+    const wire::EsgFrameData e = RandomEsg(rng);
     Counters c;
-    const std::vector<std::int32_t> w = PackEsgWords(e, &c);
+    const std::vector<std::int32_t> w = wire::PackEsgWords(e, &c);
     ASSERT_LE(w.size(), 64u);
     ASSERT_EQ(wire::FirstInvalidWord(w), -1);
     ASSERT_EQ(c.SumPrefix("saturated."), 0);
-    const EsgFrameData d = UnpackEsgWords(w);
+    const wire::EsgFrameData d = wire::UnpackEsgWords(w);
     ASSERT_EQ(d.frame_count, e.frame_count);
     ASSERT_EQ(d.control, e.control);
     for (int k = 0; k < 6; ++k) {
@@ -61,17 +61,17 @@ TEST(EsgFrame, PackedFramesFitTheIeuAndRoundTripWithinOneLsb) {
 
 TEST(EsgFrame, PositionsBeyondTheFormatSaturateAndAreCounted) {
   std::mt19937_64 rng(1);
-  EsgFrameData e = RandomEsg(rng);
+  wire::EsgFrameData e = RandomEsg(rng);
   e.p_RoEye_R_ft.x() = 1e5;
   Counters c;
-  const auto w = PackEsgWords(e, &c);
+  const auto w = wire::PackEsgWords(e, &c);
   EXPECT_EQ(c.Get("saturated.eye"), 1);
-  EXPECT_NEAR(UnpackEsgWords(w).p_RoEye_R_ft.x(), 2048.0, 1e-3);
+  EXPECT_NEAR(wire::UnpackEsgWords(w).p_RoEye_R_ft.x(), 2048.0, 1e-3);
 }
 
 std::string ErrorOf(std::vector<std::int32_t> w) {
   try {
-    UnpackEsgWords(w);
+    wire::UnpackEsgWords(w);
   } catch (const InputError& e) {
     return e.what();
   }
@@ -80,7 +80,7 @@ std::string ErrorOf(std::vector<std::int32_t> w) {
 
 TEST(EsgFrame, MalformedFramesAreRefusedNamingTheWord) {
   std::mt19937_64 rng(2);
-  const std::vector<std::int32_t> good = PackEsgWords(RandomEsg(rng), nullptr);
+  const std::vector<std::int32_t> good = wire::PackEsgWords(RandomEsg(rng), nullptr);
   ASSERT_EQ(ErrorOf(good), "");
   {
     auto w = good;
@@ -90,37 +90,37 @@ TEST(EsgFrame, MalformedFramesAreRefusedNamingTheWord) {
   {
     auto w = good;
     w.push_back(0);
-    EXPECT_NE(ErrorOf(w).find("this layout has " + std::to_string(esg_words::kCount)), std::string::npos) << ErrorOf(w);
+    EXPECT_NE(ErrorOf(w).find("this layout has " + std::to_string(wire::esg_words::kCount)), std::string::npos) << ErrorOf(w);
   }
   {
     auto w = good;
-    w[esg_words::kArm] = 0;
-    w[esg_words::kArm + 1] = 0;  // sin = cos = 0
+    w[wire::esg_words::kArm] = 0;
+    w[wire::esg_words::kArm + 1] = 0;  // sin = cos = 0
     EXPECT_NE(ErrorOf(w).find("unit circle"), std::string::npos) << ErrorOf(w);
   }
   {
     auto w = good;
-    for (int k = 0; k < 9; ++k) w[esg_words::kView + k] = 0;
+    for (int k = 0; k < 9; ++k) w[wire::esg_words::kView + k] = 0;
     EXPECT_NE(ErrorOf(w).find("rotation"), std::string::npos) << ErrorOf(w);
   }
   {
     auto w = good;
-    w[esg_words::kControl] = 0;  // mode 0
+    w[wire::esg_words::kControl] = 0;  // mode 0
     EXPECT_NE(ErrorOf(w).find("mode 0"), std::string::npos) << ErrorOf(w);
   }
   {
     auto w = good;
-    w[esg_words::kFov] = 0;
+    w[wire::esg_words::kFov] = 0;
     EXPECT_NE(ErrorOf(w).find("field of view"), std::string::npos) << ErrorOf(w);
   }
 }
 
 TEST(DcpFrame, RoundTripAndRefusals) {
   std::mt19937_64 rng(3);
-  DcpFrameData d;
+  wire::DcpFrameData d;
   d.frame = 12;
   d.input_frame = 10;
-  d.arm = SinCosFromDegrees({1, 2, 3, 4, 5, 6});
+  d.arm = arm::SinCosFromDegrees({1, 2, 3, 4, 5, 6});
   d.control.mode = 2;
   d.control.acquired = true;
   d.planes[1].n_R = Eigen::Vector3d(0, 0.6, 0.8);
@@ -134,8 +134,8 @@ TEST(DcpFrame, RoundTripAndRefusals) {
   d.p_RoPo_R_ft = {30, 1, -2};
   d.R_RP = RandomRotation(rng);
   dcp_frame_t m;
-  PackDcpFrame(d, &m, nullptr);
-  const DcpFrameData u = UnpackDcpFrame(m);
+  wire::PackDcpFrame(d, &m, nullptr);
+  const wire::DcpFrameData u = wire::UnpackDcpFrame(m);
   EXPECT_EQ(u.frame, 12);
   EXPECT_EQ(u.control, d.control);
   EXPECT_EQ(u.plane_valid, 2u);
@@ -147,13 +147,13 @@ TEST(DcpFrame, RoundTripAndRefusals) {
 
   dcp_frame_t bad = m;
   bad.control_word |= 1 << 20;  // a priority bit: scene_proc's, not the DCP's
-  EXPECT_THROW(UnpackDcpFrame(bad), InputError);
+  EXPECT_THROW(wire::UnpackDcpFrame(bad), InputError);
   bad = m;
-  bad.state_words[dcp_state::kPayloadPos] = -5;  // bits above 23
-  EXPECT_THROW(UnpackDcpFrame(bad), InputError);
+  bad.state_words[wire::dcp_state::kPayloadPos] = -5;  // bits above 23
+  EXPECT_THROW(wire::UnpackDcpFrame(bad), InputError);
   bad = m;
   bad.plane_status = 9;
-  EXPECT_THROW(UnpackDcpFrame(bad), InputError);
+  EXPECT_THROW(wire::UnpackDcpFrame(bad), InputError);
 }
 
 }  // namespace

@@ -3,12 +3,12 @@
 //   rms_resim SESSION                      exit 0 only if identical, word for word
 //   rms_resim SESSION --config FILE [--out DIR]   the same inputs, another design
 #include <CLI/CLI.hpp>
-#include "rms/command_line.h"
+#include "rms/base/command_line.h"
 #include <cstdio>
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
-#include "resim.h"
+#include "rms/resim/resim.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"rmslab rms_resim: run the DCP again on a session's recorded operator inputs, as fast as it can. "

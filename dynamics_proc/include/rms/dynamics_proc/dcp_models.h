@@ -1,0 +1,71 @@
+#pragma once
+// The models of the DYNAMIC COLLISION PROGRAM, generated every frame in
+// Reference coordinates the report's way (Section IV.A.2): the three
+// System-Two unit vectors (or the payload's, the bay's, the CAE's) scaled by
+// the dimensions of the configuration. docs/collision.md has the figures.
+#include <array>
+#include <string>
+
+#include <Eigen/Geometry>
+
+#include "rms/dynamics_proc/hexahedron.h"
+#include "rms/base/config.h"
+
+namespace rms::dynamics_proc {
+
+// EFF HEX 1 (palm), EFF HEX 2 (fixed finger), EFF HEX 3 (movable finger).
+// System Two: X2 = UX2 along the approach (a -> d: face d is the palm's
+// "bottom"), Y2 = UY2 (b -> e), Z2 = UZ2 (c -> f). Face b of EFF HEX 2 and
+// face e of EFF HEX 3 are the fingers' interior faces, `finger_gap_ft` apart.
+struct EndEffectorModel {
+  std::array<Hexahedron, 3> hex;
+};
+EndEffectorModel MakeEndEffector(const EndEffectorConfig& ee, const Eigen::Isometry3d& X_RS2,
+                                 double finger_gap_ft);
+
+// The bar receptacle (BAR, RECPT) on the payload: u = x_P along the bar
+// (faces a and d are its ends), v = -y_P, w = -z_P (face c its top).
+Hexahedron MakeBar(const PayloadConfig& p, const Eigen::Isometry3d& X_RP);
+
+// The BAR's two posts in Reference coordinates: rms::BarPosts_P (the boxes
+// the scene draws), x_P, y_P, z_P as u, v, w. Returns how many (0 or 2).
+int MakeBarPosts(const PayloadConfig& p, const Eigen::Isometry3d& X_RP, std::array<Hexahedron, 2>* posts);
+
+// The payload model (the report's Figure 8, reconstructed; docs/collision.md
+// "The payload"): the body is the drawn 16-sided prism round the cylinder
+// (a flat on top, r cos(pi/16) above the axis, as the scene draws it), so
+// contact shows where it is drawn. Its 32 vertices take the place of the
+// report's V11-V18; Mode 1 tests it as seven hexahedra, horizontal strips of
+// the 16-gon (each a trapezoid prism). V21-V24 the probe's root, V31-V36 the
+// probe's tip.
+inline constexpr int kBodySides = 16;
+inline constexpr int kBodyStrips = 7;
+inline constexpr int kBodyVertices = 2 * kBodySides;
+inline constexpr int kProbeFirst = kBodyVertices;      // V21
+inline constexpr int kProbeTipFirst = kProbeFirst + 4;  // V31
+inline constexpr int kPayloadVertices = kProbeTipFirst + 6;
+struct PayloadModel {
+  // Strip j between the 16-gon's vertex levels j and j + 1 from the top:
+  // u = y_P (face d at the probe end), v = x_P, w = -z_P (c the strip's top).
+  std::array<Hexahedron, kBodyStrips> body;
+  std::array<Eigen::Vector3d, kPayloadVertices> v;  // body (aft ring, then fore ring), V21..V24, V31..V36
+  Eigen::Vector3d probe_tip_centre;                 // centre of V31-V36
+  Eigen::Vector3d probe_axis;                       // y_P, the probe's y-axis
+};
+PayloadModel MakePayload(const PayloadConfig& p, const Eigen::Isometry3d& X_RP);
+// The payload vertex names: "B1" .. "B32" (the body), "V21" .. "V36".
+std::string PayloadVertexName(int i);
+
+// The cargo bay (Figure 8): u = X_R (a forward bulkhead, d aft bulkhead),
+// v = -Y_R (b starboard wall, e port wall), w = -Z_R (c the top, the bay's
+// opening; f the bottom).
+Hexahedron MakeCargoBay(const ShuttleConfig& s);
+
+// The CAE's front half (Figure 9): the octahedron (a hexagonal prism: six
+// sides and two ends) cut through its axis parallel to the port's face. u =
+// z_C (a, d the ends), v = x_C (b, e the slanted sides), w = y_C (c the face
+// with the docking port, f the cut). Face c's neighbours a, b, d, e bound
+// the docking envelope.
+Hexahedron MakeCaeFrontHalf(const CaeConfig& c);
+
+}  // namespace rms::dynamics_proc

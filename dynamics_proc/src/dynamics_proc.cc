@@ -1,0 +1,329 @@
+#include "rms/dynamics_proc/dynamics_proc.h"
+
+#include <spdlog/spdlog.h>
+
+#include <filesystem>
+
+#include "rms/wire/channels.h"
+#include "rms/base/check.h"
+#include "rms/dcp_frame_t.hpp"
+#include "rms/dcp_telemetry_t.hpp"
+#include "rms/wire/frame_receiver.h"
+#include "rms/wire/message_io.h"
+#include "rms/operator_input_t.hpp"
+#include "rms/session_control_t.hpp"
+#include "rms/wire/checkpoint.h"
+
+namespace rms::dynamics_proc {
+
+namespace {
+// operator_input_t has a fixed size: 8 (fingerprint) + the sender + 2 x 8 + 12 x 4.
+constexpr int kMaxInputSize = 8 + wire::kSenderBytes + 16 + 4 * wire::kInputWords;
+}  // namespace
+
+DynamicsProc::DynamicsProc(const LabConfig& config, transport::LcmInterface* lcm)
+    : config_(config), lcm_(lcm), dcp_(config) {
+  lcm_->Subscribe(wire::channels::kOperatorInput, [this](const void* d, int n, std::int64_t t) {
+    OnInput(d, n, t);
+  });
+  lcm_->Subscribe(wire::channels::kControl, [this](const void* d, int n, std::int64_t) { OnControl(d, n); });
+}
+
+wire::Checkpoint DynamicsProc::MakeCheckpoint() const {
+  wire::Checkpoint c;
+  c.dcp_frame = next_frame_ - 1;
+  c.input_frame = last_input_frame_;
+  c.saved_us = transport::WallTimeUs();
+  c.config = config_.source;
+  c.inputs = last_inputs_;
+  c.dcp = dcp_.SaveState();
+  return c;
+}
+
+void DynamicsProc::SaveCheckpoint(const std::string& path) const { wire::WriteCheckpoint(path, MakeCheckpoint()); }
+
+void DynamicsProc::RestoreCheckpoint(const std::string& path) { Restore(wire::ReadCheckpoint(path), path); }
+
+void DynamicsProc::Restore(const wire::Checkpoint& c, const std::string& what) {
+  try {
+    dcp_.RestoreState(c.dcp);
+  } catch (const std::exception& e) {
+    throw InputError("checkpoint '" + what + "': " + e.what());
+  }
+  spdlog::info("restored the DCP's state from {} (saved at DCP frame {}): Mode {}{}{}", what, c.dcp_frame,
+               dcp_.status().mode, dcp_.status().acquired ? ", acquired" : "", dcp_.status().docked ? ", docked" : "");
+}
+
+void DynamicsProc::PublishState(std::int8_t reason) {
+  dcp_state_t m{};
+  m.send_time_us = lcm_->NowUs();
+  m.reason = reason;
+  m.next_frame = next_frame_;
+  m.input_frame = last_input_frame_;
+  m.resume_pending = resume_.has_value();
+  m.resume_dcp_frame = resume_ ? resume_->first : -1;
+  m.resume_input_frame = resume_ ? resume_->second : -1;
+  m.checkpoint = wire::CheckpointText(MakeCheckpoint());
+  if (transport::PublishMessage(*lcm_, wire::channels::kDcpState, m)) counters_.Add("state.published");
+  else counters_.Add("publish_failed");
+  frames_since_state_ = 0;
+}
+
+void DynamicsProc::ApplyState(const dcp_state_t& m, bool with_state) {
+  if (with_state) {
+    const wire::Checkpoint c = wire::ParseCheckpoint(m.checkpoint, "RMS_DCP_STATE");
+    try {
+      dcp_.RestoreState(c.dcp);
+    } catch (const std::exception& e) {
+      throw InputError(std::string("RMS_DCP_STATE: ") + e.what());
+    }
+    last_inputs_ = c.inputs;
+  }
+  next_frame_ = m.next_frame;
+  last_input_frame_ = m.input_frame;
+  if (m.resume_pending) resume_ = std::pair{m.resume_dcp_frame, m.resume_input_frame};
+  else resume_.reset();
+  frames_since_state_ = 0;
+}
+
+bool DynamicsProc::ResumeFromStateFile() {
+  if (state_file_.empty() || !std::filesystem::exists(state_file_)) return false;
+  const wire::Checkpoint c = wire::ReadCheckpoint(state_file_);
+  try {
+    dcp_.RestoreState(c.dcp);
+  } catch (const std::exception& e) {
+    throw InputError("state file '" + state_file_ + "': " + e.what());
+  }
+  // The DCP frames are one to one with the operator's: the first input
+  // after the resume sets the numbering, so the scene sees as missing exactly
+  // the inputs that came while this process was down.
+  next_frame_ = c.dcp_frame + 1;
+  resume_ = std::pair{c.dcp_frame, c.input_frame};
+  last_inputs_ = c.inputs;
+  counters_.Add("resumed");
+  spdlog::warn("resumed from the last state written ({}, DCP frame {}): Mode {}{}{}", state_file_, c.dcp_frame,
+               dcp_.status().mode, dcp_.status().acquired ? ", payload attached" : "",
+               dcp_.status().docked ? ", docked" : "");
+  return true;
+}
+
+void DynamicsProc::WriteStateFile() {
+  if (state_file_.empty()) return;
+  const std::string tmp = state_file_ + ".tmp";
+  try {
+    SaveCheckpoint(tmp);
+    std::filesystem::rename(tmp, state_file_);
+    counters_.Add("state_file.writes");
+  } catch (const std::exception& e) {
+    counters_.Add("state_file.errors");
+    spdlog::error("cannot write the state file: {}", e.what());
+  }
+  state_written_us_ = lcm_->NowUs();
+}
+
+void DynamicsProc::OnControl(const void* data, int size) {
+  session_control_t m;
+  if (wire::SafeDecode(data, size, 1 << 16, &m) != wire::DecodeError::kNone) {
+    counters_.Add("dropped.control_malformed");
+    return;
+  }
+  if (m.command != session_control_t::CHECKPOINT && m.command != session_control_t::RESTORE) return;
+  // The name is the sender's (docs/security.md "The control channel"): it
+  // is looked up in the session's checkpoints folder only, a few times a
+  // second at most.
+  if (!checkpoint_rate_.Allow(lcm_->NowUs())) {
+    if (counters_.Get("control.rate_limited") == 0) {
+      spdlog::warn("checkpoint commands refused: more than {} a second (control.rate_limited)",
+                   wire::CheckpointRateLimit::kPerSecond);
+    }
+    counters_.Add("control.rate_limited");
+    return;
+  }
+  try {
+    if (m.command == session_control_t::CHECKPOINT) {
+      checkpoints_.Write(m.name, MakeCheckpoint());
+      counters_.Add("control.checkpoints");
+      spdlog::info("checkpoint: DCP frame {} saved as {}", next_frame_ - 1, checkpoints_.PathOf(m.name));
+    } else {
+      Restore(checkpoints_.Read(m.name), checkpoints_.PathOf(m.name));
+      counters_.Add("control.restores");
+      PublishState(dcp_state_t::RESTORE);
+    }
+  } catch (const InputError& e) {
+    counters_.Add("control.refused");
+    spdlog::error("{}", e.what());
+  }
+}
+
+void DynamicsProc::EnableLiveChecks(double frame_rate_hz) {
+  inputs_.SetClock(transport::SessionFrameClock(frame_rate_hz));
+  late_ = wire::LateFrameFilter(frame_rate_hz);
+}
+
+void DynamicsProc::OnInput(const void* data, int size, std::int64_t recv_time_us) {
+  // Live, the age is taken as the input is handled (a stopped process's
+  // queue is handled on waking, long after it arrived); from a log, the
+  // log's time.
+  const std::int64_t now_us = late_.enabled() ? lcm_->NowUs() : recv_time_us;
+  auto got = wire::ReceiveFrame<operator_input_t>(
+      data, size, kMaxInputSize, &inputs_, &counters_,
+      [this](const operator_input_t& m) {
+        std::array<std::int32_t, wire::kInputWords> words{};
+        std::copy(m.words, m.words + wire::kInputWords, words.begin());
+        return wire::DecodeInputs(words, config_.inputs, &counters_);
+      },
+      now_us, &late_);
+  if (!got) return;
+  const auto& [msg, in] = *got;
+  counters_.Set("input.missing", inputs_.missing());
+  RecordEndToEnd(now_us - msg.send_time_us, config_.session.frame_rate_hz, &latencies_["input_to_dcp"],
+                 &counters_);
+
+  if (resume_) {
+    if (msg.frame > resume_->second) next_frame_ = resume_->first + (msg.frame - resume_->second);
+    resume_.reset();
+  }
+  last_inputs_ = in;
+  last_input_frame_ = msg.frame;
+  wire::DcpFrameData out = dcp_.Step(in);
+  out.frame = next_frame_++;
+  out.input_frame = msg.frame;
+  out.input_send_time_us = msg.send_time_us;
+  out.send_time_us = lcm_->NowUs();
+  dcp_frame_t wire_msg;
+  wire::PackDcpFrame(out, &wire_msg, &counters_);
+  if (transport::PublishMessage(*lcm_, wire::channels::kDcpFrame, wire_msg)) counters_.Add("published");
+  else counters_.Add("publish_failed");
+  const dcp_telemetry_t tm = MakeTelemetry(dcp_.status(), out);
+  if (!transport::PublishMessage(*lcm_, wire::channels::kDcpTelemetry, tm)) counters_.Add("publish_failed");
+  Report(dcp_.status(), out.frame);
+  made_a_frame_ = true;
+  if (++frames_since_state_ >= static_cast<std::int64_t>(kStateEverySeconds * config_.session.frame_rate_hz)) {
+    PublishState(dcp_state_t::PERIODIC);
+  }
+  if (!state_file_.empty()) {
+    const DcpStatus& st = dcp_.status();
+    const std::uint32_t key = static_cast<std::uint32_t>(st.mode) | (st.acquired << 4) | (st.docked << 5) |
+                              (dcp_.released() << 6);
+    if (key != state_key_ || out.send_time_us - state_written_us_ >= 500000) {
+      state_key_ = key;
+      WriteStateFile();
+    }
+  }
+}
+
+void DynamicsProc::Report(const DcpStatus& st, std::int64_t frame) {
+  counters_.Set("mode", st.mode);
+  if (st.held) counters_.Add("frames.held");
+  if (st.finger_held) counters_.Add("frames.finger_held");
+  // docs/collision.md "Collision response": what the DCP refused.
+  if (st.motion_collision) counters_.Add("frames.motion_held");
+  if (st.too_fast) counters_.Add("frames.too_fast");
+  if (st.essential_contact) counters_.Add("frames.essential_contact");
+  if (st.input_refused) counters_.Add("inputs.non_finite");
+  if (st.reset_refused) counters_.Add("resets.refused");
+  if (st.let_go) counters_.Add("grasps.let_go");
+  for (int b = 0; b < wire::collision_bits::kCount; ++b) {
+    if (st.collisions & (1u << b)) counters_.Add(std::string("collision_frames.") + wire::CollisionName(b));
+  }
+  if (st.mode != last_mode_) {
+    if (last_mode_ != 0) counters_.Add("mode_changes");
+    last_mode_ = st.mode;
+  }
+  // Each collision as it starts and ends.
+  const std::uint32_t started = st.collisions & ~last_collisions_;
+  const std::uint32_t ended = last_collisions_ & ~st.collisions;
+  for (int b = 0; b < wire::collision_bits::kCount; ++b) {
+    if (started & (1u << b)) {
+      counters_.Add(std::string("collisions.") + wire::CollisionName(b));
+      spdlog::info("frame {}: collision {} (slave {})", frame, wire::CollisionName(b), st.held ? "holds" : st.finger_held ? "holds the finger" : "follows");
+    }
+    if (ended & (1u << b)) spdlog::info("frame {}: collision {} relieved", frame, wire::CollisionName(b));
+  }
+  last_collisions_ = st.collisions;
+}
+
+dcp_telemetry_t MakeTelemetry(const DcpStatus& st, const wire::DcpFrameData& out) {
+  dcp_telemetry_t t{};
+  t.frame = out.frame;
+  t.send_time_us = out.send_time_us;
+  t.input_frame = out.input_frame;
+  t.input_send_time_us = out.input_send_time_us;
+  t.mode = static_cast<std::int8_t>(st.mode);
+  t.acquired = st.acquired;
+  t.docked = st.docked;
+  t.released = st.released;
+  t.held = st.held;
+  t.finger_held = st.finger_held;
+  t.collisions = static_cast<std::int32_t>(st.collisions);
+  t.slave_collisions = static_cast<std::int32_t>(st.slave_collisions);
+  for (int i = 0; i < 6; ++i) {
+    t.acquisition_conditions[i] = st.acquisition[i];
+    t.acquisition_margin_ft[i] = st.acquisition_margin_ft[i];
+  }
+  t.finger_gap_ft = st.finger_gap_ft;
+  t.palm_to_bar_ft = st.palm_to_bar_ft;
+  t.bay_clearance_ft = st.bay_clearance_ft;
+  t.probe_in_envelope = st.probe_in_envelope;
+  t.envelope_margin_ft = st.envelope_margin_ft;
+  t.dock_distance_ft = st.dock_distance_ft;
+  t.dock_angle_deg = st.dock_angle_deg;
+  for (int k = 0; k < 3; ++k) {
+    t.plane_valid[k] = (st.plane_valid >> k) & 1;
+    for (int j = 0; j < 3; ++j) t.plane_n[3 * k + j] = st.planes[k].n_R[j];
+    t.plane_d_ft[k] = st.planes[k].d_ft;
+  }
+  for (int i = 0; i < 6; ++i) {
+    t.master_angles_deg[i] = st.master.angles_deg[i];
+    t.slave_angles_deg[i] = st.slave.angles_deg[i];
+  }
+  t.master_shoulder_height_ft = st.master.shoulder_height_ft;
+  t.slave_shoulder_height_ft = st.slave.shoulder_height_ft;
+  t.master_finger = st.master.finger;
+  t.slave_finger = st.slave.finger;
+  for (int i = 0; i < 3; ++i) {
+    t.p_RoA_R_ft[i] = st.X_RS2.translation()[i];
+    t.p_RoPo_R_ft[i] = st.X_RP.translation()[i];
+    for (int j = 0; j < 3; ++j) {
+      t.R_RS2[3 * i + j] = st.X_RS2.linear()(i, j);
+      t.R_RP[3 * i + j] = st.X_RP.linear()(i, j);
+    }
+  }
+  return t;
+}
+
+int RunDynamicsProc(const LabConfig& config, transport::LcmInterface& lcm, const std::string& stats_path,
+                    const std::string& ready_path, const std::string& restore_path,
+                    const std::string& state_file, const std::string& checkpoint_dir) {
+  DynamicsProc node(config, &lcm);
+  node.set_next_frame(transport::FirstFrameNumber(config.session.frame_rate_hz));
+  node.EnableLiveChecks(config.session.frame_rate_hz);
+  node.set_checkpoint_folder(wire::CheckpointFolder(checkpoint_dir));
+  node.set_state_file(state_file);
+  const bool resumed = node.ResumeFromStateFile();
+  const bool restored = !restore_path.empty() && !resumed;
+  if (restored) node.RestoreCheckpoint(restore_path);
+  // Its state for the log, until the first frame: the recorder may not
+  // have heard the first one (docs/sessions.md "Re-simulation").
+  const std::int8_t start_reason =
+      resumed ? dcp_state_t::RESUME : restored ? dcp_state_t::RESTORE : dcp_state_t::START;
+  node.PublishState(start_reason);
+  std::int64_t state_sent_us = lcm.NowUs();
+  auto until_first_frame = [&] {
+    if (node.made_a_frame() || lcm.NowUs() - state_sent_us < 500000) return;
+    node.PublishState(start_reason);
+    state_sent_us = lcm.NowUs();
+  };
+  if (!ready_path.empty()) transport::WriteReadyFile(ready_path);
+  spdlog::info("ready: {} -> {}", lcm.FullChannel(wire::channels::kOperatorInput),
+               lcm.FullChannel(wire::channels::kDcpFrame));
+  transport::RunNodeLoop(lcm, "dynamics_proc", node.counters(), node.latencies(),
+              [&] { return node.last_frame(); }, until_first_frame, stats_path);
+  node.WriteStateFile();
+  spdlog::info("published {} DCP frames; inputs missing {}, late {}, dropped {}; final mode {}",
+               node.counters().Get("published"), node.counters().Get("input.missing"),
+               node.counters().Get("frames.late"), node.counters().SumPrefix("dropped."), node.program().mode());
+  return 0;
+}
+
+}  // namespace rms::dynamics_proc

@@ -1,0 +1,296 @@
+// rms_control: commands to a running session on RMS_CONTROL
+// (docs/sessions.md "Freeze, run, step, checkpoint"; docs/security.md "The
+// control channel"):
+//   rms_control --session DIR freeze | run | step [N] | checkpoint NAME | restore NAME|FILE [--run]
+// Every command carries the session's id (from DIR/manifest.json, or
+// --session-id): the session's processes take no other. A checkpoint is a
+// name in the session's checkpoints folder, never a path; restore of a file
+// from elsewhere copies it into that folder first. restore freezes the
+// session first (so no frame is in flight), restores the DCP's state and the
+// operator station's inputs, and leaves the session frozen unless --run.
+#include <CLI/CLI.hpp>
+#include "rms/base/command_line.h"
+#include <unistd.h>
+
+#include <chrono>
+#include <map>
+#include <functional>
+#include <cstdio>
+#include <filesystem>
+#include <thread>
+
+#include "rms/wire/channels.h"
+#include "rms/base/check.h"
+#include "rms/wire/checkpoint.h"
+#include "rms/transport/lcm_interface.h"
+#include "rms/wire/message_io.h"
+#include "rms/sender_t.hpp"
+#include "rms/process_status_t.hpp"
+#include "rms/session_control_t.hpp"
+#include "rms/session/session_summary.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// "before_dock" -> "before_dock.json"; then checked as a name.
+std::string CheckpointName(std::string name) {
+  if (name.find('/') != std::string::npos) {
+    throw rms::InputError("'" + name + "' is a path: give a checkpoint's name (it is saved in the session's "
+                          "checkpoints folder)");
+  }
+  if (name.size() < 5 || name.compare(name.size() - 5, 5, ".json") != 0) name += ".json";
+  rms::wire::CheckpointFolder::ValidateName(name);
+  return name;
+}
+
+// The name to restore: one in the session's folder, or a file from
+// elsewhere copied in under a new name.
+std::string RestoreName(const std::string& what, const std::string& folder) {
+  if (what.find('/') == std::string::npos && !fs::exists(what)) return CheckpointName(what);
+  if (!fs::is_regular_file(what)) throw rms::InputError("no checkpoint '" + what + "' (a name, or a file)");
+  if (folder.empty()) {
+    throw rms::InputError("restoring the file '" + what + "' needs --session DIR: it is copied into the session's "
+                          "checkpoints folder first");
+  }
+  (void)rms::wire::ReadCheckpoint(what);  // a real checkpoint, or a clear error now
+  std::string stem = fs::path(what).stem().string();
+  for (char& c : stem) {
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-') c = '_';
+  }
+  stem = "restore-" + stem.substr(0, 40);
+  std::string name = stem + ".json";
+  for (int i = 2; fs::exists(fs::path(folder) / name); ++i) name = stem + "-" + std::to_string(i) + ".json";
+  rms::wire::CheckpointFolder::ValidateName(name);
+  fs::copy_file(what, fs::path(folder) / name);
+  std::printf("copied %s into the session as %s\n", what.c_str(), (fs::path(folder) / name).c_str());
+  return name;
+}
+
+}  // namespace
+
+namespace {
+
+// The session's control channel as this tool uses it: commands out, and
+// the DCP's own counts in (from its status reports, once a second), so what
+// a checkpoint or restore did is confirmed rather than assumed.
+class ControlLink {
+ public:
+  ControlLink(const rms::transport::LcmOptions& options, std::int64_t session_id) : lcm_(options) {
+    lcm_.SetSender({session_id, rms::sender_t::PROCESS_CONTROL, static_cast<std::int32_t>(getpid())});
+    lcm_.Subscribe(rms::wire::channels::kStatus, [this](const void* d, int n, std::int64_t) {
+      rms::process_status_t st;
+      if (rms::wire::SafeDecode(d, n, 1 << 20, &st) != rms::wire::DecodeError::kNone) return;
+      auto& counts = counts_[st.process];
+      for (int i = 0; i < st.num_counters; ++i) counts[st.counter_names[i]] = st.counter_values[i];
+      ++reports_[st.process];
+    });
+  }
+  void Send(std::int8_t command, const std::string& name = "") {
+    rms::session_control_t m;
+    m.send_time_us = lcm_.NowUs();
+    m.sequence = sequence_++;
+    m.command = command;
+    m.name = name;
+    if (!rms::transport::PublishMessage(lcm_, rms::wire::channels::kControl, m)) throw std::runtime_error("cannot publish");
+  }
+  // Handles messages until done() or `seconds` pass; done()'s last answer.
+  bool ListenUntil(double seconds, const std::function<bool()>& done) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    while (std::chrono::steady_clock::now() < end && !done()) lcm_.HandleSubscriptions(50);
+    return done();
+  }
+  // Waits (up to 2.5 s: they report once a second) for a first report of
+  // `process`'s counts; false if none came (nobody there to answer).
+  bool WaitForCounts(const std::string& process = "dynamics_proc") {
+    return ListenUntil(2.5, [&] { return reports(process) > 0; });
+  }
+  std::int64_t Count(const char* k, const std::string& process = "dynamics_proc") const {
+    const auto p = counts_.find(process);
+    if (p == counts_.end()) return 0;
+    const auto it = p->second.find(k);
+    return it == p->second.end() ? 0 : it->second;
+  }
+  int reports(const std::string& process = "dynamics_proc") const {
+    const auto it = reports_.find(process);
+    return it == reports_.end() ? 0 : it->second;
+  }
+
+ private:
+  rms::transport::UdpLcm lcm_;
+  std::int64_t sequence_ = 0;
+  std::map<std::string, std::map<std::string, std::int64_t>> counts_;  // by process
+  std::map<std::string, int> reports_;
+};
+
+void SayWhereSent(const rms::transport::LcmOptions& options, std::int64_t id);
+
+// Nobody answered: said, and a failure (docs/sessions.md "Command lines").
+int NobodyThere(const rms::transport::LcmOptions& options, std::int64_t id, const char* process) {
+  std::fprintf(stderr,
+               "rms_control: no %s of session %s is running on %s%s (no status report heard in 2.5 s): nothing "
+               "was sent\n",
+               process, id ? rms::wire::FormatSessionId(id).c_str() : "(none)", options.url.c_str(),
+               options.channel_suffix.empty() ? "" : (" with suffix " + options.channel_suffix).c_str());
+  return 1;
+}
+
+// FREEZE, RUN, STEP: confirmed by the operator station's counts (it is the
+// session's clock).
+int Clock(ControlLink& link, std::int8_t command, int steps, const rms::transport::LcmOptions& options, std::int64_t id) {
+  const char* what = command == rms::session_control_t::FREEZE ? "control.freezes"
+                     : command == rms::session_control_t::RUN  ? "control.runs"
+                                                               : "control.steps";
+  if (!link.WaitForCounts("operator_station")) return NobodyThere(options, id, "operator station");
+  const std::int64_t before = link.Count(what, "operator_station");
+  for (int i = 0; i < steps; ++i) link.Send(command);
+  SayWhereSent(options, id);
+  const int seen = link.reports("operator_station");
+  const bool done = link.ListenUntil(3.0, [&] {
+    return link.reports("operator_station") > seen && link.Count(what, "operator_station") >= before + steps;
+  });
+  if (!done) {
+    std::fprintf(stderr, "rms_control: the operator station did not confirm the command within 3 s (see the "
+                         "session's logs/operator_station.log)\n");
+    return 1;
+  }
+  std::printf("done (the operator station confirms)\n");
+  return 0;
+}
+
+void SayWhereSent(const rms::transport::LcmOptions& options, std::int64_t id) {
+  std::printf("sent to %s%s, session %s\n", options.url.c_str(),
+              options.channel_suffix.empty() ? "" : (" (suffix " + options.channel_suffix + ")").c_str(),
+              id ? rms::wire::FormatSessionId(id).c_str() : "none (only processes of no session take it)");
+}
+
+// CHECKPOINT, confirmed when there is a session folder: the DCP writes the
+// file within a frame or two, or its counts say it refused.
+int Checkpoint(ControlLink& link, const std::string& name, const std::string& folder, const rms::transport::LcmOptions& options,
+               std::int64_t id) {
+  if (!link.WaitForCounts()) return NobodyThere(options, id, "dynamics_proc");
+  const std::int64_t saved0 = link.Count("control.checkpoints");
+  auto refusals = [&link] { return link.Count("control.refused") + link.Count("control.rate_limited"); };
+  const std::int64_t refused0 = refusals();
+  link.Send(rms::session_control_t::CHECKPOINT, name);
+  SayWhereSent(options, id);
+  if (folder.empty()) {  // no folder to look in: the DCP's counts say
+    const int seen0 = link.reports();
+    link.ListenUntil(3.0, [&] { return link.reports() > seen0 && link.Count("control.checkpoints") + refusals() > saved0 + refused0; });
+    if (link.Count("control.checkpoints") > saved0) {
+      std::printf("saved %s (dynamics_proc confirms)\n", name.c_str());
+      return 0;
+    }
+    std::fprintf(stderr, "rms_control: dynamics_proc did not save checkpoint %s (%s)\n", name.c_str(),
+                 refusals() > refused0 ? "refused" : "no word from it within 3 s");
+    return 1;
+  }
+  const fs::path p = fs::path(folder) / name;
+  const int seen = link.reports();
+  link.ListenUntil(3.0, [&] { return fs::exists(p) || (link.reports() > seen && refusals() > refused0); });
+  if (!fs::exists(p) && refusals() > refused0) {
+    std::fprintf(stderr, "rms_control: dynamics_proc refused checkpoint %s (see the session's logs/dynamics_proc.log)\n",
+                 name.c_str());
+    return 1;
+  }
+  if (!fs::exists(p)) {
+    std::fprintf(stderr, "rms_control: %s did not appear within 3 s (see the session's logs/dynamics_proc.log)\n",
+                 p.c_str());
+    return 1;
+  }
+  std::printf("saved %s\n", p.c_str());
+  return 0;
+}
+
+// FREEZE, RESTORE (and RUN with --run), confirmed by the DCP's counts.
+int Restore(ControlLink& link, const std::string& name, bool then_run, const rms::transport::LcmOptions& options,
+            std::int64_t id) {
+  auto pause = [] { std::this_thread::sleep_for(std::chrono::milliseconds(300)); };
+  if (!link.WaitForCounts()) return NobodyThere(options, id, "dynamics_proc");
+  const std::int64_t restores0 = link.Count("control.restores"), refused0 = link.Count("control.refused"),
+                     limited0 = link.Count("control.rate_limited");
+  link.Send(rms::session_control_t::FREEZE);
+  pause();  // the last frames through the pipeline
+  link.Send(rms::session_control_t::RESTORE, name);
+  if (then_run) {
+    pause();
+    link.Send(rms::session_control_t::RUN);
+  }
+  SayWhereSent(options, id);
+  const int seen = link.reports();
+  link.ListenUntil(3.0, [&] {
+    return link.reports() > seen && (link.Count("control.restores") > restores0 ||
+                                     link.Count("control.refused") > refused0 ||
+                                     link.Count("control.rate_limited") > limited0);
+  });
+  if (link.Count("control.restores") > restores0) {
+    std::printf("restored from %s (dynamics_proc confirms)%s\n", name.c_str(), then_run ? "" : "; frozen: run resumes");
+    return 0;
+  }
+  std::fprintf(stderr, "rms_control: dynamics_proc did not restore %s (%s; see the session's logs/dynamics_proc.log)\n",
+               name.c_str(),
+               link.Count("control.rate_limited") > limited0 ? "too many checkpoint commands a second: try again"
+               : link.Count("control.refused") > refused0    ? "refused"
+                                                             : "no word from it within 3 s");
+  return 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"rmslab rms_control: freeze, run, step, checkpoint or restore a running session (RMS_CONTROL)"};
+  rms::transport::LcmOptions lcm_options;
+  std::string session_dir, session_id;
+  app.add_option("--session", session_dir,
+                 "The session's folder: its LCM URL, channel suffix, id and checkpoints folder come from it")
+      ->check(CLI::ExistingDirectory);
+  app.add_option("--lcm-url", lcm_options.url, "LCM URL of the session (without --session)")->capture_default_str();
+  app.add_option("--channel-suffix", lcm_options.channel_suffix, "The session's channel suffix (without --session)");
+  app.add_option("--session-id", session_id, "The session's id, from its manifest.json (without --session)");
+  app.require_subcommand(1);
+  int steps = 1;
+  std::string what;
+  bool then_run = false;
+  auto* freeze = app.add_subcommand("freeze", "Freeze the session: every process holds its frame");
+  auto* run = app.add_subcommand("run", "Run a frozen session again");
+  auto* step = app.add_subcommand("step", "While frozen: N more frames (default 1)");
+  step->add_option("n", steps, "Frames")->check(CLI::Range(1, 100000));
+  auto* checkpoint = app.add_subcommand("checkpoint", "dynamics_proc saves its state as NAME in the session's checkpoints folder");
+  checkpoint->add_option("name", what, "Checkpoint name (letters, digits, _ - .; .json is added)")->required();
+  auto* restore = app.add_subcommand(
+      "restore", "Freeze, then restore the DCP's state (and the operator's inputs) from a checkpoint NAME, or a FILE");
+  restore->add_option("checkpoint", what, "A checkpoint's name in the session, or a checkpoint file")->required();
+  restore->add_flag("--run", then_run, "Run again after restoring");
+  if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
+  try {
+    std::string folder;
+    std::int64_t id = session_id.empty() ? 0 : rms::transport::ParseSessionId(session_id, "--session-id");
+    if (!session_dir.empty()) {
+      const rms::session::SessionInfo s = rms::session::ReadSessionInfo(session_dir);
+      if (s.lcm_url.empty()) throw rms::InputError(session_dir + " ran on no network (a re-simulation): nothing to control");
+      lcm_options.url = s.lcm_url;
+      lcm_options.channel_suffix = s.channel_suffix;
+      id = s.session_id;
+      folder = (fs::path(session_dir) / "checkpoints").string();
+    }
+    std::string name;
+    if (checkpoint->parsed()) {
+      name = CheckpointName(what);
+      if (!folder.empty() && fs::exists(fs::path(folder) / name)) {
+        std::fprintf(stderr, "rms_control: checkpoint %s exists already in %s: give another name\n", name.c_str(),
+                     folder.c_str());
+        return 1;
+      }
+    }
+    if (restore->parsed()) name = RestoreName(what, folder);
+    ControlLink link(lcm_options, id);
+    if (checkpoint->parsed()) return Checkpoint(link, name, folder, lcm_options, id);
+    if (restore->parsed()) return Restore(link, name, then_run, lcm_options, id);
+    if (freeze->parsed()) return Clock(link, rms::session_control_t::FREEZE, 1, lcm_options, id);
+    if (run->parsed()) return Clock(link, rms::session_control_t::RUN, 1, lcm_options, id);
+    return Clock(link, rms::session_control_t::STEP, steps, lcm_options, id);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "rms_control: %s\n", e.what());
+    return 2;
+  }
+}

@@ -1,0 +1,77 @@
+#pragma once
+// The one reader of a session's LCM log (docs/sessions.md "The session
+// log"): the summary, the re-simulation, the export, the report and the
+// comparison all read SESSION/lcmlog through it. It gives the session's own
+// messages only (SenderCheck: docs/security.md "What the summary trusts"),
+// on the channels asked for (the rest are skipped undecoded), each with its
+// base channel, the recorder's time and the session time.
+#include <cstdint>
+#include <functional>
+#include <initializer_list>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "rms/wire/message_io.h"
+#include "rms/session/sender_check.h"
+
+namespace rms::session {
+
+// One logged message of the session's own.
+struct LogMessage {
+  std::string_view base;     // channel without the session's suffix ("RMS_DCP_FRAME")
+  std::string_view channel;  // as logged
+  std::int64_t log_us = 0;   // the recorder's receive time, us since 1970
+  double log_time_s = 0;     // the same, s since the log's first event
+  // Session time, s: the operator frame of the message (RMS_OPERATOR_INPUT)
+  // or the last one logged before it, over the frame rate. It stands still
+  // while the session is frozen and reads as flown at any --speed
+  // (docs/sessions.md "Session time").
+  double session_time_s = 0;
+  const void* data = nullptr;
+  int size = 0;
+};
+
+class SessionLog {
+ public:
+  // SESSION/lcmlog, SESSION/manifest.json (the session's id and suffix) and
+  // the frame rate of SESSION/config.toml. Throws rms::InputError naming what
+  // is missing or unreadable.
+  explicit SessionLog(const std::string& session_dir);
+
+  // Every message of the session's own on `channels` (base names; empty:
+  // every channel), in log order. Messages of other sessions and other
+  // senders are counted in check() and skipped.
+  void Read(std::initializer_list<std::string_view> channels, const std::function<void(const LogMessage&)>& visit);
+
+  // Decodes a message; a malformed one is counted (malformed()) and false.
+  template <class Msg>
+  bool Decode(const LogMessage& m, Msg* out) {
+    if (wire::SafeDecode(m.data, m.size, kMaxMessageBytes, out) == wire::DecodeError::kNone) return true;
+    ++malformed_;
+    return false;
+  }
+
+  static constexpr int kMaxMessageBytes = 1 << 20;
+  const std::string& dir() const { return dir_; }
+  const std::string& log_path() const { return log_path_; }
+  const std::string& suffix() const { return suffix_; }
+  double frame_rate_hz() const { return rate_hz_; }
+  // Of the last Read: events in the log, its first and last event's time.
+  std::int64_t events() const { return events_; }
+  std::int64_t first_us() const { return first_us_; }
+  std::int64_t last_us() const { return last_us_; }
+  std::int64_t malformed() const { return malformed_; }
+  // Of the last Read: bytes at the log's end that are no whole event (a log
+  // cut short, or garbage after it): left out, and said by its readers.
+  std::int64_t unread_bytes() const { return unread_bytes_; }
+  SenderCheck& check() { return check_; }
+
+ private:
+  std::string dir_, log_path_, suffix_;
+  double rate_hz_ = 30.0;
+  SenderCheck check_;
+  std::int64_t events_ = 0, first_us_ = -1, last_us_ = -1, malformed_ = 0, unread_bytes_ = 0;
+};
+
+}  // namespace rms::session

@@ -1,0 +1,91 @@
+#include "rms/session/session_log.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <lcm/lcm-cpp.hpp>
+
+#include "rms/wire/channels.h"
+#include "rms/base/check.h"
+#include "rms/base/config.h"
+#include "rms/session/session_summary.h"
+
+namespace fs = std::filesystem;
+
+namespace rms::session {
+
+namespace {
+
+// RMS_OPERATOR_INPUT's frame without decoding the rest: it follows the
+// fingerprint and the sender (docs/protocol.md "RMS_OPERATOR_INPUT").
+bool InputFrame(const void* data, int size, std::int64_t* frame) {
+  constexpr int kAt = 8 + wire::kSenderBytes;
+  if (size < kAt + 8) return false;
+  const auto* p = static_cast<const std::uint8_t*>(data) + kAt;
+  std::uint64_t v = 0;
+  for (int i = 0; i < 8; ++i) v = (v << 8) | p[i];
+  *frame = static_cast<std::int64_t>(v);
+  return true;
+}
+
+}  // namespace
+
+SessionLog::SessionLog(const std::string& session_dir)
+    : dir_(session_dir), log_path_((fs::path(session_dir) / "lcmlog").string()) {
+  if (!fs::exists(log_path_)) throw InputError(session_dir + ": not a session folder (no lcmlog)");
+  if (fs::exists(fs::path(session_dir) / "manifest.json")) {
+    suffix_ = ReadSessionInfo(session_dir).channel_suffix;
+    check_ = SenderCheck(session_dir);
+  }
+  try {
+    rate_hz_ = LoadConfig((fs::path(session_dir) / "config.toml").string()).session.frame_rate_hz;
+  } catch (const std::exception&) {
+    rate_hz_ = 30.0;  // a session without its config: the report's rate (docs/config.md)
+  }
+}
+
+void SessionLog::Read(std::initializer_list<std::string_view> channels,
+                      const std::function<void(const LogMessage&)>& visit) {
+  lcm::LogFile log(log_path_, "r");
+  if (!log.good()) throw InputError("cannot read the session's LCM log '" + log_path_ + "'");
+  events_ = 0;
+  first_us_ = last_us_ = -1;
+  std::int64_t input_frame = -1;
+  long good_end = 0;  // where the last whole event ends
+  while (const lcm::LogEvent* ev = log.readNextEvent()) {
+    good_end = std::ftell(log.getFilePtr());
+    ++events_;
+    if (first_us_ < 0) first_us_ = ev->timestamp;
+    last_us_ = ev->timestamp;
+    std::string_view channel = ev->channel;
+    if (!suffix_.empty()) {
+      if (channel.size() <= suffix_.size() || channel.substr(channel.size() - suffix_.size()) != suffix_) continue;
+      channel.remove_suffix(suffix_.size());
+    }
+    // Only the channels asked for are looked at (and the operator's, for the
+    // session time): the rest are skipped before any decoding.
+    const bool wanted = channels.size() == 0 || std::find(channels.begin(), channels.end(), channel) != channels.end();
+    const bool input = channel == wire::channels::kOperatorInput;
+    if (!wanted && !input) continue;
+    const std::string base(channel);
+    if (check_.Ignore(base, ev->data, ev->datalen)) continue;
+    std::int64_t f = 0;
+    if (input && InputFrame(ev->data, ev->datalen, &f) && f >= 0) input_frame = f;
+    if (!wanted) continue;
+    LogMessage m;
+    m.base = base;
+    m.channel = ev->channel;
+    m.log_us = ev->timestamp;
+    m.log_time_s = (ev->timestamp - first_us_) * 1e-6;
+    m.session_time_s = input_frame < 0 ? 0.0 : input_frame / rate_hz_;
+    m.data = ev->data;
+    m.size = ev->datalen;
+    visit(m);
+  }
+  const long at = good_end;
+  std::error_code ec;
+  const auto size = fs::file_size(log_path_, ec);
+  unread_bytes_ = (at >= 0 && !ec && static_cast<std::int64_t>(size) > at) ? static_cast<std::int64_t>(size) - at : 0;
+}
+
+}  // namespace rms::session

@@ -1,0 +1,864 @@
+#include "rms/session/session_summary.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <lcm/lcm-cpp.hpp>
+#include <algorithm>
+#include <map>
+#include <set>
+#include <ctime>
+#include <unistd.h>
+#include <array>
+
+#include "rms/wire/channels.h"
+#include "rms/base/config.h"
+#include "rms/wire/collision_bits.h"
+#include "rms/base/check.h"
+#include "rms/wire/control_word.h"
+#include "rms/base/counters.h"
+#include "rms/dcp_frame_t.hpp"
+#include "rms/dcp_telemetry_t.hpp"
+#include "rms/esg_frame_t.hpp"
+#include "rms/wire/message_io.h"
+#include "rms/operator_input_t.hpp"
+#include "rms/operator_state_t.hpp"
+#include "rms/process_status_t.hpp"
+#include "rms/transport/lcm_interface.h"
+#include "rms/transport/process.h"
+#include "rms/sender_t.hpp"
+#include "rms/session_control_t.hpp"
+#include "rms/base/text.h"
+#include "rms/base/version.h"
+#include "attempts.h"
+#include "rms/session/sender_check.h"
+#include "rms/session/session_log.h"
+#include "rms/dcp_state_t.hpp"
+
+namespace fs = std::filesystem;
+
+namespace rms::session {
+
+namespace {
+
+nlohmann::json ReadJson(const fs::path& p) {
+  std::ifstream f(p);
+  if (!f) return nlohmann::json::object();
+  try {
+    return nlohmann::json::parse(f);
+  } catch (const std::exception&) {
+    return nlohmann::json::object();
+  }
+}
+
+std::int64_t Counter(const nlohmann::json& stats, const std::string& name) {
+  if (!stats.contains("counters")) return 0;
+  const auto& c = stats["counters"];
+  return c.contains(name) ? c[name].get<std::int64_t>() : 0;
+}
+
+std::int64_t SumPrefix(const nlohmann::json& stats, const std::string& prefix) {
+  std::int64_t s = 0;
+  if (!stats.contains("counters")) return 0;
+  for (auto it = stats["counters"].begin(); it != stats["counters"].end(); ++it) {
+    if (it.key().rfind(prefix, 0) == 0) s += it.value().get<std::int64_t>();
+  }
+  return s;
+}
+
+constexpr int kCollisionBits = wire::collision_bits::kCount;
+
+// The hand controllers' modes over the session, from RMS_OPERATOR_STATE
+// (docs/sessions.md "summary.json", "by_hand").
+class HandControlLog {
+ public:
+  void Observe(const operator_state_t& m, double t_s) {
+    if (m.source != operator_state_t::SOURCE_BY_HAND) return;
+    seen_ = true;
+    const int key = m.control_mode * 100 + m.command_frame * 10 + m.vernier;
+    if (key != last_key_) {
+      static const char* kModes[3] = {"?", "single joint", "manual augmented"};
+      static const char* kFrames[4] = {"?", "end effector", "orbiter", "payload"};
+      changes_.push_back({{"time_s", t_s},
+                          {"frame", m.frame},
+                          {"control_mode", kModes[m.control_mode >= 1 && m.control_mode <= 2 ? m.control_mode : 0]},
+                          {"command_frame", kFrames[m.command_frame >= 1 && m.command_frame <= 3 ? m.command_frame : 0]},
+                          {"scale", m.vernier ? "vernier" : "coarse"}});
+      last_key_ = key;
+    }
+    key_actions_ = std::max<std::int64_t>(key_actions_, m.key_actions);
+    joint_limit_frames_ += m.joint_limits != 0;
+    singular_frames_ += m.singular;
+  }
+  nlohmann::ordered_json Json() const {
+    if (!seen_) return nullptr;
+    return {{"control_changes", changes_},
+            {"key_actions", key_actions_},
+            {"joint_limit_frames", joint_limit_frames_},
+            {"singular_frames", singular_frames_}};
+  }
+
+ private:
+  bool seen_ = false;
+  int last_key_ = -1;
+  nlohmann::ordered_json changes_ = nlohmann::ordered_json::array();
+  std::int64_t key_actions_ = 0, joint_limit_frames_ = 0, singular_frames_ = 0;
+};
+
+}  // namespace
+
+std::string BaseChannel(const std::string& channel) {
+  for (const char* base : {wire::channels::kOperatorInput, wire::channels::kOperatorState, wire::channels::kWindowKeys,
+                           wire::channels::kDcpTelemetry, wire::channels::kDcpFrame, wire::channels::kEsgFrame, wire::channels::kStatus,
+                           wire::channels::kControl, wire::channels::kDcpState}) {
+    if (channel.rfind(base, 0) == 0) return base;
+  }
+  return channel;
+}
+
+// Declared in session_summary.h.
+std::vector<std::size_t> LongestIncreasingRun(const std::vector<std::int64_t>& v) {
+  std::vector<std::size_t> tails;
+  std::vector<std::ptrdiff_t> parent(v.size(), -1);
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const auto it = std::lower_bound(tails.begin(), tails.end(), v[i],
+                                     [&v](std::size_t a, std::int64_t x) { return v[a] < x; });
+    if (it != tails.begin()) parent[i] = static_cast<std::ptrdiff_t>(*(it - 1));
+    if (it == tails.end()) tails.push_back(i);
+    else *it = i;
+  }
+  std::vector<std::size_t> run;
+  for (std::ptrdiff_t i = tails.empty() ? -1 : static_cast<std::ptrdiff_t>(tails.back()); i >= 0; i = parent[i]) {
+    run.push_back(static_cast<std::size_t>(i));
+  }
+  std::reverse(run.begin(), run.end());
+  return run;
+}
+
+namespace {
+
+// A DCP frame as logged: what confirms the telemetry of the same frame.
+struct DcpFrameRecord {
+  std::int64_t input_frame = -1;
+  wire::ControlWord word;
+  // Two different DCP frames of this number in the log, both with the
+  // session's id and the DCP's pid: one is forged, and neither is believed.
+  bool disputed = false;
+};
+
+// First pass: the session's own DCP frames, by frame number. The DCP
+// numbers its frames upward, across restarts and restores, so the frames
+// believed are the longest run of increasing numbers in the log's order; a
+// frame off it -- a forgery far ahead or behind, with the DCP's own id and
+// pid -- is left out (out_of_sequence), and its telemetry with it. Two
+// different frames of one number mark that number disputed.
+struct DcpFrames {
+  std::map<std::int64_t, DcpFrameRecord> by_frame;
+  std::int64_t out_of_sequence = 0;
+};
+
+DcpFrames ReadDcpFrames(SessionLog& log) {
+  std::vector<std::int64_t> numbers;
+  std::vector<DcpFrameRecord> records;
+  std::map<std::int64_t, DcpFrameRecord> first;
+  std::set<std::int64_t> disputed;
+  log.Read({wire::channels::kDcpFrame}, [&](const LogMessage& ev) {
+    dcp_frame_t m;
+    if (!log.Decode(ev, &m)) return;
+    try {
+      const DcpFrameRecord r{m.input_frame, wire::UnpackControlWord(m.control_word)};
+      const auto [it, fresh] = first.emplace(m.frame, r);
+      if (!fresh && (it->second.input_frame != r.input_frame || it->second.word != r.word)) disputed.insert(m.frame);
+      numbers.push_back(m.frame);
+      records.push_back(r);
+    } catch (const InputError&) {
+    }
+  });
+  DcpFrames out;
+  for (const std::size_t i : LongestIncreasingRun(numbers)) {
+    DcpFrameRecord r = first.at(numbers[i]);
+    r.disputed = disputed.count(numbers[i]) > 0;
+    out.by_frame.emplace(numbers[i], r);
+  }
+  for (const std::int64_t n : numbers) {
+    if (!out.by_frame.count(n)) ++out.out_of_sequence;
+  }
+  return out;
+}
+
+// The telemetry agrees with the DCP frame of its number: the same input
+// frame, mode, acquisition and docking.
+bool Agrees(const dcp_telemetry_t& t, const DcpFrameRecord& f) {
+  return t.input_frame == f.input_frame && t.mode == f.word.mode && t.acquired == f.word.acquired &&
+         t.docked == f.word.docked;
+}
+
+// The mission as the DCP's telemetry tells it: mode changes, collision runs,
+// docking and the phases' boundaries (DCP frame numbers; -1: not reached).
+class TelemetryLog {
+ public:
+  explicit TelemetryLog(double rate_hz = 30.0) : rate_hz_(rate_hz) {
+    for (const char* name : wire::kCollisionNames) totals_[name] = {0, 0, 0};
+  }
+  void Observe(const dcp_telemetry_t& m, std::int64_t t_us, std::int64_t first_us) {
+    ++frames_;
+    const double t_s = (t_us - first_us) * 1e-6;
+    // (Phases and docking are each attempt's: AttemptLog.)
+    if (m.mode != last_mode_) {
+      if (last_mode_ != 0) {
+        mode_changes.push_back({{"frame", m.frame}, {"time_s", m.input_frame / rate_hz_}, {"log_time_s", t_s},
+                                {"from", last_mode_}, {"to", m.mode}});
+      }
+      last_mode_ = m.mode;
+    }
+    acquired = acquired || m.acquired;
+    docked = docked || m.docked;
+    held_frames += m.held;
+    // Detrimental collisions only: the finger resting on the bar is the essential contact.
+    const auto bits = wire::DetrimentalCollisions(static_cast<std::uint32_t>(m.collisions), m.finger_held, m.held,
+                                                m.master_finger > m.slave_finger);
+    for (int b = 0; b < kCollisionBits; ++b) {
+      const bool on = bits & (1u << b), was = last_bits_ & (1u << b);
+      if (on && !was) {
+        run_start_us_[b] = t_us;
+        run_frames_[b] = 0;
+      }
+      if (on) ++run_frames_[b];
+      if (was && !on) EndRun(b, first_us, false);
+    }
+    last_bits_ = bits;
+    prev_us_ = t_us;
+  }
+  // Collisions still on at the end of the log; events in time order.
+  void Finish(std::int64_t first_us) {
+    for (int b = 0; b < kCollisionBits; ++b) {
+      if (last_bits_ & (1u << b)) EndRun(b, first_us, true);
+    }
+    std::sort(collisions.begin(), collisions.end(), [](const auto& a, const auto& b) {
+      return a["start_s"].template get<double>() < b["start_s"].template get<double>();
+    });
+  }
+  nlohmann::ordered_json ByKind() const {
+    nlohmann::ordered_json by_kind = nlohmann::ordered_json::object();
+    for (const auto& [kind, t] : totals_) {
+      by_kind[kind] = {{"events", static_cast<std::int64_t>(t[0])}, {"frames", static_cast<std::int64_t>(t[1])},
+                       {"duration_s", t[2]}};
+    }
+    return by_kind;
+  }
+  std::int64_t frames() const { return frames_; }
+
+  nlohmann::ordered_json mode_changes = nlohmann::ordered_json::array();
+  nlohmann::ordered_json collisions = nlohmann::ordered_json::array();
+  bool acquired = false, docked = false;
+  std::int64_t held_frames = 0;
+
+ private:
+  void EndRun(int b, std::int64_t first_us, bool open) {
+    const double dur = (prev_us_ - run_start_us_[b]) * 1e-6;
+    nlohmann::ordered_json e = {{"kind", wire::kCollisionNames[b]},
+                                {"start_s", (run_start_us_[b] - first_us) * 1e-6},
+                                {"duration_s", dur},
+                                {"frames", run_frames_[b]}};
+    if (open) e["open"] = true;
+    collisions.push_back(e);
+    auto& tot = totals_[wire::kCollisionNames[b]];
+    tot[0] += 1;
+    tot[1] += run_frames_[b];
+    tot[2] += dur;
+  }
+  std::map<std::string, std::array<double, 3>> totals_;  // events, frames, seconds; every kind
+  std::array<std::int64_t, kCollisionBits> run_start_us_{}, run_frames_{};
+  std::uint32_t last_bits_ = 0;
+  int last_mode_ = 0;
+  std::int64_t frames_ = 0, prev_us_ = 0;
+  double rate_hz_;
+};
+
+// Each process's runs (a restart after a fault is a new pid): the last
+// counters each run reported on RMS_STATUS.
+struct StatusRuns {
+  std::map<std::string, std::map<int, std::map<std::string, std::int64_t>>> runs;
+  std::map<std::string, int> last_pid;
+  std::map<std::string, bool> final_seen;
+};
+
+// What one pass over the log finds, the session's own messages only.
+struct LogScan {
+  std::map<std::string, std::int64_t> by_channel;
+  std::int64_t events = 0, first_us = -1, last_us = -1, malformed = 0;
+  wire::SequenceTracker input, dcp, esg;  // frame numbers as logged
+  double rate_hz = 30.0;
+  std::set<std::int64_t> telemetry_frames;  // believed
+  std::set<std::int64_t> telemetry_logged;  // of the DCP's frames, whether believed or not
+  int final_mode = 0;
+  std::set<int> modes;
+  TelemetryLog telemetry;
+  HandControlLog hand;
+  StatusRuns status;
+  nlohmann::ordered_json control = nlohmann::ordered_json::array();
+  AttemptLog* attempts = nullptr;
+  std::string last_restore_name;
+};
+
+void ScanTelemetry(const LogMessage& ev, const std::map<std::int64_t, DcpFrameRecord>& dcp, SenderCheck* check,
+                   LogScan* s) {
+  dcp_telemetry_t m{};
+  if (wire::SafeDecode(ev.data, ev.size, 4096, &m) != wire::DecodeError::kNone) {
+    ++s->malformed;
+    return;
+  }
+  // The telemetry is believed only where the DCP frame of its number says
+  // the same (docs/security.md "What the summary trusts").
+  const auto it = dcp.find(m.frame);
+  if (it == dcp.end()) return check->Count("telemetry_without_its_dcp_frame");
+  s->telemetry_logged.insert(m.frame);  // in the record, believed or not
+  if (it->second.disputed) return check->Count("disputed_dcp_frame");
+  if (!Agrees(m, it->second)) return check->Count("telemetry_contradicts_its_dcp_frame");
+  if (!s->telemetry_frames.insert(m.frame).second) return check->Count("repeated_frame");
+  s->telemetry.Observe(m, ev.log_us, s->first_us);
+  s->attempts->ObserveFrame(m, it->second.word.reset, m.input_frame / s->rate_hz);
+}
+
+void ScanStatus(const LogMessage& ev, LogScan* s) {
+  process_status_t m;
+  if (wire::SafeDecode(ev.data, ev.size, 1 << 20, &m) != wire::DecodeError::kNone) {
+    ++s->malformed;
+    return;
+  }
+  if (m.final) s->status.final_seen[m.process] = true;
+  auto& run = s->status.runs[m.process][m.pid];
+  for (int i = 0; i < m.num_counters; ++i) run[m.counter_names[i]] = m.counter_values[i];
+  s->status.last_pid[m.process] = m.pid;
+}
+
+// Session control as sent (RMS_CONTROL; docs/sessions.md "Freeze, run, step,
+// checkpoint"): what acted is in the processes' control.* counters.
+void ScanControl(const LogMessage& ev, LogScan* s) {
+  session_control_t m;
+  if (wire::SafeDecode(ev.data, ev.size, 1024, &m) != wire::DecodeError::kNone) {
+    ++s->malformed;
+    return;
+  }
+  static const char* const kNames[] = {"?", "freeze", "run", "step", "checkpoint", "restore"};
+  const char* what = m.command >= 1 && m.command <= 5 ? kNames[m.command] : "?";
+  nlohmann::ordered_json e = {{"time_s", (ev.log_us - s->first_us) * 1e-6},
+                              {"command", what},
+                              {"process", wire::ProcessCodeName(m.sender.process)},
+                              {"pid", m.sender.pid}};
+  if (!m.name.empty()) e["name"] = m.name;
+  if (m.command == session_control_t::RESTORE) s->last_restore_name = m.name;
+  s->control.push_back(e);
+}
+
+void ScanFrameNumbers(const std::string& base, const LogMessage& ev, const std::map<std::int64_t, DcpFrameRecord>& dcp,
+                      LogScan* s) {
+  if (base == wire::channels::kOperatorState) {
+    operator_state_t m;
+    if (wire::SafeDecode(ev.data, ev.size, 8192, &m) == wire::DecodeError::kNone) {
+      s->hand.Observe(m, (ev.log_us - s->first_us) * 1e-6);
+      s->attempts->ObserveOperator(m);
+    } else {
+      ++s->malformed;
+    }
+  } else if (base == wire::channels::kOperatorInput) {
+    operator_input_t m;
+    if (wire::SafeDecode(ev.data, ev.size, 1024, &m) == wire::DecodeError::kNone) s->input.Accept(m.frame);
+    else ++s->malformed;
+  } else if (base == wire::channels::kDcpFrame) {
+    // Only the frames of the increasing run (ReadDcpFrames) count.
+    dcp_frame_t m;
+    if (wire::SafeDecode(ev.data, ev.size, 1024, &m) != wire::DecodeError::kNone) {
+      ++s->malformed;
+    } else if (const auto it = dcp.find(m.frame); it != dcp.end()) {
+      s->dcp.Accept(m.frame);
+      s->final_mode = it->second.word.mode;
+      s->modes.insert(s->final_mode);
+    }
+  } else if (base == wire::channels::kEsgFrame) {
+    esg_frame_t m;
+    if (wire::SafeDecode(ev.data, ev.size, 1024, &m) == wire::DecodeError::kNone) s->esg.Accept(m.frame);
+    else ++s->malformed;
+  }
+}
+
+// A restore the DCP made (RMS_DCP_STATE RESTORE) starts an attempt.
+void ScanState(const LogMessage& ev, LogScan* s) {
+  dcp_state_t m;
+  if (wire::SafeDecode(ev.data, ev.size, SessionLog::kMaxMessageBytes, &m) != wire::DecodeError::kNone) {
+    ++s->malformed;
+    return;
+  }
+  if (m.reason == dcp_state_t::RESTORE) s->attempts->ObserveRestore(s->last_restore_name);
+}
+
+LogScan ScanLog(SessionLog& log, const std::map<std::int64_t, DcpFrameRecord>& dcp, AttemptLog* attempts) {
+  LogScan s;
+  s.attempts = attempts;
+  s.rate_hz = log.frame_rate_hz();
+  s.telemetry = TelemetryLog(s.rate_hz);
+  SenderCheck* check = &log.check();
+  log.Read({}, [&](const LogMessage& ev) {
+    if (s.first_us < 0) s.first_us = log.first_us();
+    ++s.by_channel[std::string(ev.channel)];
+    if (ev.base == wire::channels::kDcpTelemetry) ScanTelemetry(ev, dcp, check, &s);
+    else if (ev.base == wire::channels::kStatus) ScanStatus(ev, &s);
+    else if (ev.base == wire::channels::kControl) ScanControl(ev, &s);
+    else if (ev.base == wire::channels::kDcpState) ScanState(ev, &s);
+    else ScanFrameNumbers(std::string(ev.base), ev, dcp, &s);
+  });
+  s.events = log.events();
+  s.first_us = log.first_us();
+  s.last_us = log.last_us();
+  s.malformed += log.malformed();
+  s.telemetry.Finish(s.first_us);
+  return s;
+}
+
+// A status run no real process could have reported: a negative count, or
+// more frames than the session's length allows at any speed.
+bool Plausible(const std::map<std::string, std::int64_t>& run, double duration_s, double rate_hz) {
+  const double most = (duration_s + 10.0) * rate_hz * transport::kMaxSessionSpeed + 1000.0;
+  for (const auto& [k, v] : run) {
+    if (v < 0) return false;
+    if (k.rfind("latency.", 0) != 0 && static_cast<double>(v) > most * 100.0) return false;
+    if ((k == "published" || k == "rendered" || k == "received") && static_cast<double>(v) > most) return false;
+  }
+  return true;
+}
+
+// Each process's stats file (the last run's), with the counts of earlier
+// runs (ended in a fault, restarted by the launcher) that only RMS_STATUS in
+// the log kept (counts only: not the mode, not latency percentiles).
+std::map<std::string, nlohmann::json> MergedStats(const fs::path& root, const StatusRuns& st, double duration_s,
+                                                  double rate_hz, SenderCheck* check) {
+  std::map<std::string, nlohmann::json> stats;
+  for (const char* p : {"operator_station", "dynamics_proc", "scene_proc", "esg_renderer"}) {
+    stats[p] = ReadJson(root / "stats" / (std::string(p) + ".json"));
+    const auto runs = st.runs.find(p);
+    if (runs == st.runs.end()) continue;
+    // No stats file (a full disk at exit, a crash): the last run's counts
+    // are its last RMS_STATUS report in the log (said in "stats_from_log").
+    const bool no_file = !stats[p].contains("counters");
+    if (no_file) stats[p]["from_log"] = true;
+    for (const auto& [pid, counters] : runs->second) {
+      if (pid == st.last_pid.at(p) && !no_file) continue;
+      if (!Plausible(counters, duration_s, rate_hz)) {
+        check->Count("implausible_status");
+        continue;
+      }
+      if (!stats[p].contains("counters")) stats[p]["counters"] = nlohmann::json::object();
+      for (const auto& [k, v] : counters) {
+        if (k == "mode" || k.rfind("latency.", 0) == 0) continue;
+        stats[p]["counters"][k] = stats[p]["counters"].value(k, std::int64_t{0}) + v;
+      }
+    }
+  }
+  return stats;
+}
+
+double FrameRate(const fs::path& root) {
+  try {
+    return LoadConfig((root / "config.toml").string()).session.frame_rate_hz;
+  } catch (const std::exception&) {
+    return 30.0;
+  }
+}
+
+nlohmann::ordered_json Restarts(const fs::path& root) {
+  // Processes the launcher restarted after a fault (docs/sessions.md
+  // "Faults"): run/restarts, one line "NAME N EXIT_CODE DOWN_AT READY_AT".
+  nlohmann::ordered_json restarts = nlohmann::ordered_json::array();
+  std::ifstream f((root / "run" / "restarts").string());
+  std::string name;
+  int n = 0, rc = 0;
+  double down = 0, ready = 0;
+  while (f >> name >> n >> rc >> down >> ready) {
+    restarts.push_back(
+        {{"process", name}, {"restart", n}, {"exit_code", rc}, {"signal", rc > 128 ? rc - 128 : 0}, {"restart_s", ready - down}});
+  }
+  return restarts;
+}
+
+void AddMission(const LogScan& s, nlohmann::ordered_json* out) {
+  nlohmann::ordered_json& j = *out;
+  j["final_mode"] = s.final_mode;
+  j["modes_seen"] = std::vector<int>(s.modes.begin(), s.modes.end());
+  j["acquired"] = s.telemetry.acquired;
+  j["docked"] = s.telemetry.docked;
+}
+
+// Messages a receiver refused for a reason of its own, not malformed
+// (docs/protocol.md): too late to act on, of another session, beyond the
+// session's clock.
+constexpr const char* kRefusedReasons[] = {"late", "other_session", "other_sender", "far_ahead"};
+
+std::int64_t Malformed(const nlohmann::json& st) {
+  std::int64_t n = SumPrefix(st, "dropped.");
+  for (const char* r : kRefusedReasons) n -= Counter(st, std::string("dropped.") + r);
+  return n;
+}
+
+nlohmann::ordered_json FramesJson(const std::map<std::string, nlohmann::json>& stats) {
+  const auto &op = stats.at("operator_station"), &dcp = stats.at("dynamics_proc"), &scene = stats.at("scene_proc"),
+             &esg = stats.at("esg_renderer");
+  nlohmann::ordered_json frames;
+  frames["operator_published"] = Counter(op, "published");
+  frames["dcp_published"] = Counter(dcp, "published");
+  frames["esg_published"] = Counter(scene, "published");
+  frames["rendered"] = Counter(esg, "rendered");
+  frames["superseded"] = Counter(esg, "superseded");
+  frames["scenes_drawn"] = Counter(esg, "rendered.scenes");
+  frames["skipped_unchanged"] = Counter(esg, "skipped.unchanged");
+  frames["png_written"] = Counter(esg, "png_written");
+  frames["video_frames"] = Counter(esg, "video.frames");
+  frames["video_dropped"] = Counter(esg, "video.dropped");
+  frames["late_operator_frames"] = Counter(op, "frames.late");
+  frames["dropped"] = {
+      {"operator_to_dcp", Counter(dcp, "input.missing")},
+      {"dcp_to_scene", Counter(scene, "dcp.missing")},
+      {"scene_to_esg", Counter(esg, "esg.missing")},
+      {"malformed_at_dcp", Malformed(dcp)},
+      {"malformed_at_scene", Malformed(scene)},
+      {"malformed_at_esg", Malformed(esg)},
+  };
+  nlohmann::ordered_json refused = nlohmann::ordered_json::object();
+  for (const char* reason : kRefusedReasons) {
+    refused[reason] = Counter(op, std::string("dropped.") + reason) + Counter(dcp, std::string("dropped.") + reason) +
+                      Counter(scene, std::string("dropped.") + reason) +
+                      Counter(esg, std::string("dropped.") + reason);
+  }
+  frames["refused"] = refused;
+  frames["clamped_inputs"] = {{"operator_station", SumPrefix(op, "clamped.")},
+                              {"dynamics_proc", SumPrefix(dcp, "clamped.")},
+                              {"scene_proc", SumPrefix(scene, "clamped.")}};
+  return frames;
+}
+
+nlohmann::ordered_json Links(const nlohmann::json& st) {
+  nlohmann::ordered_json l = nlohmann::ordered_json::object();
+  if (!st.contains("latency_us")) return l;
+  for (auto it = st["latency_us"].begin(); it != st["latency_us"].end(); ++it) {
+    l[it.key()] = {{"p50_ms", it.value()["p50"].get<double>() / 1000.0},
+                   {"p99_ms", it.value()["p99"].get<double>() / 1000.0},
+                   {"max_ms", it.value()["max"].get<double>() / 1000.0}};
+  }
+  return l;
+}
+
+// Timing health, by process: frames lost on the way in (from the frame
+// numbers), frames late (more than a frame period after the operator sent
+// them), malformed ones dropped, and each link's latency.
+nlohmann::ordered_json TimingJson(const std::map<std::string, nlohmann::json>& stats, double rate_hz) {
+  const auto &op = stats.at("operator_station"), &dcp = stats.at("dynamics_proc"), &scene = stats.at("scene_proc"),
+             &esg = stats.at("esg_renderer");
+  nlohmann::ordered_json timing;
+  timing["frame_period_ms"] = 1000.0 / rate_hz;
+  timing["operator_station"] = {{"late_frames", Counter(op, "frames.late")}};
+  timing["dynamics_proc"] = {{"dropped_frames", Counter(dcp, "input.missing")},
+                             {"late_frames", Counter(dcp, "frames.late")},
+                             {"too_late_dropped", Counter(dcp, "dropped.late")},
+                             {"malformed", Malformed(dcp)},
+                             {"latency", Links(dcp)}};
+  timing["scene_proc"] = {{"dropped_frames", Counter(scene, "dcp.missing")},
+                          {"late_frames", Counter(scene, "frames.late")},
+                          {"too_late_dropped", Counter(scene, "dropped.late")},
+                          {"malformed", Malformed(scene)},
+                          {"latency", Links(scene)}};
+  timing["esg_renderer"] = {{"dropped_frames", Counter(esg, "esg.missing")},
+                            {"superseded", Counter(esg, "superseded")},
+                            {"late_frames", Counter(esg, "frames.late")},
+                            {"too_late_dropped", Counter(esg, "dropped.late")},
+                            {"malformed", Malformed(esg)},
+                            {"latency", Links(esg)}};
+  return timing;
+}
+
+// The record's own losses (docs/sessions.md "Losses"): each channel's frames
+// its publisher says it sent against those the log holds -- frames the
+// recorder lost (it fell behind, was stopped, or its disk filled), distinct
+// from frames lost on the way between the processes.
+nlohmann::ordered_json RecordJson(const std::map<std::string, nlohmann::json>& stats, const LogScan& s) {
+  struct Row {
+    const char* channel;
+    std::int64_t published, logged;
+  };
+  const Row rows[] = {
+      {wire::channels::kOperatorInput, Counter(stats.at("operator_station"), "published"), s.input.received()},
+      {wire::channels::kDcpFrame, Counter(stats.at("dynamics_proc"), "published"), s.dcp.received()},
+      {wire::channels::kDcpTelemetry, Counter(stats.at("dynamics_proc"), "published"),
+       static_cast<std::int64_t>(s.telemetry_logged.size())},
+      {wire::channels::kEsgFrame, Counter(stats.at("scene_proc"), "published"), s.esg.received()},
+  };
+  nlohmann::ordered_json r;
+  std::int64_t lost = 0;
+  for (const Row& row : rows) {
+    if (row.published <= 0) continue;  // no count from the publisher: nothing to hold the log against
+    const std::int64_t l = std::max<std::int64_t>(0, row.published - row.logged);
+    r["by_channel"][row.channel] = {{"published", row.published}, {"logged", row.logged}, {"lost", l}};
+    lost += l;
+  }
+  r["lost"] = lost;
+  return r;
+}
+
+nlohmann::ordered_json LogJson(const LogScan& s) {
+  nlohmann::ordered_json lj;
+  lj["file"] = "lcmlog";
+  lj["events"] = s.events;
+  lj["by_channel"] = s.by_channel;
+  lj["operator_frames"] = s.input.received();
+  lj["dcp_frames"] = s.dcp.received();
+  lj["esg_frames"] = s.esg.received();
+  lj["esg_frames_missing"] = s.esg.missing();
+  lj["malformed"] = s.malformed;
+  lj["final_status_from"] = nlohmann::json::array();
+  for (const auto& [p, seen] : s.status.final_seen) lj["final_status_from"].push_back(p);
+  return lj;
+}
+
+}  // namespace
+
+// Every number to 9 significant digits, so the summary reads 20.9 and not
+// 20.899999999999999 (its times are whole microseconds; docs/sessions.md
+// "summary.json").
+static void ForPeople(nlohmann::ordered_json* j) {
+  if (j->is_number_float()) {
+    const double v = j->get<double>();
+    if (std::isfinite(v)) *j = std::strtod(Sprintf("%.9g", v).c_str(), nullptr);
+    return;
+  }
+  if (j->is_structured()) {
+    for (auto& child : *j) ForPeople(&child);
+  }
+}
+
+nlohmann::ordered_json Summarize(const std::string& dir) {
+  const fs::path root(dir);
+  SessionLog first_pass(dir);
+  const DcpFrames dcp_frames = ReadDcpFrames(first_pass);
+  SessionLog log(dir);
+  SenderCheck& check = log.check();
+  check.Count("dcp_frame_out_of_sequence", dcp_frames.out_of_sequence);
+  LabConfig config;
+  try {
+    config = LoadConfig((root / "config.toml").string());
+  } catch (const std::exception&) {
+    config = LoadConfig(DefaultConfigPath());
+  }
+  AttemptLog attempts(config);
+  const LogScan s = ScanLog(log, dcp_frames.by_frame, &attempts);
+  const double rate_hz = FrameRate(root);
+  const double duration_s = s.first_us >= 0 ? (s.last_us - s.first_us) * 1e-6 : 0.0;
+  const auto stats = MergedStats(root, s.status, duration_s, rate_hz, &check);
+
+  nlohmann::ordered_json j;
+  j["session"] = fs::absolute(root).lexically_normal().filename().string();
+  if (j["session"].get<std::string>().empty()) j["session"] = fs::absolute(root).parent_path().filename().string();
+  if (check.session_id() != 0) j["session_id"] = wire::FormatSessionId(check.session_id());
+  j["duration_s"] = duration_s;
+  AddMission(s, &j);
+  {
+    std::ifstream pilot((root / "run" / "pilot").string());
+    std::string who;
+    if (pilot >> who) j["pilot"] = who;
+  }
+  j["restarts"] = Restarts(root);
+  for (std::size_t i = 0; i < j["restarts"].size(); ++i) attempts.ObserveRestart();
+  {
+    nlohmann::ordered_json a = attempts.Json();
+    j["attempts"] = std::move(a["attempts"]);
+    j["totals"] = std::move(a["totals"]);
+  }
+  j["mode_changes"] = s.telemetry.mode_changes;
+  j["control"] = s.control;
+  // The session's result (docs/sessions.md "summary.json"): its last
+  // attempt that docked, or else its last attempt.
+  {
+    j["result_attempt"] = nullptr;
+    j["phase_durations_s"] = nullptr;
+    j["docking"] = nullptr;
+    nlohmann::ordered_json result = nullptr;
+    for (const auto& a : j["attempts"]) {
+      if (a["outcome"] == "docked" || result.is_null() || !(result["outcome"] == "docked")) result = a;
+    }
+    if (result.is_object()) {
+      j["result_attempt"] = result["index"];
+      j["phase_durations_s"] = result["phase_durations_s"];
+      j["docking"] = result["docking"];
+      // A docking a restore brought (a checkpoint saved just before it): said,
+      // not hidden (docs/security.md "What the summary trusts").
+      if (j["docking"].is_object()) j["docking"]["after_restore"] = result["started_by"] == "restore";
+    }
+  }
+  j["by_hand"] = s.hand.Json();
+  if (j["by_hand"].is_object()) {
+    // The station's own count has the last key too (a quit ends it before
+    // another state message goes out).
+    j["by_hand"]["key_actions"] =
+        std::max(j["by_hand"]["key_actions"].get<std::int64_t>(), Counter(stats.at("operator_station"), "key_actions"));
+  }
+  j["collisions"] = s.telemetry.collisions;
+  j["collisions_by_kind"] = s.telemetry.ByKind();
+  j["held_frames"] = s.telemetry.held_frames;
+  j["telemetry_frames"] = s.telemetry.frames();
+  j["frames"] = FramesJson(stats);
+  nlohmann::ordered_json lat = nlohmann::ordered_json::object();
+  for (const auto& [proc, st] : stats) {
+    if (!st.contains("latency_us")) continue;
+    for (auto it = st["latency_us"].begin(); it != st["latency_us"].end(); ++it) {
+      lat[it.key()] = {{"count", it.value()["count"]},
+                       {"p50_ms", it.value()["p50"].get<double>() / 1000.0},
+                       {"p99_ms", it.value()["p99"].get<double>() / 1000.0},
+                       {"max_ms", it.value()["max"].get<double>() / 1000.0}};
+    }
+  }
+  j["latency"] = lat;
+  j["timing"] = TimingJson(stats, rate_hz);
+  j["record"] = RecordJson(stats, s);
+  j["log"] = LogJson(s);
+  j["log"]["unread_bytes"] = log.unread_bytes();  // a log cut short or damaged at its end
+  j["log"]["stats_from_log"] = nlohmann::json::array();
+  for (const auto& [p, st] : stats) {
+    if (st.value("from_log", false)) j["log"]["stats_from_log"].push_back(p);
+  }
+  j["ignored"] = check.Json();
+  ForPeople(&j);
+  return j;
+}
+
+nlohmann::ordered_json MakeManifest(const std::string& dir, const ManifestFields& f) {
+  const std::string &pilot = f.pilot, &url = f.url, &suffix = f.suffix, &config_sha256 = f.config_sha256,
+                    &timeline = f.timeline, &restore = f.restore, &command = f.command;
+  const std::vector<std::string>& hosts = f.hosts;
+  nlohmann::ordered_json j;
+  j["format"] = "rmslab-session-1";
+  j["session"] = fs::absolute(dir).lexically_normal().filename().string();
+  if (!f.session_id.empty()) j["session_id"] = wire::FormatSessionId(transport::ParseSessionId(f.session_id, "--session-id"));
+  const std::int64_t now = transport::WallTimeUs();
+  const std::time_t secs = static_cast<std::time_t>(now / 1000000);
+  char utc[32];
+  std::strftime(utc, sizeof utc, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&secs));
+  j["started_utc"] = utc;
+  j["started_us"] = now;
+  j["pilot"] = pilot;
+  j["kind"] = f.kind;
+  if (!f.parent.empty()) j[f.kind == "re-simulation" ? "resimulation_of" : "replay_of"] = f.parent;
+  if (!f.subject.empty()) j["subject"] = f.subject;
+  if (!f.note.empty()) j["note"] = f.note;
+  if (!timeline.empty()) j["timeline"] = {{"file", "timeline.tl"}, {"source", timeline}};
+  if (!restore.empty()) j["restored_from"] = restore;
+  j["config"] = {{"file", "config.toml"}, {"sha256", config_sha256}};
+  if (!f.config_source.empty()) j["config"]["source"] = f.config_source;
+  j["software"] = {{"version", VersionString()}, {"project", Version().project}, {"describe", Version().describe},
+                   {"commit", Version().commit}, {"build_type", Version().build_type}, {"compiler", Version().compiler}};
+  char host[256] = {};
+  gethostname(host, sizeof host - 1);
+  j["lab_host"] = host;
+  if (!url.empty()) j["lcm"] = {{"url", url}, {"channel_suffix", suffix}};
+  nlohmann::ordered_json layout = nlohmann::ordered_json::object();
+  for (const char* p : {"operator_station", "dynamics_proc", "scene_proc", "esg_renderer", "lcm-logger"}) layout[p] = "localhost";
+  for (const std::string& h : hosts) {
+    const auto eq = h.find('=');
+    if (eq == std::string::npos) throw InputError("--host must be PROCESS=HOST, got '" + h + "'");
+    layout[h.substr(0, eq)] = h.substr(eq + 1);
+  }
+  j["hosts"] = layout;
+  if (!command.empty()) j["command"] = command;
+  return j;
+}
+
+nlohmann::ordered_json ProbeAddress(const std::string& url, double seconds) {
+  lcm::LCM lcm(url);
+  if (!lcm.good()) throw transport::TransportError("cannot listen on '" + url + "' (no route for multicast? scripts/lab adds one)");
+  struct Heard {
+    std::map<std::string, std::int64_t> channels;
+    std::set<std::string> senders;
+  };
+  std::map<std::int64_t, Heard> sessions;
+  struct Handler {
+    std::map<std::int64_t, Heard>* out;
+    void On(const lcm::ReceiveBuffer* rb, const std::string& channel) {
+      std::int64_t fp = 0, id = 0;
+      std::int8_t process = 0;
+      std::int32_t pid = 0;
+      const int n = static_cast<int>(rb->data_size);
+      if (!wire::ReadFingerprint(rb->data, n, &fp) || !wire::IsRmslabFingerprint(fp) || !wire::ReadSessionId(rb->data, n, &id)) return;
+      wire::ReadSenderProcess(rb->data, n, &process, &pid);
+      Heard& h = (*out)[id];
+      ++h.channels[channel];
+      h.senders.insert(std::string(wire::ProcessCodeName(process)) + " pid " + std::to_string(pid));
+    }
+  } handler{&sessions};
+  lcm.subscribe("RMS_.*", &Handler::On, &handler);
+  const std::int64_t end = transport::WallTimeUs() + static_cast<std::int64_t>(seconds * 1e6);
+  for (std::int64_t now = transport::WallTimeUs(); now < end; now = transport::WallTimeUs()) {
+    lcm.handleTimeout(static_cast<int>(std::max<std::int64_t>(1, (end - now) / 1000)));
+  }
+  nlohmann::ordered_json j;
+  j["url"] = url;
+  j["seconds"] = seconds;
+  j["sessions"] = nlohmann::ordered_json::array();
+  for (const auto& [id, h] : sessions) {
+    j["sessions"].push_back({{"session_id", wire::FormatSessionId(id)}, {"channels", h.channels}, {"senders", h.senders}});
+  }
+  return j;
+}
+
+SessionInfo ReadSessionInfo(const std::string& dir) {
+  const fs::path p = fs::path(dir) / "manifest.json";
+  std::ifstream f(p);
+  if (!f) throw InputError("no manifest.json in " + dir + ": not a session folder");
+  SessionInfo s;
+  s.dir = dir;
+  try {
+    const auto j = nlohmann::json::parse(f);
+    if (j.contains("lcm")) {  // a re-simulation's folder has none: it ran on no network
+      s.lcm_url = j.at("lcm").value("url", "");
+      s.channel_suffix = j.at("lcm").value("channel_suffix", "");
+    }
+    if (j.contains("session_id")) s.session_id = transport::ParseSessionId(j.at("session_id").get<std::string>(), p.string() + " session_id");
+  } catch (const InputError&) {
+    throw;
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(p.string() + ": not valid JSON (at byte " + std::to_string(e.byte) + "): not a session's manifest");
+  } catch (const std::exception& e) {
+    throw InputError(p.string() + ": not a session's manifest (" + std::string(e.what()).substr(std::string(e.what()).find(']') + 1) + ")");
+  }
+  return s;
+}
+
+nlohmann::ordered_json CompareEsgFrames(const std::string& original_dir, const std::string& replay_dir) {
+  auto read = [](const std::string& dir) {
+    std::map<std::int64_t, esg_frame_t> by_dcp;
+    SessionLog log(dir);  // each session's own ESG frames
+    log.Read({wire::channels::kEsgFrame}, [&](const LogMessage& ev) {
+      esg_frame_t m;
+      if (log.Decode(ev, &m)) by_dcp[m.dcp_frame] = m;
+    });
+    return by_dcp;
+  };
+  const auto a = read(original_dir);
+  const auto b = read(replay_dir);
+  std::int64_t identical = 0, missing = 0;
+  std::string first;
+  for (const auto& [dcp_frame, m] : a) {
+    const auto it = b.find(dcp_frame);
+    if (it == b.end()) {
+      ++missing;
+      if (first.empty()) first = "DCP frame " + std::to_string(dcp_frame) + ": not replayed";
+      continue;
+    }
+    if (it->second.frame == m.frame && it->second.words == m.words) ++identical;
+    else if (first.empty()) first = "DCP frame " + std::to_string(dcp_frame) + ": words differ";
+  }
+  nlohmann::ordered_json j;
+  j["recorded"] = static_cast<std::int64_t>(a.size());
+  j["replayed"] = static_cast<std::int64_t>(b.size());
+  j["identical"] = identical;
+  j["missing"] = missing;
+  j["first_difference"] = first;
+  return j;
+}
+
+}  // namespace rms::session

@@ -1,0 +1,242 @@
+#include "rms/transport/lcm_interface.h"
+
+#include <cctype>
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <cstdlib>
+#include <lcm/lcm-cpp.hpp>
+#include <spdlog/spdlog.h>
+
+#include "rms/wire/channels.h"
+#include "rms/base/check.h"
+#include "rms/wire/message_io.h"
+
+namespace rms::transport {
+
+std::int64_t WallTimeUs() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+void ValidateChannelSuffix(std::string_view suffix) {
+  for (char ch : suffix) {
+    const bool ok = (ch >= 'A' && ch <= 'Z') || (ch >= 'a' && ch <= 'z') ||
+                    (ch >= '0' && ch <= '9') || ch == '_';
+    if (!ok) {
+      throw InputError("channel suffix '" + std::string(suffix) +
+                       "' may hold only letters, digits and '_'");
+    }
+  }
+}
+
+LcmInterface::LcmInterface(std::string suffix) : suffix_(std::move(suffix)) {
+  ValidateChannelSuffix(suffix_);
+}
+
+std::int64_t ParseSessionId(const std::string& text, const std::string& what) {
+  const bool hex = text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X');
+  const std::string digits = hex ? text.substr(2) : text;
+  bool ok = !digits.empty() && digits.size() <= (hex ? 16u : 19u);
+  for (char c : digits) ok = ok && (hex ? std::isxdigit(static_cast<unsigned char>(c)) : std::isdigit(static_cast<unsigned char>(c)));
+  if (!ok) throw InputError(what + "='" + text + "': not a session id (decimal, or 0x and up to 16 hex digits)");
+  return static_cast<std::int64_t>(std::strtoull(digits.c_str(), nullptr, hex ? 16 : 10));
+}
+
+std::int64_t SessionIdFromEnv() {
+  const char* v = std::getenv("RMSLAB_SESSION_ID");
+  if (!v || !*v) return 0;
+  return ParseSessionId(v, "RMSLAB_SESSION_ID");
+}
+
+bool LcmInterface::Admit(const std::string& channel, const void* data, int size) {
+  if (sender_.session_id == 0) return true;  // no session: takes every session's messages
+  std::int64_t fp = 0, id = 0;
+  // Only rmslab messages carry a sender; anything else goes on to be
+  // refused by the decoder (dropped.wrong_type), as before.
+  if (!wire::ReadFingerprint(data, size, &fp) || !wire::IsRmslabFingerprint(fp) || !wire::ReadSessionId(data, size, &id)) return true;
+  if (id == sender_.session_id) return AdmitPublisher(channel, data, size);
+  ++other_session_dropped_;
+  if (other_sessions_[id]++ == 0) {
+    std::int8_t process = 0;
+    std::int32_t pid = 0;
+    wire::ReadSenderProcess(data, size, &process, &pid);
+    spdlog::warn(
+        "{}: a message of another session (session {}, {} pid {}) -- dropped, as every one of it will be "
+        "(dropped.other_session). Two sessions share this address: give each its own --channel-suffix or "
+        "--lcm-url (docs/security.md)",
+        channel, wire::FormatSessionId(id), wire::ProcessCodeName(process), pid);
+  }
+  return false;
+}
+
+// One publisher a channel (docs/security.md "One publisher a channel"): on
+// the channels that only one process of a session publishes, a message from
+// another pid is taken only once the current publisher has fallen silent (it
+// ended, and this is its restart); while it still sends, the other is an
+// impostor with the session's id, dropped and counted.
+bool LcmInterface::AdmitPublisher(const std::string& channel, const void* data, int size) {
+  std::string_view base = channel;  // per message: no allocation
+  if (!suffix_.empty() && base.size() >= suffix_.size()) base.remove_suffix(suffix_.size());
+  if (base != wire::channels::kOperatorInput && base != wire::channels::kDcpFrame && base != wire::channels::kEsgFrame &&
+      base != wire::channels::kDcpTelemetry && base != wire::channels::kOperatorState && base != wire::channels::kWindowKeys &&
+      base != wire::channels::kDcpState) {
+    return true;  // RMS_STATUS and RMS_CONTROL have several publishers
+  }
+  std::int8_t process = 0;
+  std::int32_t pid = 0;
+  if (!wire::ReadSenderProcess(data, size, &process, &pid)) return true;
+  const std::int64_t now = NowUs();
+  Publisher& p = publishers_[channel];
+  if (p.last_us == 0 || (p.pid == pid && p.process == process)) {
+    p.process = process;
+    p.pid = pid;
+    p.last_us = now;
+    return true;
+  }
+  if (now - p.last_us < kPublisherSilenceUs) {
+    ++other_sender_dropped_;
+    if (!p.warned) {
+      p.warned = true;
+      spdlog::warn(
+          "{}: a message of this session from {} pid {} while its publisher ({} pid {}) is sending -- dropped, "
+          "as every one will be while it sends (dropped.other_sender): someone with this session's id is "
+          "impersonating a process (docs/security.md)",
+          channel, wire::ProcessCodeName(process), pid, wire::ProcessCodeName(p.process), p.pid);
+    }
+    return false;
+  }
+  spdlog::info("{}: a new publisher, {} pid {}, after {} ms of silence from pid {} (a restart)", channel,
+               wire::ProcessCodeName(process), pid, (now - p.last_us) / 1000, p.pid);
+  p = Publisher{process, pid, now, false};
+  return true;
+}
+
+// ---------------------------------------------------------------- UdpLcm
+
+struct UdpLcm::Sub {
+  Handler handler;
+  UdpLcm* owner = nullptr;
+  static void OnMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel, Sub* self) {
+    if (!self->owner->Admit(channel, rbuf->data, static_cast<int>(rbuf->data_size))) return;
+    self->handler(rbuf->data, static_cast<int>(rbuf->data_size), rbuf->recv_utime);
+  }
+};
+
+UdpLcm::UdpLcm(const LcmOptions& options)
+    : LcmInterface(options.channel_suffix),
+      url_(options.url),
+      queue_capacity_(options.queue_capacity) {
+  if (queue_capacity_ < 1) throw InputError("LCM queue capacity must be >= 1");
+  lcm_ = std::make_unique<lcm::LCM>(url_);
+  if (!lcm_->good()) {
+    throw TransportError(
+        "LCM could not open '" + url_ +
+        "'. For UDP multicast this machine needs a route to 224.0.0.0/4; on a host without a "
+        "default route add one on loopback:  sudo ip route add 224.0.0.0/4 dev lo  "
+        "(scripts/lab and scripts/test add it for you). Check the URL's group, port and ttl.");
+  }
+}
+
+UdpLcm::~UdpLcm() = default;
+
+bool UdpLcm::Publish(std::string_view channel, const void* data, int size) {
+  return lcm_->publish(FullChannel(channel), data, static_cast<unsigned>(size)) == 0;
+}
+
+void UdpLcm::Subscribe(std::string_view channel, Handler handler) {
+  auto sub = std::make_unique<Sub>();
+  sub->handler = std::move(handler);
+  sub->owner = this;
+  // LCM treats the channel as a regex; our names hold only [A-Za-z0-9_].
+  lcm::Subscription* s = lcm_->subscribeFunction(FullChannel(channel), &Sub::OnMessage, sub.get());
+  RMS_CHECK(s != nullptr);
+  s->setQueueCapacity(queue_capacity_);
+  subs_.push_back(std::move(sub));
+}
+
+int UdpLcm::HandleSubscriptions(int timeout_ms) {
+  int handled = 0;
+  errno = 0;
+  int r = lcm_->handleTimeout(timeout_ms);
+  while (r > 0) {
+    ++handled;
+    r = lcm_->handleTimeout(0);  // drain what is already queued
+  }
+  // A signal (SIGINT to stop) interrupting the wait is not a transport error.
+  if (r < 0 && errno == EINTR) return handled;
+  return r < 0 ? r : handled;
+}
+
+std::int64_t UdpLcm::NowUs() const { return WallTimeUs(); }
+
+// ---------------------------------------------------------------- LogLcm
+
+LogLcm::LogLcm(const std::string& input_path, const std::string& output_path,
+               std::string channel_suffix)
+    : LcmInterface(std::move(channel_suffix)) {
+  if (!input_path.empty()) {
+    in_ = std::make_unique<lcm::LogFile>(input_path, "r");
+    if (!in_->good()) throw InputError("cannot read LCM log '" + input_path + "'");
+    input_done_ = false;
+  }
+  if (!output_path.empty()) {
+    out_ = std::make_unique<lcm::LogFile>(output_path, "w");
+    if (!out_->good()) throw InputError("cannot write LCM log '" + output_path + "'");
+  }
+}
+
+LogLcm::~LogLcm() = default;
+
+bool LogLcm::Publish(std::string_view channel, const void* data, int size) {
+  const std::string full = FullChannel(channel);
+  if (out_) {
+    lcm::LogEvent ev{};
+    ev.timestamp = now_us_;
+    ev.channel = full;
+    ev.datalen = size;
+    ev.data = const_cast<void*>(data);
+    if (out_->writeEvent(&ev) != 0) return false;
+  }
+  Pending p{full, std::vector<std::uint8_t>(static_cast<const std::uint8_t*>(data),
+                                            static_cast<const std::uint8_t*>(data) + size)};
+  pending_.push_back(std::move(p));
+  return true;
+}
+
+void LogLcm::Subscribe(std::string_view channel, Handler handler) {
+  handlers_.emplace_back(FullChannel(channel), std::move(handler));
+}
+
+void LogLcm::Dispatch(const std::string& channel, const void* data, int size) {
+  if (!Admit(channel, data, size)) return;
+  for (auto& [name, handler] : handlers_) {
+    if (name == channel) handler(data, size, now_us_);
+  }
+}
+
+int LogLcm::HandleSubscriptions(int /*timeout_ms*/) {
+  // Messages published locally go first (they were "sent" before the next
+  // logged event is read), then one logged event.
+  int handled = 0;
+  while (!pending_.empty()) {
+    std::vector<Pending> batch;
+    batch.swap(pending_);
+    for (const Pending& p : batch) {
+      Dispatch(p.channel, p.data.data(), static_cast<int>(p.data.size()));
+      ++handled;
+    }
+  }
+  if (handled > 0 || input_done_) return handled;
+  const lcm::LogEvent* ev = in_->readNextEvent();
+  if (ev == nullptr) {
+    input_done_ = true;
+    return 0;
+  }
+  now_us_ = ev->timestamp;
+  Dispatch(ev->channel, ev->data, ev->datalen);
+  return 1;
+}
+
+}  // namespace rms::transport

@@ -1,0 +1,26 @@
+#pragma once
+// The six acquisition conditions of report IV.A.3, in its order: the one
+// table of their names (RMS_DCP_TELEMETRY acquisition_conditions[i] and
+// acquisition_margin_ft[i]; docs/collision.md "Acquisition").
+#include <array>
+
+namespace rms::wire {
+
+inline constexpr int kNumAcquisitionConditions = 6;
+
+struct AcquisitionConditionName {
+  const char* tag;    // a narrow screen's: "palm d"
+  const char* brief;  // a screen's column: "BAR beyond palm face d"
+  const char* text;   // a sentence's: "the BAR beyond face d of EFF HEX 1 (the palm)"
+};
+
+inline constexpr std::array<AcquisitionConditionName, kNumAcquisitionConditions> kAcquisitionConditionNames = {{
+    {"palm d", "BAR beyond palm face d", "the BAR beyond face d of EFF HEX 1 (the palm)"},
+    {"finger b", "BAR beyond finger face b", "the BAR beyond face b of EFF HEX 2 (the fixed finger)"},
+    {"finger e", "BAR beyond finger face e", "the BAR beyond face e of EFF HEX 3 (the movable finger)"},
+    {"gap D3Y", "finger gap below D3Y", "the finger gap below D3Y"},
+    {"TPOB", "palm within TPOB of BAR", "the palm within TPOB of the BAR's top"},
+    {"BAR ends", "palm between BAR ends", "the end effector between the BAR's ends"},
+}};
+
+}  // namespace rms::wire

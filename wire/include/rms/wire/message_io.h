@@ -1,0 +1,81 @@
+#pragma once
+// Safe encode / decode of LCM messages. Every message a process receives goes
+// through SafeDecode: a malformed message is classified (wrong type,
+// truncated, trailing bytes, impossible count) and never throws or crashes.
+// lcm-gen 1.3.1's decoders resize arrays from the message's own count fields
+// and can throw on hostile input; SafeDecode catches that.
+#include <cstdint>
+#include <cstring>
+#include <exception>
+#include <string>
+#include <string_view>
+#include <vector>
+
+
+namespace rms::wire {
+
+enum class DecodeError {
+  kNone = 0,
+  kTooLarge,       // larger than any valid message of the type
+  kWrongType,      // fingerprint is not the expected type's
+  kTruncated,      // ended before the message did
+  kTrailingBytes,  // bytes left after the message
+  kBadCount,       // an array or string length that cannot be valid
+};
+
+// Counter-friendly name: "too_large", "wrong_type", ...
+const char* DecodeErrorName(DecodeError e);
+
+// Reads the 8-byte big-endian fingerprint at the start of an LCM message.
+inline bool ReadFingerprint(const void* data, int size, std::int64_t* out) {
+  if (size < 8) return false;
+  const auto* b = static_cast<const std::uint8_t*>(data);
+  std::uint64_t v = 0;
+  for (int i = 0; i < 8; ++i) v = (v << 8) | b[i];
+  *out = static_cast<std::int64_t>(v);
+  return true;
+}
+
+// sender_t on the wire: right after the fingerprint (every rmslab message
+// has it first), session_id (8 bytes), process (1), pid (4), big-endian.
+inline constexpr int kSenderBytes = 13;
+
+// True for the fingerprint of one of rmslab's own message types.
+bool IsRmslabFingerprint(std::int64_t fingerprint);
+// The sender's session id / process and pid of a raw rmslab message; false
+// when it is too short to hold them.
+bool ReadSessionId(const void* data, int size, std::int64_t* session_id);
+bool ReadSenderProcess(const void* data, int size, std::int8_t* process, std::int32_t* pid);
+// "0x" and 16 hex digits, as the manifest and the logs write a session id.
+std::string FormatSessionId(std::int64_t session_id);
+// "dynamics_proc", ... for sender_t::PROCESS_*; "unknown" otherwise.
+const char* ProcessCodeName(std::int8_t process);
+// sender_t::PROCESS_* for a process name ("operator_station", ...); PROCESS_TOOL otherwise.
+std::int8_t ProcessCode(std::string_view name);
+
+template <class Msg>
+DecodeError SafeDecode(const void* data, int size, int max_size, Msg* msg) {
+  if (size > max_size) return DecodeError::kTooLarge;
+  std::int64_t fp = 0;
+  if (!ReadFingerprint(data, size, &fp)) return DecodeError::kTruncated;
+  if (fp != Msg::getHash()) return DecodeError::kWrongType;
+  int n = -1;
+  try {
+    n = msg->decode(data, 0, size);
+  } catch (const std::exception&) {  // length_error / bad_alloc from a hostile count
+    return DecodeError::kBadCount;
+  }
+  if (n < 0) return DecodeError::kTruncated;
+  if (n != size) return DecodeError::kTrailingBytes;
+  return DecodeError::kNone;
+}
+
+template <class Msg>
+std::vector<std::uint8_t> EncodeMessage(const Msg& msg) {
+  std::vector<std::uint8_t> buf(static_cast<std::size_t>(msg.getEncodedSize()));
+  const int n = msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
+  if (n < 0) buf.clear();
+  return buf;
+}
+
+}  // namespace rms::wire

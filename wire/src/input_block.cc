@@ -1,0 +1,92 @@
+#include "rms/wire/input_block.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "rms/base/check.h"
+#include "rms/wire/word_codec.h"
+
+namespace rms::wire {
+
+OperatorInputs InitialInputs(const InputCalibrations& cal) {
+  OperatorInputs in;
+  for (int i = 0; i < kNumAnalogInputs; ++i) in.value[i] = cal[i].initial;
+  return in;
+}
+
+namespace {
+
+double ClampCounted(double v, double lo, double hi, const std::string& counter, Counters* c) {
+  if (v < lo || v > hi) {
+    if (c) c->Add(counter);
+    return std::clamp(v, lo, hi);
+  }
+  return v;
+}
+
+}  // namespace
+
+std::array<std::int32_t, kInputWords> EncodeInputs(const OperatorInputs& in,
+                                                   const InputCalibrations& cal,
+                                                   Counters* counters) {
+  std::array<std::int32_t, kInputWords> words{};
+  for (int i = 0; i < kNumAnalogInputs; ++i) {
+    const std::string name(kAnalogInputNames[i]);
+    double v = in.value[i];
+    if (!std::isfinite(v)) throw InputError("input '" + name + "' is not a finite number");
+    v = ClampCounted(v, cal[i].min, cal[i].max, "clamped." + name, counters);
+    const double counts = v / cal[i].units_per_count + cal[i].zero_count;
+    const wire::Encoded e = wire::Encode(wire::kADC16, counts);
+    if (e.saturated && counters) counters->Add("clamped.adc." + name);
+    words[i] = static_cast<std::int32_t>(e.word);
+  }
+  int station = in.camera_station;
+  if (station < 1 || station > 8) {
+    if (counters) counters->Add("clamped.camera_station");
+    station = std::clamp(station, 1, 8);
+  }
+  std::uint32_t d = static_cast<std::uint32_t>(station - 1) & kDiscreteCameraMask;
+  if (in.reset) d |= kDiscreteReset;
+  if (in.overlay) d |= kDiscreteOverlay;
+  if (in.crosshairs) d |= kDiscreteCrosshairs;
+  words[kDiscreteWordIndex] = static_cast<std::int32_t>(d);
+  return words;
+}
+
+OperatorInputs DecodeInputs(const std::array<std::int32_t, kInputWords>& words,
+                            const InputCalibrations& cal, Counters* counters) {
+  const int bad = wire::FirstInvalidWord(words);
+  if (bad >= 0) {
+    throw InputError("input word " + std::to_string(bad) + " = " + wire::FormatWord(words[bad]) +
+                     " has bits above bit 23 set");
+  }
+  const std::uint32_t d = static_cast<std::uint32_t>(words[kDiscreteWordIndex]);
+  if (d & kDiscreteReservedMask) {
+    throw InputError("input discrete word " + wire::FormatWord(words[kDiscreteWordIndex]) +
+                     " has reserved bits 6-23 set");
+  }
+  OperatorInputs in;
+  for (int i = 0; i < kNumAnalogInputs; ++i) {
+    const std::string name(kAnalogInputNames[i]);
+    std::int32_t counts = wire::ToSigned(static_cast<wire::Word>(words[i]));
+    if (counts < wire::kADC16.raw_min || counts > wire::kADC16.raw_max) {
+      if (counters) counters->Add("clamped.adc." + name);
+      counts = std::clamp(counts, wire::kADC16.raw_min, wire::kADC16.raw_max);
+    }
+    const double v = (counts - cal[i].zero_count) * cal[i].units_per_count;
+    // Half a count of slack: a value encoded at the range's end reads back
+    // within rounding of it and is not a clamp.
+    const double slack = 0.5 * std::abs(cal[i].units_per_count);
+    if (v < cal[i].min - slack || v > cal[i].max + slack) {
+      if (counters) counters->Add("clamped." + name);
+    }
+    in.value[i] = std::clamp(v, cal[i].min, cal[i].max);
+  }
+  in.camera_station = static_cast<int>(d & kDiscreteCameraMask) + 1;
+  in.reset = (d & kDiscreteReset) != 0;
+  in.overlay = (d & kDiscreteOverlay) != 0;
+  in.crosshairs = (d & kDiscreteCrosshairs) != 0;
+  return in;
+}
+
+}  // namespace rms::wire
