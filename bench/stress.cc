@@ -158,9 +158,9 @@ void StressPairs(long n, std::uint64_t seed, PairStats* st, Failures* fail) {
     };
     if (r.verdict == Verdict::kSeparate) {
       if (!r.plane_valid) fail->Add("separate without a plane", detail("no plane"));
-      else if (!r.n.allFinite() || !std::isfinite(r.d) || std::fabs(r.n.norm() - 1) > 1e-12)
+      else if (!r.plane.n_R.allFinite() || !std::isfinite(r.plane.d_ft) || std::fabs(r.plane.n_R.norm() - 1) > 1e-12)
         fail->Add("plane not finite or not unit", detail("bad plane"));
-      else if (!PlaneSeparates(p.a.hex, p.b.hex, r.n, r.d, kBand * scale))
+      else if (!PlaneSeparates(p.a.hex, p.b.hex, r.plane.n_R, r.plane.d_ft, kBand * scale))
         fail->Add("plane does not separate", detail("plane"));
     }
     const auto same_or_band = [&](Verdict v, const char* what) {

@@ -111,8 +111,7 @@ int EdgePiercesFace(const Hexahedron& P, int i, int k, LocationWord wi, Location
 
 void SetPlane(CollisionResult* r, const Eigen::Vector3d& n, double d) {
   r->plane_valid = true;
-  r->n = n;
-  r->d = d;
+  r->plane = {n, d};
 }
 
 void ProjectionRange(const Hexahedron& h, const Eigen::Vector3d& n, double* lo, double* hi) {
@@ -242,10 +241,10 @@ CollisionResult Collide(const Hexahedron& a, const Hexahedron& b, const CollideO
   }
   // The hint decides only a pair it separates by more than tau on each side
   // (so touching pairs, which collide, always go to the report's test).
-  if (options.hint && PlaneSeparates(a, b, options.hint->n, options.hint->d, -tau)) {
+  if (options.hint && PlaneSeparates(a, b, options.hint->n_R, options.hint->d_ft, -tau)) {
     r.verdict = Verdict::kSeparate;
     r.decider = Decider::kHintPlane;
-    if (options.want_plane) SetPlane(&r, options.hint->n, options.hint->d);
+    if (options.want_plane) SetPlane(&r, options.hint->n_R, options.hint->d_ft);
     return r;
   }
 

@@ -31,14 +31,6 @@ bool AllHave(const std::array<LocationWord, 8>& words, int face) {
   return true;
 }
 
-std::string Names(std::uint32_t bits) {
-  std::string s;
-  for (int b = 0; b < wire::collision_bits::kCount; ++b) {
-    if (bits & (1u << b)) s += std::string(s.empty() ? "" : ", ") + wire::CollisionName(b);
-  }
-  return s.empty() ? "none" : s;
-}
-
 }  // namespace
 
 DynamicCollisionProgram::DynamicCollisionProgram(const LabConfig& config, const DcpOptions& options)
@@ -63,7 +55,7 @@ DynamicCollisionProgram::DynamicCollisionProgram(const LabConfig& config, const 
   start.finger = initial.value[kFinger];
   Evaluate(start, nullptr, slave_);
   if (slave_->collisions) {
-    throw InputError("inputs.*.initial: the arm's initial pose collides (" + Names(slave_->collisions) +
+    throw InputError("inputs.*.initial: the arm's initial pose collides (" + wire::CollisionNames(slave_->collisions, ", ", "none") +
                      "); the DCP needs a collision-free pose to start from");
   }
   initial_ = start;
@@ -104,7 +96,7 @@ bool DynamicCollisionProgram::Reset() {
   Evaluate(SlaveAsItIs(), slave_, spare_);
   if (spare_->collisions) {
     spdlog::warn("reset refused: the arm where it is would collide with the payload in the bay ({}); "
-                 "move the arm clear and reset again", Names(spare_->collisions));
+                 "move the arm clear and reset again", wire::CollisionNames(spare_->collisions, ", ", "none"));
     PlacePayload(X_RP_free);
     status_.mode = mode;
     status_.acquired = acquired;
@@ -156,7 +148,7 @@ namespace {
 // A pair's gap lower bound from its separating plane (0: colliding or none).
 double PairGap(const CollisionResult& r, const Hexahedron& a, const Hexahedron& b) {
   if (r.verdict != Verdict::kSeparate || !r.plane_valid) return 0.0;
-  return std::max(0.0, GapAlong(a, b, r.n));
+  return std::max(0.0, GapAlong(a, b, r.plane.n_R));
 }
 }  // namespace
 
@@ -185,14 +177,13 @@ void DynamicCollisionProgram::TestHandAgainstPayload(const Evaluation* prev, Eva
   namespace cb = wire::collision_bits;
   Evaluation& e = *out;
   // A pair's options: bounding rejection, and its previous plane as the hint.
-  SeparatingPlaneHint hints[1 + kBodyStrips][3];
-  auto opts = [&](const CollisionResult* last, SeparatingPlaneHint* hint) {
+  scene_model::SeparatingPlane hints[1 + kBodyStrips][3];
+  auto opts = [&](const CollisionResult* last, scene_model::SeparatingPlane* hint) {
     CollideOptions o;
     o.relative_tolerance = tau_rel_;
     o.sphere_reject = o.aabb_reject = options_.bounding_reject;
     if (options_.frame_coherence && prev && last->verdict == Verdict::kSeparate && last->plane_valid) {
-      hint->n = last->n;
-      hint->d = last->d;
+      *hint = last->plane;
       o.hint = hint;
     }
     return o;
@@ -509,7 +500,7 @@ void DynamicCollisionProgram::LetGo() {
   Evaluate(SlaveAsItIs(), slave_, spare_);
   if (spare_->collisions) {
     spdlog::warn("the finger opened but the hand would be in collision with the payload let go ({}): grasp kept",
-                 Names(spare_->collisions));
+                 wire::CollisionNames(spare_->collisions, ", ", "none"));
     PlacePayload(X_RP_free);
     status_.mode = slave_->mode;
     status_.acquired = true;
@@ -572,7 +563,7 @@ wire::DcpFrameData DynamicCollisionProgram::Step(const wire::OperatorInputs& in)
     } else {
       status_.held = true;
       spdlog::warn("the first command collides ({}): not taken; the arm stays at its initial pose",
-                   Names(spare_->collisions));
+                   wire::CollisionNames(spare_->collisions, ", ", "none"));
     }
     started_ = true;
   }
@@ -627,7 +618,7 @@ void DynamicCollisionProgram::UpdatePlanes() {
     const CollisionResult& r = slave_->ee_bar[k];
     if (r.verdict == Verdict::kSeparate && r.plane_valid) {
       // Centred in the gap, to survive rounding to the plane words.
-      status_.planes[k] = {r.n, MidGapOffset(slave_->ee.hex[k], bar_, r.n)};
+      status_.planes[k] = {r.plane.n_R, MidGapOffset(slave_->ee.hex[k], bar_, r.plane.n_R)};
       status_.plane_valid |= 1u << k;
     }
   }
@@ -650,7 +641,7 @@ void DynamicCollisionProgram::RefreshMeasures() {
     status_.acquisition = c.holds;
     status_.acquisition_margin_ft = c.margin_ft;
     status_.palm_to_bar_ft = c.palm_to_bar_ft;
-    status_.finger_contact = c.margin_ft[2] <= kFingerContactToleranceFt;
+    status_.finger_contact = c.margin_ft[wire::kBarBeyondFingerFaceE] <= kFingerContactToleranceFt;
   }
 }
 
@@ -673,43 +664,43 @@ AcquisitionCheck CheckAcquisition(const DcpConfig& dcp, const EndEffectorModel& 
   const double tau = ToleranceFt(h1, bar, relative_tolerance);
   AcquisitionCheck c;
   c.finger_gap_ft = finger_gap_ft;
-  c.holds[0] = AllHave(h1.Words(bar, tau), kFaceD);
-  c.holds[1] = AllHave(h2.Words(bar, tau), kFaceB);
-  c.holds[2] = AllHave(h3.Words(bar, tau), kFaceE);
-  c.holds[3] = finger_gap_ft < dcp.d3y_ft;
+  c.holds[wire::kBarBeyondPalmFaceD] = AllHave(h1.Words(bar, tau), kFaceD);
+  c.holds[wire::kBarBeyondFingerFaceB] = AllHave(h2.Words(bar, tau), kFaceB);
+  c.holds[wire::kBarBeyondFingerFaceE] = AllHave(h3.Words(bar, tau), kFaceE);
+  c.holds[wire::kFingerGapBelowD3Y] = finger_gap_ft < dcp.d3y_ft;
   Eigen::Vector3d top = Eigen::Vector3d::Zero();
   for (int v : kFaceVertices[kFaceC]) top += bar.vertex(v);
   top *= 0.25;
   c.palm_to_bar_ft = h1.Beyond(kFaceD, top.x(), top.y(), top.z());
   // The report's "distance": unsigned (a BAR behind the palm's face d is not
   // near it; condition 1 fails there anyway, so acquisition is unchanged).
-  c.holds[4] = std::abs(c.palm_to_bar_ft) < dcp.tpob_ft;
+  c.holds[wire::kPalmWithinTpob] = std::abs(c.palm_to_bar_ft) < dcp.tpob_ft;
   bool between = true;
   for (LocationWord w : bar.Words(h1, tau)) between = between && !(w & (FaceBit(kFaceA) | FaceBit(kFaceD)));
-  c.holds[5] = between;
+  c.holds[wire::kBetweenBarEnds] = between;
   // Margins (docs/collision.md "Margins"): least depths, ft.
   auto least_beyond = [](const Hexahedron& h, int face, const Hexahedron& of) {
     double m = 1e30;
     for (int i = 0; i < kNumVertices; ++i) m = std::min(m, h.Beyond(face, of.x[i], of.y[i], of.z[i]));
     return m;
   };
-  c.margin_ft[0] = least_beyond(h1, kFaceD, bar);
-  c.margin_ft[1] = least_beyond(h2, kFaceB, bar);
-  c.margin_ft[2] = least_beyond(h3, kFaceE, bar);
-  c.margin_ft[3] = dcp.d3y_ft - finger_gap_ft;
-  c.margin_ft[4] = dcp.tpob_ft - std::abs(c.palm_to_bar_ft);
+  c.margin_ft[wire::kBarBeyondPalmFaceD] = least_beyond(h1, kFaceD, bar);
+  c.margin_ft[wire::kBarBeyondFingerFaceB] = least_beyond(h2, kFaceB, bar);
+  c.margin_ft[wire::kBarBeyondFingerFaceE] = least_beyond(h3, kFaceE, bar);
+  c.margin_ft[wire::kFingerGapBelowD3Y] = dcp.d3y_ft - finger_gap_ft;
+  c.margin_ft[wire::kPalmWithinTpob] = dcp.tpob_ft - std::abs(c.palm_to_bar_ft);
   double inside = 1e30;
   for (int i = 0; i < kNumVertices; ++i) {
     inside = std::min({inside, -bar.Beyond(kFaceA, h1.x[i], h1.y[i], h1.z[i]),
                        -bar.Beyond(kFaceD, h1.x[i], h1.y[i], h1.z[i])});
   }
-  c.margin_ft[5] = inside;
+  c.margin_ft[wire::kBetweenBarEnds] = inside;
   // Condition 3 at the essential contact: the movable finger on the bar. A
   // bar slightly askew touches face e at one corner while its far corner,
   // beyond the finger's edge, may lie a hair behind the face's plane: within
   // the contact tolerance it counts as on the face (docs/collision.md "The
   // essential contact").
-  c.holds[2] = c.holds[2] || c.margin_ft[2] > -kFingerContactToleranceFt;
+  c.holds[wire::kBarBeyondFingerFaceE] = c.holds[wire::kBarBeyondFingerFaceE] || c.margin_ft[wire::kBarBeyondFingerFaceE] > -kFingerContactToleranceFt;
   return c;
 }
 
@@ -744,7 +735,7 @@ void DynamicCollisionProgram::UpdateAcquisition() {
   status_.acquisition_margin_ft = c.margin_ft;
   status_.palm_to_bar_ft = c.palm_to_bar_ft;
   status_.bay_clearance_ft = BayClearance(slave_->payload);
-  status_.finger_contact = c.margin_ft[2] <= kFingerContactToleranceFt;
+  status_.finger_contact = c.margin_ft[wire::kBarBeyondFingerFaceE] <= kFingerContactToleranceFt;
   if (!(c.all() && status_.finger_contact)) return;
   status_.mode = 2;
   status_.acquired = true;
@@ -775,7 +766,7 @@ bool DynamicCollisionProgram::ReevaluateSlave() {
   Evaluate(slave_->cmd, slave_, spare_);
   if (spare_->collisions) {
     spdlog::warn("Mode {} not entered: the arm where it is would collide there ({})", status_.mode,
-                 Names(spare_->collisions));
+                 wire::CollisionNames(spare_->collisions, ", ", "none"));
     return false;
   }
   AcceptSpare();
@@ -852,7 +843,7 @@ constexpr const char* kCheckpointFormat = "rmslab-dcp-state-1";
 // null when the pair had none.
 nlohmann::json PlaneJson(const CollisionResult& r) {
   if (r.verdict != Verdict::kSeparate || !r.plane_valid) return nullptr;
-  return {r.n.x(), r.n.y(), r.n.z(), r.d};
+  return {r.plane.n_R.x(), r.plane.n_R.y(), r.plane.n_R.z(), r.plane.d_ft};
 }
 
 void PlaneFrom(const nlohmann::json& j, CollisionResult* r) {
@@ -860,8 +851,7 @@ void PlaneFrom(const nlohmann::json& j, CollisionResult* r) {
   if (!j.is_array() || j.size() != 4) throw InputError("checkpoint: a plane must be null or 4 numbers");
   r->verdict = Verdict::kSeparate;
   r->plane_valid = true;
-  r->n = Eigen::Vector3d(j[0].get<double>(), j[1].get<double>(), j[2].get<double>());
-  r->d = j[3].get<double>();
+  r->plane = {Eigen::Vector3d(j[0].get<double>(), j[1].get<double>(), j[2].get<double>()), j[3].get<double>()};
 }
 
 }  // namespace
@@ -952,10 +942,10 @@ void DynamicCollisionProgram::RestoreState(const nlohmann::json& j) {
     }
   }
   for (const CollisionResult& r : p->hints.ee_bar) {
-    if (r.plane_valid && !(std::abs(r.n.norm() - 1.0) <= 1e-9)) throw InputError("checkpoint: a plane's normal is not a unit vector");
+    if (r.plane_valid && !(std::abs(r.plane.n_R.norm() - 1.0) <= 1e-9)) throw InputError("checkpoint: a plane's normal is not a unit vector");
   }
   for (const CollisionResult& r : p->hints.ee_body) {
-    if (r.plane_valid && !(std::abs(r.n.norm() - 1.0) <= 1e-9)) throw InputError("checkpoint: a plane's normal is not a unit vector");
+    if (r.plane_valid && !(std::abs(r.plane.n_R.norm() - 1.0) <= 1e-9)) throw InputError("checkpoint: a plane's normal is not a unit vector");
   }
   // The slave must be free where the checkpoint puts it: tried on the state
   // it describes, and the old state put back if not.
@@ -980,7 +970,7 @@ void DynamicCollisionProgram::RestoreState(const nlohmann::json& j) {
   const ArmCommand slave = p->have_slave ? p->slave : initial_;
   Evaluate(slave, &p->hints, spare_);
   if (spare_->collisions) {
-    const std::string pairs = Names(spare_->collisions);
+    const std::string pairs = wire::CollisionNames(spare_->collisions, ", ", "none");
     RestoreState(before);
     throw InputError("checkpoint: its arm pose collides (" + pairs + ")");
   }

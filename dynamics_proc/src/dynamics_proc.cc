@@ -4,6 +4,7 @@
 
 #include <filesystem>
 
+#include "rms/wire/acquisition_conditions.h"
 #include "rms/wire/channels.h"
 #include "rms/base/check.h"
 #include "rms/dcp_frame_t.hpp"
@@ -15,11 +16,6 @@
 #include "rms/wire/checkpoint.h"
 
 namespace rms::dynamics_proc {
-
-namespace {
-// operator_input_t has a fixed size: 8 (fingerprint) + the sender + 2 x 8 + 12 x 4.
-constexpr int kMaxInputSize = 8 + wire::kSenderBytes + 16 + 4 * wire::kInputWords;
-}  // namespace
 
 DynamicsProc::DynamicsProc(const LabConfig& config, transport::LcmInterface* lcm)
     : config_(config), lcm_(lcm), dcp_(config) {
@@ -123,7 +119,7 @@ void DynamicsProc::WriteStateFile() {
 
 void DynamicsProc::OnControl(const void* data, int size) {
   session_control_t m;
-  if (wire::SafeDecode(data, size, 1 << 16, &m) != wire::DecodeError::kNone) {
+  if (wire::SafeDecode(data, size, &m) != wire::DecodeError::kNone) {
     counters_.Add("dropped.control_malformed");
     return;
   }
@@ -166,7 +162,7 @@ void DynamicsProc::OnInput(const void* data, int size, std::int64_t recv_time_us
   // log's time.
   const std::int64_t now_us = late_.enabled() ? lcm_->NowUs() : recv_time_us;
   auto got = wire::ReceiveFrame<operator_input_t>(
-      data, size, kMaxInputSize, &inputs_, &counters_,
+      data, size, &inputs_, &counters_,
       [this](const operator_input_t& m) {
         std::array<std::int32_t, wire::kInputWords> words{};
         std::copy(m.words, m.words + wire::kInputWords, words.begin());
@@ -257,7 +253,7 @@ dcp_telemetry_t MakeTelemetry(const DcpStatus& st, const wire::DcpFrameData& out
   t.finger_held = st.finger_held;
   t.collisions = static_cast<std::int32_t>(st.collisions);
   t.slave_collisions = static_cast<std::int32_t>(st.slave_collisions);
-  for (int i = 0; i < 6; ++i) {
+  for (int i = 0; i < wire::kNumAcquisitionConditions; ++i) {
     t.acquisition_conditions[i] = st.acquisition[i];
     t.acquisition_margin_ft[i] = st.acquisition_margin_ft[i];
   }

@@ -18,8 +18,6 @@
 namespace rms::esg_renderer {
 
 namespace {
-// esg_frame_t: 8 (fingerprint) + 5 x 8 + 2 + 64 x 4 at most.
-constexpr int kMaxEsgSize = 8 + wire::kSenderBytes + 40 + 2 + 4 * wire::kEsgMaxWords;
 
 std::int64_t MonotonicUs() {
   return std::chrono::duration_cast<std::chrono::microseconds>(
@@ -40,7 +38,7 @@ EsgRenderer::EsgRenderer(const LabConfig& config, transport::LcmInterface* lcm, 
 
 void EsgRenderer::OnOperatorState(const void* data, int size) {
   operator_state_t m{};
-  if (const wire::DecodeError e = wire::SafeDecode(data, size, 8192, &m); e != wire::DecodeError::kNone) {
+  if (const wire::DecodeError e = wire::SafeDecode(data, size, &m); e != wire::DecodeError::kNone) {
     counters_.Add(std::string("dropped.operator_state_") + wire::DecodeErrorName(e));
     return;
   }
@@ -90,7 +88,7 @@ void EsgRenderer::EnableLiveChecks(double frame_rate_hz) {
 void EsgRenderer::OnFrame(const void* data, int size, std::int64_t recv_time_us) {
   const std::int64_t now_us = late_.enabled() ? lcm_->NowUs() : recv_time_us;
   auto got = wire::ReceiveFrame<esg_frame_t>(
-      data, size, kMaxEsgSize, &frames_, &counters_,
+      data, size, &frames_, &counters_,
       [](const esg_frame_t& m) {
         if (m.num_words < 1 || m.num_words > wire::kEsgMaxWords) {
           throw wire::MalformedError("word_count", "ESG frame with " + std::to_string(m.num_words) + " words");

@@ -9,6 +9,8 @@
 
 namespace rms::mission {
 
+double GraspPalmAboveBarFt(const LabConfig& c) { return kGraspTpobShare * c.dcp.tpob_ft; }
+
 MissionGeometry PlanGeometry(const LabConfig& c) { return PlanGeometry(c, c.inputs[kShoulderHeight].initial); }
 
 MissionGeometry PlanGeometry(const LabConfig& c, double shoulder_height_ft) {
@@ -20,10 +22,10 @@ MissionGeometry PlanGeometry(const LabConfig& c, double shoulder_height_ft) {
   const Eigen::Vector3d yP = p.R_RP.col(1), zP = p.R_RP.col(2);
   const Eigen::Vector3d X2 = -zP, Y2 = -yP;
   const double bar_w = p.bar_size_P_ft.y(), bar_h = p.bar_size_P_ft.z();
-  const double clearance = 0.4 * (c.dcp.d3y_ft - bar_w);
+  const double clearance = kGraspD3yMarginShare * (c.dcp.d3y_ft - bar_w);
   const double y_bar = ee.palm_half_width_ft - ee.finger_thickness_ft - clearance - 0.5 * bar_w;
   const Eigen::Vector3d bar = X_RP_bay * p.p_PoBar_P_ft;
-  const Eigen::Vector3d A = bar - y_bar * Y2 - (ee.palm_length_ft + 0.5 * c.dcp.tpob_ft + 0.5 * bar_h) * X2;
+  const Eigen::Vector3d A = bar - y_bar * Y2 - (ee.palm_length_ft + GraspPalmAboveBarFt(c) + 0.5 * bar_h) * X2;
   g.X_RS2_grasp = EndEffectorPose(A, X2, Y2);
   g.X_S2P = g.X_RS2_grasp.inverse() * X_RP_bay;
   const Eigen::Vector3d yC = c.cae.R_RC.col(1);

@@ -6,6 +6,7 @@
 
 #include "rms/operator_station/guidance.h"
 #include "rms/arm/kinematics.h"
+#include "rms/wire/acquisition_conditions.h"
 #include "rms/wire/collision_bits.h"
 
 namespace rms::operator_station {
@@ -30,6 +31,11 @@ const char* AutopilotPhaseName(AutopilotPhase p) {
 }
 
 namespace {
+
+// After the descent the autopilot corrects once more when the palm is still
+// above the BAR's top by more than this share of TPOB (the plan puts it at
+// mission::kGraspTpobShare).
+constexpr double kGraspCorrectTpobShare = 0.7;
 
 Eigen::Isometry3d Shifted(Eigen::Isometry3d X, const Eigen::Vector3d& d) {
   X.translation() += d;
@@ -302,10 +308,7 @@ void Autopilot::StartPhase(AutopilotPhase p, const dcp_telemetry_t& tm) {
 void Autopilot::Relieve(const dcp_telemetry_t& tm) {
   ++collisions_;
   counters_.Add("autopilot.collisions_relieved");
-  std::string kinds;
-  for (int b = 0; b < wire::collision_bits::kCount; ++b) {
-    if (tm.collisions & (1 << b)) kinds += std::string(kinds.empty() ? "" : ", ") + wire::CollisionName(b);
-  }
+  const std::string kinds = wire::CollisionNames(static_cast<std::uint32_t>(tm.collisions));
   spdlog::info("autopilot: collision ({}) in {}: back to the pose the slave holds, then away", kinds,
                AutopilotPhaseName(phase_));
   if (collisions_ > opt_.max_collisions) {
@@ -412,13 +415,13 @@ wire::OperatorInputs Autopilot::Step(const dcp_telemetry_t* tm_ptr) {
       const PlanState ps = StepPlan();
       if (ps == PlanState::kUnreachable) return Fail("the grasp is out of the arm's reach"), cmd_;
       if (ps != PlanState::kDone || !Settled(tm)) break;
-      // Closing the loop: the palm must be within TPOB of the bar's top.
-      const double tpob = config_.dcp.tpob_ft;
-      if (tm.palm_to_bar_ft > 0.7 * tpob && retries_ < opt_.max_retries) {
+      // Closing the loop: the palm must be within TPOB of the bar's top;
+      // well short of it (kGraspCorrectTpobShare), descend to the planned height.
+      if (tm.palm_to_bar_ft > kGraspCorrectTpobShare * config_.dcp.tpob_ft && retries_ < opt_.max_retries) {
         ++retries_;
         counters_.Add("autopilot.grasp_corrections");
         const Eigen::Isometry3d X = CommandedPose();
-        PlanLine(Shifted(X, (tm.palm_to_bar_ft - 0.5 * tpob) * X.linear().col(0)), 0.2);
+        PlanLine(Shifted(X, (tm.palm_to_bar_ft - mission::GraspPalmAboveBarFt(config_)) * X.linear().col(0)), 0.2);
         break;
       }
       StartPhase(AutopilotPhase::kClose, tm);
@@ -434,7 +437,7 @@ wire::OperatorInputs Autopilot::Step(const dcp_telemetry_t* tm_ptr) {
       if (cmd_.value[kFinger] >= 1.0 && ++finger_full_frames_ > static_cast<int>(1.5 / dt_s_)) {
         // Closed and not acquired: which conditions fail? Open and try again.
         std::string failing;
-        for (int i = 0; i < 6; ++i) {
+        for (int i = 0; i < wire::kNumAcquisitionConditions; ++i) {
           if (!tm.acquisition_conditions[i]) failing += (failing.empty() ? "" : ", ") + std::to_string(i + 1);
         }
         if (++retries_ > opt_.max_retries) return Fail("no acquisition (conditions " + failing + " fail)"), cmd_;

@@ -45,12 +45,6 @@ void SleepUntilNs(std::int64_t t_ns) {
   }
 }
 
-// The biggest message of each kind a station accepts (docs/protocol.md).
-constexpr int kMaxTelemetrySize = 4096;
-constexpr int kMaxStatusSize = 1 << 20;
-constexpr int kMaxControlSize = 1 << 16;
-constexpr int kMaxWindowKeysSize = 8 + wire::kSenderBytes + 16 + 2 + 2 * 512 + 2 + 2 * 512 + 1;
-
 bool Restarted() { return transport::RestartedByLauncher(); }
 
 }  // namespace
@@ -124,7 +118,7 @@ void OperatorStation::Subscribe() {
 
 void OperatorStation::OnTelemetry(const void* data, int size, std::int64_t recv_us) {
   dcp_telemetry_t m{};
-  if (const wire::DecodeError e = wire::SafeDecode(data, size, kMaxTelemetrySize, &m); e != wire::DecodeError::kNone) {
+  if (const wire::DecodeError e = wire::SafeDecode(data, size, &m); e != wire::DecodeError::kNone) {
     counters_.Add(std::string("dropped.telemetry_") + wire::DecodeErrorName(e));
     return;
   }
@@ -162,7 +156,7 @@ void OperatorStation::OnTelemetry(const void* data, int size, std::int64_t recv_
 
 void OperatorStation::OnStatus(const void* data, int size, std::int64_t recv_us) {
   process_status_t m;
-  if (wire::SafeDecode(data, size, kMaxStatusSize, &m) != wire::DecodeError::kNone) {
+  if (wire::SafeDecode(data, size, &m) != wire::DecodeError::kNone) {
     counters_.Add("dropped.status_malformed");
     return;
   }
@@ -187,7 +181,7 @@ void OperatorStation::OnStatus(const void* data, int size, std::int64_t recv_us)
 // publishes nothing, so every process holds its frame and nothing is lost.
 void OperatorStation::OnControl(const void* data, int size, std::int64_t) {
   session_control_t m;
-  if (wire::SafeDecode(data, size, kMaxControlSize, &m) != wire::DecodeError::kNone) {
+  if (wire::SafeDecode(data, size, &m) != wire::DecodeError::kNone) {
     counters_.Add("dropped.control_malformed");
     return;
   }
@@ -217,7 +211,7 @@ void OperatorStation::OnControl(const void* data, int size, std::int64_t) {
 
 void OperatorStation::OnWindowKeys(const void* data, int size, std::int64_t recv_us) {
   window_keys_t m;
-  if (const wire::DecodeError e = wire::SafeDecode(data, size, kMaxWindowKeysSize, &m); e != wire::DecodeError::kNone) {
+  if (const wire::DecodeError e = wire::SafeDecode(data, size, &m); e != wire::DecodeError::kNone) {
     counters_.Add(std::string("dropped.window_keys_") + wire::DecodeErrorName(e));
     return;
   }
@@ -289,10 +283,11 @@ void OperatorStation::PublishState(std::int64_t frame, const wire::OperatorInput
     m.show_guidance = h->show_guidance();
     m.key_actions = static_cast<std::int32_t>(h->key_actions());
     m.rate_limited = s.rate_limited;
-    const std::size_t n = std::min<std::size_t>(h->device_actions().size(), 16);
+    // Within the message's bounds (operator_state_t.lcm): the first devices, names cut.
+    const std::size_t n = std::min<std::size_t>(h->device_actions().size(), operator_state_t::MAX_DEVICES);
     m.num_devices = static_cast<std::int8_t>(n);
     for (std::size_t i = 0; i < n; ++i) {
-      m.device_names.push_back(h->device_name(i));
+      m.device_names.push_back(h->device_name(i).substr(0, operator_state_t::MAX_DEVICE_NAMES_BYTES));
       m.device_actions.push_back(static_cast<std::int32_t>(h->device_actions()[i]));
     }
   }

@@ -154,11 +154,7 @@ void ModeLines(const StatusSnapshot& s, Flow& flow) {
 
 void CollisionLines(const StatusSnapshot& s, Flow& flow) {
   const dcp_telemetry_t& t = *s.telemetry;
-  std::string coll;
-  for (int b = 0; b < wire::collision_bits::kCount; ++b) {
-    if (t.collisions & (1 << b)) coll += std::string(coll.empty() ? "" : ", ") + wire::CollisionName(b);
-  }
-  flow.Line("collisions: " + (coll.empty() ? std::string("none") : coll));
+  flow.Line("collisions: " + wire::CollisionNames(static_cast<std::uint32_t>(t.collisions), ", ", "none"));
 }
 
 void ConditionLines(const StatusSnapshot& s, const LabConfig& config, int width, Flow& flow) {

@@ -122,7 +122,7 @@ CompareStats Compare(std::uint64_t seed, long count, double band_rel, int exact_
         if (separation() > band) ++st.plane_missing;
       } else {
         dynamics_proc::Hexahedron a = p.a.hex, b = p.b.hex;
-        if (!dynamics_proc::PlaneSeparates(a, b, r.n, r.d, band)) ++st.plane_wrong;
+        if (!dynamics_proc::PlaneSeparates(a, b, r.plane.n_R, r.plane.d_ft, band)) ++st.plane_wrong;
       }
     }
   }

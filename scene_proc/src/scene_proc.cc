@@ -11,11 +11,6 @@
 
 namespace rms::scene_proc {
 
-namespace {
-// dcp_frame_t is fixed-size: 8 + 4 x 8 + (12 + 1 + 12 + 1 + 17) x 4.
-constexpr int kMaxDcpSize = 8 + wire::kSenderBytes + 32 + 43 * 4;
-}  // namespace
-
 SceneProc::SceneProc(const LabConfig& config, transport::LcmInterface* lcm)
     : config_(config), lcm_(lcm), scene_(config) {
   lcm_->Subscribe(wire::channels::kDcpFrame,
@@ -30,7 +25,7 @@ void SceneProc::EnableLiveChecks(double frame_rate_hz) {
 void SceneProc::OnDcpFrame(const void* data, int size, std::int64_t recv_time_us) {
   const std::int64_t now_us = late_.enabled() ? lcm_->NowUs() : recv_time_us;
   auto got = wire::ReceiveFrame<dcp_frame_t>(
-      data, size, kMaxDcpSize, &dcp_frames_, &counters_, [](const dcp_frame_t& m) { return wire::UnpackDcpFrame(m); },
+      data, size, &dcp_frames_, &counters_, [](const dcp_frame_t& m) { return wire::UnpackDcpFrame(m); },
       now_us, &late_);
   if (!got) return;
   const auto& [msg, dcp] = *got;

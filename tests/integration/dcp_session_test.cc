@@ -59,11 +59,11 @@ Session RunLab(const std::string& timeline, double speed, const std::string& tag
   while (const lcm::LogEvent* ev = f.readNextEvent()) {
     if (ev->channel == wire::channels::kDcpTelemetry) {
       dcp_telemetry_t m;
-      EXPECT_EQ(wire::SafeDecode(ev->data, ev->datalen, 4096, &m), wire::DecodeError::kNone);
+      EXPECT_EQ(wire::SafeDecode(ev->data, ev->datalen, &m), wire::DecodeError::kNone);
       s.telemetry.push_back(m);
     } else if (ev->channel == wire::channels::kDcpFrame) {
       dcp_frame_t m;
-      EXPECT_EQ(wire::SafeDecode(ev->data, ev->datalen, 4096, &m), wire::DecodeError::kNone);
+      EXPECT_EQ(wire::SafeDecode(ev->data, ev->datalen, &m), wire::DecodeError::kNone);
       s.dcp_frames.push_back(m);
     }
   }

@@ -50,11 +50,11 @@ struct Attacker {
   void Listen() {
     lcm->Subscribe(wire::channels::kDcpFrame, [this](const void* d, int n, std::int64_t) {
       dcp_frame_t m;
-      if (wire::SafeDecode(d, n, 4096, &m) == wire::DecodeError::kNone && m.frame > 0) seen_dcp = m;
+      if (wire::SafeDecode(d, n, &m) == wire::DecodeError::kNone && m.frame > 0) seen_dcp = m;
     });
     lcm->Subscribe(wire::channels::kEsgFrame, [this](const void* d, int n, std::int64_t) {
       esg_frame_t m;
-      if (wire::SafeDecode(d, n, 4096, &m) == wire::DecodeError::kNone && m.frame > 0) seen_esg = m;
+      if (wire::SafeDecode(d, n, &m) == wire::DecodeError::kNone && m.frame > 0) seen_esg = m;
     });
   }
 

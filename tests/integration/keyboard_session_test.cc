@@ -43,15 +43,15 @@ TEST(KeyboardSession, APressIsOneIncrementAndTheScreenShowsGuidance) {
   int camera_in_esg = 0;
   lcm.Subscribe(wire::channels::kDcpTelemetry, [&](const void* d, int n, std::int64_t) {
     dcp_telemetry_t m;
-    if (wire::SafeDecode(d, n, 4096, &m) == wire::DecodeError::kNone) tm = m;
+    if (wire::SafeDecode(d, n, &m) == wire::DecodeError::kNone) tm = m;
   });
   lcm.Subscribe(wire::channels::kOperatorState, [&](const void* d, int n, std::int64_t) {
     operator_state_t m;
-    if (wire::SafeDecode(d, n, 8192, &m) == wire::DecodeError::kNone) state = m;
+    if (wire::SafeDecode(d, n, &m) == wire::DecodeError::kNone) state = m;
   });
   lcm.Subscribe(wire::channels::kEsgFrame, [&](const void* d, int n, std::int64_t) {
     esg_frame_t m;
-    if (wire::SafeDecode(d, n, 4096, &m) == wire::DecodeError::kNone && m.num_words > 1) {
+    if (wire::SafeDecode(d, n, &m) == wire::DecodeError::kNone && m.num_words > 1) {
       camera_in_esg = wire::UnpackControlWord(m.words[1]).camera_station;
     }
   });

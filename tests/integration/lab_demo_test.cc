@@ -87,7 +87,7 @@ TEST(LabDemo, TheSessionFolderHoldsLogVideoFramesProcessLogsAndSummary) {
   int esg_frames = 0;
   lcm.Subscribe(wire::channels::kEsgFrame, [&](const void* d, int n, std::int64_t) {
     esg_frame_t m;
-    esg_frames += wire::SafeDecode(d, n, 400, &m) == wire::DecodeError::kNone;
+    esg_frames += wire::SafeDecode(d, n, &m) == wire::DecodeError::kNone;
   });
   Subprocess player({"/usr/bin/lcm-logplayer", "-s", "10", "-l", play_url, out + "/lcmlog"}, tmp + "/player.log");
   while (player.Running()) lcm.HandleSubscriptions(20);

@@ -219,15 +219,15 @@ struct Listener {
     lcm = std::make_unique<transport::UdpLcm>(o);
     lcm->Subscribe(wire::channels::kDcpFrame, [this](const void* d, int n, std::int64_t) {
       dcp_frame_t m;
-      if (wire::SafeDecode(d, n, 4096, &m) == wire::DecodeError::kNone) dcp.push_back(m);
+      if (wire::SafeDecode(d, n, &m) == wire::DecodeError::kNone) dcp.push_back(m);
     });
     lcm->Subscribe(wire::channels::kEsgFrame, [this](const void* d, int n, std::int64_t) {
       esg_frame_t m;
-      if (wire::SafeDecode(d, n, 4096, &m) == wire::DecodeError::kNone) esg.push_back(m.frame);
+      if (wire::SafeDecode(d, n, &m) == wire::DecodeError::kNone) esg.push_back(m.frame);
     });
     lcm->Subscribe(wire::channels::kDcpTelemetry, [this](const void* d, int n, std::int64_t) {
       dcp_telemetry_t m{};
-      if (wire::SafeDecode(d, n, 4096, &m) == wire::DecodeError::kNone) telemetry = m;
+      if (wire::SafeDecode(d, n, &m) == wire::DecodeError::kNone) telemetry = m;
     });
   }
   void Pump(double seconds) {

@@ -65,7 +65,7 @@ class Peer {
   explicit Peer(const std::string& url) : lcm_(transport::LcmOptions{url, "", 1000}) {
     lcm_.Subscribe(wire::channels::kDcpFrame, [this](const void* d, int n, std::int64_t) {
       dcp_frame_t m;
-      if (wire::SafeDecode(d, n, 1024, &m) == wire::DecodeError::kNone && m.frame > dcp_frame_) {
+      if (wire::SafeDecode(d, n, &m) == wire::DecodeError::kNone && m.frame > dcp_frame_) {
         dcp_frame_ = m.frame;
         last_dcp_ = m;
       }

@@ -68,7 +68,7 @@ TEST_F(Session, FourProcessesOverLcmRenderTheArmWhereTheKinematicsPutIt) {
   int malformed = 0;
   lcm.Subscribe(wire::channels::kEsgFrame, [&](const void* d, int n, std::int64_t) {
     esg_frame_t m;
-    if (wire::SafeDecode(d, n, 400, &m) == wire::DecodeError::kNone) {
+    if (wire::SafeDecode(d, n, &m) == wire::DecodeError::kNone) {
       frames.push_back(std::move(m));
     } else {
       ++malformed;

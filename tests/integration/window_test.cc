@@ -139,7 +139,7 @@ TEST(LiveWindow, AKeyHeldInTheWindowMovesTheArmAndItStopsWithinAFrameOfTheReleas
   std::optional<dcp_telemetry_t> tm;
   lcm.Subscribe(wire::channels::kOperatorInput, [&](const void* d, int n, std::int64_t) {
     operator_input_t m;
-    if (wire::SafeDecode(d, n, 1024, &m) != wire::DecodeError::kNone) return;
+    if (wire::SafeDecode(d, n, &m) != wire::DecodeError::kNone) return;
     const std::vector<std::int32_t> words(m.words, m.words + 6);
     inputs.push_back({m.frame, !last_words.empty() && words != last_words});
     last_words = words;
@@ -147,14 +147,14 @@ TEST(LiveWindow, AKeyHeldInTheWindowMovesTheArmAndItStopsWithinAFrameOfTheReleas
   });
   lcm.Subscribe(wire::channels::kWindowKeys, [&](const void* d, int n, std::int64_t) {
     window_keys_t m;
-    if (wire::SafeDecode(d, n, 4096, &m) != wire::DecodeError::kNone) return;
+    if (wire::SafeDecode(d, n, &m) != wire::DecodeError::kNone) return;
     const bool r_held = std::find(m.held.begin(), m.held.end(), 'r') != m.held.end();
     if (r_held && hold_seen_at_input < 0) hold_seen_at_input = latest_input;
     if (!r_held && hold_seen_at_input >= 0 && release_seen_at_input < 0) release_seen_at_input = latest_input;
   });
   lcm.Subscribe(wire::channels::kDcpTelemetry, [&](const void* d, int n, std::int64_t) {
     dcp_telemetry_t m;
-    if (wire::SafeDecode(d, n, 4096, &m) == wire::DecodeError::kNone) tm = m;
+    if (wire::SafeDecode(d, n, &m) == wire::DecodeError::kNone) tm = m;
   });
   auto pump = [&](double seconds) {
     const std::int64_t until = lcm.NowUs() + static_cast<std::int64_t>(seconds * 1e6);

@@ -30,7 +30,7 @@ TEST(UdpLcm, RealMulticastOnLoopbackDeliversToASecondInstance) {
   std::vector<std::int64_t> frames;
   b.Subscribe(wire::channels::kOperatorInput, [&](const void* d, int n, std::int64_t) {
     operator_input_t m;
-    if (wire::SafeDecode(d, n, 1000, &m) == wire::DecodeError::kNone) frames.push_back(m.frame);
+    if (wire::SafeDecode(d, n, &m) == wire::DecodeError::kNone) frames.push_back(m.frame);
   });
   for (int i = 0; i < 50; ++i) {
     operator_input_t m{};
@@ -57,7 +57,7 @@ TEST(UdpLcm, MessagesAreStampedWithTheirSenderAndOtherSessionsAreDropped) {
   auto collect = [](std::vector<sender_t>* into) {
     return [into](const void* d, int n, std::int64_t) {
       operator_input_t m;
-      if (wire::SafeDecode(d, n, 1000, &m) == wire::DecodeError::kNone) into->push_back(m.sender);
+      if (wire::SafeDecode(d, n, &m) == wire::DecodeError::kNone) into->push_back(m.sender);
     };
   };
   mine.Subscribe(wire::channels::kOperatorInput, collect(&got_mine));
@@ -108,11 +108,11 @@ TEST(SessionSenders, AnImpostorIsDroppedWhileThePublisherSendsAndARestartIsTaken
   std::vector<std::int32_t> inputs, statuses;
   rx.Subscribe(wire::channels::kOperatorInput, [&](const void* d, int n, std::int64_t) {
     operator_input_t m;
-    if (wire::SafeDecode(d, n, 1000, &m) == wire::DecodeError::kNone) inputs.push_back(m.sender.pid);
+    if (wire::SafeDecode(d, n, &m) == wire::DecodeError::kNone) inputs.push_back(m.sender.pid);
   });
   rx.Subscribe(wire::channels::kStatus, [&](const void* d, int n, std::int64_t) {
     process_status_t m;
-    if (wire::SafeDecode(d, n, 1 << 20, &m) == wire::DecodeError::kNone) statuses.push_back(m.sender.pid);
+    if (wire::SafeDecode(d, n, &m) == wire::DecodeError::kNone) statuses.push_back(m.sender.pid);
   });
   auto drain = [&](std::size_t want) {
     for (int k = 0; k < 50 && inputs.size() < want; ++k) rx.HandleSubscriptions(20);

@@ -73,7 +73,7 @@ TEST(Collide, VertexInsideAndFaceSeparation) {
   EXPECT_EQ(fast.verdict, Verdict::kSeparate);
   EXPECT_EQ(fast.decider, Decider::kSpheresApart);
   ASSERT_TRUE(fast.plane_valid);
-  EXPECT_TRUE(PlaneSeparates(a, c, fast.n, fast.d, 0.0));
+  EXPECT_TRUE(PlaneSeparates(a, c, fast.plane.n_R, fast.plane.d_ft, 0.0));
   // The report's algorithm alone names c's face a.
   CollideOptions report_only;
   report_only.sphere_reject = false;
@@ -83,8 +83,8 @@ TEST(Collide, VertexInsideAndFaceSeparation) {
   EXPECT_EQ(s.decider, Decider::kFaceOfBSeparates);
   EXPECT_EQ(s.face, kFaceA);  // all of a lies beyond c's face a (x = 3)
   ASSERT_TRUE(s.plane_valid);
-  EXPECT_LT((s.n - Vector3d::UnitX()).norm(), 1e-15);  // from a toward c
-  EXPECT_DOUBLE_EQ(s.d, 3.0);
+  EXPECT_LT((s.plane.n_R - Vector3d::UnitX()).norm(), 1e-15);  // from a toward c
+  EXPECT_DOUBLE_EQ(s.plane.d_ft, 3.0);
 }
 
 TEST(Collide, BoundingBoxesApartDecideWhereTheSpheresOverlap) {
@@ -95,11 +95,11 @@ TEST(Collide, BoundingBoxesApartDecideWhereTheSpheresOverlap) {
   EXPECT_EQ(r.verdict, Verdict::kSeparate);
   EXPECT_EQ(r.decider, Decider::kBoxesApart);
   ASSERT_TRUE(r.plane_valid);
-  EXPECT_LT((r.n - Vector3d::UnitY()).norm(), 1e-15);
-  EXPECT_DOUBLE_EQ(r.d, 1.25);  // midway in the gap
+  EXPECT_LT((r.plane.n_R - Vector3d::UnitY()).norm(), 1e-15);
+  EXPECT_DOUBLE_EQ(r.plane.d_ft, 1.25);  // midway in the gap
   const CollisionResult back = Collide(b, a);
   EXPECT_EQ(back.decider, Decider::kBoxesApart);
-  EXPECT_TRUE(PlaneSeparates(b, a, back.n, back.d, 0.0));
+  EXPECT_TRUE(PlaneSeparates(b, a, back.plane.n_R, back.plane.d_ft, 0.0));
   // Without the box test the report's algorithm decides the same.
   CollideOptions report_only;
   report_only.sphere_reject = report_only.aabb_reject = false;
@@ -240,7 +240,7 @@ TEST(Collide, TheHintCannotChangeAVerdict) {
   // call them separate.
   const Hexahedron a = AxisBox(Vector3d(0, 0, 0), Vector3d(1, 1, 1));
   const Hexahedron b = AxisBox(Vector3d(1, 0, 0), Vector3d(2, 1, 1));
-  SeparatingPlaneHint hint{Vector3d::UnitX(), 1.0};
+  scene_model::SeparatingPlane hint{Vector3d::UnitX(), 1.0};
   CollideOptions o;
   o.hint = &hint;
   o.sphere_reject = o.aabb_reject = false;  // the hint first
@@ -249,7 +249,7 @@ TEST(Collide, TheHintCannotChangeAVerdict) {
   EXPECT_NE(r.decider, Decider::kHintPlane);
   // Apart by 1e-6, the hint decides.
   const Hexahedron c = AxisBox(Vector3d(1 + 1e-6, 0, 0), Vector3d(2, 1, 1));
-  hint.d = 1 + 5e-7;
+  hint.d_ft = 1 + 5e-7;
   EXPECT_EQ(Collide(a, c, o).decider, Decider::kHintPlane);
 }
 

@@ -20,7 +20,7 @@ class Pipeline : public ::testing::Test {
   Pipeline() : lcm("", ""), dcp(config, &lcm), scene(config, &lcm) {
     lcm.Subscribe(wire::channels::kEsgFrame, [this](const void* d, int n, std::int64_t) {
       esg_frame_t m;
-      ASSERT_EQ(wire::SafeDecode(d, n, 1000, &m), wire::DecodeError::kNone);
+      ASSERT_EQ(wire::SafeDecode(d, n, &m), wire::DecodeError::kNone);
       esg.push_back(m);
     });
   }

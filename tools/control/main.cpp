@@ -80,7 +80,7 @@ class ControlLink {
     lcm_.SetSender({session_id, rms::sender_t::PROCESS_CONTROL, static_cast<std::int32_t>(getpid())});
     lcm_.Subscribe(rms::wire::channels::kStatus, [this](const void* d, int n, std::int64_t) {
       rms::process_status_t st;
-      if (rms::wire::SafeDecode(d, n, 1 << 20, &st) != rms::wire::DecodeError::kNone) return;
+      if (rms::wire::SafeDecode(d, n, &st) != rms::wire::DecodeError::kNone) return;
       auto& counts = counts_[st.process];
       for (int i = 0; i < st.num_counters; ++i) counts[st.counter_names[i]] = st.counter_values[i];
       ++reports_[st.process];

@@ -84,7 +84,7 @@ int main(int argc, char** argv) {
     using rms::wire::DecodeError;
     on(rms::wire::channels::kOperatorInput, [](const void* d, int n, ChannelStats* c) {
       rms::operator_input_t m;
-      if (rms::wire::SafeDecode(d, n, 1024, &m) != rms::wire::DecodeError::kNone) return false;
+      if (rms::wire::SafeDecode(d, n, &m) != rms::wire::DecodeError::kNone) return false;
       c->numbered = true;
       c->frames.Accept(m.frame);
       c->last = Sprintf("frame %lld, discrete word %06x", static_cast<long long>(m.frame), static_cast<unsigned>(m.words[11]));
@@ -92,7 +92,7 @@ int main(int argc, char** argv) {
     });
     on(rms::wire::channels::kDcpFrame, [](const void* d, int n, ChannelStats* c) {
       rms::dcp_frame_t m;
-      if (rms::wire::SafeDecode(d, n, 4096, &m) != rms::wire::DecodeError::kNone) return false;
+      if (rms::wire::SafeDecode(d, n, &m) != rms::wire::DecodeError::kNone) return false;
       c->numbered = true;
       c->frames.Accept(m.frame);
       try {
@@ -107,21 +107,18 @@ int main(int argc, char** argv) {
     });
     on(rms::wire::channels::kDcpTelemetry, [](const void* d, int n, ChannelStats* c) {
       rms::dcp_telemetry_t m{};
-      if (rms::wire::SafeDecode(d, n, 4096, &m) != rms::wire::DecodeError::kNone) return false;
+      if (rms::wire::SafeDecode(d, n, &m) != rms::wire::DecodeError::kNone) return false;
       c->numbered = true;
       c->frames.Accept(m.frame);
-      std::string coll;
-      for (int b = 0; b < rms::wire::collision_bits::kCount; ++b) {
-        if (m.collisions & (1 << b)) coll += std::string(coll.empty() ? "" : ",") + rms::wire::CollisionName(b);
-      }
+      const std::string coll = rms::wire::CollisionNames(static_cast<std::uint32_t>(m.collisions), ",", "none");
       c->last = Sprintf("frame %lld, mode %d%s, A (%.2f, %.2f, %.2f) ft, dock %.3f ft / %.2f deg, collisions %s",
                     static_cast<long long>(m.frame), m.mode, m.held ? " HELD" : "", m.p_RoA_R_ft[0], m.p_RoA_R_ft[1],
-                    m.p_RoA_R_ft[2], m.dock_distance_ft, m.dock_angle_deg, coll.empty() ? "none" : coll.c_str());
+                    m.p_RoA_R_ft[2], m.dock_distance_ft, m.dock_angle_deg, coll.c_str());
       return true;
     });
     on(rms::wire::channels::kEsgFrame, [](const void* d, int n, ChannelStats* c) {
       rms::esg_frame_t m;
-      if (rms::wire::SafeDecode(d, n, 4096, &m) != rms::wire::DecodeError::kNone) return false;
+      if (rms::wire::SafeDecode(d, n, &m) != rms::wire::DecodeError::kNone) return false;
       c->numbered = true;
       c->frames.Accept(m.frame);
       try {
@@ -136,7 +133,7 @@ int main(int argc, char** argv) {
     });
     on(rms::wire::channels::kStatus, [&processes](const void* d, int n, ChannelStats* c) {
       rms::process_status_t m;
-      if (rms::wire::SafeDecode(d, n, 1 << 20, &m) != rms::wire::DecodeError::kNone) return false;
+      if (rms::wire::SafeDecode(d, n, &m) != rms::wire::DecodeError::kNone) return false;
       std::map<std::string, std::int64_t> v;
       for (int i = 0; i < m.num_counters; ++i) v[m.counter_names[i]] = m.counter_values[i];
       auto get = [&](const char* k) { return v.count(k) ? v[k] : 0; };
@@ -150,14 +147,14 @@ int main(int argc, char** argv) {
     });
     on(rms::wire::channels::kOperatorState, [](const void* d, int n, ChannelStats* c) {
       rms::operator_state_t m{};
-      if (rms::wire::SafeDecode(d, n, 1 << 16, &m) != rms::wire::DecodeError::kNone) return false;
+      if (rms::wire::SafeDecode(d, n, &m) != rms::wire::DecodeError::kNone) return false;
       c->last = Sprintf("frame %lld, source %d, to go %.2f ft / %.1f deg", static_cast<long long>(m.frame), m.source,
                         m.distance_ft, m.angle_deg);
       return true;
     });
     on(rms::wire::channels::kWindowKeys, [](const void* d, int n, ChannelStats* c) {
       rms::window_keys_t m{};
-      if (rms::wire::SafeDecode(d, n, 1 << 16, &m) != rms::wire::DecodeError::kNone) return false;
+      if (rms::wire::SafeDecode(d, n, &m) != rms::wire::DecodeError::kNone) return false;
       std::string held;
       for (int k : m.held) held += (held.empty() ? "" : " ") + rms::wire::KeyName(k);
       c->last = Sprintf("#%lld held: %s%s", static_cast<long long>(m.sequence), held.empty() ? "none" : held.c_str(),
@@ -166,7 +163,7 @@ int main(int argc, char** argv) {
     });
     on(rms::wire::channels::kControl, [](const void* d, int n, ChannelStats* c) {
       rms::session_control_t m;
-      if (rms::wire::SafeDecode(d, n, 1 << 16, &m) != rms::wire::DecodeError::kNone) return false;
+      if (rms::wire::SafeDecode(d, n, &m) != rms::wire::DecodeError::kNone) return false;
       static const char* kNames[] = {"?", "freeze", "run", "step", "checkpoint", "restore"};
       c->last = Sprintf("#%lld %s %s", static_cast<long long>(m.sequence), m.command >= 1 && m.command <= 5 ? kNames[m.command] : "?",
                     m.name.c_str());

@@ -301,14 +301,6 @@ Outcome OutcomeOf(const std::map<std::int64_t, dcp_telemetry_t>& tm) {
   return o;
 }
 
-std::string Kinds(std::uint32_t bits) {
-  std::string s;
-  for (int b = 0; b < wire::collision_bits::kCount; ++b) {
-    if (bits & (1u << b)) s += std::string(s.empty() ? "" : ", ") + wire::CollisionName(b);
-  }
-  return s;
-}
-
 std::string Fmt(const char* f, double a, double b = 0, double c = 0, double d = 0) {
   char buf[256];
   std::snprintf(buf, sizeof buf, f, a, b, c, d);
@@ -358,11 +350,11 @@ nlohmann::ordered_json Compare(const Recording& rec, const std::map<std::int64_t
     const auto it = now.find(a.acquired);
     if (it != now.end()) {
       std::string failing;
-      for (int i = 0; i < 6; ++i) {
+      for (int i = 0; i < wire::kNumAcquisitionConditions; ++i) {
         if (!it->second.acquisition_conditions[i]) {
           failing += std::string(failing.empty() ? "" : "; ") + "condition " + std::to_string(i + 1) + ", " + wire::kAcquisitionConditionNames[i].text;
-          if (i == 3) failing += Fmt(" (gap %.3f ft, D3Y %.3f ft)", it->second.finger_gap_ft, cfg_now.dcp.d3y_ft);
-          if (i == 4) failing += Fmt(" (%.3f ft, TPOB %.3f ft)", it->second.palm_to_bar_ft, cfg_now.dcp.tpob_ft);
+          if (i == wire::kFingerGapBelowD3Y) failing += Fmt(" (gap %.3f ft, D3Y %.3f ft)", it->second.finger_gap_ft, cfg_now.dcp.d3y_ft);
+          if (i == wire::kPalmWithinTpob) failing += Fmt(" (%.3f ft, TPOB %.3f ft)", it->second.palm_to_bar_ft, cfg_now.dcp.tpob_ft);
         }
       }
       s += " the conditions that failed: " + (failing.empty() ? std::string("none (but the slave was held)") : failing) + ".";
@@ -376,7 +368,7 @@ nlohmann::ordered_json Compare(const Recording& rec, const std::map<std::int64_t
   if (b.held > a.held) {
     why.push_back(Fmt("The arm was held by collisions for %.0f frames (recorded: %.0f); the first at %.1f s: ",
                       static_cast<double>(b.held), static_cast<double>(a.held), b.first_collision / rate_hz) +
-                  Kinds(b.first_collision_bits) + ".");
+                  wire::CollisionNames(b.first_collision_bits) + ".");
   }
   if (a.clear >= 0 && b.acquired >= 0 && b.clear < 0) {
     why.push_back(Fmt("The payload never left the cargo bay (the recorded session cleared it at %.1f s).", a.clear / rate_hz));
@@ -470,11 +462,11 @@ ResimResult Resimulate(const ResimOptions& opt) {
     dynamics_proc::DynamicsProc node(config, &lcm);
     lcm.Subscribe(wire::channels::kDcpFrame, [&](const void* d, int n, std::int64_t) {
       frames_run.emplace_back();
-      if (wire::SafeDecode(d, n, 4096, &frames_run.back()) != wire::DecodeError::kNone) frames_run.pop_back();
+      if (wire::SafeDecode(d, n, &frames_run.back()) != wire::DecodeError::kNone) frames_run.pop_back();
     });
     lcm.Subscribe(wire::channels::kDcpTelemetry, [&](const void* d, int n, std::int64_t) {
       telemetry_run.emplace_back();
-      if (wire::SafeDecode(d, n, 4096, &telemetry_run.back()) != wire::DecodeError::kNone) telemetry_run.pop_back();
+      if (wire::SafeDecode(d, n, &telemetry_run.back()) != wire::DecodeError::kNone) telemetry_run.pop_back();
     });
     const auto t_run = std::chrono::steady_clock::now();
     const std::size_t n = plan.steps.size();

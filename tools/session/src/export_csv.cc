@@ -11,6 +11,7 @@
 #include <map>
 #include <memory>
 
+#include "rms/wire/acquisition_conditions.h"
 #include "rms/wire/channels.h"
 #include "rms/base/check.h"
 #include "rms/base/config.h"
@@ -154,7 +155,7 @@ std::vector<std::pair<std::string, long>> ExportCsv(const std::string& session_d
   std::vector<std::string> tm_cols = {"log_time [us]", "session_time [s]", "frame", "send_time [us]", "input_frame", "input_send_time [us]",
                                       "mode", "acquired", "docked", "held", "finger_held", "collisions [bits]",
                                       "slave_collisions [bits]"};
-  for (int i = 1; i <= 6; ++i) tm_cols.push_back("acquisition_condition_" + std::to_string(i));
+  for (int i = 1; i <= wire::kNumAcquisitionConditions; ++i) tm_cols.push_back("acquisition_condition_" + std::to_string(i));
   Add(&tm_cols, {"finger_gap [ft]", "palm_to_bar [ft]", "probe_in_envelope", "dock_distance [ft]", "dock_angle [deg]"});
   for (int k = 1; k <= 3; ++k) {
     const std::string p = "plane" + std::to_string(k);
@@ -186,7 +187,7 @@ std::vector<std::pair<std::string, long>> ExportCsv(const std::string& session_d
     try {
       if (base == wire::channels::kOperatorInput) {
         operator_input_t m{};
-        if (wire::SafeDecode(msg.data, msg.size, 1024, &m) != wire::DecodeError::kNone) throw InputError("malformed");
+        if (wire::SafeDecode(msg.data, msg.size, &m) != wire::DecodeError::kNone) throw InputError("malformed");
         std::array<std::int32_t, wire::kInputWords> words{};
         std::copy(m.words, m.words + wire::kInputWords, words.begin());
         const wire::OperatorInputs in = wire::DecodeInputs(words, config.inputs, nullptr);
@@ -196,7 +197,7 @@ std::vector<std::pair<std::string, long>> ExportCsv(const std::string& session_d
         in_csv.Row(row);
       } else if (base == wire::channels::kDcpFrame) {
         dcp_frame_t m{};
-        if (wire::SafeDecode(msg.data, msg.size, 4096, &m) != wire::DecodeError::kNone) throw InputError("malformed");
+        if (wire::SafeDecode(msg.data, msg.size, &m) != wire::DecodeError::kNone) throw InputError("malformed");
         const wire::DcpFrameData d = wire::UnpackDcpFrame(m);
         std::vector<std::string> row = {t, st, I(m.frame), I(m.send_time_us), I(m.input_frame), I(m.input_send_time_us)};
         for (int i = 0; i < 6; ++i) row.push_back(N(Deg(d.arm[i])));
@@ -214,7 +215,7 @@ std::vector<std::pair<std::string, long>> ExportCsv(const std::string& session_d
         dcp_csv.Row(row);
       } else if (base == wire::channels::kEsgFrame) {
         esg_frame_t m{};
-        if (wire::SafeDecode(msg.data, msg.size, 4096, &m) != wire::DecodeError::kNone) throw InputError("malformed");
+        if (wire::SafeDecode(msg.data, msg.size, &m) != wire::DecodeError::kNone) throw InputError("malformed");
         const wire::EsgFrameData d = wire::UnpackEsgWords(m.words);
         std::vector<std::string> row = {t, st, I(m.frame), I(m.send_time_us), I(m.dcp_frame), I(m.input_frame),
                                         I(m.input_send_time_us), I(m.num_words), I(d.frame_count)};
@@ -239,11 +240,11 @@ std::vector<std::pair<std::string, long>> ExportCsv(const std::string& session_d
         esg_csv.Row(row);
       } else if (base == wire::channels::kDcpTelemetry) {
         dcp_telemetry_t m{};
-        if (wire::SafeDecode(msg.data, msg.size, 4096, &m) != wire::DecodeError::kNone) throw InputError("malformed");
+        if (wire::SafeDecode(msg.data, msg.size, &m) != wire::DecodeError::kNone) throw InputError("malformed");
         std::vector<std::string> row = {t, st, I(m.frame), I(m.send_time_us), I(m.input_frame), I(m.input_send_time_us),
                                         I(m.mode), B(m.acquired), B(m.docked), B(m.held), B(m.finger_held),
                                         I(m.collisions), I(m.slave_collisions)};
-        for (int i = 0; i < 6; ++i) row.push_back(B(m.acquisition_conditions[i]));
+        for (int i = 0; i < wire::kNumAcquisitionConditions; ++i) row.push_back(B(m.acquisition_conditions[i]));
         Add(&row, {N(m.finger_gap_ft), N(m.palm_to_bar_ft), B(m.probe_in_envelope), N(m.dock_distance_ft),
                    N(m.dock_angle_deg)});
         for (int k = 0; k < 3; ++k) {
@@ -260,14 +261,14 @@ std::vector<std::pair<std::string, long>> ExportCsv(const std::string& session_d
         tm_csv.Row(row);
       } else if (base == wire::channels::kStatus) {
         process_status_t m;
-        if (wire::SafeDecode(msg.data, msg.size, 1 << 20, &m) != wire::DecodeError::kNone) throw InputError("malformed");
+        if (wire::SafeDecode(msg.data, msg.size, &m) != wire::DecodeError::kNone) throw InputError("malformed");
         for (int i = 0; i < m.num_counters; ++i) {
           st_csv.Row({t, st, I(m.send_time_us), m.process, m.host, I(m.pid), I(m.frame), B(m.final), m.counter_names[i],
                       I(m.counter_values[i])});
         }
       } else if (base == wire::channels::kControl) {
         session_control_t m;
-        if (wire::SafeDecode(msg.data, msg.size, 1 << 16, &m) != wire::DecodeError::kNone) throw InputError("malformed");
+        if (wire::SafeDecode(msg.data, msg.size, &m) != wire::DecodeError::kNone) throw InputError("malformed");
         static const char* kNames[] = {"?", "freeze", "run", "step", "checkpoint", "restore"};
         ctl_csv.Row({t, st, I(m.send_time_us), I(m.sequence), m.command >= 1 && m.command <= 5 ? kNames[m.command] : "?",
                      m.name});

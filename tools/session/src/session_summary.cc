@@ -304,7 +304,7 @@ struct LogScan {
 void ScanTelemetry(const LogMessage& ev, const std::map<std::int64_t, DcpFrameRecord>& dcp, SenderCheck* check,
                    LogScan* s) {
   dcp_telemetry_t m{};
-  if (wire::SafeDecode(ev.data, ev.size, 4096, &m) != wire::DecodeError::kNone) {
+  if (wire::SafeDecode(ev.data, ev.size, &m) != wire::DecodeError::kNone) {
     ++s->malformed;
     return;
   }
@@ -322,7 +322,7 @@ void ScanTelemetry(const LogMessage& ev, const std::map<std::int64_t, DcpFrameRe
 
 void ScanStatus(const LogMessage& ev, LogScan* s) {
   process_status_t m;
-  if (wire::SafeDecode(ev.data, ev.size, 1 << 20, &m) != wire::DecodeError::kNone) {
+  if (wire::SafeDecode(ev.data, ev.size, &m) != wire::DecodeError::kNone) {
     ++s->malformed;
     return;
   }
@@ -336,7 +336,7 @@ void ScanStatus(const LogMessage& ev, LogScan* s) {
 // checkpoint"): what acted is in the processes' control.* counters.
 void ScanControl(const LogMessage& ev, LogScan* s) {
   session_control_t m;
-  if (wire::SafeDecode(ev.data, ev.size, 1024, &m) != wire::DecodeError::kNone) {
+  if (wire::SafeDecode(ev.data, ev.size, &m) != wire::DecodeError::kNone) {
     ++s->malformed;
     return;
   }
@@ -355,7 +355,7 @@ void ScanFrameNumbers(const std::string& base, const LogMessage& ev, const std::
                       LogScan* s) {
   if (base == wire::channels::kOperatorState) {
     operator_state_t m;
-    if (wire::SafeDecode(ev.data, ev.size, 8192, &m) == wire::DecodeError::kNone) {
+    if (wire::SafeDecode(ev.data, ev.size, &m) == wire::DecodeError::kNone) {
       s->hand.Observe(m, (ev.log_us - s->first_us) * 1e-6);
       s->attempts->ObserveOperator(m);
     } else {
@@ -363,12 +363,12 @@ void ScanFrameNumbers(const std::string& base, const LogMessage& ev, const std::
     }
   } else if (base == wire::channels::kOperatorInput) {
     operator_input_t m;
-    if (wire::SafeDecode(ev.data, ev.size, 1024, &m) == wire::DecodeError::kNone) s->input.Accept(m.frame);
+    if (wire::SafeDecode(ev.data, ev.size, &m) == wire::DecodeError::kNone) s->input.Accept(m.frame);
     else ++s->malformed;
   } else if (base == wire::channels::kDcpFrame) {
     // Only the frames of the increasing run (ReadDcpFrames) count.
     dcp_frame_t m;
-    if (wire::SafeDecode(ev.data, ev.size, 1024, &m) != wire::DecodeError::kNone) {
+    if (wire::SafeDecode(ev.data, ev.size, &m) != wire::DecodeError::kNone) {
       ++s->malformed;
     } else if (const auto it = dcp.find(m.frame); it != dcp.end()) {
       s->dcp.Accept(m.frame);
@@ -377,7 +377,7 @@ void ScanFrameNumbers(const std::string& base, const LogMessage& ev, const std::
     }
   } else if (base == wire::channels::kEsgFrame) {
     esg_frame_t m;
-    if (wire::SafeDecode(ev.data, ev.size, 1024, &m) == wire::DecodeError::kNone) s->esg.Accept(m.frame);
+    if (wire::SafeDecode(ev.data, ev.size, &m) == wire::DecodeError::kNone) s->esg.Accept(m.frame);
     else ++s->malformed;
   }
 }
@@ -385,7 +385,7 @@ void ScanFrameNumbers(const std::string& base, const LogMessage& ev, const std::
 // A restore the DCP made (RMS_DCP_STATE RESTORE) starts an attempt.
 void ScanState(const LogMessage& ev, LogScan* s) {
   dcp_state_t m;
-  if (wire::SafeDecode(ev.data, ev.size, SessionLog::kMaxMessageBytes, &m) != wire::DecodeError::kNone) {
+  if (wire::SafeDecode(ev.data, ev.size, &m) != wire::DecodeError::kNone) {
     ++s->malformed;
     return;
   }

@@ -33,6 +33,7 @@
 #include <Eigen/Core>
 
 #include "rms/dynamics_proc/hexahedron.h"
+#include "rms/scene_model/separating_plane.h"
 
 namespace rms::dynamics_proc {
 
@@ -53,12 +54,6 @@ enum class Decider : std::uint8_t {
   kBoxesApart,         // the axis-aligned bounding boxes are apart (before the report's test, when enabled)
 };
 
-// A plane n . p = d, n from A's side toward B's.
-struct SeparatingPlaneHint {
-  Eigen::Vector3d n = Eigen::Vector3d::UnitZ();
-  double d = 0.0;
-};
-
 struct CollideOptions {
   double relative_tolerance = 1e-12;  // tau = relative_tolerance x scale (docs/collision.md)
   bool want_plane = true;             // find a separating plane when separate
@@ -74,7 +69,7 @@ struct CollideOptions {
   // tau to spare on each side, the verdict is separate with this plane (it
   // cannot change a verdict: a pair within tau of it goes to the report's
   // test). Null: none.
-  const SeparatingPlaneHint* hint = nullptr;
+  const scene_model::SeparatingPlane* hint = nullptr;
 };
 
 
@@ -83,11 +78,10 @@ struct CollisionResult {
   Decider decider = Decider::kNonFinite;
   int index = -1;
   int face = -1;
-  // Separating plane (when verdict is kSeparate and want_plane): points p with
-  // n . p = d; n is a unit vector pointing from A's side to B's side.
+  // Separating plane (when verdict is kSeparate and want_plane), n_R from
+  // A's side toward B's.
   bool plane_valid = false;
-  Eigen::Vector3d n = Eigen::Vector3d::UnitZ();
-  double d = 0.0;
+  scene_model::SeparatingPlane plane;
   // Location words: A's vertices against B's faces and B's against A's,
   // when the vertex phases did not decide (words_valid; the edge phase uses
   // them).

@@ -30,6 +30,7 @@
 #include "rms/dynamics_proc/collision.h"
 #include "rms/dynamics_proc/dcp_models.h"
 #include "rms/arm/kinematics.h"
+#include "rms/wire/acquisition_conditions.h"
 #include "rms/wire/collision_bits.h"
 #include "rms/base/config.h"
 #include "rms/wire/input_block.h"
@@ -75,8 +76,8 @@ inline constexpr double kFingerContactToleranceFt = 0.01;
 // depth of an EFF HEX 1 vertex inside the BAR's ends (docs/collision.md
 // "Margins").
 struct AcquisitionCheck {
-  std::array<bool, 6> holds{};
-  std::array<double, 6> margin_ft{};
+  std::array<bool, wire::kNumAcquisitionConditions> holds{};
+  std::array<double, wire::kNumAcquisitionConditions> margin_ft{};
   double finger_gap_ft = 0.0;
   double palm_to_bar_ft = 0.0;  // signed: positive when the BAR's top is beyond face d
   bool all() const;
@@ -123,8 +124,8 @@ struct DcpStatus {
   bool finger_contact = false;         // Mode 1: face e of EFF HEX 3 within kFingerContactToleranceFt of the BAR
   std::uint32_t collisions = 0;        // of the master's command
   std::uint32_t slave_collisions = 0;  // of the pose the slave holds
-  std::array<bool, 6> acquisition{};   // the six conditions, report order (Mode 1; false after)
-  std::array<double, 6> acquisition_margin_ft{};  // their margins (Mode 1; 0 after)
+  std::array<bool, wire::kNumAcquisitionConditions> acquisition{};   // the six conditions, report order (Mode 1; false after)
+  std::array<double, wire::kNumAcquisitionConditions> acquisition_margin_ft{};  // their margins (Mode 1; 0 after)
   double finger_gap_ft = 0.0;
   double palm_to_bar_ft = 0.0;
   double bay_clearance_ft = 0.0;       // the lowest payload vertex above bay face c (> 0 for all: clear)

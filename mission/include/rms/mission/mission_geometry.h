@@ -22,6 +22,15 @@ struct MissionGeometry {
   double shoulder_height_ft = 0;
 };
 
+// Where the planned grasp sits inside the acquisition tolerances (report
+// IV.A.3, docs/operator.md "The autopilot"): the BAR this share of D3Y's
+// margin over the bar's width inside the fixed finger, and the palm this
+// share of TPOB above the BAR's top.
+inline constexpr double kGraspD3yMarginShare = 0.4;
+inline constexpr double kGraspTpobShare = 0.5;
+// The palm's planned height above the BAR's top at the grasp, ft.
+double GraspPalmAboveBarFt(const LabConfig& config);
+
 // Grasp: approach down the payload's z axis, the fingers closing along its
 // long axis, the bar just inside the fixed finger (40% of D3Y's margin over
 // the bar's width) and the palm half TPOB above the bar. Docked: the probe

@@ -180,8 +180,11 @@ class LogLcm final : public LcmInterface {
 std::int64_t WallTimeUs();
 
 // Publishes msg with this process's sender stamped in (LcmInterface::sender).
+// False, and nothing sent, when the transport refused it or the message is
+// beyond its type's bounds (rms/lcm_limits.h: every receiver would drop it).
 template <class Msg>
 bool PublishMessage(LcmInterface& lcm, std::string_view channel, const Msg& msg) {
+  if (!lcm_limits::Bounds<Msg>::Within(msg)) return false;
   Msg stamped = msg;
   stamped.sender.session_id = lcm.sender().session_id;
   stamped.sender.process = lcm.sender().process;

@@ -6,7 +6,16 @@
 
 namespace rms::wire {
 
-inline constexpr int kNumAcquisitionConditions = 6;
+// The conditions by their index in the telemetry's arrays.
+enum AcquisitionCondition : int {
+  kBarBeyondPalmFaceD = 0,   // all BAR vertices on the TRUE side of face d of EFF HEX 1
+  kBarBeyondFingerFaceB,     // ... of face b of EFF HEX 2 (the fixed finger)
+  kBarBeyondFingerFaceE,     // ... of face e of EFF HEX 3 (the movable finger)
+  kFingerGapBelowD3Y,        // faces b and e nearer than D3Y
+  kPalmWithinTpob,           // EFF HEX 1's face d within TPOB of the BAR's face c
+  kBetweenBarEnds,           // the end effector between the BAR's ends
+  kNumAcquisitionConditions
+};
 
 struct AcquisitionConditionName {
   const char* tag;    // a narrow screen's: "palm d"

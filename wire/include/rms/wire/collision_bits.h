@@ -5,6 +5,8 @@
 // session tools read them.
 #include <array>
 #include <cstdint>
+#include <string>
+#include <string_view>
 
 namespace rms::wire {
 
@@ -38,6 +40,17 @@ inline constexpr std::array<const char*, collision_bits::kCount> kCollisionNames
     "payload-bay_e",     "payload-bay_f",     "payload-cae",     "eff_hex-bar_post",  "non-finite"};
 inline const char* CollisionName(int bit) {
   return bit >= 0 && bit < collision_bits::kCount ? kCollisionNames[bit] : "?";
+}
+// The names of the bits set in `bits`, in bit order, joined by `separator`
+// ("eff_hex_1-recpt, payload-bay_b"); `none` when no bit is set.
+inline std::string CollisionNames(std::uint32_t bits, std::string_view separator = ", ", std::string_view none = "") {
+  std::string s;
+  for (int b = 0; b < collision_bits::kCount; ++b) {
+    if (!(bits & (1u << b))) continue;
+    if (!s.empty()) s += separator;
+    s += kCollisionNames[b];
+  }
+  return s.empty() ? std::string(none) : s;
 }
 
 }  // namespace rms::wire

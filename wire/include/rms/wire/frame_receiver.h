@@ -64,21 +64,21 @@ class LateFrameFilter {
   std::int64_t bucket_start_us_ = 0, min_cur_ = kNone, min_prev_ = kNone;
 };
 
-// Decodes one raw message of type Msg (at most max_size bytes), applies
+// Decodes one raw message of type Msg (SafeDecode: the type's bounds), applies
 // `unpack` (Msg -> the block's content; throws InputError to refuse it),
 // the frame-number checks and -- given a filter -- the lateness check
 // (now_us: the wall clock as it is handled). Returns the message and its
 // content, or nothing when the message was dropped (and counted). Counts
 // "received" always.
 template <class Msg, class Unpack>
-auto ReceiveFrame(const void* data, int size, int max_size, SequenceTracker* seq,
+auto ReceiveFrame(const void* data, int size, SequenceTracker* seq,
                   Counters* counters, Unpack&& unpack, std::int64_t now_us = 0,
                   LateFrameFilter* late = nullptr)
     -> std::optional<std::pair<Msg, std::invoke_result_t<Unpack, const Msg&>>> {
   using Content = std::invoke_result_t<Unpack, const Msg&>;
   counters->Add("received");
   Msg msg;
-  const DecodeError err = SafeDecode(data, size, max_size, &msg);
+  const DecodeError err = SafeDecode(data, size, &msg);
   if (err != DecodeError::kNone) {
     counters->Add(std::string("dropped.") + DecodeErrorName(err));
     return std::nullopt;

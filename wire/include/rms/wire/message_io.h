@@ -11,6 +11,8 @@
 #include <string_view>
 #include <vector>
 
+#include "rms/lcm_limits.h"
+
 
 namespace rms::wire {
 
@@ -53,9 +55,13 @@ const char* ProcessCodeName(std::int8_t process);
 // sender_t::PROCESS_* for a process name ("operator_station", ...); PROCESS_TOOL otherwise.
 std::int8_t ProcessCode(std::string_view name);
 
+// Decodes a raw message of type Msg. Its size limit and the bounds of its
+// counts and strings come from the type (lcmtypes/*.lcm's MAX_* constants,
+// rms/lcm_limits.h): a larger message is kTooLarge before any decoding, a
+// count or string beyond its bound kBadCount after.
 template <class Msg>
-DecodeError SafeDecode(const void* data, int size, int max_size, Msg* msg) {
-  if (size > max_size) return DecodeError::kTooLarge;
+DecodeError SafeDecode(const void* data, int size, Msg* msg) {
+  if (size > lcm_limits::kMaxEncodedSize<Msg>) return DecodeError::kTooLarge;
   std::int64_t fp = 0;
   if (!ReadFingerprint(data, size, &fp)) return DecodeError::kTruncated;
   if (fp != Msg::getHash()) return DecodeError::kWrongType;
@@ -67,6 +73,7 @@ DecodeError SafeDecode(const void* data, int size, int max_size, Msg* msg) {
   }
   if (n < 0) return DecodeError::kTruncated;
   if (n != size) return DecodeError::kTrailingBytes;
+  if (!lcm_limits::Bounds<Msg>::Within(*msg)) return DecodeError::kBadCount;
   return DecodeError::kNone;
 }
 

@@ -13,6 +13,8 @@
 #include <Eigen/Core>
 
 #include "rms/arm/kinematics.h"
+#include "rms/dcp_frame_t.hpp"
+#include "rms/esg_frame_t.hpp"
 #include "rms/scene_model/cluster_pairs.h"
 #include "rms/scene_model/scene_model.h"
 #include "rms/scene_model/separating_plane.h"
@@ -20,10 +22,6 @@
 #include "rms/base/counters.h"
 #include "rms/wire/word_codec.h"
 
-namespace rms {
-class dcp_frame_t;
-class esg_frame_t;
-}  // namespace rms
 
 namespace rms::wire {
 
@@ -64,7 +62,7 @@ DcpFrameData UnpackDcpFrame(const dcp_frame_t& msg);
 
 // ---------------------------------------------------------------- ESG frame
 
-inline constexpr int kEsgMaxWords = 64;  // the IEU's limit (report, Section III)
+inline constexpr int kEsgMaxWords = esg_frame_t::MAX_WORDS;  // the IEU's limit (report, Section III): 64
 
 // Word indices of the ESG frame (docs/protocol.md "RMS_ESG_FRAME").
 namespace esg_words {

@@ -47,12 +47,10 @@ class SessionLog {
   // Decodes a message; a malformed one is counted (malformed()) and false.
   template <class Msg>
   bool Decode(const LogMessage& m, Msg* out) {
-    if (wire::SafeDecode(m.data, m.size, kMaxMessageBytes, out) == wire::DecodeError::kNone) return true;
+    if (wire::SafeDecode(m.data, m.size, out) == wire::DecodeError::kNone) return true;
     ++malformed_;
     return false;
   }
-
-  static constexpr int kMaxMessageBytes = 1 << 20;
   const std::string& dir() const { return dir_; }
   const std::string& log_path() const { return log_path_; }
   const std::string& suffix() const { return suffix_; }
