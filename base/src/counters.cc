@@ -4,13 +4,39 @@
 
 namespace rms {
 
-std::int64_t Counters::SumPrefix(const std::string& prefix) const {
-  std::int64_t s = 0;
-  for (auto it = values_.lower_bound(prefix); it != values_.end(); ++it) {
-    if (it->first.compare(0, prefix.size(), prefix) != 0) break;
-    s += it->second;
+std::optional<Counter> CounterNamed(std::string_view name) {
+  for (const CounterInfo& c : kCounterTable) {
+    if (c.name == name) return c.id;
   }
+  return std::nullopt;
+}
+
+std::int64_t Counters::Sum(Counter first, Counter last) const {
+  std::int64_t s = 0;
+  for (int i = static_cast<int>(first); i <= static_cast<int>(last); ++i) s += values_[i];
   return s;
+}
+
+void Counters::AddAll(const Counters& other) {
+  for (int i = 0; i < kNumCounters; ++i) {
+    if (other.touched_[i]) Add(static_cast<Counter>(i), other.values_[i]);
+  }
+}
+
+std::map<std::string, std::int64_t> Counters::ByName() const {
+  std::map<std::string, std::int64_t> out;
+  for (int i = 0; i < kNumCounters; ++i) {
+    if (touched_[i]) out.emplace(kCounterTable[i].name, values_[i]);
+  }
+  return out;
+}
+
+std::string CounterTableMarkdown() {
+  std::string out = "| Counter | Process | Meaning |\n|---|---|---|\n";
+  for (const CounterInfo& c : kCounterTable) {
+    out += "| `" + std::string(c.name) + "` | " + std::string(c.processes) + " | " + std::string(c.meaning) + " |\n";
+  }
+  return out;
 }
 
 namespace {
@@ -64,7 +90,7 @@ void LatencyHistogram::Reset() {
 
 void RecordEndToEnd(std::int64_t latency_us, double frame_rate_hz, LatencyHistogram* histogram, Counters* counters) {
   histogram->Add(latency_us);
-  if (latency_us > static_cast<std::int64_t>(1e6 / frame_rate_hz)) counters->Add("frames.late");
+  if (latency_us > static_cast<std::int64_t>(1e6 / frame_rate_hz)) counters->Add(Counter::kFramesLate);
 }
 
 }  // namespace rms

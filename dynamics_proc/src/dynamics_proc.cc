@@ -60,8 +60,8 @@ void DynamicsProc::PublishState(std::int8_t reason) {
   m.resume_dcp_frame = resume_ ? resume_->first : -1;
   m.resume_input_frame = resume_ ? resume_->second : -1;
   m.checkpoint = wire::CheckpointText(MakeCheckpoint());
-  if (transport::PublishMessage(*lcm_, wire::channels::kDcpState, m)) counters_.Add("state.published");
-  else counters_.Add("publish_failed");
+  if (transport::PublishMessage(*lcm_, wire::channels::kDcpState, m)) counters_.Add(Counter::kStatePublished);
+  else counters_.Add(Counter::kPublishFailed);
   frames_since_state_ = 0;
 }
 
@@ -96,7 +96,7 @@ bool DynamicsProc::ResumeFromStateFile() {
   next_frame_ = c.dcp_frame + 1;
   resume_ = std::pair{c.dcp_frame, c.input_frame};
   last_inputs_ = c.inputs;
-  counters_.Add("resumed");
+  counters_.Add(Counter::kResumed);
   spdlog::warn("resumed from the last state written ({}, DCP frame {}): Mode {}{}{}", state_file_, c.dcp_frame,
                dcp_.status().mode, dcp_.status().acquired ? ", payload attached" : "",
                dcp_.status().docked ? ", docked" : "");
@@ -109,9 +109,9 @@ void DynamicsProc::WriteStateFile() {
   try {
     SaveCheckpoint(tmp);
     std::filesystem::rename(tmp, state_file_);
-    counters_.Add("state_file.writes");
+    counters_.Add(Counter::kStateFileWrites);
   } catch (const std::exception& e) {
-    counters_.Add("state_file.errors");
+    counters_.Add(Counter::kStateFileErrors);
     spdlog::error("cannot write the state file: {}", e.what());
   }
   state_written_us_ = lcm_->NowUs();
@@ -120,7 +120,7 @@ void DynamicsProc::WriteStateFile() {
 void DynamicsProc::OnControl(const void* data, int size) {
   session_control_t m;
   if (wire::SafeDecode(data, size, &m) != wire::DecodeError::kNone) {
-    counters_.Add("dropped.control_malformed");
+    counters_.Add(Counter::kDroppedControlMalformed);
     return;
   }
   if (m.command != session_control_t::CHECKPOINT && m.command != session_control_t::RESTORE) return;
@@ -128,25 +128,25 @@ void DynamicsProc::OnControl(const void* data, int size) {
   // is looked up in the session's checkpoints folder only, a few times a
   // second at most.
   if (!checkpoint_rate_.Allow(lcm_->NowUs())) {
-    if (counters_.Get("control.rate_limited") == 0) {
+    if (counters_.Get(Counter::kControlRateLimited) == 0) {
       spdlog::warn("checkpoint commands refused: more than {} a second (control.rate_limited)",
                    wire::CheckpointRateLimit::kPerSecond);
     }
-    counters_.Add("control.rate_limited");
+    counters_.Add(Counter::kControlRateLimited);
     return;
   }
   try {
     if (m.command == session_control_t::CHECKPOINT) {
       checkpoints_.Write(m.name, MakeCheckpoint());
-      counters_.Add("control.checkpoints");
+      counters_.Add(Counter::kControlCheckpoints);
       spdlog::info("checkpoint: DCP frame {} saved as {}", next_frame_ - 1, checkpoints_.PathOf(m.name));
     } else {
       Restore(checkpoints_.Read(m.name), checkpoints_.PathOf(m.name));
-      counters_.Add("control.restores");
+      counters_.Add(Counter::kControlRestores);
       PublishState(dcp_state_t::RESTORE);
     }
   } catch (const InputError& e) {
-    counters_.Add("control.refused");
+    counters_.Add(Counter::kControlRefused);
     spdlog::error("{}", e.what());
   }
 }
@@ -171,7 +171,7 @@ void DynamicsProc::OnInput(const void* data, int size, std::int64_t recv_time_us
       now_us, &late_);
   if (!got) return;
   const auto& [msg, in] = *got;
-  counters_.Set("input.missing", inputs_.missing());
+  counters_.Set(Counter::kInputMissing, inputs_.missing());
   RecordEndToEnd(now_us - msg.send_time_us, config_.session.frame_rate_hz, &latencies_["input_to_dcp"],
                  &counters_);
 
@@ -188,10 +188,10 @@ void DynamicsProc::OnInput(const void* data, int size, std::int64_t recv_time_us
   out.send_time_us = lcm_->NowUs();
   dcp_frame_t wire_msg;
   wire::PackDcpFrame(out, &wire_msg, &counters_);
-  if (transport::PublishMessage(*lcm_, wire::channels::kDcpFrame, wire_msg)) counters_.Add("published");
-  else counters_.Add("publish_failed");
+  if (transport::PublishMessage(*lcm_, wire::channels::kDcpFrame, wire_msg)) counters_.Add(Counter::kPublished);
+  else counters_.Add(Counter::kPublishFailed);
   const dcp_telemetry_t tm = MakeTelemetry(dcp_.status(), out);
-  if (!transport::PublishMessage(*lcm_, wire::channels::kDcpTelemetry, tm)) counters_.Add("publish_failed");
+  if (!transport::PublishMessage(*lcm_, wire::channels::kDcpTelemetry, tm)) counters_.Add(Counter::kPublishFailed);
   Report(dcp_.status(), out.frame);
   made_a_frame_ = true;
   if (++frames_since_state_ >= static_cast<std::int64_t>(kStateEverySeconds * config_.session.frame_rate_hz)) {
@@ -209,21 +209,21 @@ void DynamicsProc::OnInput(const void* data, int size, std::int64_t recv_time_us
 }
 
 void DynamicsProc::Report(const DcpStatus& st, std::int64_t frame) {
-  counters_.Set("mode", st.mode);
-  if (st.held) counters_.Add("frames.held");
-  if (st.finger_held) counters_.Add("frames.finger_held");
+  counters_.Set(Counter::kMode, st.mode);
+  if (st.held) counters_.Add(Counter::kFramesHeld);
+  if (st.finger_held) counters_.Add(Counter::kFramesFingerHeld);
   // docs/collision.md "Collision response": what the DCP refused.
-  if (st.motion_collision) counters_.Add("frames.motion_held");
-  if (st.too_fast) counters_.Add("frames.too_fast");
-  if (st.essential_contact) counters_.Add("frames.essential_contact");
-  if (st.input_refused) counters_.Add("inputs.non_finite");
-  if (st.reset_refused) counters_.Add("resets.refused");
-  if (st.let_go) counters_.Add("grasps.let_go");
+  if (st.motion_collision) counters_.Add(Counter::kFramesMotionHeld);
+  if (st.too_fast) counters_.Add(Counter::kFramesTooFast);
+  if (st.essential_contact) counters_.Add(Counter::kFramesEssentialContact);
+  if (st.input_refused) counters_.Add(Counter::kInputsNonFinite);
+  if (st.reset_refused) counters_.Add(Counter::kResetsRefused);
+  if (st.let_go) counters_.Add(Counter::kGraspsLetGo);
   for (int b = 0; b < wire::collision_bits::kCount; ++b) {
-    if (st.collisions & (1u << b)) counters_.Add(std::string("collision_frames.") + wire::CollisionName(b));
+    if (st.collisions & (1u << b)) counters_.Add(wire::CollisionFramesCounter(b));
   }
   if (st.mode != last_mode_) {
-    if (last_mode_ != 0) counters_.Add("mode_changes");
+    if (last_mode_ != 0) counters_.Add(Counter::kModeChanges);
     last_mode_ = st.mode;
   }
   // Each collision as it starts and ends.
@@ -231,7 +231,7 @@ void DynamicsProc::Report(const DcpStatus& st, std::int64_t frame) {
   const std::uint32_t ended = last_collisions_ & ~st.collisions;
   for (int b = 0; b < wire::collision_bits::kCount; ++b) {
     if (started & (1u << b)) {
-      counters_.Add(std::string("collisions.") + wire::CollisionName(b));
+      counters_.Add(wire::CollisionCounter(b));
       spdlog::info("frame {}: collision {} (slave {})", frame, wire::CollisionName(b), st.held ? "holds" : st.finger_held ? "holds the finger" : "follows");
     }
     if (ended & (1u << b)) spdlog::info("frame {}: collision {} relieved", frame, wire::CollisionName(b));
@@ -317,8 +317,8 @@ int RunDynamicsProc(const LabConfig& config, transport::LcmInterface& lcm, const
               [&] { return node.last_frame(); }, until_first_frame, stats_path);
   node.WriteStateFile();
   spdlog::info("published {} DCP frames; inputs missing {}, late {}, dropped {}; final mode {}",
-               node.counters().Get("published"), node.counters().Get("input.missing"),
-               node.counters().Get("frames.late"), node.counters().SumPrefix("dropped."), node.program().mode());
+               node.counters().Get(Counter::kPublished), node.counters().Get(Counter::kInputMissing),
+               node.counters().Get(Counter::kFramesLate), node.counters().Sum(kDroppedFirst, kDroppedLast), node.program().mode());
   return 0;
 }
 

@@ -39,7 +39,7 @@ EsgRenderer::EsgRenderer(const LabConfig& config, transport::LcmInterface* lcm, 
 void EsgRenderer::OnOperatorState(const void* data, int size) {
   operator_state_t m{};
   if (const wire::DecodeError e = wire::SafeDecode(data, size, &m); e != wire::DecodeError::kNone) {
-    counters_.Add(std::string("dropped.operator_state_") + wire::DecodeErrorName(e));
+    counters_.Add(wire::DroppedOperatorStateCounter(e));
     return;
   }
   bool finite = std::isfinite(m.distance_ft) && std::isfinite(m.angle_deg) && std::isfinite(m.bay_clearance_ft) &&
@@ -48,11 +48,11 @@ void EsgRenderer::OnOperatorState(const void* data, int size) {
   for (int i = 0; i < 3; ++i) finite = finite && std::isfinite(m.offset_ft[i]) && std::isfinite(m.rotation_deg[i]);
   for (int i = 0; i < 6; ++i) finite = finite && std::isfinite(m.margin_ft[i]);
   if (!finite) {
-    counters_.Add("dropped.operator_state_non_finite");
+    counters_.Add(Counter::kDroppedOperatorStateNonFinite);
     return;
   }
   if (operator_state_ && m.frame < operator_state_->frame) {
-    counters_.Add("dropped.operator_state_stale");
+    counters_.Add(Counter::kDroppedOperatorStateStale);
     return;
   }
   operator_state_ = m;
@@ -73,9 +73,9 @@ void EsgRenderer::PollWindow() {
   m.num_held = static_cast<std::int16_t>(m.held.size());
   m.num_pressed = static_cast<std::int16_t>(m.pressed.size());
   m.focused = k.focused;
-  if (transport::PublishMessage(*lcm_, wire::channels::kWindowKeys, m)) counters_.Add("window.keys_messages");
-  else counters_.Add("publish_failed");
-  counters_.Add("window.keys_pressed", static_cast<std::int64_t>(k.pressed.size()));
+  if (transport::PublishMessage(*lcm_, wire::channels::kWindowKeys, m)) counters_.Add(Counter::kWindowKeysMessages);
+  else counters_.Add(Counter::kPublishFailed);
+  counters_.Add(Counter::kWindowKeysPressed, static_cast<std::int64_t>(k.pressed.size()));
   keys_sent_us_ = now;
   keys_held_ = !k.held.empty();
 }
@@ -91,16 +91,16 @@ void EsgRenderer::OnFrame(const void* data, int size, std::int64_t recv_time_us)
       data, size, &frames_, &counters_,
       [](const esg_frame_t& m) {
         if (m.num_words < 1 || m.num_words > wire::kEsgMaxWords) {
-          throw wire::MalformedError("word_count", "ESG frame with " + std::to_string(m.num_words) + " words");
+          throw wire::MalformedError(Counter::kDroppedWordCount, "ESG frame with " + std::to_string(m.num_words) + " words");
         }
         return wire::UnpackEsgWords(m.words);
       },
       now_us, &late_);
   if (!got) return;
   auto& [msg, data_words] = *got;
-  counters_.Set("esg.missing", frames_.missing());
+  counters_.Set(Counter::kEsgMissing, frames_.missing());
   latencies_["scene_to_esg"].Add(now_us - msg.send_time_us);
-  if (pending_) counters_.Add("superseded");
+  if (pending_) counters_.Add(Counter::kSuperseded);
   pending_.emplace(std::move(msg), std::move(data_words));
 }
 
@@ -123,24 +123,24 @@ bool EsgRenderer::RenderPending() {
                          std::equal(msg.words.begin() + 1, msg.words.end(), last_words_.begin() + 1);
   const std::int64_t t0 = MonotonicUs();
   if (unchanged) {
-    counters_.Add("skipped.unchanged");
+    counters_.Add(Counter::kSkippedUnchanged);
   } else {
     renderer_->Render(frame);
     const std::uint8_t* px = renderer_->pixels();
     scene_.assign(px, px + bytes);
     last_words_ = msg.words;
     const RenderStats& s = renderer_->stats();
-    counters_.Add("rendered.scenes");
-    counters_.Add("clusters.drawn", s.clusters_drawn);
-    counters_.Add("clusters.culled", s.clusters_culled);
-    counters_.Add("triangles.submitted", s.triangles_submitted);
-    if (s.cycles_broken) counters_.Add("priority.cycles_broken", s.cycles_broken);
+    counters_.Add(Counter::kRenderedScenes);
+    counters_.Add(Counter::kClustersDrawn, s.clusters_drawn);
+    counters_.Add(Counter::kClustersCulled, s.clusters_culled);
+    counters_.Add(Counter::kTrianglesSubmitted, s.triangles_submitted);
+    if (s.cycles_broken) counters_.Add(Counter::kPriorityCyclesBroken, s.cycles_broken);
     latencies_["render"].Add(MonotonicUs() - t0);
   }
   output_ = scene_;
   if (!options_.id_colors) DrawOverlay(output_.data(), w, h, frame, overlay_);
   const std::int64_t done = lcm_->NowUs();
-  counters_.Add("rendered");
+  counters_.Add(Counter::kRendered);
   latencies_["esg_to_render"].Add(done - msg.send_time_us);
   RecordEndToEnd(done - msg.input_send_time_us, config_.session.frame_rate_hz, &latencies_["input_to_render"],
                  &counters_);
@@ -154,7 +154,7 @@ bool EsgRenderer::RenderPending() {
     // The window alone shows the operator's guidance over the ESG's image.
     shown_ = output_;
     if (operator_state_) DrawGuidance(shown_.data(), w, h, *operator_state_);
-    if (window_->Show(shown_.data())) counters_.Add("window.frames");
+    if (window_->Show(shown_.data())) counters_.Add(Counter::kWindowFrames);
   }
   last_rendered_ = msg.frame;
   if (options_.png_every > 0 && !options_.png_dir.empty() && msg.frame % options_.png_every == 0) {
@@ -162,9 +162,9 @@ bool EsgRenderer::RenderPending() {
     std::snprintf(name, sizeof name, "frame_%06lld.png", static_cast<long long>(msg.frame));
     try {
       WritePng((std::filesystem::path(options_.png_dir) / name).string(), w, h, output_.data());
-      counters_.Add("png_written");
+      counters_.Add(Counter::kPngWritten);
     } catch (const std::exception& e) {
-      counters_.Add("png_failed");
+      counters_.Add(Counter::kPngFailed);
       spdlog::warn("{}", e.what());
     }
   }
@@ -215,16 +215,16 @@ int RunEsgRenderer(const LabConfig& config, transport::LcmInterface& lcm, const 
   if (video) {
     node.FinishVideo();
     video->Close();
-    node.counters().Set("video.frames", video->frames_written());
-    node.counters().Set("video.dropped", video->frames_dropped());
+    node.counters().Set(Counter::kVideoFrames, video->frames_written());
+    node.counters().Set(Counter::kVideoDropped, video->frames_dropped());
     if (!stats_path.empty()) transport::WriteStatsJson(stats_path, "esg_renderer", node.counters(), node.latencies());
   }
   spdlog::info("rendered {} frames ({} scenes drawn, {} unchanged, {} superseded, {} missing, {} late, {} dropped, "
                "{} PNG{})",
-               node.counters().Get("rendered"), node.counters().Get("rendered.scenes"),
-               node.counters().Get("skipped.unchanged"), node.counters().Get("superseded"),
-               node.counters().Get("esg.missing"), node.counters().Get("frames.late"),
-               node.counters().SumPrefix("dropped."), node.counters().Get("png_written"),
+               node.counters().Get(Counter::kRendered), node.counters().Get(Counter::kRenderedScenes),
+               node.counters().Get(Counter::kSkippedUnchanged), node.counters().Get(Counter::kSuperseded),
+               node.counters().Get(Counter::kEsgMissing), node.counters().Get(Counter::kFramesLate),
+               node.counters().Sum(kDroppedFirst, kDroppedLast), node.counters().Get(Counter::kPngWritten),
                video ? ", " + std::to_string(video->frames_written()) + " video frames" : std::string());
   return 0;
 }

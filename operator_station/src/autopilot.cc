@@ -223,19 +223,19 @@ void Autopilot::PlanApproach(const dcp_telemetry_t& tm) {
   const Eigen::Isometry3d X_up = Shifted(X0, Eigen::Vector3d(0, 0, std::max(rise, 2.0)));
   if (const auto q_up = Solve(X_up); q_up && LinePathHits(X0, X_up, tm, kInBay).empty() &&
                                      JointPathHits(*q_up, *q_hover, tm, kInBay).empty()) {
-    counters_.Add("autopilot.via_points");
+    counters_.Add(Counter::kAutopilotViaPoints);
     spdlog::info("autopilot: the direct approach would bring the {}; going up first", direct);
     PlanLine(X_up, 1.0);
     return PlanJoints(*q_hover);
   }
   const std::array<double, 6> stowed{};
   if (JointPathHits(q0, stowed, tm, kInBay).empty() && JointPathHits(stowed, *q_hover, tm, kInBay).empty()) {
-    counters_.Add("autopilot.via_points");
+    counters_.Add(Counter::kAutopilotViaPoints);
     spdlog::info("autopilot: the direct approach would bring the {}; going by the stowed arm", direct);
     PlanJoints(stowed);
     return PlanJoints(*q_hover);
   }
-  counters_.Add("autopilot.unplanned");
+  counters_.Add(Counter::kAutopilotUnplanned);
   spdlog::warn("autopilot: no clear approach found ({}); going straight, relieving collisions", direct);
   PlanJoints(*q_hover);
 }
@@ -257,7 +257,7 @@ void Autopilot::PlanTransfer(const dcp_telemetry_t& tm) {
   for (double up : {6.0, 12.0}) {
     const Eigen::Isometry3d X_up = Shifted(X0, Eigen::Vector3d(0, 0, up));
     if (LinePathHits(X0, X_up, tm, kHeld).empty() && LinePathHits(X_up, X_predock, tm, kHeld).empty()) {
-      counters_.Add("autopilot.via_points");
+      counters_.Add(Counter::kAutopilotViaPoints);
       spdlog::info("autopilot: the straight transfer would bring the {}; going {} ft higher first", direct, up);
       PlanLine(X_up, opt_.transfer_speed_ft_s);
       return PlanLine(X_predock, opt_.transfer_speed_ft_s);
@@ -307,7 +307,7 @@ void Autopilot::StartPhase(AutopilotPhase p, const dcp_telemetry_t& tm) {
 
 void Autopilot::Relieve(const dcp_telemetry_t& tm) {
   ++collisions_;
-  counters_.Add("autopilot.collisions_relieved");
+  counters_.Add(Counter::kAutopilotCollisionsRelieved);
   const std::string kinds = wire::CollisionNames(static_cast<std::uint32_t>(tm.collisions));
   spdlog::info("autopilot: collision ({}) in {}: back to the pose the slave holds, then away", kinds,
                AutopilotPhaseName(phase_));
@@ -419,7 +419,7 @@ wire::OperatorInputs Autopilot::Step(const dcp_telemetry_t* tm_ptr) {
       // well short of it (kGraspCorrectTpobShare), descend to the planned height.
       if (tm.palm_to_bar_ft > kGraspCorrectTpobShare * config_.dcp.tpob_ft && retries_ < opt_.max_retries) {
         ++retries_;
-        counters_.Add("autopilot.grasp_corrections");
+        counters_.Add(Counter::kAutopilotGraspCorrections);
         const Eigen::Isometry3d X = CommandedPose();
         PlanLine(Shifted(X, (tm.palm_to_bar_ft - mission::GraspPalmAboveBarFt(config_)) * X.linear().col(0)), 0.2);
         break;
@@ -441,7 +441,7 @@ wire::OperatorInputs Autopilot::Step(const dcp_telemetry_t* tm_ptr) {
           if (!tm.acquisition_conditions[i]) failing += (failing.empty() ? "" : ", ") + std::to_string(i + 1);
         }
         if (++retries_ > opt_.max_retries) return Fail("no acquisition (conditions " + failing + " fail)"), cmd_;
-        counters_.Add("autopilot.grasp_retries");
+        counters_.Add(Counter::kAutopilotGraspRetries);
         spdlog::info("autopilot: finger closed, no acquisition (conditions {} fail): open and grasp again", failing);
         Enter(AutopilotPhase::kOpenFinger);
       }
@@ -483,7 +483,7 @@ wire::OperatorInputs Autopilot::Step(const dcp_telemetry_t* tm_ptr) {
                     std::to_string(tm.dock_distance_ft) + " ft, angle " + std::to_string(tm.dock_angle_deg) + " deg)"),
                cmd_;
       }
-      counters_.Add("autopilot.dock_corrections");
+      counters_.Add(Counter::kAutopilotDockCorrections);
       X_S2P_ = TelemetryPose(tm.p_RoA_R_ft, tm.R_RS2).inverse() * TelemetryPose(tm.p_RoPo_R_ft, tm.R_RP);
       PlanLine(X_RP_dock_ * X_S2P_.inverse(), opt_.dock_speed_ft_s);
       break;

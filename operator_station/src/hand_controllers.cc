@@ -40,7 +40,7 @@ wire::OperatorInputs HandControllers::Step(double dt_s, const dcp_telemetry_t* t
     if (!devices_[i]->connected()) {
       if (!reported_gone_[i]) {
         spdlog::warn("device gone: {}", devices_[i]->Describe());
-        counters_.Add("device.disconnected");
+        counters_.Add(Counter::kDeviceDisconnected);
         reported_gone_[i] = true;
       }
       continue;
@@ -83,7 +83,7 @@ void HandControllers::PollFrozen() {
     else ignored = true;
   }
   if (ignored) {
-    counters_.Add("frozen.inputs_ignored");
+    counters_.Add(Counter::kFrozenInputsIgnored);
     if (!frozen_noted_) {
       spdlog::info("frozen: only freeze (to run again), step, stop and quit act; other keys do nothing");
       frozen_noted_ = true;
@@ -148,13 +148,13 @@ void HandControllers::HandleEvents(const DeviceCommands& cmd, const dcp_telemetr
       case ActionKind::kGuidance: show_guidance_ = !show_guidance_; break;
       case ActionKind::kStop:
         StopAndRelease(cmd);
-        counters_.Add("control.stops");
+        counters_.Add(Counter::kControlStops);
         break;
       case ActionKind::kMode:
         StopMotion();
         status_.mode = status_.mode == ControlMode::kManualAugmented ? ControlMode::kSingleJoint
                                                                      : ControlMode::kManualAugmented;
-        counters_.Add("control.mode_changes");
+        counters_.Add(Counter::kControlModeChanges);
         Announce("control mode");
         break;
       case ActionKind::kFrame: {
@@ -162,14 +162,14 @@ void HandControllers::HandleEvents(const DeviceCommands& cmd, const dcp_telemetr
         int f = static_cast<int>(status_.frame) % 3 + 1;
         if (f == static_cast<int>(CommandFrame::kPayload) && !held) f = static_cast<int>(CommandFrame::kEndEffector);
         status_.frame = static_cast<CommandFrame>(f);
-        counters_.Add("control.frame_changes");
+        counters_.Add(Counter::kControlFrameChanges);
         Announce("command frame");
         break;
       }
       case ActionKind::kVernier:
         StopMotion();
         status_.vernier = !status_.vernier;
-        counters_.Add("control.scale_changes");
+        counters_.Add(Counter::kControlScaleChanges);
         Announce("rate scale");
         break;
       case ActionKind::kJointNext:
@@ -189,7 +189,7 @@ void HandControllers::HandleEvents(const DeviceCommands& cmd, const dcp_telemetr
 
 void HandControllers::AddPress(const struct Press& p) {
   if (status_.mode == ControlMode::kSingleJoint && p.index != kThcX) {
-    counters_.Add("single_joint.presses_ignored");
+    counters_.Add(Counter::kSingleJointPressesIgnored);
     return;
   }
   // One increment a press, flown at the scale's rate. A press in the
@@ -290,7 +290,7 @@ void HandControllers::ConsumePending(const std::array<double, kNumHandAxes>& ach
     if (stalled_s_[i] > kBlockedS) {
       pending = 0.0;
       stalled_s_[i] = 0.0;
-      counters_.Add("increments.blocked");
+      counters_.Add(Counter::kIncrementsBlocked);
       spdlog::warn("{}: the arm cannot move that way (at a joint limit or the end of its reach): motion stopped",
                    kHandAxisNames[i]);
     }
@@ -323,7 +323,7 @@ void HandControllers::ReportLimits(std::uint32_t at_limit) {
     const double q = target_.value[i];
     const bool on_limit = q <= limits_.min_deg[i] + 1e-6 || q >= limits_.max_deg[i] - 1e-6;
     if ((at_limit & bit) && !(limit_reported_ & bit)) {
-      counters_.Add("joint_limit." + std::string(kAnalogInputNames[i]));
+      counters_.Add(JointLimitCounter(i));
       spdlog::warn("joint limit: {} stopped at {:+.1f} deg (its travel {:+.1f} .. {:+.1f})", kAnalogInputNames[i], q,
                    limits_.min_deg[i], limits_.max_deg[i]);
       limit_reported_ |= bit;
@@ -353,7 +353,7 @@ void HandControllers::DirectInputs(const DeviceCommands& cmd, double dt_s) {
     // excursion (a lever held against its stop is one excursion).
     const double c = std::clamp(t, cal[i].min, cal[i].max);
     if (c != t && !clamping_[i]) {
-      counters_.Add("clamped." + std::string(kAnalogInputNames[i]));
+      counters_.Add(ClampedCounter(i));
       const std::string unit = cal[i].unit == "1" ? std::string() : " " + cal[i].unit;
       spdlog::warn("{} command held against the end of its range [{}, {}]{}: clamped", kAnalogInputNames[i],
                    cal[i].min, cal[i].max, unit);

@@ -128,9 +128,9 @@ std::map<std::string, std::string> HandSource::key_hints() const {
 void HandSource::Resume(const wire::OperatorInputs& in, bool) { hands_->SetInputs(in); }
 
 void HandSource::AddCounters(Counters* c) const {
-  for (const auto& [k, v] : hands_->counters().values()) c->Add(k, v);
-  c->Set("key_actions", hands_->key_actions());
-  if (window_) c->Set("window.keys_timeouts", window_->timeouts());
+  c->AddAll(hands_->counters());
+  c->Set(Counter::kKeyActions, hands_->key_actions());
+  if (window_) c->Set(Counter::kWindowKeysTimeouts, window_->timeouts());
 }
 
 // ---- autopilot ----
@@ -173,8 +173,8 @@ std::optional<wire::OperatorInputs> AutopilotSource::Next(const Frame& f) {
 int AutopilotSource::exit_code() const { return autopilot_.failed() ? 3 : 0; }
 
 void AutopilotSource::AddCounters(Counters* c) const {
-  for (const auto& [k, v] : autopilot_.counters().values()) c->Add(k, v);
-  c->Set("autopilot.docked", autopilot_.docked());
+  c->AddAll(autopilot_.counters());
+  c->Set(Counter::kAutopilotDocked, autopilot_.docked());
   if (autopilot_.failed()) spdlog::error("autopilot failed: {}", autopilot_.failure());
   else if (autopilot_.docked()) spdlog::info("autopilot: docked {:.1f} s into the session", autopilot_.docked_at_s());
 }

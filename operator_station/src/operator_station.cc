@@ -119,30 +119,30 @@ void OperatorStation::Subscribe() {
 void OperatorStation::OnTelemetry(const void* data, int size, std::int64_t recv_us) {
   dcp_telemetry_t m{};
   if (const wire::DecodeError e = wire::SafeDecode(data, size, &m); e != wire::DecodeError::kNone) {
-    counters_.Add(std::string("dropped.telemetry_") + wire::DecodeErrorName(e));
+    counters_.Add(wire::DroppedTelemetryCounter(e));
     return;
   }
   if (const auto why = TelemetryProblem(m)) {
-    counters_.Add("dropped.telemetry_" + *why);
+    counters_.Add(*why);
     return;
   }
   if (m.input_frame < fresh_from_input_frame_) {
-    counters_.Add("telemetry.before_reset");  // answers an input from before the last reset or restore
+    counters_.Add(Counter::kTelemetryBeforeReset);  // answers an input from before the last reset or restore
     return;
   }
   switch (telemetry_seq_.Accept(m.frame, recv_us)) {
     case wire::SequenceTracker::Verdict::kDuplicate:
     case wire::SequenceTracker::Verdict::kStale:
-      counters_.Add("telemetry.stale");
+      counters_.Add(Counter::kTelemetryStale);
       return;
     case wire::SequenceTracker::Verdict::kFarAhead:
-      if (counters_.Get("dropped.far_ahead") == 0) {
+      if (counters_.Get(Counter::kDroppedFarAhead) == 0) {
         spdlog::warn("telemetry frame {} refused: beyond what the session's clock allows (dropped.far_ahead)", m.frame);
       }
-      counters_.Add("dropped.far_ahead");
+      counters_.Add(Counter::kDroppedFarAhead);
       return;
     case wire::SequenceTracker::Verdict::kResync:
-      counters_.Add("resyncs");
+      counters_.Add(Counter::kResyncs);
       spdlog::warn("the telemetry's numbering moved to frame {}: followed again (resyncs)", m.frame);
       break;
     default:
@@ -157,14 +157,14 @@ void OperatorStation::OnTelemetry(const void* data, int size, std::int64_t recv_
 void OperatorStation::OnStatus(const void* data, int size, std::int64_t recv_us) {
   process_status_t m;
   if (wire::SafeDecode(data, size, &m) != wire::DecodeError::kNone) {
-    counters_.Add("dropped.status_malformed");
+    counters_.Add(Counter::kDroppedStatusMalformed);
     return;
   }
   if (m.process != "esg_renderer") return;
   for (int i = 0; i < m.num_counters; ++i) {
     const std::string& n = m.counter_names[i];
     const std::int64_t v = m.counter_values[i];
-    if (n == "rendered") {
+    if (n == CounterName(Counter::kRendered)) {
       if (esg_rendered_ >= 0 && recv_us > esg_status_us_) render_hz_ = (v - esg_rendered_) * 1e6 / (recv_us - esg_status_us_);
       esg_rendered_ = v;
       esg_status_us_ = recv_us;
@@ -182,28 +182,28 @@ void OperatorStation::OnStatus(const void* data, int size, std::int64_t recv_us)
 void OperatorStation::OnControl(const void* data, int size, std::int64_t) {
   session_control_t m;
   if (wire::SafeDecode(data, size, &m) != wire::DecodeError::kNone) {
-    counters_.Add("dropped.control_malformed");
+    counters_.Add(Counter::kDroppedControlMalformed);
     return;
   }
   switch (m.command) {
     case session_control_t::FREEZE:
       if (!frozen_) spdlog::info("FROZEN: the session holds its frame");
       frozen_ = true;
-      counters_.Add("control.freezes");
+      counters_.Add(Counter::kControlFreezes);
       break;
     case session_control_t::RUN:
       if (frozen_) spdlog::info("running again");
       frozen_ = false;
-      counters_.Add("control.runs");
+      counters_.Add(Counter::kControlRuns);
       steps_pending_ = 0;
       break;
     case session_control_t::STEP:
       if (frozen_) ++steps_pending_;
-      counters_.Add("control.steps");
+      counters_.Add(Counter::kControlSteps);
       break;
     case session_control_t::RESTORE:
       if (checkpoint_rate_.Allow(lcm_.NowUs())) restored_from_ = m.name;
-      else counters_.Add("control.rate_limited");
+      else counters_.Add(Counter::kControlRateLimited);
       break;
     default: break;
   }
@@ -212,7 +212,7 @@ void OperatorStation::OnControl(const void* data, int size, std::int64_t) {
 void OperatorStation::OnWindowKeys(const void* data, int size, std::int64_t recv_us) {
   window_keys_t m;
   if (const wire::DecodeError e = wire::SafeDecode(data, size, &m); e != wire::DecodeError::kNone) {
-    counters_.Add(std::string("dropped.window_keys_") + wire::DecodeErrorName(e));
+    counters_.Add(wire::DroppedWindowKeysCounter(e));
     return;
   }
   WindowKeyboardDevice::Message k;
@@ -221,7 +221,7 @@ void OperatorStation::OnWindowKeys(const void* data, int size, std::int64_t recv
   k.pressed.assign(m.pressed.begin(), m.pressed.end());
   k.focused = m.focused;
   k.sender_pid = m.sender.pid;
-  if (!source_->window_keyboard()->Receive(k, recv_us)) counters_.Add("dropped.window_keys_stale");
+  if (!source_->window_keyboard()->Receive(k, recv_us)) counters_.Add(Counter::kDroppedWindowKeysStale);
 }
 
 void OperatorStation::SendControl(std::int8_t command) {
@@ -229,7 +229,7 @@ void OperatorStation::SendControl(std::int8_t command) {
   m.send_time_us = lcm_.NowUs();
   m.sequence = control_sequence_++;
   m.command = command;
-  if (!transport::PublishMessage(lcm_, wire::channels::kControl, m)) counters_.Add("publish_failed");
+  if (!transport::PublishMessage(lcm_, wire::channels::kControl, m)) counters_.Add(Counter::kPublishFailed);
 }
 
 void OperatorStation::ForgetTelemetry(std::int64_t fresh_from_input_frame) {
@@ -249,9 +249,9 @@ void OperatorStation::ApplyRestore() {
     source_->Resume(c.inputs, true);
     ForgetTelemetry(builder_.next_frame());
     spdlog::info("RESTORED the checkpoint {}: carrying on from its inputs", checkpoints_.PathOf(*restored_from_));
-    counters_.Add("control.restores");
+    counters_.Add(Counter::kControlRestores);
   } catch (const InputError& e) {
-    counters_.Add("control.refused");
+    counters_.Add(Counter::kControlRefused);
     spdlog::error("{}", e.what());
   }
   restored_from_.reset();
@@ -314,7 +314,7 @@ void OperatorStation::PublishState(std::int64_t frame, const wire::OperatorInput
     m.dock_angle_deg = t.dock_angle_deg;
   }
   (void)in;
-  if (!transport::PublishMessage(lcm_, wire::channels::kOperatorState, m)) counters_.Add("publish_failed");
+  if (!transport::PublishMessage(lcm_, wire::channels::kOperatorState, m)) counters_.Add(Counter::kPublishFailed);
 }
 
 void OperatorStation::DrawScreen(std::int64_t frame, const wire::OperatorInputs& in, bool frozen) {
@@ -340,7 +340,8 @@ void OperatorStation::DrawScreen(std::int64_t frame, const wire::OperatorInputs&
   s.render_hz = render_hz_;
   s.input_to_render_p50_ms = render_p50_ms_;
   s.input_to_render_p99_ms = render_p99_ms_;
-  s.clamped_inputs = counters_.SumPrefix("clamped.") + (source_->hand() ? source_->hand()->counters().SumPrefix("clamped.") : 0);
+  s.clamped_inputs = counters_.Sum(kClampedFirst, kClampedLast) +
+                     (source_->hand() ? source_->hand()->counters().Sum(kClampedFirst, kClampedLast) : 0);
   s.devices = source_->devices();
   s.help = source_->help();
   screen_->Draw(std::move(s));
@@ -367,7 +368,7 @@ int OperatorStation::Run(const std::string& stats_path, const std::string& ready
   // fault, docs/sessions.md "Faults"): the source resumes from the first
   // telemetry's command instead of starting the task over.
   bool resume_from_telemetry = Restarted() && options_.restore_path.empty() && options_.timeline_path.empty();
-  if (Restarted()) counters_.Add("restarted");
+  if (Restarted()) counters_.Add(Counter::kRestarted);
   const bool by_hand = source_->hand() != nullptr;
   if (options_.status == 1 || (options_.status == -1 && by_hand && isatty(STDOUT_FILENO))) {
     screen_ = std::make_unique<StatusScreen>(config_);
@@ -380,7 +381,7 @@ int OperatorStation::Run(const std::string& stats_path, const std::string& ready
   last_ = wire::InitialInputs(config_.inputs);
   while (!transport::StopRequested()) {
     if (options_.max_frames >= 0 && frames_ >= options_.max_frames) break;
-    if (lcm_.HandleSubscriptions(0) < 0) counters_.Add("transport_errors");
+    if (lcm_.HandleSubscriptions(0) < 0) counters_.Add(Counter::kTransportErrors);
     transport::NoteTransportCounters(lcm_, &counters_);
     if (restored_from_) ApplyRestore();
     if (frozen_ && steps_pending_ == 0) {
@@ -416,8 +417,8 @@ int OperatorStation::Run(const std::string& stats_path, const std::string& ready
       ForgetTelemetry(builder_.next_frame());
     }
     const operator_input_t block = builder_.Build(*in, lcm_.NowUs(), &counters_);
-    if (transport::PublishMessage(lcm_, wire::channels::kOperatorInput, block)) counters_.Add("published");
-    else counters_.Add("publish_failed");
+    if (transport::PublishMessage(lcm_, wire::channels::kOperatorInput, block)) counters_.Add(Counter::kPublished);
+    else counters_.Add(Counter::kPublishFailed);
     PublishState(block.frame, *in);
     publish_rate_.Tick(lcm_.NowUs());
     ++frames_;
@@ -427,7 +428,7 @@ int OperatorStation::Run(const std::string& stats_path, const std::string& ready
     next_ns += period_ns_;
     const std::int64_t now = MonotonicNs();
     if (now > next_ns + period_ns_) {
-      counters_.Add("frames.late");
+      counters_.Add(Counter::kFramesLate);
       next_ns = now;  // don't try to catch up with a burst
     } else {
       SleepUntilNs(next_ns);
@@ -436,11 +437,11 @@ int OperatorStation::Run(const std::string& stats_path, const std::string& ready
   screen_.reset();  // the terminal back, the captured log written out
   source_->AddCounters(&counters_);
   transport::NoteTransportCounters(lcm_, &counters_);
-  counters_.Set("frames.total", frames_);
+  counters_.Set(Counter::kFramesTotal, frames_);
   status.Final(builder_.next_frame() - 1, counters_);
   if (!stats_path.empty()) transport::WriteStatsJson(stats_path, "operator_station", counters_, {});
-  spdlog::info("published {} input blocks ({} late, {} clamped inputs)", counters_.Get("published"),
-               counters_.Get("frames.late"), counters_.SumPrefix("clamped."));
+  spdlog::info("published {} input blocks ({} late, {} clamped inputs)", counters_.Get(Counter::kPublished),
+               counters_.Get(Counter::kFramesLate), counters_.Sum(kClampedFirst, kClampedLast));
   if (transport::StopRequested()) {
     spdlog::info("stopped by a signal at frame {}", builder_.next_frame() - 1);
     return kExitInterrupted;

@@ -7,16 +7,16 @@
 
 namespace rms::operator_station {
 
-std::optional<std::string> TelemetryProblem(const dcp_telemetry_t& m) {
+std::optional<Counter> TelemetryProblem(const dcp_telemetry_t& m) {
   constexpr std::int64_t kMaxFrame = std::int64_t{1} << 48, kMaxTimeUs = std::int64_t{1} << 62;
-  if (m.frame < 0 || m.input_frame < 0 || m.frame >= kMaxFrame || m.input_frame >= kMaxFrame) return "frame";
+  if (m.frame < 0 || m.input_frame < 0 || m.frame >= kMaxFrame || m.input_frame >= kMaxFrame) return Counter::kDroppedTelemetryFrame;
   if (m.send_time_us < 0 || m.send_time_us >= kMaxTimeUs || m.input_send_time_us < 0 ||
       m.input_send_time_us >= kMaxTimeUs)
-    return "time";
-  if (m.mode < 1 || m.mode > 3) return "mode";
+    return Counter::kDroppedTelemetryTime;
+  if (m.mode < 1 || m.mode > 3) return Counter::kDroppedTelemetryMode;
   const std::uint32_t defined = (1u << wire::collision_bits::kCount) - 1;
   if ((static_cast<std::uint32_t>(m.collisions) & ~defined) || (static_cast<std::uint32_t>(m.slave_collisions) & ~defined))
-    return "collision_bits";
+    return Counter::kDroppedTelemetryCollisionBits;
   bool finite = true;
   auto all = [&](const double* v, int n) {
     for (int i = 0; i < n; ++i) finite = finite && std::isfinite(v[i]);
@@ -34,7 +34,7 @@ std::optional<std::string> TelemetryProblem(const dcp_telemetry_t& m) {
   all(m.R_RS2, 9);
   all(m.p_RoPo_R_ft, 3);
   all(m.R_RP, 9);
-  if (!finite) return "non_finite";
+  if (!finite) return Counter::kDroppedTelemetryNonFinite;
   return std::nullopt;
 }
 

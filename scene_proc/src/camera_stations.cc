@@ -31,11 +31,11 @@ Eigen::Matrix3d AimRotation(const Eigen::Vector3d& look_M) {
 
 void ClampPanTilt(const CameraStationConfig& cam, double* pan_deg, double* tilt_deg, Counters* counters) {
   if (*pan_deg < cam.pan_min_deg || *pan_deg > cam.pan_max_deg) {
-    if (counters) counters->Add("clamped.camera_pan");
+    if (counters) counters->Add(Counter::kClampedCameraPan);
     *pan_deg = std::clamp(*pan_deg, cam.pan_min_deg, cam.pan_max_deg);
   }
   if (*tilt_deg < cam.tilt_min_deg || *tilt_deg > cam.tilt_max_deg) {
-    if (counters) counters->Add("clamped.camera_tilt");
+    if (counters) counters->Add(Counter::kClampedCameraTilt);
     *tilt_deg = std::clamp(*tilt_deg, cam.tilt_min_deg, cam.tilt_max_deg);
   }
 }

@@ -114,14 +114,14 @@ scene_model::PriorityBits PriorityPlanner::Compute(const scene_model::ClusterPos
     int tried = 0;
     const std::optional<scene_model::SeparatingPlane> plane = scene_model::FindSeparatingPlane(
         ha, hb, PlaneTolerance(ha, hb), have_last_[p] ? &last_[p] : nullptr, &tried);
-    if (tried > 1 && counters) counters->Add("priority.dynamic_searches");
+    if (tried > 1 && counters) counters->Add(Counter::kPriorityDynamicSearches);
     if (plane) {
       last_[p] = *plane;
       have_last_[p] = true;
       bits[p] = plane->SignedDistanceFt(eye) < 0;
     } else {
       have_last_[p] = false;
-      if (counters) counters->Add("priority.unresolved");
+      if (counters) counters->Add(Counter::kPriorityUnresolved);
       bits[p] = (eye - ha.centroid_R).norm() < (eye - hb.centroid_R).norm();
     }
   }

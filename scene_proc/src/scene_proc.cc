@@ -29,7 +29,7 @@ void SceneProc::OnDcpFrame(const void* data, int size, std::int64_t recv_time_us
       now_us, &late_);
   if (!got) return;
   const auto& [msg, dcp] = *got;
-  counters_.Set("dcp.missing", dcp_frames_.missing());
+  counters_.Set(Counter::kDcpMissing, dcp_frames_.missing());
   latencies_["dcp_to_scene"].Add(now_us - msg.send_time_us);
   RecordEndToEnd(now_us - msg.input_send_time_us, config_.session.frame_rate_hz, &latencies_["input_to_scene"],
                  &counters_);
@@ -49,8 +49,8 @@ void SceneProc::OnDcpFrame(const void* data, int size, std::int64_t recv_time_us
   RMS_CHECK(out.words.size() <= static_cast<std::size_t>(wire::kEsgMaxWords));
   out.num_words = static_cast<std::int16_t>(out.words.size());
   out.send_time_us = lcm_->NowUs();
-  if (transport::PublishMessage(*lcm_, wire::channels::kEsgFrame, out)) counters_.Add("published");
-  else counters_.Add("publish_failed");
+  if (transport::PublishMessage(*lcm_, wire::channels::kEsgFrame, out)) counters_.Add(Counter::kPublished);
+  else counters_.Add(Counter::kPublishFailed);
 }
 
 int RunSceneProc(const LabConfig& config, transport::LcmInterface& lcm, const std::string& stats_path,
@@ -63,8 +63,8 @@ int RunSceneProc(const LabConfig& config, transport::LcmInterface& lcm, const st
   transport::RunNodeLoop(lcm, "scene_proc", node.counters(), node.latencies(),
               [&] { return node.last_frame(); }, nullptr, stats_path);
   spdlog::info("published {} ESG frames; DCP frames missing {}, late {}, dropped {}",
-               node.counters().Get("published"), node.counters().Get("dcp.missing"),
-               node.counters().Get("frames.late"), node.counters().SumPrefix("dropped."));
+               node.counters().Get(Counter::kPublished), node.counters().Get(Counter::kDcpMissing),
+               node.counters().Get(Counter::kFramesLate), node.counters().Sum(kDroppedFirst, kDroppedLast));
   return 0;
 }
 

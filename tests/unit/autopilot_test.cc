@@ -31,7 +31,7 @@ TEST(Autopilot, DocksFromTheDefaultState) {
   ExpectDocked(r, c);
   std::printf("docked after %.1f s: distance %.4f ft, angle %.4f deg; modes 2 at %.1f s, 3 at %.1f s\n", r.time_s,
               r.dock_distance_ft, r.dock_angle_deg, r.modes_entered[2] / 30.0, r.modes_entered[3] / 30.0);
-  EXPECT_EQ(r.autopilot.Get("autopilot.collisions_relieved"), 0);
+  EXPECT_EQ(r.autopilot.Get(Counter::kAutopilotCollisionsRelieved), 0);
 }
 
 // Moves the payload's position in the bay (and so where the DCP has it).
@@ -130,7 +130,7 @@ TEST(Autopilot, RelievesTheCollisionsItRunsIntoAndStillDocks) {
   o.plan_clear_paths = false;  // fly straight, like a novice: the DCP stops the arm
   const auto r = sim::FlyAutopilot(c, o, kMaxFrames);
   EXPECT_GT(r.held_frames, 0) << "the DCP never held the arm: no collision to relieve";
-  EXPECT_GE(r.autopilot.Get("autopilot.collisions_relieved"), 1);
+  EXPECT_GE(r.autopilot.Get(Counter::kAutopilotCollisionsRelieved), 1);
   ExpectDocked(r, c);
 }
 
@@ -139,8 +139,8 @@ TEST(Autopilot, PlansAroundWhatItWouldHit) {
   for (int i = 0; i < 6; ++i) c.inputs[i].initial = kNearPayload[i];
   const auto r = sim::FlyAutopilot(c, {}, kMaxFrames);
   EXPECT_EQ(r.held_frames, 0);
-  EXPECT_EQ(r.autopilot.Get("autopilot.collisions_relieved"), 0);
-  EXPECT_GE(r.autopilot.Get("autopilot.via_points"), 1);
+  EXPECT_EQ(r.autopilot.Get(Counter::kAutopilotCollisionsRelieved), 0);
+  EXPECT_GE(r.autopilot.Get(Counter::kAutopilotViaPoints), 1);
   ExpectDocked(r, c);
 }
 

@@ -1,11 +1,18 @@
 #include <gtest/gtest.h>
-#include "rms/session/session_summary.h"
+
 #include <algorithm>
 #include <cstdio>
+#include <fstream>
 #include <random>
+#include <regex>
+#include <set>
+#include <sstream>
 
 #include "rms/base/counters.h"
+#include "rms/session/session_summary.h"
+#include "rms/wire/collision_bits.h"
 #include "rms/wire/frame_receiver.h"
+#include "rms/wire/message_io.h"
 
 namespace rms {
 namespace {
@@ -94,14 +101,49 @@ TEST(LatencyHistogram, PercentilesAtEachResolution) {
   EXPECT_DOUBLE_EQ(h.max_us(), 250000);
 }
 
-TEST(Counters, SumByPrefix) {
+TEST(Counters, AFamilySumsItsMembersAndOnlyTouchedCountersAreReported) {
   Counters c;
-  c.Add("dropped.truncated", 2);
-  c.Add("dropped.wrong_type");
-  c.Add("droppedX");
-  c.Add("published", 10);
-  EXPECT_EQ(c.SumPrefix("dropped."), 3);
-  EXPECT_EQ(c.Get("nothing"), 0);
+  c.Add(Counter::kDroppedTruncated, 2);
+  c.Add(Counter::kDroppedWrongType);
+  c.Add(Counter::kDroppedOperatorStateNonFinite);  // the family's last member
+  c.Add(Counter::kPublished, 10);
+  c.Set(Counter::kMode, 0);  // set to 0: touched, reported
+  EXPECT_EQ(c.Sum(kDroppedFirst, kDroppedLast), 4);
+  EXPECT_EQ(c.Get(Counter::kGaps), 0);
+  const auto named = c.ByName();
+  EXPECT_EQ(named.size(), 5u);
+  EXPECT_EQ(named.at("dropped.truncated"), 2);
+  EXPECT_EQ(named.at("mode"), 0);
+  EXPECT_EQ(named.count("gaps"), 0u);
+  Counters total;
+  total.Add(Counter::kPublished, 1);
+  total.AddAll(c);
+  EXPECT_EQ(total.Get(Counter::kPublished), 11);
+  EXPECT_EQ(total.ByName().size(), 5u);
+}
+
+// One table names every counter (docs/sessions.md "Process counters"): the
+// names are unique and well formed, each family's members follow their own
+// table (static_asserts in counters.h, message_io.h, collision_bits.h), and
+// the docs list exactly this table.
+TEST(Counters, TheTableNamesEveryCounterOnceAndTheDocsListIt) {
+  std::set<std::string_view> names;
+  for (const CounterInfo& info : kCounterTable) {
+    EXPECT_TRUE(names.insert(info.name).second) << info.name;
+    EXPECT_TRUE(std::regex_match(std::string(info.name), std::regex("[a-z_]+(\\.[a-z0-9_-]+)*"))) << info.name;
+    EXPECT_FALSE(info.processes.empty()) << info.name;
+    EXPECT_FALSE(info.meaning.empty()) << info.name;
+    EXPECT_EQ(CounterNamed(info.name), info.id);
+  }
+  EXPECT_FALSE(CounterNamed("dropped.reserved_bits").has_value());
+  EXPECT_EQ(CounterName(wire::DroppedCounter(wire::DecodeError::kBadCount)), "dropped.bad_count");
+  EXPECT_EQ(CounterName(wire::CollisionFramesCounter(12)), "collision_frames.payload-cae");
+  EXPECT_EQ(CounterName(ClampedCounter(kCameraZoom)), "clamped.camera_zoom");
+  std::ifstream f(std::string(RMSLAB_SOURCE_DIR) + "/docs/sessions.md");
+  std::stringstream docs;
+  docs << f.rdbuf();
+  EXPECT_NE(docs.str().find(CounterTableMarkdown()), std::string::npos)
+      << "docs/sessions.md \"Process counters\" is not the table: build/tools/rms_session counters prints it";
 }
 
 }  // namespace

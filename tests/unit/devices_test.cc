@@ -255,7 +255,7 @@ TEST_F(Devices, ATerminalPressIsOneIncrementMergedNeverQueuedAndStopHaltsIt) {
   hc.Step(kDt, &t);
   EXPECT_TRUE(hc.status().vernier);
   EXPECT_DOUBLE_EQ(hc.status().rate[kThcX], bindings.rates.vernier_ft_s);
-  EXPECT_EQ(hc.counters().Get("control.scale_changes"), 1);
+  EXPECT_EQ(hc.counters().Get(Counter::kControlScaleChanges), 1);
 }
 
 // The keys of one frame act in the order they came: a press then a key that
@@ -396,7 +396,7 @@ TEST_F(Devices, StopHoldsUntilReleasedDockedHoldsAndFrozenTakesStopAndSteps) {
   typed.keys = {'.', '.', '.', 'w'};
   hc.PollFrozen();
   EXPECT_EQ(hc.step_requests(), 3);
-  EXPECT_EQ(hc.counters().Get("frozen.inputs_ignored"), 1);
+  EXPECT_EQ(hc.counters().Get(Counter::kFrozenInputsIgnored), 1);
 }
 
 TEST_F(Devices, SingleJointDrivesTheSelectedJointAtARateWithinItsLimit) {
@@ -418,13 +418,13 @@ TEST_F(Devices, SingleJointDrivesTheSelectedJointAtARateWithinItsLimit) {
   // Driven past its limit it stops on it, reported once.
   for (int k = 0; k < 40; ++k) in = hc.Apply(push, 1.0, nullptr);
   EXPECT_DOUBLE_EQ(in.value[1], config.arm.joint_max_deg[1]);
-  EXPECT_EQ(hc.counters().Get("joint_limit.shoulder_pitch"), 1);
+  EXPECT_EQ(hc.counters().Get(Counter::kJointLimitShoulderPitch), 1);
   EXPECT_EQ(hc.status().at_limit, 1u << 1);
   DeviceCommands mode;
   mode.events.push_back(ParseAction("mode"));
   hc.Apply(mode, kDt, nullptr);
   EXPECT_EQ(hc.status().mode, ControlMode::kManualAugmented);
-  EXPECT_EQ(hc.counters().Get("control.mode_changes"), 1);
+  EXPECT_EQ(hc.counters().Get(Counter::kControlModeChanges), 1);
 }
 
 TEST_F(Devices, ThePayloadFrameIsOfferedOnlyOnceThePayloadIsHeld) {
@@ -445,7 +445,7 @@ TEST_F(Devices, ThePayloadFrameIsOfferedOnlyOnceThePayloadIsHeld) {
   t = Telemetry(in0, 1);  // reset: the payload back in the bay
   hc.Apply({}, kDt, &t);
   EXPECT_EQ(hc.status().frame, CommandFrame::kEndEffector);
-  EXPECT_EQ(hc.counters().Get("control.frame_changes"), 4);
+  EXPECT_EQ(hc.counters().Get(Counter::kControlFrameChanges), 4);
 }
 
 TEST_F(Devices, OutOfRangeCommandsAreClampedAndReportedOnce) {
@@ -455,10 +455,10 @@ TEST_F(Devices, OutOfRangeCommandsAreClampedAndReportedOnce) {
   for (int i = 0; i < 90; ++i) hc.Apply(close, kDt, nullptr);  // 3 s at 0.5/s on a 0..1 lever
   EXPECT_DOUBLE_EQ(hc.target().value[kFinger], config.inputs[kFinger].max);
   // A lever held against its stop is one excursion, counted once; a second push, a second.
-  EXPECT_EQ(hc.counters().Get("clamped.finger"), 1);
+  EXPECT_EQ(hc.counters().Get(Counter::kClampedFinger), 1);
   hc.Apply({}, kDt, nullptr);
   for (int i = 0; i < 5; ++i) hc.Apply(close, kDt, nullptr);
-  EXPECT_EQ(hc.counters().Get("clamped.finger"), 2);
+  EXPECT_EQ(hc.counters().Get(Counter::kClampedFinger), 2);
   DeviceCommands down;
   down.input_rate[kShoulderHeight] = -1.0;
   for (int i = 0; i < 200; ++i) hc.Apply(down, 0.1, nullptr);

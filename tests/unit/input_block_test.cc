@@ -40,7 +40,7 @@ TEST_F(InputBlock, RandomInputsRoundTripWithinHalfACount) {
     ASSERT_EQ(out.camera_station, in.camera_station);
     ASSERT_EQ(out.reset, in.reset);
     ASSERT_EQ(out.overlay, in.overlay);
-    ASSERT_EQ(c.SumPrefix("clamped."), 0);
+    ASSERT_EQ(c.Sum(kClampedFirst, kClampedLast), 0);
   }
 }
 
@@ -51,9 +51,9 @@ TEST_F(InputBlock, OutOfRangeInputsAreClampedAndReported) {
   in.camera_station = 11;
   Counters c;
   const auto words = wire::EncodeInputs(in, config.inputs, &c);
-  EXPECT_EQ(c.Get("clamped.shoulder_height"), 1);
-  EXPECT_EQ(c.Get("clamped.finger"), 1);
-  EXPECT_EQ(c.Get("clamped.camera_station"), 1);
+  EXPECT_EQ(c.Get(Counter::kClampedShoulderHeight), 1);
+  EXPECT_EQ(c.Get(Counter::kClampedFinger), 1);
+  EXPECT_EQ(c.Get(Counter::kClampedCameraStation), 1);
   const wire::OperatorInputs out = wire::DecodeInputs(words, config.inputs, &c);
   EXPECT_NEAR(out.value[kShoulderHeight], 20.0, 1e-3);
   EXPECT_NEAR(out.value[kFinger], 0.0, 1e-4);
@@ -66,9 +66,9 @@ TEST_F(InputBlock, CountsBeyondTheConverterAndBeyondTheRangeAreClampedAtTheDcp) 
   w[kFinger] = static_cast<std::int32_t>(wire::FromSigned(-5000));          // finger < 0
   Counters c;
   const wire::OperatorInputs in = wire::DecodeInputs(w, config.inputs, &c);
-  EXPECT_EQ(c.Get("clamped.adc.shoulder_height"), 1);
-  EXPECT_EQ(c.Get("clamped.shoulder_height"), 1);  // 32.767 ft > 20 ft
-  EXPECT_EQ(c.Get("clamped.finger"), 1);
+  EXPECT_EQ(c.Get(Counter::kClampedAdcShoulderHeight), 1);
+  EXPECT_EQ(c.Get(Counter::kClampedShoulderHeight), 1);  // 32.767 ft > 20 ft
+  EXPECT_EQ(c.Get(Counter::kClampedFinger), 1);
   EXPECT_DOUBLE_EQ(in.value[kShoulderHeight], 20.0);
   EXPECT_DOUBLE_EQ(in.value[kFinger], 0.0);
 }

@@ -67,8 +67,8 @@ TEST_F(Pipeline, OneEsgFramePerInputBlockCarryingTheKinematics) {
     // The payload rests at its bay position in Mode 1.
     EXPECT_LT((d.p_RoPo_R_ft - config.payload.p_RoPo_R_ft).norm(), 1e-3);
   }
-  EXPECT_EQ(dcp.counters().Get("published"), 30);
-  EXPECT_EQ(scene.counters().Get("published"), 30);
+  EXPECT_EQ(dcp.counters().Get(Counter::kPublished), 30);
+  EXPECT_EQ(scene.counters().Get(Counter::kPublished), 30);
 }
 
 TEST_F(Pipeline, ViewFollowsTheSelectedCameraStation) {
@@ -99,11 +99,11 @@ TEST_F(Pipeline, MalformedDuplicateAndStaleBlocksAreCountedAndDropped) {
   }
   Send(Block(4, in));  // frames 2 and 3 lost
   EXPECT_EQ(esg.size(), 3u);
-  EXPECT_EQ(dcp.counters().Get("dropped.bad_word"), 1);
-  EXPECT_EQ(dcp.counters().Get("dropped.duplicate"), 1);
-  EXPECT_EQ(dcp.counters().Get("dropped.stale"), 1);
-  EXPECT_EQ(dcp.counters().Get("dropped.truncated"), 1);
-  EXPECT_EQ(dcp.counters().Get("input.missing"), 2);
+  EXPECT_EQ(dcp.counters().Get(Counter::kDroppedBadWord), 1);
+  EXPECT_EQ(dcp.counters().Get(Counter::kDroppedDuplicate), 1);
+  EXPECT_EQ(dcp.counters().Get(Counter::kDroppedStale), 1);
+  EXPECT_EQ(dcp.counters().Get(Counter::kDroppedTruncated), 1);
+  EXPECT_EQ(dcp.counters().Get(Counter::kInputMissing), 2);
 }
 
 TEST_F(Pipeline, ResetReturnsToMode1AndSetsTheResetBit) {

@@ -161,7 +161,7 @@ TEST_F(Scene, CameraDrivesSlewAtTheirRates) {
   Counters c;
   d.camera_pan_deg = 170;
   vs.Step(d, 0, &c);
-  EXPECT_EQ(c.Get("clamped.camera_pan"), 1);
+  EXPECT_EQ(c.Get(Counter::kClampedCameraPan), 1);
   EXPECT_EQ(vs.drive(2).pan_deg, 0);  // other stations keep their drives
 }
 
@@ -201,7 +201,7 @@ TEST_F(Scene, APlaneSeparatesEveryPairOfClustersThroughoutTheMission) {
   long frames = 0;
   while (s.Next()) ++frames;
   EXPECT_EQ(frames, 1351);
-  EXPECT_EQ(s.scene_counters().Get("priority.unresolved"), 0);
+  EXPECT_EQ(s.scene_counters().Get(Counter::kPriorityUnresolved), 0);
 }
 
 TEST_F(Scene, NoCameraEverSitsInsideASolid) {

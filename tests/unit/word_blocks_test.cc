@@ -43,7 +43,7 @@ TEST(EsgFrame, PackedFramesFitTheIeuAndRoundTripWithinOneLsb) {
     const std::vector<std::int32_t> w = wire::PackEsgWords(e, &c);
     ASSERT_LE(w.size(), 64u);
     ASSERT_EQ(wire::FirstInvalidWord(w), -1);
-    ASSERT_EQ(c.SumPrefix("saturated."), 0);
+    ASSERT_EQ(c.Sum(Counter::kSaturatedArm, Counter::kSaturatedView), 0);
     const wire::EsgFrameData d = wire::UnpackEsgWords(w);
     ASSERT_EQ(d.frame_count, e.frame_count);
     ASSERT_EQ(d.control, e.control);
@@ -65,7 +65,7 @@ TEST(EsgFrame, PositionsBeyondTheFormatSaturateAndAreCounted) {
   e.p_RoEye_R_ft.x() = 1e5;
   Counters c;
   const auto w = wire::PackEsgWords(e, &c);
-  EXPECT_EQ(c.Get("saturated.eye"), 1);
+  EXPECT_EQ(c.Get(Counter::kSaturatedEye), 1);
   EXPECT_NEAR(wire::UnpackEsgWords(w).p_RoEye_R_ft.x(), 2048.0, 1e-3);
 }
 

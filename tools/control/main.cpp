@@ -105,10 +105,10 @@ class ControlLink {
   bool WaitForCounts(const std::string& process = "dynamics_proc") {
     return ListenUntil(2.5, [&] { return reports(process) > 0; });
   }
-  std::int64_t Count(const char* k, const std::string& process = "dynamics_proc") const {
+  std::int64_t Count(rms::Counter counter, const std::string& process = "dynamics_proc") const {
     const auto p = counts_.find(process);
     if (p == counts_.end()) return 0;
-    const auto it = p->second.find(k);
+    const auto it = p->second.find(std::string(rms::CounterName(counter)));
     return it == p->second.end() ? 0 : it->second;
   }
   int reports(const std::string& process = "dynamics_proc") const {
@@ -138,9 +138,9 @@ int NobodyThere(const rms::transport::LcmOptions& options, std::int64_t id, cons
 // FREEZE, RUN, STEP: confirmed by the operator station's counts (it is the
 // session's clock).
 int Clock(ControlLink& link, std::int8_t command, int steps, const rms::transport::LcmOptions& options, std::int64_t id) {
-  const char* what = command == rms::session_control_t::FREEZE ? "control.freezes"
-                     : command == rms::session_control_t::RUN  ? "control.runs"
-                                                               : "control.steps";
+  const rms::Counter what = command == rms::session_control_t::FREEZE ? rms::Counter::kControlFreezes
+                            : command == rms::session_control_t::RUN  ? rms::Counter::kControlRuns
+                                                                      : rms::Counter::kControlSteps;
   if (!link.WaitForCounts("operator_station")) return NobodyThere(options, id, "operator station");
   const std::int64_t before = link.Count(what, "operator_station");
   for (int i = 0; i < steps; ++i) link.Send(command);
@@ -169,15 +169,15 @@ void SayWhereSent(const rms::transport::LcmOptions& options, std::int64_t id) {
 int Checkpoint(ControlLink& link, const std::string& name, const std::string& folder, const rms::transport::LcmOptions& options,
                std::int64_t id) {
   if (!link.WaitForCounts()) return NobodyThere(options, id, "dynamics_proc");
-  const std::int64_t saved0 = link.Count("control.checkpoints");
-  auto refusals = [&link] { return link.Count("control.refused") + link.Count("control.rate_limited"); };
+  const std::int64_t saved0 = link.Count(rms::Counter::kControlCheckpoints);
+  auto refusals = [&link] { return link.Count(rms::Counter::kControlRefused) + link.Count(rms::Counter::kControlRateLimited); };
   const std::int64_t refused0 = refusals();
   link.Send(rms::session_control_t::CHECKPOINT, name);
   SayWhereSent(options, id);
   if (folder.empty()) {  // no folder to look in: the DCP's counts say
     const int seen0 = link.reports();
-    link.ListenUntil(3.0, [&] { return link.reports() > seen0 && link.Count("control.checkpoints") + refusals() > saved0 + refused0; });
-    if (link.Count("control.checkpoints") > saved0) {
+    link.ListenUntil(3.0, [&] { return link.reports() > seen0 && link.Count(rms::Counter::kControlCheckpoints) + refusals() > saved0 + refused0; });
+    if (link.Count(rms::Counter::kControlCheckpoints) > saved0) {
       std::printf("saved %s (dynamics_proc confirms)\n", name.c_str());
       return 0;
     }
@@ -207,8 +207,8 @@ int Restore(ControlLink& link, const std::string& name, bool then_run, const rms
             std::int64_t id) {
   auto pause = [] { std::this_thread::sleep_for(std::chrono::milliseconds(300)); };
   if (!link.WaitForCounts()) return NobodyThere(options, id, "dynamics_proc");
-  const std::int64_t restores0 = link.Count("control.restores"), refused0 = link.Count("control.refused"),
-                     limited0 = link.Count("control.rate_limited");
+  const std::int64_t restores0 = link.Count(rms::Counter::kControlRestores), refused0 = link.Count(rms::Counter::kControlRefused),
+                     limited0 = link.Count(rms::Counter::kControlRateLimited);
   link.Send(rms::session_control_t::FREEZE);
   pause();  // the last frames through the pipeline
   link.Send(rms::session_control_t::RESTORE, name);
@@ -219,18 +219,18 @@ int Restore(ControlLink& link, const std::string& name, bool then_run, const rms
   SayWhereSent(options, id);
   const int seen = link.reports();
   link.ListenUntil(3.0, [&] {
-    return link.reports() > seen && (link.Count("control.restores") > restores0 ||
-                                     link.Count("control.refused") > refused0 ||
-                                     link.Count("control.rate_limited") > limited0);
+    return link.reports() > seen && (link.Count(rms::Counter::kControlRestores) > restores0 ||
+                                     link.Count(rms::Counter::kControlRefused) > refused0 ||
+                                     link.Count(rms::Counter::kControlRateLimited) > limited0);
   });
-  if (link.Count("control.restores") > restores0) {
+  if (link.Count(rms::Counter::kControlRestores) > restores0) {
     std::printf("restored from %s (dynamics_proc confirms)%s\n", name.c_str(), then_run ? "" : "; frozen: run resumes");
     return 0;
   }
   std::fprintf(stderr, "rms_control: dynamics_proc did not restore %s (%s; see the session's logs/dynamics_proc.log)\n",
                name.c_str(),
-               link.Count("control.rate_limited") > limited0 ? "too many checkpoint commands a second: try again"
-               : link.Count("control.refused") > refused0    ? "refused"
+               link.Count(rms::Counter::kControlRateLimited) > limited0 ? "too many checkpoint commands a second: try again"
+               : link.Count(rms::Counter::kControlRefused) > refused0    ? "refused"
                                                              : "no word from it within 3 s");
   return 1;
 }

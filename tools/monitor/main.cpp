@@ -136,11 +136,14 @@ int main(int argc, char** argv) {
       if (rms::wire::SafeDecode(d, n, &m) != rms::wire::DecodeError::kNone) return false;
       std::map<std::string, std::int64_t> v;
       for (int i = 0; i < m.num_counters; ++i) v[m.counter_names[i]] = m.counter_values[i];
-      auto get = [&](const char* k) { return v.count(k) ? v[k] : 0; };
+      auto get = [&](rms::Counter c) {
+        const std::string k(rms::CounterName(c));
+        return v.count(k) ? v[k] : 0;
+      };
       processes[m.process] = Sprintf("%-16s on %s (pid %d): frame %lld, published %lld, late %lld, missing %lld%s",
                                  m.process.c_str(), m.host.c_str(), m.pid, static_cast<long long>(m.frame),
-                                 static_cast<long long>(get("published")), static_cast<long long>(get("frames.late")),
-                                 static_cast<long long>(get("input.missing") + get("dcp.missing") + get("esg.missing")),
+                                 static_cast<long long>(get(rms::Counter::kPublished)), static_cast<long long>(get(rms::Counter::kFramesLate)),
+                                 static_cast<long long>(get(rms::Counter::kInputMissing) + get(rms::Counter::kDcpMissing) + get(rms::Counter::kEsgMissing)),
                                  m.final ? " (final)" : "");
       c->last = Sprintf("%zu processes reporting", processes.size());
       return true;

@@ -152,28 +152,28 @@ StatusReporter::StatusReporter(LcmInterface* lcm, std::string process)
   host_ = buf;
 }
 
-void StatusReporter::Tick(std::int64_t frame, const Counters& counters) {
+void StatusReporter::Tick(std::int64_t frame, const Counters& counters, const LatencyMap& latencies) {
   const std::int64_t now = lcm_->NowUs();
   if (now - last_us_ < 1000000) return;
   last_us_ = now;
-  Publish(frame, counters, false);
+  Publish(frame, counters, latencies, false);
 }
 
-void StatusReporter::Final(std::int64_t frame, const Counters& counters) {
-  Publish(frame, counters, true);
+void StatusReporter::Final(std::int64_t frame, const Counters& counters, const LatencyMap& latencies) {
+  Publish(frame, counters, latencies, true);
 }
 
-void StatusReporter::Publish(std::int64_t frame, const Counters& counters, bool final) {
+void StatusReporter::Publish(std::int64_t frame, const Counters& counters, const LatencyMap& latencies, bool final) {
   process_status_t m;
   m.send_time_us = lcm_->NowUs();
-  m.process = process_;
-  m.host = host_;
+  m.process = process_.substr(0, process_status_t::MAX_PROCESS_BYTES);
+  m.host = host_.substr(0, process_status_t::MAX_HOST_BYTES);
   m.pid = static_cast<std::int32_t>(getpid());
   m.frame = frame;
   m.final = final;
-  for (const auto& [k, v] : counters.values()) {
-    if (m.counter_names.size() >= 32000) break;
-    m.counter_names.push_back(k);
+  for (const auto& [k, v] : StatusFigures(counters, latencies)) {
+    if (m.counter_names.size() >= static_cast<std::size_t>(process_status_t::MAX_COUNTERS)) break;
+    m.counter_names.push_back(k.substr(0, process_status_t::MAX_COUNTER_NAMES_BYTES));
     m.counter_values.push_back(v);
   }
   m.num_counters = static_cast<std::int16_t>(m.counter_names.size());
@@ -181,37 +181,34 @@ void StatusReporter::Publish(std::int64_t frame, const Counters& counters, bool 
 }
 
 void NoteTransportCounters(const LcmInterface& lcm, Counters* counters) {
-  if (const std::int64_t n = lcm.other_session_dropped(); n > 0) counters->Set("dropped.other_session", n);
-  if (const std::int64_t n = lcm.other_sender_dropped(); n > 0) counters->Set("dropped.other_sender", n);
+  if (const std::int64_t n = lcm.other_session_dropped(); n > 0) counters->Set(Counter::kDroppedOtherSession, n);
+  if (const std::int64_t n = lcm.other_sender_dropped(); n > 0) counters->Set(Counter::kDroppedOtherSender, n);
 }
 
-void AddLatencyCounters(const LatencyMap& latencies, Counters* counters) {
+std::map<std::string, std::int64_t> StatusFigures(const Counters& counters, const LatencyMap& latencies) {
+  std::map<std::string, std::int64_t> out = counters.ByName();
   for (const auto& [name, h] : latencies) {
     const std::string p = "latency." + name + ".";
-    counters->Set(p + "count", h.count());
-    counters->Set(p + "p50_us", static_cast<std::int64_t>(h.Percentile(0.5)));
-    counters->Set(p + "p99_us", static_cast<std::int64_t>(h.Percentile(0.99)));
-    counters->Set(p + "max_us", static_cast<std::int64_t>(h.max_us()));
+    out[p + "count"] = h.count();
+    out[p + "p50_us"] = static_cast<std::int64_t>(h.Percentile(0.5));
+    out[p + "p99_us"] = static_cast<std::int64_t>(h.Percentile(0.99));
+    out[p + "max_us"] = static_cast<std::int64_t>(h.max_us());
   }
+  return out;
 }
 
 void RunNodeLoop(LcmInterface& lcm, const std::string& process, Counters& counters,
                  const LatencyMap& latencies, const std::function<std::int64_t()>& last_frame,
                  const std::function<void()>& after_wait, const std::string& stats_path, int wait_ms) {
   StatusReporter status(&lcm, process);
-  auto report = [&] {
-    Counters r = counters;
-    AddLatencyCounters(latencies, &r);
-    return r;
-  };
   while (!StopRequested()) {
-    if (lcm.HandleSubscriptions(wait_ms) < 0) counters.Add("transport_errors");
+    if (lcm.HandleSubscriptions(wait_ms) < 0) counters.Add(Counter::kTransportErrors);
     if (after_wait) after_wait();
     NoteTransportCounters(lcm, &counters);
-    status.Tick(last_frame(), report());
+    status.Tick(last_frame(), counters, latencies);
   }
   NoteTransportCounters(lcm, &counters);
-  status.Final(last_frame(), report());
+  status.Final(last_frame(), counters, latencies);
   if (!stats_path.empty()) WriteStatsJson(stats_path, process, counters, latencies);
 }
 
@@ -220,7 +217,7 @@ void WriteStatsJson(const std::string& path, const std::string& process, const C
   nlohmann::ordered_json j;
   j["process"] = process;
   j["counters"] = nlohmann::ordered_json::object();
-  for (const auto& [k, v] : counters.values()) j["counters"][k] = v;
+  for (const auto& [k, v] : counters.ByName()) j["counters"][k] = v;
   j["latency_us"] = nlohmann::ordered_json::object();
   for (const auto& [name, h] : latencies) {
     j["latency_us"][name] = {{"count", h.count()},

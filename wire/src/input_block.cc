@@ -16,7 +16,7 @@ OperatorInputs InitialInputs(const InputCalibrations& cal) {
 
 namespace {
 
-double ClampCounted(double v, double lo, double hi, const std::string& counter, Counters* c) {
+double ClampCounted(double v, double lo, double hi, Counter counter, Counters* c) {
   if (v < lo || v > hi) {
     if (c) c->Add(counter);
     return std::clamp(v, lo, hi);
@@ -31,18 +31,17 @@ std::array<std::int32_t, kInputWords> EncodeInputs(const OperatorInputs& in,
                                                    Counters* counters) {
   std::array<std::int32_t, kInputWords> words{};
   for (int i = 0; i < kNumAnalogInputs; ++i) {
-    const std::string name(kAnalogInputNames[i]);
     double v = in.value[i];
-    if (!std::isfinite(v)) throw InputError("input '" + name + "' is not a finite number");
-    v = ClampCounted(v, cal[i].min, cal[i].max, "clamped." + name, counters);
+    if (!std::isfinite(v)) throw InputError("input '" + std::string(kAnalogInputNames[i]) + "' is not a finite number");
+    v = ClampCounted(v, cal[i].min, cal[i].max, ClampedCounter(i), counters);
     const double counts = v / cal[i].units_per_count + cal[i].zero_count;
     const wire::Encoded e = wire::Encode(wire::kADC16, counts);
-    if (e.saturated && counters) counters->Add("clamped.adc." + name);
+    if (e.saturated && counters) counters->Add(ClampedAdcCounter(i));
     words[i] = static_cast<std::int32_t>(e.word);
   }
   int station = in.camera_station;
   if (station < 1 || station > 8) {
-    if (counters) counters->Add("clamped.camera_station");
+    if (counters) counters->Add(Counter::kClampedCameraStation);
     station = std::clamp(station, 1, 8);
   }
   std::uint32_t d = static_cast<std::uint32_t>(station - 1) & kDiscreteCameraMask;
@@ -67,10 +66,9 @@ OperatorInputs DecodeInputs(const std::array<std::int32_t, kInputWords>& words,
   }
   OperatorInputs in;
   for (int i = 0; i < kNumAnalogInputs; ++i) {
-    const std::string name(kAnalogInputNames[i]);
     std::int32_t counts = wire::ToSigned(static_cast<wire::Word>(words[i]));
     if (counts < wire::kADC16.raw_min || counts > wire::kADC16.raw_max) {
-      if (counters) counters->Add("clamped.adc." + name);
+      if (counters) counters->Add(ClampedAdcCounter(i));
       counts = std::clamp(counts, wire::kADC16.raw_min, wire::kADC16.raw_max);
     }
     const double v = (counts - cal[i].zero_count) * cal[i].units_per_count;
@@ -78,7 +76,7 @@ OperatorInputs DecodeInputs(const std::array<std::int32_t, kInputWords>& words,
     // within rounding of it and is not a clamp.
     const double slack = 0.5 * std::abs(cal[i].units_per_count);
     if (v < cal[i].min - slack || v > cal[i].max + slack) {
-      if (counters) counters->Add("clamped." + name);
+      if (counters) counters->Add(ClampedCounter(i));
     }
     in.value[i] = std::clamp(v, cal[i].min, cal[i].max);
   }

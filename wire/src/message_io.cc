@@ -85,11 +85,11 @@ std::int8_t ProcessCode(std::string_view name) {
 const char* DecodeErrorName(DecodeError e) {
   switch (e) {
     case DecodeError::kNone: return "none";
-    case DecodeError::kTooLarge: return "too_large";
-    case DecodeError::kWrongType: return "wrong_type";
-    case DecodeError::kTruncated: return "truncated";
-    case DecodeError::kTrailingBytes: return "trailing_bytes";
-    case DecodeError::kBadCount: return "bad_count";
+    case DecodeError::kTooLarge:
+    case DecodeError::kWrongType:
+    case DecodeError::kTruncated:
+    case DecodeError::kTrailingBytes:
+    case DecodeError::kBadCount: return kDecodeErrorNames[static_cast<int>(e) - 1].data();
   }
   return "unknown";
 }

@@ -10,19 +10,19 @@ namespace rms::wire {
 
 namespace {
 
-std::int32_t Put(const wire::FixedFormat& f, double v, const char* field, Counters* counters) {
+std::int32_t Put(const wire::FixedFormat& f, double v, Counter saturated, Counters* counters) {
   const wire::Encoded e = wire::Encode(f, v);
-  if (e.saturated && counters) counters->Add(std::string("saturated.") + field);
+  if (e.saturated && counters) counters->Add(saturated);
   return static_cast<std::int32_t>(e.word);
 }
 
 template <class It>
-void PutVec3(It out, const Eigen::Vector3d& v, const char* field, Counters* c) {
+void PutVec3(It out, const Eigen::Vector3d& v, Counter field, Counters* c) {
   for (int i = 0; i < 3; ++i) out[i] = Put(wire::kFT12, v[i], field, c);
 }
 
 template <class It>
-void PutRot(It out, const Eigen::Matrix3d& r, const char* field, Counters* c) {
+void PutRot(It out, const Eigen::Matrix3d& r, Counter field, Counters* c) {
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) out[3 * i + j] = Put(wire::kSC22, r(i, j), field, c);
 }
@@ -30,8 +30,8 @@ void PutRot(It out, const Eigen::Matrix3d& r, const char* field, Counters* c) {
 template <class It>
 void PutArm(It out, const arm::ArmSinCos& arm, Counters* c) {
   for (int i = 0; i < 6; ++i) {
-    out[2 * i] = Put(wire::kSC22, arm[i].s, "arm", c);
-    out[2 * i + 1] = Put(wire::kSC22, arm[i].c, "arm", c);
+    out[2 * i] = Put(wire::kSC22, arm[i].s, Counter::kSaturatedArm, c);
+    out[2 * i + 1] = Put(wire::kSC22, arm[i].c, Counter::kSaturatedArm, c);
   }
 }
 
@@ -104,19 +104,19 @@ void PackDcpFrame(const DcpFrameData& in, dcp_frame_t* out, Counters* c) {
   PutArm(out->arm_words, in.arm, c);
   out->control_word = static_cast<std::int32_t>(PackControlWord(in.control));
   for (int p = 0; p < 3; ++p) {
-    for (int k = 0; k < 3; ++k) out->plane_words[4 * p + k] = Put(wire::kSC22, in.planes[p].n_R[k], "plane", c);
-    out->plane_words[4 * p + 3] = Put(wire::kFT12, in.planes[p].d_ft, "plane", c);
+    for (int k = 0; k < 3; ++k) out->plane_words[4 * p + k] = Put(wire::kSC22, in.planes[p].n_R[k], Counter::kSaturatedPlane, c);
+    out->plane_words[4 * p + 3] = Put(wire::kFT12, in.planes[p].d_ft, Counter::kSaturatedPlane, c);
   }
   RMS_CHECK(in.plane_valid <= 7);
   out->plane_status = static_cast<std::int32_t>(in.plane_valid);
   auto* s = out->state_words;
-  s[dcp_state::kShoulderHeight] = Put(wire::kFT12, in.shoulder_height_ft, "shoulder_height", c);
-  s[dcp_state::kFingerGap] = Put(wire::kFT12, in.finger_gap_ft, "finger_gap", c);
+  s[dcp_state::kShoulderHeight] = Put(wire::kFT12, in.shoulder_height_ft, Counter::kSaturatedShoulderHeight, c);
+  s[dcp_state::kFingerGap] = Put(wire::kFT12, in.finger_gap_ft, Counter::kSaturatedFingerGap, c);
   s[dcp_state::kCameraPan] = static_cast<std::int32_t>(wire::EncodeAngleBam(in.camera_pan_deg));
   s[dcp_state::kCameraTilt] = static_cast<std::int32_t>(wire::EncodeAngleBam(in.camera_tilt_deg));
-  s[dcp_state::kCameraZoom] = Put(wire::kSC22, in.camera_zoom, "camera_zoom", c);
-  PutVec3(s + dcp_state::kPayloadPos, in.p_RoPo_R_ft, "payload_pos", c);
-  PutRot(s + dcp_state::kPayloadRot, in.R_RP, "payload_rot", c);
+  s[dcp_state::kCameraZoom] = Put(wire::kSC22, in.camera_zoom, Counter::kSaturatedCameraZoom, c);
+  PutVec3(s + dcp_state::kPayloadPos, in.p_RoPo_R_ft, Counter::kSaturatedPayloadPos, c);
+  PutRot(s + dcp_state::kPayloadRot, in.R_RP, Counter::kSaturatedPayloadRot, c);
 }
 
 DcpFrameData UnpackDcpFrame(const dcp_frame_t& m) {
@@ -160,13 +160,13 @@ std::vector<std::int32_t> PackEsgWords(const EsgFrameData& in, Counters* c) {
   w[ew::kFrameCount] = static_cast<std::int32_t>(in.frame_count & wire::kWordMask);
   w[ew::kControl] = static_cast<std::int32_t>(PackControlWord(in.control));
   PutArm(w.begin() + ew::kArm, in.arm, c);
-  w[ew::kShoulderHeight] = Put(wire::kFT12, in.shoulder_height_ft, "shoulder_height", c);
-  w[ew::kFingerGap] = Put(wire::kFT12, in.finger_gap_ft, "finger_gap", c);
-  PutVec3(w.begin() + ew::kEye, in.p_RoEye_R_ft, "eye", c);
-  PutRot(w.begin() + ew::kView, in.R_RE, "view", c);
+  w[ew::kShoulderHeight] = Put(wire::kFT12, in.shoulder_height_ft, Counter::kSaturatedShoulderHeight, c);
+  w[ew::kFingerGap] = Put(wire::kFT12, in.finger_gap_ft, Counter::kSaturatedFingerGap, c);
+  PutVec3(w.begin() + ew::kEye, in.p_RoEye_R_ft, Counter::kSaturatedEye, c);
+  PutRot(w.begin() + ew::kView, in.R_RE, Counter::kSaturatedView, c);
   w[ew::kFov] = static_cast<std::int32_t>(wire::EncodeAngleBam(in.fov_deg));
-  PutVec3(w.begin() + ew::kPayloadPos, in.p_RoPo_R_ft, "payload_pos", c);
-  PutRot(w.begin() + ew::kPayloadRot, in.R_RP, "payload_rot", c);
+  PutVec3(w.begin() + ew::kPayloadPos, in.p_RoPo_R_ft, Counter::kSaturatedPayloadPos, c);
+  PutRot(w.begin() + ew::kPayloadRot, in.R_RP, Counter::kSaturatedPayloadRot, c);
   for (int i = 0; i < ew::kPriorityCount; ++i) {
     RMS_CHECK(wire::IsValidWord(in.priority_words[i]));
     w[ew::kPriority + i] = in.priority_words[i];

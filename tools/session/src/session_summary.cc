@@ -51,13 +51,17 @@ nlohmann::json ReadJson(const fs::path& p) {
   }
 }
 
-std::int64_t Counter(const nlohmann::json& stats, const std::string& name) {
+// A counter of a process's stats (stats/PROCESS.json), 0 when absent.
+std::int64_t CounterOf(const nlohmann::json& stats, rms::Counter counter) {
   if (!stats.contains("counters")) return 0;
   const auto& c = stats["counters"];
+  const std::string name(CounterName(counter));
   return c.contains(name) ? c[name].get<std::int64_t>() : 0;
 }
 
-std::int64_t SumPrefix(const nlohmann::json& stats, const std::string& prefix) {
+// The sum of a family of counters (kDroppedPrefix, kClampedPrefix), by name:
+// a session of another version may have had other members.
+std::int64_t SumPrefix(const nlohmann::json& stats, std::string_view prefix) {
   std::int64_t s = 0;
   if (!stats.contains("counters")) return 0;
   for (auto it = stats["counters"].begin(); it != stats["counters"].end(); ++it) {
@@ -422,7 +426,10 @@ bool Plausible(const std::map<std::string, std::int64_t>& run, double duration_s
   for (const auto& [k, v] : run) {
     if (v < 0) return false;
     if (k.rfind("latency.", 0) != 0 && static_cast<double>(v) > most * 100.0) return false;
-    if ((k == "published" || k == "rendered" || k == "received") && static_cast<double>(v) > most) return false;
+    if ((k == CounterName(rms::Counter::kPublished) || k == CounterName(rms::Counter::kRendered) ||
+         k == CounterName(rms::Counter::kReceived)) &&
+        static_cast<double>(v) > most)
+      return false;
   }
   return true;
 }
@@ -449,7 +456,7 @@ std::map<std::string, nlohmann::json> MergedStats(const fs::path& root, const St
       }
       if (!stats[p].contains("counters")) stats[p]["counters"] = nlohmann::json::object();
       for (const auto& [k, v] : counters) {
-        if (k == "mode" || k.rfind("latency.", 0) == 0) continue;
+        if (k == CounterName(rms::Counter::kMode) || k.rfind("latency.", 0) == 0) continue;
         stats[p]["counters"][k] = stats[p]["counters"].value(k, std::int64_t{0}) + v;
       }
     }
@@ -491,11 +498,12 @@ void AddMission(const LogScan& s, nlohmann::ordered_json* out) {
 // Messages a receiver refused for a reason of its own, not malformed
 // (docs/protocol.md): too late to act on, of another session, beyond the
 // session's clock.
-constexpr const char* kRefusedReasons[] = {"late", "other_session", "other_sender", "far_ahead"};
+constexpr rms::Counter kRefused[] = {rms::Counter::kDroppedLate, rms::Counter::kDroppedOtherSession,
+                                     rms::Counter::kDroppedOtherSender, rms::Counter::kDroppedFarAhead};
 
 std::int64_t Malformed(const nlohmann::json& st) {
-  std::int64_t n = SumPrefix(st, "dropped.");
-  for (const char* r : kRefusedReasons) n -= Counter(st, std::string("dropped.") + r);
+  std::int64_t n = SumPrefix(st, kDroppedPrefix);
+  for (rms::Counter c : kRefused) n -= CounterOf(st, c);
   return n;
 }
 
@@ -503,35 +511,34 @@ nlohmann::ordered_json FramesJson(const std::map<std::string, nlohmann::json>& s
   const auto &op = stats.at("operator_station"), &dcp = stats.at("dynamics_proc"), &scene = stats.at("scene_proc"),
              &esg = stats.at("esg_renderer");
   nlohmann::ordered_json frames;
-  frames["operator_published"] = Counter(op, "published");
-  frames["dcp_published"] = Counter(dcp, "published");
-  frames["esg_published"] = Counter(scene, "published");
-  frames["rendered"] = Counter(esg, "rendered");
-  frames["superseded"] = Counter(esg, "superseded");
-  frames["scenes_drawn"] = Counter(esg, "rendered.scenes");
-  frames["skipped_unchanged"] = Counter(esg, "skipped.unchanged");
-  frames["png_written"] = Counter(esg, "png_written");
-  frames["video_frames"] = Counter(esg, "video.frames");
-  frames["video_dropped"] = Counter(esg, "video.dropped");
-  frames["late_operator_frames"] = Counter(op, "frames.late");
+  frames["operator_published"] = CounterOf(op, rms::Counter::kPublished);
+  frames["dcp_published"] = CounterOf(dcp, rms::Counter::kPublished);
+  frames["esg_published"] = CounterOf(scene, rms::Counter::kPublished);
+  frames["rendered"] = CounterOf(esg, rms::Counter::kRendered);
+  frames["superseded"] = CounterOf(esg, rms::Counter::kSuperseded);
+  frames["scenes_drawn"] = CounterOf(esg, rms::Counter::kRenderedScenes);
+  frames["skipped_unchanged"] = CounterOf(esg, rms::Counter::kSkippedUnchanged);
+  frames["png_written"] = CounterOf(esg, rms::Counter::kPngWritten);
+  frames["video_frames"] = CounterOf(esg, rms::Counter::kVideoFrames);
+  frames["video_dropped"] = CounterOf(esg, rms::Counter::kVideoDropped);
+  frames["late_operator_frames"] = CounterOf(op, rms::Counter::kFramesLate);
   frames["dropped"] = {
-      {"operator_to_dcp", Counter(dcp, "input.missing")},
-      {"dcp_to_scene", Counter(scene, "dcp.missing")},
-      {"scene_to_esg", Counter(esg, "esg.missing")},
+      {"operator_to_dcp", CounterOf(dcp, rms::Counter::kInputMissing)},
+      {"dcp_to_scene", CounterOf(scene, rms::Counter::kDcpMissing)},
+      {"scene_to_esg", CounterOf(esg, rms::Counter::kEsgMissing)},
       {"malformed_at_dcp", Malformed(dcp)},
       {"malformed_at_scene", Malformed(scene)},
       {"malformed_at_esg", Malformed(esg)},
   };
   nlohmann::ordered_json refused = nlohmann::ordered_json::object();
-  for (const char* reason : kRefusedReasons) {
-    refused[reason] = Counter(op, std::string("dropped.") + reason) + Counter(dcp, std::string("dropped.") + reason) +
-                      Counter(scene, std::string("dropped.") + reason) +
-                      Counter(esg, std::string("dropped.") + reason);
+  for (rms::Counter c : kRefused) {
+    const std::string reason(CounterName(c).substr(kDroppedPrefix.size()));  // "late", "other_session", ...
+    refused[reason] = CounterOf(op, c) + CounterOf(dcp, c) + CounterOf(scene, c) + CounterOf(esg, c);
   }
   frames["refused"] = refused;
-  frames["clamped_inputs"] = {{"operator_station", SumPrefix(op, "clamped.")},
-                              {"dynamics_proc", SumPrefix(dcp, "clamped.")},
-                              {"scene_proc", SumPrefix(scene, "clamped.")}};
+  frames["clamped_inputs"] = {{"operator_station", SumPrefix(op, kClampedPrefix)},
+                              {"dynamics_proc", SumPrefix(dcp, kClampedPrefix)},
+                              {"scene_proc", SumPrefix(scene, kClampedPrefix)}};
   return frames;
 }
 
@@ -554,21 +561,21 @@ nlohmann::ordered_json TimingJson(const std::map<std::string, nlohmann::json>& s
              &esg = stats.at("esg_renderer");
   nlohmann::ordered_json timing;
   timing["frame_period_ms"] = 1000.0 / rate_hz;
-  timing["operator_station"] = {{"late_frames", Counter(op, "frames.late")}};
-  timing["dynamics_proc"] = {{"dropped_frames", Counter(dcp, "input.missing")},
-                             {"late_frames", Counter(dcp, "frames.late")},
-                             {"too_late_dropped", Counter(dcp, "dropped.late")},
+  timing["operator_station"] = {{"late_frames", CounterOf(op, rms::Counter::kFramesLate)}};
+  timing["dynamics_proc"] = {{"dropped_frames", CounterOf(dcp, rms::Counter::kInputMissing)},
+                             {"late_frames", CounterOf(dcp, rms::Counter::kFramesLate)},
+                             {"too_late_dropped", CounterOf(dcp, rms::Counter::kDroppedLate)},
                              {"malformed", Malformed(dcp)},
                              {"latency", Links(dcp)}};
-  timing["scene_proc"] = {{"dropped_frames", Counter(scene, "dcp.missing")},
-                          {"late_frames", Counter(scene, "frames.late")},
-                          {"too_late_dropped", Counter(scene, "dropped.late")},
+  timing["scene_proc"] = {{"dropped_frames", CounterOf(scene, rms::Counter::kDcpMissing)},
+                          {"late_frames", CounterOf(scene, rms::Counter::kFramesLate)},
+                          {"too_late_dropped", CounterOf(scene, rms::Counter::kDroppedLate)},
                           {"malformed", Malformed(scene)},
                           {"latency", Links(scene)}};
-  timing["esg_renderer"] = {{"dropped_frames", Counter(esg, "esg.missing")},
-                            {"superseded", Counter(esg, "superseded")},
-                            {"late_frames", Counter(esg, "frames.late")},
-                            {"too_late_dropped", Counter(esg, "dropped.late")},
+  timing["esg_renderer"] = {{"dropped_frames", CounterOf(esg, rms::Counter::kEsgMissing)},
+                            {"superseded", CounterOf(esg, rms::Counter::kSuperseded)},
+                            {"late_frames", CounterOf(esg, rms::Counter::kFramesLate)},
+                            {"too_late_dropped", CounterOf(esg, rms::Counter::kDroppedLate)},
                             {"malformed", Malformed(esg)},
                             {"latency", Links(esg)}};
   return timing;
@@ -584,11 +591,11 @@ nlohmann::ordered_json RecordJson(const std::map<std::string, nlohmann::json>& s
     std::int64_t published, logged;
   };
   const Row rows[] = {
-      {wire::channels::kOperatorInput, Counter(stats.at("operator_station"), "published"), s.input.received()},
-      {wire::channels::kDcpFrame, Counter(stats.at("dynamics_proc"), "published"), s.dcp.received()},
-      {wire::channels::kDcpTelemetry, Counter(stats.at("dynamics_proc"), "published"),
+      {wire::channels::kOperatorInput, CounterOf(stats.at("operator_station"), rms::Counter::kPublished), s.input.received()},
+      {wire::channels::kDcpFrame, CounterOf(stats.at("dynamics_proc"), rms::Counter::kPublished), s.dcp.received()},
+      {wire::channels::kDcpTelemetry, CounterOf(stats.at("dynamics_proc"), rms::Counter::kPublished),
        static_cast<std::int64_t>(s.telemetry_logged.size())},
-      {wire::channels::kEsgFrame, Counter(stats.at("scene_proc"), "published"), s.esg.received()},
+      {wire::channels::kEsgFrame, CounterOf(stats.at("scene_proc"), rms::Counter::kPublished), s.esg.received()},
   };
   nlohmann::ordered_json r;
   std::int64_t lost = 0;
@@ -633,76 +640,51 @@ static void ForPeople(nlohmann::ordered_json* j) {
   }
 }
 
-nlohmann::ordered_json Summarize(const std::string& dir) {
-  const fs::path root(dir);
-  SessionLog first_pass(dir);
-  const DcpFrames dcp_frames = ReadDcpFrames(first_pass);
-  SessionLog log(dir);
-  SenderCheck& check = log.check();
-  check.Count("dcp_frame_out_of_sequence", dcp_frames.out_of_sequence);
-  LabConfig config;
-  try {
-    config = LoadConfig((root / "config.toml").string());
-  } catch (const std::exception&) {
-    config = LoadConfig(DefaultConfigPath());
-  }
-  AttemptLog attempts(config);
-  const LogScan s = ScanLog(log, dcp_frames.by_frame, &attempts);
-  const double rate_hz = FrameRate(root);
-  const double duration_s = s.first_us >= 0 ? (s.last_us - s.first_us) * 1e-6 : 0.0;
-  const auto stats = MergedStats(root, s.status, duration_s, rate_hz, &check);
+namespace {
 
-  nlohmann::ordered_json j;
-  j["session"] = fs::absolute(root).lexically_normal().filename().string();
-  if (j["session"].get<std::string>().empty()) j["session"] = fs::absolute(root).parent_path().filename().string();
-  if (check.session_id() != 0) j["session_id"] = wire::FormatSessionId(check.session_id());
-  j["duration_s"] = duration_s;
-  AddMission(s, &j);
-  {
-    std::ifstream pilot((root / "run" / "pilot").string());
-    std::string who;
-    if (pilot >> who) j["pilot"] = who;
+// The session's configuration, or the default one when its copy is gone.
+LabConfig SessionConfig(const fs::path& root) {
+  try {
+    return LoadConfig((root / "config.toml").string());
+  } catch (const std::exception&) {
+    return LoadConfig(DefaultConfigPath());
   }
-  j["restarts"] = Restarts(root);
-  for (std::size_t i = 0; i < j["restarts"].size(); ++i) attempts.ObserveRestart();
-  {
-    nlohmann::ordered_json a = attempts.Json();
-    j["attempts"] = std::move(a["attempts"]);
-    j["totals"] = std::move(a["totals"]);
+}
+
+// Which session, how long, the mission and who flew it.
+void AddSessionFields(const fs::path& root, const LogScan& s, double duration_s, std::int64_t session_id,
+                      nlohmann::ordered_json* j) {
+  (*j)["session"] = fs::absolute(root).lexically_normal().filename().string();
+  if ((*j)["session"].get<std::string>().empty()) (*j)["session"] = fs::absolute(root).parent_path().filename().string();
+  if (session_id != 0) (*j)["session_id"] = wire::FormatSessionId(session_id);
+  (*j)["duration_s"] = duration_s;
+  AddMission(s, j);
+  std::ifstream pilot((root / "run" / "pilot").string());
+  std::string who;
+  if (pilot >> who) (*j)["pilot"] = who;
+}
+
+// The session's result (docs/sessions.md "summary.json"): its last attempt
+// that docked, or else its last attempt.
+void AddResult(nlohmann::ordered_json* j) {
+  (*j)["result_attempt"] = nullptr;
+  (*j)["phase_durations_s"] = nullptr;
+  (*j)["docking"] = nullptr;
+  nlohmann::ordered_json result = nullptr;
+  for (const auto& a : (*j)["attempts"]) {
+    if (a["outcome"] == "docked" || result.is_null() || !(result["outcome"] == "docked")) result = a;
   }
-  j["mode_changes"] = s.telemetry.mode_changes;
-  j["control"] = s.control;
-  // The session's result (docs/sessions.md "summary.json"): its last
-  // attempt that docked, or else its last attempt.
-  {
-    j["result_attempt"] = nullptr;
-    j["phase_durations_s"] = nullptr;
-    j["docking"] = nullptr;
-    nlohmann::ordered_json result = nullptr;
-    for (const auto& a : j["attempts"]) {
-      if (a["outcome"] == "docked" || result.is_null() || !(result["outcome"] == "docked")) result = a;
-    }
-    if (result.is_object()) {
-      j["result_attempt"] = result["index"];
-      j["phase_durations_s"] = result["phase_durations_s"];
-      j["docking"] = result["docking"];
-      // A docking a restore brought (a checkpoint saved just before it): said,
-      // not hidden (docs/security.md "What the summary trusts").
-      if (j["docking"].is_object()) j["docking"]["after_restore"] = result["started_by"] == "restore";
-    }
-  }
-  j["by_hand"] = s.hand.Json();
-  if (j["by_hand"].is_object()) {
-    // The station's own count has the last key too (a quit ends it before
-    // another state message goes out).
-    j["by_hand"]["key_actions"] =
-        std::max(j["by_hand"]["key_actions"].get<std::int64_t>(), Counter(stats.at("operator_station"), "key_actions"));
-  }
-  j["collisions"] = s.telemetry.collisions;
-  j["collisions_by_kind"] = s.telemetry.ByKind();
-  j["held_frames"] = s.telemetry.held_frames;
-  j["telemetry_frames"] = s.telemetry.frames();
-  j["frames"] = FramesJson(stats);
+  if (!result.is_object()) return;
+  (*j)["result_attempt"] = result["index"];
+  (*j)["phase_durations_s"] = result["phase_durations_s"];
+  (*j)["docking"] = result["docking"];
+  // A docking a restore brought (a checkpoint saved just before it): said,
+  // not hidden (docs/security.md "What the summary trusts").
+  if ((*j)["docking"].is_object()) (*j)["docking"]["after_restore"] = result["started_by"] == "restore";
+}
+
+// Each link's latency from the processes' stats, ms.
+nlohmann::ordered_json LatencyJson(const std::map<std::string, nlohmann::json>& stats) {
   nlohmann::ordered_json lat = nlohmann::ordered_json::object();
   for (const auto& [proc, st] : stats) {
     if (!st.contains("latency_us")) continue;
@@ -713,15 +695,64 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
                        {"max_ms", it.value()["max"].get<double>() / 1000.0}};
     }
   }
-  j["latency"] = lat;
+  return lat;
+}
+
+// The log: its events, what could not be read at its end, whose counts it kept.
+nlohmann::ordered_json LogSection(const LogScan& s, const SessionLog& log,
+                                  const std::map<std::string, nlohmann::json>& stats) {
+  nlohmann::ordered_json l = LogJson(s);
+  l["unread_bytes"] = log.unread_bytes();  // a log cut short or damaged at its end
+  l["stats_from_log"] = nlohmann::json::array();
+  for (const auto& [p, st] : stats) {
+    if (st.value("from_log", false)) l["stats_from_log"].push_back(p);
+  }
+  return l;
+}
+
+}  // namespace
+
+// In passes over the log (docs/sessions.md "summary.json"): the DCP frames
+// to believe first, then everything else against them; then the stats.
+nlohmann::ordered_json Summarize(const std::string& dir) {
+  const fs::path root(dir);
+  SessionLog first_pass(dir);
+  const DcpFrames dcp_frames = ReadDcpFrames(first_pass);
+  SessionLog log(dir);
+  SenderCheck& check = log.check();
+  check.Count("dcp_frame_out_of_sequence", dcp_frames.out_of_sequence);
+  AttemptLog attempts(SessionConfig(root));
+  const LogScan s = ScanLog(log, dcp_frames.by_frame, &attempts);
+  const double rate_hz = FrameRate(root);
+  const double duration_s = s.first_us >= 0 ? (s.last_us - s.first_us) * 1e-6 : 0.0;
+  const auto stats = MergedStats(root, s.status, duration_s, rate_hz, &check);
+
+  nlohmann::ordered_json j;
+  AddSessionFields(root, s, duration_s, check.session_id(), &j);
+  j["restarts"] = Restarts(root);
+  for (std::size_t i = 0; i < j["restarts"].size(); ++i) attempts.ObserveRestart();
+  nlohmann::ordered_json a = attempts.Json();
+  j["attempts"] = std::move(a["attempts"]);
+  j["totals"] = std::move(a["totals"]);
+  j["mode_changes"] = s.telemetry.mode_changes;
+  j["control"] = s.control;
+  AddResult(&j);
+  j["by_hand"] = s.hand.Json();
+  if (j["by_hand"].is_object()) {
+    // The station's own count has the last key too (a quit ends it before
+    // another state message goes out).
+    j["by_hand"]["key_actions"] = std::max(j["by_hand"]["key_actions"].get<std::int64_t>(),
+                                           CounterOf(stats.at("operator_station"), rms::Counter::kKeyActions));
+  }
+  j["collisions"] = s.telemetry.collisions;
+  j["collisions_by_kind"] = s.telemetry.ByKind();
+  j["held_frames"] = s.telemetry.held_frames;
+  j["telemetry_frames"] = s.telemetry.frames();
+  j["frames"] = FramesJson(stats);
+  j["latency"] = LatencyJson(stats);
   j["timing"] = TimingJson(stats, rate_hz);
   j["record"] = RecordJson(stats, s);
-  j["log"] = LogJson(s);
-  j["log"]["unread_bytes"] = log.unread_bytes();  // a log cut short or damaged at its end
-  j["log"]["stats_from_log"] = nlohmann::json::array();
-  for (const auto& [p, st] : stats) {
-    if (st.value("from_log", false)) j["log"]["stats_from_log"].push_back(p);
-  }
+  j["log"] = LogSection(s, log, stats);
   j["ignored"] = check.Json();
   ForPeople(&j);
   return j;

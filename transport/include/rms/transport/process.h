@@ -88,28 +88,28 @@ void RequestStop();
 // (docs/sessions.md "Ready files"). Throws InputError when it cannot.
 void WriteReadyFile(const std::string& path);
 
+// Latency histograms by link name, e.g. "input_to_dcp_us".
+using LatencyMap = std::map<std::string, LatencyHistogram>;
+
+// What a status report carries, by name: the counters the process touched
+// and each link's latency as latency.LINK.count, .p50_us, .p99_us, .max_us.
+std::map<std::string, std::int64_t> StatusFigures(const Counters& counters, const LatencyMap& latencies);
+
 // Publishes process_status_t on RMS_STATUS once a second (transport time)
 // and once at exit.
 class StatusReporter {
  public:
   StatusReporter(LcmInterface* lcm, std::string process);
-  void Tick(std::int64_t frame, const Counters& counters);
-  void Final(std::int64_t frame, const Counters& counters);
+  void Tick(std::int64_t frame, const Counters& counters, const LatencyMap& latencies = {});
+  void Final(std::int64_t frame, const Counters& counters, const LatencyMap& latencies = {});
 
  private:
-  void Publish(std::int64_t frame, const Counters& counters, bool final);
+  void Publish(std::int64_t frame, const Counters& counters, const LatencyMap& latencies, bool final);
   LcmInterface* lcm_;
   std::string process_;
   std::string host_;
   std::int64_t last_us_ = 0;
 };
-
-// Latency histograms by link name, e.g. "input_to_dcp_us".
-using LatencyMap = std::map<std::string, LatencyHistogram>;
-
-// Adds p50 / p99 / max / count of each histogram to the counters (as
-// "latency.NAME.p50_us" ...), for status reports.
-void AddLatencyCounters(const LatencyMap& latencies, Counters* counters);
 
 // The transport's own counts into the process's counters:
 // "dropped.other_session" (messages of another session) and "dropped.other_sender"

@@ -8,6 +8,8 @@
 #include <string>
 #include <string_view>
 
+#include "rms/base/counters.h"
+
 namespace rms::wire {
 
 namespace collision_bits {
@@ -41,6 +43,19 @@ inline constexpr std::array<const char*, collision_bits::kCount> kCollisionNames
 inline const char* CollisionName(int bit) {
   return bit >= 0 && bit < collision_bits::kCount ? kCollisionNames[bit] : "?";
 }
+// collisions.KIND and collision_frames.KIND for a collision bit (rms/base/counters.h).
+constexpr Counter CollisionCounter(int bit) { return CounterAt(Counter::kCollisionsEffHex1Recpt, bit); }
+constexpr Counter CollisionFramesCounter(int bit) { return CounterAt(Counter::kCollisionFramesEffHex1Recpt, bit); }
+constexpr bool CollisionFamilyFollows(Counter first, std::string_view prefix) {
+  for (int b = 0; b < collision_bits::kCount; ++b) {
+    const std::string_view n = CounterName(CounterAt(first, b));
+    if (n.substr(0, prefix.size()) != prefix || n.substr(prefix.size()) != kCollisionNames[b]) return false;
+  }
+  return true;
+}
+static_assert(CollisionFamilyFollows(Counter::kCollisionsEffHex1Recpt, "collisions."));
+static_assert(CollisionFamilyFollows(Counter::kCollisionFramesEffHex1Recpt, "collision_frames."));
+
 // The names of the bits set in `bits`, in bit order, joined by `separator`
 // ("eff_hex_1-recpt, payload-bay_b"); `none` when no bit is set.
 inline std::string CollisionNames(std::uint32_t bits, std::string_view separator = ", ", std::string_view none = "") {

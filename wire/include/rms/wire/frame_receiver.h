@@ -19,16 +19,15 @@
 
 namespace rms::wire {
 
-// Thrown by a block's checks to drop a message under a reason of its own
-// (plain InputError drops it as "bad_word").
+// Thrown by a block's checks to drop a message under a counter of its own
+// (plain InputError drops it as dropped.bad_word).
 class MalformedError : public InputError {
  public:
-  MalformedError(std::string reason, const std::string& what)
-      : InputError(what), reason_(std::move(reason)) {}
-  const std::string& reason() const { return reason_; }
+  MalformedError(Counter counter, const std::string& what) : InputError(what), counter_(counter) {}
+  Counter counter() const { return counter_; }
 
  private:
-  std::string reason_;
+  Counter counter_;
 };
 
 // Frames that waited too long to be worth acting on (docs/protocol.md "Late
@@ -76,18 +75,18 @@ auto ReceiveFrame(const void* data, int size, SequenceTracker* seq,
                   LateFrameFilter* late = nullptr)
     -> std::optional<std::pair<Msg, std::invoke_result_t<Unpack, const Msg&>>> {
   using Content = std::invoke_result_t<Unpack, const Msg&>;
-  counters->Add("received");
+  counters->Add(Counter::kReceived);
   Msg msg;
   const DecodeError err = SafeDecode(data, size, &msg);
   if (err != DecodeError::kNone) {
-    counters->Add(std::string("dropped.") + DecodeErrorName(err));
+    counters->Add(DroppedCounter(err));
     return std::nullopt;
   }
   // Frame numbers and send times a real sender cannot produce (negative, or
   // beyond 2^48 frames, times outside [0, 2^62) us): dropped before any arithmetic on them.
   constexpr std::int64_t kMaxFrame = std::int64_t{1} << 48, kMaxTimeUs = std::int64_t{1} << 62;
   if (msg.frame < 0 || msg.frame >= kMaxFrame) {
-    counters->Add("dropped.bad_frame");
+    counters->Add(Counter::kDroppedBadFrame);
     return std::nullopt;
   }
   bool times_ok = msg.send_time_us >= 0 && msg.send_time_us < kMaxTimeUs;
@@ -95,34 +94,34 @@ auto ReceiveFrame(const void* data, int size, SequenceTracker* seq,
     times_ok = times_ok && msg.input_send_time_us >= 0 && msg.input_send_time_us < kMaxTimeUs;
   }
   if (!times_ok) {
-    counters->Add("dropped.bad_time");
+    counters->Add(Counter::kDroppedBadTime);
     return std::nullopt;
   }
   std::optional<Content> content;
   try {
     content.emplace(unpack(msg));
   } catch (const MalformedError& e) {
-    counters->Add("dropped." + e.reason());
+    counters->Add(e.counter());
     spdlog::debug("frame {} dropped: {}", msg.frame, e.what());
     return std::nullopt;
   } catch (const InputError& e) {
-    counters->Add("dropped.bad_word");
+    counters->Add(Counter::kDroppedBadWord);
     spdlog::debug("frame {} dropped: {}", msg.frame, e.what());
     return std::nullopt;
   }
   const std::int64_t before = seq->last();
   switch (seq->Accept(msg.frame, now_us)) {
-    case SequenceTracker::Verdict::kDuplicate: counters->Add("dropped.duplicate"); return std::nullopt;
-    case SequenceTracker::Verdict::kStale: counters->Add("dropped.stale"); return std::nullopt;
+    case SequenceTracker::Verdict::kDuplicate: counters->Add(Counter::kDroppedDuplicate); return std::nullopt;
+    case SequenceTracker::Verdict::kStale: counters->Add(Counter::kDroppedStale); return std::nullopt;
     case SequenceTracker::Verdict::kFarAhead:
       // A frame number no sender of this session can have reached: refused.
-      if (counters->Get("dropped.far_ahead") == 0) {
+      if (counters->Get(Counter::kDroppedFarAhead) == 0) {
         spdlog::warn("frame {} refused: beyond what the session's clock allows (dropped.far_ahead)", msg.frame);
       }
-      counters->Add("dropped.far_ahead");
+      counters->Add(Counter::kDroppedFarAhead);
       return std::nullopt;
     case SequenceTracker::Verdict::kResync:
-      counters->Add("resyncs");
+      counters->Add(Counter::kResyncs);
       spdlog::warn("frame numbers resynchronised: {} refused in a row, now following frame {} (the last accepted "
                    "was {}; a sender restarted, or that frame was not real)",
                    SequenceTracker::kResyncAfter, msg.frame, before);
@@ -130,7 +129,7 @@ auto ReceiveFrame(const void* data, int size, SequenceTracker* seq,
     case SequenceTracker::Verdict::kGap: {
       // Frames lost on the way (or while the sender was down): counted by
       // the caller from seq->missing(); a gap of several frames is said.
-      counters->Add("gaps");
+      counters->Add(Counter::kGaps);
       if (const std::int64_t n = msg.frame - seq->previous() - 1; n >= 3) {
         spdlog::warn("gap: {} frames missing before frame {} (a lossy link or a restarted sender)", n, msg.frame);
       }
@@ -140,11 +139,11 @@ auto ReceiveFrame(const void* data, int size, SequenceTracker* seq,
   }
   if (late && late->TooLate(msg.send_time_us, now_us)) {
     // In the sequence (not counted missing), but not acted on.
-    counters->Add("dropped.late");
-    if (counters->Get("dropped.late") == 1 || counters->Get("dropped.late") % 1000 == 0) {
+    counters->Add(Counter::kDroppedLate);
+    if (counters->Get(Counter::kDroppedLate) == 1 || counters->Get(Counter::kDroppedLate) % 1000 == 0) {
       spdlog::warn("frame {} dropped: {} ms old, later than {} ms beyond the link's delay (dropped.late: {} so far; "
                    "a stall, or a process that was stopped)",
-                   msg.frame, (now_us - msg.send_time_us) / 1000, late->limit_us() / 1000, counters->Get("dropped.late"));
+                   msg.frame, (now_us - msg.send_time_us) / 1000, late->limit_us() / 1000, counters->Get(Counter::kDroppedLate));
     }
     return std::nullopt;
   }

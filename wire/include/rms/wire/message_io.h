@@ -4,6 +4,7 @@
 // truncated, trailing bytes, impossible count) and never throws or crashes.
 // lcm-gen 1.3.1's decoders resize arrays from the message's own count fields
 // and can throw on hostile input; SafeDecode catches that.
+#include <array>
 #include <cstdint>
 #include <cstring>
 #include <exception>
@@ -11,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "rms/base/counters.h"
 #include "rms/lcm_limits.h"
 
 
@@ -25,8 +27,31 @@ enum class DecodeError {
   kBadCount,       // an array or string length that cannot be valid
 };
 
-// Counter-friendly name: "too_large", "wrong_type", ...
+// Counter-friendly names, kTooLarge first: "too_large", "wrong_type", ...
+inline constexpr int kNumDecodeErrors = 5;
+inline constexpr std::array<std::string_view, kNumDecodeErrors> kDecodeErrorNames = {
+    "too_large", "wrong_type", "truncated", "trailing_bytes", "bad_count"};
 const char* DecodeErrorName(DecodeError e);
+// The counter a message dropped for `e` goes to (e != kNone): dropped.E on a
+// process's input channel, and the families of the operator station's
+// telemetry and window keys and the renderer's operator state.
+constexpr Counter DroppedCounter(DecodeError e) { return CounterAt(Counter::kDroppedTooLarge, static_cast<int>(e) - 1); }
+constexpr Counter DroppedTelemetryCounter(DecodeError e) {
+  return CounterAt(Counter::kDroppedTelemetryTooLarge, static_cast<int>(e) - 1);
+}
+constexpr Counter DroppedWindowKeysCounter(DecodeError e) {
+  return CounterAt(Counter::kDroppedWindowKeysTooLarge, static_cast<int>(e) - 1);
+}
+constexpr Counter DroppedOperatorStateCounter(DecodeError e) {
+  return CounterAt(Counter::kDroppedOperatorStateTooLarge, static_cast<int>(e) - 1);
+}
+static_assert(FamilyFollows(Counter::kDroppedTooLarge, "dropped.", kDecodeErrorNames.data(), kNumDecodeErrors));
+static_assert(FamilyFollows(Counter::kDroppedTelemetryTooLarge, "dropped.telemetry_", kDecodeErrorNames.data(),
+                            kNumDecodeErrors));
+static_assert(FamilyFollows(Counter::kDroppedWindowKeysTooLarge, "dropped.window_keys_", kDecodeErrorNames.data(),
+                            kNumDecodeErrors));
+static_assert(FamilyFollows(Counter::kDroppedOperatorStateTooLarge, "dropped.operator_state_",
+                            kDecodeErrorNames.data(), kNumDecodeErrors));
 
 // Reads the 8-byte big-endian fingerprint at the start of an LCM message.
 inline bool ReadFingerprint(const void* data, int size, std::int64_t* out) {
