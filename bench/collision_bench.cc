@@ -98,141 +98,126 @@ struct Agreement {
   std::map<std::string, long> pairs_by_kind;
 };
 
-}  // namespace
+// What a method says of a pair: collide or not.
+using Verdicts = std::map<std::string, bool>;
 
-int main(int argc, char** argv) {
-  std::string md_path;
-  long agreement_pairs = 14000;
-  // Our own flags first; the rest go to Google Benchmark.
-  std::vector<char*> rest = {argv[0]};
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--md") && i + 1 < argc) md_path = argv[++i];
-    else if (!std::strcmp(argv[i], "--agreement") && i + 1 < argc) agreement_pairs = std::atol(argv[++i]);
-    else rest.push_back(argv[i]);
+void Tally(const Pair& p, bool exact, const Verdicts& says, Agreement* ag) {
+  ++ag->pairs;
+  ++ag->pairs_by_kind[p.kind];
+  for (const auto& [m, v] : says) {
+    if (v != exact) {
+      ++ag->wrong[m];
+      ++ag->wrong_by_kind[m][p.kind];
+    }
   }
-  int bargc = static_cast<int>(rest.size());
-  benchmark::Initialize(&bargc, rest.data());
-  rms::bench::InitOde();
+}
 
-  static Sets sets = MakeSets();
+rms::dynamics_proc::CollideOptions VerdictOnly() {
+  rms::dynamics_proc::CollideOptions o;
+  o.want_plane = false;
+  return o;
+}
+
+bool DcpSaysCollide(const Pair& p) {
+  return rms::dynamics_proc::Collide(p.a.hex, p.b.hex, VerdictOnly()).verdict == rms::dynamics_proc::Verdict::kCollide;
+}
+
+// Every method's verdict against the exact reference on the generator's box
+// families, then on general hexahedra: the same pairs for every method.
+std::pair<Agreement, Agreement> MeasureAgreement(long agreement_pairs, std::uint64_t seed) {
+  Agreement boxes, general;
+  rms::reference::PairGenerator gen(seed);
+  for (long n = 0; n < 7 * (agreement_pairs / 7); ++n) {
+    const Pair p = gen.Next(1.0, true);
+    const auto a = Shape(p.a), b = Shape(p.b);
+    Tally(p, rms::reference::ExactHullsIntersect(p.a.v, p.b.v),
+          {{"DCP", DcpSaysCollide(p)},
+           {"separating axes, 15", rms::bench::SatBoxesIntersect(a, b)},
+           {"ODE dBoxTouchesBox", rms::bench::OdeBoxesTouch(a, b)},
+           {"FCL boxes", rms::bench::FclPair::Boxes(a, b)->Collide()},
+           {"libccd MPR", rms::bench::CcdMprBoxes(a, b)}},
+          &boxes);
+  }
+  while (general.pairs < agreement_pairs / 2) {
+    const Pair p = gen.Next(1.0, false);
+    if (p.a.is_box || p.b.is_box) continue;
+    Tally(p, rms::reference::ExactHullsIntersect(p.a.v, p.b.v),
+          {{"DCP", DcpSaysCollide(p)},
+           {"libccd MPR", rms::bench::CcdMprHulls(p.a.v, p.b.v)},
+           {"FCL convex", rms::bench::FclPair::Hulls(p.a.v, p.b.v)->Collide()}},
+          &general);
+  }
+  // Every method appears, with 0 when it never disagreed.
+  for (const char* m : {"DCP", "separating axes, 15", "ODE dBoxTouchesBox", "FCL boxes", "libccd MPR"}) boxes.wrong[m] += 0;
+  for (const char* m : {"DCP", "libccd MPR", "FCL convex"}) general.wrong[m] += 0;
+  return {boxes, general};
+}
+
+// Every method on the same 4096 pairs of each set, cycled.
+void RegisterTimings(const Sets& sets) {
+  using rms::dynamics_proc::Collide;
   auto cycle = [](benchmark::State& st, auto&& f) {
     std::size_t i = 0;
     for (auto _ : st) benchmark::DoNotOptimize(f(i++ & 4095));
   };
-  rms::dynamics_proc::CollideOptions verdict_only;
-  verdict_only.want_plane = false;
+  const rms::dynamics_proc::CollideOptions verdict_only = VerdictOnly();
   rms::dynamics_proc::CollideOptions report_only = verdict_only;
   report_only.sphere_reject = false;
   report_only.aabb_reject = false;
   rms::dynamics_proc::CollideOptions spheres_only = verdict_only;
   spheres_only.aabb_reject = false;
+  auto dcp = [&](const char* name, const auto& pairs, rms::dynamics_proc::CollideOptions o) {
+    benchmark::RegisterBenchmark(name, [&pairs, o, cycle](benchmark::State& st) {
+      cycle(st, [&](std::size_t i) { return Collide(pairs[i].first, pairs[i].second, o).verdict; });
+    });
+  };
   // Boxes.
-  benchmark::RegisterBenchmark("boxes/DCP, verdict", [&](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) { return rms::dynamics_proc::Collide(sets.hex_boxes[i].first, sets.hex_boxes[i].second, verdict_only).verdict; });
-  });
-  benchmark::RegisterBenchmark("boxes/DCP, verdict, no bounding-volume rejection", [&](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) { return rms::dynamics_proc::Collide(sets.hex_boxes[i].first, sets.hex_boxes[i].second, report_only).verdict; });
-  });
-  benchmark::RegisterBenchmark("boxes/DCP, verdict, spheres but no box rejection", [&](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) { return rms::dynamics_proc::Collide(sets.hex_boxes[i].first, sets.hex_boxes[i].second, spheres_only).verdict; });
-  });
-  benchmark::RegisterBenchmark("boxes/DCP, verdict and separating plane", [&](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) { return rms::dynamics_proc::Collide(sets.hex_boxes[i].first, sets.hex_boxes[i].second).verdict; });
-  });
-  benchmark::RegisterBenchmark("boxes/separating axes, 15 (double)", [&](benchmark::State& st) {
+  dcp("boxes/DCP, verdict", sets.hex_boxes, verdict_only);
+  dcp("boxes/DCP, verdict, no bounding-volume rejection", sets.hex_boxes, report_only);
+  dcp("boxes/DCP, verdict, spheres but no box rejection", sets.hex_boxes, spheres_only);
+  dcp("boxes/DCP, verdict and separating plane", sets.hex_boxes, {});
+  benchmark::RegisterBenchmark("boxes/separating axes, 15 (double)", [&sets, cycle](benchmark::State& st) {
     cycle(st, [&](std::size_t i) { return rms::bench::SatBoxesIntersect(sets.boxes[i].first, sets.boxes[i].second); });
   });
-  benchmark::RegisterBenchmark("boxes/ODE dBoxTouchesBox", [&](benchmark::State& st) {
+  benchmark::RegisterBenchmark("boxes/ODE dBoxTouchesBox", [&sets, cycle](benchmark::State& st) {
     cycle(st, [&](std::size_t i) { return rms::bench::OdeBoxesTouch(sets.boxes[i].first, sets.boxes[i].second); });
   });
-  benchmark::RegisterBenchmark("boxes/FCL collide() on boxes (computes a contact)", [&](benchmark::State& st) {
+  benchmark::RegisterBenchmark("boxes/FCL collide() on boxes (computes a contact)", [&sets, cycle](benchmark::State& st) {
     cycle(st, [&](std::size_t i) { return sets.fcl_boxes[i]->Collide(); });
   });
-  benchmark::RegisterBenchmark("boxes/libccd MPR", [&](benchmark::State& st) {
+  benchmark::RegisterBenchmark("boxes/libccd MPR", [&sets, cycle](benchmark::State& st) {
     cycle(st, [&](std::size_t i) { return rms::bench::CcdMprBoxes(sets.boxes[i].first, sets.boxes[i].second); });
   });
-  benchmark::RegisterBenchmark("boxes/exact (CGAL)", [&](benchmark::State& st) {
+  benchmark::RegisterBenchmark("boxes/exact (CGAL)", [&sets, cycle](benchmark::State& st) {
     cycle(st, [&](std::size_t i) { return rms::reference::ExactHullsIntersect(sets.hulls_boxes[i].first, sets.hulls_boxes[i].second); });
   });
   // General hexahedra.
-  benchmark::RegisterBenchmark("general/DCP, verdict", [&](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) { return rms::dynamics_proc::Collide(sets.hex_general[i].first, sets.hex_general[i].second, verdict_only).verdict; });
-  });
-  benchmark::RegisterBenchmark("general/DCP, verdict and separating plane", [&](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) { return rms::dynamics_proc::Collide(sets.hex_general[i].first, sets.hex_general[i].second).verdict; });
-  });
-  benchmark::RegisterBenchmark("general/libccd MPR", [&](benchmark::State& st) {
+  dcp("general/DCP, verdict", sets.hex_general, verdict_only);
+  dcp("general/DCP, verdict and separating plane", sets.hex_general, {});
+  benchmark::RegisterBenchmark("general/libccd MPR", [&sets, cycle](benchmark::State& st) {
     cycle(st, [&](std::size_t i) { return rms::bench::CcdMprHulls(sets.hulls_general[i].first, sets.hulls_general[i].second); });
   });
-  benchmark::RegisterBenchmark("general/FCL collide() on convex (GJK/EPA)", [&](benchmark::State& st) {
+  benchmark::RegisterBenchmark("general/FCL collide() on convex (GJK/EPA)", [&sets, cycle](benchmark::State& st) {
     cycle(st, [&](std::size_t i) { return sets.fcl_general[i]->Collide(); });
   });
-  benchmark::RegisterBenchmark("general/exact (CGAL)", [&](benchmark::State& st) {
+  benchmark::RegisterBenchmark("general/exact (CGAL)", [&sets, cycle](benchmark::State& st) {
     cycle(st, [&](std::size_t i) { return rms::reference::ExactHullsIntersect(sets.hulls_general[i].first, sets.hulls_general[i].second); });
   });
-  Collector collector;
-  benchmark::RunSpecifiedBenchmarks(&collector);
-  benchmark::Shutdown();
+}
 
-  // Agreement with the exact reference, every method, the same pairs.
-  const std::uint64_t seed = 19721122;
-  std::fprintf(stderr, "agreement: %ld pairs a family, seed %llu\n", agreement_pairs, static_cast<unsigned long long>(seed));
-  Agreement box_agree, gen_agree;
-  {
-    rms::reference::PairGenerator gen(seed);
-    for (long n = 0; n < 7 * (agreement_pairs / 7); ++n) {
-      const Pair p = gen.Next(1.0, true);
-      const bool exact = rms::reference::ExactHullsIntersect(p.a.v, p.b.v);
-      const auto a = Shape(p.a), b = Shape(p.b);
-      const std::map<std::string, bool> says = {
-          {"DCP", rms::dynamics_proc::Collide(p.a.hex, p.b.hex, verdict_only).verdict == rms::dynamics_proc::Verdict::kCollide},
-          {"separating axes, 15", rms::bench::SatBoxesIntersect(a, b)},
-          {"ODE dBoxTouchesBox", rms::bench::OdeBoxesTouch(a, b)},
-          {"FCL boxes", rms::bench::FclPair::Boxes(a, b)->Collide()},
-          {"libccd MPR", rms::bench::CcdMprBoxes(a, b)}};
-      ++box_agree.pairs;
-      ++box_agree.pairs_by_kind[p.kind];
-      for (const auto& [m, v] : says) {
-        if (v != exact) {
-          ++box_agree.wrong[m];
-          ++box_agree.wrong_by_kind[m][p.kind];
-        }
-      }
-    }
-    while (gen_agree.pairs < agreement_pairs / 2) {
-      const Pair p = gen.Next(1.0, false);
-      if (p.a.is_box || p.b.is_box) continue;
-      const bool exact = rms::reference::ExactHullsIntersect(p.a.v, p.b.v);
-      const std::map<std::string, bool> says = {
-          {"DCP", rms::dynamics_proc::Collide(p.a.hex, p.b.hex, verdict_only).verdict == rms::dynamics_proc::Verdict::kCollide},
-          {"libccd MPR", rms::bench::CcdMprHulls(p.a.v, p.b.v)},
-          {"FCL convex", rms::bench::FclPair::Hulls(p.a.v, p.b.v)->Collide()}};
-      ++gen_agree.pairs;
-      ++gen_agree.pairs_by_kind[p.kind];
-      for (const auto& [m, v] : says) {
-        if (v != exact) {
-          ++gen_agree.wrong[m];
-          ++gen_agree.wrong_by_kind[m][p.kind];
-        }
-      }
-    }
-  }
-
-  // The tables.
-  std::ostringstream md;
+// The timing tables and their targets (docs/performance.md).
+void TimingTables(Collector& collector, std::ostringstream& md) {
   const double dcp = collector.ns["boxes/DCP, verdict"];
   const double sat = collector.ns["boxes/separating axes, 15 (double)"];
   const double fcl = collector.ns["boxes/FCL collide() on boxes (computes a contact)"];
   char line[600];
   // The FCL ratio repetition by repetition (the same pairs, run after run).
   double ratio_lo = 1e30, ratio_hi = 0;
-  {
-    const auto& d = collector.all["boxes/DCP, verdict"];
-    const auto& f = collector.all["boxes/FCL collide() on boxes (computes a contact)"];
-    for (std::size_t i = 0; i < std::min(d.size(), f.size()); ++i) {
-      ratio_lo = std::min(ratio_lo, f[i] / d[i]);
-      ratio_hi = std::max(ratio_hi, f[i] / d[i]);
-    }
+  const auto& d = collector.all["boxes/DCP, verdict"];
+  const auto& f = collector.all["boxes/FCL collide() on boxes (computes a contact)"];
+  for (std::size_t i = 0; i < std::min(d.size(), f.size()); ++i) {
+    ratio_lo = std::min(ratio_lo, f[i] / d[i]);
+    ratio_hi = std::max(ratio_hi, f[i] / d[i]);
   }
   const std::size_t reps = collector.all["boxes/DCP, verdict"].size();
   md << "## Collision against its peers\n\n"
@@ -262,35 +247,63 @@ int main(int argc, char** argv) {
                 dcp, dcp <= 40.0 ? "met" : "MISSED", 2 * sat, fcl / dcp, fcl / dcp >= 8.0 ? "met" : "MISSED",
                 ratio_lo, ratio_hi);
   md << line;
-  auto agreement_table = [&](const Agreement& ag, const char* title) {
-    md << "\n| " << title << " | pairs |";
-    for (const auto& [m, n] : ag.wrong) md << " " << m << " |";
-    (void)0;
-    std::vector<std::string> methods;
-    for (const auto& [m, n] : ag.wrong) methods.push_back(m);
-    md << "\n|---|---|";
-    for (std::size_t i = 0; i < methods.size(); ++i) md << "---|";
-    md << "\n";
-    for (const auto& [kind, n] : ag.pairs_by_kind) {
-      md << "| " << kind << " | " << n << " |";
-      for (const auto& m : methods) {
-        const auto it = ag.wrong_by_kind.find(m);
-        const long w = it == ag.wrong_by_kind.end() ? 0 : (it->second.count(kind) ? it->second.at(kind) : 0);
-        md << " " << w << " |";
-      }
-      md << "\n";
+}
+
+// Disagreements with the exact reference, by family of pairs, every method.
+void AgreementTable(const Agreement& ag, const char* title, std::ostringstream& md) {
+  md << "\n| " << title << " | pairs |";
+  for (const auto& [m, n] : ag.wrong) md << " " << m << " |";
+  std::vector<std::string> methods;
+  for (const auto& [m, n] : ag.wrong) methods.push_back(m);
+  md << "\n|---|---|";
+  for (std::size_t i = 0; i < methods.size(); ++i) md << "---|";
+  md << "\n";
+  for (const auto& [kind, n] : ag.pairs_by_kind) {
+    md << "| " << kind << " | " << n << " |";
+    for (const auto& m : methods) {
+      const auto it = ag.wrong_by_kind.find(m);
+      const long w = it == ag.wrong_by_kind.end() ? 0 : (it->second.count(kind) ? it->second.at(kind) : 0);
+      md << " " << w << " |";
     }
-    md << "| **all** | " << ag.pairs << " |";
-    for (const auto& m : methods) md << " **" << ag.wrong.at(m) << "** |";
     md << "\n";
-  };
-  // Every method appears, with 0 when it never disagreed.
-  for (const char* m : {"DCP", "separating axes, 15", "ODE dBoxTouchesBox", "FCL boxes", "libccd MPR"}) box_agree.wrong[m] += 0;
-  for (const char* m : {"DCP", "libccd MPR", "FCL convex"}) gen_agree.wrong[m] += 0;
+  }
+  md << "| **all** | " << ag.pairs << " |";
+  for (const auto& m : methods) md << " **" << ag.wrong.at(m) << "** |";
+  md << "\n";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string md_path;
+  long agreement_pairs = 14000;
+  // Our own flags first; the rest go to Google Benchmark.
+  std::vector<char*> rest = {argv[0]};
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--md") && i + 1 < argc) md_path = argv[++i];
+    else if (!std::strcmp(argv[i], "--agreement") && i + 1 < argc) agreement_pairs = std::atol(argv[++i]);
+    else rest.push_back(argv[i]);
+  }
+  int bargc = static_cast<int>(rest.size());
+  benchmark::Initialize(&bargc, rest.data());
+  rms::bench::InitOde();
+
+  static const Sets sets = MakeSets();
+  RegisterTimings(sets);
+  Collector collector;
+  benchmark::RunSpecifiedBenchmarks(&collector);
+  benchmark::Shutdown();
+
+  const std::uint64_t seed = 19721122;
+  std::fprintf(stderr, "agreement: %ld pairs a family, seed %llu\n", agreement_pairs, static_cast<unsigned long long>(seed));
+  const auto [box_agree, gen_agree] = MeasureAgreement(agreement_pairs, seed);
+
+  std::ostringstream md;
+  TimingTables(collector, md);
   md << "\nVerdicts that disagree with the exact reference (CGAL, exact arithmetic; touching counts as intersecting), "
         "by family of pairs (seed 19721122):\n";
-  agreement_table(box_agree, "Boxes: family");
-  agreement_table(gen_agree, "General hexahedra: family");
+  AgreementTable(box_agree, "Boxes: family", md);
+  AgreementTable(gen_agree, "General hexahedra: family", md);
   std::fputs(md.str().c_str(), stdout);
   if (!md_path.empty()) std::ofstream(md_path) << md.str();
   return 0;

@@ -44,204 +44,239 @@ struct Variant {
   long clusters = 0, triangles = 0, differing = 0, frames_differing = 0, worst = 0;
 };
 
+struct Options {
+  std::string config_path = rms::DefaultConfigPath();
+  std::string timeline = std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl";
+  int every = 1, width = 1024, height = 768;
+  std::string json_out, gl_name = "osmesa", dump_dir, md_path;
+  std::vector<std::string> sizes;
+};
+
+// What the mission measured beyond each variant's own figures.
+struct Mission {
+  long frames = 0, unchanged = 0;
+  std::vector<double> all_stations_ms, overlay_ms;
+};
+
+// The variants, v[0] the reference the others are compared with.
+std::vector<Variant> MakeVariants(const rms::LabConfig& config, const Options& o) {
+  using rms::esg_renderer::Visibility;
+  std::vector<Variant> v;
+  auto add = [&](std::string name, Visibility vis, bool frustum, bool backface) {
+    Variant x;
+    x.name = std::move(name);
+    x.options = {.visibility = vis, .id_colors = false, .frustum_cull = frustum, .backface_cull = backface};
+    v.push_back(std::move(x));
+  };
+  add("depth buffer, all culls (reference)", Visibility::kDepth, true, true);
+  add("priority, all culls (the ESG default)", Visibility::kPriority, true, true);
+  add("priority, no frustum cull", Visibility::kPriority, false, true);
+  add("priority, no back-face cull", Visibility::kPriority, true, false);
+  add("depth buffer, no culls", Visibility::kDepth, false, false);
+  for (Variant& x : v) {
+    x.gl = rms::esg_renderer::CreateGlContext(rms::esg_renderer::ParseGlBackend(o.gl_name), o.width, o.height);
+    x.renderer = std::make_unique<rms::esg_renderer::FrameRenderer>(config, x.gl.get(), x.options);
+  }
+  return v;
+}
+
+// One frame drawn by every variant, each compared with the reference (kept in `ref`).
+void DrawVariants(const rms::wire::EsgFrameData& f, const Options& o, std::vector<Variant>* v,
+                  std::vector<std::uint8_t>* ref) {
+  const std::size_t n = static_cast<std::size_t>(o.width) * o.height;
+  for (std::size_t k = 0; k < v->size(); ++k) {
+    Variant& x = (*v)[k];
+    const auto t0 = Clock::now();
+    x.renderer->Render(f);
+    const std::uint8_t* px = x.renderer->pixels();
+    x.ms.push_back(Ms(Clock::now() - t0));
+    x.clusters += x.renderer->stats().clusters_drawn;
+    x.triangles += x.renderer->stats().triangles_submitted;
+    if (k == 0) {
+      std::memcpy(ref->data(), px, n * 4);
+      continue;
+    }
+    long d = 0;
+    for (std::size_t i = 0; i < n; ++i) d += std::memcmp(px + 4 * i, &(*ref)[4 * i], 3) != 0;
+    if (d > x.worst && !o.dump_dir.empty()) {  // the worst frame so far
+      const std::string stem = o.dump_dir + "/variant" + std::to_string(k) + "_worst_";
+      rms::esg_renderer::WritePng(stem + "variant.png", o.width, o.height, px);
+      rms::esg_renderer::WritePng(stem + "reference.png", o.width, o.height, ref->data());
+      x.worst = d;
+    }
+    x.differing += d;
+    x.frames_differing += d > 0;
+  }
+}
+
+// The mission flown; every `every`th frame of the selected station drawn by
+// each variant, every station by the default, and an unchanged frame's cost.
+Mission FlyMission(const rms::LabConfig& config, const Options& o, std::vector<Variant>* v) {
+  rms::sim::OfflineSession session(config, rms::operator_station::Timeline::Load(o.timeline, config.inputs));
+  const std::size_t n = static_cast<std::size_t>(o.width) * o.height;
+  std::vector<std::uint8_t> ref(n * 4), out(n * 4);
+  const rms::esg_renderer::OverlayModel overlay = rms::esg_renderer::MakeOverlayModel(config);
+  Mission m;
+  std::vector<std::int32_t> prev_words;
+  while (session.Next()) {
+    // Unchanged frames: the selected station's words but for the frame
+    // counter (word 0) equal the previous frame's, as esg_renderer tests.
+    const std::vector<std::int32_t> words = rms::wire::PackEsgWords(session.esg(), nullptr);
+    const bool same = !prev_words.empty() && std::equal(words.begin() + 1, words.end(), prev_words.begin() + 1);
+    prev_words = words;
+    ++m.frames;
+    m.unchanged += same;
+    if (session.frame() % o.every) continue;
+    const rms::wire::EsgFrameData& f = session.esg();
+    DrawVariants(f, o, v, &ref);
+    // Every station drawn each frame (what the ESG does not do) against the selected one.
+    Variant& x = (*v)[1];
+    auto t0 = Clock::now();
+    for (int s = 1; s <= rms::kNumCameraStations; ++s) {
+      x.renderer->Render(session.esg(s));
+      x.renderer->pixels();
+    }
+    m.all_stations_ms.push_back(Ms(Clock::now() - t0));
+    // An unchanged frame costs a copy of the last scene and the overlay.
+    t0 = Clock::now();
+    std::memcpy(out.data(), ref.data(), n * 4);
+    rms::esg_renderer::DrawOverlay(out.data(), o.width, o.height, f, overlay);
+    m.overlay_ms.push_back(Ms(Clock::now() - t0));
+  }
+  return m;
+}
+
+// The figures on the terminal and, with --json, as JSON.
+void PrintFigures(const Options& o, const std::vector<Variant>& v, const Mission& m) {
+  const long measured = static_cast<long>(v[0].ms.size());
+  nlohmann::ordered_json j;
+  j["timeline"] = o.timeline;
+  j["size"] = {o.width, o.height};
+  j["gl"] = v[0].gl->description();
+  j["frames"] = m.frames;
+  j["frames_measured"] = measured;
+  std::printf("%s, %dx%d, %s: %ld frames, %ld measured\n\n", o.timeline.c_str(), o.width, o.height,
+              v[0].gl->description().c_str(), m.frames, measured);
+  std::printf("%-40s %9s %9s %9s %9s %10s %12s %8s\n", "variant (selected station)", "mean ms", "p50 ms", "p99 ms",
+              "clusters", "triangles", "px differ", "frames");
+  for (const Variant& x : v) {
+    const double mean = Mean(x.ms);
+    std::printf("%-40s %9.3f %9.3f %9.3f %9.1f %10.1f %12ld %8ld\n", x.name.c_str(), mean, Percentile(x.ms, 0.5),
+                Percentile(x.ms, 0.99), static_cast<double>(x.clusters) / measured,
+                static_cast<double>(x.triangles) / measured, x.differing, x.frames_differing);
+    j["variants"].push_back({{"name", x.name},
+                             {"mean_ms", mean},
+                             {"p50_ms", Percentile(x.ms, 0.5)},
+                             {"p99_ms", Percentile(x.ms, 0.99)},
+                             {"clusters_drawn_mean", static_cast<double>(x.clusters) / measured},
+                             {"triangles_submitted_mean", static_cast<double>(x.triangles) / measured},
+                             {"pixels_differing_from_reference", x.differing},
+                             {"frames_differing_from_reference", x.frames_differing}});
+  }
+  const double sel = Mean(v[1].ms), all8 = Mean(m.all_stations_ms), ov = Mean(m.overlay_ms);
+  const double frac = static_cast<double>(m.unchanged) / m.frames;
+  std::printf("\nselected station only: %.3f ms a frame; all eight stations: %.3f ms (x%.1f)\n", sel, all8,
+              all8 / sel);
+  std::printf("unchanged frames (words 1.. equal the previous frame's): %ld of %ld (%.1f%%); such a frame costs "
+              "%.3f ms (copy + overlay) instead of %.3f ms\n",
+              m.unchanged, m.frames, 100 * frac, ov, sel);
+  std::printf("mission render time with skipping: %.3f ms a frame on average, without: %.3f ms (%.1f%% saved)\n",
+              (1 - frac) * sel + frac * ov, sel, 100 * frac * (sel - ov) / sel);
+  j["selected_station_ms"] = sel;
+  j["all_stations_ms"] = all8;
+  j["unchanged_frames"] = m.unchanged;
+  j["unchanged_fraction"] = frac;
+  j["unchanged_frame_ms"] = ov;
+  j["mean_ms_with_skipping"] = (1 - frac) * sel + frac * ov;
+  if (!o.json_out.empty()) std::ofstream(o.json_out) << j.dump(2) << "\n";
+}
+
+// docs/performance.md's table of the variants.
+void PriorityTable(const Options& o, const std::vector<Variant>& v, const Mission& m, std::ostringstream& md) {
+  const long measured = static_cast<long>(v[0].ms.size());
+  md << "## Priority rendering against the depth buffer\n\n"
+     << rms::Sprintf("`rms_render_bench`: the scripted mission (%s) in process, every %s frame of the selected "
+                     "station drawn by each variant at %dx%d (%s), timed from the first GL call to the pixels in "
+                     "memory, and compared pixel by pixel with the depth-buffer reference (%ld frames measured).\n\n",
+                     std::filesystem::path(o.timeline).filename().c_str(),
+                     o.every == 1 ? "" : (std::to_string(o.every) + "th").c_str(), o.width, o.height,
+                     v[0].gl->description().c_str(), measured)
+     << "| variant | mean ms | p50 ms | p99 ms | clusters drawn | triangles | pixels differing | frames differing |\n"
+     << "|---|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const Variant& x : v) {
+    md << rms::Sprintf("| %s | %.3f | %.3f | %.3f | %.1f | %.1f | %ld | %ld |\n", x.name.c_str(), Mean(x.ms),
+                       Percentile(x.ms, 0.5), Percentile(x.ms, 0.99), static_cast<double>(x.clusters) / measured,
+                       static_cast<double>(x.triangles) / measured, x.differing, x.frames_differing);
+  }
+  const double sel = Mean(v[1].ms), all8 = Mean(m.all_stations_ms), ov = Mean(m.overlay_ms);
+  const double frac = static_cast<double>(m.unchanged) / m.frames;
+  md << rms::Sprintf("\nEvery station drawn each frame: %.3f ms against %.3f ms for the selected one (x%.1f). "
+                     "Unchanged frames: %ld of %ld (%.1f%%), each costing %.3f ms (copy + overlay): %.3f ms a frame "
+                     "on average with skipping, %.3f without.\n\n",
+                     all8, sel, all8 / sel, m.unchanged, m.frames, 100 * frac, ov, (1 - frac) * sel + frac * ov, sel);
+}
+
+// The ESG's default and the depth buffer at each --sizes size, every 10th frame.
+void ResolutionTable(const rms::LabConfig& config, const Options& o, const std::vector<Variant>& v,
+                     std::ostringstream& md) {
+  md << "## Render resolution against frame time\n\n"
+     << "The same mission, every 10th frame, the ESG's default (priority, all culls) and the depth buffer:\n\n"
+     << "| size | pixels | priority mean ms | priority p99 ms | depth buffer mean ms | depth buffer p99 ms |\n"
+     << "|---|---:|---:|---:|---:|---:|\n";
+  for (const std::string& wh : o.sizes) {
+    int w = 0, h = 0;
+    if (std::sscanf(wh.c_str(), "%dx%d", &w, &h) != 2 || w <= 0 || h <= 0) {
+      throw rms::InputError("--sizes: '" + wh + "' is not WIDTHxHEIGHT");
+    }
+    rms::sim::OfflineSession sz(config, rms::operator_station::Timeline::Load(o.timeline, config.inputs));
+    std::vector<double> ms[2];
+    std::unique_ptr<rms::esg_renderer::GlContext> gl[2];
+    std::unique_ptr<rms::esg_renderer::FrameRenderer> r[2];
+    for (int k = 0; k < 2; ++k) {
+      gl[k] = rms::esg_renderer::CreateGlContext(rms::esg_renderer::ParseGlBackend(o.gl_name), w, h);
+      r[k] = std::make_unique<rms::esg_renderer::FrameRenderer>(config, gl[k].get(), k ? v[0].options : v[1].options);
+    }
+    while (sz.Next()) {
+      if (sz.frame() % 10) continue;
+      for (int k = 0; k < 2; ++k) {
+        const auto t0 = Clock::now();
+        r[k]->Render(sz.esg());
+        r[k]->pixels();
+        ms[k].push_back(Ms(Clock::now() - t0));
+      }
+    }
+    md << rms::Sprintf("| %dx%d | %d | %.3f | %.3f | %.3f | %.3f |\n", w, h, w * h, Mean(ms[0]),
+                       Percentile(ms[0], 0.99), Mean(ms[1]), Percentile(ms[1], 0.99));
+  }
+  md << "\n";
+}
 
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"rmslab rms_render_bench: the ESG's savings (frustum cull, back-face cull, priority instead of a "
                "depth buffer, the selected station only, unchanged frames not redrawn) measured over a mission"};
-  std::string config_path = rms::DefaultConfigPath();
-  std::string timeline = std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl";
-  int every = 1, width = 1024, height = 768;
-  std::string json_out, gl_name = "osmesa", dump_dir;
-  app.add_option("--config", config_path, "Configuration file")->capture_default_str();
-  app.add_option("--timeline", timeline, "Timeline to fly")->capture_default_str();
-  app.add_option("--every", every, "Measure every Nth frame")->capture_default_str()->check(CLI::PositiveNumber);
-  app.add_option("--width", width, "Image width")->capture_default_str();
-  app.add_option("--height", height, "Image height")->capture_default_str();
-  app.add_option("--gl", gl_name, "GL backend: osmesa or egl")->capture_default_str();
-  app.add_option("--json", json_out, "Also write the figures as JSON to this file");
-  app.add_option("--dump", dump_dir, "Write each variant's worst frame, and the reference's, as PNG here");
-  std::string md_path;
-  std::vector<std::string> sizes;
-  app.add_option("--md", md_path, "Write the tables as markdown to this file");
-  app.add_option("--sizes", sizes, "Also time the ESG's default renderer and the depth buffer at these sizes (WxH)");
+  Options o;
+  app.add_option("--config", o.config_path, "Configuration file")->capture_default_str();
+  app.add_option("--timeline", o.timeline, "Timeline to fly")->capture_default_str();
+  app.add_option("--every", o.every, "Measure every Nth frame")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--width", o.width, "Image width")->capture_default_str();
+  app.add_option("--height", o.height, "Image height")->capture_default_str();
+  app.add_option("--gl", o.gl_name, "GL backend: osmesa or egl")->capture_default_str();
+  app.add_option("--json", o.json_out, "Also write the figures as JSON to this file");
+  app.add_option("--dump", o.dump_dir, "Write each variant's worst frame, and the reference's, as PNG here");
+  app.add_option("--md", o.md_path, "Write the tables as markdown to this file");
+  app.add_option("--sizes", o.sizes, "Also time the ESG's default renderer and the depth buffer at these sizes (WxH)");
   if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   try {
-    using rms::esg_renderer::Visibility;
-    const rms::LabConfig config = rms::LoadConfig(config_path);
-    rms::sim::OfflineSession session(config, rms::operator_station::Timeline::Load(timeline, config.inputs));
-    std::vector<Variant> v;
-    auto add = [&](std::string name, Visibility vis, bool frustum, bool backface) {
-      Variant x;
-      x.name = std::move(name);
-      x.options = {.visibility = vis, .id_colors = false, .frustum_cull = frustum, .backface_cull = backface};
-      v.push_back(std::move(x));
-    };
-    // v[0] is the reference the others are compared with.
-    add("depth buffer, all culls (reference)", Visibility::kDepth, true, true);
-    add("priority, all culls (the ESG default)", Visibility::kPriority, true, true);
-    add("priority, no frustum cull", Visibility::kPriority, false, true);
-    add("priority, no back-face cull", Visibility::kPriority, true, false);
-    add("depth buffer, no culls", Visibility::kDepth, false, false);
-    for (Variant& x : v) {
-      x.gl = rms::esg_renderer::CreateGlContext(rms::esg_renderer::ParseGlBackend(gl_name), width, height);
-      x.renderer = std::make_unique<rms::esg_renderer::FrameRenderer>(config, x.gl.get(), x.options);
-    }
-    const std::size_t n = static_cast<std::size_t>(width) * height;
-    std::vector<std::uint8_t> ref(n * 4), out(n * 4);
-    std::vector<std::string> names;
-    for (const auto& c : config.cameras) names.push_back(c.name);
-    const rms::esg_renderer::OverlayModel overlay = rms::esg_renderer::MakeOverlayModel(config);
-
-    std::vector<double> all_stations_ms, overlay_ms;
-    long frames = 0, unchanged = 0;
-    std::vector<std::int32_t> prev_words;
-    while (session.Next()) {
-      // Unchanged frames: the selected station's words but for the frame
-      // counter (word 0) equal the previous frame's, as esg_renderer tests.
-      const std::vector<std::int32_t> words = rms::wire::PackEsgWords(session.esg(), nullptr);
-      const bool same = !prev_words.empty() && std::equal(words.begin() + 1, words.end(), prev_words.begin() + 1);
-      prev_words = words;
-      ++frames;
-      unchanged += same;
-      if (session.frame() % every) continue;
-      const rms::wire::EsgFrameData& f = session.esg();
-      for (std::size_t k = 0; k < v.size(); ++k) {
-        Variant& x = v[k];
-        const auto t0 = Clock::now();
-        x.renderer->Render(f);
-        const std::uint8_t* px = x.renderer->pixels();
-        x.ms.push_back(Ms(Clock::now() - t0));
-        x.clusters += x.renderer->stats().clusters_drawn;
-        x.triangles += x.renderer->stats().triangles_submitted;
-        if (k == 0) {
-          std::memcpy(ref.data(), px, n * 4);
-        } else {
-          long d = 0;
-          for (std::size_t i = 0; i < n; ++i) d += std::memcmp(px + 4 * i, &ref[4 * i], 3) != 0;
-          if (d > x.worst && !dump_dir.empty()) {  // the worst frame so far
-            const std::string stem = dump_dir + "/variant" + std::to_string(k) + "_worst_";
-            rms::esg_renderer::WritePng(stem + "variant.png", width, height, px);
-            rms::esg_renderer::WritePng(stem + "reference.png", width, height, ref.data());
-            x.worst = d;
-          }
-          x.differing += d;
-          x.frames_differing += d > 0;
-        }
-      }
-      // Every station drawn each frame (what the ESG does not do) against the selected one.
-      {
-        Variant& x = v[1];
-        const auto t0 = Clock::now();
-        for (int s = 1; s <= rms::kNumCameraStations; ++s) {
-          x.renderer->Render(session.esg(s));
-          x.renderer->pixels();
-        }
-        all_stations_ms.push_back(Ms(Clock::now() - t0));
-      }
-      // An unchanged frame costs a copy of the last scene and the overlay.
-      {
-        const auto t0 = Clock::now();
-        std::memcpy(out.data(), ref.data(), n * 4);
-        rms::esg_renderer::DrawOverlay(out.data(), width, height, f, overlay);
-        overlay_ms.push_back(Ms(Clock::now() - t0));
-      }
-    }
-
-    const long measured = static_cast<long>(v[0].ms.size());
-    nlohmann::ordered_json j;
-    j["timeline"] = timeline;
-    j["size"] = {width, height};
-    j["gl"] = v[0].gl->description();
-    j["frames"] = frames;
-    j["frames_measured"] = measured;
-    std::printf("%s, %dx%d, %s: %ld frames, %ld measured\n\n", timeline.c_str(), width, height,
-                v[0].gl->description().c_str(), frames, measured);
-    std::printf("%-40s %9s %9s %9s %9s %10s %12s %8s\n", "variant (selected station)", "mean ms", "p50 ms", "p99 ms",
-                "clusters", "triangles", "px differ", "frames");
-    for (const Variant& x : v) {
-      const double m = Mean(x.ms);
-      std::printf("%-40s %9.3f %9.3f %9.3f %9.1f %10.1f %12ld %8ld\n", x.name.c_str(), m, Percentile(x.ms, 0.5),
-                  Percentile(x.ms, 0.99), static_cast<double>(x.clusters) / measured,
-                  static_cast<double>(x.triangles) / measured, x.differing, x.frames_differing);
-      j["variants"].push_back({{"name", x.name},
-                               {"mean_ms", m},
-                               {"p50_ms", Percentile(x.ms, 0.5)},
-                               {"p99_ms", Percentile(x.ms, 0.99)},
-                               {"clusters_drawn_mean", static_cast<double>(x.clusters) / measured},
-                               {"triangles_submitted_mean", static_cast<double>(x.triangles) / measured},
-                               {"pixels_differing_from_reference", x.differing},
-                               {"frames_differing_from_reference", x.frames_differing}});
-    }
-    const double sel = Mean(v[1].ms), all8 = Mean(all_stations_ms), ov = Mean(overlay_ms);
-    const double frac = static_cast<double>(unchanged) / frames;
-    std::printf("\nselected station only: %.3f ms a frame; all eight stations: %.3f ms (x%.1f)\n", sel, all8,
-                all8 / sel);
-    std::printf("unchanged frames (words 1.. equal the previous frame's): %ld of %ld (%.1f%%); such a frame costs "
-                "%.3f ms (copy + overlay) instead of %.3f ms\n",
-                unchanged, frames, 100 * frac, ov, sel);
-    std::printf("mission render time with skipping: %.3f ms a frame on average, without: %.3f ms (%.1f%% saved)\n",
-                (1 - frac) * sel + frac * ov, sel, 100 * frac * (sel - ov) / sel);
-    j["selected_station_ms"] = sel;
-    j["all_stations_ms"] = all8;
-    j["unchanged_frames"] = unchanged;
-    j["unchanged_fraction"] = frac;
-    j["unchanged_frame_ms"] = ov;
-    j["mean_ms_with_skipping"] = (1 - frac) * sel + frac * ov;
-    if (!json_out.empty()) std::ofstream(json_out) << j.dump(2) << "\n";
-
+    const rms::LabConfig config = rms::LoadConfig(o.config_path);
+    std::vector<Variant> v = MakeVariants(config, o);
+    const Mission m = FlyMission(config, o, &v);
+    PrintFigures(o, v, m);
     std::ostringstream md;
-    md << "## Priority rendering against the depth buffer\n\n"
-       << rms::Sprintf("`rms_render_bench`: the scripted mission (%s) in process, every %s frame of the selected "
-                       "station drawn by each variant at %dx%d (%s), timed from the first GL call to the pixels in "
-                       "memory, and compared pixel by pixel with the depth-buffer reference (%ld frames measured).\n\n",
-                       std::filesystem::path(timeline).filename().c_str(), every == 1 ? "" : (std::to_string(every) + "th").c_str(),
-                       width, height, v[0].gl->description().c_str(), measured)
-       << "| variant | mean ms | p50 ms | p99 ms | clusters drawn | triangles | pixels differing | frames differing |\n"
-       << "|---|---:|---:|---:|---:|---:|---:|---:|\n";
-    for (const Variant& x : v) {
-      md << rms::Sprintf("| %s | %.3f | %.3f | %.3f | %.1f | %.1f | %ld | %ld |\n", x.name.c_str(), Mean(x.ms),
-                         Percentile(x.ms, 0.5), Percentile(x.ms, 0.99), static_cast<double>(x.clusters) / measured,
-                         static_cast<double>(x.triangles) / measured, x.differing, x.frames_differing);
-    }
-    md << rms::Sprintf("\nEvery station drawn each frame: %.3f ms against %.3f ms for the selected one (x%.1f). "
-                       "Unchanged frames: %ld of %ld (%.1f%%), each costing %.3f ms (copy + overlay): %.3f ms a frame "
-                       "on average with skipping, %.3f without.\n\n",
-                       all8, sel, all8 / sel, unchanged, frames, 100 * frac, ov, (1 - frac) * sel + frac * ov, sel);
-    if (!sizes.empty()) {
-      md << "## Render resolution against frame time\n\n"
-         << "The same mission, every 10th frame, the ESG's default (priority, all culls) and the depth buffer:\n\n"
-         << "| size | pixels | priority mean ms | priority p99 ms | depth buffer mean ms | depth buffer p99 ms |\n"
-         << "|---|---:|---:|---:|---:|---:|\n";
-      for (const std::string& wh : sizes) {
-        int w = 0, h = 0;
-        if (std::sscanf(wh.c_str(), "%dx%d", &w, &h) != 2 || w <= 0 || h <= 0) {
-          throw rms::InputError("--sizes: '" + wh + "' is not WIDTHxHEIGHT");
-        }
-        rms::sim::OfflineSession sz(config, rms::operator_station::Timeline::Load(timeline, config.inputs));
-        std::vector<double> ms[2];
-        std::unique_ptr<rms::esg_renderer::GlContext> gl[2];
-        std::unique_ptr<rms::esg_renderer::FrameRenderer> r[2];
-        for (int k = 0; k < 2; ++k) {
-          gl[k] = rms::esg_renderer::CreateGlContext(rms::esg_renderer::ParseGlBackend(gl_name), w, h);
-          r[k] = std::make_unique<rms::esg_renderer::FrameRenderer>(config, gl[k].get(), k ? v[0].options : v[1].options);
-        }
-        while (sz.Next()) {
-          if (sz.frame() % 10) continue;
-          for (int k = 0; k < 2; ++k) {
-            const auto t0 = Clock::now();
-            r[k]->Render(sz.esg());
-            r[k]->pixels();
-            ms[k].push_back(Ms(Clock::now() - t0));
-          }
-        }
-        md << rms::Sprintf("| %dx%d | %d | %.3f | %.3f | %.3f | %.3f |\n", w, h, w * h, Mean(ms[0]), Percentile(ms[0], 0.99),
-                           Mean(ms[1]), Percentile(ms[1], 0.99));
-      }
-      md << "\n";
-    }
-    if (!md_path.empty()) std::ofstream(md_path) << md.str();
+    PriorityTable(o, v, m, md);
+    if (!o.sizes.empty()) ResolutionTable(config, o, v, md);
+    if (!o.md_path.empty()) std::ofstream(o.md_path) << md.str();
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rms_render_bench: %s\n", e.what());

@@ -378,155 +378,159 @@ wire::OperatorInputs Autopilot::Step(const dcp_telemetry_t* tm_ptr) {
   }
 
   switch (phase_) {
-    case AutopilotPhase::kWaitTelemetry:
-      // Take the arm as it is, so the first command moves nothing.
-      for (int i = 0; i < 6; ++i) cmd_.value[i] = tm.slave_angles_deg[i];
-      cmd_.value[kShoulderHeight] = tm.slave_shoulder_height_ft;
-      cmd_.value[kFinger] = tm.slave_finger;
-      Camera(8);
-      if (tm.mode != 1 || tm.acquired || tm.docked) {
-        Enter(AutopilotPhase::kReset);
-        reset_frames_ = 0;
-      } else {
-        Enter(AutopilotPhase::kOpenFinger);
-      }
-      break;
-
-    case AutopilotPhase::kReset:
-      // The reset button, one frame; then wait for Mode 1.
-      if (reset_frames_++ == 0) cmd_.reset = true;
-      else if (reset_frames_ > 3 && tm.mode == 1 && !tm.acquired && !tm.docked) Enter(AutopilotPhase::kOpenFinger);
-      else if (reset_frames_ > 60) Fail("the DCP did not return to Mode 1 after a reset");
-      break;
-
-    case AutopilotPhase::kOpenFinger:
-      cmd_.value[kFinger] = std::max(0.0, cmd_.value[kFinger] - opt_.finger_rate_per_s * dt_s_);
-      if (cmd_.value[kFinger] <= 0.0 && Settled(tm)) StartPhase(AutopilotPhase::kApproach, tm);
-      break;
-
-    case AutopilotPhase::kApproach: {
-      const PlanState ps = StepPlan();
-      if (ps == PlanState::kUnreachable) return Fail("the approach left the arm's reach"), cmd_;
-      if (ps == PlanState::kDone && Settled(tm)) StartPhase(AutopilotPhase::kDescend, tm);
-      break;
-    }
-
-    case AutopilotPhase::kDescend: {
-      const PlanState ps = StepPlan();
-      if (ps == PlanState::kUnreachable) return Fail("the grasp is out of the arm's reach"), cmd_;
-      if (ps != PlanState::kDone || !Settled(tm)) break;
-      // Closing the loop: the palm must be within TPOB of the bar's top;
-      // well short of it (kGraspCorrectTpobShare), descend to the planned height.
-      if (tm.palm_to_bar_ft > kGraspCorrectTpobShare * config_.dcp.tpob_ft && retries_ < opt_.max_retries) {
-        ++retries_;
-        counters_.Add(Counter::kAutopilotGraspCorrections);
-        const Eigen::Isometry3d X = CommandedPose();
-        PlanLine(Shifted(X, (tm.palm_to_bar_ft - mission::GraspPalmAboveBarFt(config_)) * X.linear().col(0)), 0.2);
-        break;
-      }
-      StartPhase(AutopilotPhase::kClose, tm);
-      break;
-    }
-
-    case AutopilotPhase::kClose:
-      if (tm.acquired && tm.mode == 2) {
-        StartPhase(AutopilotPhase::kLift, tm);
-        break;
-      }
-      cmd_.value[kFinger] = std::min(1.0, cmd_.value[kFinger] + opt_.finger_rate_per_s * dt_s_);
-      if (cmd_.value[kFinger] >= 1.0 && ++finger_full_frames_ > static_cast<int>(1.5 / dt_s_)) {
-        // Closed and not acquired: which conditions fail? Open and try again.
-        std::string failing;
-        for (int i = 0; i < wire::kNumAcquisitionConditions; ++i) {
-          if (!tm.acquisition_conditions[i]) failing += (failing.empty() ? "" : ", ") + std::to_string(i + 1);
-        }
-        if (++retries_ > opt_.max_retries) return Fail("no acquisition (conditions " + failing + " fail)"), cmd_;
-        counters_.Add(Counter::kAutopilotGraspRetries);
-        spdlog::info("autopilot: finger closed, no acquisition (conditions {} fail): open and grasp again", failing);
-        Enter(AutopilotPhase::kOpenFinger);
-      }
-      break;
-
-    case AutopilotPhase::kLift: {
-      if (tm.mode == 3 && !seen_mode3_) {
-        seen_mode3_ = true;
-        mode3_height_ft_ = CommandedPose().translation().z();
-        Camera(3);
-      }
-      if (seen_mode3_ && CommandedPose().translation().z() >= mode3_height_ft_ + opt_.lift_margin_ft) plan_.clear();
-      const PlanState ps = StepPlan();
-      if (ps == PlanState::kUnreachable && !seen_mode3_) return Fail("the arm cannot lift the payload out of the bay"), cmd_;
-      if (ps == PlanState::kUnreachable) plan_.clear();  // as high as it goes
-      if (plan_.empty() && seen_mode3_ && Settled(tm)) StartPhase(AutopilotPhase::kTransfer, tm);
-      break;
-    }
-
-    case AutopilotPhase::kTransfer: {
-      const PlanState ps = StepPlan();
-      if (ps == PlanState::kUnreachable) return Fail("the transfer path left the arm's reach"), cmd_;
-      if (t_s_ - phase_t0_s_ > 6.0 && cmd_.camera_station == 2) Camera(8);
-      if (ps == PlanState::kDone && Settled(tm)) StartPhase(AutopilotPhase::kDock, tm);
-      break;
-    }
-
-    case AutopilotPhase::kDock: {
-      if (tm.docked) {
-        StartPhase(AutopilotPhase::kDocked, tm);
-        break;
-      }
-      const PlanState ps = StepPlan();
-      if (ps == PlanState::kUnreachable) return Fail("the port is out of the arm's reach"), cmd_;
-      if (ps != PlanState::kDone || !Settled(tm)) break;
-      // At the dock pose and not docked: correct by what the telemetry shows.
-      if (++retries_ > opt_.max_retries) {
-        return Fail("not docked after " + std::to_string(opt_.max_retries) + " corrections (distance " +
-                    std::to_string(tm.dock_distance_ft) + " ft, angle " + std::to_string(tm.dock_angle_deg) + " deg)"),
-               cmd_;
-      }
-      counters_.Add(Counter::kAutopilotDockCorrections);
-      X_S2P_ = TelemetryPose(tm.p_RoA_R_ft, tm.R_RS2).inverse() * TelemetryPose(tm.p_RoPo_R_ft, tm.R_RP);
-      PlanLine(X_RP_dock_ * X_S2P_.inverse(), opt_.dock_speed_ft_s);
-      break;
-    }
-
-    case AutopilotPhase::kDocked:
-      ++docked_frames_;
-      break;
-
-    case AutopilotPhase::kRelieve: {
-      const PlanState ps = StepPlan();
-      if (ps == PlanState::kUnreachable) return Fail("cannot back away from the collision"), cmd_;
-      if (ps == PlanState::kDone && Settled(tm)) {
-        if (resume_ == AutopilotPhase::kDock) {
-          // Re-aim at the dock from here.
-          Enter(AutopilotPhase::kDock);
-          PlanLine(X_RP_dock_ * X_S2P_.inverse(), opt_.dock_speed_ft_s);
-        } else {
-          StartPhase(resume_, tm);
-        }
-      }
-      break;
-    }
-
-    case AutopilotPhase::kResync:
-      // The first telemetry that answers the restored command says where
-      // the task stands.
-      if (!Settled(tm)) break;
-      if (tm.docked) {
-        StartPhase(AutopilotPhase::kDocked, tm);
-      } else if (tm.mode == 3) {
-        StartPhase(AutopilotPhase::kTransfer, tm);
-      } else if (tm.mode == 2) {
-        StartPhase(AutopilotPhase::kLift, tm);
-      } else {
-        Enter(AutopilotPhase::kOpenFinger);
-      }
-      break;
-
-    case AutopilotPhase::kFailed:
-      break;
+    case AutopilotPhase::kWaitTelemetry: StepWaitTelemetry(tm); break;
+    case AutopilotPhase::kReset: StepReset(tm); break;
+    case AutopilotPhase::kOpenFinger: StepOpenFinger(tm); break;
+    case AutopilotPhase::kApproach: StepApproach(tm); break;
+    case AutopilotPhase::kDescend: StepDescend(tm); break;
+    case AutopilotPhase::kClose: StepClose(tm); break;
+    case AutopilotPhase::kLift: StepLift(tm); break;
+    case AutopilotPhase::kTransfer: StepTransfer(tm); break;
+    case AutopilotPhase::kDock: StepDock(tm); break;
+    case AutopilotPhase::kDocked: StepDocked(tm); break;
+    case AutopilotPhase::kRelieve: StepRelieve(tm); break;
+    case AutopilotPhase::kResync: StepResync(tm); break;
+    case AutopilotPhase::kFailed: break;
   }
   return cmd_;
+}
+
+void Autopilot::StepWaitTelemetry(const dcp_telemetry_t& tm) {
+  // Take the arm as it is, so the first command moves nothing.
+  for (int i = 0; i < 6; ++i) cmd_.value[i] = tm.slave_angles_deg[i];
+  cmd_.value[kShoulderHeight] = tm.slave_shoulder_height_ft;
+  cmd_.value[kFinger] = tm.slave_finger;
+  Camera(8);
+  if (tm.mode != 1 || tm.acquired || tm.docked) {
+    Enter(AutopilotPhase::kReset);
+    reset_frames_ = 0;
+  } else {
+    Enter(AutopilotPhase::kOpenFinger);
+  }
+}
+
+void Autopilot::StepReset(const dcp_telemetry_t& tm) {
+  // The reset button, one frame; then wait for Mode 1.
+  if (reset_frames_++ == 0) cmd_.reset = true;
+  else if (reset_frames_ > 3 && tm.mode == 1 && !tm.acquired && !tm.docked) Enter(AutopilotPhase::kOpenFinger);
+  else if (reset_frames_ > 60) Fail("the DCP did not return to Mode 1 after a reset");
+}
+
+void Autopilot::StepOpenFinger(const dcp_telemetry_t& tm) {
+  cmd_.value[kFinger] = std::max(0.0, cmd_.value[kFinger] - opt_.finger_rate_per_s * dt_s_);
+  if (cmd_.value[kFinger] <= 0.0 && Settled(tm)) StartPhase(AutopilotPhase::kApproach, tm);
+}
+
+void Autopilot::StepApproach(const dcp_telemetry_t& tm) {
+  const PlanState ps = StepPlan();
+  if (ps == PlanState::kUnreachable) return Fail("the approach left the arm's reach");
+  if (ps == PlanState::kDone && Settled(tm)) StartPhase(AutopilotPhase::kDescend, tm);
+}
+
+void Autopilot::StepDescend(const dcp_telemetry_t& tm) {
+  const PlanState ps = StepPlan();
+  if (ps == PlanState::kUnreachable) return Fail("the grasp is out of the arm's reach");
+  if (ps != PlanState::kDone || !Settled(tm)) return;
+  // Closing the loop: the palm must be within TPOB of the bar's top;
+  // well short of it (kGraspCorrectTpobShare), descend to the planned height.
+  if (tm.palm_to_bar_ft > kGraspCorrectTpobShare * config_.dcp.tpob_ft && retries_ < opt_.max_retries) {
+    ++retries_;
+    counters_.Add(Counter::kAutopilotGraspCorrections);
+    const Eigen::Isometry3d X = CommandedPose();
+    PlanLine(Shifted(X, (tm.palm_to_bar_ft - mission::GraspPalmAboveBarFt(config_)) * X.linear().col(0)), 0.2);
+    return;
+  }
+  StartPhase(AutopilotPhase::kClose, tm);
+}
+
+void Autopilot::StepClose(const dcp_telemetry_t& tm) {
+  if (tm.acquired && tm.mode == 2) {
+    StartPhase(AutopilotPhase::kLift, tm);
+    return;
+  }
+  cmd_.value[kFinger] = std::min(1.0, cmd_.value[kFinger] + opt_.finger_rate_per_s * dt_s_);
+  if (cmd_.value[kFinger] >= 1.0 && ++finger_full_frames_ > static_cast<int>(1.5 / dt_s_)) {
+    // Closed and not acquired: which conditions fail? Open and try again.
+    std::string failing;
+    for (int i = 0; i < wire::kNumAcquisitionConditions; ++i) {
+      if (!tm.acquisition_conditions[i]) failing += (failing.empty() ? "" : ", ") + std::to_string(i + 1);
+    }
+    if (++retries_ > opt_.max_retries) return Fail("no acquisition (conditions " + failing + " fail)");
+    counters_.Add(Counter::kAutopilotGraspRetries);
+    spdlog::info("autopilot: finger closed, no acquisition (conditions {} fail): open and grasp again", failing);
+    Enter(AutopilotPhase::kOpenFinger);
+  }
+}
+
+void Autopilot::StepLift(const dcp_telemetry_t& tm) {
+  if (tm.mode == 3 && !seen_mode3_) {
+    seen_mode3_ = true;
+    mode3_height_ft_ = CommandedPose().translation().z();
+    Camera(3);
+  }
+  if (seen_mode3_ && CommandedPose().translation().z() >= mode3_height_ft_ + opt_.lift_margin_ft) plan_.clear();
+  const PlanState ps = StepPlan();
+  if (ps == PlanState::kUnreachable && !seen_mode3_) return Fail("the arm cannot lift the payload out of the bay");
+  if (ps == PlanState::kUnreachable) plan_.clear();  // as high as it goes
+  if (plan_.empty() && seen_mode3_ && Settled(tm)) StartPhase(AutopilotPhase::kTransfer, tm);
+}
+
+void Autopilot::StepTransfer(const dcp_telemetry_t& tm) {
+  const PlanState ps = StepPlan();
+  if (ps == PlanState::kUnreachable) return Fail("the transfer path left the arm's reach");
+  if (t_s_ - phase_t0_s_ > 6.0 && cmd_.camera_station == 2) Camera(8);
+  if (ps == PlanState::kDone && Settled(tm)) StartPhase(AutopilotPhase::kDock, tm);
+}
+
+void Autopilot::StepDock(const dcp_telemetry_t& tm) {
+  if (tm.docked) {
+    StartPhase(AutopilotPhase::kDocked, tm);
+    return;
+  }
+  const PlanState ps = StepPlan();
+  if (ps == PlanState::kUnreachable) return Fail("the port is out of the arm's reach");
+  if (ps != PlanState::kDone || !Settled(tm)) return;
+  // At the dock pose and not docked: correct by what the telemetry shows.
+  if (++retries_ > opt_.max_retries) {
+    return Fail("not docked after " + std::to_string(opt_.max_retries) + " corrections (distance " +
+                std::to_string(tm.dock_distance_ft) + " ft, angle " + std::to_string(tm.dock_angle_deg) + " deg)");
+  }
+  counters_.Add(Counter::kAutopilotDockCorrections);
+  X_S2P_ = TelemetryPose(tm.p_RoA_R_ft, tm.R_RS2).inverse() * TelemetryPose(tm.p_RoPo_R_ft, tm.R_RP);
+  PlanLine(X_RP_dock_ * X_S2P_.inverse(), opt_.dock_speed_ft_s);
+}
+
+void Autopilot::StepDocked(const dcp_telemetry_t& /*tm*/) {
+  ++docked_frames_;
+}
+
+void Autopilot::StepRelieve(const dcp_telemetry_t& tm) {
+  const PlanState ps = StepPlan();
+  if (ps == PlanState::kUnreachable) return Fail("cannot back away from the collision");
+  if (ps == PlanState::kDone && Settled(tm)) {
+    if (resume_ == AutopilotPhase::kDock) {
+      // Re-aim at the dock from here.
+      Enter(AutopilotPhase::kDock);
+      PlanLine(X_RP_dock_ * X_S2P_.inverse(), opt_.dock_speed_ft_s);
+    } else {
+      StartPhase(resume_, tm);
+    }
+  }
+}
+
+void Autopilot::StepResync(const dcp_telemetry_t& tm) {
+  // The first telemetry that answers the restored command says where
+  // the task stands.
+  if (!Settled(tm)) return;
+  if (tm.docked) {
+    StartPhase(AutopilotPhase::kDocked, tm);
+  } else if (tm.mode == 3) {
+    StartPhase(AutopilotPhase::kTransfer, tm);
+  } else if (tm.mode == 2) {
+    StartPhase(AutopilotPhase::kLift, tm);
+  } else {
+    Enter(AutopilotPhase::kOpenFinger);
+  }
 }
 
 }  // namespace rms::operator_station

@@ -113,6 +113,196 @@ std::vector<std::string> MatColumns(const std::string& name) {
   return v;
 }
 
+// The columns of each channel's file, units in brackets.
+std::vector<std::string> InputColumns(const LabConfig& config) {
+  std::vector<std::string> cols = {"log_time [us]", "session_time [s]", "frame", "send_time [us]"};
+  for (int i = 0; i < kNumAnalogInputs; ++i) {
+    cols.push_back(std::string(kAnalogInputNames[i]) + " [" + config.inputs[i].unit + "]");
+  }
+  Add(&cols, {"camera_station", "reset", "overlay"});
+  return cols;
+}
+
+void AddPlaneColumns(std::vector<std::string>* cols) {
+  for (int k = 1; k <= 3; ++k) {
+    const std::string p = "plane" + std::to_string(k);
+    Add(cols, {p + "_valid", p + "_n_x", p + "_n_y", p + "_n_z", p + "_d [ft]"});
+  }
+}
+
+void AddPoseColumns(std::vector<std::string>* cols, const std::string& p, const std::string& R) {
+  for (const auto& c : Vec3Columns(p, "ft")) cols->push_back(c);
+  for (const auto& c : MatColumns(R)) cols->push_back(c);
+}
+
+std::vector<std::string> DcpColumns() {
+  std::vector<std::string> cols = {"log_time [us]", "session_time [s]", "frame", "send_time [us]", "input_frame", "input_send_time [us]"};
+  cols.insert(cols.end(), kAngle, kAngle + 6);
+  for (const auto& c : ControlColumns("")) cols.push_back(c);
+  AddPlaneColumns(&cols);
+  Add(&cols, {"shoulder_height [ft]", "finger_gap [ft]", "camera_pan [deg]", "camera_tilt [deg]", "camera_zoom [1]"});
+  AddPoseColumns(&cols, "p_RoPo_R", "R_RP");
+  return cols;
+}
+
+std::vector<std::string> EsgColumns() {
+  std::vector<std::string> cols = {"log_time [us]", "session_time [s]", "frame", "send_time [us]", "dcp_frame", "input_frame",
+                                   "input_send_time [us]", "num_words", "frame_count"};
+  for (const auto& c : ControlColumns("")) cols.push_back(c);
+  Add(&cols, {"priority_dynamic", "priority_fixed"});
+  cols.insert(cols.end(), kAngle, kAngle + 6);
+  Add(&cols, {"shoulder_height [ft]", "finger_gap [ft]"});
+  AddPoseColumns(&cols, "p_RoEye_R", "R_RE");
+  cols.push_back("fov [deg]");
+  AddPoseColumns(&cols, "p_RoPo_R", "R_RP");
+  for (int w = 0; w < wire::esg_words::kPriorityCount; ++w) cols.push_back("priority_word_" + std::to_string(w) + " [hex]");
+  return cols;
+}
+
+std::vector<std::string> TelemetryColumns() {
+  std::vector<std::string> cols = {"log_time [us]", "session_time [s]", "frame", "send_time [us]", "input_frame", "input_send_time [us]",
+                                   "mode", "acquired", "docked", "held", "finger_held", "collisions [bits]",
+                                   "slave_collisions [bits]"};
+  for (int i = 1; i <= wire::kNumAcquisitionConditions; ++i) cols.push_back("acquisition_condition_" + std::to_string(i));
+  Add(&cols, {"finger_gap [ft]", "palm_to_bar [ft]", "probe_in_envelope", "dock_distance [ft]", "dock_angle [deg]"});
+  AddPlaneColumns(&cols);
+  for (const char* w : {"master_", "slave_"}) {
+    for (const char* a : kAngle) cols.push_back(std::string(w) + a);
+  }
+  Add(&cols, {"master_shoulder_height [ft]", "slave_shoulder_height [ft]", "master_finger [1]", "slave_finger [1]"});
+  AddPoseColumns(&cols, "p_RoA_R", "R_RS2");
+  AddPoseColumns(&cols, "p_RoPo_R", "R_RP");
+  return cols;
+}
+
+void AddVec3(std::vector<std::string>* row, const Eigen::Vector3d& v) {
+  for (int i = 0; i < 3; ++i) row->push_back(N(v[i]));
+}
+void AddMat(std::vector<std::string>* row, const Eigen::Matrix3d& m) {
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) row->push_back(N(m(r, c)));
+  }
+}
+
+// A message decoded, or InputError ("malformed": counted, not exported).
+template <class Msg>
+Msg Decoded(const LogMessage& msg) {
+  Msg m{};
+  if (wire::SafeDecode(msg.data, msg.size, &m) != wire::DecodeError::kNone) throw InputError("malformed");
+  return m;
+}
+
+// Each channel's row; t and st: the log time and the session time, as written.
+std::vector<std::string> InputRow(const LogMessage& msg, const std::string& t, const std::string& st,
+                                  const LabConfig& config) {
+  const auto m = Decoded<operator_input_t>(msg);
+  std::array<std::int32_t, wire::kInputWords> words{};
+  std::copy(m.words, m.words + wire::kInputWords, words.begin());
+  const wire::OperatorInputs in = wire::DecodeInputs(words, config.inputs, nullptr);
+  std::vector<std::string> row = {t, st, I(m.frame), I(m.send_time_us)};
+  for (int i = 0; i < kNumAnalogInputs; ++i) row.push_back(N(in.value[i]));
+  Add(&row, {I(in.camera_station), B(in.reset), B(in.overlay)});
+  return row;
+}
+
+std::vector<std::string> DcpRow(const LogMessage& msg, const std::string& t, const std::string& st) {
+  const auto m = Decoded<dcp_frame_t>(msg);
+  const wire::DcpFrameData d = wire::UnpackDcpFrame(m);
+  std::vector<std::string> row = {t, st, I(m.frame), I(m.send_time_us), I(m.input_frame), I(m.input_send_time_us)};
+  for (int i = 0; i < 6; ++i) row.push_back(N(Deg(d.arm[i])));
+  ControlCells(&row, d.control);
+  for (int k = 0; k < 3; ++k) {
+    Add(&row, {B((d.plane_valid >> k) & 1), N(d.planes[k].n_R.x()), N(d.planes[k].n_R.y()), N(d.planes[k].n_R.z()),
+               N(d.planes[k].d_ft)});
+  }
+  Add(&row, {N(d.shoulder_height_ft), N(d.finger_gap_ft), N(d.camera_pan_deg), N(d.camera_tilt_deg), N(d.camera_zoom)});
+  AddVec3(&row, d.p_RoPo_R_ft);
+  AddMat(&row, d.R_RP);
+  return row;
+}
+
+std::vector<std::string> EsgRow(const LogMessage& msg, const std::string& t, const std::string& st) {
+  const auto m = Decoded<esg_frame_t>(msg);
+  const wire::EsgFrameData d = wire::UnpackEsgWords(m.words);
+  std::vector<std::string> row = {t, st, I(m.frame), I(m.send_time_us), I(m.dcp_frame), I(m.input_frame),
+                                  I(m.input_send_time_us), I(m.num_words), I(d.frame_count)};
+  ControlCells(&row, d.control);
+  Add(&row, {I(d.control.priority_dynamic), I(d.control.priority_fixed)});
+  for (int i = 0; i < 6; ++i) row.push_back(N(Deg(d.arm[i])));
+  Add(&row, {N(d.shoulder_height_ft), N(d.finger_gap_ft)});
+  AddVec3(&row, d.p_RoEye_R_ft);
+  AddMat(&row, d.R_RE);
+  row.push_back(N(d.fov_deg));
+  AddVec3(&row, d.p_RoPo_R_ft);
+  AddMat(&row, d.R_RP);
+  for (std::int32_t w : d.priority_words) {
+    char hex[16];
+    std::snprintf(hex, sizeof hex, "%06x", static_cast<unsigned>(w));
+    row.push_back(hex);
+  }
+  return row;
+}
+
+std::vector<std::string> TelemetryRow(const LogMessage& msg, const std::string& t, const std::string& st) {
+  const auto m = Decoded<dcp_telemetry_t>(msg);
+  std::vector<std::string> row = {t, st, I(m.frame), I(m.send_time_us), I(m.input_frame), I(m.input_send_time_us),
+                                  I(m.mode), B(m.acquired), B(m.docked), B(m.held), B(m.finger_held),
+                                  I(m.collisions), I(m.slave_collisions)};
+  for (int i = 0; i < wire::kNumAcquisitionConditions; ++i) row.push_back(B(m.acquisition_conditions[i]));
+  Add(&row, {N(m.finger_gap_ft), N(m.palm_to_bar_ft), B(m.probe_in_envelope), N(m.dock_distance_ft),
+             N(m.dock_angle_deg)});
+  for (int k = 0; k < 3; ++k) {
+    Add(&row, {B(m.plane_valid[k]), N(m.plane_n[3 * k]), N(m.plane_n[3 * k + 1]), N(m.plane_n[3 * k + 2]),
+               N(m.plane_d_ft[k])});
+  }
+  for (int i = 0; i < 6; ++i) row.push_back(N(m.master_angles_deg[i]));
+  for (int i = 0; i < 6; ++i) row.push_back(N(m.slave_angles_deg[i]));
+  Add(&row, {N(m.master_shoulder_height_ft), N(m.slave_shoulder_height_ft), N(m.master_finger), N(m.slave_finger)});
+  for (int i = 0; i < 3; ++i) row.push_back(N(m.p_RoA_R_ft[i]));
+  for (int i = 0; i < 9; ++i) row.push_back(N(m.R_RS2[i]));
+  for (int i = 0; i < 3; ++i) row.push_back(N(m.p_RoPo_R_ft[i]));
+  for (int i = 0; i < 9; ++i) row.push_back(N(m.R_RP[i]));
+  return row;
+}
+
+// The session's files, one a channel.
+struct ChannelFiles {
+  Csv in, dcp, esg, tm, st, ctl;
+  ChannelFiles(const fs::path& out, const LabConfig& config)
+      : in(out / "operator_input.csv", InputColumns(config)),
+        dcp(out / "dcp_frame.csv", DcpColumns()),
+        esg(out / "esg_frame.csv", EsgColumns()),
+        tm(out / "dcp_telemetry.csv", TelemetryColumns()),
+        st(out / "status.csv", {"log_time [us]", "session_time [s]", "send_time [us]", "process", "host", "pid",
+                                "frame", "final", "counter", "value"}),
+        ctl(out / "control.csv", {"log_time [us]", "session_time [s]", "send_time [us]", "sequence", "command", "name"}) {}
+
+  void Write(const LogMessage& msg, const LabConfig& config) {
+    const std::string_view base = msg.base;
+    const std::string t = I(msg.log_us), st_s = N(msg.session_time_s);
+    if (base == wire::channels::kOperatorInput) {
+      in.Row(InputRow(msg, t, st_s, config));
+    } else if (base == wire::channels::kDcpFrame) {
+      dcp.Row(DcpRow(msg, t, st_s));
+    } else if (base == wire::channels::kEsgFrame) {
+      esg.Row(EsgRow(msg, t, st_s));
+    } else if (base == wire::channels::kDcpTelemetry) {
+      tm.Row(TelemetryRow(msg, t, st_s));
+    } else if (base == wire::channels::kStatus) {
+      const auto m = Decoded<process_status_t>(msg);
+      for (int i = 0; i < m.num_counters; ++i) {
+        st.Row({t, st_s, I(m.send_time_us), m.process, m.host, I(m.pid), I(m.frame), B(m.final), m.counter_names[i],
+                I(m.counter_values[i])});
+      }
+    } else if (base == wire::channels::kControl) {
+      const auto m = Decoded<session_control_t>(msg);
+      static const char* kNames[] = {"?", "freeze", "run", "step", "checkpoint", "restore"};
+      ctl.Row({t, st_s, I(m.send_time_us), I(m.sequence), m.command >= 1 && m.command <= 5 ? kNames[m.command] : "?",
+               m.name});
+    }
+  }
+};
+
 }  // namespace
 
 std::vector<std::pair<std::string, long>> ExportCsv(const std::string& session_dir, const std::string& out_dir,
@@ -120,171 +310,26 @@ std::vector<std::pair<std::string, long>> ExportCsv(const std::string& session_d
   const fs::path root(session_dir), out(out_dir);
   const LabConfig config = LoadConfig((root / "config.toml").string());
   fs::create_directories(out);
-
-  // Columns, by channel.
-  std::vector<std::string> in_cols = {"log_time [us]", "session_time [s]", "frame", "send_time [us]"};
-  for (int i = 0; i < kNumAnalogInputs; ++i) {
-    in_cols.push_back(std::string(kAnalogInputNames[i]) + " [" + config.inputs[i].unit + "]");
-  }
-  Add(&in_cols, {"camera_station", "reset", "overlay"});
-
-  std::vector<std::string> dcp_cols = {"log_time [us]", "session_time [s]", "frame", "send_time [us]", "input_frame", "input_send_time [us]"};
-  dcp_cols.insert(dcp_cols.end(), kAngle, kAngle + 6);
-  for (const auto& c : ControlColumns("")) dcp_cols.push_back(c);
-  for (int k = 1; k <= 3; ++k) {
-    const std::string p = "plane" + std::to_string(k);
-    Add(&dcp_cols, {p + "_valid", p + "_n_x", p + "_n_y", p + "_n_z", p + "_d [ft]"});
-  }
-  Add(&dcp_cols, {"shoulder_height [ft]", "finger_gap [ft]", "camera_pan [deg]", "camera_tilt [deg]", "camera_zoom [1]"});
-  for (const auto& c : Vec3Columns("p_RoPo_R", "ft")) dcp_cols.push_back(c);
-  for (const auto& c : MatColumns("R_RP")) dcp_cols.push_back(c);
-
-  std::vector<std::string> esg_cols = {"log_time [us]", "session_time [s]", "frame", "send_time [us]", "dcp_frame", "input_frame",
-                                       "input_send_time [us]", "num_words", "frame_count"};
-  for (const auto& c : ControlColumns("")) esg_cols.push_back(c);
-  Add(&esg_cols, {"priority_dynamic", "priority_fixed"});
-  esg_cols.insert(esg_cols.end(), kAngle, kAngle + 6);
-  Add(&esg_cols, {"shoulder_height [ft]", "finger_gap [ft]"});
-  for (const auto& c : Vec3Columns("p_RoEye_R", "ft")) esg_cols.push_back(c);
-  for (const auto& c : MatColumns("R_RE")) esg_cols.push_back(c);
-  esg_cols.push_back("fov [deg]");
-  for (const auto& c : Vec3Columns("p_RoPo_R", "ft")) esg_cols.push_back(c);
-  for (const auto& c : MatColumns("R_RP")) esg_cols.push_back(c);
-  for (int w = 0; w < wire::esg_words::kPriorityCount; ++w) esg_cols.push_back("priority_word_" + std::to_string(w) + " [hex]");
-
-  std::vector<std::string> tm_cols = {"log_time [us]", "session_time [s]", "frame", "send_time [us]", "input_frame", "input_send_time [us]",
-                                      "mode", "acquired", "docked", "held", "finger_held", "collisions [bits]",
-                                      "slave_collisions [bits]"};
-  for (int i = 1; i <= wire::kNumAcquisitionConditions; ++i) tm_cols.push_back("acquisition_condition_" + std::to_string(i));
-  Add(&tm_cols, {"finger_gap [ft]", "palm_to_bar [ft]", "probe_in_envelope", "dock_distance [ft]", "dock_angle [deg]"});
-  for (int k = 1; k <= 3; ++k) {
-    const std::string p = "plane" + std::to_string(k);
-    Add(&tm_cols, {p + "_valid", p + "_n_x", p + "_n_y", p + "_n_z", p + "_d [ft]"});
-  }
-  for (const char* w : {"master_", "slave_"}) {
-    for (const char* a : kAngle) tm_cols.push_back(std::string(w) + a);
-  }
-  Add(&tm_cols, {"master_shoulder_height [ft]", "slave_shoulder_height [ft]", "master_finger [1]", "slave_finger [1]"});
-  for (const auto& c : Vec3Columns("p_RoA_R", "ft")) tm_cols.push_back(c);
-  for (const auto& c : MatColumns("R_RS2")) tm_cols.push_back(c);
-  for (const auto& c : Vec3Columns("p_RoPo_R", "ft")) tm_cols.push_back(c);
-  for (const auto& c : MatColumns("R_RP")) tm_cols.push_back(c);
-
-  Csv in_csv(out / "operator_input.csv", in_cols);
-  Csv dcp_csv(out / "dcp_frame.csv", dcp_cols);
-  Csv esg_csv(out / "esg_frame.csv", esg_cols);
-  Csv tm_csv(out / "dcp_telemetry.csv", tm_cols);
-  Csv st_csv(out / "status.csv", {"log_time [us]", "session_time [s]", "send_time [us]", "process", "host", "pid", "frame", "final",
-                                  "counter", "value"});
-  Csv ctl_csv(out / "control.csv", {"log_time [us]", "session_time [s]", "send_time [us]", "sequence", "command", "name"});
-  long skipped = 0;
+  ChannelFiles files(out, config);
+  long skipped = 0, events = 0;
   SessionLog log(session_dir);  // only the session's own messages (docs/security.md)
-  long events = 0;
   log.Read({}, [&](const LogMessage& msg) {
-    const std::string_view base = msg.base;
-    const std::string t = I(msg.log_us), st = N(msg.session_time_s);
     if (progress && ++events % 100000 == 0) progress("export: " + std::to_string(events) + " messages");
     try {
-      if (base == wire::channels::kOperatorInput) {
-        operator_input_t m{};
-        if (wire::SafeDecode(msg.data, msg.size, &m) != wire::DecodeError::kNone) throw InputError("malformed");
-        std::array<std::int32_t, wire::kInputWords> words{};
-        std::copy(m.words, m.words + wire::kInputWords, words.begin());
-        const wire::OperatorInputs in = wire::DecodeInputs(words, config.inputs, nullptr);
-        std::vector<std::string> row = {t, st, I(m.frame), I(m.send_time_us)};
-        for (int i = 0; i < kNumAnalogInputs; ++i) row.push_back(N(in.value[i]));
-        Add(&row, {I(in.camera_station), B(in.reset), B(in.overlay)});
-        in_csv.Row(row);
-      } else if (base == wire::channels::kDcpFrame) {
-        dcp_frame_t m{};
-        if (wire::SafeDecode(msg.data, msg.size, &m) != wire::DecodeError::kNone) throw InputError("malformed");
-        const wire::DcpFrameData d = wire::UnpackDcpFrame(m);
-        std::vector<std::string> row = {t, st, I(m.frame), I(m.send_time_us), I(m.input_frame), I(m.input_send_time_us)};
-        for (int i = 0; i < 6; ++i) row.push_back(N(Deg(d.arm[i])));
-        ControlCells(&row, d.control);
-        for (int k = 0; k < 3; ++k) {
-          Add(&row, {B((d.plane_valid >> k) & 1), N(d.planes[k].n_R.x()), N(d.planes[k].n_R.y()), N(d.planes[k].n_R.z()),
-                     N(d.planes[k].d_ft)});
-        }
-        Add(&row, {N(d.shoulder_height_ft), N(d.finger_gap_ft), N(d.camera_pan_deg), N(d.camera_tilt_deg),
-                   N(d.camera_zoom)});
-        for (int i = 0; i < 3; ++i) row.push_back(N(d.p_RoPo_R_ft[i]));
-        for (int r = 0; r < 3; ++r) {
-          for (int c = 0; c < 3; ++c) row.push_back(N(d.R_RP(r, c)));
-        }
-        dcp_csv.Row(row);
-      } else if (base == wire::channels::kEsgFrame) {
-        esg_frame_t m{};
-        if (wire::SafeDecode(msg.data, msg.size, &m) != wire::DecodeError::kNone) throw InputError("malformed");
-        const wire::EsgFrameData d = wire::UnpackEsgWords(m.words);
-        std::vector<std::string> row = {t, st, I(m.frame), I(m.send_time_us), I(m.dcp_frame), I(m.input_frame),
-                                        I(m.input_send_time_us), I(m.num_words), I(d.frame_count)};
-        ControlCells(&row, d.control);
-        Add(&row, {I(d.control.priority_dynamic), I(d.control.priority_fixed)});
-        for (int i = 0; i < 6; ++i) row.push_back(N(Deg(d.arm[i])));
-        Add(&row, {N(d.shoulder_height_ft), N(d.finger_gap_ft)});
-        for (int i = 0; i < 3; ++i) row.push_back(N(d.p_RoEye_R_ft[i]));
-        for (int r = 0; r < 3; ++r) {
-          for (int c = 0; c < 3; ++c) row.push_back(N(d.R_RE(r, c)));
-        }
-        row.push_back(N(d.fov_deg));
-        for (int i = 0; i < 3; ++i) row.push_back(N(d.p_RoPo_R_ft[i]));
-        for (int r = 0; r < 3; ++r) {
-          for (int c = 0; c < 3; ++c) row.push_back(N(d.R_RP(r, c)));
-        }
-        for (std::int32_t w : d.priority_words) {
-          char hex[16];
-          std::snprintf(hex, sizeof hex, "%06x", static_cast<unsigned>(w));
-          row.push_back(hex);
-        }
-        esg_csv.Row(row);
-      } else if (base == wire::channels::kDcpTelemetry) {
-        dcp_telemetry_t m{};
-        if (wire::SafeDecode(msg.data, msg.size, &m) != wire::DecodeError::kNone) throw InputError("malformed");
-        std::vector<std::string> row = {t, st, I(m.frame), I(m.send_time_us), I(m.input_frame), I(m.input_send_time_us),
-                                        I(m.mode), B(m.acquired), B(m.docked), B(m.held), B(m.finger_held),
-                                        I(m.collisions), I(m.slave_collisions)};
-        for (int i = 0; i < wire::kNumAcquisitionConditions; ++i) row.push_back(B(m.acquisition_conditions[i]));
-        Add(&row, {N(m.finger_gap_ft), N(m.palm_to_bar_ft), B(m.probe_in_envelope), N(m.dock_distance_ft),
-                   N(m.dock_angle_deg)});
-        for (int k = 0; k < 3; ++k) {
-          Add(&row, {B(m.plane_valid[k]), N(m.plane_n[3 * k]), N(m.plane_n[3 * k + 1]), N(m.plane_n[3 * k + 2]),
-                     N(m.plane_d_ft[k])});
-        }
-        for (int i = 0; i < 6; ++i) row.push_back(N(m.master_angles_deg[i]));
-        for (int i = 0; i < 6; ++i) row.push_back(N(m.slave_angles_deg[i]));
-        Add(&row, {N(m.master_shoulder_height_ft), N(m.slave_shoulder_height_ft), N(m.master_finger), N(m.slave_finger)});
-        for (int i = 0; i < 3; ++i) row.push_back(N(m.p_RoA_R_ft[i]));
-        for (int i = 0; i < 9; ++i) row.push_back(N(m.R_RS2[i]));
-        for (int i = 0; i < 3; ++i) row.push_back(N(m.p_RoPo_R_ft[i]));
-        for (int i = 0; i < 9; ++i) row.push_back(N(m.R_RP[i]));
-        tm_csv.Row(row);
-      } else if (base == wire::channels::kStatus) {
-        process_status_t m;
-        if (wire::SafeDecode(msg.data, msg.size, &m) != wire::DecodeError::kNone) throw InputError("malformed");
-        for (int i = 0; i < m.num_counters; ++i) {
-          st_csv.Row({t, st, I(m.send_time_us), m.process, m.host, I(m.pid), I(m.frame), B(m.final), m.counter_names[i],
-                      I(m.counter_values[i])});
-        }
-      } else if (base == wire::channels::kControl) {
-        session_control_t m;
-        if (wire::SafeDecode(msg.data, msg.size, &m) != wire::DecodeError::kNone) throw InputError("malformed");
-        static const char* kNames[] = {"?", "freeze", "run", "step", "checkpoint", "restore"};
-        ctl_csv.Row({t, st, I(m.send_time_us), I(m.sequence), m.command >= 1 && m.command <= 5 ? kNames[m.command] : "?",
-                     m.name});
-      }
+      files.Write(msg, config);
     } catch (const std::exception&) {
       ++skipped;  // a malformed message: counted, not exported
     }
   });
-  std::vector<std::pair<std::string, long>> files;
-  for (Csv* c : {&in_csv, &dcp_csv, &esg_csv, &tm_csv, &st_csv, &ctl_csv}) {
+  std::vector<std::pair<std::string, long>> written;
+  for (Csv* c : {&files.in, &files.dcp, &files.esg, &files.tm, &files.st, &files.ctl}) {
     c->Close();
-    files.emplace_back(c->path().string(), c->rows());
+    written.emplace_back(c->path().string(), c->rows());
   }
-  files.emplace_back("skipped (malformed)", skipped);
-  files.emplace_back("not exported (not the session's own: other sessions, other senders)", static_cast<long>(log.check().ignored_total()));
-  return files;
+  written.emplace_back("skipped (malformed)", skipped);
+  written.emplace_back("not exported (not the session's own: other sessions, other senders)",
+                       static_cast<long>(log.check().ignored_total()));
+  return written;
 }
 
 }  // namespace rms::session

@@ -123,6 +123,19 @@ class Autopilot {
   std::string LinePathHits(const Eigen::Isometry3d& X0, const Eigen::Isometry3d& X1, const dcp_telemetry_t& tm,
                            mission::PayloadState payload) const;
   void Enter(AutopilotPhase p);
+  // One frame of each phase (docs/operator.md "The autopilot").
+  void StepWaitTelemetry(const dcp_telemetry_t& tm);
+  void StepReset(const dcp_telemetry_t& tm);
+  void StepOpenFinger(const dcp_telemetry_t& tm);
+  void StepApproach(const dcp_telemetry_t& tm);
+  void StepDescend(const dcp_telemetry_t& tm);
+  void StepClose(const dcp_telemetry_t& tm);
+  void StepLift(const dcp_telemetry_t& tm);
+  void StepTransfer(const dcp_telemetry_t& tm);
+  void StepDock(const dcp_telemetry_t& tm);
+  void StepDocked(const dcp_telemetry_t& tm);
+  void StepRelieve(const dcp_telemetry_t& tm);
+  void StepResync(const dcp_telemetry_t& tm);
   void Fail(const std::string& why);
   void Relieve(const dcp_telemetry_t& tm);
   void Camera(int station, double zoom = 0.0);
