@@ -1,0 +1,92 @@
+#include "comparison.h"
+
+#include <map>
+#include <sstream>
+#include <vector>
+
+#include <toml++/toml.h>
+
+#include "rms/base/text.h"
+
+namespace rms::resim {
+
+bool SameFrame(const dcp_frame_t& a, const dcp_frame_t& b, std::string* what) {
+  auto diff = [&](const char* field, int i) {
+    *what = field;
+    if (i >= 0) what->append("[").append(std::to_string(i)).append("]");
+    return false;
+  };
+  if (a.frame != b.frame) return diff("frame", -1);
+  if (a.input_frame != b.input_frame) return diff("input_frame", -1);
+  if (a.input_send_time_us != b.input_send_time_us) return diff("input_send_time_us", -1);
+  for (int i = 0; i < 12; ++i) {
+    if (a.arm_words[i] != b.arm_words[i]) return diff("arm_words", i);
+  }
+  if (a.control_word != b.control_word) return diff("control_word", -1);
+  for (int i = 0; i < 12; ++i) {
+    if (a.plane_words[i] != b.plane_words[i]) return diff("plane_words", i);
+  }
+  if (a.plane_status != b.plane_status) return diff("plane_status", -1);
+  for (int i = 0; i < 17; ++i) {
+    if (a.state_words[i] != b.state_words[i]) return diff("state_words", i);
+  }
+  return true;
+}
+
+bool SameTelemetry(dcp_telemetry_t a, dcp_telemetry_t b, std::string* what) {
+  // Everything but the wall-clock send time and the sender (a re-simulation
+  // is another process), field for field: the message's encoding with those
+  // equalised compares every bit of every other field.
+  a.send_time_us = b.send_time_us = 0;
+  a.sender = b.sender = sender_t{};
+  std::vector<std::uint8_t> ea(a.getEncodedSize()), eb(b.getEncodedSize());
+  a.encode(ea.data(), 0, static_cast<int>(ea.size()));
+  b.encode(eb.data(), 0, static_cast<int>(eb.size()));
+  if (ea == eb) return true;
+  *what = "telemetry";
+  return false;
+}
+
+namespace {
+
+// Every key of a TOML file as "a.b.c" -> value text.
+void Flatten(const toml::node& n, const std::string& prefix, std::map<std::string, std::string>* out) {
+  if (const toml::table* t = n.as_table()) {
+    for (auto&& [k, v] : *t) Flatten(v, prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str()), out);
+  } else if (const toml::array* a = n.as_array()) {
+    bool tables = !a->empty() && a->front().is_table();
+    if (tables) {
+      for (std::size_t i = 0; i < a->size(); ++i) Flatten(*a->get(i), prefix + "[" + std::to_string(i) + "]", out);
+    } else {
+      std::ostringstream os;
+      os << *a;
+      (*out)[prefix] = os.str();
+    }
+  } else if (const auto* d = n.as_floating_point()) {
+    (*out)[prefix] = HumanNumber(d->get(), 9);  // 0.6, not 0.59999999999999998
+  } else {
+    std::ostringstream os;
+    n.visit([&](auto&& v) { os << v; });
+    (*out)[prefix] = os.str();
+  }
+}
+
+}  // namespace
+
+nlohmann::ordered_json ConfigChanges(const std::string& a_path, const std::string& b_path) {
+  nlohmann::ordered_json changes = nlohmann::ordered_json::array();
+  std::map<std::string, std::string> a, b;
+  try {
+    Flatten(toml::parse_file(a_path), "", &a);
+    Flatten(toml::parse_file(b_path), "", &b);
+  } catch (const std::exception&) {
+    return changes;
+  }
+  for (const auto& [k, v] : b) {
+    const auto it = a.find(k);
+    if (it == a.end() || it->second != v) changes.push_back({{"key", k}, {"recorded", it == a.end() ? "" : it->second}, {"now", v}});
+  }
+  return changes;
+}
+
+}  // namespace rms::resim
