@@ -198,47 +198,104 @@ double ToleranceFt(const Hexahedron& a, const Hexahedron& b, double relative_tol
   return relative_tolerance * std::max(a.scale, b.scale) + kRoundingPerFt * std::max(a.magnitude, b.magnitude);
 }
 
+namespace {
+
+// Before the report's test (when enabled): the bounding spheres apart by
+// more than tau means separate, with the plane midway between the spheres'
+// surfaces along the centre line.
+bool SpheresApart(const Hexahedron& a, const Hexahedron& b, double tau, bool want_plane, CollisionResult* r) {
+  const double dx = b.cx - a.cx, dy = b.cy - a.cy, dz = b.cz - a.cz;
+  const double dist2 = dx * dx + dy * dy + dz * dz, reach = a.radius + b.radius + tau;
+  if (dist2 <= reach * reach) return false;
+  r->verdict = Verdict::kSeparate;
+  r->decider = Decider::kSpheresApart;
+  if (want_plane) {
+    const double dist = std::sqrt(dist2);
+    const Eigen::Vector3d n(dx / dist, dy / dist, dz / dist);
+    const double gap_mid = 0.5 * (dist + a.radius - b.radius);
+    SetPlane(r, n, n.x() * a.cx + n.y() * a.cy + n.z() * a.cz + gap_mid);
+  }
+  return true;
+}
+
+// The axis-aligned bounding boxes apart by more than tau along an axis:
+// separate, with the plane normal to that axis midway in the gap.
+bool BoxesApart(const Hexahedron& a, const Hexahedron& b, double tau, bool want_plane, CollisionResult* r) {
+  // The boxes' gap along each axis: centre distance less both half extents.
+  const double d[3] = {b.cx - a.cx, b.cy - a.cy, b.cz - a.cz};
+  const double gap[3] = {std::abs(d[0]) - a.hx - b.hx, std::abs(d[1]) - a.hy - b.hy, std::abs(d[2]) - a.hz - b.hz};
+  const int k = gap[0] >= gap[1] ? (gap[0] >= gap[2] ? 0 : 2) : (gap[1] >= gap[2] ? 1 : 2);
+  if (gap[k] <= tau) return false;
+  r->verdict = Verdict::kSeparate;
+  r->decider = Decider::kBoxesApart;
+  if (want_plane) {
+    const double sign = d[k] > 0 ? 1.0 : -1.0;  // from A toward B
+    const double ha[3] = {a.hx, a.hy, a.hz};
+    const double ca[3] = {a.cx, a.cy, a.cz};
+    Eigen::Vector3d n = Eigen::Vector3d::Zero();
+    n[k] = sign;
+    SetPlane(r, n, sign * ca[k] + ha[k] + 0.5 * gap[k]);  // A's face plus half the gap
+  }
+  return true;
+}
+
+// Steps 1 and 2: the vertices of `verts` against the faces of `faces` (A's
+// against B's when a_in_b). Decides, and ends the algorithm, when a face has
+// a 1 in all eight words (separate: the lowest such face, as the full words
+// would name) or a word is all zeros (collision). Computed face by face as
+// masks of the eight vertices; the words themselves are formed only for the
+// edge phase.
+bool VertexPhase(const Hexahedron& faces, const Hexahedron& verts, bool a_in_b, double tau, bool want_plane,
+                 std::array<std::uint8_t, 6>* masks, CollisionResult* r) {
+  const int f = faces.FaceMasks(verts, tau, masks);
+  if (f >= 0) {
+    r->verdict = Verdict::kSeparate;
+    r->decider = a_in_b ? Decider::kFaceOfBSeparates : Decider::kFaceOfASeparates;
+    r->index = r->face = f;
+    // The plane's normal points from A toward B: B's outward normal
+    // reversed, or A's outward normal.
+    if (want_plane) {
+      if (a_in_b) SetPlane(r, -faces.normal(f), -faces.d[f]);
+      else SetPlane(r, faces.normal(f), faces.d[f]);
+    }
+    return true;
+  }
+  unsigned beyond_some = 0;
+  for (int k = 0; k < kNumFaces; ++k) beyond_some |= (*masks)[k];
+  const unsigned inside = ~beyond_some & 0xFFu;
+  if (!inside) return false;
+  r->verdict = Verdict::kCollide;
+  r->decider = a_in_b ? Decider::kVertexOfAInB : Decider::kVertexOfBInA;
+  r->index = std::countr_zero(inside);
+  return true;
+}
+
+// Step 3, one direction: the edges of `edges` (by their vertices' words)
+// against the faces of `faces`; an edge that pierces one decides collision.
+bool EdgePhase(const Hexahedron& edges, const std::array<LocationWord, 8>& words, const Hexahedron& faces, double tau,
+               Decider decider, PlaneCandidate* cand, CollisionResult* r) {
+  for (int e = 0; e < kNumEdges; ++e) {
+    const int i = kEdges[e][0], k = kEdges[e][1];
+    const int f = EdgePiercesFace(edges, i, k, words[i], words[k], faces, tau, cand, &r->triple_products);
+    if (f >= 0) {
+      r->verdict = Verdict::kCollide;
+      r->decider = decider;
+      r->index = e;
+      r->face = f;
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
 CollisionResult Collide(const Hexahedron& a, const Hexahedron& b, const CollideOptions& options) {
   CollisionResult r;
   if (!a.valid || !b.valid) return r;  // kInvalid, kNonFinite
   const double tau = ToleranceFt(a, b, options.relative_tolerance);
-
-  if (options.sphere_reject) {
-    const double dx = b.cx - a.cx, dy = b.cy - a.cy, dz = b.cz - a.cz;
-    const double dist2 = dx * dx + dy * dy + dz * dz, reach = a.radius + b.radius + tau;
-    if (dist2 > reach * reach) {
-      r.verdict = Verdict::kSeparate;
-      r.decider = Decider::kSpheresApart;
-      if (options.want_plane) {
-        const double dist = std::sqrt(dist2);
-        const Eigen::Vector3d n(dx / dist, dy / dist, dz / dist);
-        // Midway between the spheres' surfaces along the centre line.
-        const double gap_mid = 0.5 * (dist + a.radius - b.radius);
-        SetPlane(&r, n, n.x() * a.cx + n.y() * a.cy + n.z() * a.cz + gap_mid);
-      }
-      return r;
-    }
-  }
-  if (options.aabb_reject) {
-    // The boxes' gap along each axis: centre distance less both half extents.
-    const double d[3] = {b.cx - a.cx, b.cy - a.cy, b.cz - a.cz};
-    const double gap[3] = {std::abs(d[0]) - a.hx - b.hx, std::abs(d[1]) - a.hy - b.hy, std::abs(d[2]) - a.hz - b.hz};
-    const int k = gap[0] >= gap[1] ? (gap[0] >= gap[2] ? 0 : 2) : (gap[1] >= gap[2] ? 1 : 2);
-    if (gap[k] > tau) {
-      r.verdict = Verdict::kSeparate;
-      r.decider = Decider::kBoxesApart;
-      if (options.want_plane) {
-        const double sign = d[k] > 0 ? 1.0 : -1.0;  // from A toward B
-        const double ha[3] = {a.hx, a.hy, a.hz};
-        const double ca[3] = {a.cx, a.cy, a.cz};
-        Eigen::Vector3d n = Eigen::Vector3d::Zero();
-        n[k] = sign;
-        // Midway in the gap: A's face plus half the gap.
-        SetPlane(&r, n, sign * ca[k] + ha[k] + 0.5 * gap[k]);
-      }
-      return r;
-    }
-  }
+  if (options.sphere_reject && SpheresApart(a, b, tau, options.want_plane, &r)) return r;
+  if (options.aabb_reject && BoxesApart(a, b, tau, options.want_plane, &r)) return r;
   // The hint decides only a pair it separates by more than tau on each side
   // (so touching pairs, which collide, always go to the report's test).
   if (options.hint && PlaneSeparates(a, b, options.hint->n_R, options.hint->d_ft, -tau)) {
@@ -247,71 +304,17 @@ CollisionResult Collide(const Hexahedron& a, const Hexahedron& b, const CollideO
     if (options.want_plane) SetPlane(&r, options.hint->n_R, options.hint->d_ft);
     return r;
   }
-
-  // 1. A's vertices against B's faces; 2. B's against A's. Either decides
-  // and ends the algorithm when a word is all zeros (collision) or a face
-  // has a 1 in all eight words (separate). Computed face by face as masks of
-  // the eight vertices: a separating face ends the phase at once (the lowest
-  // such face, as the full words would name), a vertex beyond no face is
-  // inside; the words themselves are formed only for the edge phase.
-  auto phase = [&](const Hexahedron& faces, const Hexahedron& verts, bool a_in_b,
-                   std::array<std::uint8_t, 6>* masks) {
-    const int f = faces.FaceMasks(verts, tau, masks);
-    if (f >= 0) {
-      r.verdict = Verdict::kSeparate;
-      r.decider = a_in_b ? Decider::kFaceOfBSeparates : Decider::kFaceOfASeparates;
-      r.index = r.face = f;
-      // The plane's normal points from A toward B: B's outward normal
-      // reversed, or A's outward normal.
-      if (options.want_plane) {
-        if (a_in_b) SetPlane(&r, -faces.normal(f), -faces.d[f]);
-        else SetPlane(&r, faces.normal(f), faces.d[f]);
-      }
-      return true;
-    }
-    unsigned beyond_some = 0;
-    for (int k = 0; k < kNumFaces; ++k) beyond_some |= (*masks)[k];
-    const unsigned inside = ~beyond_some & 0xFFu;
-    if (inside) {
-      r.verdict = Verdict::kCollide;
-      r.decider = a_in_b ? Decider::kVertexOfAInB : Decider::kVertexOfBInA;
-      r.index = std::countr_zero(inside);
-      return true;
-    }
-    return false;
-  };
+  // 1. A's vertices against B's faces; 2. B's against A's.
   std::array<std::uint8_t, 6> masks_a{}, masks_b{};
-  if (phase(b, a, /*a_in_b=*/true, &masks_a)) return r;
-  if (phase(a, b, /*a_in_b=*/false, &masks_b)) return r;
+  if (VertexPhase(b, a, /*a_in_b=*/true, tau, options.want_plane, &masks_a, &r)) return r;
+  if (VertexPhase(a, b, /*a_in_b=*/false, tau, options.want_plane, &masks_b, &r)) return r;
   r.words_a = WordsFromMasks(masks_a);
   r.words_b = WordsFromMasks(masks_b);
   r.words_valid = true;
-
   // 3. Potential edge collisions, both directions.
   PlaneCandidate cand;
-  for (int e = 0; e < kNumEdges; ++e) {
-    const int i = kEdges[e][0], k = kEdges[e][1];
-    const int f = EdgePiercesFace(a, i, k, r.words_a[i], r.words_a[k], b, tau, &cand, &r.triple_products);
-    if (f >= 0) {
-      r.verdict = Verdict::kCollide;
-      r.decider = Decider::kEdgeOfAPiercesB;
-      r.index = e;
-      r.face = f;
-      return r;
-    }
-  }
-  for (int e = 0; e < kNumEdges; ++e) {
-    const int i = kEdges[e][0], k = kEdges[e][1];
-    const int f = EdgePiercesFace(b, i, k, r.words_b[i], r.words_b[k], a, tau, &cand, &r.triple_products);
-    if (f >= 0) {
-      r.verdict = Verdict::kCollide;
-      r.decider = Decider::kEdgeOfBPiercesA;
-      r.index = e;
-      r.face = f;
-      return r;
-    }
-  }
-
+  if (EdgePhase(a, r.words_a, b, tau, Decider::kEdgeOfAPiercesB, &cand, &r)) return r;
+  if (EdgePhase(b, r.words_b, a, tau, Decider::kEdgeOfBPiercesA, &cand, &r)) return r;
   // 4. Separate.
   r.verdict = Verdict::kSeparate;
   r.decider = Decider::kNoEdgePierces;

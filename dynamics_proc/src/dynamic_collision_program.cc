@@ -212,6 +212,81 @@ void DynamicCollisionProgram::TestHandAgainstPayload(const Evaluation* prev, Eva
   }
 }
 
+// Mode 1: EFF HEX 1-3 against the BAR, the payload's body and the BAR's posts.
+void DynamicCollisionProgram::EvaluateMode1(const Evaluation* prev, Evaluation* e) const {
+  e->ee = MakeEndEffector(config_.end_effector, e->pose.X_RS2, e->finger_gap_ft);
+  e->X_RP = X_RP_free_;
+  e->payload = payload_;
+  TestHandAgainstPayload(prev, e);
+  if (options_.mode_pairs_only) return;
+  // The pairs of Modes 2 and 3, computed and discarded.
+  CollideOptions plain;
+  plain.sphere_reject = plain.aabb_reject = options_.bounding_reject;
+  plain.want_plane = false;
+  for (const Hexahedron& strip : payload_.body) {
+    e->extra_collisions |= Collide(strip, bay_, plain).verdict != Verdict::kSeparate;
+    e->extra_collisions |= Collide(strip, cae_, plain).verdict != Verdict::kSeparate;
+  }
+}
+
+// Mode 2: the payload's and probe's vertices against the bay's walls and
+// bottom: a vertex below face c that is beyond a wall collides with it.
+void DynamicCollisionProgram::EvaluateMode2(Evaluation* e) const {
+  e->X_RP = e->pose.X_RS2 * X_S2P_;
+  e->payload = MakePayload(config_.payload, e->X_RP);
+  e->clearance_ft = std::numeric_limits<double>::infinity();
+  e->collisions |= BayCollisions(e->payload, &e->clearance_ft);
+}
+
+// Mode 3: the payload's and probe's vertices against the CAE's front half,
+// and still against the bay's walls while any is below face c (lowered back
+// toward the bay, it cannot pass through them). Docked: the payload is
+// captured by the CAE; let go, the hand is tested against it as in Mode 1
+// (it cannot pass back through the bar).
+void DynamicCollisionProgram::EvaluateMode3(const Evaluation* prev, Evaluation* e) const {
+  if (status_.docked) {
+    e->X_RP = X_RP_docked_;
+    e->payload = payload_;  // placed at the dock
+    e->clearance_ft = std::numeric_limits<double>::infinity();
+    if (released_) {
+      e->ee = MakeEndEffector(config_.end_effector, e->pose.X_RS2, e->finger_gap_ft);
+      TestHandAgainstPayload(prev, e);
+    }
+    return;
+  }
+  e->X_RP = e->pose.X_RS2 * X_S2P_;
+  e->payload = MakePayload(config_.payload, e->X_RP);
+  const double tau = ToleranceFt(cae_, cae_, tau_rel_);
+  e->clearance_ft = std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector3d& v : e->payload.v) {
+    if (cae_.Word(v, tau) == 0) e->collisions |= wire::collision_bits::kPayloadCae;
+    // Outside a convex solid, the farthest face plane is a lower bound on the distance to it.
+    double out = -std::numeric_limits<double>::infinity();
+    for (int f = 0; f < kNumFaces; ++f) out = std::max(out, cae_.Beyond(f, v.x(), v.y(), v.z()));
+    e->clearance_ft = std::min(e->clearance_ft, std::max(0.0, out));
+  }
+  e->collisions |= BayCollisions(e->payload, &e->clearance_ft);
+}
+
+// Modes 2 and 3 with every pair (DcpOptions::mode_pairs_only off): the end
+// effector against the BAR and the payload where they are now, the payload
+// against the bay and the CAE as whole hexahedra, computed and discarded.
+void DynamicCollisionProgram::EvaluateExtraPairs(Evaluation* e) const {
+  CollideOptions o;
+  o.sphere_reject = o.aabb_reject = options_.bounding_reject;
+  const EndEffectorModel ee = MakeEndEffector(config_.end_effector, e->pose.X_RS2, e->finger_gap_ft);
+  const Hexahedron bar = MakeBar(config_.payload, e->X_RP);
+  for (int k = 0; k < 3; ++k) {
+    e->extra_collisions |= Collide(ee.hex[k], bar, o).verdict != Verdict::kSeparate;
+    for (const Hexahedron& strip : e->payload.body)
+      e->extra_collisions |= Collide(ee.hex[k], strip, o).verdict != Verdict::kSeparate;
+  }
+  for (const Hexahedron& strip : e->payload.body) {
+    e->extra_collisions |= Collide(strip, bay_, o).verdict != Verdict::kSeparate;
+    e->extra_collisions |= Collide(strip, cae_, o).verdict != Verdict::kSeparate;
+  }
+}
+
 void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* prev, Evaluation* out) const {
   RMS_DASSERT(out != prev);
   Evaluation& e = *out;
@@ -227,89 +302,17 @@ void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* 
     const double widest = status_.docked ? config_.end_effector.finger_gap_open_ft : acquisition_gap_ft_;
     e.finger_gap_ft = std::clamp(e.finger_gap_ft, contact_gap_ft_, widest);
   }
-  namespace cb = wire::collision_bits;
   switch (status_.mode) {
-    case 1: {
-      // EFF HEX 1-3 against the BAR, the payload's body and the BAR's posts.
-      e.ee = MakeEndEffector(config_.end_effector, e.pose.X_RS2, e.finger_gap_ft);
-      e.X_RP = X_RP_free_;
-      e.payload = payload_;
-      TestHandAgainstPayload(prev, &e);
-      if (!options_.mode_pairs_only) {
-        // The pairs of Modes 2 and 3, computed and discarded.
-        CollideOptions plain;
-        plain.sphere_reject = plain.aabb_reject = options_.bounding_reject;
-        plain.want_plane = false;
-        for (const Hexahedron& strip : payload_.body) {
-          e.extra_collisions |= Collide(strip, bay_, plain).verdict != Verdict::kSeparate;
-          e.extra_collisions |= Collide(strip, cae_, plain).verdict != Verdict::kSeparate;
-        }
-      }
-      break;
-    }
-    case 2: {
-      // The payload's and probe's vertices against the bay's walls and
-      // bottom: a vertex below face c that is beyond a wall collides with it.
-      e.X_RP = e.pose.X_RS2 * X_S2P_;
-      e.payload = MakePayload(config_.payload, e.X_RP);
-      e.clearance_ft = std::numeric_limits<double>::infinity();
-      e.collisions |= BayCollisions(e.payload, &e.clearance_ft);
-      break;
-    }
-    default: {
-      if (status_.docked) {
-        e.X_RP = X_RP_docked_;  // captured by the CAE
-        e.payload = payload_;   // placed at the dock
-        e.clearance_ft = std::numeric_limits<double>::infinity();
-        if (released_) {
-          // Let go, the arm is free: the hand is tested against the docked
-          // payload as in Mode 1 (it cannot pass back through the bar).
-          e.ee = MakeEndEffector(config_.end_effector, e.pose.X_RS2, e.finger_gap_ft);
-          TestHandAgainstPayload(prev, &e);
-        }
-        break;
-      }
-      // The payload's and probe's vertices against the CAE's front half, and
-      // still against the bay's walls while any is below face c (lowered
-      // back toward the bay, it cannot pass through them).
-      e.X_RP = e.pose.X_RS2 * X_S2P_;
-      e.payload = MakePayload(config_.payload, e.X_RP);
-      const double tau = ToleranceFt(cae_, cae_, tau_rel_);
-      e.clearance_ft = std::numeric_limits<double>::infinity();
-      for (const Eigen::Vector3d& v : e.payload.v) {
-        if (cae_.Word(v, tau) == 0) e.collisions |= cb::kPayloadCae;
-        // Outside a convex solid, the farthest face plane is a lower bound on the distance to it.
-        double out = -std::numeric_limits<double>::infinity();
-        for (int f = 0; f < kNumFaces; ++f) out = std::max(out, cae_.Beyond(f, v.x(), v.y(), v.z()));
-        e.clearance_ft = std::min(e.clearance_ft, std::max(0.0, out));
-      }
-      e.collisions |= BayCollisions(e.payload, &e.clearance_ft);
-      break;
-    }
+    case 1: EvaluateMode1(prev, &e); break;
+    case 2: EvaluateMode2(&e); break;
+    default: EvaluateMode3(prev, &e); break;
   }
   // Non-finite models (a pose from non-finite words or a restored state)
   // are refused as a collision, never read as "no collision".
-  if (!Finite(e.payload) || !e.pose.X_RS2.matrix().allFinite()) e.collisions |= cb::kNonFinite;
+  if (!Finite(e.payload) || !e.pose.X_RS2.matrix().allFinite()) e.collisions |= wire::collision_bits::kNonFinite;
   if (e.collisions) e.clearance_ft = 0.0;
   e.mode = status_.mode;
-  if (!options_.mode_pairs_only && status_.mode >= 2) {
-    // Every other pair, computed and discarded: the end effector against the
-    // BAR and the payload where they are now, the payload against the bay
-    // and the CAE as whole hexahedra.
-    CollideOptions o;
-    o.sphere_reject = o.aabb_reject = options_.bounding_reject;
-    const EndEffectorModel ee = MakeEndEffector(config_.end_effector, e.pose.X_RS2, e.finger_gap_ft);
-    const Hexahedron bar = MakeBar(config_.payload, e.X_RP);
-    for (int k = 0; k < 3; ++k) {
-      e.extra_collisions |= Collide(ee.hex[k], bar, o).verdict != Verdict::kSeparate;
-      for (const Hexahedron& strip : e.payload.body)
-        e.extra_collisions |= Collide(ee.hex[k], strip, o).verdict != Verdict::kSeparate;
-    }
-    for (const Hexahedron& strip : e.payload.body) {
-      e.extra_collisions |= Collide(strip, bay_, o).verdict != Verdict::kSeparate;
-      e.extra_collisions |= Collide(strip, cae_, o).verdict != Verdict::kSeparate;
-    }
-  }
+  if (!options_.mode_pairs_only && status_.mode >= 2) EvaluateExtraPairs(&e);
 }
 
 void DynamicCollisionProgram::AcceptSpare() { std::swap(slave_, spare_); }
@@ -512,7 +515,9 @@ void DynamicCollisionProgram::LetGo() {
   AcceptSpare();
 }
 
-wire::DcpFrameData DynamicCollisionProgram::Step(const wire::OperatorInputs& in) {
+// The master arm's command from the inputs (the last one held when these
+// are not finite), and the reset button acted on as it is pressed.
+ArmCommand DynamicCollisionProgram::TakeInputs(const wire::OperatorInputs& in) {
   ArmCommand master;
   for (int i = 0; i < 6; ++i) master.angles_deg[i] = in.value[i];
   master.shoulder_height_ft = in.value[kShoulderHeight];
@@ -531,11 +536,16 @@ wire::DcpFrameData DynamicCollisionProgram::Step(const wire::OperatorInputs& in)
   status_.finger_contact = false;  // Mode 1's, set by UpdateAcquisition
   status_.motion_collision = status_.too_fast = false;
   status_.substeps = 0;
+  return master;
+}
 
+// What the slave is commanded: the master's, but a docked payload is
+// captured at the port (the arm keeps its pose and only the finger moves,
+// until opening it releases it), and a grasp lasts only while the finger
+// stays closed.
+ArmCommand DynamicCollisionProgram::SlaveCommand(const ArmCommand& master) {
   ArmCommand command = master;
   if (status_.docked && !released_) {
-    // A docked payload is captured at the port: the arm that holds it keeps
-    // its pose and only the finger moves, until opening it releases it.
     if (slave_->finger_gap_ft >= acquisition_gap_ft_ + kReleaseOpeningFt) {
       released_ = true;
       PlacePayload(X_RP_docked_);  // the hand is tested against it from now on
@@ -546,41 +556,31 @@ wire::DcpFrameData DynamicCollisionProgram::Step(const wire::OperatorInputs& in)
     }
   } else if (status_.mode >= 2 && !status_.docked &&
              FingerGapFt(master.finger) >= acquisition_gap_ft_ + kReleaseOpeningFt) {
-    // The grasp lasts only while the finger stays closed.
     LetGo();
   }
-  if (started_) {
-    Respond(command);
+  return command;
+}
+
+// The first frame after start: nothing to move from but the initial pose,
+// which the command need not be near. Its pose is tested where it is, and
+// taken only when free.
+void DynamicCollisionProgram::FirstFrame(const ArmCommand& command) {
+  Evaluate(command, nullptr, spare_);
+  status_.collisions = spare_->collisions;
+  status_.substeps = 1;
+  if (spare_->collisions == 0) {
+    AcceptSpare();
   } else {
-    // The first frame after start: nothing to move from but the initial
-    // pose, which the command need not be near. Its pose is tested where it
-    // is, and taken only when free.
-    Evaluate(command, nullptr, spare_);
-    status_.collisions = spare_->collisions;
-    status_.substeps = 1;
-    if (spare_->collisions == 0) {
-      AcceptSpare();
-    } else {
-      status_.held = true;
-      spdlog::warn("the first command collides ({}): not taken; the arm stays at its initial pose",
-                   wire::CollisionNames(spare_->collisions, ", ", "none"));
-    }
-    started_ = true;
+    status_.held = true;
+    spdlog::warn("the first command collides ({}): not taken; the arm stays at its initial pose",
+                 wire::CollisionNames(spare_->collisions, ", ", "none"));
   }
-  status_.released = released_;
-  status_.slave_collisions = slave_->collisions;
-  status_.slave = slave_->cmd;
-  status_.X_RS2 = slave_->pose.X_RS2;
-  status_.X_RP = slave_->X_RP;
-  status_.finger_gap_ft = slave_->finger_gap_ft;
+  started_ = true;
+}
 
-  UpdatePlanes();
-  const int mode_before = status_.mode;
-  UpdateDocking();  // distance and angle every frame; docking in Mode 3
-  if (mode_before == 1) UpdateAcquisition();
-  else if (mode_before == 2) UpdateExtraction();
-  else status_.bay_clearance_ft = BayClearance(slave_->payload);
-
+// The DCP's output block for this frame (report IV.B: the arm words, the
+// control word with the six bits the DCP generates, the planes, the state).
+wire::DcpFrameData DynamicCollisionProgram::FrameOut(const wire::OperatorInputs& in) const {
   wire::DcpFrameData out;
   out.arm = slave_->words;
   out.control.camera_station = in.camera_station;
@@ -604,6 +604,26 @@ wire::DcpFrameData DynamicCollisionProgram::Step(const wire::OperatorInputs& in)
   out.planes = status_.planes;
   out.plane_valid = status_.plane_valid;
   return out;
+}
+
+wire::DcpFrameData DynamicCollisionProgram::Step(const wire::OperatorInputs& in) {
+  const ArmCommand master = TakeInputs(in);
+  const ArmCommand command = SlaveCommand(master);
+  if (started_) Respond(command);
+  else FirstFrame(command);
+  status_.released = released_;
+  status_.slave_collisions = slave_->collisions;
+  status_.slave = slave_->cmd;
+  status_.X_RS2 = slave_->pose.X_RS2;
+  status_.X_RP = slave_->X_RP;
+  status_.finger_gap_ft = slave_->finger_gap_ft;
+  UpdatePlanes();
+  const int mode_before = status_.mode;
+  UpdateDocking();  // distance and angle every frame; docking in Mode 3
+  if (mode_before == 1) UpdateAcquisition();
+  else if (mode_before == 2) UpdateExtraction();
+  else status_.bay_clearance_ft = BayClearance(slave_->payload);
+  return FrameOut(in);
 }
 
 void DynamicCollisionProgram::UpdatePlanes() {
@@ -882,20 +902,21 @@ nlohmann::ordered_json DynamicCollisionProgram::SaveState() const {
   return j;
 }
 
-void DynamicCollisionProgram::RestoreState(const nlohmann::json& j) {
-  // Read every key first; change the state only when all of them are good
-  // (a refused checkpoint changes nothing). Keys added after the format's
-  // first version (X_RP_free, reset_pressed) default to the payload in the
-  // bay and the button up.
-  struct Parsed {
-    int mode = 1;
-    bool acquired = false, docked = false, released = false, have_slave = false, reset_pressed = false;
-    Eigen::Isometry3d X_S2P, X_RP_docked, X_RP_free;
-    double contact_gap_ft = 0, acquisition_gap_ft = 0;
-    ArmCommand master, slave;
-    Evaluation hints;  // only its planes
-  };
-  auto p = std::make_unique<Parsed>();
+// A checkpoint's state, every key read (RestoreState). Keys added after the
+// format's first version (X_RP_free, reset_pressed) default to the payload
+// in the bay and the button up.
+struct DynamicCollisionProgram::RestoredState {
+  int mode = 1;
+  bool acquired = false, docked = false, released = false, have_slave = false, reset_pressed = false;
+  Eigen::Isometry3d X_S2P, X_RP_docked, X_RP_free;
+  double contact_gap_ft = 0, acquisition_gap_ft = 0;
+  ArmCommand master, slave;
+  Evaluation hints;  // only its planes
+};
+
+std::unique_ptr<DynamicCollisionProgram::RestoredState> DynamicCollisionProgram::ReadRestoredState(
+    const nlohmann::json& j) const {
+  auto p = std::make_unique<RestoredState>();
   try {
     if (j.at("format").get<std::string>() != kCheckpointFormat) {
       throw InputError("checkpoint: format '" + j.at("format").get<std::string>() + "', expected '" +
@@ -930,27 +951,40 @@ void DynamicCollisionProgram::RestoreState(const nlohmann::json& j) {
   } catch (const nlohmann::json::exception& e) {
     throw InputError(std::string("checkpoint: ") + e.what());
   }
-  CheckRestored(p->mode, p->acquired, p->docked, p->released, p->contact_gap_ft, p->acquisition_gap_ft);
-  if (!Finite(p->master) || (p->have_slave && !Finite(p->slave))) throw InputError("checkpoint: a command is not finite");
-  for (const ArmCommand* c : {&p->master, &p->slave}) {
+  return p;
+}
+
+// A state the DCP can be in: reachable, finite commands, rigid poses, unit
+// plane normals (InputError naming what is not).
+void DynamicCollisionProgram::CheckRestoredState(const RestoredState& p) const {
+  CheckRestored(p.mode, p.acquired, p.docked, p.released, p.contact_gap_ft, p.acquisition_gap_ft);
+  if (!Finite(p.master) || (p.have_slave && !Finite(p.slave))) throw InputError("checkpoint: a command is not finite");
+  for (const ArmCommand* c : {&p.master, &p.slave}) {
     if (!(std::abs(c->finger) <= 10.0)) throw InputError("checkpoint: a finger lever is out of range");
   }
-  for (const auto& [X, key] : {std::pair{&p->X_S2P, "X_S2P"}, {&p->X_RP_free, "X_RP_free"}, {&p->X_RP_docked, "X_RP_docked"}}) {
+  for (const auto& [X, key] : {std::pair{&p.X_S2P, "X_S2P"}, {&p.X_RP_free, "X_RP_free"}, {&p.X_RP_docked, "X_RP_docked"}}) {
     const Eigen::Matrix3d R = X->linear();
     if (!X->matrix().allFinite() || !((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= 1e-9)) {
       throw InputError(std::string("checkpoint: '") + key + "' is not a rigid pose");
     }
   }
-  for (const CollisionResult& r : p->hints.ee_bar) {
-    if (r.plane_valid && !(std::abs(r.plane.n_R.norm() - 1.0) <= 1e-9)) throw InputError("checkpoint: a plane's normal is not a unit vector");
+  auto unit = [](const CollisionResult& r) { return !r.plane_valid || std::abs(r.plane.n_R.norm() - 1.0) <= 1e-9; };
+  for (const CollisionResult& r : p.hints.ee_bar) {
+    if (!unit(r)) throw InputError("checkpoint: a plane's normal is not a unit vector");
   }
-  for (const CollisionResult& r : p->hints.ee_body) {
-    if (r.plane_valid && !(std::abs(r.plane.n_R.norm() - 1.0) <= 1e-9)) throw InputError("checkpoint: a plane's normal is not a unit vector");
+  for (const CollisionResult& r : p.hints.ee_body) {
+    if (!unit(r)) throw InputError("checkpoint: a plane's normal is not a unit vector");
   }
+}
+
+void DynamicCollisionProgram::RestoreState(const nlohmann::json& j) {
+  // Read every key first; change the state only when all of them are good
+  // (a refused checkpoint changes nothing).
+  const std::unique_ptr<RestoredState> p = ReadRestoredState(j);
+  CheckRestoredState(*p);
   // The slave must be free where the checkpoint puts it: tried on the state
   // it describes, and the old state put back if not.
   const nlohmann::ordered_json before = SaveState();
-  // All read: now the state.
   status_.mode = p->mode;
   status_.acquired = p->acquired;
   status_.docked = p->docked;

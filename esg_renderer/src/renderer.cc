@@ -113,82 +113,77 @@ void FrameRenderer::DrawCluster(GpuCluster& c, const Eigen::Affine3d& X, const E
   stats_.triangles_submitted += static_cast<int>(c.n.size());
 }
 
-void FrameRenderer::Render(const wire::EsgFrameData& f) {
-  stats_ = {};
-  context_->MakeCurrent();
-  const int w = context_->width(), h = context_->height();
-  const Eigen::Matrix4d P = ProjectionMatrix(f.fov_deg, static_cast<double>(w) / h, kNearFt, kFarFt);
-  const Eigen::Matrix4d view = ViewMatrix(f);
-  const scene_model::ClusterPoses poses = scene_model::ComputeClusterPoses(config_, f.scene_pose());
-
-  // Each cluster's silhouette: what of it lies in front of the near plane,
-  // projected (its vertices there and where its edges cross the near plane);
-  // culled when all of it lies beyond one plane of the view volume, or when
-  // it is a flat, one-sided cluster seen from behind.
-  std::array<ScreenBox, scene_model::kNumClusters> boxes{};
-  for (int c = 0; c < scene_model::kNumClusters; ++c) {
-    if (!poses.present[c]) continue;
-    const scene_model::Cluster& model = model_[c];
-    const Eigen::Matrix4d VM = view * poses.X_RC[c].matrix();
-    if (options_.backface_cull && model.flat) {
-      const Eigen::Vector3d n_R = (poses.X_RC[c].linear().inverse().transpose() * model.normals[0]).normalized();
-      const Eigen::Vector3d p_R = poses.X_RC[c] * model.points[0];
-      if (n_R.dot(f.p_RoEye_R_ft - p_R) <= 0) {
-        ++stats_.clusters_backfacing;
-        continue;
-      }
+// What of the cluster lies in front of the near plane, projected (its
+// vertices there and where its edges cross the near plane); culled when all
+// of it lies beyond one plane of the view volume, or when it is a flat,
+// one-sided cluster seen from behind.
+ScreenBox FrameRenderer::Silhouette(int c, const scene_model::ClusterPoses& poses, const wire::EsgFrameData& f,
+                                    const Eigen::Matrix4d& view, const Eigen::Matrix4d& P) {
+  ScreenBox b;
+  const scene_model::Cluster& model = model_[c];
+  const Eigen::Matrix4d VM = view * poses.X_RC[c].matrix();
+  if (options_.backface_cull && model.flat) {
+    const Eigen::Vector3d n_R = (poses.X_RC[c].linear().inverse().transpose() * model.normals[0]).normalized();
+    const Eigen::Vector3d p_R = poses.X_RC[c] * model.points[0];
+    if (n_R.dot(f.p_RoEye_R_ft - p_R) <= 0) {
+      ++stats_.clusters_backfacing;
+      return b;
     }
-    std::vector<Eigen::Vector3d> eye_pts;
-    eye_pts.reserve(model.points.size());
-    unsigned outside_all = 0x3F;
-    for (const Eigen::Vector3d& p : model.points) {
-      const Eigen::Vector4d e = VM * p.homogeneous();
-      eye_pts.push_back(e.head<3>());
-      const Eigen::Vector4d q = P * e;
-      unsigned out = 0;
-      if (q.x() < -q.w()) out |= 1;
-      if (q.x() > q.w()) out |= 2;
-      if (q.y() < -q.w()) out |= 4;
-      if (q.y() > q.w()) out |= 8;
-      if (q.z() < -q.w()) out |= 16;
-      if (q.z() > q.w()) out |= 32;
-      outside_all &= out;
-    }
-    ScreenBox& b = boxes[c];
-    if (options_.frustum_cull && outside_all != 0) {
-      ++stats_.clusters_culled;
-      continue;
-    }
-    // Eye coordinates look down -z; in front of the near plane: z < -near.
-    const double zn = -kNearFt;
-    std::vector<Eigen::Vector3d> front;
-    for (const auto& e : eye_pts) {
-      if (e.z() < zn) front.push_back(e);
-    }
-    if (front.size() != eye_pts.size()) {
-      for (const auto& [i, j] : gpu_[c].edges) {
-        const Eigen::Vector3d &a = eye_pts[i], &bb = eye_pts[j];
-        if ((a.z() < zn) != (bb.z() < zn)) front.push_back(a + (zn - a.z()) / (bb.z() - a.z()) * (bb - a));
-      }
-    }
-    if (front.empty()) {  // all behind the eye
-      ++stats_.clusters_culled;
-      continue;
-    }
-    b.visible = true;
-    std::vector<Eigen::Vector2f> projected;
-    float x0 = 1e9f, y0 = 1e9f, x1 = -1e9f, y1 = -1e9f;
-    for (const auto& e : front) {
-      const Eigen::Vector4d q = P * e.homogeneous();
-      const float sx = static_cast<float>(q.x() / q.w()), sy = static_cast<float>(q.y() / q.w());
-      x0 = std::min(x0, sx); x1 = std::max(x1, sx); y0 = std::min(y0, sy); y1 = std::max(y1, sy);
-      projected.emplace_back(sx, sy);
-    }
-    b.x0 = x0; b.y0 = y0; b.x1 = x1; b.y1 = y1;
-    b.outline = ConvexHull2d(std::move(projected));
   }
+  std::vector<Eigen::Vector3d> eye_pts;
+  eye_pts.reserve(model.points.size());
+  unsigned outside_all = 0x3F;
+  for (const Eigen::Vector3d& p : model.points) {
+    const Eigen::Vector4d e = VM * p.homogeneous();
+    eye_pts.push_back(e.head<3>());
+    const Eigen::Vector4d q = P * e;
+    unsigned out = 0;
+    if (q.x() < -q.w()) out |= 1;
+    if (q.x() > q.w()) out |= 2;
+    if (q.y() < -q.w()) out |= 4;
+    if (q.y() > q.w()) out |= 8;
+    if (q.z() < -q.w()) out |= 16;
+    if (q.z() > q.w()) out |= 32;
+    outside_all &= out;
+  }
+  if (options_.frustum_cull && outside_all != 0) {
+    ++stats_.clusters_culled;
+    return b;
+  }
+  // Eye coordinates look down -z; in front of the near plane: z < -near.
+  const double zn = -kNearFt;
+  std::vector<Eigen::Vector3d> front;
+  for (const auto& e : eye_pts) {
+    if (e.z() < zn) front.push_back(e);
+  }
+  if (front.size() != eye_pts.size()) {
+    for (const auto& [i, j] : gpu_[c].edges) {
+      const Eigen::Vector3d &a = eye_pts[i], &bb = eye_pts[j];
+      if ((a.z() < zn) != (bb.z() < zn)) front.push_back(a + (zn - a.z()) / (bb.z() - a.z()) * (bb - a));
+    }
+  }
+  if (front.empty()) {  // all behind the eye
+    ++stats_.clusters_culled;
+    return b;
+  }
+  b.visible = true;
+  std::vector<Eigen::Vector2f> projected;
+  float x0 = 1e9f, y0 = 1e9f, x1 = -1e9f, y1 = -1e9f;
+  for (const auto& e : front) {
+    const Eigen::Vector4d q = P * e.homogeneous();
+    const float sx = static_cast<float>(q.x() / q.w()), sy = static_cast<float>(q.y() / q.w());
+    x0 = std::min(x0, sx); x1 = std::max(x1, sx); y0 = std::min(y0, sy); y1 = std::max(y1, sy);
+    projected.emplace_back(sx, sy);
+  }
+  b.x0 = x0; b.y0 = y0; b.x1 = x1; b.y1 = y1;
+  b.outline = ConvexHull2d(std::move(projected));
+  return b;
+}
 
-  gl_.Viewport(0, 0, w, h);
+void FrameRenderer::DrawInOrder(const wire::EsgFrameData& f, const scene_model::ClusterPoses& poses,
+                                const std::array<ScreenBox, scene_model::kNumClusters>& boxes,
+                                const Eigen::Matrix4d& view, const Eigen::Matrix4d& P) {
+  gl_.Viewport(0, 0, context_->width(), context_->height());
   gl_.ClearColor(0, 0, 0, 1);
   if (options_.backface_cull) gl_.Enable(GL_CULL_FACE);
   else gl_.Disable(GL_CULL_FACE);
@@ -214,6 +209,20 @@ void FrameRenderer::Render(const wire::EsgFrameData& f) {
     DrawCluster(gpu_[c], poses.X_RC[c], view);
     ++stats_.clusters_drawn;
   }
+}
+
+void FrameRenderer::Render(const wire::EsgFrameData& f) {
+  stats_ = {};
+  context_->MakeCurrent();
+  const int w = context_->width(), h = context_->height();
+  const Eigen::Matrix4d P = ProjectionMatrix(f.fov_deg, static_cast<double>(w) / h, kNearFt, kFarFt);
+  const Eigen::Matrix4d view = ViewMatrix(f);
+  const scene_model::ClusterPoses poses = scene_model::ComputeClusterPoses(config_, f.scene_pose());
+  std::array<ScreenBox, scene_model::kNumClusters> boxes{};
+  for (int c = 0; c < scene_model::kNumClusters; ++c) {
+    if (poses.present[c]) boxes[c] = Silhouette(c, poses, f, view, P);
+  }
+  DrawInOrder(f, poses, boxes, view, P);
 }
 
 }  // namespace rms::esg_renderer

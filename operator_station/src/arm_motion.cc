@@ -71,6 +71,88 @@ double SmallestSingularValue(const Matrix6d& J) {
   return Eigen::JacobiSVD<Matrix6d>(J).singularValues()[5];
 }
 
+// A nearly straight elbow: the direction the damping slows is the arm's
+// reach, and the joint motion that gives no end-effector motion to first
+// order (the last right singular vector) bends the elbow. The rate, rad/s a
+// joint, that moves along it, elbow-up, so the arm leaves the singularity
+// while it flies; faded in smoothly (by how singular, how straight, how
+// much of the self-motion is the elbow's) so it never jumps. Zero when the
+// elbow is not nearly straight or the arm not singular.
+Vector6d ElbowBend(const Matrix6d& Jl, const JointAngles& q, double ratio, const ResolveOptions& o) {
+  if (!(std::abs(q[2]) < o.elbow_straight_deg && ratio < 1.0)) return Vector6d::Zero();
+  // Among the weak directions (the arm may be singular twice over, the
+  // elbow straight and the wrist roll in line with the yaw), the one that
+  // is most the elbow's.
+  const Eigen::JacobiSVD<Matrix6d> svd(Jl, Eigen::ComputeFullV);
+  int best = -1;
+  for (int k = 5; k >= 0 && svd.singularValues()[k] < o.epsilon_ft; --k) {
+    if (best < 0 || std::abs(svd.matrixV()(2, k)) > std::abs(svd.matrixV()(2, best))) best = k;
+  }
+  if (best < 0) return Vector6d::Zero();
+  Vector6d n = svd.matrixV().col(best);
+  const double elbow_part = std::clamp((std::abs(n[2]) - 0.2) / 0.3, 0.0, 1.0);
+  if (elbow_part <= 0) return Vector6d::Zero();
+  if (n[2] > 0) n = -n;
+  const double weak = 1.0 - svd.singularValues()[best] / o.epsilon_ft;
+  const double fade = weak * (1.0 - std::abs(q[2]) / o.elbow_straight_deg) * elbow_part;
+  return n * (o.elbow_bend_deg_s * kDeg / std::abs(n[2])) * fade;
+}
+
+// The joint rates (rad/s) for the weighted twist xw: joints at (or beyond) a
+// limit and pushed further out are locked (their bits in *locked) and the
+// rest solved again, until none is pushed out.
+Vector6d SolveWithLimits(const Matrix6d& Jw, const Vector6d& xw, const JointLimits& limits, const JointAngles& q,
+                         double lambda, double ratio, double dt_s, const ResolveOptions& o, std::uint32_t* locked) {
+  *locked = 0;
+  Vector6d dq = Vector6d::Zero();
+  for (int pass = 0; pass < 7; ++pass) {
+    Matrix6d Jl = Jw;
+    for (int i = 0; i < 6; ++i) {
+      if (*locked & (1u << i)) Jl.col(i).setZero();
+    }
+    dq = DampedPseudoInverse(Jl, lambda) * xw;
+    if (!(*locked & (1u << 2))) dq += ElbowBend(Jl, q, ratio, o);
+    for (int i = 0; i < 6; ++i) {
+      if (*locked & (1u << i)) dq[i] = 0.0;
+    }
+    std::uint32_t pushed = 0;
+    for (int i = 0; i < 6; ++i) {
+      const double next = q[i] + dq[i] / kDeg * dt_s;
+      if ((dq[i] > 0 && next > limits.max_deg[i] && q[i] >= limits.max_deg[i] - 1e-9) ||
+          (dq[i] < 0 && next < limits.min_deg[i] && q[i] <= limits.min_deg[i] + 1e-9)) {
+        pushed |= 1u << i;
+      }
+    }
+    if (pushed == 0) break;
+    *locked |= pushed;
+  }
+  return dq;
+}
+
+// Every joint within its rate, the direction kept; a joint reaching its
+// limit this frame stops on it. Fills r's rates, angles and limits.
+void TakeRates(Vector6d dq, const JointLimits& limits, const JointAngles& q, double dt_s, RateResult* r) {
+  double k = 1.0;
+  for (int i = 0; i < 6; ++i) {
+    const double rate = std::abs(dq[i]) / kDeg;
+    if (rate > limits.rate_deg_s[i]) k = std::min(k, limits.rate_deg_s[i] / rate);
+  }
+  r->rate_limited = k < 1.0;
+  dq *= k;
+  for (int i = 0; i < 6; ++i) {
+    double next = q[i] + dq[i] / kDeg * dt_s;
+    if (next > limits.max_deg[i] && dq[i] > 0) {
+      next = std::max(q[i], limits.max_deg[i]);
+      r->at_limit |= 1u << i;
+    } else if (next < limits.min_deg[i] && dq[i] < 0) {
+      next = std::min(q[i], limits.min_deg[i]);
+      r->at_limit |= 1u << i;
+    }
+    r->rate_deg_s[i] = (next - q[i]) / dt_s;
+    r->q_deg[i] = next;
+  }
+}
+
 }  // namespace
 
 RateResult ResolveRate(const ArmGeometry& arm, const JointLimits& limits, const JointAngles& q, double h,
@@ -89,81 +171,10 @@ RateResult ResolveRate(const ArmGeometry& arm, const JointLimits& limits, const 
   if (v_R.squaredNorm() == 0.0 && w_R.squaredNorm() == 0.0) return r;
   Vector6d x;
   x << v_R, w_R;
-  const Vector6d xw = weight.asDiagonal() * x;
-
-  // Joints at (or beyond) a limit and pushed further out are locked and the
-  // rest solved again, until none is pushed out.
   std::uint32_t locked = 0;
-  Vector6d dq = Vector6d::Zero();  // rad/s
-  for (int pass = 0; pass < 7; ++pass) {
-    Matrix6d Jl = Jw;
-    for (int i = 0; i < 6; ++i) {
-      if (locked & (1u << i)) Jl.col(i).setZero();
-    }
-    const Matrix6d pinv = DampedPseudoInverse(Jl, lambda);
-    dq = pinv * xw;
-    // A nearly straight elbow: the direction the damping slows is the arm's
-    // reach, and the joint motion that gives no end-effector motion to first
-    // order (the last right singular vector) bends the elbow. Move along it,
-    // elbow-up, so the arm leaves the singularity while it flies.
-    // Faded in smoothly (by how singular, how straight, how much of the
-    // self-motion is the elbow's) so it never jumps.
-    if (!(locked & (1u << 2)) && std::abs(q[2]) < o.elbow_straight_deg && ratio < 1.0) {
-      // Among the weak directions (the arm may be singular twice over, the
-      // elbow straight and the wrist roll in line with the yaw), the one
-      // that is most the elbow's.
-      const Eigen::JacobiSVD<Matrix6d> svd(Jl, Eigen::ComputeFullV);
-      int best = -1;
-      for (int k = 5; k >= 0 && svd.singularValues()[k] < o.epsilon_ft; --k) {
-        if (best < 0 || std::abs(svd.matrixV()(2, k)) > std::abs(svd.matrixV()(2, best))) best = k;
-      }
-      if (best >= 0) {
-        Vector6d n = svd.matrixV().col(best);
-        const double elbow_part = std::clamp((std::abs(n[2]) - 0.2) / 0.3, 0.0, 1.0);
-        if (elbow_part > 0) {
-          if (n[2] > 0) n = -n;
-          const double weak = 1.0 - svd.singularValues()[best] / o.epsilon_ft;
-          const double fade = weak * (1.0 - std::abs(q[2]) / o.elbow_straight_deg) * elbow_part;
-          dq += n * (o.elbow_bend_deg_s * kDeg / std::abs(n[2])) * fade;
-        }
-      }
-    }
-    for (int i = 0; i < 6; ++i) {
-      if (locked & (1u << i)) dq[i] = 0.0;
-    }
-    std::uint32_t pushed = 0;
-    for (int i = 0; i < 6; ++i) {
-      const double next = q[i] + dq[i] / kDeg * dt_s;
-      if ((dq[i] > 0 && next > limits.max_deg[i] && q[i] >= limits.max_deg[i] - 1e-9) ||
-          (dq[i] < 0 && next < limits.min_deg[i] && q[i] <= limits.min_deg[i] + 1e-9)) {
-        pushed |= 1u << i;
-      }
-    }
-    if (pushed == 0) break;
-    locked |= pushed;
-  }
+  const Vector6d dq = SolveWithLimits(Jw, weight.asDiagonal() * x, limits, q, lambda, ratio, dt_s, o, &locked);
   r.at_limit = locked;
-  // Every joint within its rate, the direction kept.
-  double k = 1.0;
-  for (int i = 0; i < 6; ++i) {
-    const double rate = std::abs(dq[i]) / kDeg;
-    if (rate > limits.rate_deg_s[i]) k = std::min(k, limits.rate_deg_s[i] / rate);
-  }
-  r.rate_limited = k < 1.0;
-  dq *= k;
-  for (int i = 0; i < 6; ++i) {
-    double next = q[i] + dq[i] / kDeg * dt_s;
-    // A joint reaching its limit this frame stops on it.
-    if (next > limits.max_deg[i] && dq[i] > 0) {
-      next = std::max(q[i], limits.max_deg[i]);
-      r.at_limit |= 1u << i;
-    } else if (next < limits.min_deg[i] && dq[i] < 0) {
-      next = std::min(q[i], limits.min_deg[i]);
-      r.at_limit |= 1u << i;
-    }
-    r.rate_deg_s[i] = (next - q[i]) / dt_s;
-    r.q_deg[i] = next;
-  }
+  TakeRates(dq, limits, q, dt_s, &r);
   Vector6d done;
   for (int i = 0; i < 6; ++i) done[i] = r.rate_deg_s[i] * kDeg;
   r.achieved = J * done;

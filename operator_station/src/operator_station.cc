@@ -358,6 +358,62 @@ bool OperatorStation::RunFrozen() {
   return true;
 }
 
+// A restarted station (RMSLAB_RESTART) resumes from the command the DCP's
+// first telemetry shows, not from the start of the task.
+void OperatorStation::ResumeFromTelemetry() {
+  const dcp_telemetry_t& t = *telemetry_;
+  wire::OperatorInputs from = last_;
+  for (int i = 0; i < 6; ++i) from.value[i] = t.master_angles_deg[i];
+  from.value[kShoulderHeight] = t.master_shoulder_height_ft;
+  from.value[kFinger] = t.master_finger;
+  source_->Resume(from, false);
+  spdlog::warn("restarted: resuming from the DCP's telemetry (Mode {}, frame {})", static_cast<int>(t.mode), t.frame);
+}
+
+// One frame: the source's inputs, published as the input block and the
+// operator's state, the status and the screen. False when the source ended.
+bool OperatorStation::StepFrame(transport::StatusReporter* status) {
+  Frame f;
+  f.count = frames_;
+  f.dt_s = 1.0 / config_.session.frame_rate_hz;
+  f.telemetry = telemetry_ ? &*telemetry_ : nullptr;
+  f.now_us = lcm_.NowUs();
+  const std::optional<wire::OperatorInputs> in = source_->Next(f);
+  if (source_->requests().freeze) SendControl(session_control_t::FREEZE);
+  if (!in) return false;
+  last_ = *in;
+  if (in->reset) {
+    spdlog::info("reset pressed: back to Mode 1");
+    ForgetTelemetry(builder_.next_frame());
+  }
+  const operator_input_t block = builder_.Build(*in, lcm_.NowUs(), &counters_);
+  if (transport::PublishMessage(lcm_, wire::channels::kOperatorInput, block)) counters_.Add(Counter::kPublished);
+  else counters_.Add(Counter::kPublishFailed);
+  PublishState(block.frame, *in);
+  publish_rate_.Tick(lcm_.NowUs());
+  ++frames_;
+  status->Tick(block.frame, counters_);
+  DrawScreen(block.frame, *in, false);
+  return true;
+}
+
+// At the end: the counters reported and written; the exit code.
+int OperatorStation::Finish(const std::string& stats_path, transport::StatusReporter* status) {
+  screen_.reset();  // the terminal back, the captured log written out
+  source_->AddCounters(&counters_);
+  transport::NoteTransportCounters(lcm_, &counters_);
+  counters_.Set(Counter::kFramesTotal, frames_);
+  status->Final(builder_.next_frame() - 1, counters_);
+  if (!stats_path.empty()) transport::WriteStatsJson(stats_path, "operator_station", counters_, {});
+  spdlog::info("published {} input blocks ({} late, {} clamped inputs)", counters_.Get(Counter::kPublished),
+               counters_.Get(Counter::kFramesLate), counters_.Sum(kClampedFirst, kClampedLast));
+  if (transport::StopRequested()) {
+    spdlog::info("stopped by a signal at frame {}", builder_.next_frame() - 1);
+    return kExitInterrupted;
+  }
+  return source_->exit_code();
+}
+
 int OperatorStation::Run(const std::string& stats_path, const std::string& ready_path) {
   if (!options_.restore_path.empty()) {
     const wire::Checkpoint c = wire::ReadCheckpoint(options_.restore_path);
@@ -393,38 +449,10 @@ int OperatorStation::Run(const std::string& stats_path, const std::string& ready
     }
     if (steps_pending_ > 0) --steps_pending_;
     if (resume_from_telemetry && telemetry_) {
-      const dcp_telemetry_t& t = *telemetry_;
-      wire::OperatorInputs from = last_;
-      for (int i = 0; i < 6; ++i) from.value[i] = t.master_angles_deg[i];
-      from.value[kShoulderHeight] = t.master_shoulder_height_ft;
-      from.value[kFinger] = t.master_finger;
-      source_->Resume(from, false);
+      ResumeFromTelemetry();
       resume_from_telemetry = false;
-      spdlog::warn("restarted: resuming from the DCP's telemetry (Mode {}, frame {})", static_cast<int>(t.mode),
-                   t.frame);
     }
-    Frame f;
-    f.count = frames_;
-    f.dt_s = 1.0 / config_.session.frame_rate_hz;
-    f.telemetry = telemetry_ ? &*telemetry_ : nullptr;
-    f.now_us = lcm_.NowUs();
-    const std::optional<wire::OperatorInputs> in = source_->Next(f);
-    if (source_->requests().freeze) SendControl(session_control_t::FREEZE);
-    if (!in) break;
-    last_ = *in;
-    if (in->reset) {
-      spdlog::info("reset pressed: back to Mode 1");
-      ForgetTelemetry(builder_.next_frame());
-    }
-    const operator_input_t block = builder_.Build(*in, lcm_.NowUs(), &counters_);
-    if (transport::PublishMessage(lcm_, wire::channels::kOperatorInput, block)) counters_.Add(Counter::kPublished);
-    else counters_.Add(Counter::kPublishFailed);
-    PublishState(block.frame, *in);
-    publish_rate_.Tick(lcm_.NowUs());
-    ++frames_;
-    status.Tick(block.frame, counters_);
-    DrawScreen(block.frame, *in, false);
-
+    if (!StepFrame(&status)) break;
     next_ns += period_ns_;
     const std::int64_t now = MonotonicNs();
     if (now > next_ns + period_ns_) {
@@ -434,19 +462,7 @@ int OperatorStation::Run(const std::string& stats_path, const std::string& ready
       SleepUntilNs(next_ns);
     }
   }
-  screen_.reset();  // the terminal back, the captured log written out
-  source_->AddCounters(&counters_);
-  transport::NoteTransportCounters(lcm_, &counters_);
-  counters_.Set(Counter::kFramesTotal, frames_);
-  status.Final(builder_.next_frame() - 1, counters_);
-  if (!stats_path.empty()) transport::WriteStatsJson(stats_path, "operator_station", counters_, {});
-  spdlog::info("published {} input blocks ({} late, {} clamped inputs)", counters_.Get(Counter::kPublished),
-               counters_.Get(Counter::kFramesLate), counters_.Sum(kClampedFirst, kClampedLast));
-  if (transport::StopRequested()) {
-    spdlog::info("stopped by a signal at frame {}", builder_.next_frame() - 1);
-    return kExitInterrupted;
-  }
-  return source_->exit_code();
+  return Finish(stats_path, &status);
 }
 
 }  // namespace rms::operator_station

@@ -189,132 +189,133 @@ void ConditionLines(const StatusSnapshot& s, const LabConfig& config, int width,
                                  : Sprintf("probe outside the envelope by %.2f ft", -t.envelope_margin_ft));
 }
 
+void CameraLines(const StatusSnapshot& s, const LabConfig& config, Flow& flow) {
+  const wire::OperatorInputs& in = s.inputs;
+  const int st = in.camera_station;
+  flow.Line(Sprintf("camera %d %s", st,
+                    st >= 1 && st <= static_cast<int>(config.cameras.size()) ? config.cameras[st - 1].name.c_str() : "?"))
+      .Field(Sprintf("pan %+6.1f  tilt %+6.1f  zoom %.2f", in.value[kCameraPan], in.value[kCameraTilt],
+                     in.value[kCameraZoom]))
+      .Field(std::string("crosshairs ") + (in.crosshairs ? "on" : "off"))
+      .Field(std::string("overlay ") + (in.overlay ? "on" : "off"));
+  if (s.hand) flow.Field(std::string("window guidance ") + (s.show_guidance ? "on" : "off"));
+}
+
+void ArmLines(const StatusSnapshot& s, Flow& flow) {
+  const wire::OperatorInputs& in = s.inputs;
+  flow.Line(Sprintf("arm, deg: yaw %+7.2f", in.value[0]))
+      .Field(Sprintf("pitch %+7.2f", in.value[1]))
+      .Field(Sprintf("elbow %+7.2f", in.value[2]))
+      .Field(Sprintf("wrist pitch %+7.2f", in.value[3]))
+      .Field(Sprintf("yaw %+7.2f", in.value[4]))
+      .Field(Sprintf("roll %+7.2f", in.value[5]))
+      .Field(Sprintf("shoulder height %.2f ft", in.value[kShoulderHeight]))
+      .Field(Sprintf("finger %.2f (0 open, 1 closed)", in.value[kFinger]));
+}
+
+void RateLines(const StatusSnapshot& s, Flow& flow) {
+  flow.Line(Sprintf("rates: published %.1f Hz", s.publish_hz))
+      .Field(Sprintf("DCP %.1f Hz", s.telemetry_hz))
+      .Field(s.render_hz >= 0 ? Sprintf("rendered %.1f Hz", s.render_hz) : "rendered ? (no status from esg_renderer)");
+  flow.Line("latency: input to DCP " + (s.input_to_dcp_ms >= 0 ? Sprintf("%.1f ms", s.input_to_dcp_ms) : "?"))
+      .Field("input to rendered frame " +
+             (s.input_to_render_p50_ms >= 0
+                  ? Sprintf("p50 %.1f ms, p99 %.1f ms", s.input_to_render_p50_ms, s.input_to_render_p99_ms)
+                  : std::string("? (no status from esg_renderer)")));
+  flow.Line(Sprintf("inputs clamped to their range: %ld", s.clamped_inputs));
+  if (s.key_actions >= 0) flow.Field(Sprintf("keys pressed: %ld", s.key_actions));
+}
+
+void DeviceLines(const StatusSnapshot& s, Flow& flow) {
+  flow.Line(s.devices.empty() ? "devices: none" : "devices: " + s.devices[0] + ";");
+  for (std::size_t i = 1; i < s.devices.size(); ++i) flow.Field(s.devices[i] + ";");
+}
+
+void HelpLines(const StatusSnapshot& s, Flow& flow) {
+  if (s.help.empty()) return;
+  flow.Line("");
+  // Groups are two spaces apart ("w/s fwd/back  d/a right/left ...").
+  std::size_t from = 0;
+  while (from < s.help.size()) {
+    std::size_t to = s.help.find("  ", from);
+    if (to == std::string::npos) to = s.help.size();
+    if (to > from) flow.Field(s.help.substr(from, to - from));
+    from = to + 2;
+  }
+}
+
+// Too small for the screen: say so, in what room there is.
+std::string TooSmallScreen(const StatusSnapshot& s, int width, int height) {
+  std::vector<std::string> L = {"rmslab operator station",
+                                Sprintf("terminal %dx%d: needs %dx%d", width, height, kMinWidth, kMinHeight)};
+  if (s.telemetry) L.push_back(Sprintf("MODE %d%s%s", s.telemetry->mode, s.telemetry->acquired ? " ACQ" : "",
+                                       s.telemetry->docked ? " DOCK" : ""));
+  if (s.guidance) L.push_back(Sprintf("to go %.2f ft %.1f deg", s.guidance->distance_ft, s.guidance->angle_deg));
+  std::string out;
+  for (int i = 0; i < std::min<int>(height, static_cast<int>(L.size())); ++i) {
+    out += L[i].substr(0, static_cast<std::size_t>(std::max(width, 1))) + "\n";
+  }
+  return out;
+}
+
+// A section of the screen, and how soon it goes on a short terminal: 0
+// always; then 1 (conditions, docking), 2 (camera), 3 (rates), 4 (arm), 5
+// (devices), 6 (the keys' help, shown under the events pane).
+struct Section {
+  int priority;
+  std::vector<std::string> lines;
+};
+
+// The sections in the order shown.
+std::vector<Section> BuildSections(const StatusSnapshot& s, const LabConfig& config, int width) {
+  std::vector<Section> sections;
+  const std::string title = "rmslab operator station -- " + s.source;
+  const std::string right = Sprintf("t %.1f s  frame %06lld", s.session_s, static_cast<long long>(s.frame));
+  sections.push_back(
+      {0, {title + std::string(std::max<int>(1, width - static_cast<int>(title.size() + right.size())), ' ') + right}});
+  // Each section's lines are written while it is the last one (a Flow
+  // points into it).
+  auto add = [&](int priority, const auto& lines) {
+    sections.push_back({priority, {}});
+    Flow flow(&sections.back().lines, width);
+    lines(flow);
+  };
+  add(0, [&](Flow& f) {
+    if (s.telemetry) ModeLines(s, f);
+    else f.Line("MODE ?  (no telemetry from dynamics_proc since the start, the last reset or restore)");
+  });
+  if (s.telemetry) add(s.telemetry->collisions ? 0 : 1, [&](Flow& f) { CollisionLines(s, f); });
+  if (s.hand) add(0, [&](Flow& f) { ControlLines(s, f); });
+  if (s.guidance) add(0, [&](Flow& f) { GuidanceLines(s, f); });
+  if (s.telemetry) add(1, [&](Flow& f) { ConditionLines(s, config, width, f); });
+  add(2, [&](Flow& f) { CameraLines(s, config, f); });
+  add(4, [&](Flow& f) { ArmLines(s, f); });
+  add(3, [&](Flow& f) { RateLines(s, f); });
+  add(5, [&](Flow& f) { DeviceLines(s, f); });
+  add(6, [&](Flow& f) { HelpLines(s, f); });
+  return sections;
+}
+
+// The lines the sections take, with the events pane's heading.
+int LinesUsed(const std::vector<Section>& sections) {
+  int n = 1;
+  for (const Section& sec : sections) n += static_cast<int>(sec.lines.size());
+  return n;
+}
+
 }  // namespace
 
 std::string RenderStatusScreen(const StatusSnapshot& s, const LabConfig& config, int width, int height) {
-  if (width < kMinWidth || height < kMinHeight) {
-    // Too small for the screen: say so, in what room there is.
-    std::vector<std::string> L = {"rmslab operator station",
-                                  Sprintf("terminal %dx%d: needs %dx%d", width, height, kMinWidth, kMinHeight)};
-    if (s.telemetry) L.push_back(Sprintf("MODE %d%s%s", s.telemetry->mode, s.telemetry->acquired ? " ACQ" : "",
-                                         s.telemetry->docked ? " DOCK" : ""));
-    if (s.guidance) L.push_back(Sprintf("to go %.2f ft %.1f deg", s.guidance->distance_ft, s.guidance->angle_deg));
-    std::string out;
-    for (int i = 0; i < std::min<int>(height, static_cast<int>(L.size())); ++i) {
-      out += L[i].substr(0, static_cast<std::size_t>(std::max(width, 1))) + "\n";
-    }
-    return out;
-  }
-  // Sections in the order shown; when the terminal is short, the ones of
-  // lowest priority go first, so the events pane keeps at least 3 lines.
-  struct Section {
-    int priority;  // 0: always
-    std::vector<std::string> lines;
-  };
-  std::vector<Section> sections;
-  auto section = [&](int priority) -> Flow {
-    sections.push_back({priority, {}});
-    return Flow(&sections.back().lines, width);
-  };
-  {
-    Section top{0, {}};
-    const std::string title = "rmslab operator station -- " + s.source;
-    const std::string right = Sprintf("t %.1f s  frame %06lld", s.session_s, static_cast<long long>(s.frame));
-    top.lines.push_back(title + std::string(std::max<int>(1, width - static_cast<int>(title.size() + right.size())), ' ') +
-                        right);
-    sections.push_back(std::move(top));
-  }
-  // Priority 0 always; then 1 (conditions, docking), 2 (camera), 3
-  // (rates), 4 (arm), 5 (devices), 6 (the keys' help) go first on a short terminal.
-  {
-    Flow flow = section(0);
-    if (s.telemetry) ModeLines(s, flow);
-    else flow.Line("MODE ?  (no telemetry from dynamics_proc since the start, the last reset or restore)");
-  }
-  if (s.telemetry) {
-    Flow flow = section(s.telemetry->collisions ? 0 : 1);
-    CollisionLines(s, flow);
-  }
-  if (s.hand) {
-    Flow flow = section(0);
-    ControlLines(s, flow);
-  }
-  if (s.guidance) {
-    Flow flow = section(0);
-    GuidanceLines(s, flow);
-  }
-  if (s.telemetry) {
-    Flow flow = section(1);
-    ConditionLines(s, config, width, flow);
-  }
-  const wire::OperatorInputs& in = s.inputs;
-  {
-    Flow flow = section(2);
-    const int st = in.camera_station;
-    flow.Line(Sprintf("camera %d %s", st,
-                      st >= 1 && st <= static_cast<int>(config.cameras.size()) ? config.cameras[st - 1].name.c_str() : "?"))
-        .Field(Sprintf("pan %+6.1f  tilt %+6.1f  zoom %.2f", in.value[kCameraPan], in.value[kCameraTilt],
-                       in.value[kCameraZoom]))
-        .Field(std::string("crosshairs ") + (in.crosshairs ? "on" : "off"))
-        .Field(std::string("overlay ") + (in.overlay ? "on" : "off"));
-    if (s.hand) flow.Field(std::string("window guidance ") + (s.show_guidance ? "on" : "off"));
-  }
-  {
-    Flow flow = section(4);
-    flow.Line(Sprintf("arm, deg: yaw %+7.2f", in.value[0]))
-        .Field(Sprintf("pitch %+7.2f", in.value[1]))
-        .Field(Sprintf("elbow %+7.2f", in.value[2]))
-        .Field(Sprintf("wrist pitch %+7.2f", in.value[3]))
-        .Field(Sprintf("yaw %+7.2f", in.value[4]))
-        .Field(Sprintf("roll %+7.2f", in.value[5]))
-        .Field(Sprintf("shoulder height %.2f ft", in.value[kShoulderHeight]))
-        .Field(Sprintf("finger %.2f (0 open, 1 closed)", in.value[kFinger]));
-  }
-  {
-    Flow flow = section(3);
-    flow.Line(Sprintf("rates: published %.1f Hz", s.publish_hz))
-        .Field(Sprintf("DCP %.1f Hz", s.telemetry_hz))
-        .Field(s.render_hz >= 0 ? Sprintf("rendered %.1f Hz", s.render_hz) : "rendered ? (no status from esg_renderer)");
-    flow.Line("latency: input to DCP " + (s.input_to_dcp_ms >= 0 ? Sprintf("%.1f ms", s.input_to_dcp_ms) : "?"))
-        .Field("input to rendered frame " +
-               (s.input_to_render_p50_ms >= 0
-                    ? Sprintf("p50 %.1f ms, p99 %.1f ms", s.input_to_render_p50_ms, s.input_to_render_p99_ms)
-                    : std::string("? (no status from esg_renderer)")));
-    flow.Line(Sprintf("inputs clamped to their range: %ld", s.clamped_inputs));
-    if (s.key_actions >= 0) flow.Field(Sprintf("keys pressed: %ld", s.key_actions));
-  }
-  {
-    Flow flow = section(5);
-    flow.Line(s.devices.empty() ? "devices: none" : "devices: " + s.devices[0] + ";");
-    for (std::size_t i = 1; i < s.devices.size(); ++i) flow.Field(s.devices[i] + ";");
-  }
-  {
-    Flow flow = section(6);
-    if (!s.help.empty()) {
-      flow.Line("");
-      // Groups are two spaces apart ("w/s fwd/back  d/a right/left ...").
-      std::size_t from = 0;
-      while (from < s.help.size()) {
-        std::size_t to = s.help.find("  ", from);
-        if (to == std::string::npos) to = s.help.size();
-        if (to > from) flow.Field(s.help.substr(from, to - from));
-        from = to + 2;
-      }
-    }
-  }
+  if (width < kMinWidth || height < kMinHeight) return TooSmallScreen(s, width, height);
+  std::vector<Section> sections = BuildSections(s, config, width);
   // Drop the least important sections until the events pane has 3 lines.
   constexpr int kMinPane = 3;
-  auto used = [&] {
-    int n = 1;  // the pane's heading
-    for (const Section& sec : sections) n += static_cast<int>(sec.lines.size());
-    return n;
-  };
-  for (int p = 6; p >= 1 && used() + kMinPane > height; --p) {
+  for (int p = 6; p >= 1 && LinesUsed(sections) + kMinPane > height; --p) {
     for (Section& sec : sections) {
       if (sec.priority == p) sec.lines.clear();
     }
   }
-  const int pane = std::max(kMinPane, height - used());
+  const int pane = std::max(kMinPane, height - LinesUsed(sections));
   std::vector<std::string> L;
   const Section* help = nullptr;
   for (const Section& sec : sections) {

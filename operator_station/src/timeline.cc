@@ -42,6 +42,71 @@ std::string KnownKeys() {
 
 }  // namespace
 
+namespace {
+
+// A line's time: a number of seconds, not negative, not before the line
+// before's, at most 1e6; InputError "WHERE: why" otherwise.
+double LineTime(std::string_view tok, double prev_t, const std::string& where) {
+  double t = 0;
+  if (!ParseDouble(tok, &t)) throw InputError(where + ": '" + std::string(tok) + "' is not a time in seconds");
+  if (t < 0) throw InputError(where + ": time " + std::string(tok) + " is negative");
+  if (t < prev_t) {
+    throw InputError(where + ": time " + std::string(tok) +
+                     " s is before the previous line's time; lines must be in time order");
+  }
+  if (t > 1e6) throw InputError(where + ": time " + std::string(tok) + " s is beyond 1e6 s");
+  return t;
+}
+
+}  // namespace
+
+// One item of a line at time t: reset, end, or key=value.
+void Timeline::AddItem(double t, std::string_view item, const InputCalibrations& cal, const std::string& where,
+                       bool* end) {
+  auto fail = [&](const std::string& why) -> void { throw InputError(where + ": " + why); };
+  if (item == "reset") {
+    resets_.push_back(t);
+    return;
+  }
+  if (item == "end") {
+    *end = true;
+    return;
+  }
+  const std::size_t eq = item.find('=');
+  if (eq == std::string_view::npos) fail("'" + std::string(item) + "' is not key=value, reset or end");
+  const std::string key(item.substr(0, eq));
+  const std::string_view val = item.substr(eq + 1);
+  if (key == "camera") {
+    double v = 0;
+    if (!ParseDouble(val, &v) || v != std::floor(v) || v < 1 || v > 8) {
+      fail("camera must be a station number 1-8, got '" + std::string(val) + "'");
+    }
+    camera_.emplace_back(t, static_cast<int>(v));
+    return;
+  }
+  if (key == "overlay" || key == "crosshairs") {
+    auto& steps = key == "overlay" ? overlay_ : crosshairs_;
+    if (val == "on" || val == "1") steps.emplace_back(t, true);
+    else if (val == "off" || val == "0") steps.emplace_back(t, false);
+    else fail(std::string(key) + " must be on or off, got '" + std::string(val) + "'");
+    return;
+  }
+  const int idx = AnalogInputIndex(key);
+  if (idx < 0) fail("unknown key '" + key + "' (known: " + KnownKeys() + ")");
+  double v = 0;
+  if (!ParseDouble(val, &v)) fail("value '" + std::string(val) + "' for '" + key + "' is not a number");
+  const InputCalibration& c = cal[idx];
+  if (v < c.min || v > c.max) {
+    std::ostringstream w;
+    w << where << ": " << key << "=" << v << " is outside [" << c.min << ", " << c.max << "] " << c.unit
+      << "; it will be clamped";
+    warnings_.push_back(w.str());
+  }
+  auto& keys = analog_[idx];
+  if (!keys.empty() && keys.back().t == t) keys.back().v = v;
+  else keys.push_back({t, v});
+}
+
 Timeline Timeline::Parse(std::string_view text, const std::string& source,
                          const InputCalibrations& cal) {
   Timeline tl;
@@ -59,66 +124,13 @@ Timeline Timeline::Parse(std::string_view text, const std::string& source,
     if (const std::size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
     std::vector<std::string_view> tok = SplitWs(line);
     if (tok.empty()) continue;
-    auto fail = [&](const std::string& why) -> void {
-      throw InputError(source + ":" + std::to_string(line_no) + ": " + why);
-    };
-    if (have_end) fail("nothing may follow the 'end' line");
-    double t = 0;
-    if (!ParseDouble(tok[0], &t)) fail("'" + std::string(tok[0]) + "' is not a time in seconds");
-    if (t < 0) fail("time " + std::string(tok[0]) + " is negative");
-    if (t < prev_t) {
-      fail("time " + std::string(tok[0]) + " s is before the previous line's time; lines must be in time order");
-    }
-    if (t > 1e6) fail("time " + std::string(tok[0]) + " s is beyond 1e6 s");
+    const std::string where = source + ":" + std::to_string(line_no);
+    if (have_end) throw InputError(where + ": nothing may follow the 'end' line");
+    const double t = LineTime(tok[0], prev_t, where);
     prev_t = t;
     tl.end_time_ = t;
-    if (tok.size() == 1) fail("a time with nothing to do (expected key=value, reset or end)");
-    for (std::size_t i = 1; i < tok.size(); ++i) {
-      const std::string_view item = tok[i];
-      if (item == "reset") {
-        tl.resets_.push_back(t);
-        continue;
-      }
-      if (item == "end") {
-        have_end = true;
-        continue;
-      }
-      const std::size_t eq = item.find('=');
-      if (eq == std::string_view::npos) {
-        fail("'" + std::string(item) + "' is not key=value, reset or end");
-      }
-      const std::string key(item.substr(0, eq));
-      const std::string_view val = item.substr(eq + 1);
-      if (key == "camera") {
-        double v = 0;
-        if (!ParseDouble(val, &v) || v != std::floor(v) || v < 1 || v > 8) {
-          fail("camera must be a station number 1-8, got '" + std::string(val) + "'");
-        }
-        tl.camera_.emplace_back(t, static_cast<int>(v));
-        continue;
-      }
-      if (key == "overlay" || key == "crosshairs") {
-        auto& steps = key == "overlay" ? tl.overlay_ : tl.crosshairs_;
-        if (val == "on" || val == "1") steps.emplace_back(t, true);
-        else if (val == "off" || val == "0") steps.emplace_back(t, false);
-        else fail(std::string(key) + " must be on or off, got '" + std::string(val) + "'");
-        continue;
-      }
-      const int idx = AnalogInputIndex(key);
-      if (idx < 0) fail("unknown key '" + key + "' (known: " + KnownKeys() + ")");
-      double v = 0;
-      if (!ParseDouble(val, &v)) fail("value '" + std::string(val) + "' for '" + key + "' is not a number");
-      const InputCalibration& c = cal[idx];
-      if (v < c.min || v > c.max) {
-        std::ostringstream w;
-        w << source << ":" << line_no << ": " << key << "=" << v << " is outside [" << c.min << ", "
-          << c.max << "] " << c.unit << "; it will be clamped";
-        tl.warnings_.push_back(w.str());
-      }
-      auto& keys = tl.analog_[idx];
-      if (!keys.empty() && keys.back().t == t) keys.back().v = v;
-      else keys.push_back({t, v});
-    }
+    if (tok.size() == 1) throw InputError(where + ": a time with nothing to do (expected key=value, reset or end)");
+    for (std::size_t i = 1; i < tok.size(); ++i) tl.AddItem(t, tok[i], cal, where, &have_end);
   }
   if (tl.end_time_ <= 0.0) throw InputError(source + ": the timeline must last longer than 0 s");
   // Implicit keyframes at t = 0 with the initial values.

@@ -89,12 +89,10 @@ struct ShuttleDims {
   float L, hw, D, sill, belly;
 };
 
-void BuildShuttle(const ShuttleConfig& s, std::array<Cluster, kNumClusters>* c) {
-  const ShuttleDims d{static_cast<float>(s.bay_length_ft), static_cast<float>(s.bay_width_ft / 2),
-                      static_cast<float>(s.bay_depth_ft), static_cast<float>(s.bay_width_ft / 2) + 2.0f,
-                      -static_cast<float>(s.bay_depth_ft) - 5.0f};
+// The cargo bay's interior faces (its top face c is open), the longerons'
+// tops and the mid fuselage's sides.
+void BuildBay(const ShuttleDims& d, std::array<Cluster, kNumClusters>* c) {
   auto quad = [&](ClusterId id, V a, V b, V cc, V dd, V out, Rgb rgb) { (*c)[id].mesh.AddQuad(a, b, cc, dd, out, rgb); };
-  // The cargo bay's interior faces (the bay's top face c is open).
   quad(kFloor, V(0, -d.hw, -d.D), V(d.L, -d.hw, -d.D), V(d.L, d.hw, -d.D), V(0, d.hw, -d.D), V(0, 0, 1), kBayFloor);
   quad(kWallPort, V(0, -d.hw, -d.D), V(d.L, -d.hw, -d.D), V(d.L, -d.hw, 0), V(0, -d.hw, 0), V(0, 1, 0), kBayWall);
   quad(kWallStbd, V(0, d.hw, -d.D), V(d.L, d.hw, -d.D), V(d.L, d.hw, 0), V(0, d.hw, 0), V(0, -1, 0), kBayWall);
@@ -105,53 +103,58 @@ void BuildShuttle(const ShuttleConfig& s, std::array<Cluster, kNumClusters>* c) 
   quad(kSillStbd, V(0, d.hw, 0), V(d.L, d.hw, 0), V(d.L, d.sill, 0), V(0, d.sill, 0), V(0, 0, 1), kWhite);
   quad(kSidePort, V(0, -d.sill, 0), V(d.L, -d.sill, 0), V(d.L, -d.sill, d.belly), V(0, -d.sill, d.belly), V(0, -1, 0), kWhite);
   quad(kSideStbd, V(0, d.sill, 0), V(d.L, d.sill, 0), V(d.L, d.sill, d.belly), V(0, d.sill, d.belly), V(0, 1, 0), kWhite);
+}
+
+void BuildCabin(const ShuttleDims& d, std::array<Cluster, kNumClusters>* c) {
   // The crew cabin and its nose: one convex solid (a box and the frustum on
   // its front face); the aft flight deck windows and the forward windows are
   // decals.
-  {
-    Mesh& m = (*c)[kCabin].mesh;
-    const float x0 = -28.0f, xa = -0.05f, top = 6.0f, cw = d.hw + 1.5f, xn = -44.0f;
-    const V a(x0, -cw, d.belly), b(x0, cw, d.belly), cc(x0, cw, top), dd(x0, -cw, top);
-    const V ea(xa, -cw, d.belly), eb(xa, cw, d.belly), ec(xa, cw, top), ed(xa, -cw, top);
-    const V an(xn, -2.5f, -12.0f), bn(xn, 2.5f, -12.0f), cn(xn, 2.5f, -6.0f), dn(xn, -2.5f, -6.0f);
-    Hull h{&m, V((x0 + xa + 2 * xn) / 4, 0, (d.belly + top) / 2)};
-    h.Quad(ea, eb, ec, ed, kWhite);       // aft face
-    h.Quad(a, b, eb, ea, kTile);          // belly
-    h.Quad(dd, cc, ec, ed, kWhite);       // roof
-    h.Quad(a, dd, ed, ea, kWhite);        // port side
-    h.Quad(b, cc, ec, eb, kWhite);        // starboard side
-    h.Quad(a, b, bn, an, kTile);          // nose, underside
-    h.Quad(b, cc, cn, bn, kWhite);
-    h.Quad(cc, dd, dn, cn, kWhite);
-    h.Quad(dd, a, an, dn, kWhite);
-    h.Quad(an, bn, cn, dn, kTile);        // nose tip
-    m.SetDecal(true);
-    for (float sg : {-1.0f, 1.0f}) {      // aft flight deck windows
-      const float y0 = sg * 0.6f, y1 = sg * 3.2f, x = xa + kDecalOffset;
-      m.AddQuad(V(x, y0, 1.2f), V(x, y1, 1.2f), V(x, y1, 4.2f), V(x, y0, 4.2f), V(1, 0, 0), kWindow);
-    }
-    // Forward windows on the sloping roof of the nose.
-    V up = (cn - cc).cross(dd - cc).normalized();
-    if (up.z() < 0) up = -up;  // the sloping roof's outward normal
-    const V side = (dd - cc).normalized(), fwd = (cn - cc).normalized();
-    const V w0 = cc + 0.15f * (cn - cc) + kDecalOffset * up;
-    m.AddQuad(w0 + 1.0f * side, w0 + 1.0f * side + 2.5f * fwd, w0 + (2 * cw - 1.0f) * side + 2.5f * fwd,
-              w0 + (2 * cw - 1.0f) * side, up, kWindow);
-    m.SetDecal(false);
+  Mesh& m = (*c)[kCabin].mesh;
+  const float x0 = -28.0f, xa = -0.05f, top = 6.0f, cw = d.hw + 1.5f, xn = -44.0f;
+  const V a(x0, -cw, d.belly), b(x0, cw, d.belly), cc(x0, cw, top), dd(x0, -cw, top);
+  const V ea(xa, -cw, d.belly), eb(xa, cw, d.belly), ec(xa, cw, top), ed(xa, -cw, top);
+  const V an(xn, -2.5f, -12.0f), bn(xn, 2.5f, -12.0f), cn(xn, 2.5f, -6.0f), dn(xn, -2.5f, -6.0f);
+  Hull h{&m, V((x0 + xa + 2 * xn) / 4, 0, (d.belly + top) / 2)};
+  h.Quad(ea, eb, ec, ed, kWhite);       // aft face
+  h.Quad(a, b, eb, ea, kTile);          // belly
+  h.Quad(dd, cc, ec, ed, kWhite);       // roof
+  h.Quad(a, dd, ed, ea, kWhite);        // port side
+  h.Quad(b, cc, ec, eb, kWhite);        // starboard side
+  h.Quad(a, b, bn, an, kTile);          // nose, underside
+  h.Quad(b, cc, cn, bn, kWhite);
+  h.Quad(cc, dd, dn, cn, kWhite);
+  h.Quad(dd, a, an, dn, kWhite);
+  h.Quad(an, bn, cn, dn, kTile);        // nose tip
+  m.SetDecal(true);
+  for (float sg : {-1.0f, 1.0f}) {      // aft flight deck windows
+    const float y0 = sg * 0.6f, y1 = sg * 3.2f, x = xa + kDecalOffset;
+    m.AddQuad(V(x, y0, 1.2f), V(x, y1, 1.2f), V(x, y1, 4.2f), V(x, y0, 4.2f), V(1, 0, 0), kWindow);
   }
+  // Forward windows on the sloping roof of the nose.
+  V up = (cn - cc).cross(dd - cc).normalized();
+  if (up.z() < 0) up = -up;  // the sloping roof's outward normal
+  const V side = (dd - cc).normalized(), fwd = (cn - cc).normalized();
+  const V w0 = cc + 0.15f * (cn - cc) + kDecalOffset * up;
+  m.AddQuad(w0 + 1.0f * side, w0 + 1.0f * side + 2.5f * fwd, w0 + (2 * cw - 1.0f) * side + 2.5f * fwd,
+            w0 + (2 * cw - 1.0f) * side, up, kWindow);
+  m.SetDecal(false);
+}
+
+void BuildAftFuselage(const ShuttleDims& d, std::array<Cluster, kNumClusters>* c) {
   // Aft fuselage with the main engines' bells as decals on its aft face.
-  {
-    Mesh& m = (*c)[kAftFuselage].mesh;
-    const float xa = d.L + 0.05f, xe = d.L + 18.0f;
-    m.AddBox(V(xa, -d.sill, d.belly), V(xe, d.sill, 2.0f), kWhite);
-    m.SetDecal(true);
-    for (const V& e : {V(xe + kDecalOffset, 0, -3), V(xe + kDecalOffset, -4.5f, -10), V(xe + kDecalOffset, 4.5f, -10)}) {
-      Disc(&m, e, V(1, 0, 0), 2.6f, 10, kEngine);
-    }
-    m.SetDecal(false);
-    (*c)[kTail].mesh.AddExtrusion({V(d.L + 4, -0.8f, 2 + kGap), V(xe + 4, -0.8f, 2 + kGap), V(xe + 10, -0.8f, 30), V(xe + 2, -0.8f, 30)},
-                                  V(0, 1.6f, 0), kWhite);
+  Mesh& m = (*c)[kAftFuselage].mesh;
+  const float xa = d.L + 0.05f, xe = d.L + 18.0f;
+  m.AddBox(V(xa, -d.sill, d.belly), V(xe, d.sill, 2.0f), kWhite);
+  m.SetDecal(true);
+  for (const V& e : {V(xe + kDecalOffset, 0, -3), V(xe + kDecalOffset, -4.5f, -10), V(xe + kDecalOffset, 4.5f, -10)}) {
+    Disc(&m, e, V(1, 0, 0), 2.6f, 10, kEngine);
   }
+  m.SetDecal(false);
+  (*c)[kTail].mesh.AddExtrusion({V(d.L + 4, -0.8f, 2 + kGap), V(xe + 4, -0.8f, 2 + kGap), V(xe + 10, -0.8f, 30), V(xe + 2, -0.8f, 30)},
+                                V(0, 1.6f, 0), kWhite);
+}
+
+void BuildWings(const ShuttleDims& d, std::array<Cluster, kNumClusters>* c) {
   // Wings (delta): white above, tiles below; the root lies against the side.
   for (float sg : {-1.0f, 1.0f}) {
     Mesh& m = (*c)[sg < 0 ? kWingPort : kWingStbd].mesh;
@@ -165,28 +168,40 @@ void BuildShuttle(const ShuttleConfig& s, std::array<Cluster, kNumClusters>* c) 
     m.AddQuad(at(p1, z0), at(p2, z0), at(p2, z1), at(p1, z1), V(1, 0, 0), kTile);
     m.AddQuad(at(p2, z0), at(p3, z0), at(p3, z1), at(p2, z1), V(0, sg, 0), kWhite);
   }
+}
+
+void BuildDoors(const ShuttleConfig& s, const ShuttleDims& d, std::array<Cluster, kNumClusters>* c) {
   // The payload bay doors, open by door_open_deg about the hinge at each
   // longeron: thin slabs. Closed, a door reaches inboard with its radiators
   // facing down; opening turns it up and over, so at 175 deg the radiators
   // face (almost) straight up.
-  {
-    const float phi = static_cast<float>(s.door_open_deg * M_PI / 180.0);
-    const float width = d.hw + 2.5f, thick = 0.1f;
-    for (float sg : {-1.0f, 1.0f}) {
-      Mesh& m = (*c)[sg < 0 ? kDoorPort : kDoorStbd].mesh;
-      const V dir(0, -sg * std::cos(phi), std::sin(phi));       // from the hinge across the door
-      const V n_in(0, -sg * std::sin(phi), -std::cos(phi));     // the radiator side's normal
-      const V a(0, sg * d.sill, 0.1f), b(d.L, sg * d.sill, 0.1f), cc = b + width * dir, dd = a + width * dir;
-      const V back = -thick * n_in;  // the outer skin, one thickness behind the radiators
-      Hull h{&m, (a + cc) * 0.5f + 0.5f * back};
-      h.Quad(a, b, cc, dd, kRadiator);
-      h.Quad(a + back, b + back, cc + back, dd + back, kWhite);
-      h.Quad(a, b, b + back, a + back, kWhite);
-      h.Quad(b, cc, cc + back, b + back, kWhite);
-      h.Quad(cc, dd, dd + back, cc + back, kWhite);
-      h.Quad(dd, a, a + back, dd + back, kWhite);
-    }
+  const float phi = static_cast<float>(s.door_open_deg * M_PI / 180.0);
+  const float width = d.hw + 2.5f, thick = 0.1f;
+  for (float sg : {-1.0f, 1.0f}) {
+    Mesh& m = (*c)[sg < 0 ? kDoorPort : kDoorStbd].mesh;
+    const V dir(0, -sg * std::cos(phi), std::sin(phi));       // from the hinge across the door
+    const V n_in(0, -sg * std::sin(phi), -std::cos(phi));     // the radiator side's normal
+    const V a(0, sg * d.sill, 0.1f), b(d.L, sg * d.sill, 0.1f), cc = b + width * dir, dd = a + width * dir;
+    const V back = -thick * n_in;  // the outer skin, one thickness behind the radiators
+    Hull h{&m, (a + cc) * 0.5f + 0.5f * back};
+    h.Quad(a, b, cc, dd, kRadiator);
+    h.Quad(a + back, b + back, cc + back, dd + back, kWhite);
+    h.Quad(a, b, b + back, a + back, kWhite);
+    h.Quad(b, cc, cc + back, b + back, kWhite);
+    h.Quad(cc, dd, dd + back, cc + back, kWhite);
+    h.Quad(dd, a, a + back, dd + back, kWhite);
   }
+}
+
+void BuildShuttle(const ShuttleConfig& s, std::array<Cluster, kNumClusters>* c) {
+  const ShuttleDims d{static_cast<float>(s.bay_length_ft), static_cast<float>(s.bay_width_ft / 2),
+                      static_cast<float>(s.bay_depth_ft), static_cast<float>(s.bay_width_ft / 2) + 2.0f,
+                      -static_cast<float>(s.bay_depth_ft) - 5.0f};
+  BuildBay(d, c);
+  BuildCabin(d, c);
+  BuildAftFuselage(d, c);
+  BuildWings(d, c);
+  BuildDoors(s, d, c);
 }
 
 void BuildCae(const CaeConfig& cae, std::array<Cluster, kNumClusters>* c) {

@@ -23,6 +23,7 @@
 // the finger stops on it and the acquisition conditions are met.
 #include <array>
 #include <cstdint>
+#include <memory>
 
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
@@ -219,6 +220,21 @@ class DynamicCollisionProgram {
   // the hints (frame coherence); null: none. e->ee is left as it was outside
   // Mode 1 (only Mode 1 reads it).
   void Evaluate(const ArmCommand& cmd, const Evaluation* prev, Evaluation* e) const;
+  // The mode's tests of Evaluate, and every other pair when asked.
+  void EvaluateMode1(const Evaluation* prev, Evaluation* e) const;
+  void EvaluateMode2(Evaluation* e) const;
+  void EvaluateMode3(const Evaluation* prev, Evaluation* e) const;
+  void EvaluateExtraPairs(Evaluation* e) const;
+  // The parts of Step: the inputs taken, the slave's command, the first
+  // frame, the output block.
+  ArmCommand TakeInputs(const wire::OperatorInputs& in);
+  ArmCommand SlaveCommand(const ArmCommand& master);
+  void FirstFrame(const ArmCommand& command);
+  wire::DcpFrameData FrameOut(const wire::OperatorInputs& in) const;
+  // RestoreState's parts: every key read, then checked.
+  struct RestoredState;
+  std::unique_ptr<RestoredState> ReadRestoredState(const nlohmann::json& j) const;
+  void CheckRestoredState(const RestoredState& p) const;
   // The payload's and probe's vertices against the bay's walls and bottom
   // (a vertex below face c beyond one), Modes 2 and 3.
   // EFF HEX 1-3 (out->ee) against the resting payload: collision bits,

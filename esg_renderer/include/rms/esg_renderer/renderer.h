@@ -75,6 +75,14 @@ class FrameRenderer {
     std::vector<std::uint8_t> colours;
   };
   void DrawCluster(GpuCluster& c, const Eigen::Affine3d& X_RC, const Eigen::Matrix4d& view);
+  // Cluster c's silhouette on the screen (view: R to eye; P: projection);
+  // not visible, and counted, when culled.
+  ScreenBox Silhouette(int c, const scene_model::ClusterPoses& poses, const wire::EsgFrameData& f,
+                       const Eigen::Matrix4d& view, const Eigen::Matrix4d& P);
+  // The clusters drawn in the order the frame's priority bits give.
+  void DrawInOrder(const wire::EsgFrameData& f, const scene_model::ClusterPoses& poses,
+                   const std::array<ScreenBox, scene_model::kNumClusters>& boxes, const Eigen::Matrix4d& view,
+                   const Eigen::Matrix4d& P);
 
   const LabConfig& config_;
   GlContext* context_;

@@ -80,6 +80,9 @@ class OperatorStation {
   const Counters& counters() const { return counters_; }
 
  private:
+  void ResumeFromTelemetry();
+  bool StepFrame(transport::StatusReporter* status);
+  int Finish(const std::string& stats_path, transport::StatusReporter* status);
   void Subscribe();
   void OnTelemetry(const void* data, int size, std::int64_t recv_us);
   void OnStatus(const void* data, int size, std::int64_t recv_us);
