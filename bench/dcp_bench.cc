@@ -128,12 +128,16 @@ rms::arm::ArmSinCos Quantize(const rms::arm::ArmSinCos& sc, int how) {  // 0 dou
   return q;
 }
 
-double QuantizeFt(double x, int how) {
+// Not inlined: GCC 12.2 at -O3 miscompiles a loop that stores
+// `how == 1 ? double(float(x)) : x` into a matrix (its SLP vectorizer drops
+// the float rounding; a 15-line reproducer without Eigen shows it, and
+// -fno-tree-slp-vectorize or clang get it right). Called, the rounding stays.
+[[gnu::noinline]] double QuantizeFt(double x, int how) {
   if (how == 1) return static_cast<float>(x);
   if (how == 2) return rms::wire::RoundTrip(rms::wire::kFT12, x);
   return x;
 }
-double QuantizeUnit(double x, int how) {
+[[gnu::noinline]] double QuantizeUnit(double x, int how) {
   if (how == 1) return static_cast<float>(x);
   if (how == 2) return rms::wire::RoundTrip(rms::wire::kSC22, x);
   return x;

@@ -224,47 +224,84 @@ struct SoakStats {
   double worst_orthonormal = 0, worst_rigid_ft = 0;
 };
 
-void Soak(const LabConfig& config, long frames, std::uint64_t seed, SoakStats* st, Failures* fail) {
-  // Checkpoints of Modes 2 and 3 from the autopilot's mission.
+// Checkpoints of Modes 2 and 3 from the autopilot's mission, each a little
+// after entering the mode.
+std::vector<nlohmann::json> MissionCheckpoints(const LabConfig& config, Failures* fail) {
   std::vector<wire::OperatorInputs> inputs;
   rms::sim::FlyAutopilot(config, {}, 20000, 1, &inputs);
   std::vector<nlohmann::json> checkpoints;
-  {
-    DynamicCollisionProgram d(config);
-    int last_mode = 1;
-    for (std::size_t f = 0; f < inputs.size(); ++f) {
-      d.Step(inputs[f]);
-      if (d.mode() != last_mode && d.mode() >= 2 && !d.status().docked) {
-        // A little after entering the mode.
-        for (int k = 0; k < 30 && f + 1 < inputs.size(); ++k) d.Step(inputs[++f]);
-        checkpoints.push_back(d.SaveState());
-      }
-      last_mode = d.mode();
+  DynamicCollisionProgram d(config);
+  int last_mode = 1;
+  for (std::size_t f = 0; f < inputs.size(); ++f) {
+    d.Step(inputs[f]);
+    if (d.mode() != last_mode && d.mode() >= 2 && !d.status().docked) {
+      for (int k = 0; k < 30 && f + 1 < inputs.size(); ++k) d.Step(inputs[++f]);
+      checkpoints.push_back(d.SaveState());
     }
+    last_mode = d.mode();
   }
   if (checkpoints.size() < 2) fail->Add("no Mode 2 / Mode 3 checkpoint from the mission", "autopilot");
+  return checkpoints;
+}
 
+std::array<double, 12> EdgeLengths(const Hexahedron& h) {
+  std::array<double, 12> l;
+  for (int e = 0; e < 12; ++e) l[e] = (h.vertex(kEdges[e][0]) - h.vertex(kEdges[e][1])).norm();
+  return l;
+}
+
+// One soak frame's state: finite, rotations orthonormal, a held payload
+// rigid, the slave free (but right after a start, reset or restore), every
+// plane sent separating its pair. False when the state is not finite.
+bool CheckSoakFrame(const LabConfig& config, const DynamicCollisionProgram& dcp, const wire::DcpFrameData& out,
+                    bool fresh, bool reset, const std::string& what, SoakStats* st, Failures* fail) {
+  const DcpStatus& s = dcp.status();
+  if (!s.X_RS2.matrix().allFinite() || !s.X_RP.matrix().allFinite() || !std::isfinite(s.finger_gap_ft) ||
+      !std::isfinite(s.dock_distance_ft) || !std::isfinite(s.dock_angle_deg)) {
+    fail->Add("NaN or infinity in the DCP's state", what);
+    return false;
+  }
+  const double orth = (s.X_RS2.linear().transpose() * s.X_RS2.linear() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  const double orth_p = (s.X_RP.linear().transpose() * s.X_RP.linear() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  st->worst_orthonormal = std::max({st->worst_orthonormal, orth, orth_p});
+  if (orth > 1e-12 || orth_p > 1e-12) fail->Add("a rotation drifted from orthonormal (1e-12)", what);
+  if (s.mode >= 2) {
+    const Eigen::Isometry3d X_RP_bay = arm::MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft);
+    const auto l0 = EdgeLengths(MakePayload(config.payload, X_RP_bay).body[0]);
+    const auto l = EdgeLengths(MakePayload(config.payload, s.X_RP).body[0]);
+    for (int e = 0; e < 12; ++e) st->worst_rigid_ft = std::max(st->worst_rigid_ft, std::fabs(l[e] - l0[e]));
+    if (st->worst_rigid_ft > 1e-9) fail->Add("the held payload is not rigid (1e-9 ft)", what);
+  }
+  if (s.slave_collisions != 0 && !fresh && !reset)
+    fail->Add("the slave shown in collision", what + Sprintf(": bits 0x%x, held %d, finger held %d, reset %d",
+                                                             s.slave_collisions, s.held, s.finger_held, reset));
+  const Hexahedron bar_bay =
+      MakeBar(config.payload, arm::MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft));
+  for (int k = 0; k < 3; ++k) {
+    if (!(out.plane_valid & (1u << k))) continue;
+    ++st->planes;
+    const EndEffectorModel ee = MakeEndEffector(config.end_effector, s.X_RS2, s.finger_gap_ft);
+    const double tol = 1e-9 * std::max(ee.hex[k].scale, bar_bay.scale);  // the same size wherever it rests
+    // The bar where the payload rests (the bay, or where the finger let it go).
+    const Hexahedron bar = MakeBar(config.payload, s.X_RP);
+    if (!PlaneSeparates(ee.hex[k], bar, out.planes[k].n_R, out.planes[k].d_ft, tol))
+      fail->Add("a plane sent does not separate its pair", what);
+  }
+  return true;
+}
+
+void Soak(const LabConfig& config, long frames, std::uint64_t seed, SoakStats* st, Failures* fail) {
+  const std::vector<nlohmann::json> checkpoints = MissionCheckpoints(config, fail);
   DynamicCollisionProgram dcp(config);
   rms::sim::RandomOperator op(config.inputs, seed);
   Counters counters;
-  // The payload's body edge lengths, to check the held payload stays rigid.
-  const PayloadModel p0 = MakePayload(config.payload, arm::MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft));
-  auto edge_lengths = [](const Hexahedron& h) {
-    std::array<double, 12> l;
-    for (int e = 0; e < 12; ++e) l[e] = (h.vertex(kEdges[e][0]) - h.vertex(kEdges[e][1])).norm();
-    return l;
-  };
-  const auto l0 = edge_lengths(p0.body[0]);
-  const Hexahedron bar_bay = MakeBar(config.payload, arm::MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft));
-  std::optional<Eigen::Isometry3d> first_after_reset;
-  std::array<double, 8> first_inputs{};
   bool fresh = true;  // the next frame follows a start, a reset or a restore
   for (long f = 0; f < frames; ++f) {
     if (f > 0 && f % 5000 == 0 && !checkpoints.empty()) {
       dcp.RestoreState(checkpoints[(f / 5000) % checkpoints.size()]);
       ++st->restores;
     }
-    wire::OperatorInputs in = op.Next();
+    const wire::OperatorInputs in = op.Next();
     const auto words = wire::EncodeInputs(in, config.inputs, &counters);
     const wire::OperatorInputs dec = wire::DecodeInputs(words, config.inputs, &counters);
     if (dec.reset) ++st->resets;
@@ -273,56 +310,18 @@ void Soak(const LabConfig& config, long frames, std::uint64_t seed, SoakStats* s
     const DcpStatus& s = dcp.status();
     ++st->frames_in_mode[s.mode];
     st->held += s.held;
-    const std::string what = Sprintf("frame %ld (mode %d)", f, s.mode);
-    const dcp_telemetry_t tm = MakeTelemetry(s, out);
-    (void)tm;
-    if (!s.X_RS2.matrix().allFinite() || !s.X_RP.matrix().allFinite() || !std::isfinite(s.finger_gap_ft) ||
-        !std::isfinite(s.dock_distance_ft) || !std::isfinite(s.dock_angle_deg)) {
-      fail->Add("NaN or infinity in the DCP's state", what);
+    (void)MakeTelemetry(s, out);  // the telemetry is made from every state
+    if (!CheckSoakFrame(config, dcp, out, fresh, dec.reset, Sprintf("frame %ld (mode %d)", f, s.mode), st, fail)) {
       continue;
-    }
-    const double orth = (s.X_RS2.linear().transpose() * s.X_RS2.linear() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
-    const double orth_p = (s.X_RP.linear().transpose() * s.X_RP.linear() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
-    st->worst_orthonormal = std::max({st->worst_orthonormal, orth, orth_p});
-    if (orth > 1e-12 || orth_p > 1e-12) fail->Add("a rotation drifted from orthonormal (1e-12)", what);
-    if (s.mode >= 2) {
-      const auto l = edge_lengths(MakePayload(config.payload, s.X_RP).body[0]);
-      for (int e = 0; e < 12; ++e) st->worst_rigid_ft = std::max(st->worst_rigid_ft, std::fabs(l[e] - l0[e]));
-      if (st->worst_rigid_ft > 1e-9) fail->Add("the held payload is not rigid (1e-9 ft)", what);
-    }
-    if (s.slave_collisions != 0 && !fresh && !dec.reset)
-      fail->Add("the slave shown in collision",
-                what + Sprintf(": bits 0x%x, held %d, finger held %d, reset %d", s.slave_collisions, s.held,
-                               s.finger_held, dec.reset));
-    for (int k = 0; k < 3; ++k) {
-      if (!(out.plane_valid & (1u << k))) continue;
-      ++st->planes;
-      const EndEffectorModel ee = MakeEndEffector(config.end_effector, s.X_RS2, s.finger_gap_ft);
-      const double tol = 1e-9 * std::max(ee.hex[k].scale, bar_bay.scale);  // the same size wherever it rests
-      // The bar where the payload rests (the bay, or where the finger let it go).
-      const Hexahedron bar = MakeBar(config.payload, s.X_RP);
-      if (!PlaneSeparates(ee.hex[k], bar, out.planes[k].n_R, out.planes[k].d_ft, tol))
-        fail->Add("a plane sent does not separate its pair", what);
-    }
-    // After a reset the same inputs give the same state as the first frame.
-    if (dec.reset) {
-      std::array<double, 8> v;
-      std::copy(dec.value.begin(), dec.value.begin() + 8, v.begin());
-      if (!first_after_reset) {
-        first_after_reset = s.X_RS2;
-        first_inputs = v;
-      }
     }
     // Until the slave first takes a collision-free command it may start in collision.
     fresh = dec.reset || (fresh && s.slave_collisions != 0);
   }
   // Drift over the soak: nothing accumulates; the slave's pose is its
   // command's, through the transmitted words, bit for bit.
-  (void)first_after_reset;
-  (void)first_inputs;
   const DcpStatus& end = dcp.status();
   const rms::arm::ArmPose pose = rms::arm::ComputeArmPose(config.arm, TransmittedArmWords(end.slave.angles_deg),
-                                                end.slave.shoulder_height_ft);
+                                                          end.slave.shoulder_height_ft);
   if (!(pose.X_RS2.matrix() == end.X_RS2.matrix())) fail->Add("the slave's pose drifted from its command's", "end of soak");
 }
 

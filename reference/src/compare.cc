@@ -28,6 +28,96 @@ const char* DeciderName(dynamics_proc::Decider d) {
   }
   return "?";
 }
+
+// Pair n of the comparison at this scale. Every third block of 8 draws from
+// all ten kinds (three of them general hexahedra), the rest from the seven
+// box kinds: 10% general in all. Every 7th pair: two boxes with nearly
+// parallel edges, gap or overlap from just outside the band to 100x it (or
+// inside it, one in 8). Every 5th pair of scale <= 1 ft is moved 1 to 1e4 ft
+// from the origin.
+Pair DrawPair(PairGenerator& gen, long n, double scale, double band_rel) {
+  const bool boxes_only = (n / 8) % 3 != 2;
+  Pair p;
+  if (n % 7 == 3) {
+    std::uniform_real_distribution<double> lg(0.0, 2.0);
+    std::uniform_int_distribution<int> sg(0, 15);
+    const int k = sg(gen.rng());
+    const double mag = (k < 2 ? 0.5 : 1.01) * band_rel * std::pow(10.0, k < 2 ? -lg(gen.rng()) : lg(gen.rng()));
+    p = gen.NearParallelEdges(scale, k % 2 ? mag : -mag);
+  } else {
+    p = gen.Next(scale, boxes_only);
+  }
+  if (n % 5 == 1 && scale <= 1.0) {
+    std::uniform_real_distribution<double> lg(0.0, 4.0);
+    const Eigen::Vector3d dir = RandomRotation(gen.rng()).col(0);
+    p = Translated(p, std::pow(10.0, lg(gen.rng())) * dir);
+  }
+  return p;
+}
+
+// The reference's verdict: boxes by the long double separating-axis test
+// (exactly, every exact_every-th pair and every near-parallel one: exact
+// wins), general hexahedra exactly.
+bool ReferenceHit(const Pair& p, long n, int exact_every, CompareStats* st) {
+  if (!(p.a.is_box && p.b.is_box)) {
+    ++st->exact_checked;
+    return ExactHullsIntersect(p.a.v, p.b.v);
+  }
+  bool hit = BoxesIntersect(p.a.box, p.b.box);
+  if ((exact_every > 0 && n % exact_every == 0) || p.kind.rfind("near-parallel", 0) == 0) {
+    ++st->exact_checked;
+    hit = ExactHullsIntersect(p.a.v, p.b.v);  // near contact the long double test may differ; exact wins
+  }
+  return hit;
+}
+
+// The DCP's verdict and plane against the reference's, within the band
+// (docs/collision.md "Tolerance rule": 1000 x tau).
+void Judge(const Pair& p, const dynamics_proc::CollisionResult& r, bool ref_hit, long n, double scale,
+           double band_rel, const Topology& topo, CompareStats* st) {
+  const double band = 1000.0 * dynamics_proc::ToleranceFt(p.a.hex, p.b.hex, band_rel / 1000.0);
+  const double s = std::max(p.a.hex.scale, p.b.hex.scale);
+  if (r.verdict == dynamics_proc::Verdict::kInvalid) {
+    ++st->invalid;
+    if (st->examples.size() < 10) {
+      st->examples.push_back("pair " + std::to_string(n) + " (" + p.kind + ", scale " + std::to_string(scale) +
+                             "): invalid: " + dynamics_proc::HexProblemName(p.a.hex.valid ? p.b.hex.problem : p.a.hex.problem));
+    }
+    return;
+  }
+  const bool dcp_hit = r.verdict == dynamics_proc::Verdict::kCollide;
+  // The pair's separation, only when needed: distance if disjoint, minus
+  // the penetration depth if overlapping.
+  auto separation = [&] {
+    return ref_hit ? -static_cast<double>(PenetrationDepth(p.a.v, p.b.v, topo))
+                   : static_cast<double>(HullDistance(p.a.v, p.b.v, topo));
+  };
+  if (dcp_hit != ref_hit) {
+    const double sep = separation();
+    if (std::abs(sep) <= band) {
+      ++st->disagree_in_band;
+      ++st->in_band_by_kind[p.kind];
+      return;
+    }
+    ++st->disagree_outside;
+    if (st->examples.size() < 10) {
+      std::ostringstream os;
+      os.precision(17);
+      os << "pair " << n << " (" << p.kind << ", scale " << scale << "): dcp " << (dcp_hit ? "collide" : "separate")
+         << " by '" << DeciderName(r.decider) << "', reference " << (ref_hit ? "intersect" : "disjoint")
+         << ", separation " << sep << " = " << sep / s << " x scale (band " << band / s << " x scale)";
+      st->examples.push_back(os.str());
+    }
+  } else if (!dcp_hit) {
+    // Separate: the plane must separate the solids (within the band).
+    if (!r.plane_valid) {
+      if (separation() > band) ++st->plane_missing;
+    } else if (!dynamics_proc::PlaneSeparates(p.a.hex, p.b.hex, r.plane.n_R, r.plane.d_ft, band)) {
+      ++st->plane_wrong;
+    }
+  }
+}
+
 }  // namespace
 
 CompareStats Compare(std::uint64_t seed, long count, double band_rel, int exact_every) {
@@ -38,93 +128,19 @@ CompareStats Compare(std::uint64_t seed, long count, double band_rel, int exact_
   using Clock = std::chrono::steady_clock;
   for (long n = 0; n < count; ++n) {
     const double scale = kScales[n % 8];
-    // Every third block of 8 draws from all ten kinds (three of them general
-    // hexahedra), the rest from the seven box kinds: 10% general in all.
-    const bool boxes_only = (n / 8) % 3 != 2;
-    // Every 7th pair: two boxes with nearly parallel edges, gap or overlap
-    // from just outside the band to 100x it (or inside it, one in 8). Every
-    // 5th pair of scale <= 1 ft is moved 1 to 1e4 ft from the origin.
-    Pair p;
-    if (n % 7 == 3) {
-      std::uniform_real_distribution<double> lg(0.0, 2.0);
-      std::uniform_int_distribution<int> sg(0, 15);
-      const int k = sg(gen.rng());
-      const double mag = (k < 2 ? 0.5 : 1.01) * band_rel * std::pow(10.0, k < 2 ? -lg(gen.rng()) : lg(gen.rng()));
-      p = gen.NearParallelEdges(scale, k % 2 ? mag : -mag);
-    } else {
-      p = gen.Next(scale, boxes_only);
-    }
-    if (n % 5 == 1 && scale <= 1.0) {
-      std::uniform_real_distribution<double> lg(0.0, 4.0);
-      const Eigen::Vector3d dir = RandomRotation(gen.rng()).col(0);
-      p = Translated(p, std::pow(10.0, lg(gen.rng())) * dir);
-    }
+    const Pair p = DrawPair(gen, n, scale, band_rel);
     ++st.pairs;
     ++st.pairs_by_kind[p.kind];
-
-    auto t0 = Clock::now();
+    const auto t0 = Clock::now();
     const dynamics_proc::CollisionResult r = dynamics_proc::Collide(p.a.hex, p.b.hex);
-    auto t1 = Clock::now();
-    bool ref_hit;
-    if (p.a.is_box && p.b.is_box) {
-      ref_hit = BoxesIntersect(p.a.box, p.b.box);
-      if ((exact_every > 0 && n % exact_every == 0) || p.kind.rfind("near-parallel", 0) == 0) {
-        ++st.exact_checked;
-        const bool exact = ExactHullsIntersect(p.a.v, p.b.v);
-        if (exact != ref_hit) ref_hit = exact;  // near contact the long double test may differ; exact wins
-      }
-    } else {
-      ++st.exact_checked;
-      ref_hit = ExactHullsIntersect(p.a.v, p.b.v);
-    }
-    auto t2 = Clock::now();
+    const auto t1 = Clock::now();
+    const bool ref_hit = ReferenceHit(p, n, exact_every, &st);
+    const auto t2 = Clock::now();
     st.dcp_seconds += std::chrono::duration<double>(t1 - t0).count();
     st.ref_seconds += std::chrono::duration<double>(t2 - t1).count();
     ++st.deciders[DeciderName(r.decider)];
     st.collide += ref_hit;
-    // The band (docs/collision.md "Tolerance rule"): 1000 x tau.
-    const double band = 1000.0 * dynamics_proc::ToleranceFt(p.a.hex, p.b.hex, band_rel / 1000.0);
-    const double s = std::max(p.a.hex.scale, p.b.hex.scale);
-    if (r.verdict == dynamics_proc::Verdict::kInvalid) {
-      ++st.invalid;
-      if (st.examples.size() < 10) {
-        st.examples.push_back("pair " + std::to_string(n) + " (" + p.kind + ", scale " + std::to_string(scale) +
-                              "): invalid: " + dynamics_proc::HexProblemName(p.a.hex.valid ? p.b.hex.problem : p.a.hex.problem));
-      }
-      continue;
-    }
-    const bool dcp_hit = r.verdict == dynamics_proc::Verdict::kCollide;
-    // The pair's separation, only when needed: distance if disjoint, minus
-    // the penetration depth if overlapping.
-    auto separation = [&] {
-      return ref_hit ? -static_cast<double>(PenetrationDepth(p.a.v, p.b.v, topo))
-                     : static_cast<double>(HullDistance(p.a.v, p.b.v, topo));
-    };
-    if (dcp_hit != ref_hit) {
-      const double sep = separation();
-      if (std::abs(sep) <= band) {
-        ++st.disagree_in_band;
-        ++st.in_band_by_kind[p.kind];
-      } else {
-        ++st.disagree_outside;
-        if (st.examples.size() < 10) {
-          std::ostringstream os;
-          os.precision(17);
-          os << "pair " << n << " (" << p.kind << ", scale " << scale << "): dcp " << (dcp_hit ? "collide" : "separate")
-             << " by '" << DeciderName(r.decider) << "', reference " << (ref_hit ? "intersect" : "disjoint")
-             << ", separation " << sep << " = " << sep / s << " x scale (band " << band / s << " x scale)";
-          st.examples.push_back(os.str());
-        }
-      }
-    } else if (!dcp_hit) {
-      // Separate: the plane must separate the solids (within the band).
-      if (!r.plane_valid) {
-        if (separation() > band) ++st.plane_missing;
-      } else {
-        dynamics_proc::Hexahedron a = p.a.hex, b = p.b.hex;
-        if (!dynamics_proc::PlaneSeparates(a, b, r.plane.n_R, r.plane.d_ft, band)) ++st.plane_wrong;
-      }
-    }
+    Judge(p, r, ref_hit, n, scale, band_rel, topo, &st);
   }
   return st;
 }
