@@ -7,11 +7,11 @@
 #include <filesystem>
 #include <spdlog/spdlog.h>
 
-#include "rms/esg_renderer/overlay.h"
-#include "rms/window_keys_t.hpp"
-#include "rms/esg_renderer/png_io.h"
-#include "rms/wire/channels.h"
 #include "rms/base/check.h"
+#include "rms/esg_renderer/overlay.h"
+#include "rms/esg_renderer/png_io.h"
+#include "rms/window_keys_t.hpp"
+#include "rms/wire/channels.h"
 #include "rms/wire/frame_receiver.h"
 #include "rms/wire/message_io.h"
 
@@ -26,13 +26,21 @@ std::int64_t MonotonicUs() {
 }
 }  // namespace
 
-EsgRenderer::EsgRenderer(const LabConfig& config, transport::LcmInterface* lcm, FrameRenderer* renderer, EsgOptions options,
-                 VideoWriter* video, LiveWindow* window)
-    : config_(config), lcm_(lcm), renderer_(renderer), options_(std::move(options)), video_(video), window_(window) {
+EsgRenderer::EsgRenderer(const LabConfig& config, transport::LcmInterface* lcm,
+                         FrameRenderer* renderer, EsgOptions options, VideoWriter* video,
+                         LiveWindow* window)
+    : config_(config),
+      lcm_(lcm),
+      renderer_(renderer),
+      options_(std::move(options)),
+      video_(video),
+      window_(window) {
   overlay_ = MakeOverlayModel(config);
-  lcm_->Subscribe(wire::channels::kEsgFrame, [this](const void* d, int n, std::int64_t t) { OnFrame(d, n, t); });
+  lcm_->Subscribe(wire::channels::kEsgFrame,
+                  [this](const void* d, int n, std::int64_t t) { OnFrame(d, n, t); });
   if (window_) {
-    lcm_->Subscribe(wire::channels::kOperatorState, [this](const void* d, int n, std::int64_t) { OnOperatorState(d, n); });
+    lcm_->Subscribe(wire::channels::kOperatorState,
+                    [this](const void* d, int n, std::int64_t) { OnOperatorState(d, n); });
   }
 }
 
@@ -42,10 +50,11 @@ void EsgRenderer::OnOperatorState(const void* data, int size) {
     counters_.Add(wire::DroppedOperatorStateCounter(e));
     return;
   }
-  bool finite = std::isfinite(m.distance_ft) && std::isfinite(m.angle_deg) && std::isfinite(m.bay_clearance_ft) &&
-                std::isfinite(m.close_gap_ft) &&
+  bool finite = std::isfinite(m.distance_ft) && std::isfinite(m.angle_deg) &&
+                std::isfinite(m.bay_clearance_ft) && std::isfinite(m.close_gap_ft) &&
                 std::isfinite(m.dock_distance_ft) && std::isfinite(m.dock_angle_deg);
-  for (int i = 0; i < 3; ++i) finite = finite && std::isfinite(m.offset_ft[i]) && std::isfinite(m.rotation_deg[i]);
+  for (int i = 0; i < 3; ++i)
+    finite = finite && std::isfinite(m.offset_ft[i]) && std::isfinite(m.rotation_deg[i]);
   for (int i = 0; i < 6; ++i) finite = finite && std::isfinite(m.margin_ft[i]);
   if (!finite) {
     counters_.Add(Counter::kDroppedOperatorStateNonFinite);
@@ -73,8 +82,10 @@ void EsgRenderer::PollWindow() {
   m.num_held = static_cast<std::int16_t>(m.held.size());
   m.num_pressed = static_cast<std::int16_t>(m.pressed.size());
   m.focused = k.focused;
-  if (transport::PublishMessage(*lcm_, wire::channels::kWindowKeys, m)) counters_.Add(Counter::kWindowKeysMessages);
-  else counters_.Add(Counter::kPublishFailed);
+  if (transport::PublishMessage(*lcm_, wire::channels::kWindowKeys, m))
+    counters_.Add(Counter::kWindowKeysMessages);
+  else
+    counters_.Add(Counter::kPublishFailed);
   counters_.Add(Counter::kWindowKeysPressed, static_cast<std::int64_t>(k.pressed.size()));
   keys_sent_us_ = now;
   keys_held_ = !k.held.empty();
@@ -91,7 +102,8 @@ void EsgRenderer::OnFrame(const void* data, int size, std::int64_t recv_time_us)
       data, size, &frames_, &counters_,
       [](const esg_frame_t& m) {
         if (m.num_words < 1 || m.num_words > wire::kEsgMaxWords) {
-          throw wire::MalformedError(Counter::kDroppedWordCount, "ESG frame with " + std::to_string(m.num_words) + " words");
+          throw wire::MalformedError(Counter::kDroppedWordCount,
+                                     "ESG frame with " + std::to_string(m.num_words) + " words");
         }
         return wire::UnpackEsgWords(m.words);
       },
@@ -100,6 +112,7 @@ void EsgRenderer::OnFrame(const void* data, int size, std::int64_t recv_time_us)
   auto& [msg, data_words] = *got;
   counters_.Set(Counter::kEsgMissing, frames_.missing());
   latencies_["scene_to_esg"].Add(now_us - msg.send_time_us);
+  if (first_frame_ < 0) first_frame_ = msg.frame;
   if (pending_) counters_.Add(Counter::kSuperseded);
   pending_.emplace(std::move(msg), std::move(data_words));
 }
@@ -107,7 +120,8 @@ void EsgRenderer::OnFrame(const void* data, int size, std::int64_t recv_time_us)
 void EsgRenderer::FinishVideo() {
   RenderPending();
   if (video_ && last_rendered_ >= 0 && frames_.last() > last_rendered_) {
-    video_->Add(output_.data(), static_cast<int>(std::clamp<std::int64_t>(frames_.last() - last_rendered_, 1, 300)));
+    video_->Add(output_.data(), static_cast<int>(std::clamp<std::int64_t>(
+                                    frames_.last() - last_rendered_, 1, 300)));
   }
 }
 
@@ -119,8 +133,9 @@ bool EsgRenderer::RenderPending() {
   const std::size_t bytes = static_cast<std::size_t>(w) * h * 4;
   // Skip what the scene doesn't need: the same words but for the frame
   // counter (word 0) draw the same scene; only the overlay changes.
-  const bool unchanged = options_.skip_unchanged && !scene_.empty() && msg.words.size() == last_words_.size() &&
-                         std::equal(msg.words.begin() + 1, msg.words.end(), last_words_.begin() + 1);
+  const bool unchanged =
+      options_.skip_unchanged && !scene_.empty() && msg.words.size() == last_words_.size() &&
+      std::equal(msg.words.begin() + 1, msg.words.end(), last_words_.begin() + 1);
   const std::int64_t t0 = MonotonicUs();
   if (unchanged) {
     counters_.Add(Counter::kSkippedUnchanged);
@@ -142,12 +157,14 @@ bool EsgRenderer::RenderPending() {
   const std::int64_t done = lcm_->NowUs();
   counters_.Add(Counter::kRendered);
   latencies_["esg_to_render"].Add(done - msg.send_time_us);
-  RecordEndToEnd(done - msg.input_send_time_us, config_.session.frame_rate_hz, &latencies_["input_to_render"],
-                 &counters_);
+  RecordEndToEnd(done - msg.input_send_time_us, config_.session.frame_rate_hz,
+                 &latencies_["input_to_render"], &counters_);
   if (video_) {
-    // One video frame per frame number: frames skipped or lost repeat the
-    // last image, so the video keeps the session's time.
-    const std::int64_t gap = last_rendered_ < 0 ? 1 : std::clamp<std::int64_t>(msg.frame - last_rendered_, 1, 300);
+    // One video frame per frame number: frames skipped, superseded or lost
+    // repeat the last image (before the first drawn, the first drawn), so the
+    // video keeps the session's time.
+    const std::int64_t since = last_rendered_ < 0 ? first_frame_ - 1 : last_rendered_;
+    const std::int64_t gap = std::clamp<std::int64_t>(msg.frame - since, 1, 300);
     video_->Add(output_.data(), static_cast<int>(gap));
   }
   if (window_ && window_->open()) {
@@ -176,15 +193,19 @@ int RunEsgRenderer(const LabConfig& config, transport::LcmInterface& lcm, const 
   if (!options.png_dir.empty()) std::filesystem::create_directories(options.png_dir);
   RenderOptions ro;
   ro.id_colors = options.id_colors;
-  if (options.visibility == "depth") ro.visibility = Visibility::kDepth;
-  else if (options.visibility != "priority") throw InputError("--visibility must be priority or depth");
+  if (options.visibility == "depth")
+    ro.visibility = Visibility::kDepth;
+  else if (options.visibility != "priority")
+    throw InputError("--visibility must be priority or depth");
   ro.frustum_cull = options.frustum_cull;
   ro.backface_cull = options.backface_cull;
-  std::unique_ptr<GlContext> gl = CreateGlContext(ParseGlBackend(options.gl), options.width, options.height);
+  std::unique_ptr<GlContext> gl =
+      CreateGlContext(ParseGlBackend(options.gl), options.width, options.height);
   FrameRenderer renderer(config, gl.get(), ro);
-  spdlog::info("{}; {}x{}; {} triangles in {} clusters; visibility by {}", gl->description(), options.width,
-               options.height, renderer.triangle_count(), scene_model::kNumClusters,
-               ro.visibility == Visibility::kDepth ? "depth buffer" : "priority (separating planes)");
+  spdlog::info(
+      "{}; {}x{}; {} triangles in {} clusters; visibility by {}", gl->description(), options.width,
+      options.height, renderer.triangle_count(), scene_model::kNumClusters,
+      ro.visibility == Visibility::kDepth ? "depth buffer" : "priority (separating planes)");
   std::unique_ptr<VideoWriter> video;
   if (!options.video_path.empty()) {
     video = std::make_unique<VideoWriter>(options.video_path, options.width, options.height,
@@ -213,19 +234,24 @@ int RunEsgRenderer(const LabConfig& config, transport::LcmInterface& lcm, const 
       },
       stats_path, window ? 5 : 100);
   if (video) {
+    // Frames already in the socket at the stop still belong in the video.
+    lcm.HandleSubscriptions(0);
     node.FinishVideo();
     video->Close();
     node.counters().Set(Counter::kVideoFrames, video->frames_written());
     node.counters().Set(Counter::kVideoDropped, video->frames_dropped());
-    if (!stats_path.empty()) transport::WriteStatsJson(stats_path, "esg_renderer", node.counters(), node.latencies());
+    if (!stats_path.empty())
+      transport::WriteStatsJson(stats_path, "esg_renderer", node.counters(), node.latencies());
   }
-  spdlog::info("rendered {} frames ({} scenes drawn, {} unchanged, {} superseded, {} missing, {} late, {} dropped, "
-               "{} PNG{})",
-               node.counters().Get(Counter::kRendered), node.counters().Get(Counter::kRenderedScenes),
-               node.counters().Get(Counter::kSkippedUnchanged), node.counters().Get(Counter::kSuperseded),
-               node.counters().Get(Counter::kEsgMissing), node.counters().Get(Counter::kFramesLate),
-               node.counters().Sum(kDroppedFirst, kDroppedLast), node.counters().Get(Counter::kPngWritten),
-               video ? ", " + std::to_string(video->frames_written()) + " video frames" : std::string());
+  spdlog::info(
+      "rendered {} frames ({} scenes drawn, {} unchanged, {} superseded, {} missing, {} late, {} "
+      "dropped, "
+      "{} PNG{})",
+      node.counters().Get(Counter::kRendered), node.counters().Get(Counter::kRenderedScenes),
+      node.counters().Get(Counter::kSkippedUnchanged), node.counters().Get(Counter::kSuperseded),
+      node.counters().Get(Counter::kEsgMissing), node.counters().Get(Counter::kFramesLate),
+      node.counters().Sum(kDroppedFirst, kDroppedLast), node.counters().Get(Counter::kPngWritten),
+      video ? ", " + std::to_string(video->frames_written()) + " video frames" : std::string());
   return 0;
 }
 

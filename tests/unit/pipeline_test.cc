@@ -1,16 +1,23 @@
 // dynamics_proc's and scene_proc's libraries chained on one log-backed
 // transport: deterministic, no network. One ESG frame per input block, in
 // order, carrying the kinematics; malformed blocks are counted and dropped.
+// With esg_renderer's library on the end, the video has one frame per frame
+// number.
+#include <unistd.h>
+
+#include <filesystem>
 #include <gtest/gtest.h>
 
-#include "rms/scene_proc/camera_stations.h"
-#include "rms/dynamics_proc/dynamics_proc.h"
-#include "rms/wire/channels.h"
 #include "rms/base/config.h"
+#include "rms/dynamics_proc/dynamics_proc.h"
 #include "rms/esg_frame_t.hpp"
-#include "rms/wire/message_io.h"
+#include "rms/esg_renderer/esg_renderer.h"
+#include "rms/esg_renderer/gl_context.h"
 #include "rms/operator_input_t.hpp"
+#include "rms/scene_proc/camera_stations.h"
 #include "rms/scene_proc/scene_proc.h"
+#include "rms/wire/channels.h"
+#include "rms/wire/message_io.h"
 
 namespace rms {
 namespace {
@@ -114,6 +121,35 @@ TEST_F(Pipeline, ResetReturnsToMode1AndSetsTheResetBit) {
   const wire::EsgFrameData d = wire::UnpackEsgWords(esg[0].words);
   EXPECT_TRUE(d.control.reset);
   EXPECT_EQ(d.control.mode, 1);
+}
+
+TEST_F(Pipeline, TheVideoHasOneFramePerFrameNumberThoughTheFirstFramesWereSuperseded) {
+  // On a loaded machine frames 0 and 1 may both arrive before the ESG draws:
+  // frame 1 supersedes frame 0, and the video must still start at frame 0.
+  constexpr int kW = 64, kH = 48;
+  auto gl = esg_renderer::CreateGlContext(esg_renderer::GlBackend::kOsMesa, kW, kH);
+  esg_renderer::FrameRenderer renderer(config, gl.get(), {});
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("rms_pipeline_video_" + std::to_string(getpid()) + ".mp4"))
+                               .string();
+  esg_renderer::VideoWriter video(path, kW, kH, config.session.frame_rate_hz);
+  esg_renderer::EsgOptions options;
+  options.width = kW;
+  options.height = kH;
+  esg_renderer::EsgRenderer esg_node(config, &lcm, &renderer, options, &video, nullptr);
+  wire::OperatorInputs in = wire::InitialInputs(config.inputs);
+  for (int f = 0; f < 3; ++f) Send(Block(f, in));  // nothing drawn yet
+  EXPECT_TRUE(esg_node.RenderPending());
+  EXPECT_EQ(esg_node.counters().Get(Counter::kSuperseded), 2);
+  Send(Block(3, in));
+  EXPECT_TRUE(esg_node.RenderPending());
+  Send(Block(4, in));
+  Send(Block(5, in));  // frame 4 superseded at the end
+  esg_node.FinishVideo();
+  video.Close();
+  EXPECT_EQ(video.frames_written(), 6);  // frames 0 to 5
+  EXPECT_EQ(video.frames_dropped(), 0);
+  std::filesystem::remove(path);
 }
 
 }  // namespace

@@ -10,39 +10,39 @@
 #include <string>
 #include <vector>
 
+#include "rms/base/counters.h"
+#include "rms/esg_frame_t.hpp"
 #include "rms/esg_renderer/overlay.h"
 #include "rms/esg_renderer/renderer.h"
-#include "rms/base/counters.h"
-#include "rms/wire/frame_receiver.h"
-#include "rms/esg_frame_t.hpp"
-#include "rms/transport/lcm_interface.h"
-#include "rms/operator_state_t.hpp"
-#include "rms/transport/process.h"
-#include "rms/wire/word_blocks.h"
 #include "rms/esg_renderer/video.h"
 #include "rms/esg_renderer/window.h"
+#include "rms/operator_state_t.hpp"
+#include "rms/transport/lcm_interface.h"
+#include "rms/transport/process.h"
+#include "rms/wire/frame_receiver.h"
+#include "rms/wire/word_blocks.h"
 
 namespace rms::esg_renderer {
 
 struct EsgOptions {
   int width = 1024;
   int height = 768;
-  std::string png_dir;      // --png-dir: where PNG frames go
-  int png_every = 0;        // --png-every N: write every Nth ESG frame (by frame number); 0: none
-  bool id_colors = false;   // --id-colors
-  std::string gl = "osmesa";         // --gl osmesa|egl
+  std::string png_dir;        // --png-dir: where PNG frames go
+  int png_every = 0;          // --png-every N: write every Nth ESG frame (by frame number); 0: none
+  bool id_colors = false;     // --id-colors
+  std::string gl = "osmesa";  // --gl osmesa|egl
   std::string visibility = "priority";  // --visibility priority|depth
-  std::string video_path;   // --video FILE: the session's video
-  bool window = false;      // --window: a live window on the desktop
-  bool skip_unchanged = true;   // --no-skip-unchanged turns off
-  bool frustum_cull = true;     // --no-frustum-cull turns off
-  bool backface_cull = true;    // --no-backface-cull turns off
+  std::string video_path;               // --video FILE: the session's video
+  bool window = false;                  // --window: a live window on the desktop
+  bool skip_unchanged = true;           // --no-skip-unchanged turns off
+  bool frustum_cull = true;             // --no-frustum-cull turns off
+  bool backface_cull = true;            // --no-backface-cull turns off
 };
 
 class EsgRenderer {
  public:
-  EsgRenderer(const LabConfig& config, transport::LcmInterface* lcm, FrameRenderer* renderer, EsgOptions options,
-          VideoWriter* video, LiveWindow* window);
+  EsgRenderer(const LabConfig& config, transport::LcmInterface* lcm, FrameRenderer* renderer,
+              EsgOptions options, VideoWriter* video, LiveWindow* window);
   void OnFrame(const void* data, int size, std::int64_t recv_time_us);
   // Renders the newest frame received since the last call, if any.
   bool RenderPending();
@@ -76,11 +76,15 @@ class EsgRenderer {
   wire::LateFrameFilter late_;
   std::optional<std::pair<esg_frame_t, wire::EsgFrameData>> pending_;
   std::int64_t last_rendered_ = -1;
+  // The first frame number accepted: the video starts there even when that
+  // frame was superseded before it could be drawn.
+  std::int64_t first_frame_ = -1;
   std::vector<std::int32_t> last_words_;  // the words of the image in scene_
   std::vector<std::uint8_t> scene_;       // the last rendered scene, before the overlay
   std::vector<std::uint8_t> output_;      // the last output image, overlay included
   std::vector<std::uint8_t> shown_;       // the window's: the output and the operator's guidance
-  std::optional<operator_state_t> operator_state_;  // the newest RMS_OPERATOR_STATE (the window's guidance)
+  std::optional<operator_state_t>
+      operator_state_;  // the newest RMS_OPERATOR_STATE (the window's guidance)
   std::int64_t keys_sequence_ = 0, keys_sent_us_ = 0;
   bool keys_held_ = false;
 };
