@@ -1,6 +1,7 @@
 #pragma once
 // Small statistics the benchmarks share.
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <vector>
 
@@ -10,7 +11,8 @@ namespace rms::bench {
 inline double Percentile(std::vector<double> v, double p) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<std::size_t>(p * (v.size() - 1) + 0.5))];
+  return v[std::min(v.size() - 1,
+                    static_cast<std::size_t>(std::lround(p * static_cast<double>(v.size() - 1))))];
 }
 
 inline double Mean(const std::vector<double>& v) {

@@ -10,10 +10,8 @@
 // generator (random, touching to 1e-6..1e-12, parallel edges, nested, rods
 // through slabs, near contact), against the exact reference (CGAL, exact
 // arithmetic).
-#include <benchmark/benchmark.h>
-
 #include <algorithm>
-
+#include <benchmark/benchmark.h>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -25,6 +23,7 @@
 #include "rms/dynamics_proc/collision.h"
 #include "rms/reference/exact_hull.h"
 #include "rms/reference/generators.h"
+
 #include "peers.h"
 
 namespace {
@@ -43,7 +42,8 @@ rms::bench::BoxShape Shape(const rms::reference::Solid& s) {
 }
 
 struct Sets {
-  std::vector<std::pair<rms::dynamics_proc::Hexahedron, rms::dynamics_proc::Hexahedron>> hex_boxes, hex_general;
+  std::vector<std::pair<rms::dynamics_proc::Hexahedron, rms::dynamics_proc::Hexahedron>> hex_boxes,
+      hex_general;
   std::vector<std::pair<rms::bench::BoxShape, rms::bench::BoxShape>> boxes;
   std::vector<std::pair<Hull, Hull>> hulls_boxes, hulls_general;
   std::vector<std::unique_ptr<rms::bench::FclPair>> fcl_boxes, fcl_general;
@@ -87,13 +87,13 @@ class Collector : public benchmark::ConsoleReporter {
     }
     ConsoleReporter::ReportRuns(runs);
   }
-  std::map<std::string, double> ns;               // median over repetitions
+  std::map<std::string, double> ns;                // median over repetitions
   std::map<std::string, std::vector<double>> all;  // every repetition
 };
 
 struct Agreement {
   long pairs = 0;
-  std::map<std::string, long> wrong;               // by method
+  std::map<std::string, long> wrong;  // by method
   std::map<std::string, std::map<std::string, long>> wrong_by_kind;
   std::map<std::string, long> pairs_by_kind;
 };
@@ -119,7 +119,8 @@ rms::dynamics_proc::CollideOptions VerdictOnly() {
 }
 
 bool DcpSaysCollide(const Pair& p) {
-  return rms::dynamics_proc::Collide(p.a.hex, p.b.hex, VerdictOnly()).verdict == rms::dynamics_proc::Verdict::kCollide;
+  return rms::dynamics_proc::Collide(p.a.hex, p.b.hex, VerdictOnly()).verdict ==
+         rms::dynamics_proc::Verdict::kCollide;
 }
 
 // Every method's verdict against the exact reference on the generator's box
@@ -148,7 +149,9 @@ std::pair<Agreement, Agreement> MeasureAgreement(long agreement_pairs, std::uint
           &general);
   }
   // Every method appears, with 0 when it never disagreed.
-  for (const char* m : {"DCP", "separating axes, 15", "ODE dBoxTouchesBox", "FCL boxes", "libccd MPR"}) boxes.wrong[m] += 0;
+  for (const char* m :
+       {"DCP", "separating axes, 15", "ODE dBoxTouchesBox", "FCL boxes", "libccd MPR"})
+    boxes.wrong[m] += 0;
   for (const char* m : {"DCP", "libccd MPR", "FCL convex"}) general.wrong[m] += 0;
   return {boxes, general};
 }
@@ -176,32 +179,49 @@ void RegisterTimings(const Sets& sets) {
   dcp("boxes/DCP, verdict, no bounding-volume rejection", sets.hex_boxes, report_only);
   dcp("boxes/DCP, verdict, spheres but no box rejection", sets.hex_boxes, spheres_only);
   dcp("boxes/DCP, verdict and separating plane", sets.hex_boxes, {});
-  benchmark::RegisterBenchmark("boxes/separating axes, 15 (double)", [&sets, cycle](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) { return rms::bench::SatBoxesIntersect(sets.boxes[i].first, sets.boxes[i].second); });
-  });
+  benchmark::RegisterBenchmark(
+      "boxes/separating axes, 15 (double)", [&sets, cycle](benchmark::State& st) {
+        cycle(st, [&](std::size_t i) {
+          return rms::bench::SatBoxesIntersect(sets.boxes[i].first, sets.boxes[i].second);
+        });
+      });
   benchmark::RegisterBenchmark("boxes/ODE dBoxTouchesBox", [&sets, cycle](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) { return rms::bench::OdeBoxesTouch(sets.boxes[i].first, sets.boxes[i].second); });
+    cycle(st, [&](std::size_t i) {
+      return rms::bench::OdeBoxesTouch(sets.boxes[i].first, sets.boxes[i].second);
+    });
   });
-  benchmark::RegisterBenchmark("boxes/FCL collide() on boxes (computes a contact)", [&sets, cycle](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) { return sets.fcl_boxes[i]->Collide(); });
-  });
+  benchmark::RegisterBenchmark(
+      "boxes/FCL collide() on boxes (computes a contact)", [&sets, cycle](benchmark::State& st) {
+        cycle(st, [&](std::size_t i) { return sets.fcl_boxes[i]->Collide(); });
+      });
   benchmark::RegisterBenchmark("boxes/libccd MPR", [&sets, cycle](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) { return rms::bench::CcdMprBoxes(sets.boxes[i].first, sets.boxes[i].second); });
+    cycle(st, [&](std::size_t i) {
+      return rms::bench::CcdMprBoxes(sets.boxes[i].first, sets.boxes[i].second);
+    });
   });
   benchmark::RegisterBenchmark("boxes/exact (CGAL)", [&sets, cycle](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) { return rms::reference::ExactHullsIntersect(sets.hulls_boxes[i].first, sets.hulls_boxes[i].second); });
+    cycle(st, [&](std::size_t i) {
+      return rms::reference::ExactHullsIntersect(sets.hulls_boxes[i].first,
+                                                 sets.hulls_boxes[i].second);
+    });
   });
   // General hexahedra.
   dcp("general/DCP, verdict", sets.hex_general, verdict_only);
   dcp("general/DCP, verdict and separating plane", sets.hex_general, {});
   benchmark::RegisterBenchmark("general/libccd MPR", [&sets, cycle](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) { return rms::bench::CcdMprHulls(sets.hulls_general[i].first, sets.hulls_general[i].second); });
+    cycle(st, [&](std::size_t i) {
+      return rms::bench::CcdMprHulls(sets.hulls_general[i].first, sets.hulls_general[i].second);
+    });
   });
-  benchmark::RegisterBenchmark("general/FCL collide() on convex (GJK/EPA)", [&sets, cycle](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) { return sets.fcl_general[i]->Collide(); });
-  });
+  benchmark::RegisterBenchmark(
+      "general/FCL collide() on convex (GJK/EPA)", [&sets, cycle](benchmark::State& st) {
+        cycle(st, [&](std::size_t i) { return sets.fcl_general[i]->Collide(); });
+      });
   benchmark::RegisterBenchmark("general/exact (CGAL)", [&sets, cycle](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) { return rms::reference::ExactHullsIntersect(sets.hulls_general[i].first, sets.hulls_general[i].second); });
+    cycle(st, [&](std::size_t i) {
+      return rms::reference::ExactHullsIntersect(sets.hulls_general[i].first,
+                                                 sets.hulls_general[i].second);
+    });
   });
 }
 
@@ -221,31 +241,43 @@ void TimingTables(Collector& collector, std::ostringstream& md) {
   }
   const std::size_t reps = collector.all["boxes/DCP, verdict"].size();
   md << "## Collision against its peers\n\n"
-     << "`rms_collision_bench` (Google Benchmark): the same 4096 random pairs for every method, cycled, time per "
-        "pair (CPU), the median of " << reps << " repetition" << (reps == 1 ? "" : "s") << ". The DCP is the "
-        "report's algorithm (Section IV.A.1; `docs/collision.md`), verdict only unless said; FCL's `collide()` on "
-        "boxes computes a contact (point, normal, depth) as it decides; ODE's `dBoxTouchesBox` and the 15-axis "
-        "separating-axis test (double) give a verdict only; for general hexahedra FCL works on convex meshes "
+     << "`rms_collision_bench` (Google Benchmark): the same 4096 random pairs for every method, "
+        "cycled, time per "
+        "pair (CPU), the median of "
+     << reps << " repetition" << (reps == 1 ? "" : "s")
+     << ". The DCP is the "
+        "report's algorithm (Section IV.A.1; `docs/collision.md`), verdict only unless said; FCL's "
+        "`collide()` on "
+        "boxes computes a contact (point, normal, depth) as it decides; ODE's `dBoxTouchesBox` and "
+        "the 15-axis "
+        "separating-axis test (double) give a verdict only; for general hexahedra FCL works on "
+        "convex meshes "
         "(GJK/EPA) and libccd with MPR.\n\n";
-  md << "| Method (4096 random box pairs, cycled) | ns / pair | vs the DCP | vs separating axes |\n|---|---|---|---|\n";
+  md << "| Method (4096 random box pairs, cycled) | ns / pair | vs the DCP | vs separating axes "
+        "|\n|---|---|---|---|\n";
   for (const auto& [name, ns] : collector.ns) {
     if (name.rfind("boxes/", 0) != 0) continue;
-    std::snprintf(line, sizeof line, "| %s | %.1f | %.2f | %.2f |\n", name.substr(6).c_str(), ns, ns / dcp, ns / sat);
+    std::snprintf(line, sizeof line, "| %s | %.1f | %.2f | %.2f |\n", name.substr(6).c_str(), ns,
+                  ns / dcp, ns / sat);
     md << line;
   }
   const double dcp_g = collector.ns["general/DCP, verdict"];
-  md << "\n| Method (4096 random general hexahedra: frusta, skewed) | ns / pair | vs the DCP |\n|---|---|---|\n";
+  md << "\n| Method (4096 random general hexahedra: frusta, skewed) | ns / pair | vs the DCP "
+        "|\n|---|---|---|\n";
   for (const auto& [name, ns] : collector.ns) {
     if (name.rfind("general/", 0) != 0) continue;
-    std::snprintf(line, sizeof line, "| %s | %.1f | %.2f |\n", name.substr(8).c_str(), ns, ns / dcp_g);
+    std::snprintf(line, sizeof line, "| %s | %.1f | %.2f |\n", name.substr(8).c_str(), ns,
+                  ns / dcp_g);
     md << line;
   }
   std::snprintf(line, sizeof line,
-                "\n- **Target** collision at most 40 ns a random box pair: %.1f ns (%s; twice the separating-axis "
-                "floor here is %.1f ns).\n- **Target** collision at least 8x faster than FCL on the same pairs: "
+                "\n- **Target** collision at most 40 ns a random box pair: %.1f ns (%s; twice the "
+                "separating-axis "
+                "floor here is %.1f ns).\n- **Target** collision at least 8x faster than FCL on "
+                "the same pairs: "
                 "%.1fx (%s; over the repetitions %.1fx to %.1fx).\n",
-                dcp, dcp <= 40.0 ? "met" : "MISSED", 2 * sat, fcl / dcp, fcl / dcp >= 8.0 ? "met" : "MISSED",
-                ratio_lo, ratio_hi);
+                dcp, dcp <= 40.0 ? "met" : "MISSED", 2 * sat, fcl / dcp,
+                fcl / dcp >= 8.0 ? "met" : "MISSED", ratio_lo, ratio_hi);
   md << line;
 }
 
@@ -262,7 +294,8 @@ void AgreementTable(const Agreement& ag, const char* title, std::ostringstream& 
     md << "| " << kind << " | " << n << " |";
     for (const auto& m : methods) {
       const auto it = ag.wrong_by_kind.find(m);
-      const long w = it == ag.wrong_by_kind.end() ? 0 : (it->second.count(kind) ? it->second.at(kind) : 0);
+      const long w =
+          it == ag.wrong_by_kind.end() ? 0 : (it->second.count(kind) ? it->second.at(kind) : 0);
       md << " " << w << " |";
     }
     md << "\n";
@@ -280,9 +313,12 @@ int main(int argc, char** argv) {
   // Our own flags first; the rest go to Google Benchmark.
   std::vector<char*> rest = {argv[0]};
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--md") && i + 1 < argc) md_path = argv[++i];
-    else if (!std::strcmp(argv[i], "--agreement") && i + 1 < argc) agreement_pairs = std::atol(argv[++i]);
-    else rest.push_back(argv[i]);
+    if (!std::strcmp(argv[i], "--md") && i + 1 < argc)
+      md_path = argv[++i];
+    else if (!std::strcmp(argv[i], "--agreement") && i + 1 < argc)
+      agreement_pairs = std::atol(argv[++i]);
+    else
+      rest.push_back(argv[i]);
   }
   int bargc = static_cast<int>(rest.size());
   benchmark::Initialize(&bargc, rest.data());
@@ -295,12 +331,14 @@ int main(int argc, char** argv) {
   benchmark::Shutdown();
 
   const std::uint64_t seed = 19721122;
-  std::fprintf(stderr, "agreement: %ld pairs a family, seed %llu\n", agreement_pairs, static_cast<unsigned long long>(seed));
+  std::fprintf(stderr, "agreement: %ld pairs a family, seed %llu\n", agreement_pairs,
+               static_cast<unsigned long long>(seed));
   const auto [box_agree, gen_agree] = MeasureAgreement(agreement_pairs, seed);
 
   std::ostringstream md;
   TimingTables(collector, md);
-  md << "\nVerdicts that disagree with the exact reference (CGAL, exact arithmetic; touching counts as intersecting), "
+  md << "\nVerdicts that disagree with the exact reference (CGAL, exact arithmetic; touching "
+        "counts as intersecting), "
         "by family of pairs (seed 19721122):\n";
   AgreementTable(box_agree, "Boxes: family", md);
   AgreementTable(gen_agree, "General hexahedra: family", md);

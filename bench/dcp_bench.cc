@@ -14,33 +14,32 @@
 //
 //   build/bench/rms_dcp_bench [--md FILE] [--reps N] [--trajectories N] [--seed S]
 #include <CLI/CLI.hpp>
-#include "rms/base/command_line.h"
-#include <spdlog/spdlog.h>
-#include <benchmark/benchmark.h>
-
 #include <algorithm>
+#include <benchmark/benchmark.h>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <functional>
 #include <random>
+#include <spdlog/spdlog.h>
 #include <sstream>
 
-#include "bench_stats.h"
+#include "rms/base/command_line.h"
+#include "rms/base/text.h"
+#include "rms/dynamics_proc/dynamic_collision_program.h"
 #include "rms/sim/closed_loop.h"
 #include "rms/sim/random_operator.h"
-#include "rms/dynamics_proc/dynamic_collision_program.h"
-#include "rms/base/text.h"
 #include "rms/wire/word_codec.h"
+
+#include "bench_stats.h"
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-using rms::bench::Percentile;
 using rms::Sprintf;
+using rms::bench::Percentile;
 using namespace rms::dynamics_proc;
-
 
 // ---------------------------------------------------------------- 1. frame
 
@@ -52,9 +51,9 @@ struct Flight {
 struct FrameVariant {
   std::string name;
   DcpOptions options;
-  std::vector<double> ns;          // every frame of every repetition
+  std::vector<double> ns;                      // every frame of every repetition
   std::array<std::vector<double>, 4> ns_mode;  // by the mode the frame started in
-  long mismatches = 0;             // frames whose decisions differ from the first variant's
+  long mismatches = 0;  // frames whose decisions differ from the first variant's
 };
 
 // What must not depend on the options: the control word, the collision
@@ -86,15 +85,16 @@ void RunFrames(const rms::LabConfig& config, const std::vector<Flight>& flights,
           v.ns.push_back(ns);
           v.ns_mode[mode].push_back(ns);
           if (r == 0) {
-            decisions.push_back({rms::wire::PackControlWord(out.control), dcp.status().collisions, dcp.mode(),
-                                 dcp.status().X_RS2.translation()});
+            decisions.push_back({rms::wire::PackControlWord(out.control), dcp.status().collisions,
+                                 dcp.mode(), dcp.status().X_RS2.translation()});
           }
         }
         if (r != 0) continue;
         if (vi == 0) {
           reference.push_back(decisions);
         } else {
-          for (std::size_t k = 0; k < decisions.size(); ++k) v.mismatches += !(decisions[k] == reference[fi][k]);
+          for (std::size_t k = 0; k < decisions.size(); ++k)
+            v.mismatches += !(decisions[k] == reference[fi][k]);
         }
       }
     }
@@ -143,7 +143,8 @@ rms::arm::ArmSinCos Quantize(const rms::arm::ArmSinCos& sc, int how) {  // 0 dou
   return x;
 }
 
-const char* kPrecisionName[3] = {"double (reference)", "float (IEEE single, 24-bit significand)", "24-bit words (SC22 / FT12)"};
+const char* kPrecisionName[3] = {"double (reference)", "float (IEEE single, 24-bit significand)",
+                                 "24-bit words (SC22 / FT12)"};
 
 struct ArmSample {
   std::array<double, 6> deg;
@@ -151,7 +152,8 @@ struct ArmSample {
 };
 
 // The end effector (EFF HEX 1-3) for a pose.
-EndEffectorModel EndEffectorFor(const rms::LabConfig& c, const rms::arm::ArmSinCos& sc, const ArmSample& s) {
+EndEffectorModel EndEffectorFor(const rms::LabConfig& c, const rms::arm::ArmSinCos& sc,
+                                const ArmSample& s) {
   const rms::arm::ArmPose pose = rms::arm::ComputeArmPose(c.arm, sc, s.height_ft);
   return MakeEndEffector(c.end_effector, pose.X_RS2, s.gap_ft);
 }
@@ -214,10 +216,14 @@ rms::arm::SinCos PolySinCosDeg(double deg) {
   }
   s *= x;
   switch (static_cast<int>(q) & 3) {
-    case 0: return {s, c};
-    case 1: return {c, -s};
-    case 2: return {-s, -c};
-    default: return {-c, s};
+    case 0:
+      return {s, c};
+    case 1:
+      return {c, -s};
+    case 2:
+      return {-s, -c};
+    default:
+      return {-c, s};
   }
 }
 
@@ -235,7 +241,8 @@ struct TunnelScene {
       if (Collide(ee.hex[k], bar, {.want_plane = false}).verdict != Verdict::kSeparate) return true;
       for (const Hexahedron& strip : body) {
         ++*tests;
-        if (Collide(ee.hex[k], strip, {.want_plane = false}).verdict != Verdict::kSeparate) return true;
+        if (Collide(ee.hex[k], strip, {.want_plane = false}).verdict != Verdict::kSeparate)
+          return true;
       }
     }
     return false;
@@ -258,8 +265,8 @@ struct Bench {
   const rms::LabConfig& config;
   std::mt19937_64 rng;
   std::vector<Flight> flights;
-  std::array<long, 3> held{};  // frames each flight held
-  std::vector<ArmSample> near;  // the missions' Mode 1 states, jittered
+  std::array<long, 3> held{};     // frames each flight held
+  std::vector<ArmSample> near;    // the missions' Mode 1 states, jittered
   std::vector<ArmSample> random;  // random states within the input ranges
   Hexahedron bar;
   PayloadModel payload;
@@ -292,7 +299,8 @@ void MakeFlights(Bench* b, std::uint64_t seed) {
   const auto r0 = rms::sim::FlyAutopilot(config, planned, 20000, 1, &b->flights[0].inputs);
   const auto r1 = rms::sim::FlyAutopilot(config, straight, 20000, 1, &b->flights[1].inputs);
   std::fprintf(stderr, "flights: %zu frames (docked %d), %zu frames (docked %d, %d held)\n",
-               b->flights[0].inputs.size(), r0.docked, b->flights[1].inputs.size(), r1.docked, r1.held_frames);
+               b->flights[0].inputs.size(), r0.docked, b->flights[1].inputs.size(), r1.docked,
+               r1.held_frames);
 }
 
 // 1. The whole frame under each saving; 1 when a variant decided a frame
@@ -302,7 +310,8 @@ int FrameTable(const Bench& b, int reps, std::ostringstream& md) {
   auto add = [&](std::string name, bool mode_only, bool spheres, bool coherence) {
     FrameVariant v;
     v.name = std::move(name);
-    v.options = {.mode_pairs_only = mode_only, .bounding_reject = spheres, .frame_coherence = coherence};
+    v.options = {
+        .mode_pairs_only = mode_only, .bounding_reject = spheres, .frame_coherence = coherence};
     fv.push_back(std::move(v));
   };
   add("the default: mode pairs, bounding spheres and boxes", true, true, false);
@@ -315,16 +324,24 @@ int FrameTable(const Bench& b, int reps, std::ostringstream& md) {
   long frames = 0;
   for (const Flight& f : b.flights) frames += static_cast<long>(f.inputs.size());
   md << "## The DCP's whole frame\n\n"
-     << Sprintf("`rms_dcp_bench`: the real `DynamicCollisionProgram::Step` (arm words, kinematics, the mode's "
-                "models and tests, acquisition / extraction / docking checks, planes, control word) over the "
-                "frames of two autopilot missions (planned: %zu frames, %ld held; straight: %zu frames, %ld held; "
-                "all three modes) and of a random operator (%zu frames, %ld held, mostly Mode 1), "
-                "each run %d times; every frame timed alone (a clock read costs %.0f ns, included). A saving is "
-                "the variant's time minus the default's (negative: the variant is faster). Decisions (control word, collision bits, mode, "
-                "end-effector position) compared frame by frame with the default's.\n\n",
-                b.flights[0].inputs.size(), b.held[0], b.flights[1].inputs.size(), b.held[1],
-                b.flights[2].inputs.size(), b.held[2], reps, overhead)
-     << "| variant | median ns | p99 ns | mean ns | Mode 1 median | Mode 2 median | Mode 3 median | saving (median ns) | saving, Mode 1 median | saving (mean ns) | frames deciding differently |\n"
+     << Sprintf(
+            "`rms_dcp_bench`: the real `DynamicCollisionProgram::Step` (arm words, kinematics, the "
+            "mode's "
+            "models and tests, acquisition / extraction / docking checks, planes, control word) "
+            "over the "
+            "frames of two autopilot missions (planned: %zu frames, %ld held; straight: %zu "
+            "frames, %ld held; "
+            "all three modes) and of a random operator (%zu frames, %ld held, mostly Mode 1), "
+            "each run %d times; every frame timed alone (a clock read costs %.0f ns, included). A "
+            "saving is "
+            "the variant's time minus the default's (negative: the variant is faster). Decisions "
+            "(control word, collision bits, mode, "
+            "end-effector position) compared frame by frame with the default's.\n\n",
+            b.flights[0].inputs.size(), b.held[0], b.flights[1].inputs.size(), b.held[1],
+            b.flights[2].inputs.size(), b.held[2], reps, overhead)
+     << "| variant | median ns | p99 ns | mean ns | Mode 1 median | Mode 2 median | Mode 3 median "
+        "| saving (median ns) | saving, Mode 1 median | saving (mean ns) | frames deciding "
+        "differently |\n"
      << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   auto mean_of = [](const std::vector<double>& v) {
     double m = 0;
@@ -339,14 +356,15 @@ int FrameTable(const Bench& b, int reps, std::ostringstream& md) {
     const double med = Percentile(v.ns, 0.5);
     const double med1 = Percentile(v.ns_mode[1], 0.5);
     const bool first = &v == &fv[0];
-    md << Sprintf("| %s | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %s | %s | %s | %ld of %ld |\n", v.name.c_str(),
-                  med, Percentile(v.ns, 0.99), mean, med1, Percentile(v.ns_mode[2], 0.5),
-                  Percentile(v.ns_mode[3], 0.5), first ? "" : Sprintf("%+.0f", med - base).c_str(),
+    md << Sprintf("| %s | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %s | %s | %s | %ld of %ld |\n",
+                  v.name.c_str(), med, Percentile(v.ns, 0.99), mean, med1,
+                  Percentile(v.ns_mode[2], 0.5), Percentile(v.ns_mode[3], 0.5),
+                  first ? "" : Sprintf("%+.0f", med - base).c_str(),
                   first ? "" : Sprintf("%+.0f", med1 - base1).c_str(),
                   first ? "" : Sprintf("%+.0f", mean - base_mean).c_str(), v.mismatches, frames);
     if (v.mismatches) {
-      std::fprintf(stderr, "rms_dcp_bench: '%s' decided %ld frames differently from the default\n", v.name.c_str(),
-                   v.mismatches);
+      std::fprintf(stderr, "rms_dcp_bench: '%s' decided %ld frames differently from the default\n",
+                   v.name.c_str(), v.mismatches);
       status = 1;
     }
   }
@@ -382,34 +400,43 @@ void DrawSamples(Bench* b) {
     for (int j = 0; j < 6; ++j) s.deg[j] = cal[j].min + u01(b->rng) * (cal[j].max - cal[j].min);
     const auto& h = cal[rms::kShoulderHeight];
     s.height_ft = h.min + u01(b->rng) * (h.max - h.min);
-    s.gap_ft = ee.finger_gap_closed_ft + u01(b->rng) * (ee.finger_gap_open_ft - ee.finger_gap_closed_ft);
+    s.gap_ft =
+        ee.finger_gap_closed_ft + u01(b->rng) * (ee.finger_gap_open_ft - ee.finger_gap_closed_ft);
   }
 }
 
 // 2. The arm words as double, float and 24-bit words: error, verdicts, cost.
 void ArmWordsTable(const Bench& b, std::ostringstream& md) {
   md << "## Run time against error: word precision\n\n"
-     << Sprintf("Arm words: the six angles' sin/cos held as each representation, the kinematics in double "
-                "(ComputeArmPose normalises each pair); error = the largest distance of any EFF HEX 1-3 vertex "
-                "from the all-double pose, over %d random arm states within the input ranges; verdicts = "
-                "EFF HEX 1-3 against the BAR and the payload body over %zu near-contact states (the Mode 1 "
-                "frames of the missions, angles jittered by 0.05 deg) that differ from the double verdicts. "
-                "Cost: quantising the twelve numbers.\n\n",
-                kRandom, b.near.size())
-     << "| arm words | max error ft | rms error ft | verdicts changed | ns to quantise a frame's words |\n|---|---:|---:|---:|---:|\n";
+     << Sprintf(
+            "Arm words: the six angles' sin/cos held as each representation, the kinematics in "
+            "double "
+            "(ComputeArmPose normalises each pair); error = the largest distance of any EFF HEX "
+            "1-3 vertex "
+            "from the all-double pose, over %d random arm states within the input ranges; verdicts "
+            "= "
+            "EFF HEX 1-3 against the BAR and the payload body over %zu near-contact states (the "
+            "Mode 1 "
+            "frames of the missions, angles jittered by 0.05 deg) that differ from the double "
+            "verdicts. "
+            "Cost: quantising the twelve numbers.\n\n",
+            kRandom, b.near.size())
+     << "| arm words | max error ft | rms error ft | verdicts changed | ns to quantise a frame's "
+        "words |\n|---|---:|---:|---:|---:|\n";
   for (int how = 0; how < 3; ++how) {
     double maxe = 0, sum2 = 0;
     for (const ArmSample& s : b.random) {
       const rms::arm::ArmSinCos sc = rms::arm::SinCosFromDegrees(s.deg);
-      const double e =
-          MaxVertexDistance(EndEffectorFor(b.config, Quantize(sc, how), s), EndEffectorFor(b.config, sc, s));
+      const double e = MaxVertexDistance(EndEffectorFor(b.config, Quantize(sc, how), s),
+                                         EndEffectorFor(b.config, sc, s));
       maxe = std::max(maxe, e);
       sum2 += e * e;
     }
     long changed = 0;
     for (const ArmSample& s : b.near) {
       const rms::arm::ArmSinCos sc = rms::arm::SinCosFromDegrees(s.deg);
-      const EndEffectorModel x = EndEffectorFor(b.config, sc, s), y = EndEffectorFor(b.config, Quantize(sc, how), s);
+      const EndEffectorModel x = EndEffectorFor(b.config, sc, s),
+                             y = EndEffectorFor(b.config, Quantize(sc, how), s);
       for (int k = 0; k < 3; ++k) {
         changed += Collide(x.hex[k], b.bar).verdict != Collide(y.hex[k], b.bar).verdict;
         for (const Hexahedron& strip : b.payload.body)
@@ -424,15 +451,15 @@ void ArmWordsTable(const Bench& b, std::ostringstream& md) {
       benchmark::DoNotOptimize(q);
     }
     const double qns = std::chrono::duration<double, std::nano>(Clock::now() - t0).count() / kQ;
-    md << Sprintf("| %s | %.2e | %.2e | %ld of %zu | %.1f |\n", kPrecisionName[how], maxe, std::sqrt(sum2 / kRandom),
-                  changed, 6 * b.near.size(), qns);
+    md << Sprintf("| %s | %.2e | %.2e | %ld of %zu | %.1f |\n", kPrecisionName[how], maxe,
+                  std::sqrt(sum2 / kRandom), changed, 6 * b.near.size(), qns);
   }
 }
 
 // How far the worse side's vertex of a DCP pair lies on the wrong side of
 // its plane as sent (0 when it still separates).
-double WrongSideFt(const Hexahedron& hex, const Hexahedron& bar, const rms::scene_model::SeparatingPlane& plane,
-                   int how) {
+double WrongSideFt(const Hexahedron& hex, const Hexahedron& bar,
+                   const rms::scene_model::SeparatingPlane& plane, int how) {
   Eigen::Vector3d n;
   for (int i = 0; i < 3; ++i) n[i] = QuantizeUnit(plane.n_R[i], how);
   const double dd = QuantizeFt(plane.d_ft, how);
@@ -466,7 +493,8 @@ void PlanesAndPosesTable(const Bench& b, std::ostringstream& md) {
     DynamicCollisionProgram d(b.config);
     for (const auto& in : f.inputs) {
       const rms::wire::DcpFrameData out = d.Step(in);
-      const EndEffectorModel ee = MakeEndEffector(b.config.end_effector, d.status().X_RS2, d.status().finger_gap_ft);
+      const EndEffectorModel ee =
+          MakeEndEffector(b.config.end_effector, d.status().X_RS2, d.status().finger_gap_ft);
       for (int k = 0; k < 3; ++k) {
         if (!(out.plane_valid & (1u << k))) continue;
         ++planes;
@@ -478,19 +506,25 @@ void PlanesAndPosesTable(const Bench& b, std::ostringstream& md) {
       }
       ++poses;
       for (int how = 1; how < 3; ++how) {
-        pose_err[how] = std::max(pose_err[how], PoseErrorFt(b.config.payload, d.status().X_RP, how));
+        pose_err[how] =
+            std::max(pose_err[how], PoseErrorFt(b.config.payload, d.status().X_RP, how));
       }
     }
   }
-  md << Sprintf("\nPlanes and poses as sent, over the missions' frames (%ld separating planes, %ld payload poses): "
-                "a plane's error is how far a vertex of its pair lies on the wrong side once the plane is "
-                "quantised (the ESG uses it only to order the pair); a pose's error is the largest payload "
-                "vertex displacement.\n\n",
-                planes, poses)
-     << "| representation | planes no longer separating | worst wrong-side distance ft | payload vertex error ft |\n|---|---:|---:|---:|\n";
+  md << Sprintf(
+            "\nPlanes and poses as sent, over the missions' frames (%ld separating planes, %ld "
+            "payload poses): "
+            "a plane's error is how far a vertex of its pair lies on the wrong side once the plane "
+            "is "
+            "quantised (the ESG uses it only to order the pair); a pose's error is the largest "
+            "payload "
+            "vertex displacement.\n\n",
+            planes, poses)
+     << "| representation | planes no longer separating | worst wrong-side distance ft | payload "
+        "vertex error ft |\n|---|---:|---:|---:|\n";
   for (int how = 1; how < 3; ++how) {
-    md << Sprintf("| %s | %ld of %ld | %.2e | %.2e |\n", kPrecisionName[how], not_separating[how], planes,
-                  plane_err[how], pose_err[how]);
+    md << Sprintf("| %s | %ld of %ld | %.2e | %.2e |\n", kPrecisionName[how], not_separating[how],
+                  planes, plane_err[how], pose_err[how]);
   }
   md << "\n";
 }
@@ -498,20 +532,31 @@ void PlanesAndPosesTable(const Bench& b, std::ostringstream& md) {
 // 3. The joints' sines and cosines by the library, tables and polynomials.
 void TrigonometryTable(const Bench& b, std::ostringstream& md) {
   md << "## Run time against error: trigonometry\n\n"
-     << Sprintf("The six joint angles' sine and cosine each frame, by each method, over %d random arm states: "
-                "worst error of a sine or cosine, the end effector's worst vertex error (ft) against the "
-                "library, how many SC22 words (LSB 2^-22 = 2.4e-7) differ, and the time for six pairs.\n\n",
-                kRandom)
-     << "| method | max sin/cos error | EFF HEX vertex error ft | SC22 words differing | ns for six pairs |\n|---|---:|---:|---:|---:|\n";
+     << Sprintf(
+            "The six joint angles' sine and cosine each frame, by each method, over %d random arm "
+            "states: "
+            "worst error of a sine or cosine, the end effector's worst vertex error (ft) against "
+            "the "
+            "library, how many SC22 words (LSB 2^-22 = 2.4e-7) differ, and the time for six "
+            "pairs.\n\n",
+            kRandom)
+     << "| method | max sin/cos error | EFF HEX vertex error ft | SC22 words differing | ns for "
+        "six pairs |\n|---|---:|---:|---:|---:|\n";
   const SineTable t4096(4096), t65536(65536);
   struct Method {
     const char* name;
     std::function<rms::arm::SinCos(double)> f;
   };
   const std::vector<Method> methods = {
-      {"C library sin, cos (double)", [](double d) { const double r = d * M_PI / 180; return rms::arm::SinCos{std::sin(r), std::cos(r)}; }},
-      {"table, 4096 entries a turn, linear interpolation", [&](double d) { return t4096.SinCosDeg(d); }},
-      {"table, 65536 entries a turn, linear interpolation", [&](double d) { return t65536.SinCosDeg(d); }},
+      {"C library sin, cos (double)",
+       [](double d) {
+         const double r = d * M_PI / 180;
+         return rms::arm::SinCos{std::sin(r), std::cos(r)};
+       }},
+      {"table, 4096 entries a turn, linear interpolation",
+       [&](double d) { return t4096.SinCosDeg(d); }},
+      {"table, 65536 entries a turn, linear interpolation",
+       [&](double d) { return t65536.SinCosDeg(d); }},
       {"polynomial, octant reduction, degree 7 / 6", PolySinCosDeg<4>},
       {"polynomial, octant reduction, degree 11 / 10", PolySinCosDeg<6>},
   };
@@ -528,7 +573,8 @@ void TrigonometryTable(const Bench& b, std::ostringstream& md) {
       const rms::arm::ArmSinCos x = Quantize(lib, 2), y = Quantize(mine, 2);
       for (int j = 0; j < 6; ++j) words_differ += (x[j].s != y[j].s) + (x[j].c != y[j].c);
       if (i < 20000) {
-        eff = std::max(eff, MaxVertexDistance(EndEffectorFor(b.config, mine, s), EndEffectorFor(b.config, lib, s)));
+        eff = std::max(eff, MaxVertexDistance(EndEffectorFor(b.config, mine, s),
+                                              EndEffectorFor(b.config, lib, s)));
       }
     }
     const int kT = 200000;
@@ -541,7 +587,8 @@ void TrigonometryTable(const Bench& b, std::ostringstream& md) {
       }
     }
     const double ns = std::chrono::duration<double, std::nano>(Clock::now() - t0).count() / kT;
-    md << Sprintf("| %s | %.1e | %.1e | %ld of %d | %.1f |\n", m.name, maxe, eff, words_differ, 12 * kRandom, ns);
+    md << Sprintf("| %s | %.1e | %.1e | %ld of %d | %.1f |\n", m.name, maxe, eff, words_differ,
+                  12 * kRandom, ns);
   }
   md << "\n(The timings include a `std::function` call per pair, the same for every method.)\n\n";
 }
@@ -576,7 +623,8 @@ double ReachFt(Bench* b) {
         rms::arm::ComputeArmPose(b->config.arm, rms::arm::SinCosFromDegrees(s.deg), s.height_ft);
     const EndEffectorModel ee = MakeEndEffector(b->config.end_effector, pose.X_RS2, s.gap_ft);
     for (int k = 0; k < 3; ++k)
-      for (int v = 0; v < 8; ++v) reach = std::max(reach, (ee.hex[k].vertex(v) - pose.p_RoS_R).norm());
+      for (int v = 0; v < 8; ++v)
+        reach = std::max(reach, (ee.hex[k].vertex(v) - pose.p_RoS_R).norm());
   }
   return reach * 1.25;  // margin for poses not sampled
 }
@@ -598,13 +646,15 @@ double ThinnestFt(const Bench& b) {
   };
   extents(b.bar);
   for (const Hexahedron& strip : b.payload.body) extents(strip);
-  const EndEffectorModel ee = EndEffectorFor(b.config, rms::arm::SinCosFromDegrees(b.near[0].deg), b.near[0]);
+  const EndEffectorModel ee =
+      EndEffectorFor(b.config, rms::arm::SinCosFromDegrees(b.near[0].deg), b.near[0]);
   for (int k = 0; k < 3; ++k) extents(ee.hex[k]);
   return thin;
 }
 
 // Trajectories that start clear and collide within kDuration (by the truth).
-std::vector<Traj> CollidingTrajectories(Bench* b, const TunnelScene& scene, int wanted, long* generated) {
+std::vector<Traj> CollidingTrajectories(Bench* b, const TunnelScene& scene, int wanted,
+                                        long* generated) {
   std::uniform_real_distribution<double> rate(-kRate, kRate);
   std::uniform_int_distribution<std::size_t> pick(0, b->near.size() - 1);
   std::vector<Traj> colliding;
@@ -615,7 +665,8 @@ std::vector<Traj> CollidingTrajectories(Bench* b, const TunnelScene& scene, int 
     for (double& r : t.rate_deg_s) r = rate(b->rng);
     if (scene.Collides(t.start, &tests)) continue;  // start clear
     bool hit = false;
-    for (int i = 1; i <= static_cast<int>(kDuration * kTruthHz) && !hit; ++i) hit = scene.Collides(t.At(i, kTruthHz), &tests);
+    for (int i = 1; i <= static_cast<int>(kDuration * kTruthHz) && !hit; ++i)
+      hit = scene.Collides(t.At(i, kTruthHz), &tests);
     if (hit) colliding.push_back(t);
   }
   return colliding;
@@ -626,8 +677,8 @@ struct SampledRow {
   long missed_sampled = 0, missed_swept = 0, substeps = 0, frames = 0;
   double us_sampled = 0, us_swept = 0;
 };
-SampledRow SampleAndSubstep(const TunnelScene& scene, const std::vector<Traj>& colliding, double hz, double reach,
-                            double step_ft) {
+SampledRow SampleAndSubstep(const TunnelScene& scene, const std::vector<Traj>& colliding, double hz,
+                            double reach, double step_ft) {
   SampledRow row;
   for (const Traj& t : colliding) {
     const int nf = static_cast<int>(std::ceil(kDuration * hz));
@@ -643,10 +694,12 @@ SampledRow SampleAndSubstep(const TunnelScene& scene, const std::vector<Traj>& c
       t0 = Clock::now();
       if (!seen_w) {
         double travel = 0;
-        for (int j = 0; j < 6; ++j) travel += std::abs(cur.deg[j] - prev.deg[j]) * M_PI / 180 * reach;
+        for (int j = 0; j < 6; ++j)
+          travel += std::abs(cur.deg[j] - prev.deg[j]) * M_PI / 180 * reach;
         const int n = std::max(1, static_cast<int>(std::ceil(travel / step_ft)));
         row.substeps += n;
-        for (int i = 1; i <= n && !seen_w; ++i) seen_w = scene.Collides(Lerp(prev, cur, double(i) / n), &dummy);
+        for (int i = 1; i <= n && !seen_w; ++i)
+          seen_w = scene.Collides(Lerp(prev, cur, double(i) / n), &dummy);
       }
       row.us_swept += std::chrono::duration<double, std::micro>(Clock::now() - t0).count();
       prev = cur;
@@ -669,7 +722,8 @@ ShippedRow RunShipped(const rms::LabConfig& config, const std::vector<Traj>& col
     for (int j = 0; j < 6; ++j) in.value[j] = a.deg[j];
     in.value[rms::kShoulderHeight] = a.height_ft;
     const auto& ee = config.end_effector;
-    in.value[rms::kFinger] = (ee.finger_gap_open_ft - a.gap_ft) / (ee.finger_gap_open_ft - ee.finger_gap_closed_ft);
+    in.value[rms::kFinger] =
+        (ee.finger_gap_open_ft - a.gap_ft) / (ee.finger_gap_open_ft - ee.finger_gap_closed_ft);
     return in;
   };
   ShippedRow row;
@@ -703,40 +757,60 @@ int TunnellingTable(Bench* b, int trajectories, std::ostringstream& md) {
   std::vector<double> speeds;
   for (const Traj& t : colliding) {
     const ArmSample s1 = t.At(1e-3, 1.0);
-    const EndEffectorModel x = EndEffectorFor(b->config, rms::arm::SinCosFromDegrees(t.start.deg), t.start);
+    const EndEffectorModel x =
+        EndEffectorFor(b->config, rms::arm::SinCosFromDegrees(t.start.deg), t.start);
     const EndEffectorModel y = EndEffectorFor(b->config, rms::arm::SinCosFromDegrees(s1.deg), s1);
     speeds.push_back((y.hex[0].vertex(0) - x.hex[0].vertex(0)).norm() / 1e-3);
   }
   md << "## Frame rate against tunnelling\n\n"
-     << Sprintf("%zu trajectories that collide (of %ld drawn): each starts clear at a near-contact state of "
-                "the missions, every joint turning at a random rate up to %.0f deg/s for %.1f s (end-effector "
-                "speed median %.1f ft/s, 90th percentile %.1f ft/s); truth is the first collision found sampling at %.0f Hz. Sampled: "
-                "the DCP's test at each frame only -- a trajectory is missed when no frame of it sees a "
-                "collision (the arm passed through between frames). Substeps: between frames, enough evenly spaced tests that "
-                "no vertex moves more than %.3f ft (half the thinnest solid) a step, bounded by the sum of the "
-                "joint angle changes times the end effector's reach from the shoulder (%.1f ft).\n\n",
-                colliding.size(), generated, kRate, kDuration, Percentile(speeds, 0.5), Percentile(speeds, 0.9),
-                kTruthHz, step_ft, reach)
-     << "| frame rate Hz | missed, frame sampling | missed, substeps | substeps a frame (mean) | us a frame, sampling | us a frame, substeps | missed, the DCP as shipped | its poses a frame (mean) | its us a frame (whole Step) |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+     << Sprintf(
+            "%zu trajectories that collide (of %ld drawn): each starts clear at a near-contact "
+            "state of "
+            "the missions, every joint turning at a random rate up to %.0f deg/s for %.1f s "
+            "(end-effector "
+            "speed median %.1f ft/s, 90th percentile %.1f ft/s); truth is the first collision "
+            "found sampling at %.0f Hz. Sampled: "
+            "the DCP's test at each frame only -- a trajectory is missed when no frame of it sees "
+            "a "
+            "collision (the arm passed through between frames). Substeps: between frames, enough "
+            "evenly spaced tests that "
+            "no vertex moves more than %.3f ft (half the thinnest solid) a step, bounded by the "
+            "sum of the "
+            "joint angle changes times the end effector's reach from the shoulder (%.1f ft).\n\n",
+            colliding.size(), generated, kRate, kDuration, Percentile(speeds, 0.5),
+            Percentile(speeds, 0.9), kTruthHz, step_ft, reach)
+     << "| frame rate Hz | missed, frame sampling | missed, substeps | substeps a frame (mean) | "
+        "us a frame, sampling | us a frame, substeps | missed, the DCP as shipped | its poses a "
+        "frame (mean) | its us a frame (whole Step) "
+        "|\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   int status = 0;
   for (double hz : {15.0, 30.0, 60.0, 120.0}) {
     const SampledRow s = SampleAndSubstep(scene, colliding, hz, reach, step_ft);
     const ShippedRow d = RunShipped(b->config, colliding, hz);
     status |= d.missed != 0 && !colliding.empty() ? 1 : 0;
-    md << Sprintf("| %.0f | %ld of %zu (%.1f%%) | %ld | %.1f | %.2f | %.2f | %ld | %.1f | %.2f |\n", hz,
-                  s.missed_sampled, colliding.size(),
-                  100.0 * s.missed_sampled / std::max<std::size_t>(1, colliding.size()), s.missed_swept,
-                  double(s.substeps) / std::max(1L, s.frames), s.us_sampled / s.frames, s.us_swept / s.frames,
-                  d.missed, double(d.substeps) / std::max(1L, d.frames), d.us / std::max(1L, d.frames));
+    md << Sprintf("| %.0f | %ld of %zu (%.1f%%) | %ld | %.1f | %.2f | %.2f | %ld | %.1f | %.2f |\n",
+                  hz, s.missed_sampled, colliding.size(),
+                  100.0 * s.missed_sampled / std::max<std::size_t>(1, colliding.size()),
+                  s.missed_swept, double(s.substeps) / std::max(1L, s.frames),
+                  s.us_sampled / s.frames, s.us_swept / s.frames, d.missed,
+                  double(d.substeps) / std::max(1L, d.frames), d.us / std::max(1L, d.frames));
   }
-  md << "\nA trajectory counts as missed only if no frame in the whole run sees a collision (the arm passed "
-        "through and out); the substep test runs only while the arm moves, and stops at the first hit. Substeps "
-        "that move no vertex more than half the thinnest solid cannot pass through a solid; a grazing contact "
-        "shallower than a step can still fall between two of them (as between the truth's own samples), which "
-        "is what a miss in the substep column is. The DCP as shipped (`DynamicCollisionProgram::Step`, "
-        "docs/collision.md \"Nothing passes through\") tests every frame's motion in substeps of at most "
-        "0.05 ft of any vertex's travel and holds the arm at the first colliding one; the bench fails (exit 1) "
-        "if it misses any trajectory. Its time is the whole frame's Step, counted until the first collision.\n\n";
+  md << "\nA trajectory counts as missed only if no frame in the whole run sees a collision (the "
+        "arm passed "
+        "through and out); the substep test runs only while the arm moves, and stops at the first "
+        "hit. Substeps "
+        "that move no vertex more than half the thinnest solid cannot pass through a solid; a "
+        "grazing contact "
+        "shallower than a step can still fall between two of them (as between the truth's own "
+        "samples), which "
+        "is what a miss in the substep column is. The DCP as shipped "
+        "(`DynamicCollisionProgram::Step`, "
+        "docs/collision.md \"Nothing passes through\") tests every frame's motion in substeps of "
+        "at most "
+        "0.05 ft of any vertex's travel and holds the arm at the first colliding one; the bench "
+        "fails (exit 1) "
+        "if it misses any trajectory. Its time is the whole frame's Step, counted until the first "
+        "collision.\n\n";
   return status;
 }
 
@@ -749,7 +823,8 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 19721122;
   app.add_option("--config", config_path, "Configuration file")->capture_default_str();
   app.add_option("--md", md_path, "Write the tables as markdown to this file");
-  app.add_option("--reps", reps, "Repetitions of each flight for the frame timings")->capture_default_str();
+  app.add_option("--reps", reps, "Repetitions of each flight for the frame timings")
+      ->capture_default_str();
   app.add_option("--trajectories", trajectories, "Colliding trajectories for the tunnelling table")
       ->capture_default_str();
   app.add_option("--seed", seed, "Seed of the random samples")->capture_default_str();
@@ -760,8 +835,15 @@ int main(int argc, char** argv) {
   int status = 0;  // 1: a saving changed a decision, or the DCP let a trajectory through
   try {
     const rms::LabConfig config = rms::LoadConfig(config_path);
-    const Eigen::Isometry3d X_RP = rms::arm::MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft);
-    Bench b{config, std::mt19937_64(seed), {}, {}, {}, {}, MakeBar(config.payload, X_RP),
+    const Eigen::Isometry3d X_RP =
+        rms::arm::MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft);
+    Bench b{config,
+            std::mt19937_64(seed),
+            {},
+            {},
+            {},
+            {},
+            MakeBar(config.payload, X_RP),
             MakePayload(config.payload, X_RP)};
     MakeFlights(&b, seed);
     status |= FrameTable(b, reps, md);

@@ -2,10 +2,9 @@
 
 #include <ccd/ccd.h>
 #include <ccd/vec3.h>
-#include <ode/ode.h>
-
 #include <cmath>
 #include <fcl/fcl.h>
+#include <ode/ode.h>
 
 namespace rms::bench {
 
@@ -64,7 +63,8 @@ void BoxSupport(const void* obj, const ccd_vec3_t* dir, ccd_vec3_t* out) {
   const auto* s = static_cast<const BoxShape*>(obj);
   const Eigen::Vector3d d(dir->v[0], dir->v[1], dir->v[2]);
   Eigen::Vector3d p = s->centre;
-  for (int k = 0; k < 3; ++k) p += (s->R.col(k).dot(d) >= 0 ? 1.0 : -1.0) * s->half[k] * s->R.col(k);
+  for (int k = 0; k < 3; ++k)
+    p += (s->R.col(k).dot(d) >= 0 ? 1.0 : -1.0) * s->half[k] * s->R.col(k);
   ccdVec3Set(out, p.x(), p.y(), p.z());
 }
 void BoxCenter(const void* obj, ccd_vec3_t* c) {
@@ -135,16 +135,20 @@ std::unique_ptr<FclPair> FclPair::Boxes(const BoxShape& a, const BoxShape& b) {
   return p;
 }
 
-std::unique_ptr<FclPair> FclPair::Hulls(const std::array<Eigen::Vector3d, 8>& a, const std::array<Eigen::Vector3d, 8>& b) {
+std::unique_ptr<FclPair> FclPair::Hulls(const std::array<Eigen::Vector3d, 8>& a,
+                                        const std::array<Eigen::Vector3d, 8>& b) {
   std::unique_ptr<FclPair> p(new FclPair);
   // The standard notation's faces (docs/collision.md), outward.
-  static const int kFaces[6][4] = {{0, 1, 3, 4}, {0, 2, 5, 1}, {0, 4, 7, 2}, {2, 7, 6, 5}, {4, 3, 6, 7}, {1, 5, 6, 3}};
-  auto make = [](const std::array<Eigen::Vector3d, 8>& v, std::shared_ptr<fcl::CollisionGeometryd>* g) {
+  static const int kFaces[6][4] = {{0, 1, 3, 4}, {0, 2, 5, 1}, {0, 4, 7, 2},
+                                   {2, 7, 6, 5}, {4, 3, 6, 7}, {1, 5, 6, 3}};
+  auto make = [](const std::array<Eigen::Vector3d, 8>& v,
+                 std::shared_ptr<fcl::CollisionGeometryd>* g) {
     auto verts = std::make_shared<std::vector<fcl::Vector3d>>(v.begin(), v.end());
     auto faces = std::make_shared<std::vector<int>>();
     for (const auto& f : kFaces) {
       faces->push_back(4);
-      for (int k = 0; k < 4; ++k) faces->push_back(f[k]);  // counter-clockwise seen from outside, as FCL wants
+      for (int k = 0; k < 4; ++k)
+        faces->push_back(f[k]);  // counter-clockwise seen from outside, as FCL wants
     }
     *g = std::make_shared<fcl::Convexd>(verts, 6, faces);
     return std::make_unique<fcl::CollisionObjectd>(*g, fcl::Transform3d::Identity());

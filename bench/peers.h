@@ -7,18 +7,17 @@
 //  - FCL's collide() on boxes (it computes a contact: more work than a yes/no);
 //  - libccd's MPR (boxes and general hexahedra, through support functions);
 //  - FCL's collide() on convex polyhedra (general hexahedra, GJK/EPA inside).
+#include <Eigen/Geometry>
 #include <array>
 #include <memory>
 #include <vector>
-
-#include <Eigen/Geometry>
 
 namespace rms::bench {
 
 struct BoxShape {
   Eigen::Vector3d centre;
-  Eigen::Matrix3d R;       // columns: unit axes
-  Eigen::Vector3d half;    // half extents along them
+  Eigen::Matrix3d R;     // columns: unit axes
+  Eigen::Vector3d half;  // half extents along them
 };
 
 // The 15-axis separating-axis test in double: true when the closed boxes
@@ -38,7 +37,8 @@ class FclPair {
  public:
   static std::unique_ptr<FclPair> Boxes(const BoxShape& a, const BoxShape& b);
   // General hexahedra as fcl::Convex (the standard vertex numbering's faces).
-  static std::unique_ptr<FclPair> Hulls(const std::array<Eigen::Vector3d, 8>& a, const std::array<Eigen::Vector3d, 8>& b);
+  static std::unique_ptr<FclPair> Hulls(const std::array<Eigen::Vector3d, 8>& a,
+                                        const std::array<Eigen::Vector3d, 8>& b);
   ~FclPair();
   bool Collide() const;
 

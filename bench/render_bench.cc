@@ -8,25 +8,25 @@
 //
 //   build/bench/rms_render_bench [--width 1024 --height 768] [--every 1] [--json out.json]
 #include <CLI/CLI.hpp>
-#include "rms/base/command_line.h"
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
-#include <nlohmann/json.hpp>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "rms/base/check.h"
+#include "rms/base/command_line.h"
 #include "rms/base/text.h"
-
-#include "bench_stats.h"
 #include "rms/esg_renderer/gl_context.h"
-#include "rms/sim/offline_session.h"
 #include "rms/esg_renderer/overlay.h"
 #include "rms/esg_renderer/png_io.h"
 #include "rms/esg_renderer/renderer.h"
+#include "rms/sim/offline_session.h"
+
+#include "bench_stats.h"
 
 namespace {
 
@@ -65,7 +65,8 @@ std::vector<Variant> MakeVariants(const rms::LabConfig& config, const Options& o
   auto add = [&](std::string name, Visibility vis, bool frustum, bool backface) {
     Variant x;
     x.name = std::move(name);
-    x.options = {.visibility = vis, .id_colors = false, .frustum_cull = frustum, .backface_cull = backface};
+    x.options = {
+        .visibility = vis, .id_colors = false, .frustum_cull = frustum, .backface_cull = backface};
     v.push_back(std::move(x));
   };
   add("depth buffer, all culls (reference)", Visibility::kDepth, true, true);
@@ -74,7 +75,8 @@ std::vector<Variant> MakeVariants(const rms::LabConfig& config, const Options& o
   add("priority, no back-face cull", Visibility::kPriority, true, false);
   add("depth buffer, no culls", Visibility::kDepth, false, false);
   for (Variant& x : v) {
-    x.gl = rms::esg_renderer::CreateGlContext(rms::esg_renderer::ParseGlBackend(o.gl_name), o.width, o.height);
+    x.gl = rms::esg_renderer::CreateGlContext(rms::esg_renderer::ParseGlBackend(o.gl_name), o.width,
+                                              o.height);
     x.renderer = std::make_unique<rms::esg_renderer::FrameRenderer>(config, x.gl.get(), x.options);
   }
   return v;
@@ -112,7 +114,8 @@ void DrawVariants(const rms::wire::EsgFrameData& f, const Options& o, std::vecto
 // The mission flown; every `every`th frame of the selected station drawn by
 // each variant, every station by the default, and an unchanged frame's cost.
 Mission FlyMission(const rms::LabConfig& config, const Options& o, std::vector<Variant>* v) {
-  rms::sim::OfflineSession session(config, rms::operator_station::Timeline::Load(o.timeline, config.inputs));
+  rms::sim::OfflineSession session(
+      config, rms::operator_station::Timeline::Load(o.timeline, config.inputs));
   const std::size_t n = static_cast<std::size_t>(o.width) * o.height;
   std::vector<std::uint8_t> ref(n * 4), out(n * 4);
   const rms::esg_renderer::OverlayModel overlay = rms::esg_renderer::MakeOverlayModel(config);
@@ -122,7 +125,8 @@ Mission FlyMission(const rms::LabConfig& config, const Options& o, std::vector<V
     // Unchanged frames: the selected station's words but for the frame
     // counter (word 0) equal the previous frame's, as esg_renderer tests.
     const std::vector<std::int32_t> words = rms::wire::PackEsgWords(session.esg(), nullptr);
-    const bool same = !prev_words.empty() && std::equal(words.begin() + 1, words.end(), prev_words.begin() + 1);
+    const bool same =
+        !prev_words.empty() && std::equal(words.begin() + 1, words.end(), prev_words.begin() + 1);
     prev_words = words;
     ++m.frames;
     m.unchanged += same;
@@ -157,31 +161,37 @@ void PrintFigures(const Options& o, const std::vector<Variant>& v, const Mission
   j["frames_measured"] = measured;
   std::printf("%s, %dx%d, %s: %ld frames, %ld measured\n\n", o.timeline.c_str(), o.width, o.height,
               v[0].gl->description().c_str(), m.frames, measured);
-  std::printf("%-40s %9s %9s %9s %9s %10s %12s %8s\n", "variant (selected station)", "mean ms", "p50 ms", "p99 ms",
-              "clusters", "triangles", "px differ", "frames");
+  std::printf("%-40s %9s %9s %9s %9s %10s %12s %8s\n", "variant (selected station)", "mean ms",
+              "p50 ms", "p99 ms", "clusters", "triangles", "px differ", "frames");
   for (const Variant& x : v) {
     const double mean = Mean(x.ms);
-    std::printf("%-40s %9.3f %9.3f %9.3f %9.1f %10.1f %12ld %8ld\n", x.name.c_str(), mean, Percentile(x.ms, 0.5),
-                Percentile(x.ms, 0.99), static_cast<double>(x.clusters) / measured,
+    std::printf("%-40s %9.3f %9.3f %9.3f %9.1f %10.1f %12ld %8ld\n", x.name.c_str(), mean,
+                Percentile(x.ms, 0.5), Percentile(x.ms, 0.99),
+                static_cast<double>(x.clusters) / measured,
                 static_cast<double>(x.triangles) / measured, x.differing, x.frames_differing);
-    j["variants"].push_back({{"name", x.name},
-                             {"mean_ms", mean},
-                             {"p50_ms", Percentile(x.ms, 0.5)},
-                             {"p99_ms", Percentile(x.ms, 0.99)},
-                             {"clusters_drawn_mean", static_cast<double>(x.clusters) / measured},
-                             {"triangles_submitted_mean", static_cast<double>(x.triangles) / measured},
-                             {"pixels_differing_from_reference", x.differing},
-                             {"frames_differing_from_reference", x.frames_differing}});
+    j["variants"].push_back(
+        {{"name", x.name},
+         {"mean_ms", mean},
+         {"p50_ms", Percentile(x.ms, 0.5)},
+         {"p99_ms", Percentile(x.ms, 0.99)},
+         {"clusters_drawn_mean", static_cast<double>(x.clusters) / measured},
+         {"triangles_submitted_mean", static_cast<double>(x.triangles) / measured},
+         {"pixels_differing_from_reference", x.differing},
+         {"frames_differing_from_reference", x.frames_differing}});
   }
   const double sel = Mean(v[1].ms), all8 = Mean(m.all_stations_ms), ov = Mean(m.overlay_ms);
   const double frac = static_cast<double>(m.unchanged) / m.frames;
-  std::printf("\nselected station only: %.3f ms a frame; all eight stations: %.3f ms (x%.1f)\n", sel, all8,
-              all8 / sel);
-  std::printf("unchanged frames (words 1.. equal the previous frame's): %ld of %ld (%.1f%%); such a frame costs "
-              "%.3f ms (copy + overlay) instead of %.3f ms\n",
-              m.unchanged, m.frames, 100 * frac, ov, sel);
-  std::printf("mission render time with skipping: %.3f ms a frame on average, without: %.3f ms (%.1f%% saved)\n",
-              (1 - frac) * sel + frac * ov, sel, 100 * frac * (sel - ov) / sel);
+  std::printf("\nselected station only: %.3f ms a frame; all eight stations: %.3f ms (x%.1f)\n",
+              sel, all8, all8 / sel);
+  std::printf(
+      "unchanged frames (words 1.. equal the previous frame's): %ld of %ld (%.1f%%); such a frame "
+      "costs "
+      "%.3f ms (copy + overlay) instead of %.3f ms\n",
+      m.unchanged, m.frames, 100 * frac, ov, sel);
+  std::printf(
+      "mission render time with skipping: %.3f ms a frame on average, without: %.3f ms (%.1f%% "
+      "saved)\n",
+      (1 - frac) * sel + frac * ov, sel, 100 * frac * (sel - ov) / sel);
   j["selected_station_ms"] = sel;
   j["all_stations_ms"] = all8;
   j["unchanged_frames"] = m.unchanged;
@@ -192,49 +202,64 @@ void PrintFigures(const Options& o, const std::vector<Variant>& v, const Mission
 }
 
 // docs/performance.md's table of the variants.
-void PriorityTable(const Options& o, const std::vector<Variant>& v, const Mission& m, std::ostringstream& md) {
+void PriorityTable(const Options& o, const std::vector<Variant>& v, const Mission& m,
+                   std::ostringstream& md) {
   const long measured = static_cast<long>(v[0].ms.size());
   md << "## Priority rendering against the depth buffer\n\n"
-     << rms::Sprintf("`rms_render_bench`: the scripted mission (%s) in process, every %s frame of the selected "
-                     "station drawn by each variant at %dx%d (%s), timed from the first GL call to the pixels in "
-                     "memory, and compared pixel by pixel with the depth-buffer reference (%ld frames measured).\n\n",
-                     std::filesystem::path(o.timeline).filename().c_str(),
-                     o.every == 1 ? "" : (std::to_string(o.every) + "th").c_str(), o.width, o.height,
-                     v[0].gl->description().c_str(), measured)
-     << "| variant | mean ms | p50 ms | p99 ms | clusters drawn | triangles | pixels differing | frames differing |\n"
+     << rms::Sprintf(
+            "`rms_render_bench`: the scripted mission (%s) in process, every %s frame of the "
+            "selected "
+            "station drawn by each variant at %dx%d (%s), timed from the first GL call to the "
+            "pixels in "
+            "memory, and compared pixel by pixel with the depth-buffer reference (%ld frames "
+            "measured).\n\n",
+            std::filesystem::path(o.timeline).filename().c_str(),
+            o.every == 1 ? "" : (std::to_string(o.every) + "th").c_str(), o.width, o.height,
+            v[0].gl->description().c_str(), measured)
+     << "| variant | mean ms | p50 ms | p99 ms | clusters drawn | triangles | pixels differing | "
+        "frames differing |\n"
      << "|---|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const Variant& x : v) {
-    md << rms::Sprintf("| %s | %.3f | %.3f | %.3f | %.1f | %.1f | %ld | %ld |\n", x.name.c_str(), Mean(x.ms),
-                       Percentile(x.ms, 0.5), Percentile(x.ms, 0.99), static_cast<double>(x.clusters) / measured,
-                       static_cast<double>(x.triangles) / measured, x.differing, x.frames_differing);
+    md << rms::Sprintf(
+        "| %s | %.3f | %.3f | %.3f | %.1f | %.1f | %ld | %ld |\n", x.name.c_str(), Mean(x.ms),
+        Percentile(x.ms, 0.5), Percentile(x.ms, 0.99), static_cast<double>(x.clusters) / measured,
+        static_cast<double>(x.triangles) / measured, x.differing, x.frames_differing);
   }
   const double sel = Mean(v[1].ms), all8 = Mean(m.all_stations_ms), ov = Mean(m.overlay_ms);
   const double frac = static_cast<double>(m.unchanged) / m.frames;
-  md << rms::Sprintf("\nEvery station drawn each frame: %.3f ms against %.3f ms for the selected one (x%.1f). "
-                     "Unchanged frames: %ld of %ld (%.1f%%), each costing %.3f ms (copy + overlay): %.3f ms a frame "
-                     "on average with skipping, %.3f without.\n\n",
-                     all8, sel, all8 / sel, m.unchanged, m.frames, 100 * frac, ov, (1 - frac) * sel + frac * ov, sel);
+  md << rms::Sprintf(
+      "\nEvery station drawn each frame: %.3f ms against %.3f ms for the selected one (x%.1f). "
+      "Unchanged frames: %ld of %ld (%.1f%%), each costing %.3f ms (copy + overlay): %.3f ms a "
+      "frame "
+      "on average with skipping, %.3f without.\n\n",
+      all8, sel, all8 / sel, m.unchanged, m.frames, 100 * frac, ov, (1 - frac) * sel + frac * ov,
+      sel);
 }
 
 // The ESG's default and the depth buffer at each --sizes size, every 10th frame.
 void ResolutionTable(const rms::LabConfig& config, const Options& o, const std::vector<Variant>& v,
                      std::ostringstream& md) {
   md << "## Render resolution against frame time\n\n"
-     << "The same mission, every 10th frame, the ESG's default (priority, all culls) and the depth buffer:\n\n"
-     << "| size | pixels | priority mean ms | priority p99 ms | depth buffer mean ms | depth buffer p99 ms |\n"
+     << "The same mission, every 10th frame, the ESG's default (priority, all culls) and the depth "
+        "buffer:\n\n"
+     << "| size | pixels | priority mean ms | priority p99 ms | depth buffer mean ms | depth "
+        "buffer p99 ms |\n"
      << "|---|---:|---:|---:|---:|---:|\n";
   for (const std::string& wh : o.sizes) {
     int w = 0, h = 0;
     if (std::sscanf(wh.c_str(), "%dx%d", &w, &h) != 2 || w <= 0 || h <= 0) {
       throw rms::InputError("--sizes: '" + wh + "' is not WIDTHxHEIGHT");
     }
-    rms::sim::OfflineSession sz(config, rms::operator_station::Timeline::Load(o.timeline, config.inputs));
+    rms::sim::OfflineSession sz(config,
+                                rms::operator_station::Timeline::Load(o.timeline, config.inputs));
     std::vector<double> ms[2];
     std::unique_ptr<rms::esg_renderer::GlContext> gl[2];
     std::unique_ptr<rms::esg_renderer::FrameRenderer> r[2];
     for (int k = 0; k < 2; ++k) {
-      gl[k] = rms::esg_renderer::CreateGlContext(rms::esg_renderer::ParseGlBackend(o.gl_name), w, h);
-      r[k] = std::make_unique<rms::esg_renderer::FrameRenderer>(config, gl[k].get(), k ? v[0].options : v[1].options);
+      gl[k] =
+          rms::esg_renderer::CreateGlContext(rms::esg_renderer::ParseGlBackend(o.gl_name), w, h);
+      r[k] = std::make_unique<rms::esg_renderer::FrameRenderer>(config, gl[k].get(),
+                                                                k ? v[0].options : v[1].options);
     }
     while (sz.Next()) {
       if (sz.frame() % 10) continue;
@@ -254,19 +279,26 @@ void ResolutionTable(const rms::LabConfig& config, const Options& o, const std::
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"rmslab rms_render_bench: the ESG's savings (frustum cull, back-face cull, priority instead of a "
-               "depth buffer, the selected station only, unchanged frames not redrawn) measured over a mission"};
+  CLI::App app{
+      "rmslab rms_render_bench: the ESG's savings (frustum cull, back-face cull, priority instead "
+      "of a "
+      "depth buffer, the selected station only, unchanged frames not redrawn) measured over a "
+      "mission"};
   Options o;
   app.add_option("--config", o.config_path, "Configuration file")->capture_default_str();
   app.add_option("--timeline", o.timeline, "Timeline to fly")->capture_default_str();
-  app.add_option("--every", o.every, "Measure every Nth frame")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--every", o.every, "Measure every Nth frame")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_option("--width", o.width, "Image width")->capture_default_str();
   app.add_option("--height", o.height, "Image height")->capture_default_str();
   app.add_option("--gl", o.gl_name, "GL backend: osmesa or egl")->capture_default_str();
   app.add_option("--json", o.json_out, "Also write the figures as JSON to this file");
-  app.add_option("--dump", o.dump_dir, "Write each variant's worst frame, and the reference's, as PNG here");
+  app.add_option("--dump", o.dump_dir,
+                 "Write each variant's worst frame, and the reference's, as PNG here");
   app.add_option("--md", o.md_path, "Write the tables as markdown to this file");
-  app.add_option("--sizes", o.sizes, "Also time the ESG's default renderer and the depth buffer at these sizes (WxH)");
+  app.add_option("--sizes", o.sizes,
+                 "Also time the ESG's default renderer and the depth buffer at these sizes (WxH)");
   if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   try {
     const rms::LabConfig config = rms::LoadConfig(o.config_path);

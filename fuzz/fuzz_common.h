@@ -4,9 +4,8 @@
 // which a target publishes the fuzzer's bytes to a process's real handlers.
 #include <cstdint>
 #include <cstdlib>
-#include <string>
-
 #include <spdlog/spdlog.h>
+#include <string>
 
 #include "rms/base/config.h"
 #include "rms/transport/lcm_interface.h"

@@ -2,6 +2,7 @@
 // UnpackEsgWords's checks, frame numbers). Rendering is not fuzzed: the
 // node queues the unpacked frame and the renderer draws only what passed.
 #include "rms/esg_renderer/esg_renderer.h"
+
 #include "fuzz_common.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

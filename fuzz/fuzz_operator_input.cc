@@ -5,8 +5,9 @@
 #include <cstring>
 
 #include "rms/dynamics_proc/dynamics_proc.h"
-#include "fuzz_common.h"
 #include "rms/wire/channels.h"
+
+#include "fuzz_common.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static const rms::LabConfig& config = rms::fuzz::Config();

@@ -4,14 +4,15 @@
 // every process), RMS_OPERATOR_STATE (operator_state_t, as esg_renderer) and
 // RMS_WINDOW_KEYS (window_keys_t, as operator_station). The first byte picks
 // the message type.
-#include "fuzz_common.h"
 #include "rms/dcp_telemetry_t.hpp"
-#include "rms/wire/message_io.h"
-#include "rms/process_status_t.hpp"
-#include "rms/session_control_t.hpp"
 #include "rms/operator_state_t.hpp"
 #include "rms/operator_station/telemetry_check.h"
+#include "rms/process_status_t.hpp"
+#include "rms/session_control_t.hpp"
 #include "rms/window_keys_t.hpp"
+#include "rms/wire/message_io.h"
+
+#include "fuzz_common.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
@@ -19,7 +20,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   switch (data[0] % 5) {
     case 0: {
       rms::dcp_telemetry_t m{};
-      if (rms::wire::SafeDecode(data + 1, n, &m) == rms::wire::DecodeError::kNone) (void)rms::operator_station::TelemetryProblem(m);
+      if (rms::wire::SafeDecode(data + 1, n, &m) == rms::wire::DecodeError::kNone)
+        (void)rms::operator_station::TelemetryProblem(m);
       break;
     }
     case 1: {

@@ -5,12 +5,13 @@
 // refuse it with rms::InputError; anything else escaping is a finding.
 #include <string_view>
 
-#include "rms/dynamics_proc/dynamic_collision_program.h"
-#include "fuzz_common.h"
-#include "rms/session/lab_file.h"
 #include "rms/base/check.h"
-#include "rms/wire/checkpoint.h"
+#include "rms/dynamics_proc/dynamic_collision_program.h"
 #include "rms/operator_station/timeline.h"
+#include "rms/session/lab_file.h"
+#include "rms/wire/checkpoint.h"
+
+#include "fuzz_common.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static const rms::LabConfig& config = rms::fuzz::Config();
@@ -18,9 +19,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string_view text(reinterpret_cast<const char*>(data + 1), size - 1);
   try {
     switch (data[0] % 4) {
-      case 0: (void)rms::ParseConfig(text, "fuzz.toml"); break;
-      case 1: (void)rms::operator_station::Timeline::Parse(text, "fuzz.tl", config.inputs); break;
-      case 2: (void)rms::session::ParseLabFile(text, "fuzz-lab.toml"); break;
+      case 0:
+        (void)rms::ParseConfig(text, "fuzz.toml");
+        break;
+      case 1:
+        (void)rms::operator_station::Timeline::Parse(text, "fuzz.tl", config.inputs);
+        break;
+      case 2:
+        (void)rms::session::ParseLabFile(text, "fuzz-lab.toml");
+        break;
       default: {
         const rms::wire::Checkpoint c = rms::wire::ParseCheckpoint(text, "fuzz.json");
         rms::dynamics_proc::DynamicCollisionProgram dcp(config);

@@ -2,17 +2,18 @@
 // A thin main over scene_proc/src; see docs/scene.md.
 #include <CLI/CLI.hpp>
 
-#include "rms/transport/process.h"
 #include "rms/scene_proc/scene_proc.h"
+#include "rms/transport/process.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"rmslab scene_proc: the Visual Scene Program. Turns each DCP frame "
-               "(RMS_DCP_FRAME) into the selected camera's view and packs the ESG frame "
-               "(RMS_ESG_FRAME, at most 64 twenty-four-bit words)."};
+  CLI::App app{
+      "rmslab scene_proc: the Visual Scene Program. Turns each DCP frame "
+      "(RMS_DCP_FRAME) into the selected camera's view and packs the ESG frame "
+      "(RMS_ESG_FRAME, at most 64 twenty-four-bit words)."};
   rms::transport::CommonOptions common;
-  return rms::transport::ProcessMain(app, argc, argv, "scene_proc", &common,
-                          [&](const rms::LabConfig& config, rms::transport::LcmInterface& lcm) {
-                            return rms::scene_proc::RunSceneProc(config, lcm, common.stats_path,
-                                                            common.ready_path);
-                          });
+  return rms::transport::ProcessMain(
+      app, argc, argv, "scene_proc", &common,
+      [&](const rms::LabConfig& config, rms::transport::LcmInterface& lcm) {
+        return rms::scene_proc::RunSceneProc(config, lcm, common.stats_path, common.ready_path);
+      });
 }

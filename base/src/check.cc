@@ -7,8 +7,8 @@ namespace rms {
 
 void AbortOnBrokenInvariant(const char* condition, const char* file, int line,
                             const char* message) {
-  std::fprintf(stderr, "rmslab: internal invariant broken: %s at %s:%d %s\n", condition, file,
-               line, message);
+  std::fprintf(stderr, "rmslab: internal invariant broken: %s at %s:%d %s\n", condition, file, line,
+               message);
   std::fflush(stderr);
   std::abort();
 }

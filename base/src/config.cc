@@ -6,10 +6,9 @@
 #include <sstream>
 #include <toml++/toml.h>
 
-#include "rms/base/toml_reader.h"
-
 #include "rms/base/check.h"
 #include "rms/base/text.h"
+#include "rms/base/toml_reader.h"
 
 #ifndef RMSLAB_DEFAULT_CONFIG
 #error "RMSLAB_DEFAULT_CONFIG must be defined by the build"
@@ -22,7 +21,6 @@ using TableReader = TomlReader;
 std::string DefaultConfigPath() { return RMSLAB_DEFAULT_CONFIG; }
 
 namespace {
-
 
 CameraMount ParseMount(TableReader& r) {
   const std::string m = r.String("mount");
@@ -65,8 +63,10 @@ void ReadArm(TableReader& top, LabConfig* config) {
   const std::vector<double> hi = r.Numbers("joint_max_deg", 6, -180.0, 180.0);
   for (int i = 0; i < 6; ++i) {
     if (!(lo[i] < hi[i])) {
-      r.Fail("joint_max_deg", "joint " + std::to_string(i + 1) + " (" + std::string(kAnalogInputNames[i]) +
-                                  "): max " + FormatNumber(hi[i]) + " must be greater than min " + FormatNumber(lo[i]));
+      r.Fail("joint_max_deg", "joint " + std::to_string(i + 1) + " (" +
+                                  std::string(kAnalogInputNames[i]) + "): max " +
+                                  FormatNumber(hi[i]) + " must be greater than min " +
+                                  FormatNumber(lo[i]));
     }
     c.arm.joint_min_deg[i] = lo[i];
     c.arm.joint_max_deg[i] = hi[i];
@@ -105,7 +105,8 @@ void ReadPayload(TableReader& top, LabConfig* config) {
   p.diameter_ft = r.Positive("diameter_ft");
   p.length_ft = r.Positive("length_ft");
   p.probe_diameter_ft = r.Positive("probe_diameter_ft");
-  if (p.probe_diameter_ft >= p.diameter_ft) r.Fail("probe_diameter_ft", "must be less than payload.diameter_ft");
+  if (p.probe_diameter_ft >= p.diameter_ft)
+    r.Fail("probe_diameter_ft", "must be less than payload.diameter_ft");
   p.probe_length_ft = r.Positive("probe_length_ft");
   p.p_RoPo_R_ft = r.Vec3("position_ft");
   p.R_RP = r.Rotation("y_axis", "z_axis");
@@ -139,13 +140,16 @@ void ReadDcp(TableReader& top, LabConfig* config) {
   c.dcp.dock_distance_ft = r.Positive("dock_distance_ft");
   c.dcp.dock_angle_deg = r.Number("dock_angle_deg", 0.0, 90.0, true);
   if (c.dcp.d3y_ft <= c.end_effector.finger_gap_closed_ft) {
-    r.Fail("d3y_ft", "must be greater than end_effector.finger_gap_closed_ft, or no gap could satisfy it");
+    r.Fail("d3y_ft",
+           "must be greater than end_effector.finger_gap_closed_ft, or no gap could satisfy it");
   }
   // The finger must close onto the bar within D3Y, and open past it to let go.
   const double bar_width = c.payload.bar_size_P_ft.y();
   if (c.dcp.d3y_ft <= bar_width) {
-    r.Fail("d3y_ft", "must be greater than the bar's width (payload.bar_size_ft[1] = " + HumanNumber(bar_width) +
-                         " ft), or the finger could never close onto the bar within D3Y: acquisition impossible");
+    r.Fail("d3y_ft", "must be greater than the bar's width (payload.bar_size_ft[1] = " +
+                         HumanNumber(bar_width) +
+                         " ft), or the finger could never close onto the bar within D3Y: "
+                         "acquisition impossible");
   }
   if (c.dcp.d3y_ft + kReleaseOpeningFt > c.end_effector.finger_gap_open_ft) {
     r.Fail("d3y_ft", "must be at most end_effector.finger_gap_open_ft - 0.05 ft (" +
@@ -153,8 +157,10 @@ void ReadDcp(TableReader& top, LabConfig* config) {
                          "), or opening the finger could not let the payload go");
   }
   if (c.end_effector.finger_gap_closed_ft >= bar_width) {
-    r.Fail("d3y_ft", "needs end_effector.finger_gap_closed_ft below the bar's width (payload.bar_size_ft[1] = " +
-                         HumanNumber(bar_width) + " ft), or the finger could not close onto the bar");
+    r.Fail(
+        "d3y_ft",
+        "needs end_effector.finger_gap_closed_ft below the bar's width (payload.bar_size_ft[1] = " +
+            HumanNumber(bar_width) + " ft), or the finger could not close onto the bar");
   }
   r.Finish();
 }
@@ -236,14 +242,16 @@ LabConfig ParseConfig(std::string_view text, const std::string& source) {
   c.source = source;
   TableReader top(&root, "", &c.source);
   // In the file's order; [dcp] is checked against [end_effector] and [payload].
-  for (auto read : {ReadSession, ReadShuttle, ReadArm, ReadEndEffector, ReadPayload, ReadCae, ReadDcp, ReadInputs,
-                    ReadCameras}) {
+  for (auto read : {ReadSession, ReadShuttle, ReadArm, ReadEndEffector, ReadPayload, ReadCae,
+                    ReadDcp, ReadInputs, ReadCameras}) {
     read(top, &c);
   }
   top.Finish();
   return c;
 }
 
-LabConfig LoadConfig(const std::string& path) { return ParseConfig(ReadTextFile(path, "the configuration file"), path); }
+LabConfig LoadConfig(const std::string& path) {
+  return ParseConfig(ReadTextFile(path, "the configuration file"), path);
+}
 
 }  // namespace rms

@@ -34,7 +34,8 @@ std::map<std::string, std::int64_t> Counters::ByName() const {
 std::string CounterTableMarkdown() {
   std::string out = "| Counter | Process | Meaning |\n|---|---|---|\n";
   for (const CounterInfo& c : kCounterTable) {
-    out += "| `" + std::string(c.name) + "` | " + std::string(c.processes) + " | " + std::string(c.meaning) + " |\n";
+    out += "| `" + std::string(c.name) + "` | " + std::string(c.processes) + " | " +
+           std::string(c.meaning) + " |\n";
   }
   return out;
 }
@@ -74,7 +75,8 @@ void LatencyHistogram::Add(std::int64_t us) {
 double LatencyHistogram::Percentile(double q) const {
   if (count_ == 0) return 0.0;
   q = std::clamp(q, 0.0, 1.0);
-  const std::int64_t rank = std::max<std::int64_t>(1, static_cast<std::int64_t>(q * count_ + 0.999999));
+  const std::int64_t rank =
+      std::max<std::int64_t>(1, static_cast<std::int64_t>(q * count_ + 0.999999));
   std::int64_t seen = 0;
   for (int b = 0; b < kTotalBins; ++b) {
     seen += bins_[b];
@@ -88,9 +90,11 @@ void LatencyHistogram::Reset() {
   count_ = sum_ = max_ = 0;
 }
 
-void RecordEndToEnd(std::int64_t latency_us, double frame_rate_hz, LatencyHistogram* histogram, Counters* counters) {
+void RecordEndToEnd(std::int64_t latency_us, double frame_rate_hz, LatencyHistogram* histogram,
+                    Counters* counters) {
   histogram->Add(latency_us);
-  if (latency_us > static_cast<std::int64_t>(1e6 / frame_rate_hz)) counters->Add(Counter::kFramesLate);
+  if (latency_us > static_cast<std::int64_t>(1e6 / frame_rate_hz))
+    counters->Add(Counter::kFramesLate);
 }
 
 }  // namespace rms

@@ -1,13 +1,11 @@
-#include <cmath>
 #include "rms/base/text.h"
 
-#include <sys/stat.h>
-
-#include <vector>
-
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <fstream>
+#include <sys/stat.h>
+#include <vector>
 
 #include "rms/base/check.h"
 

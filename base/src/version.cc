@@ -5,13 +5,14 @@
 namespace rms {
 
 const SoftwareVersion& Version() {
-  static const SoftwareVersion v{RMSLAB_PROJECT_VERSION, RMSLAB_GIT_DESCRIBE, RMSLAB_GIT_COMMIT, RMSLAB_BUILD_TYPE,
+  static const SoftwareVersion v {
+    RMSLAB_PROJECT_VERSION, RMSLAB_GIT_DESCRIBE, RMSLAB_GIT_COMMIT, RMSLAB_BUILD_TYPE,
 #if defined(__clang__)
-                                 std::string("Clang ") + __clang_version__
+        std::string("Clang ") + __clang_version__
 #elif defined(__GNUC__)
-                                 std::string("GCC ") + __VERSION__
+        std::string("GCC ") + __VERSION__
 #else
-                                 "unknown compiler"
+        "unknown compiler"
 #endif
   };
   return v;

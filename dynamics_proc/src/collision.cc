@@ -128,8 +128,8 @@ void ProjectionRange(const Hexahedron& h, const Eigen::Vector3d& n, double* lo, 
 // candidate if it separates the whole solids, else the widest gap along the
 // cross products of A's and B's edge directions (for convex solids whose
 // faces do not separate them, one of these does).
-void FindEdgePlane(const Hexahedron& a, const Hexahedron& b, const PlaneCandidate& cand,
-                   double tau, CollisionResult* r) {
+void FindEdgePlane(const Hexahedron& a, const Hexahedron& b, const PlaneCandidate& cand, double tau,
+                   CollisionResult* r) {
   if (cand.have) {
     Eigen::Vector3d n = (cand.q0 - cand.apex).cross(cand.q1 - cand.q0);
     const double len = n.norm();
@@ -195,7 +195,8 @@ double MidGapOffset(const Hexahedron& a, const Hexahedron& b, const Eigen::Vecto
 }
 
 double ToleranceFt(const Hexahedron& a, const Hexahedron& b, double relative_tolerance) {
-  return relative_tolerance * std::max(a.scale, b.scale) + kRoundingPerFt * std::max(a.magnitude, b.magnitude);
+  return relative_tolerance * std::max(a.scale, b.scale) +
+         kRoundingPerFt * std::max(a.magnitude, b.magnitude);
 }
 
 namespace {
@@ -203,7 +204,8 @@ namespace {
 // Before the report's test (when enabled): the bounding spheres apart by
 // more than tau means separate, with the plane midway between the spheres'
 // surfaces along the centre line.
-bool SpheresApart(const Hexahedron& a, const Hexahedron& b, double tau, bool want_plane, CollisionResult* r) {
+bool SpheresApart(const Hexahedron& a, const Hexahedron& b, double tau, bool want_plane,
+                  CollisionResult* r) {
   const double dx = b.cx - a.cx, dy = b.cy - a.cy, dz = b.cz - a.cz;
   const double dist2 = dx * dx + dy * dy + dz * dz, reach = a.radius + b.radius + tau;
   if (dist2 <= reach * reach) return false;
@@ -220,10 +222,12 @@ bool SpheresApart(const Hexahedron& a, const Hexahedron& b, double tau, bool wan
 
 // The axis-aligned bounding boxes apart by more than tau along an axis:
 // separate, with the plane normal to that axis midway in the gap.
-bool BoxesApart(const Hexahedron& a, const Hexahedron& b, double tau, bool want_plane, CollisionResult* r) {
+bool BoxesApart(const Hexahedron& a, const Hexahedron& b, double tau, bool want_plane,
+                CollisionResult* r) {
   // The boxes' gap along each axis: centre distance less both half extents.
   const double d[3] = {b.cx - a.cx, b.cy - a.cy, b.cz - a.cz};
-  const double gap[3] = {std::abs(d[0]) - a.hx - b.hx, std::abs(d[1]) - a.hy - b.hy, std::abs(d[2]) - a.hz - b.hz};
+  const double gap[3] = {std::abs(d[0]) - a.hx - b.hx, std::abs(d[1]) - a.hy - b.hy,
+                         std::abs(d[2]) - a.hz - b.hz};
   const int k = gap[0] >= gap[1] ? (gap[0] >= gap[2] ? 0 : 2) : (gap[1] >= gap[2] ? 1 : 2);
   if (gap[k] <= tau) return false;
   r->verdict = Verdict::kSeparate;
@@ -245,8 +249,8 @@ bool BoxesApart(const Hexahedron& a, const Hexahedron& b, double tau, bool want_
 // would name) or a word is all zeros (collision). Computed face by face as
 // masks of the eight vertices; the words themselves are formed only for the
 // edge phase.
-bool VertexPhase(const Hexahedron& faces, const Hexahedron& verts, bool a_in_b, double tau, bool want_plane,
-                 std::array<std::uint8_t, 6>* masks, CollisionResult* r) {
+bool VertexPhase(const Hexahedron& faces, const Hexahedron& verts, bool a_in_b, double tau,
+                 bool want_plane, std::array<std::uint8_t, 6>* masks, CollisionResult* r) {
   const int f = faces.FaceMasks(verts, tau, masks);
   if (f >= 0) {
     r->verdict = Verdict::kSeparate;
@@ -255,8 +259,10 @@ bool VertexPhase(const Hexahedron& faces, const Hexahedron& verts, bool a_in_b, 
     // The plane's normal points from A toward B: B's outward normal
     // reversed, or A's outward normal.
     if (want_plane) {
-      if (a_in_b) SetPlane(r, -faces.normal(f), -faces.d[f]);
-      else SetPlane(r, faces.normal(f), faces.d[f]);
+      if (a_in_b)
+        SetPlane(r, -faces.normal(f), -faces.d[f]);
+      else
+        SetPlane(r, faces.normal(f), faces.d[f]);
     }
     return true;
   }
@@ -272,11 +278,13 @@ bool VertexPhase(const Hexahedron& faces, const Hexahedron& verts, bool a_in_b, 
 
 // Step 3, one direction: the edges of `edges` (by their vertices' words)
 // against the faces of `faces`; an edge that pierces one decides collision.
-bool EdgePhase(const Hexahedron& edges, const std::array<LocationWord, 8>& words, const Hexahedron& faces, double tau,
-               Decider decider, PlaneCandidate* cand, CollisionResult* r) {
+bool EdgePhase(const Hexahedron& edges, const std::array<LocationWord, 8>& words,
+               const Hexahedron& faces, double tau, Decider decider, PlaneCandidate* cand,
+               CollisionResult* r) {
   for (int e = 0; e < kNumEdges; ++e) {
     const int i = kEdges[e][0], k = kEdges[e][1];
-    const int f = EdgePiercesFace(edges, i, k, words[i], words[k], faces, tau, cand, &r->triple_products);
+    const int f =
+        EdgePiercesFace(edges, i, k, words[i], words[k], faces, tau, cand, &r->triple_products);
     if (f >= 0) {
       r->verdict = Verdict::kCollide;
       r->decider = decider;

@@ -31,13 +31,14 @@ Hexahedron MakeBar(const PayloadConfig& p, const Eigen::Isometry3d& X_RP) {
   return MakeBox(centre - 0.5 * size.x() * u, u, v, w, size.x(), 0.5 * size.y(), 0.5 * size.z());
 }
 
-int MakeBarPosts(const PayloadConfig& p, const Eigen::Isometry3d& X_RP, std::array<Hexahedron, 2>* posts) {
+int MakeBarPosts(const PayloadConfig& p, const Eigen::Isometry3d& X_RP,
+                 std::array<Hexahedron, 2>* posts) {
   const scene_model::BarPostBoxes b = scene_model::BarPosts_P(p);
   const Eigen::Matrix3d& R = X_RP.linear();
   for (int k = 0; k < b.count; ++k) {
     const Eigen::Vector3d centre = X_RP * b.centre_P[k];
-    (*posts)[k] = MakeBox(centre - b.half_P.x() * R.col(0), R.col(0), R.col(1), R.col(2), 2 * b.half_P.x(),
-                          b.half_P.y(), b.half_P.z());
+    (*posts)[k] = MakeBox(centre - b.half_P.x() * R.col(0), R.col(0), R.col(1), R.col(2),
+                          2 * b.half_P.x(), b.half_P.y(), b.half_P.z());
   }
   return b.count;
 }
@@ -46,7 +47,8 @@ PayloadModel MakePayload(const PayloadConfig& p, const Eigen::Isometry3d& X_RP) 
   const Eigen::Matrix3d& R = X_RP.linear();
   const Eigen::Vector3d xP = R.col(0), yP = R.col(1), zP = R.col(2);
   const Eigen::Vector3d centre = X_RP.translation();
-  const double half_len = 0.5 * p.length_ft, r = 0.5 * p.diameter_ft, pr = 0.5 * p.probe_diameter_ft;
+  const double half_len = 0.5 * p.length_ft, r = 0.5 * p.diameter_ft,
+               pr = 0.5 * p.probe_diameter_ft;
   PayloadModel m;
   // The 16-gon's vertex levels from the top: level j at angle (2j + 1) pi/16
   // from +z_P, z = r cos, half-width r sin (scene_model.cc draws the same).
@@ -56,7 +58,9 @@ PayloadModel MakePayload(const PayloadConfig& p, const Eigen::Isometry3d& X_RP) 
     z[j] = r * std::cos(a);
     hx[j] = r * std::sin(a);
   }
-  auto at = [&](double x, double y, double zz) { return Eigen::Vector3d(centre + x * xP + y * yP + zz * zP); };
+  auto at = [&](double x, double y, double zz) {
+    return Eigen::Vector3d(centre + x * xP + y * yP + zz * zP);
+  };
   // The rings: vertex k of a ring at angle (2k + 1) pi/16 round y_P from +z_P toward +x_P.
   for (int end = 0; end < 2; ++end) {
     const double y = end ? half_len : -half_len;
@@ -93,14 +97,18 @@ PayloadModel MakePayload(const PayloadConfig& p, const Eigen::Isometry3d& X_RP) 
 
 std::string PayloadVertexName(int i) {
   char name[8] = "?";
-  if (i >= 0 && i < kBodyVertices) std::snprintf(name, sizeof name, "B%d", i + 1);
-  else if (i >= kProbeFirst && i < kProbeTipFirst) std::snprintf(name, sizeof name, "V2%d", i - kProbeFirst + 1);
-  else if (i >= kProbeTipFirst && i < kPayloadVertices) std::snprintf(name, sizeof name, "V3%d", i - kProbeTipFirst + 1);
+  if (i >= 0 && i < kBodyVertices)
+    std::snprintf(name, sizeof name, "B%d", i + 1);
+  else if (i >= kProbeFirst && i < kProbeTipFirst)
+    std::snprintf(name, sizeof name, "V2%d", i - kProbeFirst + 1);
+  else if (i >= kProbeTipFirst && i < kPayloadVertices)
+    std::snprintf(name, sizeof name, "V3%d", i - kProbeTipFirst + 1);
   return name;
 }
 
 Hexahedron MakeCargoBay(const ShuttleConfig& s) {
-  const Eigen::Vector3d A(0.0, 0.0, -0.5 * s.bay_depth_ft);  // centre of face a, the forward bulkhead
+  const Eigen::Vector3d A(0.0, 0.0,
+                          -0.5 * s.bay_depth_ft);  // centre of face a, the forward bulkhead
   return MakeBox(A, Eigen::Vector3d::UnitX(), -Eigen::Vector3d::UnitY(), -Eigen::Vector3d::UnitZ(),
                  s.bay_length_ft, 0.5 * s.bay_width_ft, 0.5 * s.bay_depth_ft);
 }
@@ -109,8 +117,14 @@ Hexahedron MakeCaeFrontHalf(const CaeConfig& c) {
   const double F = c.across_flats_ft, s = F / std::sqrt(3.0), hl = 0.5 * c.length_ft;
   // In the CAE frame (x_C, y_C, z_C); the port's face c is y_C = 0.
   const std::array<Eigen::Vector3d, 8> v_C = {{
-      {-0.5 * s, 0, -hl}, {-s, 0.5 * F, -hl}, {-0.5 * s, 0, hl}, {s, 0.5 * F, -hl},
-      {0.5 * s, 0, -hl},  {-s, 0.5 * F, hl},  {s, 0.5 * F, hl},  {0.5 * s, 0, hl},
+      {-0.5 * s, 0, -hl},
+      {-s, 0.5 * F, -hl},
+      {-0.5 * s, 0, hl},
+      {s, 0.5 * F, -hl},
+      {0.5 * s, 0, -hl},
+      {-s, 0.5 * F, hl},
+      {s, 0.5 * F, hl},
+      {0.5 * s, 0, hl},
   }};
   std::array<Eigen::Vector3d, 8> v;
   for (int i = 0; i < 8; ++i) v[i] = c.p_RoCo_R_ft + c.R_RC * v_C[i];

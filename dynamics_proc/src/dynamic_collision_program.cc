@@ -8,7 +8,6 @@
 
 #include "rms/base/check.h"
 #include "rms/scene_model/scene_model.h"
-
 #include "rms/wire/word_codec.h"
 
 namespace rms::dynamics_proc {
@@ -43,9 +42,11 @@ DynamicCollisionProgram::DynamicCollisionProgram(const LabConfig& config, const 
   // solid tested against another (the fingers, the BAR, its posts), so no
   // solid can step through another between two tested poses.
   const auto& ee = config.end_effector;
-  double thinnest = std::min({ee.finger_thickness_ft, 2 * ee.palm_half_width_ft, 2 * ee.palm_half_height_ft,
-                              ee.palm_length_ft, ee.finger_length_ft, config.payload.bar_size_P_ft.minCoeff()});
-  if (post_count_ > 0) thinnest = std::min(thinnest, 2 * scene_model::BarPosts_P(config.payload).half_P.minCoeff());
+  double thinnest =
+      std::min({ee.finger_thickness_ft, 2 * ee.palm_half_width_ft, 2 * ee.palm_half_height_ft,
+                ee.palm_length_ft, ee.finger_length_ft, config.payload.bar_size_P_ft.minCoeff()});
+  if (post_count_ > 0)
+    thinnest = std::min(thinnest, 2 * scene_model::BarPosts_P(config.payload).half_P.minCoeff());
   substep_ft_ = std::min(kMaxSubstepTravelFt, 0.45 * thinnest);
   // The slave starts at the initial inputs' pose, which must be free.
   const wire::OperatorInputs initial = wire::InitialInputs(config.inputs);
@@ -55,7 +56,8 @@ DynamicCollisionProgram::DynamicCollisionProgram(const LabConfig& config, const 
   start.finger = initial.value[kFinger];
   Evaluate(start, nullptr, slave_);
   if (slave_->collisions) {
-    throw InputError("inputs.*.initial: the arm's initial pose collides (" + wire::CollisionNames(slave_->collisions, ", ", "none") +
+    throw InputError("inputs.*.initial: the arm's initial pose collides (" +
+                     wire::CollisionNames(slave_->collisions, ", ", "none") +
                      "); the DCP needs a collision-free pose to start from");
   }
   initial_ = start;
@@ -77,7 +79,8 @@ ArmCommand DynamicCollisionProgram::SlaveAsItIs() const {
   // gives that gap unclamped, so the slave evaluated in Mode 1 is where it is.
   ArmCommand c = slave_->cmd;
   const auto& e = config_.end_effector;
-  c.finger = (e.finger_gap_open_ft - slave_->finger_gap_ft) / (e.finger_gap_open_ft - e.finger_gap_closed_ft);
+  c.finger = (e.finger_gap_open_ft - slave_->finger_gap_ft) /
+             (e.finger_gap_open_ft - e.finger_gap_closed_ft);
   return c;
 }
 
@@ -95,8 +98,10 @@ bool DynamicCollisionProgram::Reset() {
   payload_reach_ft_ = 0.0;
   Evaluate(SlaveAsItIs(), slave_, spare_);
   if (spare_->collisions) {
-    spdlog::warn("reset refused: the arm where it is would collide with the payload in the bay ({}); "
-                 "move the arm clear and reset again", wire::CollisionNames(spare_->collisions, ", ", "none"));
+    spdlog::warn(
+        "reset refused: the arm where it is would collide with the payload in the bay ({}); "
+        "move the arm clear and reset again",
+        wire::CollisionNames(spare_->collisions, ", ", "none"));
     PlacePayload(X_RP_free);
     status_.mode = mode;
     status_.acquired = acquired;
@@ -136,7 +141,8 @@ constexpr std::uint32_t kTooFast = 1u << 31;
 
 ArmCommand Lerp(const ArmCommand& a, const ArmCommand& b, double t) {
   ArmCommand c;
-  for (int i = 0; i < 6; ++i) c.angles_deg[i] = a.angles_deg[i] + t * (b.angles_deg[i] - a.angles_deg[i]);
+  for (int i = 0; i < 6; ++i)
+    c.angles_deg[i] = a.angles_deg[i] + t * (b.angles_deg[i] - a.angles_deg[i]);
   c.shoulder_height_ft = a.shoulder_height_ft + t * (b.shoulder_height_ft - a.shoulder_height_ft);
   c.finger = a.finger + t * (b.finger - a.finger);
   return c;
@@ -152,7 +158,8 @@ double PairGap(const CollisionResult& r, const Hexahedron& a, const Hexahedron& 
 }
 }  // namespace
 
-std::uint32_t DynamicCollisionProgram::BayCollisions(const PayloadModel& p, double* clearance_ft) const {
+std::uint32_t DynamicCollisionProgram::BayCollisions(const PayloadModel& p,
+                                                     double* clearance_ft) const {
   // The payload lives inside the bay: a vertex not above face c (by more
   // than tau) that is on or beyond a wall or the bottom (within tau:
   // touching counts) collides with it.
@@ -171,7 +178,8 @@ std::uint32_t DynamicCollisionProgram::BayCollisions(const PayloadModel& p, doub
   return bits;
 }
 
-void DynamicCollisionProgram::TestHandAgainstPayload(const Evaluation* prev, Evaluation* out) const {
+void DynamicCollisionProgram::TestHandAgainstPayload(const Evaluation* prev,
+                                                     Evaluation* out) const {
   // EFF HEX 1-3 against the resting payload's BAR, body (seven strips) and
   // the BAR's posts, with each pair's clearance.
   namespace cb = wire::collision_bits;
@@ -182,7 +190,8 @@ void DynamicCollisionProgram::TestHandAgainstPayload(const Evaluation* prev, Eva
     CollideOptions o;
     o.relative_tolerance = tau_rel_;
     o.sphere_reject = o.aabb_reject = options_.bounding_reject;
-    if (options_.frame_coherence && prev && last->verdict == Verdict::kSeparate && last->plane_valid) {
+    if (options_.frame_coherence && prev && last->verdict == Verdict::kSeparate &&
+        last->plane_valid) {
       *hint = last->plane;
       o.hint = hint;
     }
@@ -200,7 +209,8 @@ void DynamicCollisionProgram::TestHandAgainstPayload(const Evaluation* prev, Eva
     e.clearance_ft = std::min(e.clearance_ft, PairGap(e.ee_bar[k], h, bar_));
     for (int j = 0; j < kBodyStrips; ++j) {
       const int i = k * kBodyStrips + j;
-      e.ee_body[i] = Collide(h, payload_.body[j], opts(prev ? &prev->ee_body[i] : nullptr, &hints[1 + j][k]));
+      e.ee_body[i] =
+          Collide(h, payload_.body[j], opts(prev ? &prev->ee_body[i] : nullptr, &hints[1 + j][k]));
       if (e.ee_body[i].verdict != Verdict::kSeparate) e.collisions |= cb::kEffHexPayload << k;
       e.clearance_ft = std::min(e.clearance_ft, PairGap(e.ee_body[i], h, payload_.body[j]));
     }
@@ -274,7 +284,8 @@ void DynamicCollisionProgram::EvaluateMode3(const Evaluation* prev, Evaluation* 
 void DynamicCollisionProgram::EvaluateExtraPairs(Evaluation* e) const {
   CollideOptions o;
   o.sphere_reject = o.aabb_reject = options_.bounding_reject;
-  const EndEffectorModel ee = MakeEndEffector(config_.end_effector, e->pose.X_RS2, e->finger_gap_ft);
+  const EndEffectorModel ee =
+      MakeEndEffector(config_.end_effector, e->pose.X_RS2, e->finger_gap_ft);
   const Hexahedron bar = MakeBar(config_.payload, e->X_RP);
   for (int k = 0; k < 3; ++k) {
     e->extra_collisions |= Collide(ee.hex[k], bar, o).verdict != Verdict::kSeparate;
@@ -287,7 +298,8 @@ void DynamicCollisionProgram::EvaluateExtraPairs(Evaluation* e) const {
   }
 }
 
-void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* prev, Evaluation* out) const {
+void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* prev,
+                                       Evaluation* out) const {
   RMS_DASSERT(out != prev);
   Evaluation& e = *out;
   e.collisions = 0;
@@ -299,17 +311,25 @@ void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* 
   e.pose = arm::ComputeArmPose(config_.arm, e.words, cmd.shoulder_height_ft);
   e.finger_gap_ft = FingerGapFt(cmd.finger);
   if (status_.mode >= 2 && !(status_.docked && released_)) {
-    const double widest = status_.docked ? config_.end_effector.finger_gap_open_ft : acquisition_gap_ft_;
+    const double widest =
+        status_.docked ? config_.end_effector.finger_gap_open_ft : acquisition_gap_ft_;
     e.finger_gap_ft = std::clamp(e.finger_gap_ft, contact_gap_ft_, widest);
   }
   switch (status_.mode) {
-    case 1: EvaluateMode1(prev, &e); break;
-    case 2: EvaluateMode2(&e); break;
-    default: EvaluateMode3(prev, &e); break;
+    case 1:
+      EvaluateMode1(prev, &e);
+      break;
+    case 2:
+      EvaluateMode2(&e);
+      break;
+    default:
+      EvaluateMode3(prev, &e);
+      break;
   }
   // Non-finite models (a pose from non-finite words or a restored state)
   // are refused as a collision, never read as "no collision".
-  if (!Finite(e.payload) || !e.pose.X_RS2.matrix().allFinite()) e.collisions |= wire::collision_bits::kNonFinite;
+  if (!Finite(e.payload) || !e.pose.X_RS2.matrix().allFinite())
+    e.collisions |= wire::collision_bits::kNonFinite;
   if (e.collisions) e.clearance_ft = 0.0;
   e.mode = status_.mode;
   if (!options_.mode_pairs_only && status_.mode >= 2) EvaluateExtraPairs(&e);
@@ -326,7 +346,8 @@ std::array<double, 6> DynamicCollisionProgram::JointReachFt() const {
   const double hand = std::max(ee.palm_length_ft + ee.finger_length_ft +
                                    std::hypot(ee.palm_half_width_ft, ee.palm_half_height_ft),
                                payload_reach_ft_);
-  const double at_w = a.wrist_to_palm_ft + hand, at_e = a.lower_boom_ft + at_w, at_s = a.upper_boom_ft + at_e;
+  const double at_w = a.wrist_to_palm_ft + hand, at_e = a.lower_boom_ft + at_w,
+               at_s = a.upper_boom_ft + at_e;
   return {at_s, at_s, at_e, at_w, at_w, at_w};
 }
 
@@ -336,7 +357,8 @@ double DynamicCollisionProgram::TravelFt(const ArmCommand& from, const ArmComman
   // finger moves the movable finger alone.
   const std::array<double, 6> reach = JointReachFt();
   double travel = std::abs(to.shoulder_height_ft - from.shoulder_height_ft);
-  for (int i = 0; i < 6; ++i) travel += std::abs(to.angles_deg[i] - from.angles_deg[i]) * (M_PI / 180.0) * reach[i];
+  for (int i = 0; i < 6; ++i)
+    travel += std::abs(to.angles_deg[i] - from.angles_deg[i]) * (M_PI / 180.0) * reach[i];
   return travel + std::abs(FingerGapFt(to.finger) - FingerGapFt(from.finger));
 }
 
@@ -355,7 +377,8 @@ int DynamicCollisionProgram::Substeps(double travel_ft) const {
   return std::max(1, static_cast<int>(n));
 }
 
-std::uint32_t DynamicCollisionProgram::TestMotion(const ArmCommand& from, const ArmCommand& to, Evaluation* out) {
+std::uint32_t DynamicCollisionProgram::TestMotion(const ArmCommand& from, const ArmCommand& to,
+                                                  Evaluation* out) {
   Evaluate(to, slave_, out);  // the end pose first: most collisions show there
   status_.substeps = 1;
   if (out->collisions) return out->collisions;
@@ -384,8 +407,9 @@ std::uint32_t DynamicCollisionProgram::TestMotion(const ArmCommand& from, const 
       c = scratch_->clearance_ft;
     }
     double hit_s = 0.0;
-    const std::uint32_t bits = Refine(from, to, static_cast<double>(k - 1) / n, static_cast<double>(k) / n, c_prev,
-                                      c, step_ft, slack_ft, 0, &hit_s);
+    const std::uint32_t bits =
+        Refine(from, to, static_cast<double>(k - 1) / n, static_cast<double>(k) / n, c_prev, c,
+               step_ft, slack_ft, 0, &hit_s);
     if (bits) {
       status_.motion_collision = true;
       return bits;
@@ -395,8 +419,9 @@ std::uint32_t DynamicCollisionProgram::TestMotion(const ArmCommand& from, const 
   return 0;
 }
 
-std::uint32_t DynamicCollisionProgram::Refine(const ArmCommand& from, const ArmCommand& to, double s0, double s1,
-                                              double c0, double c1, double travel_ft, double slack_ft, int depth,
+std::uint32_t DynamicCollisionProgram::Refine(const ArmCommand& from, const ArmCommand& to,
+                                              double s0, double s1, double c0, double c1,
+                                              double travel_ft, double slack_ft, int depth,
                                               double* hit_s) {
   if (c0 + c1 > travel_ft + slack_ft || depth >= kRefineDepth) return 0;
   const double sm = 0.5 * (s0 + s1);
@@ -407,7 +432,8 @@ std::uint32_t DynamicCollisionProgram::Refine(const ArmCommand& from, const ArmC
     return probe_->collisions;
   }
   const double cm = probe_->clearance_ft;
-  if (const std::uint32_t bits = Refine(from, to, s0, sm, c0, cm, 0.5 * travel_ft, slack_ft, depth + 1, hit_s)) {
+  if (const std::uint32_t bits =
+          Refine(from, to, s0, sm, c0, cm, 0.5 * travel_ft, slack_ft, depth + 1, hit_s)) {
     return bits;
   }
   return Refine(from, to, sm, s1, cm, c1, 0.5 * travel_ft, slack_ft, depth + 1, hit_s);
@@ -502,8 +528,10 @@ void DynamicCollisionProgram::LetGo() {
   PlacePayload(X_RP);
   Evaluate(SlaveAsItIs(), slave_, spare_);
   if (spare_->collisions) {
-    spdlog::warn("the finger opened but the hand would be in collision with the payload let go ({}): grasp kept",
-                 wire::CollisionNames(spare_->collisions, ", ", "none"));
+    spdlog::warn(
+        "the finger opened but the hand would be in collision with the payload let go ({}): grasp "
+        "kept",
+        wire::CollisionNames(spare_->collisions, ", ", "none"));
     PlacePayload(X_RP_free);
     status_.mode = slave_->mode;
     status_.acquired = true;
@@ -527,8 +555,10 @@ ArmCommand DynamicCollisionProgram::TakeInputs(const wire::OperatorInputs& in) {
   status_.reset_refused = false;
   status_.let_go = false;
   if (in.reset && !reset_pressed_) {
-    if (Reset()) spdlog::info("reset: Mode 1, payload in the cargo bay");
-    else status_.reset_refused = true;
+    if (Reset())
+      spdlog::info("reset: Mode 1, payload in the cargo bay");
+    else
+      status_.reset_refused = true;
   }
   reset_pressed_ = in.reset;
   status_.master = master;
@@ -589,7 +619,8 @@ wire::DcpFrameData DynamicCollisionProgram::FrameOut(const wire::OperatorInputs&
   out.control.crosshairs = in.crosshairs;
   out.control.mode = status_.mode;
   // COLLISION: a detrimental collision; RECPT: the essential contact.
-  const std::uint32_t essential = status_.essential_contact ? wire::collision_bits::kEffHexRecpt << 2 : 0u;
+  const std::uint32_t essential =
+      status_.essential_contact ? wire::collision_bits::kEffHexRecpt << 2 : 0u;
   out.control.collision = (status_.collisions & ~essential) != 0;
   out.control.receptacle_collision = status_.essential_contact;
   out.control.acquired = status_.acquired;
@@ -609,8 +640,10 @@ wire::DcpFrameData DynamicCollisionProgram::FrameOut(const wire::OperatorInputs&
 wire::DcpFrameData DynamicCollisionProgram::Step(const wire::OperatorInputs& in) {
   const ArmCommand master = TakeInputs(in);
   const ArmCommand command = SlaveCommand(master);
-  if (started_) Respond(command);
-  else FirstFrame(command);
+  if (started_)
+    Respond(command);
+  else
+    FirstFrame(command);
   status_.released = released_;
   status_.slave_collisions = slave_->collisions;
   status_.slave = slave_->cmd;
@@ -620,9 +653,12 @@ wire::DcpFrameData DynamicCollisionProgram::Step(const wire::OperatorInputs& in)
   UpdatePlanes();
   const int mode_before = status_.mode;
   UpdateDocking();  // distance and angle every frame; docking in Mode 3
-  if (mode_before == 1) UpdateAcquisition();
-  else if (mode_before == 2) UpdateExtraction();
-  else status_.bay_clearance_ft = BayClearance(slave_->payload);
+  if (mode_before == 1)
+    UpdateAcquisition();
+  else if (mode_before == 2)
+    UpdateExtraction();
+  else
+    status_.bay_clearance_ft = BayClearance(slave_->payload);
   return FrameOut(in);
 }
 
@@ -657,7 +693,8 @@ void DynamicCollisionProgram::RefreshMeasures() {
   status_.palm_to_bar_ft = 0.0;
   status_.finger_contact = false;
   if (status_.mode == 1) {
-    const AcquisitionCheck c = CheckAcquisition(config_.dcp, slave_->ee, bar_, slave_->finger_gap_ft, tau_rel_);
+    const AcquisitionCheck c =
+        CheckAcquisition(config_.dcp, slave_->ee, bar_, slave_->finger_gap_ft, tau_rel_);
     status_.acquisition = c.holds;
     status_.acquisition_margin_ft = c.margin_ft;
     status_.palm_to_bar_ft = c.palm_to_bar_ft;
@@ -668,7 +705,8 @@ void DynamicCollisionProgram::RefreshMeasures() {
 double DynamicCollisionProgram::BayClearance(const PayloadModel& p) const {
   // Height above the bay's top face c (its outward normal is +Z_R).
   double lowest = 1e30;
-  for (const Eigen::Vector3d& v : p.v) lowest = std::min(lowest, bay_.Beyond(kFaceC, v.x(), v.y(), v.z()));
+  for (const Eigen::Vector3d& v : p.v)
+    lowest = std::min(lowest, bay_.Beyond(kFaceC, v.x(), v.y(), v.z()));
   return lowest;
 }
 
@@ -676,8 +714,9 @@ bool AcquisitionCheck::all() const {
   return std::all_of(holds.begin(), holds.end(), [](bool b) { return b; });
 }
 
-AcquisitionCheck CheckAcquisition(const DcpConfig& dcp, const EndEffectorModel& ee, const Hexahedron& bar,
-                                  double finger_gap_ft, double relative_tolerance) {
+AcquisitionCheck CheckAcquisition(const DcpConfig& dcp, const EndEffectorModel& ee,
+                                  const Hexahedron& bar, double finger_gap_ft,
+                                  double relative_tolerance) {
   const Hexahedron& h1 = ee.hex[0];
   const Hexahedron& h2 = ee.hex[1];
   const Hexahedron& h3 = ee.hex[2];
@@ -696,12 +735,14 @@ AcquisitionCheck CheckAcquisition(const DcpConfig& dcp, const EndEffectorModel& 
   // near it; condition 1 fails there anyway, so acquisition is unchanged).
   c.holds[wire::kPalmWithinTpob] = std::abs(c.palm_to_bar_ft) < dcp.tpob_ft;
   bool between = true;
-  for (LocationWord w : bar.Words(h1, tau)) between = between && !(w & (FaceBit(kFaceA) | FaceBit(kFaceD)));
+  for (LocationWord w : bar.Words(h1, tau))
+    between = between && !(w & (FaceBit(kFaceA) | FaceBit(kFaceD)));
   c.holds[wire::kBetweenBarEnds] = between;
   // Margins (docs/collision.md "Margins"): least depths, ft.
   auto least_beyond = [](const Hexahedron& h, int face, const Hexahedron& of) {
     double m = 1e30;
-    for (int i = 0; i < kNumVertices; ++i) m = std::min(m, h.Beyond(face, of.x[i], of.y[i], of.z[i]));
+    for (int i = 0; i < kNumVertices; ++i)
+      m = std::min(m, h.Beyond(face, of.x[i], of.y[i], of.z[i]));
     return m;
   };
   c.margin_ft[wire::kBarBeyondPalmFaceD] = least_beyond(h1, kFaceD, bar);
@@ -720,7 +761,9 @@ AcquisitionCheck CheckAcquisition(const DcpConfig& dcp, const EndEffectorModel& 
   // beyond the finger's edge, may lie a hair behind the face's plane: within
   // the contact tolerance it counts as on the face (docs/collision.md "The
   // essential contact").
-  c.holds[wire::kBarBeyondFingerFaceE] = c.holds[wire::kBarBeyondFingerFaceE] || c.margin_ft[wire::kBarBeyondFingerFaceE] > -kFingerContactToleranceFt;
+  c.holds[wire::kBarBeyondFingerFaceE] =
+      c.holds[wire::kBarBeyondFingerFaceE] ||
+      c.margin_ft[wire::kBarBeyondFingerFaceE] > -kFingerContactToleranceFt;
   return c;
 }
 
@@ -735,14 +778,16 @@ DockingCheck CheckDocking(const DcpConfig& dcp, const CaeConfig& cae, const Hexa
     const LocationWord w = front.Word(p.v[i], tau);
     d.in_envelope = d.in_envelope && (w & FaceBit(kFaceC)) && !(w & sides);
     const Eigen::Vector3d& v = p.v[i];
-    d.envelope_margin_ft = std::min({d.envelope_margin_ft, front.Beyond(kFaceC, v.x(), v.y(), v.z()),
-                                     -front.Beyond(kFaceA, v.x(), v.y(), v.z()), -front.Beyond(kFaceB, v.x(), v.y(), v.z()),
-                                     -front.Beyond(kFaceD, v.x(), v.y(), v.z()), -front.Beyond(kFaceE, v.x(), v.y(), v.z())});
+    d.envelope_margin_ft = std::min(
+        {d.envelope_margin_ft, front.Beyond(kFaceC, v.x(), v.y(), v.z()),
+         -front.Beyond(kFaceA, v.x(), v.y(), v.z()), -front.Beyond(kFaceB, v.x(), v.y(), v.z()),
+         -front.Beyond(kFaceD, v.x(), v.y(), v.z()), -front.Beyond(kFaceE, v.x(), v.y(), v.z())});
   }
   d.distance_ft = (p.probe_tip_centre - cae.p_RoCo_R_ft).norm();
   const double c = std::clamp(p.probe_axis.dot(cae.R_RC.col(1)), -1.0, 1.0);
   d.angle_deg = std::acos(c) * 180.0 / M_PI;
-  d.docked = d.in_envelope && d.distance_ft <= dcp.dock_distance_ft && d.angle_deg <= dcp.dock_angle_deg;
+  d.docked =
+      d.in_envelope && d.distance_ft <= dcp.dock_distance_ft && d.angle_deg <= dcp.dock_angle_deg;
   return d;
 }
 
@@ -750,7 +795,8 @@ void DynamicCollisionProgram::UpdateAcquisition() {
   // Report IV.A.3: the six conditions, on the slave's (collision-free) pose,
   // and the essential contact: the movable finger on the bar (face e of EFF
   // HEX 3 within kFingerContactToleranceFt of it; docs/collision.md).
-  const AcquisitionCheck c = CheckAcquisition(config_.dcp, slave_->ee, bar_, slave_->finger_gap_ft, tau_rel_);
+  const AcquisitionCheck c =
+      CheckAcquisition(config_.dcp, slave_->ee, bar_, slave_->finger_gap_ft, tau_rel_);
   status_.acquisition = c.holds;
   status_.acquisition_margin_ft = c.margin_ft;
   status_.palm_to_bar_ft = c.palm_to_bar_ft;
@@ -764,11 +810,13 @@ void DynamicCollisionProgram::UpdateAcquisition() {
   // of EFF HEX 2 (at Y2 = W - t) to the bar's nearest vertex along -Y2.
   const Eigen::Isometry3d& X_RS2 = slave_->pose.X_RS2;
   double y_min = 1e30;
-  for (int i = 0; i < kNumVertices; ++i) y_min = std::min(y_min, X_RS2.linear().col(1).dot(bar_.vertex(i) - X_RS2.translation()));
+  for (int i = 0; i < kNumVertices; ++i)
+    y_min = std::min(y_min, X_RS2.linear().col(1).dot(bar_.vertex(i) - X_RS2.translation()));
   const auto& ee = config_.end_effector;
   acquisition_gap_ft_ = slave_->finger_gap_ft;
-  contact_gap_ft_ = std::clamp(ee.palm_half_width_ft - ee.finger_thickness_ft - y_min + kFingerContactClearanceFt,
-                               0.0, acquisition_gap_ft_);
+  contact_gap_ft_ =
+      std::clamp(ee.palm_half_width_ft - ee.finger_thickness_ft - y_min + kFingerContactClearanceFt,
+                 0.0, acquisition_gap_ft_);
   payload_reach_ft_ = PayloadReachFt(X_S2P_);  // bounds the held payload's travel
   if (!ReevaluateSlave()) {
     status_.mode = 1;
@@ -776,8 +824,8 @@ void DynamicCollisionProgram::UpdateAcquisition() {
     payload_reach_ft_ = 0.0;
     return;
   }
-  spdlog::info("acquisition: Mode 1 -> Mode 2 (finger gap {:.3f} ft, palm to bar {:.3f} ft)", c.finger_gap_ft,
-               c.palm_to_bar_ft);
+  spdlog::info("acquisition: Mode 1 -> Mode 2 (finger gap {:.3f} ft, palm to bar {:.3f} ft)",
+               c.finger_gap_ft, c.palm_to_bar_ft);
 }
 
 bool DynamicCollisionProgram::ReevaluateSlave() {
@@ -837,7 +885,8 @@ nlohmann::json PoseJson(const Eigen::Isometry3d& X) {
 }
 
 Eigen::Isometry3d PoseFrom(const nlohmann::json& j, const char* key) {
-  if (!j.is_array() || j.size() != 12) throw InputError(std::string("checkpoint: '") + key + "' must be 12 numbers");
+  if (!j.is_array() || j.size() != 12)
+    throw InputError(std::string("checkpoint: '") + key + "' must be 12 numbers");
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 4; ++c) X.matrix()(r, c) = j.at(4 * r + c).get<double>();
@@ -846,7 +895,9 @@ Eigen::Isometry3d PoseFrom(const nlohmann::json& j, const char* key) {
 }
 
 nlohmann::json CommandJson(const ArmCommand& a) {
-  return {{"angles_deg", a.angles_deg}, {"shoulder_height_ft", a.shoulder_height_ft}, {"finger", a.finger}};
+  return {{"angles_deg", a.angles_deg},
+          {"shoulder_height_ft", a.shoulder_height_ft},
+          {"finger", a.finger}};
 }
 
 ArmCommand CommandFrom(const nlohmann::json& j) {
@@ -868,10 +919,12 @@ nlohmann::json PlaneJson(const CollisionResult& r) {
 
 void PlaneFrom(const nlohmann::json& j, CollisionResult* r) {
   if (j.is_null()) return;
-  if (!j.is_array() || j.size() != 4) throw InputError("checkpoint: a plane must be null or 4 numbers");
+  if (!j.is_array() || j.size() != 4)
+    throw InputError("checkpoint: a plane must be null or 4 numbers");
   r->verdict = Verdict::kSeparate;
   r->plane_valid = true;
-  r->plane = {Eigen::Vector3d(j[0].get<double>(), j[1].get<double>(), j[2].get<double>()), j[3].get<double>()};
+  r->plane = {Eigen::Vector3d(j[0].get<double>(), j[1].get<double>(), j[2].get<double>()),
+              j[3].get<double>()};
 }
 
 }  // namespace
@@ -885,7 +938,8 @@ nlohmann::ordered_json DynamicCollisionProgram::SaveState() const {
   j["released"] = released_;
   j["have_slave"] = started_;
   j["slave"] = CommandJson(slave_->cmd);
-  j["slave_collisions"] = slave_->collisions;  // always 0 (a restore re-tests the slave); kept for older readers
+  j["slave_collisions"] =
+      slave_->collisions;  // always 0 (a restore re-tests the slave); kept for older readers
   j["master"] = CommandJson(status_.master);
   j["X_S2P"] = PoseJson(X_S2P_);
   j["X_RP_docked"] = PoseJson(X_RP_docked_);
@@ -907,7 +961,8 @@ nlohmann::ordered_json DynamicCollisionProgram::SaveState() const {
 // in the bay and the button up.
 struct DynamicCollisionProgram::RestoredState {
   int mode = 1;
-  bool acquired = false, docked = false, released = false, have_slave = false, reset_pressed = false;
+  bool acquired = false, docked = false, released = false, have_slave = false,
+       reset_pressed = false;
   Eigen::Isometry3d X_S2P, X_RP_docked, X_RP_free;
   double contact_gap_ft = 0, acquisition_gap_ft = 0;
   ArmCommand master, slave;
@@ -919,8 +974,8 @@ std::unique_ptr<DynamicCollisionProgram::RestoredState> DynamicCollisionProgram:
   auto p = std::make_unique<RestoredState>();
   try {
     if (j.at("format").get<std::string>() != kCheckpointFormat) {
-      throw InputError("checkpoint: format '" + j.at("format").get<std::string>() + "', expected '" +
-                       kCheckpointFormat + "'");
+      throw InputError("checkpoint: format '" + j.at("format").get<std::string>() +
+                       "', expected '" + kCheckpointFormat + "'");
     }
     p->mode = j.at("mode").get<int>();
     if (p->mode < 1 || p->mode > 3) throw InputError("checkpoint: mode must be 1, 2 or 3");
@@ -958,17 +1013,24 @@ std::unique_ptr<DynamicCollisionProgram::RestoredState> DynamicCollisionProgram:
 // plane normals (InputError naming what is not).
 void DynamicCollisionProgram::CheckRestoredState(const RestoredState& p) const {
   CheckRestored(p.mode, p.acquired, p.docked, p.released, p.contact_gap_ft, p.acquisition_gap_ft);
-  if (!Finite(p.master) || (p.have_slave && !Finite(p.slave))) throw InputError("checkpoint: a command is not finite");
+  if (!Finite(p.master) || (p.have_slave && !Finite(p.slave)))
+    throw InputError("checkpoint: a command is not finite");
   for (const ArmCommand* c : {&p.master, &p.slave}) {
-    if (!(std::abs(c->finger) <= 10.0)) throw InputError("checkpoint: a finger lever is out of range");
+    if (!(std::abs(c->finger) <= 10.0))
+      throw InputError("checkpoint: a finger lever is out of range");
   }
-  for (const auto& [X, key] : {std::pair{&p.X_S2P, "X_S2P"}, {&p.X_RP_free, "X_RP_free"}, {&p.X_RP_docked, "X_RP_docked"}}) {
+  for (const auto& [X, key] : {std::pair{&p.X_S2P, "X_S2P"},
+                               {&p.X_RP_free, "X_RP_free"},
+                               {&p.X_RP_docked, "X_RP_docked"}}) {
     const Eigen::Matrix3d R = X->linear();
-    if (!X->matrix().allFinite() || !((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= 1e-9)) {
+    if (!X->matrix().allFinite() ||
+        !((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= 1e-9)) {
       throw InputError(std::string("checkpoint: '") + key + "' is not a rigid pose");
     }
   }
-  auto unit = [](const CollisionResult& r) { return !r.plane_valid || std::abs(r.plane.n_R.norm() - 1.0) <= 1e-9; };
+  auto unit = [](const CollisionResult& r) {
+    return !r.plane_valid || std::abs(r.plane.n_R.norm() - 1.0) <= 1e-9;
+  };
   for (const CollisionResult& r : p.hints.ee_bar) {
     if (!unit(r)) throw InputError("checkpoint: a plane's normal is not a unit vector");
   }
@@ -1016,10 +1078,12 @@ void DynamicCollisionProgram::RestoreState(const nlohmann::json& j) {
   RefreshMeasures();  // nothing of the frames before the restore
 }
 
-void DynamicCollisionProgram::CheckRestored(int mode, bool acquired, bool docked, bool released, double contact_gap_ft,
+void DynamicCollisionProgram::CheckRestored(int mode, bool acquired, bool docked, bool released,
+                                            double contact_gap_ft,
                                             double acquisition_gap_ft) const {
   // A state the program could have reached (docs/sessions.md "checkpoint").
-  if (acquired != (mode >= 2)) throw InputError("checkpoint: 'acquired' must be true exactly in Modes 2 and 3");
+  if (acquired != (mode >= 2))
+    throw InputError("checkpoint: 'acquired' must be true exactly in Modes 2 and 3");
   if (docked && mode != 3) throw InputError("checkpoint: 'docked' needs Mode 3");
   if (released && !docked) throw InputError("checkpoint: 'released' needs 'docked'");
   if (!std::isfinite(contact_gap_ft) || !std::isfinite(acquisition_gap_ft)) {
@@ -1028,8 +1092,9 @@ void DynamicCollisionProgram::CheckRestored(int mode, bool acquired, bool docked
   const auto& e = config_.end_effector;
   if (acquired && !(contact_gap_ft >= 0.0 && contact_gap_ft <= acquisition_gap_ft &&
                     acquisition_gap_ft <= e.finger_gap_open_ft)) {
-    throw InputError("checkpoint: the finger gaps must satisfy 0 <= contact_gap_ft <= acquisition_gap_ft <= "
-                     "the open gap");
+    throw InputError(
+        "checkpoint: the finger gaps must satisfy 0 <= contact_gap_ft <= acquisition_gap_ft <= "
+        "the open gap");
   }
 }
 

@@ -1,28 +1,27 @@
 #include "rms/dynamics_proc/dynamics_proc.h"
 
+#include <filesystem>
 #include <spdlog/spdlog.h>
 
-#include <filesystem>
-
-#include "rms/wire/acquisition_conditions.h"
-#include "rms/wire/channels.h"
 #include "rms/base/check.h"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
-#include "rms/wire/frame_receiver.h"
-#include "rms/wire/message_io.h"
 #include "rms/operator_input_t.hpp"
 #include "rms/session_control_t.hpp"
+#include "rms/wire/acquisition_conditions.h"
+#include "rms/wire/channels.h"
 #include "rms/wire/checkpoint.h"
+#include "rms/wire/frame_receiver.h"
+#include "rms/wire/message_io.h"
 
 namespace rms::dynamics_proc {
 
 DynamicsProc::DynamicsProc(const LabConfig& config, transport::LcmInterface* lcm)
     : config_(config), lcm_(lcm), dcp_(config) {
-  lcm_->Subscribe(wire::channels::kOperatorInput, [this](const void* d, int n, std::int64_t t) {
-    OnInput(d, n, t);
-  });
-  lcm_->Subscribe(wire::channels::kControl, [this](const void* d, int n, std::int64_t) { OnControl(d, n); });
+  lcm_->Subscribe(wire::channels::kOperatorInput,
+                  [this](const void* d, int n, std::int64_t t) { OnInput(d, n, t); });
+  lcm_->Subscribe(wire::channels::kControl,
+                  [this](const void* d, int n, std::int64_t) { OnControl(d, n); });
 }
 
 wire::Checkpoint DynamicsProc::MakeCheckpoint() const {
@@ -36,9 +35,13 @@ wire::Checkpoint DynamicsProc::MakeCheckpoint() const {
   return c;
 }
 
-void DynamicsProc::SaveCheckpoint(const std::string& path) const { wire::WriteCheckpoint(path, MakeCheckpoint()); }
+void DynamicsProc::SaveCheckpoint(const std::string& path) const {
+  wire::WriteCheckpoint(path, MakeCheckpoint());
+}
 
-void DynamicsProc::RestoreCheckpoint(const std::string& path) { Restore(wire::ReadCheckpoint(path), path); }
+void DynamicsProc::RestoreCheckpoint(const std::string& path) {
+  Restore(wire::ReadCheckpoint(path), path);
+}
 
 void DynamicsProc::Restore(const wire::Checkpoint& c, const std::string& what) {
   try {
@@ -46,8 +49,9 @@ void DynamicsProc::Restore(const wire::Checkpoint& c, const std::string& what) {
   } catch (const std::exception& e) {
     throw InputError("checkpoint '" + what + "': " + e.what());
   }
-  spdlog::info("restored the DCP's state from {} (saved at DCP frame {}): Mode {}{}{}", what, c.dcp_frame,
-               dcp_.status().mode, dcp_.status().acquired ? ", acquired" : "", dcp_.status().docked ? ", docked" : "");
+  spdlog::info("restored the DCP's state from {} (saved at DCP frame {}): Mode {}{}{}", what,
+               c.dcp_frame, dcp_.status().mode, dcp_.status().acquired ? ", acquired" : "",
+               dcp_.status().docked ? ", docked" : "");
 }
 
 void DynamicsProc::PublishState(std::int8_t reason) {
@@ -60,8 +64,10 @@ void DynamicsProc::PublishState(std::int8_t reason) {
   m.resume_dcp_frame = resume_ ? resume_->first : -1;
   m.resume_input_frame = resume_ ? resume_->second : -1;
   m.checkpoint = wire::CheckpointText(MakeCheckpoint());
-  if (transport::PublishMessage(*lcm_, wire::channels::kDcpState, m)) counters_.Add(Counter::kStatePublished);
-  else counters_.Add(Counter::kPublishFailed);
+  if (transport::PublishMessage(*lcm_, wire::channels::kDcpState, m))
+    counters_.Add(Counter::kStatePublished);
+  else
+    counters_.Add(Counter::kPublishFailed);
   frames_since_state_ = 0;
 }
 
@@ -77,8 +83,10 @@ void DynamicsProc::ApplyState(const dcp_state_t& m, bool with_state) {
   }
   next_frame_ = m.next_frame;
   last_input_frame_ = m.input_frame;
-  if (m.resume_pending) resume_ = std::pair{m.resume_dcp_frame, m.resume_input_frame};
-  else resume_.reset();
+  if (m.resume_pending)
+    resume_ = std::pair{m.resume_dcp_frame, m.resume_input_frame};
+  else
+    resume_.reset();
   frames_since_state_ = 0;
 }
 
@@ -97,8 +105,8 @@ bool DynamicsProc::ResumeFromStateFile() {
   resume_ = std::pair{c.dcp_frame, c.input_frame};
   last_inputs_ = c.inputs;
   counters_.Add(Counter::kResumed);
-  spdlog::warn("resumed from the last state written ({}, DCP frame {}): Mode {}{}{}", state_file_, c.dcp_frame,
-               dcp_.status().mode, dcp_.status().acquired ? ", payload attached" : "",
+  spdlog::warn("resumed from the last state written ({}, DCP frame {}): Mode {}{}{}", state_file_,
+               c.dcp_frame, dcp_.status().mode, dcp_.status().acquired ? ", payload attached" : "",
                dcp_.status().docked ? ", docked" : "");
   return true;
 }
@@ -139,7 +147,8 @@ void DynamicsProc::OnControl(const void* data, int size) {
     if (m.command == session_control_t::CHECKPOINT) {
       checkpoints_.Write(m.name, MakeCheckpoint());
       counters_.Add(Counter::kControlCheckpoints);
-      spdlog::info("checkpoint: DCP frame {} saved as {}", next_frame_ - 1, checkpoints_.PathOf(m.name));
+      spdlog::info("checkpoint: DCP frame {} saved as {}", next_frame_ - 1,
+                   checkpoints_.PathOf(m.name));
     } else {
       Restore(checkpoints_.Read(m.name), checkpoints_.PathOf(m.name));
       counters_.Add(Counter::kControlRestores);
@@ -172,8 +181,8 @@ void DynamicsProc::OnInput(const void* data, int size, std::int64_t recv_time_us
   if (!got) return;
   const auto& [msg, in] = *got;
   counters_.Set(Counter::kInputMissing, inputs_.missing());
-  RecordEndToEnd(now_us - msg.send_time_us, config_.session.frame_rate_hz, &latencies_["input_to_dcp"],
-                 &counters_);
+  RecordEndToEnd(now_us - msg.send_time_us, config_.session.frame_rate_hz,
+                 &latencies_["input_to_dcp"], &counters_);
 
   if (resume_) {
     if (msg.frame > resume_->second) next_frame_ = resume_->first + (msg.frame - resume_->second);
@@ -188,19 +197,23 @@ void DynamicsProc::OnInput(const void* data, int size, std::int64_t recv_time_us
   out.send_time_us = lcm_->NowUs();
   dcp_frame_t wire_msg;
   wire::PackDcpFrame(out, &wire_msg, &counters_);
-  if (transport::PublishMessage(*lcm_, wire::channels::kDcpFrame, wire_msg)) counters_.Add(Counter::kPublished);
-  else counters_.Add(Counter::kPublishFailed);
+  if (transport::PublishMessage(*lcm_, wire::channels::kDcpFrame, wire_msg))
+    counters_.Add(Counter::kPublished);
+  else
+    counters_.Add(Counter::kPublishFailed);
   const dcp_telemetry_t tm = MakeTelemetry(dcp_.status(), out);
-  if (!transport::PublishMessage(*lcm_, wire::channels::kDcpTelemetry, tm)) counters_.Add(Counter::kPublishFailed);
+  if (!transport::PublishMessage(*lcm_, wire::channels::kDcpTelemetry, tm))
+    counters_.Add(Counter::kPublishFailed);
   Report(dcp_.status(), out.frame);
   made_a_frame_ = true;
-  if (++frames_since_state_ >= static_cast<std::int64_t>(kStateEverySeconds * config_.session.frame_rate_hz)) {
+  if (++frames_since_state_ >=
+      static_cast<std::int64_t>(kStateEverySeconds * config_.session.frame_rate_hz)) {
     PublishState(dcp_state_t::PERIODIC);
   }
   if (!state_file_.empty()) {
     const DcpStatus& st = dcp_.status();
-    const std::uint32_t key = static_cast<std::uint32_t>(st.mode) | (st.acquired << 4) | (st.docked << 5) |
-                              (dcp_.released() << 6);
+    const std::uint32_t key = static_cast<std::uint32_t>(st.mode) | (st.acquired << 4) |
+                              (st.docked << 5) | (dcp_.released() << 6);
     if (key != state_key_ || out.send_time_us - state_written_us_ >= 500000) {
       state_key_ = key;
       WriteStateFile();
@@ -232,9 +245,13 @@ void DynamicsProc::Report(const DcpStatus& st, std::int64_t frame) {
   for (int b = 0; b < wire::collision_bits::kCount; ++b) {
     if (started & (1u << b)) {
       counters_.Add(wire::CollisionCounter(b));
-      spdlog::info("frame {}: collision {} (slave {})", frame, wire::CollisionName(b), st.held ? "holds" : st.finger_held ? "holds the finger" : "follows");
+      spdlog::info("frame {}: collision {} (slave {})", frame, wire::CollisionName(b),
+                   st.held          ? "holds"
+                   : st.finger_held ? "holds the finger"
+                                    : "follows");
     }
-    if (ended & (1u << b)) spdlog::info("frame {}: collision {} relieved", frame, wire::CollisionName(b));
+    if (ended & (1u << b))
+      spdlog::info("frame {}: collision {} relieved", frame, wire::CollisionName(b));
   }
   last_collisions_ = st.collisions;
 }
@@ -288,9 +305,10 @@ dcp_telemetry_t MakeTelemetry(const DcpStatus& st, const wire::DcpFrameData& out
   return t;
 }
 
-int RunDynamicsProc(const LabConfig& config, transport::LcmInterface& lcm, const std::string& stats_path,
-                    const std::string& ready_path, const std::string& restore_path,
-                    const std::string& state_file, const std::string& checkpoint_dir) {
+int RunDynamicsProc(const LabConfig& config, transport::LcmInterface& lcm,
+                    const std::string& stats_path, const std::string& ready_path,
+                    const std::string& restore_path, const std::string& state_file,
+                    const std::string& checkpoint_dir) {
   DynamicsProc node(config, &lcm);
   node.set_next_frame(transport::FirstFrameNumber(config.session.frame_rate_hz));
   node.EnableLiveChecks(config.session.frame_rate_hz);
@@ -301,8 +319,9 @@ int RunDynamicsProc(const LabConfig& config, transport::LcmInterface& lcm, const
   if (restored) node.RestoreCheckpoint(restore_path);
   // Its state for the log, until the first frame: the recorder may not
   // have heard the first one (docs/sessions.md "Re-simulation").
-  const std::int8_t start_reason =
-      resumed ? dcp_state_t::RESUME : restored ? dcp_state_t::RESTORE : dcp_state_t::START;
+  const std::int8_t start_reason = resumed    ? dcp_state_t::RESUME
+                                   : restored ? dcp_state_t::RESTORE
+                                              : dcp_state_t::START;
   node.PublishState(start_reason);
   std::int64_t state_sent_us = lcm.NowUs();
   auto until_first_frame = [&] {
@@ -313,12 +332,15 @@ int RunDynamicsProc(const LabConfig& config, transport::LcmInterface& lcm, const
   if (!ready_path.empty()) transport::WriteReadyFile(ready_path);
   spdlog::info("ready: {} -> {}", lcm.FullChannel(wire::channels::kOperatorInput),
                lcm.FullChannel(wire::channels::kDcpFrame));
-  transport::RunNodeLoop(lcm, "dynamics_proc", node.counters(), node.latencies(),
-              [&] { return node.last_frame(); }, until_first_frame, stats_path);
+  transport::RunNodeLoop(
+      lcm, "dynamics_proc", node.counters(), node.latencies(), [&] { return node.last_frame(); },
+      until_first_frame, stats_path);
   node.WriteStateFile();
   spdlog::info("published {} DCP frames; inputs missing {}, late {}, dropped {}; final mode {}",
-               node.counters().Get(Counter::kPublished), node.counters().Get(Counter::kInputMissing),
-               node.counters().Get(Counter::kFramesLate), node.counters().Sum(kDroppedFirst, kDroppedLast), node.program().mode());
+               node.counters().Get(Counter::kPublished),
+               node.counters().Get(Counter::kInputMissing),
+               node.counters().Get(Counter::kFramesLate),
+               node.counters().Sum(kDroppedFirst, kDroppedLast), node.program().mode());
   return 0;
 }
 

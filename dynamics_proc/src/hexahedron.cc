@@ -13,16 +13,26 @@ char FaceLetter(int f) { return static_cast<char>('a' + f); }
 
 const char* HexProblemName(HexProblem p) {
   switch (p) {
-    case HexProblem::kNone: return "valid";
-    case HexProblem::kNonFinite: return "a coordinate is not finite";
-    case HexProblem::kOverflow: return "a coordinate beyond 1e75 ft (its products would overflow)";
-    case HexProblem::kTooSmall: return "smaller than 1e-75 ft (its products would underflow)";
-    case HexProblem::kBadDimension: return "a length or half-width not positive";
-    case HexProblem::kSkewedAxes: return "its axes U, V, W are not orthonormal";
-    case HexProblem::kDegenerateFace: return "a face has no area";
-    case HexProblem::kFlat: return "flat: thinner than the rounding tolerance at its coordinates";
-    case HexProblem::kTwisted: return "twisted: its faces disagree on the outward side";
-    case HexProblem::kNonConvex: return "not convex: a vertex beyond a face's plane";
+    case HexProblem::kNone:
+      return "valid";
+    case HexProblem::kNonFinite:
+      return "a coordinate is not finite";
+    case HexProblem::kOverflow:
+      return "a coordinate beyond 1e75 ft (its products would overflow)";
+    case HexProblem::kTooSmall:
+      return "smaller than 1e-75 ft (its products would underflow)";
+    case HexProblem::kBadDimension:
+      return "a length or half-width not positive";
+    case HexProblem::kSkewedAxes:
+      return "its axes U, V, W are not orthonormal";
+    case HexProblem::kDegenerateFace:
+      return "a face has no area";
+    case HexProblem::kFlat:
+      return "flat: thinner than the rounding tolerance at its coordinates";
+    case HexProblem::kTwisted:
+      return "twisted: its faces disagree on the outward side";
+    case HexProblem::kNonConvex:
+      return "not convex: a vertex beyond a face's plane";
   }
   return "?";
 }
@@ -57,9 +67,10 @@ namespace {
 
 #if defined(__x86_64__) || defined(__i386__)
 // (Helpers, not lambdas: a lambda would not inherit the target.)
-__attribute__((target("avx"))) inline __m256d ProjectAvx(const Hexahedron& h, int f, __m256d X, __m256d Y,
-                                                          __m256d Z) {
-  return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(_mm256_set1_pd(h.nx[f]), X), _mm256_mul_pd(_mm256_set1_pd(h.ny[f]), Y)),
+__attribute__((target("avx"))) inline __m256d ProjectAvx(const Hexahedron& h, int f, __m256d X,
+                                                         __m256d Y, __m256d Z) {
+  return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(_mm256_set1_pd(h.nx[f]), X),
+                                     _mm256_mul_pd(_mm256_set1_pd(h.ny[f]), Y)),
                        _mm256_mul_pd(_mm256_set1_pd(h.nz[f]), Z));
 }
 __attribute__((target("avx"))) inline std::uint8_t AboveAvx(__m256d s0, __m256d s1, double lim) {
@@ -74,7 +85,7 @@ __attribute__((target("avx"))) inline std::uint8_t BelowAvx(__m256d s0, __m256d 
 }
 
 __attribute__((target("avx"))) void MasksAvx(const Hexahedron& h, const Hexahedron& o, double tau,
-                                               std::array<std::uint8_t, 6>* masks) {
+                                             std::array<std::uint8_t, 6>* masks) {
   const __m256d X0 = _mm256_loadu_pd(&o.x[0]), X1 = _mm256_loadu_pd(&o.x[4]);
   const __m256d Y0 = _mm256_loadu_pd(&o.y[0]), Y1 = _mm256_loadu_pd(&o.y[4]);
   const __m256d Z0 = _mm256_loadu_pd(&o.z[0]), Z1 = _mm256_loadu_pd(&o.z[4]);
@@ -88,7 +99,8 @@ __attribute__((target("avx"))) void MasksAvx(const Hexahedron& h, const Hexahedr
     }
   } else {
     for (int f = 0; f < kNumFaces; ++f) {
-      (*masks)[f] = AboveAvx(ProjectAvx(h, f, X0, Y0, Z0), ProjectAvx(h, f, X1, Y1, Z1), h.d[f] + tau);
+      (*masks)[f] =
+          AboveAvx(ProjectAvx(h, f, X0, Y0, Z0), ProjectAvx(h, f, X1, Y1, Z1), h.d[f] + tau);
     }
   }
 }
@@ -98,7 +110,8 @@ const bool kHaveAvx = __builtin_cpu_supports("avx");
 
 }  // namespace
 
-int Hexahedron::FaceMasks(const Hexahedron& o, double tau, std::array<std::uint8_t, 6>* masks) const {
+int Hexahedron::FaceMasks(const Hexahedron& o, double tau,
+                          std::array<std::uint8_t, 6>* masks) const {
 #if defined(__x86_64__) || defined(__i386__)
   if (kHaveAvx) {
     MasksAvx(*this, o, tau, masks);
@@ -116,8 +129,9 @@ int Hexahedron::FaceMasks(const Hexahedron& o, double tau, std::array<std::uint8
     Z[k] = _mm_loadu_pd(&o.z[2 * k]);
   }
   auto project = [&](int f, int k) {
-    return _mm_add_pd(_mm_add_pd(_mm_mul_pd(_mm_set1_pd(nx[f]), X[k]), _mm_mul_pd(_mm_set1_pd(ny[f]), Y[k])),
-                      _mm_mul_pd(_mm_set1_pd(nz[f]), Z[k]));
+    return _mm_add_pd(
+        _mm_add_pd(_mm_mul_pd(_mm_set1_pd(nx[f]), X[k]), _mm_mul_pd(_mm_set1_pd(ny[f]), Y[k])),
+        _mm_mul_pd(_mm_set1_pd(nz[f]), Z[k]));
   };
   if (parallel_opposites) {
     for (int f = 0; f < 3; ++f) {
@@ -135,7 +149,8 @@ int Hexahedron::FaceMasks(const Hexahedron& o, double tau, std::array<std::uint8
     for (int f = 0; f < kNumFaces; ++f) {
       const __m128d off = _mm_set1_pd(d[f] + tau);
       unsigned m = 0;
-      for (int k = 0; k < 4; ++k) m |= static_cast<unsigned>(_mm_movemask_pd(_mm_cmpgt_pd(project(f, k), off))) << (2 * k);
+      for (int k = 0; k < 4; ++k)
+        m |= static_cast<unsigned>(_mm_movemask_pd(_mm_cmpgt_pd(project(f, k), off))) << (2 * k);
       (*masks)[f] = static_cast<std::uint8_t>(m);
     }
   }
@@ -143,7 +158,8 @@ int Hexahedron::FaceMasks(const Hexahedron& o, double tau, std::array<std::uint8
   for (int f = 0; f < kNumFaces; ++f) {
     const double a = nx[f], b = ny[f], c = nz[f], off = d[f] + tau;
     unsigned m = 0;
-    for (int i = 0; i < kNumVertices; ++i) m |= static_cast<unsigned>((a * o.x[i] + b * o.y[i]) + c * o.z[i] > off) << i;
+    for (int i = 0; i < kNumVertices; ++i)
+      m |= static_cast<unsigned>((a * o.x[i] + b * o.y[i]) + c * o.z[i] > off) << i;
     (*masks)[f] = static_cast<std::uint8_t>(m);
   }
 #endif
@@ -156,7 +172,8 @@ int Hexahedron::FaceMasks(const Hexahedron& o, double tau, std::array<std::uint8
 std::array<LocationWord, 8> WordsFromMasks(const std::array<std::uint8_t, 6>& masks) {
   std::array<LocationWord, 8> w{};
   for (int f = 0; f < kNumFaces; ++f) {
-    for (int i = 0; i < kNumVertices; ++i) w[i] |= static_cast<LocationWord>(((masks[f] >> i) & 1u) << f);
+    for (int i = 0; i < kNumVertices; ++i)
+      w[i] |= static_cast<LocationWord>(((masks[f] >> i) & 1u) << f);
   }
   return w;
 }
@@ -193,7 +210,8 @@ HexProblem Finish(Hexahedron* h) {
   for (int f = 0; f < kNumFaces; ++f) zero += (h->nx[f] + h->ny[f] + h->nz[f] + h->d[f]) * 0.0;
   const bool finite = zero == 0.0;
   h->magnitude = 0.0;
-  for (int k = 0; k < 3; ++k) h->magnitude = std::max({h->magnitude, std::abs(lo[k]), std::abs(hi[k])});
+  for (int k = 0; k < 3; ++k)
+    h->magnitude = std::max({h->magnitude, std::abs(lo[k]), std::abs(hi[k])});
   h->scale = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                        (hi[2] - lo[2]) * (hi[2] - lo[2]));
   h->cx = 0.5 * (lo[0] + hi[0]);
@@ -201,8 +219,9 @@ HexProblem Finish(Hexahedron* h) {
   h->cz = 0.5 * (lo[2] + hi[2]);
   double r2 = 0.0;
   for (int i = 0; i < kNumVertices; ++i) {
-    r2 = std::max(r2, (h->x[i] - h->cx) * (h->x[i] - h->cx) + (h->y[i] - h->cy) * (h->y[i] - h->cy) +
-                          (h->z[i] - h->cz) * (h->z[i] - h->cz));
+    r2 =
+        std::max(r2, (h->x[i] - h->cx) * (h->x[i] - h->cx) + (h->y[i] - h->cy) * (h->y[i] - h->cy) +
+                         (h->z[i] - h->cz) * (h->z[i] - h->cz));
   }
   h->radius = std::sqrt(r2);
   h->hx = 0.5 * (hi[0] - lo[0]);
@@ -251,11 +270,15 @@ Hexahedron MakeBox(const Eigen::Vector3d& p_A, const Eigen::Vector3d& U, const E
   h.parallel_opposites = true;  // the normals above are exact negatives
   HexProblem problem = Finish(&h);
   if (problem == HexProblem::kNone) {
-    const double skew = std::max({std::abs(U.squaredNorm() - 1), std::abs(V.squaredNorm() - 1), std::abs(W.squaredNorm() - 1),
-                                  std::abs(U.dot(V)), std::abs(V.dot(W)), std::abs(W.dot(U))});
-    if (!(length > 0 && half_v > 0 && half_w > 0)) problem = HexProblem::kBadDimension;
-    else if (!(skew <= 1e-9)) problem = HexProblem::kSkewedAxes;
-    else if (std::min({length, 2 * half_v, 2 * half_w}) <= ShapeTolerance(h)) problem = HexProblem::kFlat;
+    const double skew = std::max({std::abs(U.squaredNorm() - 1), std::abs(V.squaredNorm() - 1),
+                                  std::abs(W.squaredNorm() - 1), std::abs(U.dot(V)),
+                                  std::abs(V.dot(W)), std::abs(W.dot(U))});
+    if (!(length > 0 && half_v > 0 && half_w > 0))
+      problem = HexProblem::kBadDimension;
+    else if (!(skew <= 1e-9))
+      problem = HexProblem::kSkewedAxes;
+    else if (std::min({length, 2 * half_v, 2 * half_w}) <= ShapeTolerance(h))
+      problem = HexProblem::kFlat;
   }
   SetValidity(&h, problem);
   return h;
@@ -271,7 +294,7 @@ Hexahedron FromVertices(const std::array<Eigen::Vector3d, 8>& v) {
   }
   // Faces from differences of vertices (accurate at any distance from the
   // origin), about the first vertex.
-  const Eigen::Vector3d o = v[0];
+  const Eigen::Vector3d& o = v[0];
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (const auto& p : v) centroid += p - o;
   centroid /= 8.0;
@@ -287,7 +310,8 @@ Hexahedron FromVertices(const std::array<Eigen::Vector3d, 8>& v) {
       return h;
     }
     n /= len;
-    const Eigen::Vector3d mid = 0.25 * ((v[fv[0]] - o) + (v[fv[1]] - o) + (v[fv[2]] - o) + (v[fv[3]] - o));
+    const Eigen::Vector3d mid =
+        0.25 * ((v[fv[0]] - o) + (v[fv[1]] - o) + (v[fv[2]] - o) + (v[fv[3]] - o));
     if (n.dot(mid - centroid) < 0) {
       n = -n;
       ++inward;
@@ -318,8 +342,8 @@ Hexahedron FromVertices(const std::array<Eigen::Vector3d, 8>& v) {
   // within the rounding of non-planar faces and of the coordinates.
   for (int f = 0; f < kNumFaces; ++f) {
     for (int i = 0; i < kNumVertices; ++i) {
-      const double beyond = h.nx[f] * (h.x[i] - o.x()) + h.ny[f] * (h.y[i] - o.y()) + h.nz[f] * (h.z[i] - o.z()) -
-                            d_o[f];
+      const double beyond = h.nx[f] * (h.x[i] - o.x()) + h.ny[f] * (h.y[i] - o.y()) +
+                            h.nz[f] * (h.z[i] - o.z()) - d_o[f];
       if (beyond > tol) {
         SetValidity(&h, HexProblem::kNonConvex);
         return h;

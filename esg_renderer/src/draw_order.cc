@@ -6,11 +6,10 @@
 
 namespace rms::esg_renderer {
 
-using scene_model::kNumClusters;
-using scene_model::PairIndex;
-
 std::vector<Eigen::Vector2f> ConvexHull2d(std::vector<Eigen::Vector2f> p) {
-  std::sort(p.begin(), p.end(), [](const auto& a, const auto& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
+  std::sort(p.begin(), p.end(), [](const auto& a, const auto& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
   if (p.size() < 3) return p;
   auto cross = [](const Eigen::Vector2f& o, const Eigen::Vector2f& a, const Eigen::Vector2f& b) {
     return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
@@ -32,7 +31,8 @@ std::vector<Eigen::Vector2f> ConvexHull2d(std::vector<Eigen::Vector2f> p) {
 namespace {
 // Is there an edge normal of `a`'s outline along which `b` lies beyond a
 // (by more than -tol)? Then they do not overlap by more than tol.
-bool SeparatedByEdgesOf(const std::vector<Eigen::Vector2f>& a, const std::vector<Eigen::Vector2f>& b, float tol) {
+bool SeparatedByEdgesOf(const std::vector<Eigen::Vector2f>& a,
+                        const std::vector<Eigen::Vector2f>& b, float tol) {
   const std::size_t n = a.size();
   if (n < 2) return false;
   for (std::size_t i = 0; i < n; ++i) {
@@ -51,15 +51,19 @@ bool SeparatedByEdgesOf(const std::vector<Eigen::Vector2f>& a, const std::vector
 
 bool OutlinesOverlap(const ScreenBox& a, const ScreenBox& b, float tol) {
   if (a.everywhere || b.everywhere) return true;
-  if (a.x1 < b.x0 + tol || b.x1 < a.x0 + tol || a.y1 < b.y0 + tol || b.y1 < a.y0 + tol) return false;
-  return !SeparatedByEdgesOf(a.outline, b.outline, tol) && !SeparatedByEdgesOf(b.outline, a.outline, tol);
+  if (a.x1 < b.x0 + tol || b.x1 < a.x0 + tol || a.y1 < b.y0 + tol || b.y1 < a.y0 + tol)
+    return false;
+  return !SeparatedByEdgesOf(a.outline, b.outline, tol) &&
+         !SeparatedByEdgesOf(b.outline, a.outline, tol);
 }
 
-std::vector<int> DrawOrder(const scene_model::PriorityBits& bits, const std::array<ScreenBox, scene_model::kNumClusters>& boxes,
+std::vector<int> DrawOrder(const scene_model::PriorityBits& bits,
+                           const std::array<ScreenBox, scene_model::kNumClusters>& boxes,
                            int* cycles_broken, float overlap_tol) {
   // Edges "drawn before": u -> v. A pair's bit set: the first cluster may
   // hide the second, so the second goes first.
-  std::array<std::uint64_t, scene_model::kNumClusters> before{};  // (kNumClusters <= 64)  // bit u of before[v]: u must precede v
+  std::array<std::uint64_t, scene_model::kNumClusters>
+      before{};  // (kNumClusters <= 64)  // bit u of before[v]: u must precede v
   std::vector<int> nodes;
   for (int c = 0; c < scene_model::kNumClusters; ++c) {
     if (boxes[c].visible) nodes.push_back(c);

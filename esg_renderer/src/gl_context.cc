@@ -1,10 +1,10 @@
 #include "rms/esg_renderer/gl_context.h"
 
+#include <dlfcn.h>
+
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
 #include <GL/osmesa.h>
-#include <dlfcn.h>
-
 #include <cstring>
 #include <stdexcept>
 
@@ -48,7 +48,9 @@ class OsMesaContext final : public GlContext {
   OsMesaContext(int w, int h) : w_(w), h_(h), buffer_(static_cast<std::size_t>(w) * h * 4) {
     std::string tried;
     lib_ = OpenFirst({"libOSMesa.so.8", "libOSMesa.so.6", "libOSMesa.so"}, &tried);
-    if (!lib_) throw std::runtime_error("cannot load OSMesa (" + tried + "): install libosmesa6, or use --gl egl");
+    if (!lib_)
+      throw std::runtime_error("cannot load OSMesa (" + tried +
+                               "): install libosmesa6, or use --gl egl");
     create_ = reinterpret_cast<decltype(create_)>(dlsym(lib_, "OSMesaCreateContextExt"));
     make_current_ = reinterpret_cast<decltype(make_current_)>(dlsym(lib_, "OSMesaMakeCurrent"));
     destroy_ = reinterpret_cast<decltype(destroy_)>(dlsym(lib_, "OSMesaDestroyContext"));
@@ -63,10 +65,12 @@ class OsMesaContext final : public GlContext {
     if (!ctx_) ctx_ = create_(OSMESA_RGBA, 24, 0, 0, nullptr);
     if (!ctx_) throw std::runtime_error("OSMesaCreateContextExt failed");
     if (!make_current_(ctx_, buffer_.data(), GL_UNSIGNED_BYTE, w_, h_)) {
-      throw std::runtime_error("OSMesaMakeCurrent failed for " + std::to_string(w) + "x" + std::to_string(h));
+      throw std::runtime_error("OSMesaMakeCurrent failed for " + std::to_string(w) + "x" +
+                               std::to_string(h));
     }
     pixel_store_(OSMESA_Y_UP, 0);  // row 0 is the top of the image
-    const std::string missing = gl_.Load([&](const char* n) { return reinterpret_cast<void*>(get_proc_(n)); }, false);
+    const std::string missing =
+        gl_.Load([&](const char* n) { return reinterpret_cast<void*>(get_proc_(n)); }, false);
     if (!missing.empty()) throw std::runtime_error("OSMesa has no " + missing);
   }
   ~OsMesaContext() override {
@@ -103,38 +107,45 @@ class OsMesaContext final : public GlContext {
 
 class EglContext final : public GlContext {
  public:
-  EglContext(int w, int h) : w_(w), h_(h), raw_(static_cast<std::size_t>(w) * h * 4), buffer_(raw_.size()) {
+  EglContext(int w, int h)
+      : w_(w), h_(h), raw_(static_cast<std::size_t>(w) * h * 4), buffer_(raw_.size()) {
     std::string tried;
     lib_ = OpenFirst({"libEGL.so.1", "libEGL.so"}, &tried);
     if (!lib_) throw std::runtime_error("cannot load EGL (" + tried + "): install libegl1");
     auto sym = [&](const char* n) { return dlsym(lib_, n); };
     auto get_proc = reinterpret_cast<void* (*)(const char*)>(sym("eglGetProcAddress"));
-    auto get_platform_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(get_proc("eglGetPlatformDisplayEXT"));
+    auto get_platform_display =
+        reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(get_proc("eglGetPlatformDisplayEXT"));
     auto initialize = reinterpret_cast<PFNEGLINITIALIZEPROC>(sym("eglInitialize"));
     auto bind_api = reinterpret_cast<PFNEGLBINDAPIPROC>(sym("eglBindAPI"));
     auto choose = reinterpret_cast<PFNEGLCHOOSECONFIGPROC>(sym("eglChooseConfig"));
     auto create = reinterpret_cast<PFNEGLCREATECONTEXTPROC>(sym("eglCreateContext"));
     auto make_current = reinterpret_cast<PFNEGLMAKECURRENTPROC>(sym("eglMakeCurrent"));
-    if (!get_proc || !get_platform_display || !initialize || !bind_api || !choose || !create || !make_current) {
+    if (!get_proc || !get_platform_display || !initialize || !bind_api || !choose || !create ||
+        !make_current) {
       throw std::runtime_error("EGL lacks EGL_EXT_platform_base or its core entry points");
     }
     display_ = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
     EGLint major = 0, minor = 0;
     if (display_ == EGL_NO_DISPLAY || !initialize(display_, &major, &minor)) {
-      throw std::runtime_error("EGL surfaceless display (EGL_MESA_platform_surfaceless) is not available");
+      throw std::runtime_error(
+          "EGL surfaceless display (EGL_MESA_platform_surfaceless) is not available");
     }
     if (!bind_api(EGL_OPENGL_API)) throw std::runtime_error("EGL cannot bind the OpenGL API");
-    const EGLint attrs[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
+    const EGLint attrs[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT,
+                            EGL_NONE};
     EGLConfig config = nullptr;
     EGLint n = 0;
     choose(display_, attrs, &config, 1, &n);
     // A compatibility-profile context (fixed-function pipeline).
-    const EGLint ctx_attrs[] = {EGL_CONTEXT_MAJOR_VERSION, 2, EGL_CONTEXT_MINOR_VERSION, 1, EGL_NONE};
+    const EGLint ctx_attrs[] = {EGL_CONTEXT_MAJOR_VERSION, 2, EGL_CONTEXT_MINOR_VERSION, 1,
+                                EGL_NONE};
     ctx_ = create(display_, n > 0 ? config : nullptr, EGL_NO_CONTEXT, ctx_attrs);
     if (ctx_ == EGL_NO_CONTEXT) throw std::runtime_error("eglCreateContext failed");
     make_current_ = make_current;
     if (!make_current(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx_)) {
-      throw std::runtime_error("eglMakeCurrent without a surface failed (EGL_KHR_surfaceless_context)");
+      throw std::runtime_error(
+          "eglMakeCurrent without a surface failed (EGL_KHR_surfaceless_context)");
     }
     const std::string missing = gl_.Load([&](const char* name) { return get_proc(name); }, true);
     if (!missing.empty()) throw std::runtime_error("EGL's OpenGL has no " + missing);

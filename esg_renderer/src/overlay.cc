@@ -51,39 +51,59 @@ const std::uint8_t* Glyph(char ch) {
   if (c >= '0' && c <= '9') return kDigits[c - '0'];
   if (c >= 'A' && c <= 'Z') return kLetters[c - 'A'];
   switch (c) {
-    case '-': return kDash;
-    case ':': return kColon;
-    case '.': return kDot;
-    case '/': return kSlash;
-    case ',': return kComma;
-    case '+': return kPlus;
-    case '(': return kOpen;
-    case ')': return kClose;
-    case '<': return kLess;
-    case '=': return kEqual;
-    default: return kBlank;
+    case '-':
+      return kDash;
+    case ':':
+      return kColon;
+    case '.':
+      return kDot;
+    case '/':
+      return kSlash;
+    case ',':
+      return kComma;
+    case '+':
+      return kPlus;
+    case '(':
+      return kOpen;
+    case ')':
+      return kClose;
+    case '<':
+      return kLess;
+    case '=':
+      return kEqual;
+    default:
+      return kBlank;
   }
 }
 
 }  // namespace
 
-void FillRect(std::uint8_t* rgba, int w, int h, int x0, int y0, int x1, int y1, const scene_model::Rgb& c) {
-  x0 = std::max(x0, 0); y0 = std::max(y0, 0); x1 = std::min(x1, w); y1 = std::min(y1, h);
+void FillRect(std::uint8_t* rgba, int w, int h, int x0, int y0, int x1, int y1,
+              const scene_model::Rgb& c) {
+  x0 = std::max(x0, 0);
+  y0 = std::max(y0, 0);
+  x1 = std::min(x1, w);
+  y1 = std::min(y1, h);
   for (int y = y0; y < y1; ++y) {
     std::uint8_t* p = rgba + (static_cast<std::size_t>(y) * w + x0) * 4;
     for (int x = x0; x < x1; ++x, p += 4) {
-      p[0] = c[0]; p[1] = c[1]; p[2] = c[2]; p[3] = 255;
+      p[0] = c[0];
+      p[1] = c[1];
+      p[2] = c[2];
+      p[3] = 255;
     }
   }
 }
 
-void DrawText(std::uint8_t* rgba, int w, int h, int x, int y, std::string_view text, const scene_model::Rgb& colour, int scale) {
+void DrawText(std::uint8_t* rgba, int w, int h, int x, int y, std::string_view text,
+              const scene_model::Rgb& colour, int scale) {
   for (char ch : text) {
     const std::uint8_t* g = Glyph(ch);
     for (int row = 0; row < 7; ++row) {
       for (int col = 0; col < 5; ++col) {
         if (g[row] & (0x10 >> col)) {
-          FillRect(rgba, w, h, x + col * scale, y + row * scale, x + (col + 1) * scale, y + (row + 1) * scale, colour);
+          FillRect(rgba, w, h, x + col * scale, y + row * scale, x + (col + 1) * scale,
+                   y + (row + 1) * scale, colour);
         }
       }
     }
@@ -97,14 +117,16 @@ OverlayModel MakeOverlayModel(const LabConfig& config) {
     m.camera_names.push_back(cam.name);
     m.mounts.push_back(cam.mount);
   }
-  m.p_S2oT_S2 = mission::PlanGeometry(config).X_S2P * scene_model::GrappleTargetCentre_P(config.payload);
+  m.p_S2oT_S2 =
+      mission::PlanGeometry(config).X_S2P * scene_model::GrappleTargetCentre_P(config.payload);
   m.p_RoPort_R = config.cae.p_RoCo_R_ft;
   m.y_port_R = config.cae.R_RC.col(1);
   m.arm = config.arm;
   return m;
 }
 
-bool ProjectToImage(const wire::EsgFrameData& f, int w, int h, const Eigen::Vector3d& p_R, double* x, double* y) {
+bool ProjectToImage(const wire::EsgFrameData& f, int w, int h, const Eigen::Vector3d& p_R,
+                    double* x, double* y) {
   const Eigen::Vector3d d = f.R_RE.transpose() * (p_R - f.p_RoEye_R_ft);
   if (d.x() < 0.05) return false;
   const double focal = 0.5 * h / std::tan(0.5 * f.fov_deg * M_PI / 180.0);
@@ -113,16 +135,19 @@ bool ProjectToImage(const wire::EsgFrameData& f, int w, int h, const Eigen::Vect
   return true;
 }
 
-void DrawLine(std::uint8_t* rgba, int w, int h, int x0, int y0, int x1, int y1, const scene_model::Rgb& c, int thick) {
+void DrawLine(std::uint8_t* rgba, int w, int h, int x0, int y0, int x1, int y1,
+              const scene_model::Rgb& c, int thick) {
   const int n = std::max({std::abs(x1 - x0), std::abs(y1 - y0), 1});
   if (n > 4 * (w + h)) return;  // far off the image: nothing to draw
   for (int i = 0; i <= n; ++i) {
     const int x = x0 + (x1 - x0) * i / n, y = y0 + (y1 - y0) * i / n;
-    FillRect(rgba, w, h, x - thick / 2, y - thick / 2, x - thick / 2 + thick, y - thick / 2 + thick, c);
+    FillRect(rgba, w, h, x - thick / 2, y - thick / 2, x - thick / 2 + thick, y - thick / 2 + thick,
+             c);
   }
 }
 
-void DrawCrosshairs(std::uint8_t* rgba, int w, int h, const wire::EsgFrameData& f, const OverlayModel& m) {
+void DrawCrosshairs(std::uint8_t* rgba, int w, int h, const wire::EsgFrameData& f,
+                    const OverlayModel& m) {
   const int st = f.control.camera_station;
   if (st < 1 || st > static_cast<int>(m.mounts.size())) return;
   const int t = std::max(1, h / 400);
@@ -152,15 +177,17 @@ void DrawCrosshairs(std::uint8_t* rgba, int w, int h, const wire::EsgFrameData& 
       continue;
     }
     if (have_prev) {
-      DrawLine(rgba, w, h, static_cast<int>(px), static_cast<int>(py), static_cast<int>(x), static_cast<int>(y), green, t);
+      DrawLine(rgba, w, h, static_cast<int>(px), static_cast<int>(py), static_cast<int>(x),
+               static_cast<int>(y), green, t);
     }
     if (k % 4 == 0) {
       const int tick = h / 60;
-      DrawLine(rgba, w, h, static_cast<int>(x) - tick, static_cast<int>(y), static_cast<int>(x) + tick,
-               static_cast<int>(y), green, t);
+      DrawLine(rgba, w, h, static_cast<int>(x) - tick, static_cast<int>(y),
+               static_cast<int>(x) + tick, static_cast<int>(y), green, t);
       char label[8];
       std::snprintf(label, sizeof label, "%d", k / 2);
-      DrawText(rgba, w, h, static_cast<int>(x) + tick + 2 * s, static_cast<int>(y) - 3 * s, label, green, s);
+      DrawText(rgba, w, h, static_cast<int>(x) + tick + 2 * s, static_cast<int>(y) - 3 * s, label,
+               green, s);
     }
     px = x;
     py = y;
@@ -168,7 +195,8 @@ void DrawCrosshairs(std::uint8_t* rgba, int w, int h, const wire::EsgFrameData& 
   }
 }
 
-void DrawOverlay(std::uint8_t* rgba, int w, int h, const wire::EsgFrameData& f, const OverlayModel& model) {
+void DrawOverlay(std::uint8_t* rgba, int w, int h, const wire::EsgFrameData& f,
+                 const OverlayModel& model) {
   if (f.control.crosshairs) DrawCrosshairs(rgba, w, h, f, model);
   const std::vector<std::string>& names = model.camera_names;
   if (!f.control.overlay) return;
@@ -207,7 +235,8 @@ void DrawOverlay(std::uint8_t* rgba, int w, int h, const wire::EsgFrameData& f, 
 
 namespace {
 
-std::string Offset(const char* axis, double v, const char* plus, const char* minus, const char* unit) {
+std::string Offset(const char* axis, double v, const char* plus, const char* minus,
+                   const char* unit) {
   char b[48];
   std::snprintf(b, sizeof b, "%s %s %.2f%s", axis, v >= 0 ? plus : minus, std::abs(v), unit);
   return b;
@@ -223,17 +252,24 @@ void DrawGuidance(std::uint8_t* rgba, int w, int h, const operator_state_t& st) 
   static const char* kFrames[4] = {"", "END EFFECTOR", "ORBITER", "PAYLOAD"};
   const int frame = st.command_frame >= 1 && st.command_frame <= 3 ? st.command_frame : 1;
   char b[96];
-  std::snprintf(b, sizeof b, "%s  %s FRAME  %s", st.target == 1 ? "TO THE GRASP" : "TO THE PORT", kFrames[frame],
-                st.control_mode == 1 ? "SINGLE JOINT" : st.vernier ? "VERNIER" : st.control_mode ? "COARSE" : "");
+  std::snprintf(b, sizeof b, "%s  %s FRAME  %s", st.target == 1 ? "TO THE GRASP" : "TO THE PORT",
+                kFrames[frame],
+                st.control_mode == 1 ? "SINGLE JOINT"
+                : st.vernier         ? "VERNIER"
+                : st.control_mode    ? "COARSE"
+                                     : "");
   L.push_back(b);
-  L.push_back(Offset("X", st.offset_ft[0], "FWD", "BACK", "") + "  " + Offset("Y", st.offset_ft[1], "RIGHT", "LEFT", "") +
-              "  " + Offset("Z", st.offset_ft[2], "DOWN", "UP", " FT"));
-  L.push_back(Offset("ROLL", st.rotation_deg[0], "R", "L", "") + "  " + Offset("PITCH", st.rotation_deg[1], "UP", "DN", "") +
-              "  " + Offset("YAW", st.rotation_deg[2], "R", "L", " DEG"));
+  L.push_back(Offset("X", st.offset_ft[0], "FWD", "BACK", "") + "  " +
+              Offset("Y", st.offset_ft[1], "RIGHT", "LEFT", "") + "  " +
+              Offset("Z", st.offset_ft[2], "DOWN", "UP", " FT"));
+  L.push_back(Offset("ROLL", st.rotation_deg[0], "R", "L", "") + "  " +
+              Offset("PITCH", st.rotation_deg[1], "UP", "DN", "") + "  " +
+              Offset("YAW", st.rotation_deg[2], "R", "L", " DEG"));
   if (st.mode == 1) {
     std::string c = "ACQ";
     for (int i = 0; i < 6; ++i) {
-      std::snprintf(b, sizeof b, "  %d %s %.2f", i + 1, st.margin_ft[i] >= 0 ? "OK" : "NO", std::abs(st.margin_ft[i]));
+      std::snprintf(b, sizeof b, "  %d %s %.2f", i + 1, st.margin_ft[i] >= 0 ? "OK" : "NO",
+                    std::abs(st.margin_ft[i]));
       c += b;
     }
     L.push_back(c);
@@ -256,7 +292,8 @@ void DrawGuidance(std::uint8_t* rgba, int w, int h, const operator_state_t& st) 
   const int x0 = margin, y0 = h - margin - panel_h;
   FillRect(rgba, w, h, x0, y0, x0 + panel_w, y0 + panel_h, {16, 20, 28});
   for (std::size_t i = 0; i < L.size(); ++i) {
-    DrawText(rgba, w, h, x0 + margin, y0 + margin + static_cast<int>(i) * line, L[i], {120, 230, 255}, s);
+    DrawText(rgba, w, h, x0 + margin, y0 + margin + static_cast<int>(i) * line, L[i],
+             {120, 230, 255}, s);
   }
 }
 

@@ -1,15 +1,18 @@
 #include "rms/esg_renderer/png_io.h"
 
+#include <png.h>
+
 #include <cstdio>
 #include <memory>
-#include <png.h>
 #include <stdexcept>
 
 namespace rms::esg_renderer {
 
 namespace {
 struct FileCloser {
-  void operator()(FILE* f) const { if (f) std::fclose(f); }
+  void operator()(FILE* f) const {
+    if (f) std::fclose(f);
+  }
 };
 }  // namespace
 

@@ -44,7 +44,11 @@ Eigen::Matrix4d ProjectionMatrix(double fov_deg, double aspect, double n, double
 }
 
 FrameRenderer::FrameRenderer(const LabConfig& config, GlContext* context, RenderOptions options)
-    : config_(config), context_(context), gl_(context->gl()), options_(options), model_(scene_model::BuildSceneModel(config)) {
+    : config_(config),
+      context_(context),
+      gl_(context->gl()),
+      options_(options),
+      model_(scene_model::BuildSceneModel(config)) {
   sun_R_ = Eigen::Vector3f(-0.35f, 0.45f, 1.0f).normalized();
   context_->MakeCurrent();
   for (const scene_model::Cluster& c : model_.clusters) {
@@ -56,7 +60,10 @@ FrameRenderer::FrameRenderer(const LabConfig& config, GlContext* context, Render
       double dist = 1e30;
       for (std::size_t i = 0; i < c.points.size(); ++i) {
         const double dd = (c.points[i] - v.cast<double>()).squaredNorm();
-        if (dd < dist) { dist = dd; best = static_cast<int>(i); }
+        if (dd < dist) {
+          dist = dd;
+          best = static_cast<int>(i);
+        }
       }
       return best;
     };
@@ -70,7 +77,8 @@ FrameRenderer::FrameRenderer(const LabConfig& config, GlContext* context, Render
     for (bool decals : {false, true}) {  // base faces first, decals after
       for (const scene_model::Triangle& t : c.mesh.triangles()) {
         if (t.decal != decals) continue;
-        for (const Eigen::Vector3f* v : {&t.a, &t.b, &t.c}) g.xyz.insert(g.xyz.end(), {v->x(), v->y(), v->z()});
+        for (const Eigen::Vector3f* v : {&t.a, &t.b, &t.c})
+          g.xyz.insert(g.xyz.end(), {v->x(), v->y(), v->z()});
         g.n.push_back(t.n);
         g.rgb.push_back(options_.id_colors ? IdColor(c.id) : t.rgb);
       }
@@ -93,13 +101,15 @@ std::size_t FrameRenderer::triangle_count() const {
   return n;
 }
 
-void FrameRenderer::DrawCluster(GpuCluster& c, const Eigen::Affine3d& X, const Eigen::Matrix4d& view) {
+void FrameRenderer::DrawCluster(GpuCluster& c, const Eigen::Affine3d& X,
+                                const Eigen::Matrix4d& view) {
   // Flat shading: one lit colour a triangle from its Reference normal.
   const Eigen::Matrix3f R = X.linear().inverse().transpose().cast<float>();
   constexpr float kAmbient = 0.30f, kDiffuse = 0.70f;
   for (std::size_t i = 0; i < c.n.size(); ++i) {
     float k = 1.0f;
-    if (!options_.id_colors) k = kAmbient + kDiffuse * std::max(0.0f, (R * c.n[i]).normalized().dot(sun_R_));
+    if (!options_.id_colors)
+      k = kAmbient + kDiffuse * std::max(0.0f, (R * c.n[i]).normalized().dot(sun_R_));
     for (int ch = 0; ch < 3; ++ch) {
       const auto v = static_cast<std::uint8_t>(std::min(255.0f, c.rgb[i][ch] * k + 0.5f));
       c.colours[9 * i + ch] = c.colours[9 * i + 3 + ch] = c.colours[9 * i + 6 + ch] = v;
@@ -117,13 +127,15 @@ void FrameRenderer::DrawCluster(GpuCluster& c, const Eigen::Affine3d& X, const E
 // vertices there and where its edges cross the near plane); culled when all
 // of it lies beyond one plane of the view volume, or when it is a flat,
 // one-sided cluster seen from behind.
-ScreenBox FrameRenderer::Silhouette(int c, const scene_model::ClusterPoses& poses, const wire::EsgFrameData& f,
-                                    const Eigen::Matrix4d& view, const Eigen::Matrix4d& P) {
+ScreenBox FrameRenderer::Silhouette(int c, const scene_model::ClusterPoses& poses,
+                                    const wire::EsgFrameData& f, const Eigen::Matrix4d& view,
+                                    const Eigen::Matrix4d& P) {
   ScreenBox b;
   const scene_model::Cluster& model = model_[c];
   const Eigen::Matrix4d VM = view * poses.X_RC[c].matrix();
   if (options_.backface_cull && model.flat) {
-    const Eigen::Vector3d n_R = (poses.X_RC[c].linear().inverse().transpose() * model.normals[0]).normalized();
+    const Eigen::Vector3d n_R =
+        (poses.X_RC[c].linear().inverse().transpose() * model.normals[0]).normalized();
     const Eigen::Vector3d p_R = poses.X_RC[c] * model.points[0];
     if (n_R.dot(f.p_RoEye_R_ft - p_R) <= 0) {
       ++stats_.clusters_backfacing;
@@ -159,7 +171,8 @@ ScreenBox FrameRenderer::Silhouette(int c, const scene_model::ClusterPoses& pose
   if (front.size() != eye_pts.size()) {
     for (const auto& [i, j] : gpu_[c].edges) {
       const Eigen::Vector3d &a = eye_pts[i], &bb = eye_pts[j];
-      if ((a.z() < zn) != (bb.z() < zn)) front.push_back(a + (zn - a.z()) / (bb.z() - a.z()) * (bb - a));
+      if ((a.z() < zn) != (bb.z() < zn))
+        front.push_back(a + (zn - a.z()) / (bb.z() - a.z()) * (bb - a));
     }
   }
   if (front.empty()) {  // all behind the eye
@@ -172,10 +185,16 @@ ScreenBox FrameRenderer::Silhouette(int c, const scene_model::ClusterPoses& pose
   for (const auto& e : front) {
     const Eigen::Vector4d q = P * e.homogeneous();
     const float sx = static_cast<float>(q.x() / q.w()), sy = static_cast<float>(q.y() / q.w());
-    x0 = std::min(x0, sx); x1 = std::max(x1, sx); y0 = std::min(y0, sy); y1 = std::max(y1, sy);
+    x0 = std::min(x0, sx);
+    x1 = std::max(x1, sx);
+    y0 = std::min(y0, sy);
+    y1 = std::max(y1, sy);
     projected.emplace_back(sx, sy);
   }
-  b.x0 = x0; b.y0 = y0; b.x1 = x1; b.y1 = y1;
+  b.x0 = x0;
+  b.y0 = y0;
+  b.x1 = x1;
+  b.y1 = y1;
   b.outline = ConvexHull2d(std::move(projected));
   return b;
 }
@@ -185,8 +204,10 @@ void FrameRenderer::DrawInOrder(const wire::EsgFrameData& f, const scene_model::
                                 const Eigen::Matrix4d& view, const Eigen::Matrix4d& P) {
   gl_.Viewport(0, 0, context_->width(), context_->height());
   gl_.ClearColor(0, 0, 0, 1);
-  if (options_.backface_cull) gl_.Enable(GL_CULL_FACE);
-  else gl_.Disable(GL_CULL_FACE);
+  if (options_.backface_cull)
+    gl_.Enable(GL_CULL_FACE);
+  else
+    gl_.Disable(GL_CULL_FACE);
   // The priority bits order the clusters (silhouettes that only share an
   // edge, within rounding, need no order). The ESG's way draws them so with
   // no depth buffer; the reference draws them in the same order with the
@@ -215,7 +236,8 @@ void FrameRenderer::Render(const wire::EsgFrameData& f) {
   stats_ = {};
   context_->MakeCurrent();
   const int w = context_->width(), h = context_->height();
-  const Eigen::Matrix4d P = ProjectionMatrix(f.fov_deg, static_cast<double>(w) / h, kNearFt, kFarFt);
+  const Eigen::Matrix4d P =
+      ProjectionMatrix(f.fov_deg, static_cast<double>(w) / h, kNearFt, kFarFt);
   const Eigen::Matrix4d view = ViewMatrix(f);
   const scene_model::ClusterPoses poses = scene_model::ComputeClusterPoses(config_, f.scene_pose());
   std::array<ScreenBox, scene_model::kNumClusters> boxes{};

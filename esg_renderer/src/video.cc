@@ -3,12 +3,12 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
+#include <sys/wait.h>
 
 extern char** environ;
 
@@ -21,9 +21,10 @@ VideoWriter::VideoWriter(const std::string& path, int width, int height, double 
   if (pipe(fds) != 0) throw std::runtime_error("pipe failed");
   const std::string size = std::to_string(width) + "x" + std::to_string(height);
   const std::string rate = std::to_string(fps);
-  std::vector<std::string> args = {"ffmpeg", "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt", "rgba",
-                                   "-s", size, "-r", rate, "-i", "-", "-c:v", "libx264", "-preset", "ultrafast",
-                                   "-pix_fmt", "yuv420p", path};
+  std::vector<std::string> args = {
+      "ffmpeg", "-loglevel", "error",   "-y",        "-f",       "rawvideo", "-pix_fmt",
+      "rgba",   "-s",        size,      "-r",        rate,       "-i",       "-",
+      "-c:v",   "libx264",   "-preset", "ultrafast", "-pix_fmt", "yuv420p",  path};
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);

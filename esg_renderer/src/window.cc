@@ -1,7 +1,6 @@
 #include "rms/esg_renderer/window.h"
 
 #include <SDL2/SDL.h>
-
 #include <stdexcept>
 
 #include "rms/wire/key_codes.h"
@@ -14,21 +13,35 @@ struct LiveWindow::Impl {
 
 int KeyCodeFromSdl(int sym, int mod) {
   switch (sym) {
-    case SDLK_UP: return wire::kKeyUp;
-    case SDLK_DOWN: return wire::kKeyDown;
-    case SDLK_LEFT: return wire::kKeyLeft;
-    case SDLK_RIGHT: return wire::kKeyRight;
-    case SDLK_PAGEUP: return wire::kKeyPageUp;
-    case SDLK_PAGEDOWN: return wire::kKeyPageDown;
-    case SDLK_BACKSPACE: return wire::kKeyBackspace;
-    case SDLK_TAB: return wire::kKeyTab;
-    case SDLK_RETURN: case SDLK_KP_ENTER: return wire::kKeyEnter;
-    case SDLK_KP_PLUS: return '+';
-    case SDLK_KP_MINUS: return '-';
-    default: break;
+    case SDLK_UP:
+      return wire::kKeyUp;
+    case SDLK_DOWN:
+      return wire::kKeyDown;
+    case SDLK_LEFT:
+      return wire::kKeyLeft;
+    case SDLK_RIGHT:
+      return wire::kKeyRight;
+    case SDLK_PAGEUP:
+      return wire::kKeyPageUp;
+    case SDLK_PAGEDOWN:
+      return wire::kKeyPageDown;
+    case SDLK_BACKSPACE:
+      return wire::kKeyBackspace;
+    case SDLK_TAB:
+      return wire::kKeyTab;
+    case SDLK_RETURN:
+    case SDLK_KP_ENTER:
+      return wire::kKeyEnter;
+    case SDLK_KP_PLUS:
+      return '+';
+    case SDLK_KP_MINUS:
+      return '-';
+    default:
+      break;
   }
   if (sym >= 'a' && sym <= 'z') return (mod & KMOD_SHIFT) ? sym - 'a' + 'A' : sym;
-  if (sym == '=' && (mod & KMOD_SHIFT)) return '+';  // the US layout's shifted keys that bindings name
+  if (sym == '=' && (mod & KMOD_SHIFT))
+    return '+';  // the US layout's shifted keys that bindings name
   if (sym == '-' && (mod & KMOD_SHIFT)) return '_';
   if (sym >= ' ' && sym < 127) return sym;
   return -1;
@@ -44,7 +57,8 @@ LiveWindow::LiveWindow(int width, int height, const std::string& title)
   if (SDL_InitSubSystem(SDL_INIT_VIDEO) != 0) {
     throw std::runtime_error(std::string("cannot open a window: ") + SDL_GetError());
   }
-  impl_->window = SDL_CreateWindow(title.c_str(), SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED, width, height, 0);
+  impl_->window = SDL_CreateWindow(title.c_str(), SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED,
+                                   width, height, 0);
   if (!impl_->window) throw std::runtime_error(std::string("SDL_CreateWindow: ") + SDL_GetError());
   open_ = true;
 }
@@ -57,7 +71,8 @@ LiveWindow::~LiveWindow() {
 WindowKeys LiveWindow::Poll() {
   SDL_Event e;
   while (open_ && SDL_PollEvent(&e)) {
-    if (e.type == SDL_QUIT || (e.type == SDL_WINDOWEVENT && e.window.event == SDL_WINDOWEVENT_CLOSE)) {
+    if (e.type == SDL_QUIT ||
+        (e.type == SDL_WINDOWEVENT && e.window.event == SDL_WINDOWEVENT_CLOSE)) {
       open_ = false;
       SDL_DestroyWindow(impl_->window);
       impl_->window = nullptr;
@@ -95,8 +110,8 @@ WindowKeys LiveWindow::Poll() {
 
 bool LiveWindow::Show(const std::uint8_t* rgba) {
   if (!open_) return false;
-  SDL_Surface* frame = SDL_CreateRGBSurfaceWithFormatFrom(const_cast<std::uint8_t*>(rgba), width_, height_, 32,
-                                                          width_ * 4, SDL_PIXELFORMAT_RGBA32);
+  SDL_Surface* frame = SDL_CreateRGBSurfaceWithFormatFrom(
+      const_cast<std::uint8_t*>(rgba), width_, height_, 32, width_ * 4, SDL_PIXELFORMAT_RGBA32);
   SDL_Surface* target = SDL_GetWindowSurface(impl_->window);
   if (frame && target) {
     SDL_SetSurfaceBlendMode(frame, SDL_BLENDMODE_NONE);  // copy, do not blend on alpha

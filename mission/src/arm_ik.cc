@@ -45,13 +45,16 @@ std::optional<IkSolution> SolveArmIk(const ArmGeometry& arm, const Eigen::Isomet
   const double t2 = elbow == Elbow::kUp ? elev + alpha : elev - alpha;
   const double t3 = elbow == Elbow::kUp ? -(M_PI - beta) : (M_PI - beta);
   // The wrist's rotation relative to the lower boom's frame F3.
-  const Eigen::Matrix3d R3 = arm::RotZ({std::sin(t1), std::cos(t1)}) * arm::RotPitch({std::sin(t2 + t3), std::cos(t2 + t3)});
+  const Eigen::Matrix3d R3 = arm::RotZ({std::sin(t1), std::cos(t1)}) *
+                             arm::RotPitch({std::sin(t2 + t3), std::cos(t2 + t3)});
   const Eigen::Matrix3d M = R3.transpose() * R;
   // M = R_y(-t4) R_z(t5) R_x(t6): first column (cos t4 cos t5, sin t5, sin t4 cos t5).
   const double t5 = std::asin(std::clamp(M(1, 0), -1.0, 1.0));
   const double t4 = std::abs(std::cos(t5)) > 1e-9 ? std::atan2(M(2, 0), M(0, 0)) : 0.0;
   const Eigen::Matrix3d N =
-      (arm::RotPitch({std::sin(t4), std::cos(t4)}) * arm::RotZ({std::sin(t5), std::cos(t5)})).transpose() * M;
+      (arm::RotPitch({std::sin(t4), std::cos(t4)}) * arm::RotZ({std::sin(t5), std::cos(t5)}))
+          .transpose() *
+      M;
   const double t6 = std::atan2(N(2, 1), N(1, 1));
   s.angles_deg = {Deg(t1), Deg(t2), Deg(t3), Deg(t4), Deg(t5), Deg(t6)};
   return s;

@@ -1,16 +1,15 @@
 #include "rms/mission/mission_plan.h"
 
-#include "rms/mission/mission_geometry.h"
-
 #include <cmath>
 #include <cstdio>
 #include <sstream>
 
-#include "rms/mission/arm_ik.h"
 #include "rms/arm/kinematics.h"
 #include "rms/base/check.h"
-#include "rms/scene_model/separating_plane.h"
+#include "rms/mission/arm_ik.h"
+#include "rms/mission/mission_geometry.h"
 #include "rms/scene_model/scene_model.h"
+#include "rms/scene_model/separating_plane.h"
 
 namespace rms::mission {
 
@@ -24,8 +23,9 @@ std::vector<Keyframe> PlanMission(const LabConfig& c) {
   // waypoints stays smooth); a waypoint that puts the arm or the payload
   // into the orbiter or the CAE is refused.
   auto solve = [&](const Eigen::Isometry3d& X_RS2, double finger, const std::string& note) {
-    const double gap = c.end_effector.finger_gap_open_ft -
-                       finger * (c.end_effector.finger_gap_open_ft - c.end_effector.finger_gap_closed_ft);
+    const double gap =
+        c.end_effector.finger_gap_open_ft -
+        finger * (c.end_effector.finger_gap_open_ft - c.end_effector.finger_gap_closed_ft);
     const Eigen::Isometry3d X_RP = finger > 0.5 ? X_RS2 * g.X_S2P : X_RP_bay;
     const auto s = SolveArmIk(c.arm, X_RS2, h, Elbow::kUp);
     if (!s) throw InputError("mission waypoint '" + note + "' is out of the arm's reach");
@@ -33,8 +33,8 @@ std::vector<Keyframe> PlanMission(const LabConfig& c) {
     if (!why.empty()) throw InputError("mission waypoint '" + note + "': " + why);
     return s->angles_deg;
   };
-  auto add = [&](double t, const Eigen::Isometry3d& X_RS2, double finger, int camera, const std::string& note,
-                 const std::string& extra = "") {
+  auto add = [&](double t, const Eigen::Isometry3d& X_RS2, double finger, int camera,
+                 const std::string& note, const std::string& extra = "") {
     keys.push_back({t, solve(X_RS2, finger, note), h, finger, camera, note, extra});
   };
   Keyframe stowed;
@@ -62,8 +62,14 @@ std::vector<Keyframe> PlanMission(const LabConfig& c) {
   const double lift = (c.payload.p_RoPo_R_ft.z() < 0 ? -c.payload.p_RoPo_R_ft.z() : 0) + r + 3.0;
   const int steps = 6;
   for (int i = 1; i <= steps; ++i) {
-    add(15.0 + 1.5 * i, shifted(g.X_RS2_grasp, (lift * i / steps) * up), 1, i == 1 ? 6 : i == 4 ? 3 : 0,
-        i == steps ? "clear of the bay" : i == 1 ? "lifting, aft bulkhead camera" : i == 4 ? "lifting, elbow camera" : "lifting");
+    add(15.0 + 1.5 * i, shifted(g.X_RS2_grasp, (lift * i / steps) * up), 1,
+        i == 1   ? 6
+        : i == 4 ? 3
+                 : 0,
+        i == steps ? "clear of the bay"
+        : i == 1   ? "lifting, aft bulkhead camera"
+        : i == 4   ? "lifting, elbow camera"
+                   : "lifting");
   }
   double t = 15.0 + 1.5 * steps;
   // Mode 3: up and over, the probe turned toward the port, then rise to it.
@@ -82,14 +88,21 @@ std::vector<Keyframe> PlanMission(const LabConfig& c) {
     Eigen::Isometry3d X_RP = Eigen::Isometry3d::Identity();
     X_RP.linear() = q0.slerp(u, q1).toRotationMatrix();
     X_RP.translation() = (1 - u) * X_RP_high.translation() + u * X_RP_pre.translation();
-    add(t += 1.5, X_RP * g.X_S2P.inverse(), 1, i == turn ? 7 : i == 3 ? 8 : 0,
-        i == turn ? "under the port, CAE camera" : i == 3 ? "turning toward the port, external camera" : "turning toward the port",
-        i == 2 ? "camera_pan=15 camera_tilt=30 camera_zoom=0.4" : i == 3 ? "camera_pan=0 camera_tilt=0 camera_zoom=0" : "");
+    add(t += 1.5, X_RP * g.X_S2P.inverse(), 1,
+        i == turn ? 7
+        : i == 3  ? 8
+                  : 0,
+        i == turn ? "under the port, CAE camera"
+        : i == 3  ? "turning toward the port, external camera"
+                  : "turning toward the port",
+        i == 2   ? "camera_pan=15 camera_tilt=30 camera_zoom=0.4"
+        : i == 3 ? "camera_pan=0 camera_tilt=0 camera_zoom=0"
+                 : "");
   }
   const int rise = 6;
   for (int i = 1; i <= rise; ++i) {
-    add(t += 1.0, shifted(X_RS2_predock, (3.0 * i / rise) * yC), 1, 0, i == rise ? "docked" : "rising to the port",
-        i == rise ? "camera_zoom=0.5" : "");
+    add(t += 1.0, shifted(X_RS2_predock, (3.0 * i / rise) * yC), 1, 0,
+        i == rise ? "docked" : "rising to the port", i == rise ? "camera_zoom=0.5" : "");
   }
   add(t += 2.0, X_RS2_dock, 1, 8, "hold, external camera", "camera_zoom=0");
   return keys;
@@ -103,8 +116,8 @@ std::string FormatTimeline(const std::vector<Keyframe>& keys, const std::string&
     std::snprintf(line, sizeof line,
                   "%-6.2f shoulder_yaw=%.4f shoulder_pitch=%.4f elbow_pitch=%.4f wrist_pitch=%.4f "
                   "wrist_yaw=%.4f wrist_roll=%.4f shoulder_height=%.3f finger=%.2f",
-                  k.t_s, k.angles_deg[0], k.angles_deg[1], k.angles_deg[2], k.angles_deg[3], k.angles_deg[4],
-                  k.angles_deg[5], k.shoulder_height_ft, k.finger);
+                  k.t_s, k.angles_deg[0], k.angles_deg[1], k.angles_deg[2], k.angles_deg[3],
+                  k.angles_deg[4], k.angles_deg[5], k.shoulder_height_ft, k.finger);
     os << line;
     if (k.camera) os << " camera=" << k.camera;
     if (!k.extra.empty()) os << " " << k.extra;

@@ -1,12 +1,11 @@
 #include "rms/operator_station/arm_motion.h"
 
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/SVD>
-
-#include "rms/mission/arm_ik.h"
 #include "rms/arm/kinematics.h"
+#include "rms/mission/arm_ik.h"
 
 namespace rms::operator_station {
 
@@ -34,15 +33,16 @@ Eigen::Isometry3d ForwardPose(const ArmGeometry& arm, const JointAngles& q, doub
   return arm::ComputeArmPose(arm, arm::SinCosFromDegrees(q), h).X_RS2;
 }
 
-Matrix6d ArmJacobian(const ArmGeometry& arm, const JointAngles& q, double h, const Eigen::Vector3d& p_S2oQ_S2) {
+Matrix6d ArmJacobian(const ArmGeometry& arm, const JointAngles& q, double h,
+                     const Eigen::Vector3d& p_S2oQ_S2) {
   const arm::ArmPose pose = arm::ComputeArmPose(arm, arm::SinCosFromDegrees(q), h);
   const Eigen::Vector3d Q = pose.X_RS2 * p_S2oQ_S2;
   // docs/kinematics.md: yaw about +Z (R) at S; the pitches about -Y of the
   // frame before, at S, E and W; wrist yaw about +Z of F4 and wrist roll
   // about +X of F5, both at W.
   const std::array<Eigen::Vector3d, 6> axis = {
-      Eigen::Vector3d::UnitZ(),          -pose.X_RF1.linear().col(1), -pose.X_RF2.linear().col(1),
-      -pose.X_RF3.linear().col(1),       pose.X_RF4.linear().col(2),  pose.X_RF5.linear().col(0)};
+      Eigen::Vector3d::UnitZ(),    -pose.X_RF1.linear().col(1), -pose.X_RF2.linear().col(1),
+      -pose.X_RF3.linear().col(1), pose.X_RF4.linear().col(2),  pose.X_RF5.linear().col(0)};
   const std::array<Eigen::Vector3d, 6> at = {pose.p_RoS_R, pose.p_RoS_R, pose.p_RoE_R,
                                              pose.p_RoW_R, pose.p_RoW_R, pose.p_RoW_R};
   Matrix6d J;
@@ -59,7 +59,7 @@ namespace {
 // sum over singular values of sigma / (sigma^2 + lambda^2) v u^T.
 Matrix6d DampedPseudoInverse(const Matrix6d& J, double lambda) {
   const Eigen::JacobiSVD<Matrix6d> svd(J, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  const Vector6d s = svd.singularValues();
+  const Vector6d& s = svd.singularValues();
   Vector6d g = Vector6d::Zero();
   for (int i = 0; i < 6; ++i) {
     if (s[i] > 1e-12) g[i] = s[i] / (s[i] * s[i] + lambda * lambda);
@@ -78,7 +78,8 @@ double SmallestSingularValue(const Matrix6d& J) {
 // while it flies; faded in smoothly (by how singular, how straight, how
 // much of the self-motion is the elbow's) so it never jumps. Zero when the
 // elbow is not nearly straight or the arm not singular.
-Vector6d ElbowBend(const Matrix6d& Jl, const JointAngles& q, double ratio, const ResolveOptions& o) {
+Vector6d ElbowBend(const Matrix6d& Jl, const JointAngles& q, double ratio,
+                   const ResolveOptions& o) {
   if (!(std::abs(q[2]) < o.elbow_straight_deg && ratio < 1.0)) return Vector6d::Zero();
   // Among the weak directions (the arm may be singular twice over, the
   // elbow straight and the wrist roll in line with the yaw), the one that
@@ -101,8 +102,9 @@ Vector6d ElbowBend(const Matrix6d& Jl, const JointAngles& q, double ratio, const
 // The joint rates (rad/s) for the weighted twist xw: joints at (or beyond) a
 // limit and pushed further out are locked (their bits in *locked) and the
 // rest solved again, until none is pushed out.
-Vector6d SolveWithLimits(const Matrix6d& Jw, const Vector6d& xw, const JointLimits& limits, const JointAngles& q,
-                         double lambda, double ratio, double dt_s, const ResolveOptions& o, std::uint32_t* locked) {
+Vector6d SolveWithLimits(const Matrix6d& Jw, const Vector6d& xw, const JointLimits& limits,
+                         const JointAngles& q, double lambda, double ratio, double dt_s,
+                         const ResolveOptions& o, std::uint32_t* locked) {
   *locked = 0;
   Vector6d dq = Vector6d::Zero();
   for (int pass = 0; pass < 7; ++pass) {
@@ -131,7 +133,8 @@ Vector6d SolveWithLimits(const Matrix6d& Jw, const Vector6d& xw, const JointLimi
 
 // Every joint within its rate, the direction kept; a joint reaching its
 // limit this frame stops on it. Fills r's rates, angles and limits.
-void TakeRates(Vector6d dq, const JointLimits& limits, const JointAngles& q, double dt_s, RateResult* r) {
+void TakeRates(Vector6d dq, const JointLimits& limits, const JointAngles& q, double dt_s,
+               RateResult* r) {
   double k = 1.0;
   for (int i = 0; i < 6; ++i) {
     const double rate = std::abs(dq[i]) / kDeg;
@@ -155,9 +158,9 @@ void TakeRates(Vector6d dq, const JointLimits& limits, const JointAngles& q, dou
 
 }  // namespace
 
-RateResult ResolveRate(const ArmGeometry& arm, const JointLimits& limits, const JointAngles& q, double h,
-                       const Eigen::Vector3d& p_S2oQ_S2, const Eigen::Vector3d& v_R, const Eigen::Vector3d& w_R,
-                       double dt_s, const ResolveOptions& o) {
+RateResult ResolveRate(const ArmGeometry& arm, const JointLimits& limits, const JointAngles& q,
+                       double h, const Eigen::Vector3d& p_S2oQ_S2, const Eigen::Vector3d& v_R,
+                       const Eigen::Vector3d& w_R, double dt_s, const ResolveOptions& o) {
   RateResult r;
   r.q_deg = q;
   const Matrix6d J = ArmJacobian(arm, q, h, p_S2oQ_S2);
@@ -172,7 +175,8 @@ RateResult ResolveRate(const ArmGeometry& arm, const JointLimits& limits, const 
   Vector6d x;
   x << v_R, w_R;
   std::uint32_t locked = 0;
-  const Vector6d dq = SolveWithLimits(Jw, weight.asDiagonal() * x, limits, q, lambda, ratio, dt_s, o, &locked);
+  const Vector6d dq =
+      SolveWithLimits(Jw, weight.asDiagonal() * x, limits, q, lambda, ratio, dt_s, o, &locked);
   r.at_limit = locked;
   TakeRates(dq, limits, q, dt_s, &r);
   Vector6d done;
@@ -181,7 +185,8 @@ RateResult ResolveRate(const ArmGeometry& arm, const JointLimits& limits, const 
   return r;
 }
 
-bool StepJointsToward(JointAngles* q, const JointAngles& target, const JointAngles& rate_deg_s, double dt_s) {
+bool StepJointsToward(JointAngles* q, const JointAngles& target, const JointAngles& rate_deg_s,
+                      double dt_s) {
   double k = 1.0;
   JointAngles d{};
   for (int i = 0; i < 6; ++i) {
@@ -198,7 +203,8 @@ std::optional<JointAngles> SolveWithinLimits(const ArmGeometry& arm, const Joint
   const auto s = mission::SolveArmIk(arm, X_RS2, h, mission::Elbow::kUp);
   if (!s) return std::nullopt;
   for (int i = 0; i < 6; ++i) {
-    if (s->angles_deg[i] < limits.min_deg[i] || s->angles_deg[i] > limits.max_deg[i]) return std::nullopt;
+    if (s->angles_deg[i] < limits.min_deg[i] || s->angles_deg[i] > limits.max_deg[i])
+      return std::nullopt;
   }
   return s->angles_deg;
 }

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <spdlog/spdlog.h>
 
-#include "rms/operator_station/guidance.h"
 #include "rms/arm/kinematics.h"
+#include "rms/operator_station/guidance.h"
 #include "rms/wire/acquisition_conditions.h"
 #include "rms/wire/collision_bits.h"
 
@@ -13,19 +13,32 @@ namespace rms::operator_station {
 
 const char* AutopilotPhaseName(AutopilotPhase p) {
   switch (p) {
-    case AutopilotPhase::kWaitTelemetry: return "waiting for the DCP";
-    case AutopilotPhase::kReset: return "reset";
-    case AutopilotPhase::kOpenFinger: return "open the finger";
-    case AutopilotPhase::kApproach: return "approach";
-    case AutopilotPhase::kDescend: return "descend onto the bar";
-    case AutopilotPhase::kClose: return "close the finger";
-    case AutopilotPhase::kLift: return "lift out of the bay";
-    case AutopilotPhase::kTransfer: return "transfer under the port";
-    case AutopilotPhase::kDock: return "dock";
-    case AutopilotPhase::kDocked: return "docked";
-    case AutopilotPhase::kRelieve: return "relieve a collision";
-    case AutopilotPhase::kResync: return "resume from a checkpoint";
-    case AutopilotPhase::kFailed: return "failed";
+    case AutopilotPhase::kWaitTelemetry:
+      return "waiting for the DCP";
+    case AutopilotPhase::kReset:
+      return "reset";
+    case AutopilotPhase::kOpenFinger:
+      return "open the finger";
+    case AutopilotPhase::kApproach:
+      return "approach";
+    case AutopilotPhase::kDescend:
+      return "descend onto the bar";
+    case AutopilotPhase::kClose:
+      return "close the finger";
+    case AutopilotPhase::kLift:
+      return "lift out of the bay";
+    case AutopilotPhase::kTransfer:
+      return "transfer under the port";
+    case AutopilotPhase::kDock:
+      return "dock";
+    case AutopilotPhase::kDocked:
+      return "docked";
+    case AutopilotPhase::kRelieve:
+      return "relieve a collision";
+    case AutopilotPhase::kResync:
+      return "resume from a checkpoint";
+    case AutopilotPhase::kFailed:
+      return "failed";
   }
   return "?";
 }
@@ -152,8 +165,9 @@ bool Autopilot::Settled(const dcp_telemetry_t& tm) const {
   return std::abs(tm.master_finger - cmd_.value[kFinger]) < 0.002;
 }
 
-std::string Autopilot::JointPathHits(const std::array<double, 6>& q0, const std::array<double, 6>& q1,
-                                     const dcp_telemetry_t& tm, mission::PayloadState payload) const {
+std::string Autopilot::JointPathHits(const std::array<double, 6>& q0,
+                                     const std::array<double, 6>& q1, const dcp_telemetry_t& tm,
+                                     mission::PayloadState payload) const {
   double m = 0.0;
   for (int i = 0; i < 6; ++i) m = std::max(m, std::abs(WrapDeg(q1[i] - q0[i])));
   const int n = std::max(1, static_cast<int>(std::ceil(m / 1.0)));  // a sample a degree
@@ -162,16 +176,18 @@ std::string Autopilot::JointPathHits(const std::array<double, 6>& q0, const std:
   for (int k = 1; k <= n; ++k) {
     std::array<double, 6> q{};
     for (int i = 0; i < 6; ++i) q[i] = q0[i] + WrapDeg(q1[i] - q0[i]) * k / n;
-    const std::string hit = mission::Interpenetration(config_, model_, q, cmd_.value[kShoulderHeight],
-                                                      tm.finger_gap_ft, X_RP, payload, margin);
+    std::string hit = mission::Interpenetration(config_, model_, q, cmd_.value[kShoulderHeight],
+                                                tm.finger_gap_ft, X_RP, payload, margin);
     if (!hit.empty()) return hit;
   }
   return "";
 }
 
 std::string Autopilot::LinePathHits(const Eigen::Isometry3d& X0, const Eigen::Isometry3d& X1,
-                                    const dcp_telemetry_t& tm, mission::PayloadState payload) const {
-  const double len = (X1.translation() - X0.translation()).norm() + AngleBetweenDeg(X0.linear(), X1.linear()) / 10.0;
+                                    const dcp_telemetry_t& tm,
+                                    mission::PayloadState payload) const {
+  const double len = (X1.translation() - X0.translation()).norm() +
+                     AngleBetweenDeg(X0.linear(), X1.linear()) / 10.0;
   const double margin = payload == mission::PayloadState::kInBay ? margin_ft_ : opt_.clearance_ft;
   const int n = std::max(1, static_cast<int>(std::ceil(len / 0.5)));  // a sample every half foot
   // The payload: where it is (in the bay), or carried along with System Two.
@@ -181,8 +197,8 @@ std::string Autopilot::LinePathHits(const Eigen::Isometry3d& X0, const Eigen::Is
     const auto q = Solve(X);
     if (!q) return "out of reach";
     const Eigen::Isometry3d X_RP = payload == mission::PayloadState::kHeld ? X * X_S2P_ : X_RP_bay;
-    const std::string hit = mission::Interpenetration(config_, model_, *q, cmd_.value[kShoulderHeight],
-                                                      tm.finger_gap_ft, X_RP, payload, margin);
+    std::string hit = mission::Interpenetration(config_, model_, *q, cmd_.value[kShoulderHeight],
+                                                tm.finger_gap_ft, X_RP, payload, margin);
     if (!hit.empty()) return hit;
   }
   return "";
@@ -229,21 +245,25 @@ void Autopilot::PlanApproach(const dcp_telemetry_t& tm) {
     return PlanJoints(*q_hover);
   }
   const std::array<double, 6> stowed{};
-  if (JointPathHits(q0, stowed, tm, kInBay).empty() && JointPathHits(stowed, *q_hover, tm, kInBay).empty()) {
+  if (JointPathHits(q0, stowed, tm, kInBay).empty() &&
+      JointPathHits(stowed, *q_hover, tm, kInBay).empty()) {
     counters_.Add(Counter::kAutopilotViaPoints);
-    spdlog::info("autopilot: the direct approach would bring the {}; going by the stowed arm", direct);
+    spdlog::info("autopilot: the direct approach would bring the {}; going by the stowed arm",
+                 direct);
     PlanJoints(stowed);
     return PlanJoints(*q_hover);
   }
   counters_.Add(Counter::kAutopilotUnplanned);
-  spdlog::warn("autopilot: no clear approach found ({}); going straight, relieving collisions", direct);
+  spdlog::warn("autopilot: no clear approach found ({}); going straight, relieving collisions",
+               direct);
   PlanJoints(*q_hover);
 }
 
 void Autopilot::PlanTransfer(const dcp_telemetry_t& tm) {
   plan_.clear();
   // The payload as the DCP holds it, in System Two.
-  X_S2P_ = TelemetryPose(tm.p_RoA_R_ft, tm.R_RS2).inverse() * TelemetryPose(tm.p_RoPo_R_ft, tm.R_RP);
+  X_S2P_ =
+      TelemetryPose(tm.p_RoA_R_ft, tm.R_RS2).inverse() * TelemetryPose(tm.p_RoPo_R_ft, tm.R_RP);
   X_RP_dock_ = mission::PlanGeometry(config_, cmd_.value[kShoulderHeight]).X_RP_dock;
   const Eigen::Vector3d yC = config_.cae.R_RC.col(1);
   const Eigen::Isometry3d X_predock = Shifted(X_RP_dock_ * X_S2P_.inverse(), -opt_.predock_ft * yC);
@@ -256,9 +276,11 @@ void Autopilot::PlanTransfer(const dcp_telemetry_t& tm) {
   if (direct.empty()) return PlanLine(X_predock, opt_.transfer_speed_ft_s);
   for (double up : {6.0, 12.0}) {
     const Eigen::Isometry3d X_up = Shifted(X0, Eigen::Vector3d(0, 0, up));
-    if (LinePathHits(X0, X_up, tm, kHeld).empty() && LinePathHits(X_up, X_predock, tm, kHeld).empty()) {
+    if (LinePathHits(X0, X_up, tm, kHeld).empty() &&
+        LinePathHits(X_up, X_predock, tm, kHeld).empty()) {
       counters_.Add(Counter::kAutopilotViaPoints);
-      spdlog::info("autopilot: the straight transfer would bring the {}; going {} ft higher first", direct, up);
+      spdlog::info("autopilot: the straight transfer would bring the {}; going {} ft higher first",
+                   direct, up);
       PlanLine(X_up, opt_.transfer_speed_ft_s);
       return PlanLine(X_predock, opt_.transfer_speed_ft_s);
     }
@@ -309,10 +331,11 @@ void Autopilot::Relieve(const dcp_telemetry_t& tm) {
   ++collisions_;
   counters_.Add(Counter::kAutopilotCollisionsRelieved);
   const std::string kinds = wire::CollisionNames(static_cast<std::uint32_t>(tm.collisions));
-  spdlog::info("autopilot: collision ({}) in {}: back to the pose the slave holds, then away", kinds,
-               AutopilotPhaseName(phase_));
+  spdlog::info("autopilot: collision ({}) in {}: back to the pose the slave holds, then away",
+               kinds, AutopilotPhaseName(phase_));
   if (collisions_ > opt_.max_collisions) {
-    return Fail("gave up after " + std::to_string(opt_.max_collisions) + " collisions (last: " + kinds + ")");
+    return Fail("gave up after " + std::to_string(opt_.max_collisions) +
+                " collisions (last: " + kinds + ")");
   }
   // What the operator must do: bring the master back to where the slave
   // stopped, which ends the collision (unless the slave itself started in
@@ -370,27 +393,53 @@ wire::OperatorInputs Autopilot::Step(const dcp_telemetry_t* tm_ptr) {
 
   // A collision: the DCP holds the slave arm. (The finger stopping on the
   // bar while closing is the essential contact, not a collision.)
-  const bool moving_phase = phase_ != AutopilotPhase::kWaitTelemetry && phase_ != AutopilotPhase::kReset &&
-                            phase_ != AutopilotPhase::kDocked && phase_ != AutopilotPhase::kResync;
+  const bool moving_phase = phase_ != AutopilotPhase::kWaitTelemetry &&
+                            phase_ != AutopilotPhase::kReset && phase_ != AutopilotPhase::kDocked &&
+                            phase_ != AutopilotPhase::kResync;
   if (moving_phase && tm.held && tm.frame > relieved_at_frame_ + 3) {
     Relieve(tm);
     return cmd_;
   }
 
   switch (phase_) {
-    case AutopilotPhase::kWaitTelemetry: StepWaitTelemetry(tm); break;
-    case AutopilotPhase::kReset: StepReset(tm); break;
-    case AutopilotPhase::kOpenFinger: StepOpenFinger(tm); break;
-    case AutopilotPhase::kApproach: StepApproach(tm); break;
-    case AutopilotPhase::kDescend: StepDescend(tm); break;
-    case AutopilotPhase::kClose: StepClose(tm); break;
-    case AutopilotPhase::kLift: StepLift(tm); break;
-    case AutopilotPhase::kTransfer: StepTransfer(tm); break;
-    case AutopilotPhase::kDock: StepDock(tm); break;
-    case AutopilotPhase::kDocked: StepDocked(tm); break;
-    case AutopilotPhase::kRelieve: StepRelieve(tm); break;
-    case AutopilotPhase::kResync: StepResync(tm); break;
-    case AutopilotPhase::kFailed: break;
+    case AutopilotPhase::kWaitTelemetry:
+      StepWaitTelemetry(tm);
+      break;
+    case AutopilotPhase::kReset:
+      StepReset(tm);
+      break;
+    case AutopilotPhase::kOpenFinger:
+      StepOpenFinger(tm);
+      break;
+    case AutopilotPhase::kApproach:
+      StepApproach(tm);
+      break;
+    case AutopilotPhase::kDescend:
+      StepDescend(tm);
+      break;
+    case AutopilotPhase::kClose:
+      StepClose(tm);
+      break;
+    case AutopilotPhase::kLift:
+      StepLift(tm);
+      break;
+    case AutopilotPhase::kTransfer:
+      StepTransfer(tm);
+      break;
+    case AutopilotPhase::kDock:
+      StepDock(tm);
+      break;
+    case AutopilotPhase::kDocked:
+      StepDocked(tm);
+      break;
+    case AutopilotPhase::kRelieve:
+      StepRelieve(tm);
+      break;
+    case AutopilotPhase::kResync:
+      StepResync(tm);
+      break;
+    case AutopilotPhase::kFailed:
+      break;
   }
   return cmd_;
 }
@@ -411,9 +460,12 @@ void Autopilot::StepWaitTelemetry(const dcp_telemetry_t& tm) {
 
 void Autopilot::StepReset(const dcp_telemetry_t& tm) {
   // The reset button, one frame; then wait for Mode 1.
-  if (reset_frames_++ == 0) cmd_.reset = true;
-  else if (reset_frames_ > 3 && tm.mode == 1 && !tm.acquired && !tm.docked) Enter(AutopilotPhase::kOpenFinger);
-  else if (reset_frames_ > 60) Fail("the DCP did not return to Mode 1 after a reset");
+  if (reset_frames_++ == 0)
+    cmd_.reset = true;
+  else if (reset_frames_ > 3 && tm.mode == 1 && !tm.acquired && !tm.docked)
+    Enter(AutopilotPhase::kOpenFinger);
+  else if (reset_frames_ > 60)
+    Fail("the DCP did not return to Mode 1 after a reset");
 }
 
 void Autopilot::StepOpenFinger(const dcp_telemetry_t& tm) {
@@ -433,11 +485,14 @@ void Autopilot::StepDescend(const dcp_telemetry_t& tm) {
   if (ps != PlanState::kDone || !Settled(tm)) return;
   // Closing the loop: the palm must be within TPOB of the bar's top;
   // well short of it (kGraspCorrectTpobShare), descend to the planned height.
-  if (tm.palm_to_bar_ft > kGraspCorrectTpobShare * config_.dcp.tpob_ft && retries_ < opt_.max_retries) {
+  if (tm.palm_to_bar_ft > kGraspCorrectTpobShare * config_.dcp.tpob_ft &&
+      retries_ < opt_.max_retries) {
     ++retries_;
     counters_.Add(Counter::kAutopilotGraspCorrections);
     const Eigen::Isometry3d X = CommandedPose();
-    PlanLine(Shifted(X, (tm.palm_to_bar_ft - mission::GraspPalmAboveBarFt(config_)) * X.linear().col(0)), 0.2);
+    PlanLine(
+        Shifted(X, (tm.palm_to_bar_ft - mission::GraspPalmAboveBarFt(config_)) * X.linear().col(0)),
+        0.2);
     return;
   }
   StartPhase(AutopilotPhase::kClose, tm);
@@ -453,11 +508,15 @@ void Autopilot::StepClose(const dcp_telemetry_t& tm) {
     // Closed and not acquired: which conditions fail? Open and try again.
     std::string failing;
     for (int i = 0; i < wire::kNumAcquisitionConditions; ++i) {
-      if (!tm.acquisition_conditions[i]) failing += (failing.empty() ? "" : ", ") + std::to_string(i + 1);
+      if (!tm.acquisition_conditions[i])
+        failing += (failing.empty() ? "" : ", ") + std::to_string(i + 1);
     }
-    if (++retries_ > opt_.max_retries) return Fail("no acquisition (conditions " + failing + " fail)");
+    if (++retries_ > opt_.max_retries)
+      return Fail("no acquisition (conditions " + failing + " fail)");
     counters_.Add(Counter::kAutopilotGraspRetries);
-    spdlog::info("autopilot: finger closed, no acquisition (conditions {} fail): open and grasp again", failing);
+    spdlog::info(
+        "autopilot: finger closed, no acquisition (conditions {} fail): open and grasp again",
+        failing);
     Enter(AutopilotPhase::kOpenFinger);
   }
 }
@@ -468,9 +527,11 @@ void Autopilot::StepLift(const dcp_telemetry_t& tm) {
     mode3_height_ft_ = CommandedPose().translation().z();
     Camera(3);
   }
-  if (seen_mode3_ && CommandedPose().translation().z() >= mode3_height_ft_ + opt_.lift_margin_ft) plan_.clear();
+  if (seen_mode3_ && CommandedPose().translation().z() >= mode3_height_ft_ + opt_.lift_margin_ft)
+    plan_.clear();
   const PlanState ps = StepPlan();
-  if (ps == PlanState::kUnreachable && !seen_mode3_) return Fail("the arm cannot lift the payload out of the bay");
+  if (ps == PlanState::kUnreachable && !seen_mode3_)
+    return Fail("the arm cannot lift the payload out of the bay");
   if (ps == PlanState::kUnreachable) plan_.clear();  // as high as it goes
   if (plan_.empty() && seen_mode3_ && Settled(tm)) StartPhase(AutopilotPhase::kTransfer, tm);
 }
@@ -493,16 +554,16 @@ void Autopilot::StepDock(const dcp_telemetry_t& tm) {
   // At the dock pose and not docked: correct by what the telemetry shows.
   if (++retries_ > opt_.max_retries) {
     return Fail("not docked after " + std::to_string(opt_.max_retries) + " corrections (distance " +
-                std::to_string(tm.dock_distance_ft) + " ft, angle " + std::to_string(tm.dock_angle_deg) + " deg)");
+                std::to_string(tm.dock_distance_ft) + " ft, angle " +
+                std::to_string(tm.dock_angle_deg) + " deg)");
   }
   counters_.Add(Counter::kAutopilotDockCorrections);
-  X_S2P_ = TelemetryPose(tm.p_RoA_R_ft, tm.R_RS2).inverse() * TelemetryPose(tm.p_RoPo_R_ft, tm.R_RP);
+  X_S2P_ =
+      TelemetryPose(tm.p_RoA_R_ft, tm.R_RS2).inverse() * TelemetryPose(tm.p_RoPo_R_ft, tm.R_RP);
   PlanLine(X_RP_dock_ * X_S2P_.inverse(), opt_.dock_speed_ft_s);
 }
 
-void Autopilot::StepDocked(const dcp_telemetry_t& /*tm*/) {
-  ++docked_frames_;
-}
+void Autopilot::StepDocked(const dcp_telemetry_t& /*tm*/) { ++docked_frames_; }
 
 void Autopilot::StepRelieve(const dcp_telemetry_t& tm) {
   const PlanState ps = StepPlan();

@@ -1,7 +1,6 @@
 #include "rms/operator_station/bindings.h"
 
 #include <SDL2/SDL_gamecontroller.h>
-
 #include <algorithm>
 #include <fstream>
 #include <set>
@@ -29,13 +28,20 @@ struct Named {
   ActionKind kind;
 };
 constexpr Named kNamedActions[] = {
-    {"camera_next", ActionKind::kCameraNext}, {"camera_prev", ActionKind::kCameraPrev},
-    {"reset", ActionKind::kReset},            {"overlay", ActionKind::kOverlay},
-    {"crosshairs", ActionKind::kCrosshairs},  {"guidance", ActionKind::kGuidance},
-    {"stop", ActionKind::kStop},              {"mode", ActionKind::kMode},
-    {"frame", ActionKind::kFrame},            {"vernier", ActionKind::kVernier},
-    {"joint_next", ActionKind::kJointNext},   {"joint_prev", ActionKind::kJointPrev},
-    {"quit", ActionKind::kQuit},              {"freeze", ActionKind::kFreeze},
+    {"camera_next", ActionKind::kCameraNext},
+    {"camera_prev", ActionKind::kCameraPrev},
+    {"reset", ActionKind::kReset},
+    {"overlay", ActionKind::kOverlay},
+    {"crosshairs", ActionKind::kCrosshairs},
+    {"guidance", ActionKind::kGuidance},
+    {"stop", ActionKind::kStop},
+    {"mode", ActionKind::kMode},
+    {"frame", ActionKind::kFrame},
+    {"vernier", ActionKind::kVernier},
+    {"joint_next", ActionKind::kJointNext},
+    {"joint_prev", ActionKind::kJointPrev},
+    {"quit", ActionKind::kQuit},
+    {"freeze", ActionKind::kFreeze},
     {"step", ActionKind::kStep},
 };
 
@@ -68,25 +74,31 @@ Action ParseAction(std::string_view t) {
       return a;
     }
     if (input >= 0) {
-      throw InputError("\"" + std::string(t) +
-                       "\": the arm's joints move through the control modes (thc_x+ / thc_x- drive the joint "
-                       "joint_next and joint_prev select in single joint mode; docs/operator.md)");
+      throw InputError(
+          "\"" + std::string(t) +
+          "\": the arm's joints move through the control modes (thc_x+ / thc_x- drive the joint "
+          "joint_next and joint_prev select in single joint mode; docs/operator.md)");
     }
   }
-  throw InputError("unknown action \"" + std::string(t) +
-                   "\" (thc_x, thc_y, thc_z, rhc_roll, rhc_pitch, rhc_yaw, finger, shoulder_height, camera_pan, "
-                   "camera_tilt, camera_zoom with + or -; camera_1..camera_8, camera_next, camera_prev, reset, "
-                   "overlay, crosshairs, guidance, stop, mode, frame, vernier, joint_next, joint_prev, quit, "
-                   "freeze, step)");
+  throw InputError(
+      "unknown action \"" + std::string(t) +
+      "\" (thc_x, thc_y, thc_z, rhc_roll, rhc_pitch, rhc_yaw, finger, shoulder_height, camera_pan, "
+      "camera_tilt, camera_zoom with + or -; camera_1..camera_8, camera_next, camera_prev, reset, "
+      "overlay, crosshairs, guidance, stop, mode, frame, vernier, joint_next, joint_prev, quit, "
+      "freeze, step)");
 }
 
 std::string ActionName(const Action& a) {
   const std::string sign = a.sign > 0 ? "+" : "-";
   switch (a.kind) {
-    case ActionKind::kHand: return std::string(kHandAxisNames[a.index]) + sign;
-    case ActionKind::kInput: return std::string(kAnalogInputNames[a.index]) + sign;
-    case ActionKind::kCamera: return "camera_" + std::to_string(a.camera);
-    default: break;
+    case ActionKind::kHand:
+      return std::string(kHandAxisNames[a.index]) + sign;
+    case ActionKind::kInput:
+      return std::string(kAnalogInputNames[a.index]) + sign;
+    case ActionKind::kCamera:
+      return "camera_" + std::to_string(a.camera);
+    default:
+      break;
   }
   for (const Named& n : kNamedActions) {
     if (n.kind == a.kind) return std::string(n.name);
@@ -122,9 +134,14 @@ AxisBinding AxisAt(TomlReader& r, std::string_view key, bool hand_only) {
     b.index = input;
     return b;
   }
-  r.Fail(key, std::string("must name a hand-controller axis (thc_x, thc_y, thc_z, rhc_roll, rhc_pitch, rhc_yaw)") +
-                  (hand_only ? "" : " or a direct input (finger, shoulder_height, camera_pan, camera_tilt, camera_zoom)") +
-                  ", a leading '-' reversing it; got \"" + text + "\"");
+  r.Fail(
+      key,
+      std::string(
+          "must name a hand-controller axis (thc_x, thc_y, thc_z, rhc_roll, rhc_pitch, rhc_yaw)") +
+          (hand_only ? ""
+                     : " or a direct input (finger, shoulder_height, camera_pan, camera_tilt, "
+                       "camera_zoom)") +
+          ", a leading '-' reversing it; got \"" + text + "\"");
 }
 
 void ReadControl(TomlReader& top, Bindings* b) {
@@ -136,12 +153,15 @@ void ReadControl(TomlReader& top, Bindings* b) {
   const std::string frame = r.String("frame");
   const auto f = ParseCommandFrame(frame);
   if (!f || *f == CommandFrame::kPayload) {
-    r.Fail("frame", "must be \"end_effector\" or \"orbiter\" (the payload's frame needs a payload held), got \"" +
-                        frame + "\"");
+    r.Fail("frame",
+           "must be \"end_effector\" or \"orbiter\" (the payload's frame needs a payload held), "
+           "got \"" +
+               frame + "\"");
   }
   b->initial_frame = *f;
   const std::string scale = r.String("scale");
-  if (scale != "coarse" && scale != "vernier") r.Fail("scale", "must be \"coarse\" or \"vernier\", got \"" + scale + "\"");
+  if (scale != "coarse" && scale != "vernier")
+    r.Fail("scale", "must be \"coarse\" or \"vernier\", got \"" + scale + "\"");
   b->initial_vernier = scale == "vernier";
   r.Finish();
 }
@@ -155,8 +175,10 @@ void ReadRates(TomlReader& top, Bindings* b) {
   h.vernier_deg_s = r.Positive("vernier_deg_s", 360.0);
   h.joint_coarse_deg_s = r.Positive("joint_coarse_deg_s", 360.0);
   h.joint_vernier_deg_s = r.Positive("joint_vernier_deg_s", 360.0);
-  if (h.vernier_ft_s >= h.coarse_ft_s) r.Fail("vernier_ft_s", "must be less than rates.coarse_ft_s");
-  if (h.vernier_deg_s >= h.coarse_deg_s) r.Fail("vernier_deg_s", "must be less than rates.coarse_deg_s");
+  if (h.vernier_ft_s >= h.coarse_ft_s)
+    r.Fail("vernier_ft_s", "must be less than rates.coarse_ft_s");
+  if (h.vernier_deg_s >= h.coarse_deg_s)
+    r.Fail("vernier_deg_s", "must be less than rates.coarse_deg_s");
   if (h.joint_vernier_deg_s >= h.joint_coarse_deg_s) {
     r.Fail("joint_vernier_deg_s", "must be less than rates.joint_coarse_deg_s");
   }
@@ -178,7 +200,8 @@ void ReadKeyboard(TomlReader& top, Bindings* b) {
   }
   {
     TomlReader s = r.Sub("step");
-    for (int i = kFinger; i < kNumAnalogInputs; ++i) b->key_step[i] = s.Positive(kAnalogInputNames[i]);
+    for (int i = kFinger; i < kNumAnalogInputs; ++i)
+      b->key_step[i] = s.Positive(kAnalogInputNames[i]);
     s.Finish();
   }
   TomlReader k = r.Sub("keys");
@@ -186,8 +209,9 @@ void ReadKeyboard(TomlReader& top, Bindings* b) {
     const std::string name(key.str());
     const int code = wire::KeyCode(name);
     if (code < 0) {
-      k.Fail(name, "is not a key (a printable character, space, up, down, left, right, pageup, pagedown, "
-                   "backspace, tab, enter, plus, minus)");
+      k.Fail(name,
+             "is not a key (a printable character, space, up, down, left, right, pageup, pagedown, "
+             "backspace, tab, enter, plus, minus)");
     }
     if (b->keys.count(code)) k.Fail(name, "is bound twice");
     b->keys[code] = ActionAt(k, name);
@@ -209,7 +233,8 @@ void ReadKeyboard(TomlReader& top, Bindings* b) {
     if (!bound.count(n)) missing += (missing.empty() ? "" : ", ") + std::string(n);
   }
   if (!missing.empty()) {
-    r.Fail("keys", "no key is bound to " + missing + " (every one needs a key, e.g. Q = \"quit\"; see config/bindings.toml)");
+    r.Fail("keys", "no key is bound to " + missing +
+                       " (every one needs a key, e.g. Q = \"quit\"; see config/bindings.toml)");
   }
   r.Finish();
 }
@@ -220,7 +245,9 @@ void ReadGamepad(TomlReader& top, Bindings* b) {
   for (auto&& [key, node] : ax.table()) {
     const std::string name(key.str());
     if (SDL_GameControllerGetAxisFromString(name.c_str()) == SDL_CONTROLLER_AXIS_INVALID) {
-      ax.Fail(name, "is not an SDL game controller axis (leftx, lefty, rightx, righty, lefttrigger, righttrigger)");
+      ax.Fail(name,
+              "is not an SDL game controller axis (leftx, lefty, rightx, righty, lefttrigger, "
+              "righttrigger)");
     }
     b->gamepad_axes[name] = AxisAt(ax, name, false);
   }
@@ -229,11 +256,14 @@ void ReadGamepad(TomlReader& top, Bindings* b) {
   for (auto&& [key, node] : bt.table()) {
     const std::string name(key.str());
     if (SDL_GameControllerGetButtonFromString(name.c_str()) == SDL_CONTROLLER_BUTTON_INVALID) {
-      bt.Fail(name, "is not an SDL game controller button (a, b, x, y, back, guide, start, leftstick, rightstick, "
-                    "leftshoulder, rightshoulder, dpup, dpdown, dpleft, dpright)");
+      bt.Fail(name,
+              "is not an SDL game controller button (a, b, x, y, back, guide, start, leftstick, "
+              "rightstick, "
+              "leftshoulder, rightshoulder, dpup, dpdown, dpleft, dpright)");
     }
     b->gamepad_buttons[name] = ActionAt(bt, name);
-    if (b->gamepad_buttons[name].kind == ActionKind::kQuit) bt.Fail(name, "quit is for the keyboards only");
+    if (b->gamepad_buttons[name].kind == ActionKind::kQuit)
+      bt.Fail(name, "quit is for the keyboards only");
   }
   bt.Finish();
   r.Finish();
@@ -258,7 +288,8 @@ void ReadSpaceMouse(TomlReader& top, Bindings* b) {
     }
     if (n < 0 || n > 63) bt.Fail(name, "must be a button number 0..63");
     b->spacemouse_buttons[n] = ActionAt(bt, name);
-    if (b->spacemouse_buttons[n].kind == ActionKind::kQuit) bt.Fail(name, "quit is for the keyboards only");
+    if (b->spacemouse_buttons[n].kind == ActionKind::kQuit)
+      bt.Fail(name, "quit is for the keyboards only");
   }
   bt.Finish();
   r.Finish();
@@ -288,6 +319,8 @@ Bindings ParseBindings(std::string_view text, const std::string& source) {
   return b;
 }
 
-Bindings LoadBindings(const std::string& path) { return ParseBindings(ReadTextFile(path, "the bindings file"), path); }
+Bindings LoadBindings(const std::string& path) {
+  return ParseBindings(ReadTextFile(path, "the bindings file"), path);
+}
 
 }  // namespace rms::operator_station

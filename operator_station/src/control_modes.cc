@@ -4,17 +4,22 @@ namespace rms::operator_station {
 
 std::string_view ControlModeName(ControlMode m) {
   switch (m) {
-    case ControlMode::kSingleJoint: return "single joint";
-    case ControlMode::kManualAugmented: return "manual augmented";
+    case ControlMode::kSingleJoint:
+      return "single joint";
+    case ControlMode::kManualAugmented:
+      return "manual augmented";
   }
   return "?";
 }
 
 std::string_view CommandFrameName(CommandFrame f) {
   switch (f) {
-    case CommandFrame::kEndEffector: return "end effector";
-    case CommandFrame::kOrbiter: return "orbiter";
-    case CommandFrame::kPayload: return "payload";
+    case CommandFrame::kEndEffector:
+      return "end effector";
+    case CommandFrame::kOrbiter:
+      return "orbiter";
+    case CommandFrame::kPayload:
+      return "payload";
   }
   return "?";
 }

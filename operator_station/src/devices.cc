@@ -1,7 +1,6 @@
 #include "rms/operator_station/devices.h"
 
 #include <SDL2/SDL.h>
-
 #include <algorithm>
 #include <cmath>
 #include <spdlog/spdlog.h>
@@ -33,8 +32,10 @@ bool StopsMotion(const Action& a) {
     case ActionKind::kVernier:
     case ActionKind::kJointNext:
     case ActionKind::kJointPrev:
-    case ActionKind::kReset: return true;
-    default: return false;
+    case ActionKind::kReset:
+      return true;
+    default:
+      return false;
   }
 }
 
@@ -45,8 +46,10 @@ void DropEarlierPresses(DeviceCommands* out) {
 
 // A control held down: an axis or an input at full rate.
 void AddHeld(const Action& a, DeviceCommands* out) {
-  if (a.kind == ActionKind::kHand) out->hand[a.index] += a.sign;
-  else if (a.kind == ActionKind::kInput) out->input_rate[a.index] += a.sign;
+  if (a.kind == ActionKind::kHand)
+    out->hand[a.index] += a.sign;
+  else if (a.kind == ActionKind::kInput)
+    out->input_rate[a.index] += a.sign;
 }
 
 // A control that went down this frame: a discrete action fires once.
@@ -58,15 +61,18 @@ void AddPressed(const Action& a, DeviceCommands* out) {
 // An analog axis, deadband applied.
 void AddAxis(const AxisBinding& b, double deflection, double deadband, DeviceCommands* out) {
   const double v = b.sign * ApplyDeadband(std::clamp(deflection, -1.0, 1.0), deadband);
-  if (b.hand) out->hand[b.index] += v;
-  else out->input_rate[b.index] += v;
+  if (b.hand)
+    out->hand[b.index] += v;
+  else
+    out->input_rate[b.index] += v;
 }
 
 }  // namespace
 
 // ---- a terminal's keyboard ----
 
-KeyboardDevice::KeyboardDevice(const Bindings& bindings, std::function<int()> next_key, std::string where)
+KeyboardDevice::KeyboardDevice(const Bindings& bindings, std::function<int()> next_key,
+                               std::string where)
     : b_(bindings), next_key_(std::move(next_key)), where_(std::move(where)) {}
 
 void KeyboardDevice::Poll(DeviceCommands* out) {
@@ -74,16 +80,20 @@ void KeyboardDevice::Poll(DeviceCommands* out) {
     const auto it = b_.keys.find(k);
     if (it == b_.keys.end()) {
       // Said once a key, so a person knows the press did nothing.
-      if (unbound_seen_.insert(k).second) spdlog::info("key '{}' is not bound to anything ({})", wire::KeyName(k), b_.source);
+      if (unbound_seen_.insert(k).second)
+        spdlog::info("key '{}' is not bound to anything ({})", wire::KeyName(k), b_.source);
       ++unbound_;
       continue;
     }
     const Action& a = it->second;
     ++out->key_actions;
     if (StopsMotion(a)) DropEarlierPresses(out);
-    if (a.kind == ActionKind::kHand) out->hand_presses.push_back({a.index, a.sign});
-    else if (a.kind == ActionKind::kInput) out->input_presses.push_back({a.index, a.sign});
-    else out->events.push_back(a);
+    if (a.kind == ActionKind::kHand)
+      out->hand_presses.push_back({a.index, a.sign});
+    else if (a.kind == ActionKind::kInput)
+      out->input_presses.push_back({a.index, a.sign});
+    else
+      out->events.push_back(a);
   }
 }
 
@@ -98,18 +108,23 @@ bool WindowKeyboardDevice::Receive(const Message& m, std::int64_t now_us) {
     sequence_ = wire::SequenceTracker{};
     held_.clear();
     ++new_windows_;
-    spdlog::warn("window keys: a new live window (esg_renderer pid {}, was {}); its keys are taken from now on",
-                 m.sender_pid, sender_pid_);
+    spdlog::warn(
+        "window keys: a new live window (esg_renderer pid {}, was {}); its keys are taken from now "
+        "on",
+        m.sender_pid, sender_pid_);
   }
   if (m.sender_pid != 0) sender_pid_ = m.sender_pid;
   const wire::SequenceTracker::Verdict v = sequence_.Accept(m.sequence);
-  if (v == wire::SequenceTracker::Verdict::kDuplicate || v == wire::SequenceTracker::Verdict::kStale ||
+  if (v == wire::SequenceTracker::Verdict::kDuplicate ||
+      v == wire::SequenceTracker::Verdict::kStale ||
       v == wire::SequenceTracker::Verdict::kFarAhead) {
     return false;
   }
   if (v == wire::SequenceTracker::Verdict::kResync) {
-    spdlog::warn("window keys: sequence numbers resynchronised at {} (the window restarted, or {} was not real)",
-                 m.sequence, last_sequence_);
+    spdlog::warn(
+        "window keys: sequence numbers resynchronised at {} (the window restarted, or {} was not "
+        "real)",
+        m.sequence, last_sequence_);
   }
   last_sequence_ = m.sequence;
   heard_us_ = now_us;
@@ -127,7 +142,8 @@ void WindowKeyboardDevice::Poll(DeviceCommands* out) {
     AddPressed(it->second, out);
     // A direct input's key down is a terminal's press too (a tap of the
     // finger key closes it all the way); held, it moves on at its rate.
-    if (it->second.kind == ActionKind::kInput) out->input_presses.push_back({it->second.index, it->second.sign});
+    if (it->second.kind == ActionKind::kInput)
+      out->input_presses.push_back({it->second.index, it->second.sign});
   }
   pressed_.clear();
   if (!held_.empty() && now_us_ - heard_us_ > timeout_us_) {
@@ -154,15 +170,18 @@ std::unique_ptr<GamepadDevice> GamepadDevice::Open(const Bindings& bindings, std
   const int n = SDL_NumJoysticks();
   for (int i = 0; i < n; ++i) {
     if (!SDL_IsGameController(i)) continue;
-    if (SDL_GameController* c = SDL_GameControllerOpen(i)) return std::unique_ptr<GamepadDevice>(new GamepadDevice(bindings, c));
+    if (SDL_GameController* c = SDL_GameControllerOpen(i))
+      return std::unique_ptr<GamepadDevice>(new GamepadDevice(bindings, c));
   }
   *why = n == 0 ? "no gamepad or joystick found"
-                : std::to_string(n) + " joystick(s) found, none with a game controller mapping SDL knows";
+                : std::to_string(n) +
+                      " joystick(s) found, none with a game controller mapping SDL knows";
   SDL_QuitSubSystem(SDL_INIT_GAMECONTROLLER);
   return nullptr;
 }
 
-GamepadDevice::GamepadDevice(const Bindings& bindings, void* controller) : b_(bindings), controller_(controller) {}
+GamepadDevice::GamepadDevice(const Bindings& bindings, void* controller)
+    : b_(bindings), controller_(controller) {}
 
 GamepadDevice::~GamepadDevice() {
   SDL_GameControllerClose(static_cast<SDL_GameController*>(controller_));
@@ -186,7 +205,8 @@ void GamepadDevice::Poll(DeviceCommands* out) {
     AddAxis(bind, SDL_GameControllerGetAxis(c, axis) / 32767.0, b_.deadband, out);
   }
   for (const auto& [name, action] : b_.gamepad_buttons) {
-    const bool down = SDL_GameControllerGetButton(c, SDL_GameControllerGetButtonFromString(name.c_str())) != 0;
+    const bool down =
+        SDL_GameControllerGetButton(c, SDL_GameControllerGetButtonFromString(name.c_str())) != 0;
     if (down && !was_down_[name]) AddPressed(action, out);
     if (down) AddHeld(action, out);
     was_down_[name] = down;
@@ -196,9 +216,12 @@ void GamepadDevice::Poll(DeviceCommands* out) {
 // ---- 3D mouse (libspnav) ----
 
 #ifdef RMSLAB_HAVE_SPNAV
-std::unique_ptr<SpaceMouseDevice> SpaceMouseDevice::Open(const Bindings& bindings, std::string* why) {
+std::unique_ptr<SpaceMouseDevice> SpaceMouseDevice::Open(const Bindings& bindings,
+                                                         std::string* why) {
   if (spnav_open() == -1) {
-    *why = "no 3D mouse (spacenavd is not running, or no socket at $SPNAV_SOCKET or /var/run/spnav.sock)";
+    *why =
+        "no 3D mouse (spacenavd is not running, or no socket at $SPNAV_SOCKET or "
+        "/var/run/spnav.sock)";
     return nullptr;
   }
   return std::unique_ptr<SpaceMouseDevice>(new SpaceMouseDevice(bindings));
@@ -210,7 +233,8 @@ void SpaceMouseDevice::Poll(DeviceCommands* out) {
   spnav_event ev;
   while (spnav_poll_event(&ev) != 0) {
     if (ev.type == SPNAV_EVENT_MOTION) {
-      const int v[6] = {ev.motion.x, ev.motion.y, ev.motion.z, ev.motion.rx, ev.motion.ry, ev.motion.rz};
+      const int v[6] = {ev.motion.x,  ev.motion.y,  ev.motion.z,
+                        ev.motion.rx, ev.motion.ry, ev.motion.rz};
       for (int i = 0; i < 6; ++i) axes_[i] = v[i];
     } else if (ev.type == SPNAV_EVENT_BUTTON) {
       const auto it = b_.spacemouse_buttons.find(ev.button.bnum);
@@ -224,7 +248,8 @@ void SpaceMouseDevice::Poll(DeviceCommands* out) {
     const auto it = b_.spacemouse_buttons.find(bnum);
     if (down && it != b_.spacemouse_buttons.end()) AddHeld(it->second, out);
   }
-  for (int i = 0; i < 6; ++i) AddAxis(b_.spacemouse_axes[i], axes_[i] / b_.spacemouse_full_scale, b_.deadband, out);
+  for (int i = 0; i < 6; ++i)
+    AddAxis(b_.spacemouse_axes[i], axes_[i] / b_.spacemouse_full_scale, b_.deadband, out);
 }
 #else
 std::unique_ptr<SpaceMouseDevice> SpaceMouseDevice::Open(const Bindings&, std::string* why) {

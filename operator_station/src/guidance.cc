@@ -2,9 +2,9 @@
 
 #include <cmath>
 
-#include "rms/operator_station/arm_motion.h"
 #include "rms/arm/kinematics.h"
 #include "rms/mission/mission_geometry.h"
+#include "rms/operator_station/arm_motion.h"
 
 namespace rms::operator_station {
 
@@ -54,10 +54,12 @@ GuidanceGeometry MakeGuidanceGeometry(const LabConfig& c) {
   g.y_port_R = c.cae.R_RC.col(1);
   const Eigen::Vector3d bc = c.payload.p_PoBar_P_ft, half = 0.5 * c.payload.bar_size_P_ft;
   for (int k = 0; k < 8; ++k) {
-    g.bar_P[k] = bc + Eigen::Vector3d((k & 1) ? half.x() : -half.x(), (k & 2) ? half.y() : -half.y(),
-                                      (k & 4) ? half.z() : -half.z());
+    g.bar_P[k] =
+        bc + Eigen::Vector3d((k & 1) ? half.x() : -half.x(), (k & 2) ? half.y() : -half.y(),
+                             (k & 4) ? half.z() : -half.z());
   }
-  g.fixed_finger_face_Y2_ft = c.end_effector.palm_half_width_ft - c.end_effector.finger_thickness_ft;
+  g.fixed_finger_face_Y2_ft =
+      c.end_effector.palm_half_width_ft - c.end_effector.finger_thickness_ft;
   return g;
 }
 
@@ -106,7 +108,8 @@ Guidance ComputeGuidance(const GuidanceGeometry& g, const ArmState& s, CommandFr
     // Where the finger would stop: on the BAR's corner nearest it along Y2.
     const Eigen::Vector3d y2 = s.X_RS2.linear().col(1);
     double y_min = 1e30;
-    for (const Eigen::Vector3d& v : g.bar_P) y_min = std::min(y_min, y2.dot(s.X_RP * v - s.X_RS2.translation()));
+    for (const Eigen::Vector3d& v : g.bar_P)
+      y_min = std::min(y_min, y2.dot(s.X_RP * v - s.X_RS2.translation()));
     const double gap = g.fixed_finger_face_Y2_ft - y_min;
     out.close_gap_ft = gap > 0 ? gap : -1.0;
   } else {
@@ -116,9 +119,12 @@ Guidance ComputeGuidance(const GuidanceGeometry& g, const ArmState& s, CommandFr
     const Eigen::Vector3d y = s.X_RP.linear().col(1);
     const Eigen::Vector3d axis = y.cross(g.y_port_R);
     const double angle = std::atan2(axis.norm(), y.dot(g.y_port_R));
-    if (axis.norm() > 1e-12) phi_R = angle * axis.normalized();
-    else if (angle > 1.0) phi_R = M_PI * s.X_RP.linear().col(0);  // exactly reversed: half a turn about x_P
-    else phi_R.setZero();
+    if (axis.norm() > 1e-12)
+      phi_R = angle * axis.normalized();
+    else if (angle > 1.0)
+      phi_R = M_PI * s.X_RP.linear().col(0);  // exactly reversed: half a turn about x_P
+    else
+      phi_R.setZero();
   }
   if (s.mode == 2) {
     out.leave_bay = true;

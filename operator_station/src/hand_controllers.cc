@@ -76,16 +76,22 @@ void HandControllers::PollFrozen() {
   key_actions_ += cmd.key_actions;
   bool ignored = !cmd.hand_presses.empty() || !cmd.input_presses.empty();
   for (const Action& a : cmd.events) {
-    if (a.kind == ActionKind::kFreeze) freeze_requested_ = true;
-    else if (a.kind == ActionKind::kStep) ++step_requests_;
-    else if (a.kind == ActionKind::kQuit) quit_ = true;
-    else if (a.kind == ActionKind::kStop) StopAndRelease(cmd);  // nothing resumes when the session runs again
-    else ignored = true;
+    if (a.kind == ActionKind::kFreeze)
+      freeze_requested_ = true;
+    else if (a.kind == ActionKind::kStep)
+      ++step_requests_;
+    else if (a.kind == ActionKind::kQuit)
+      quit_ = true;
+    else if (a.kind == ActionKind::kStop)
+      StopAndRelease(cmd);  // nothing resumes when the session runs again
+    else
+      ignored = true;
   }
   if (ignored) {
     counters_.Add(Counter::kFrozenInputsIgnored);
     if (!frozen_noted_) {
-      spdlog::info("frozen: only freeze (to run again), step, stop and quit act; other keys do nothing");
+      spdlog::info(
+          "frozen: only freeze (to run again), step, stop and quit act; other keys do nothing");
       frozen_noted_ = true;
     }
   }
@@ -93,16 +99,20 @@ void HandControllers::PollFrozen() {
 
 void HandControllers::Announce(const char* what) {
   std::string s = std::string(ControlModeName(status_.mode));
-  if (status_.mode == ControlMode::kManualAugmented) s += ", " + std::string(CommandFrameName(status_.frame)) + " frame";
-  else s += " (" + std::string(kAnalogInputNames[status_.joint]) + ")";
+  if (status_.mode == ControlMode::kManualAugmented)
+    s += ", " + std::string(CommandFrameName(status_.frame)) + " frame";
+  else
+    s += " (" + std::string(kAnalogInputNames[status_.joint]) + ")";
   s += status_.vernier ? ", vernier" : ", coarse";
   spdlog::info("{}: {}", what, s);
 }
 
 void HandControllers::StopAndRelease(const DeviceCommands& cmd) {
   StopMotion();
-  for (int i = 0; i < kNumHandAxes; ++i) hand_suppressed_[i] = hand_suppressed_[i] || cmd.hand[i] != 0.0;
-  for (int i = 0; i < kNumAnalogInputs; ++i) input_suppressed_[i] = input_suppressed_[i] || cmd.input_rate[i] != 0.0;
+  for (int i = 0; i < kNumHandAxes; ++i)
+    hand_suppressed_[i] = hand_suppressed_[i] || cmd.hand[i] != 0.0;
+  for (int i = 0; i < kNumAnalogInputs; ++i)
+    input_suppressed_[i] = input_suppressed_[i] || cmd.input_rate[i] != 0.0;
 }
 
 void HandControllers::FollowHeldArm(const dcp_telemetry_t& tm) {
@@ -118,14 +128,16 @@ void HandControllers::StopMotion() {
 
 double HandControllers::Increment(int axis) const {
   const HandIncrements& k = b_.increments;
-  if (status_.mode == ControlMode::kSingleJoint) return status_.vernier ? k.joint_vernier_deg : k.joint_coarse_deg;
+  if (status_.mode == ControlMode::kSingleJoint)
+    return status_.vernier ? k.joint_vernier_deg : k.joint_coarse_deg;
   if (axis < 3) return status_.vernier ? k.vernier_ft : k.coarse_ft;
   return status_.vernier ? k.vernier_deg : k.coarse_deg;
 }
 
 double HandControllers::FullRate(int axis) const {
   const HandRates& r = b_.rates;
-  if (status_.mode == ControlMode::kSingleJoint) return status_.vernier ? r.joint_vernier_deg_s : r.joint_coarse_deg_s;
+  if (status_.mode == ControlMode::kSingleJoint)
+    return status_.vernier ? r.joint_vernier_deg_s : r.joint_coarse_deg_s;
   if (axis < 3) return status_.vernier ? r.vernier_ft_s : r.coarse_ft_s;
   return status_.vernier ? r.vernier_deg_s : r.coarse_deg_s;
 }
@@ -134,33 +146,46 @@ void HandControllers::HandleEvents(const DeviceCommands& cmd, const dcp_telemetr
   const bool held = tm && tm->mode >= 2;
   for (const Action& a : cmd.events) {
     switch (a.kind) {
-      case ActionKind::kCamera: target_.camera_station = a.camera; break;
-      case ActionKind::kCameraNext: target_.camera_station = target_.camera_station % kNumCameraStations + 1; break;
+      case ActionKind::kCamera:
+        target_.camera_station = a.camera;
+        break;
+      case ActionKind::kCameraNext:
+        target_.camera_station = target_.camera_station % kNumCameraStations + 1;
+        break;
       case ActionKind::kCameraPrev:
-        target_.camera_station = (target_.camera_station + kNumCameraStations - 2) % kNumCameraStations + 1;
+        target_.camera_station =
+            (target_.camera_station + kNumCameraStations - 2) % kNumCameraStations + 1;
         break;
       case ActionKind::kReset:
         out_.reset = true;
         StopMotion();
         break;
-      case ActionKind::kOverlay: target_.overlay = !target_.overlay; break;
-      case ActionKind::kCrosshairs: target_.crosshairs = !target_.crosshairs; break;
-      case ActionKind::kGuidance: show_guidance_ = !show_guidance_; break;
+      case ActionKind::kOverlay:
+        target_.overlay = !target_.overlay;
+        break;
+      case ActionKind::kCrosshairs:
+        target_.crosshairs = !target_.crosshairs;
+        break;
+      case ActionKind::kGuidance:
+        show_guidance_ = !show_guidance_;
+        break;
       case ActionKind::kStop:
         StopAndRelease(cmd);
         counters_.Add(Counter::kControlStops);
         break;
       case ActionKind::kMode:
         StopMotion();
-        status_.mode = status_.mode == ControlMode::kManualAugmented ? ControlMode::kSingleJoint
-                                                                     : ControlMode::kManualAugmented;
+        status_.mode = status_.mode == ControlMode::kManualAugmented
+                           ? ControlMode::kSingleJoint
+                           : ControlMode::kManualAugmented;
         counters_.Add(Counter::kControlModeChanges);
         Announce("control mode");
         break;
       case ActionKind::kFrame: {
         StopMotion();
         int f = static_cast<int>(status_.frame) % 3 + 1;
-        if (f == static_cast<int>(CommandFrame::kPayload) && !held) f = static_cast<int>(CommandFrame::kEndEffector);
+        if (f == static_cast<int>(CommandFrame::kPayload) && !held)
+          f = static_cast<int>(CommandFrame::kEndEffector);
         status_.frame = static_cast<CommandFrame>(f);
         counters_.Add(Counter::kControlFrameChanges);
         Announce("command frame");
@@ -178,11 +203,18 @@ void HandControllers::HandleEvents(const DeviceCommands& cmd, const dcp_telemetr
         status_.joint = (status_.joint + (a.kind == ActionKind::kJointNext ? 1 : 5)) % 6;
         if (status_.mode == ControlMode::kSingleJoint) Announce("joint");
         break;
-      case ActionKind::kQuit: quit_ = true; break;
-      case ActionKind::kFreeze: freeze_requested_ = true; break;
-      case ActionKind::kStep: ++step_requests_; break;
+      case ActionKind::kQuit:
+        quit_ = true;
+        break;
+      case ActionKind::kFreeze:
+        freeze_requested_ = true;
+        break;
+      case ActionKind::kStep:
+        ++step_requests_;
+        break;
       case ActionKind::kHand:
-      case ActionKind::kInput: break;  // not events
+      case ActionKind::kInput:
+        break;  // not events
     }
   }
 }
@@ -198,12 +230,16 @@ void HandControllers::AddPress(const struct Press& p) {
   // stops it.
   double& pending = status_.pending[p.index];
   const double inc = Increment(p.index);
-  if (pending * p.sign > 0) pending = p.sign * std::max(std::abs(pending), inc);
-  else if (pending * p.sign < 0) pending = 0.0;
-  else pending = p.sign * inc;
+  if (pending * p.sign > 0)
+    pending = p.sign * std::max(std::abs(pending), inc);
+  else if (pending * p.sign < 0)
+    pending = 0.0;
+  else
+    pending = p.sign * inc;
 }
 
-std::array<double, kNumHandAxes> HandControllers::CommandedRates(const DeviceCommands& cmd, double dt_s) {
+std::array<double, kNumHandAxes> HandControllers::CommandedRates(const DeviceCommands& cmd,
+                                                                 double dt_s) {
   std::array<double, kNumHandAxes> rate{};
   for (int i = 0; i < kNumHandAxes; ++i) {
     const double full = FullRate(i);
@@ -219,21 +255,26 @@ std::array<double, kNumHandAxes> HandControllers::CommandedRates(const DeviceCom
   return rate;
 }
 
-void HandControllers::FlyManualAugmented(const std::array<double, kNumHandAxes>& rate, double dt_s) {
+void HandControllers::FlyManualAugmented(const std::array<double, kNumHandAxes>& rate,
+                                         double dt_s) {
   JointAngles q{};
   for (int i = 0; i < 6; ++i) q[i] = target_.value[i];
   const double h = target_.value[kShoulderHeight];
   ArmState s;
   s.mode = dcp_mode_;
   s.X_RS2 = ForwardPose(config_.arm, q, h);
-  if (X_S2P_) s.X_RP = s.X_RS2 * *X_S2P_;
-  else s.mode = 1;
-  const CommandFrame frame = status_.frame == CommandFrame::kPayload && !X_S2P_ ? CommandFrame::kEndEffector
-                                                                                  : status_.frame;
+  if (X_S2P_)
+    s.X_RP = s.X_RS2 * *X_S2P_;
+  else
+    s.mode = 1;
+  const CommandFrame frame = status_.frame == CommandFrame::kPayload && !X_S2P_
+                                 ? CommandFrame::kEndEffector
+                                 : status_.frame;
   const Eigen::Matrix3d R_RF = CommandAxes(geometry_, frame, s);
   const Eigen::Vector3d por = PointOfResolution(geometry_, s);
   const Eigen::Vector3d v_R = R_RF * Eigen::Vector3d(rate[kThcX], rate[kThcY], rate[kThcZ]);
-  const Eigen::Vector3d w_R = R_RF * Eigen::Vector3d(rate[kRhcRoll], rate[kRhcPitch], rate[kRhcYaw]) * kDeg;
+  const Eigen::Vector3d w_R =
+      R_RF * Eigen::Vector3d(rate[kRhcRoll], rate[kRhcPitch], rate[kRhcYaw]) * kDeg;
   // The motion is flown closed loop on a reference pose that moves exactly
   // as commanded (about the point of resolution), so the rate's first-order
   // steps and the elbow's self-motion do not drift; released, nothing moves.
@@ -242,9 +283,11 @@ void HandControllers::FlyManualAugmented(const std::array<double, kNumHandAxes>&
   } else {
     if (!X_ref_) X_ref_ = s.X_RS2;
     const Eigen::Vector3d Q_ref = *X_ref_ * por + v_R * dt_s;
-    X_ref_->linear() = Eigen::AngleAxisd(w_R.norm() * dt_s, w_R.norm() > 0 ? w_R.normalized() : Eigen::Vector3d::UnitX())
-                           .toRotationMatrix() *
-                       X_ref_->linear();
+    X_ref_->linear() =
+        Eigen::AngleAxisd(w_R.norm() * dt_s,
+                          w_R.norm() > 0 ? w_R.normalized() : Eigen::Vector3d::UnitX())
+            .toRotationMatrix() *
+        X_ref_->linear();
     X_ref_->translation() = Q_ref - X_ref_->linear() * por;
   }
   Eigen::Vector3d v_fly = v_R, w_fly = w_R;
@@ -252,9 +295,11 @@ void HandControllers::FlyManualAugmented(const std::array<double, kNumHandAxes>&
     // Where the reference will be after this frame, less where the arm is.
     constexpr double kCatchUpS = 0.2;
     const Eigen::Vector3d e_v = *X_ref_ * por - s.X_RS2 * por - v_R * dt_s;
-    const Eigen::Vector3d e_w = RotationVector(X_ref_->linear() * s.X_RS2.linear().transpose()) - w_R * dt_s;
+    const Eigen::Vector3d e_w =
+        RotationVector(X_ref_->linear() * s.X_RS2.linear().transpose()) - w_R * dt_s;
     if (e_v.norm() > 1.5 || e_w.norm() > 10.0 * kDeg) {
-      X_ref_ = s.X_RS2;  // the arm cannot follow (a limit, a singular pose): start again from where it is
+      X_ref_ = s.X_RS2;  // the arm cannot follow (a limit, a singular pose): start again from where
+                         // it is
     } else {
       v_fly += e_v / kCatchUpS;
       w_fly += e_w / kCatchUpS;
@@ -271,7 +316,8 @@ void HandControllers::FlyManualAugmented(const std::array<double, kNumHandAxes>&
   ReportLimits(r.at_limit);
 }
 
-void HandControllers::ConsumePending(const std::array<double, kNumHandAxes>& achieved, double dt_s) {
+void HandControllers::ConsumePending(const std::array<double, kNumHandAxes>& achieved,
+                                     double dt_s) {
   // An increment is done when the arm has moved it (not when it was asked
   // for): near a singular pose the first of it may go slowly. One that
   // makes no headway for kBlockedS (a joint at its limit, the arm at the
@@ -291,8 +337,10 @@ void HandControllers::ConsumePending(const std::array<double, kNumHandAxes>& ach
       pending = 0.0;
       stalled_s_[i] = 0.0;
       counters_.Add(Counter::kIncrementsBlocked);
-      spdlog::warn("{}: the arm cannot move that way (at a joint limit or the end of its reach): motion stopped",
-                   kHandAxisNames[i]);
+      spdlog::warn(
+          "{}: the arm cannot move that way (at a joint limit or the end of its reach): motion "
+          "stopped",
+          kHandAxisNames[i]);
     }
   }
 }
@@ -324,8 +372,8 @@ void HandControllers::ReportLimits(std::uint32_t at_limit) {
     const bool on_limit = q <= limits_.min_deg[i] + 1e-6 || q >= limits_.max_deg[i] - 1e-6;
     if ((at_limit & bit) && !(limit_reported_ & bit)) {
       counters_.Add(JointLimitCounter(i));
-      spdlog::warn("joint limit: {} stopped at {:+.1f} deg (its travel {:+.1f} .. {:+.1f})", kAnalogInputNames[i], q,
-                   limits_.min_deg[i], limits_.max_deg[i]);
+      spdlog::warn("joint limit: {} stopped at {:+.1f} deg (its travel {:+.1f} .. {:+.1f})",
+                   kAnalogInputNames[i], q, limits_.min_deg[i], limits_.max_deg[i]);
       limit_reported_ |= bit;
     } else if (!on_limit) {
       limit_reported_ &= ~bit;
@@ -340,9 +388,12 @@ void HandControllers::DirectInputs(const DeviceCommands& cmd, double dt_s) {
     // most; a press the other way stops it.
     double& t = target_.value[p.index];
     const double o = out_.value[p.index], moving = t - o;
-    if (moving * p.sign > 1e-12) t = o + p.sign * std::max(std::abs(moving), b_.key_step[p.index]);
-    else if (moving * p.sign < -1e-12) t = o;
-    else t = o + p.sign * b_.key_step[p.index];
+    if (moving * p.sign > 1e-12)
+      t = o + p.sign * std::max(std::abs(moving), b_.key_step[p.index]);
+    else if (moving * p.sign < -1e-12)
+      t = o;
+    else
+      t = o + p.sign * b_.key_step[p.index];
   }
   for (int i = kFinger; i < kNumAnalogInputs; ++i) {
     const double lim = b_.max_rate[i] * dt_s;
@@ -355,8 +406,8 @@ void HandControllers::DirectInputs(const DeviceCommands& cmd, double dt_s) {
     if (c != t && !clamping_[i]) {
       counters_.Add(ClampedCounter(i));
       const std::string unit = cal[i].unit == "1" ? std::string() : " " + cal[i].unit;
-      spdlog::warn("{} command held against the end of its range [{}, {}]{}: clamped", kAnalogInputNames[i],
-                   cal[i].min, cal[i].max, unit);
+      spdlog::warn("{} command held against the end of its range [{}, {}]{}: clamped",
+                   kAnalogInputNames[i], cal[i].min, cal[i].max, unit);
     }
     clamping_[i] = c != t;
     target_.value[i] = c;
@@ -364,7 +415,8 @@ void HandControllers::DirectInputs(const DeviceCommands& cmd, double dt_s) {
   }
 }
 
-wire::OperatorInputs HandControllers::Apply(const DeviceCommands& cmd, double dt_s, const dcp_telemetry_t* tm) {
+wire::OperatorInputs HandControllers::Apply(const DeviceCommands& cmd, double dt_s,
+                                            const dcp_telemetry_t* tm) {
   out_.reset = false;
   freeze_requested_ = false;
   step_requests_ = 0;
@@ -376,8 +428,11 @@ wire::OperatorInputs HandControllers::Apply(const DeviceCommands& cmd, double dt
       Announce("command frame");
     }
     dcp_mode_ = tm->mode;
-    if (tm->mode >= 2) X_S2P_ = TelemetryPose(tm->p_RoA_R_ft, tm->R_RS2).inverse() * TelemetryPose(tm->p_RoPo_R_ft, tm->R_RP);
-    else X_S2P_.reset();
+    if (tm->mode >= 2)
+      X_S2P_ = TelemetryPose(tm->p_RoA_R_ft, tm->R_RS2).inverse() *
+               TelemetryPose(tm->p_RoPo_R_ft, tm->R_RP);
+    else
+      X_S2P_.reset();
     // The DCP holds the arm (the command collides): carry on from the pose
     // the slave holds, so the next command away from the contact relieves
     // it. Docked, the port holds the payload and the arm until the finger
@@ -395,8 +450,10 @@ wire::OperatorInputs HandControllers::Apply(const DeviceCommands& cmd, double dt
     for (const struct Press& p : cmd.hand_presses) AddPress(p);
     const auto rate = CommandedRates(cmd, dt_s);
     status_.rate = rate;
-    if (status_.mode == ControlMode::kManualAugmented) FlyManualAugmented(rate, dt_s);
-    else FlySingleJoint(rate[kThcX], dt_s);
+    if (status_.mode == ControlMode::kManualAugmented)
+      FlyManualAugmented(rate, dt_s);
+    else
+      FlySingleJoint(rate[kThcX], dt_s);
   }
   DirectInputs(cmd, dt_s);
   for (int i = 0; i < 6; ++i) out_.value[i] = target_.value[i];

@@ -1,7 +1,8 @@
 #include "rms/operator_station/input_sources.h"
 
-#include <spdlog/spdlog.h>
 #include <unistd.h>
+
+#include <spdlog/spdlog.h>
 
 #include "rms/base/check.h"
 
@@ -9,7 +10,8 @@ namespace rms::operator_station {
 
 // ---- timeline ----
 
-TimelineSource::TimelineSource(const std::string& path, const LabConfig& config, double speed, bool hold)
+TimelineSource::TimelineSource(const std::string& path, const LabConfig& config, double speed,
+                               bool hold)
     : path_(path), timeline_(Timeline::Load(path, config.inputs)), speed_(speed), hold_(hold) {
   for (const std::string& w : timeline_.warnings()) spdlog::warn("{}", w);
   spdlog::info("timeline {}: {:.2f} s at {:.1f} Hz, speed {}", path, timeline_.end_time(),
@@ -56,8 +58,8 @@ std::string KeyHelp(const Bindings& b) {
   pair("camera_pan+", "camera_pan-", "pan");
   pair("camera_tilt+", "camera_tilt-", "tilt");
   pair("camera_zoom+", "camera_zoom-", "zoom");
-  for (const char* one : {"stop", "vernier", "mode", "frame", "joint_next", "joint_prev", "crosshairs", "guidance",
-                          "overlay", "reset", "freeze", "step", "quit"}) {
+  for (const char* one : {"stop", "vernier", "mode", "frame", "joint_next", "joint_prev",
+                          "crosshairs", "guidance", "overlay", "reset", "freeze", "step", "quit"}) {
     if (by_action.count(one)) {
       s += "  " + by_action[one] + " " + one;
       by_action.erase(one);
@@ -73,7 +75,8 @@ HandSource::HandSource(const LabConfig& config, const HandOptions& o)
   // Each device is optional: looked for, and reported either way.
   if (isatty(STDIN_FILENO)) {
     terminal_ = std::make_unique<TerminalKeys>();
-    hands_->AddDevice(std::make_unique<KeyboardDevice>(bindings_, [t = terminal_.get()] { return t->Next(); }));
+    hands_->AddDevice(
+        std::make_unique<KeyboardDevice>(bindings_, [t = terminal_.get()] { return t->Next(); }));
   } else if (o.keyboard_required) {
     throw InputError("--keyboard needs a terminal on standard input");
   } else {
@@ -86,19 +89,24 @@ HandSource::HandSource(const LabConfig& config, const HandOptions& o)
   }
   std::string why;
   if (o.gamepad) {
-    if (auto g = GamepadDevice::Open(bindings_, &why)) hands_->AddDevice(std::move(g));
-    else device_report_.push_back("gamepad: none (" + why + ")");
+    if (auto g = GamepadDevice::Open(bindings_, &why))
+      hands_->AddDevice(std::move(g));
+    else
+      device_report_.push_back("gamepad: none (" + why + ")");
   }
   if (o.spacemouse) {
-    if (auto m = SpaceMouseDevice::Open(bindings_, &why)) hands_->AddDevice(std::move(m));
-    else device_report_.push_back("3D mouse: none (" + why + ")");
+    if (auto m = SpaceMouseDevice::Open(bindings_, &why))
+      hands_->AddDevice(std::move(m));
+    else
+      device_report_.push_back("3D mouse: none (" + why + ")");
   }
   for (const auto& d : device_report_) spdlog::info("{}", d);
   if (hands_->devices().empty()) {
     throw InputError("no input device found (" + device_report_.front() +
                      "; give --window-keys to fly from the live window)");
   }
-  for (const auto& d : hands_->devices()) device_report_.insert(device_report_.begin(), d->Describe());
+  for (const auto& d : hands_->devices())
+    device_report_.insert(device_report_.begin(), d->Describe());
   help_ = KeyHelp(bindings_);
 }
 
@@ -135,9 +143,12 @@ void HandSource::AddCounters(Counters* c) const {
 
 // ---- autopilot ----
 
-AutopilotSource::AutopilotSource(const LabConfig& config, const AutopilotOptions& options, bool hold,
-                                 bool resume_from_telemetry)
-    : config_(config), autopilot_(config, options), hold_(hold), resume_from_telemetry_(resume_from_telemetry) {}
+AutopilotSource::AutopilotSource(const LabConfig& config, const AutopilotOptions& options,
+                                 bool hold, bool resume_from_telemetry)
+    : config_(config),
+      autopilot_(config, options),
+      hold_(hold),
+      resume_from_telemetry_(resume_from_telemetry) {}
 
 std::string AutopilotSource::Describe() const {
   return std::string("autopilot: ") + AutopilotPhaseName(autopilot_.phase());
@@ -166,7 +177,8 @@ std::optional<wire::OperatorInputs> AutopilotSource::Next(const Frame& f) {
   const wire::OperatorInputs in = autopilot_.Step(f.telemetry);
   if (autopilot_.failed() && !hold_) return std::nullopt;
   // Docked: hold two seconds of session time (the scene shows it), then stop.
-  if (autopilot_.docked() && ++docked_frames_ > 2 * config_.session.frame_rate_hz && !hold_) return std::nullopt;
+  if (autopilot_.docked() && ++docked_frames_ > 2 * config_.session.frame_rate_hz && !hold_)
+    return std::nullopt;
   return in;
 }
 
@@ -175,8 +187,10 @@ int AutopilotSource::exit_code() const { return autopilot_.failed() ? 3 : 0; }
 void AutopilotSource::AddCounters(Counters* c) const {
   c->AddAll(autopilot_.counters());
   c->Set(Counter::kAutopilotDocked, autopilot_.docked());
-  if (autopilot_.failed()) spdlog::error("autopilot failed: {}", autopilot_.failure());
-  else if (autopilot_.docked()) spdlog::info("autopilot: docked {:.1f} s into the session", autopilot_.docked_at_s());
+  if (autopilot_.failed())
+    spdlog::error("autopilot failed: {}", autopilot_.failure());
+  else if (autopilot_.docked())
+    spdlog::info("autopilot: docked {:.1f} s into the session", autopilot_.docked_at_s());
 }
 
 }  // namespace rms::operator_station

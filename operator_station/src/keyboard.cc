@@ -1,12 +1,11 @@
 #include "rms/operator_station/keyboard.h"
 
-#include "rms/operator_station/bindings.h"
-
+#include <fcntl.h>
 #include <termios.h>
 #include <unistd.h>
-#include <fcntl.h>
 
 #include "rms/base/check.h"
+#include "rms/operator_station/bindings.h"
 
 namespace rms::operator_station {
 
@@ -50,13 +49,20 @@ int TerminalKeys::Next() {
   const int b = ReadByte();
   if (b != '[') return 27;
   switch (ReadByte()) {
-    case 'A': return wire::kKeyUp;
-    case 'B': return wire::kKeyDown;
-    case 'C': return wire::kKeyRight;
-    case 'D': return wire::kKeyLeft;
-    case '5': return ReadByte() == '~' ? wire::kKeyPageUp : -1;
-    case '6': return ReadByte() == '~' ? wire::kKeyPageDown : -1;
-    default: return -1;
+    case 'A':
+      return wire::kKeyUp;
+    case 'B':
+      return wire::kKeyDown;
+    case 'C':
+      return wire::kKeyRight;
+    case 'D':
+      return wire::kKeyLeft;
+    case '5':
+      return ReadByte() == '~' ? wire::kKeyPageUp : -1;
+    case '6':
+      return ReadByte() == '~' ? wire::kKeyPageDown : -1;
+    default:
+      return -1;
   }
 }
 

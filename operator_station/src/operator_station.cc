@@ -1,20 +1,21 @@
 #include "rms/operator_station/operator_station.h"
 
-#include <cerrno>
-#include <cmath>
-#include <spdlog/spdlog.h>
 #include <time.h>
 #include <unistd.h>
 
-#include "rms/wire/channels.h"
+#include <cerrno>
+#include <cmath>
+#include <spdlog/spdlog.h>
+
 #include "rms/base/check.h"
-#include "rms/wire/checkpoint.h"
-#include "rms/wire/message_io.h"
 #include "rms/operator_state_t.hpp"
+#include "rms/operator_station/telemetry_check.h"
 #include "rms/process_status_t.hpp"
 #include "rms/session_control_t.hpp"
-#include "rms/operator_station/telemetry_check.h"
 #include "rms/window_keys_t.hpp"
+#include "rms/wire/channels.h"
+#include "rms/wire/checkpoint.h"
+#include "rms/wire/message_io.h"
 
 namespace rms::operator_station {
 
@@ -52,9 +53,11 @@ bool Restarted() { return transport::RestartedByLauncher(); }
 std::unique_ptr<InputSource> MakeSource(const OperatorOptions& o, const LabConfig& config) {
   const int sources = !o.timeline_path.empty() + o.keyboard + o.manual + o.autopilot;
   if (sources != 1) {
-    throw InputError("give exactly one input source: --timeline FILE, --keyboard, --manual or --autopilot");
+    throw InputError(
+        "give exactly one input source: --timeline FILE, --keyboard, --manual or --autopilot");
   }
-  if (!o.timeline_path.empty()) return std::make_unique<TimelineSource>(o.timeline_path, config, o.speed, o.hold);
+  if (!o.timeline_path.empty())
+    return std::make_unique<TimelineSource>(o.timeline_path, config, o.speed, o.hold);
   if (o.keyboard || o.manual) {
     HandOptions h;
     h.bindings_path = o.bindings_path;
@@ -71,7 +74,8 @@ std::unique_ptr<InputSource> MakeSource(const OperatorOptions& o, const LabConfi
 
 void CheckSourceFiles(const OperatorOptions& o, const LabConfig& config) {
   const int sources = !o.timeline_path.empty() + o.keyboard + o.manual + o.autopilot;
-  if (sources > 1) throw InputError("give one input source: --timeline FILE, --keyboard, --manual or --autopilot");
+  if (sources > 1)
+    throw InputError("give one input source: --timeline FILE, --keyboard, --manual or --autopilot");
   if (!o.timeline_path.empty()) (void)Timeline::Load(o.timeline_path, config.inputs);
   if (o.keyboard || o.manual || !o.bindings_path.empty()) {
     (void)LoadBindings(o.bindings_path.empty() ? DefaultBindingsPath() : o.bindings_path);
@@ -92,8 +96,8 @@ void OperatorStation::RateMeter::Tick(std::int64_t now_us) {
   }
 }
 
-OperatorStation::OperatorStation(const OperatorOptions& options, const LabConfig& config, transport::LcmInterface& lcm,
-                                 std::unique_ptr<InputSource> source)
+OperatorStation::OperatorStation(const OperatorOptions& options, const LabConfig& config,
+                                 transport::LcmInterface& lcm, std::unique_ptr<InputSource> source)
     : options_(options),
       config_(config),
       lcm_(lcm),
@@ -108,11 +112,15 @@ OperatorStation::OperatorStation(const OperatorOptions& options, const LabConfig
 }
 
 void OperatorStation::Subscribe() {
-  lcm_.Subscribe(wire::channels::kDcpTelemetry, [this](const void* d, int n, std::int64_t t) { OnTelemetry(d, n, t); });
-  lcm_.Subscribe(wire::channels::kStatus, [this](const void* d, int n, std::int64_t t) { OnStatus(d, n, t); });
-  lcm_.Subscribe(wire::channels::kControl, [this](const void* d, int n, std::int64_t t) { OnControl(d, n, t); });
+  lcm_.Subscribe(wire::channels::kDcpTelemetry,
+                 [this](const void* d, int n, std::int64_t t) { OnTelemetry(d, n, t); });
+  lcm_.Subscribe(wire::channels::kStatus,
+                 [this](const void* d, int n, std::int64_t t) { OnStatus(d, n, t); });
+  lcm_.Subscribe(wire::channels::kControl,
+                 [this](const void* d, int n, std::int64_t t) { OnControl(d, n, t); });
   if (source_->window_keyboard()) {
-    lcm_.Subscribe(wire::channels::kWindowKeys, [this](const void* d, int n, std::int64_t t) { OnWindowKeys(d, n, t); });
+    lcm_.Subscribe(wire::channels::kWindowKeys,
+                   [this](const void* d, int n, std::int64_t t) { OnWindowKeys(d, n, t); });
   }
 }
 
@@ -127,7 +135,8 @@ void OperatorStation::OnTelemetry(const void* data, int size, std::int64_t recv_
     return;
   }
   if (m.input_frame < fresh_from_input_frame_) {
-    counters_.Add(Counter::kTelemetryBeforeReset);  // answers an input from before the last reset or restore
+    counters_.Add(
+        Counter::kTelemetryBeforeReset);  // answers an input from before the last reset or restore
     return;
   }
   switch (telemetry_seq_.Accept(m.frame, recv_us)) {
@@ -137,13 +146,17 @@ void OperatorStation::OnTelemetry(const void* data, int size, std::int64_t recv_
       return;
     case wire::SequenceTracker::Verdict::kFarAhead:
       if (counters_.Get(Counter::kDroppedFarAhead) == 0) {
-        spdlog::warn("telemetry frame {} refused: beyond what the session's clock allows (dropped.far_ahead)", m.frame);
+        spdlog::warn(
+            "telemetry frame {} refused: beyond what the session's clock allows "
+            "(dropped.far_ahead)",
+            m.frame);
       }
       counters_.Add(Counter::kDroppedFarAhead);
       return;
     case wire::SequenceTracker::Verdict::kResync:
       counters_.Add(Counter::kResyncs);
-      spdlog::warn("the telemetry's numbering moved to frame {}: followed again (resyncs)", m.frame);
+      spdlog::warn("the telemetry's numbering moved to frame {}: followed again (resyncs)",
+                   m.frame);
       break;
     default:
       break;
@@ -165,7 +178,8 @@ void OperatorStation::OnStatus(const void* data, int size, std::int64_t recv_us)
     const std::string& n = m.counter_names[i];
     const std::int64_t v = m.counter_values[i];
     if (n == CounterName(Counter::kRendered)) {
-      if (esg_rendered_ >= 0 && recv_us > esg_status_us_) render_hz_ = (v - esg_rendered_) * 1e6 / (recv_us - esg_status_us_);
+      if (esg_rendered_ >= 0 && recv_us > esg_status_us_)
+        render_hz_ = (v - esg_rendered_) * 1e6 / (recv_us - esg_status_us_);
       esg_rendered_ = v;
       esg_status_us_ = recv_us;
     } else if (n == "latency.input_to_render.p50_us") {
@@ -202,10 +216,13 @@ void OperatorStation::OnControl(const void* data, int size, std::int64_t) {
       counters_.Add(Counter::kControlSteps);
       break;
     case session_control_t::RESTORE:
-      if (checkpoint_rate_.Allow(lcm_.NowUs())) restored_from_ = m.name;
-      else counters_.Add(Counter::kControlRateLimited);
+      if (checkpoint_rate_.Allow(lcm_.NowUs()))
+        restored_from_ = m.name;
+      else
+        counters_.Add(Counter::kControlRateLimited);
       break;
-    default: break;
+    default:
+      break;
   }
 }
 
@@ -221,7 +238,8 @@ void OperatorStation::OnWindowKeys(const void* data, int size, std::int64_t recv
   k.pressed.assign(m.pressed.begin(), m.pressed.end());
   k.focused = m.focused;
   k.sender_pid = m.sender.pid;
-  if (!source_->window_keyboard()->Receive(k, recv_us)) counters_.Add(Counter::kDroppedWindowKeysStale);
+  if (!source_->window_keyboard()->Receive(k, recv_us))
+    counters_.Add(Counter::kDroppedWindowKeysStale);
 }
 
 void OperatorStation::SendControl(std::int8_t command) {
@@ -229,7 +247,8 @@ void OperatorStation::SendControl(std::int8_t command) {
   m.send_time_us = lcm_.NowUs();
   m.sequence = control_sequence_++;
   m.command = command;
-  if (!transport::PublishMessage(lcm_, wire::channels::kControl, m)) counters_.Add(Counter::kPublishFailed);
+  if (!transport::PublishMessage(lcm_, wire::channels::kControl, m))
+    counters_.Add(Counter::kPublishFailed);
 }
 
 void OperatorStation::ForgetTelemetry(std::int64_t fresh_from_input_frame) {
@@ -248,7 +267,8 @@ void OperatorStation::ApplyRestore() {
     const wire::Checkpoint c = checkpoints_.Read(*restored_from_);
     source_->Resume(c.inputs, true);
     ForgetTelemetry(builder_.next_frame());
-    spdlog::info("RESTORED the checkpoint {}: carrying on from its inputs", checkpoints_.PathOf(*restored_from_));
+    spdlog::info("RESTORED the checkpoint {}: carrying on from its inputs",
+                 checkpoints_.PathOf(*restored_from_));
     counters_.Add(Counter::kControlRestores);
   } catch (const InputError& e) {
     counters_.Add(Counter::kControlRefused);
@@ -284,10 +304,12 @@ void OperatorStation::PublishState(std::int64_t frame, const wire::OperatorInput
     m.key_actions = static_cast<std::int32_t>(h->key_actions());
     m.rate_limited = s.rate_limited;
     // Within the message's bounds (operator_state_t.lcm): the first devices, names cut.
-    const std::size_t n = std::min<std::size_t>(h->device_actions().size(), operator_state_t::MAX_DEVICES);
+    const std::size_t n =
+        std::min<std::size_t>(h->device_actions().size(), operator_state_t::MAX_DEVICES);
     m.num_devices = static_cast<std::int8_t>(n);
     for (std::size_t i = 0; i < n; ++i) {
-      m.device_names.push_back(h->device_name(i).substr(0, operator_state_t::MAX_DEVICE_NAMES_BYTES));
+      m.device_names.push_back(
+          h->device_name(i).substr(0, operator_state_t::MAX_DEVICE_NAMES_BYTES));
       m.device_actions.push_back(static_cast<std::int32_t>(h->device_actions()[i]));
     }
   }
@@ -314,15 +336,18 @@ void OperatorStation::PublishState(std::int64_t frame, const wire::OperatorInput
     m.dock_angle_deg = t.dock_angle_deg;
   }
   (void)in;
-  if (!transport::PublishMessage(lcm_, wire::channels::kOperatorState, m)) counters_.Add(Counter::kPublishFailed);
+  if (!transport::PublishMessage(lcm_, wire::channels::kOperatorState, m))
+    counters_.Add(Counter::kPublishFailed);
 }
 
 void OperatorStation::DrawScreen(std::int64_t frame, const wire::OperatorInputs& in, bool frozen) {
   if (!screen_) return;
   StatusSnapshot s;
-  s.source = source_->Describe() +
-             (frozen ? std::string(" -- FROZEN (") + (source_->hand() ? "freeze key runs, step key steps" : "rms_control run") + ")"
-                     : "");
+  s.source =
+      source_->Describe() +
+      (frozen ? std::string(" -- FROZEN (") +
+                    (source_->hand() ? "freeze key runs, step key steps" : "rms_control run") + ")"
+              : "");
   s.frame = frame;
   s.session_s = static_cast<double>(frames_) / rate_hz_;
   s.inputs = in;
@@ -340,8 +365,9 @@ void OperatorStation::DrawScreen(std::int64_t frame, const wire::OperatorInputs&
   s.render_hz = render_hz_;
   s.input_to_render_p50_ms = render_p50_ms_;
   s.input_to_render_p99_ms = render_p99_ms_;
-  s.clamped_inputs = counters_.Sum(kClampedFirst, kClampedLast) +
-                     (source_->hand() ? source_->hand()->counters().Sum(kClampedFirst, kClampedLast) : 0);
+  s.clamped_inputs =
+      counters_.Sum(kClampedFirst, kClampedLast) +
+      (source_->hand() ? source_->hand()->counters().Sum(kClampedFirst, kClampedLast) : 0);
   s.devices = source_->devices();
   s.help = source_->help();
   screen_->Draw(std::move(s));
@@ -367,7 +393,8 @@ void OperatorStation::ResumeFromTelemetry() {
   from.value[kShoulderHeight] = t.master_shoulder_height_ft;
   from.value[kFinger] = t.master_finger;
   source_->Resume(from, false);
-  spdlog::warn("restarted: resuming from the DCP's telemetry (Mode {}, frame {})", static_cast<int>(t.mode), t.frame);
+  spdlog::warn("restarted: resuming from the DCP's telemetry (Mode {}, frame {})",
+               static_cast<int>(t.mode), t.frame);
 }
 
 // One frame: the source's inputs, published as the input block and the
@@ -387,8 +414,10 @@ bool OperatorStation::StepFrame(transport::StatusReporter* status) {
     ForgetTelemetry(builder_.next_frame());
   }
   const operator_input_t block = builder_.Build(*in, lcm_.NowUs(), &counters_);
-  if (transport::PublishMessage(lcm_, wire::channels::kOperatorInput, block)) counters_.Add(Counter::kPublished);
-  else counters_.Add(Counter::kPublishFailed);
+  if (transport::PublishMessage(lcm_, wire::channels::kOperatorInput, block))
+    counters_.Add(Counter::kPublished);
+  else
+    counters_.Add(Counter::kPublishFailed);
   PublishState(block.frame, *in);
   publish_rate_.Tick(lcm_.NowUs());
   ++frames_;
@@ -405,8 +434,9 @@ int OperatorStation::Finish(const std::string& stats_path, transport::StatusRepo
   counters_.Set(Counter::kFramesTotal, frames_);
   status->Final(builder_.next_frame() - 1, counters_);
   if (!stats_path.empty()) transport::WriteStatsJson(stats_path, "operator_station", counters_, {});
-  spdlog::info("published {} input blocks ({} late, {} clamped inputs)", counters_.Get(Counter::kPublished),
-               counters_.Get(Counter::kFramesLate), counters_.Sum(kClampedFirst, kClampedLast));
+  spdlog::info("published {} input blocks ({} late, {} clamped inputs)",
+               counters_.Get(Counter::kPublished), counters_.Get(Counter::kFramesLate),
+               counters_.Sum(kClampedFirst, kClampedLast));
   if (transport::StopRequested()) {
     spdlog::info("stopped by a signal at frame {}", builder_.next_frame() - 1);
     return kExitInterrupted;
@@ -417,13 +447,15 @@ int OperatorStation::Finish(const std::string& stats_path, transport::StatusRepo
 int OperatorStation::Run(const std::string& stats_path, const std::string& ready_path) {
   if (!options_.restore_path.empty()) {
     const wire::Checkpoint c = wire::ReadCheckpoint(options_.restore_path);
-    spdlog::info("starting from the checkpoint {} (DCP frame {})", options_.restore_path, c.dcp_frame);
+    spdlog::info("starting from the checkpoint {} (DCP frame {})", options_.restore_path,
+                 c.dcp_frame);
     source_->Resume(c.inputs, true);
   }
   // RMSLAB_RESTART (set by the launcher when it restarts this process after a
   // fault, docs/sessions.md "Faults"): the source resumes from the first
   // telemetry's command instead of starting the task over.
-  bool resume_from_telemetry = Restarted() && options_.restore_path.empty() && options_.timeline_path.empty();
+  bool resume_from_telemetry =
+      Restarted() && options_.restore_path.empty() && options_.timeline_path.empty();
   if (Restarted()) counters_.Add(Counter::kRestarted);
   const bool by_hand = source_->hand() != nullptr;
   if (options_.status == 1 || (options_.status == -1 && by_hand && isatty(STDOUT_FILENO))) {

@@ -10,8 +10,8 @@ void TelemetryEvents::Observe(const dcp_telemetry_t& t) {
   if (!last_) {
     last_ = t;
     ++events_;
-    spdlog::info("DCP: Mode {}{}{}", static_cast<int>(t.mode), t.acquired ? ", the payload held" : "",
-                 t.docked ? ", docked" : "");
+    spdlog::info("DCP: Mode {}{}{}", static_cast<int>(t.mode),
+                 t.acquired ? ", the payload held" : "", t.docked ? ", docked" : "");
     return;
   }
   const dcp_telemetry_t& p = *last_;
@@ -31,15 +31,20 @@ void TelemetryEvents::Observe(const dcp_telemetry_t& t) {
     }
   }
   if (t.docked && !p.docked) {
-    event(fmt::format("DOCKED: distance {:.3f} ft, angle {:.2f} deg", t.dock_distance_ft, t.dock_angle_deg));
+    event(fmt::format("DOCKED: distance {:.3f} ft, angle {:.2f} deg", t.dock_distance_ft,
+                      t.dock_angle_deg));
   }
-  const auto now = static_cast<std::uint32_t>(t.collisions), before = static_cast<std::uint32_t>(p.collisions);
+  const auto now = static_cast<std::uint32_t>(t.collisions),
+             before = static_cast<std::uint32_t>(p.collisions);
   for (int b = 0; b < wire::collision_bits::kCount; ++b) {
     const std::uint32_t bit = 1u << b;
-    if ((now & bit) && !(before & bit)) event(fmt::format("COLLISION {} begins", wire::CollisionName(b)));
-    if (!(now & bit) && (before & bit)) event(fmt::format("collision {} ends", wire::CollisionName(b)));
+    if ((now & bit) && !(before & bit))
+      event(fmt::format("COLLISION {} begins", wire::CollisionName(b)));
+    if (!(now & bit) && (before & bit))
+      event(fmt::format("collision {} ends", wire::CollisionName(b)));
   }
-  if (t.held && !p.held) event("HELD: the DCP holds the arm (the command collides): move away from the contact");
+  if (t.held && !p.held)
+    event("HELD: the DCP holds the arm (the command collides): move away from the contact");
   if (!t.held && p.held) event("the arm follows again");
   if (t.finger_held && !p.finger_held) event("the finger stops on the bar");
   last_ = t;

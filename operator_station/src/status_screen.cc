@@ -1,19 +1,19 @@
 #include "rms/operator_station/status_screen.h"
 
-#include <spdlog/sinks/base_sink.h>
-#include <spdlog/spdlog.h>
-#include <sys/ioctl.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <mutex>
+#include <spdlog/sinks/base_sink.h>
+#include <spdlog/spdlog.h>
 #include <sstream>
+#include <sys/ioctl.h>
 
+#include "rms/base/text.h"
 #include "rms/wire/acquisition_conditions.h"
 #include "rms/wire/collision_bits.h"
-#include "rms/base/text.h"
 
 namespace rms::operator_station {
 
@@ -21,10 +21,14 @@ namespace {
 
 const char* ModeName(int m) {
   switch (m) {
-    case 1: return "1 ACQUISITION";
-    case 2: return "2 EXTRACTION";
-    case 3: return "3 MANOEUVRING AND DOCKING";
-    default: return "?";
+    case 1:
+      return "1 ACQUISITION";
+    case 2:
+      return "2 EXTRACTION";
+    case 3:
+      return "3 MANOEUVRING AND DOCKING";
+    default:
+      return "?";
   }
 }
 
@@ -39,8 +43,8 @@ class Flow {
   }
   Flow& Field(const std::string& f) {
     std::string& l = lines_->back();
-    if (static_cast<int>(l.size() + 3 + f.size()) > width_ && l.find_first_not_of(' ') != std::string::npos &&
-        l.size() > 4) {
+    if (static_cast<int>(l.size() + 3 + f.size()) > width_ &&
+        l.find_first_not_of(' ') != std::string::npos && l.size() > 4) {
       lines_->push_back("    " + f);
     } else {
       l += (l.empty() || l.back() == ' ' ? "" : "   ") + f;
@@ -61,7 +65,8 @@ std::string Margin(double m) {
 // The key that moves `action`, for hints: "(w)", or "" when unbound.
 std::string KeyHint(const StatusSnapshot& s, const std::string& action) {
   // In single joint control the hand-controller keys drive a joint: no hint.
-  if (s.hand && s.hand->mode == ControlMode::kSingleJoint && action.rfind("finger", 0) != 0) return "";
+  if (s.hand && s.hand->mode == ControlMode::kSingleJoint && action.rfind("finger", 0) != 0)
+    return "";
   const auto it = s.keys.find(action);
   return it == s.keys.end() ? "" : " (" + it->second + ")";
 }
@@ -75,7 +80,8 @@ void OffsetFields(const StatusSnapshot& s, const Eigen::Vector3d& d_ft, Flow& fl
   for (int i = 0; i < 3; ++i) {
     const double d = d_ft[i];
     const std::string action = std::string(kHandAxisNames[i]) + (d >= 0 ? "+" : "-");
-    flow.Field(Sprintf("%s %s %.2f ft", kAxis[i], kWord[i][d >= 0 ? 0 : 1], std::abs(d)) + KeyHint(s, action));
+    flow.Field(Sprintf("%s %s %.2f ft", kAxis[i], kWord[i][d >= 0 ? 0 : 1], std::abs(d)) +
+               KeyHint(s, action));
   }
 }
 
@@ -94,7 +100,8 @@ void GuidanceLines(const StatusSnapshot& s, Flow& flow) {
     }
   }
   flow.Line(std::string(g.leave_bay ? "then " : "GUIDANCE ") +
-            (g.target == GuidanceTarget::kGrasp ? "to the grasp on the bar receptacle," : "to the CAE's docking port,"))
+            (g.target == GuidanceTarget::kGrasp ? "to the grasp on the bar receptacle,"
+                                                : "to the CAE's docking port,"))
       .Field(g.target == GuidanceTarget::kGrasp ? "from the grasp point," : "from the probe's tip,")
       .Field(axes + ":");
   OffsetFields(s, g.offset_ft, flow);
@@ -105,7 +112,8 @@ void GuidanceLines(const StatusSnapshot& s, Flow& flow) {
   for (int i = 0; i < 3; ++i) {
     const double d = g.rotation_deg[i];
     const std::string action = std::string(kHandAxisNames[3 + i]) + (d >= 0 ? "+" : "-");
-    flow.Field(Sprintf("%s %s %.1f deg", kRot[i], kRotWord[i][d >= 0 ? 0 : 1], std::abs(d)) + KeyHint(s, action));
+    flow.Field(Sprintf("%s %s %.1f deg", kRot[i], kRotWord[i][d >= 0 ? 0 : 1], std::abs(d)) +
+               KeyHint(s, action));
   }
   flow.Field(Sprintf("angle %.1f deg", g.angle_deg));
 }
@@ -113,8 +121,10 @@ void GuidanceLines(const StatusSnapshot& s, Flow& flow) {
 void ControlLines(const StatusSnapshot& s, Flow& flow) {
   const HandStatus& h = *s.hand;
   flow.Line("CONTROL " + std::string(ControlModeName(h.mode)));
-  if (h.mode == ControlMode::kManualAugmented) flow.Field("frame: " + std::string(CommandFrameName(h.frame)));
-  else flow.Field(Sprintf("joint: %s", std::string(kAnalogInputNames[h.joint]).c_str()));
+  if (h.mode == ControlMode::kManualAugmented)
+    flow.Field("frame: " + std::string(CommandFrameName(h.frame)));
+  else
+    flow.Field(Sprintf("joint: %s", std::string(kAnalogInputNames[h.joint]).c_str()));
   flow.Field(std::string("scale: ") + (h.vernier ? "VERNIER" : "COARSE"));
   // What each axis does: "moving x +2.00 ft/s (1.20 ft to go)".
   static const char* kAxis[6] = {"x", "y", "z", "roll", "pitch", "yaw"};
@@ -123,9 +133,10 @@ void ControlLines(const StatusSnapshot& s, Flow& flow) {
   for (int i = 0; i < kNumHandAxes; ++i) {
     if (h.rate[i] == 0.0) continue;
     const bool joint = h.mode == ControlMode::kSingleJoint;
-    std::string m = Sprintf("%s %s %+.2f %s/s", moving ? "" : "moving", joint ? "joint" : kAxis[i], h.rate[i],
-                            joint ? "deg" : kUnit[i]);
-    if (h.pending[i] != 0.0) m += Sprintf(" (%.2f %s to go)", std::abs(h.pending[i]), joint ? "deg" : kUnit[i]);
+    std::string m = Sprintf("%s %s %+.2f %s/s", moving ? "" : "moving", joint ? "joint" : kAxis[i],
+                            h.rate[i], joint ? "deg" : kUnit[i]);
+    if (h.pending[i] != 0.0)
+      m += Sprintf(" (%.2f %s to go)", std::abs(h.pending[i]), joint ? "deg" : kUnit[i]);
     flow.Field(moving ? m.substr(1) : m);
     moving = true;
   }
@@ -133,14 +144,18 @@ void ControlLines(const StatusSnapshot& s, Flow& flow) {
   if (h.at_limit) {
     std::string j;
     for (int i = 0; i < 6; ++i) {
-      if (h.at_limit & (1u << i)) j += std::string(j.empty() ? "" : ", ") + std::string(kAnalogInputNames[i]);
+      if (h.at_limit & (1u << i))
+        j += std::string(j.empty() ? "" : ", ") + std::string(kAnalogInputNames[i]);
     }
     flow.Field("AT JOINT LIMIT: " + j);
   }
-  if (h.singular) flow.Field("NEAR A SINGULAR POSE: some motions slowed").Field("(the arm straight, or the wrist yaw near 90 deg)");
+  if (h.singular)
+    flow.Field("NEAR A SINGULAR POSE: some motions slowed")
+        .Field("(the arm straight, or the wrist yaw near 90 deg)");
   if (h.rate_limited) flow.Field("slowed: a joint at its rate");
   if (h.held_at_port) {
-    flow.Field("DOCKED: the port holds the payload and the arm; open the finger" + KeyHint(s, "finger-") + " to let go");
+    flow.Field("DOCKED: the port holds the payload and the arm; open the finger" +
+               KeyHint(s, "finger-") + " to let go");
   }
 }
 
@@ -149,12 +164,15 @@ void ModeLines(const StatusSnapshot& s, Flow& flow) {
   flow.Line(Sprintf("MODE %s", ModeName(t.mode)))
       .Field(Sprintf("acquired %s", t.acquired ? "YES" : "no"))
       .Field(Sprintf("docked %s", t.docked ? "YES" : "no"))
-      .Field(std::string("arm ") + (t.held ? "HELD: the command collides" : t.finger_held ? "follows, finger held on the bar" : "follows"));
+      .Field(std::string("arm ") + (t.held          ? "HELD: the command collides"
+                                    : t.finger_held ? "follows, finger held on the bar"
+                                                    : "follows"));
 }
 
 void CollisionLines(const StatusSnapshot& s, Flow& flow) {
   const dcp_telemetry_t& t = *s.telemetry;
-  flow.Line("collisions: " + wire::CollisionNames(static_cast<std::uint32_t>(t.collisions), ", ", "none"));
+  flow.Line("collisions: " +
+            wire::CollisionNames(static_cast<std::uint32_t>(t.collisions), ", ", "none"));
 }
 
 void ConditionLines(const StatusSnapshot& s, const LabConfig& config, int width, Flow& flow) {
@@ -165,37 +183,46 @@ void ConditionLines(const StatusSnapshot& s, const LabConfig& config, int width,
     const bool wide = width >= 110;
     for (int i = 0; i < wire::kNumAcquisitionConditions; ++i) {
       if (i % (wide ? 2 : 3) == 0) flow.Line(" ");
-      flow.Field(Sprintf(wide ? "[%c] %d %-24s %-20s" : "[%c] %d %s: %s", t.acquisition_conditions[i] ? 'x' : ' ', i + 1,
-                         wide ? wire::kAcquisitionConditionNames[i].brief : wire::kAcquisitionConditionNames[i].tag,
+      flow.Field(Sprintf(wide ? "[%c] %d %-24s %-20s" : "[%c] %d %s: %s",
+                         t.acquisition_conditions[i] ? 'x' : ' ', i + 1,
+                         wide ? wire::kAcquisitionConditionNames[i].brief
+                              : wire::kAcquisitionConditionNames[i].tag,
                          Margin(t.acquisition_margin_ft[i]).c_str()));
     }
     flow.Line(Sprintf("  finger gap %.3f ft (D3Y %.3f)", t.finger_gap_ft, config.dcp.d3y_ft))
-        .Field(Sprintf("palm to BAR %.3f ft (TPOB %.3f)", std::abs(t.palm_to_bar_ft), config.dcp.tpob_ft));
+        .Field(Sprintf("palm to BAR %.3f ft (TPOB %.3f)", std::abs(t.palm_to_bar_ft),
+                       config.dcp.tpob_ft));
     if (s.guidance && s.guidance->close_gap_ft > 0) {
       const double g = s.guidance->close_gap_ft;
-      flow.Field(Sprintf("closed, the finger would stop at %.3f ft: %s", g,
-                         g < config.dcp.d3y_ft ? "below D3Y" : "NOT below D3Y (the BAR nearer the fixed finger)"));
+      flow.Field(Sprintf(
+          "closed, the finger would stop at %.3f ft: %s", g,
+          g < config.dcp.d3y_ft ? "below D3Y" : "NOT below D3Y (the BAR nearer the fixed finger)"));
     }
   } else if (t.mode == 2) {
     flow.Line("ACQUISITION: acquired; the payload is held")
-        .Field(t.bay_clearance_ft > 0 ? Sprintf("clear of the bay by %.2f ft", t.bay_clearance_ft)
-                                      : Sprintf("in the bay: %.2f ft to lift it clear", -t.bay_clearance_ft));
+        .Field(t.bay_clearance_ft > 0
+                   ? Sprintf("clear of the bay by %.2f ft", t.bay_clearance_ft)
+                   : Sprintf("in the bay: %.2f ft to lift it clear", -t.bay_clearance_ft));
   } else {
     flow.Line("ACQUISITION: acquired; the payload is held, out of the bay");
   }
-  flow.Line(Sprintf("DOCKING distance %.3f ft (<= %.2f)", t.dock_distance_ft, config.dcp.dock_distance_ft))
+  flow.Line(Sprintf("DOCKING distance %.3f ft (<= %.2f)", t.dock_distance_ft,
+                    config.dcp.dock_distance_ft))
       .Field(Sprintf("angle %.2f deg (<= %.2f)", t.dock_angle_deg, config.dcp.dock_angle_deg))
-      .Field(t.probe_in_envelope ? Sprintf("probe in the envelope (by %.2f ft)", t.envelope_margin_ft)
-                                 : Sprintf("probe outside the envelope by %.2f ft", -t.envelope_margin_ft));
+      .Field(t.probe_in_envelope
+                 ? Sprintf("probe in the envelope (by %.2f ft)", t.envelope_margin_ft)
+                 : Sprintf("probe outside the envelope by %.2f ft", -t.envelope_margin_ft));
 }
 
 void CameraLines(const StatusSnapshot& s, const LabConfig& config, Flow& flow) {
   const wire::OperatorInputs& in = s.inputs;
   const int st = in.camera_station;
   flow.Line(Sprintf("camera %d %s", st,
-                    st >= 1 && st <= static_cast<int>(config.cameras.size()) ? config.cameras[st - 1].name.c_str() : "?"))
-      .Field(Sprintf("pan %+6.1f  tilt %+6.1f  zoom %.2f", in.value[kCameraPan], in.value[kCameraTilt],
-                     in.value[kCameraZoom]))
+                    st >= 1 && st <= static_cast<int>(config.cameras.size())
+                        ? config.cameras[st - 1].name.c_str()
+                        : "?"))
+      .Field(Sprintf("pan %+6.1f  tilt %+6.1f  zoom %.2f", in.value[kCameraPan],
+                     in.value[kCameraTilt], in.value[kCameraZoom]))
       .Field(std::string("crosshairs ") + (in.crosshairs ? "on" : "off"))
       .Field(std::string("overlay ") + (in.overlay ? "on" : "off"));
   if (s.hand) flow.Field(std::string("window guidance ") + (s.show_guidance ? "on" : "off"));
@@ -216,11 +243,14 @@ void ArmLines(const StatusSnapshot& s, Flow& flow) {
 void RateLines(const StatusSnapshot& s, Flow& flow) {
   flow.Line(Sprintf("rates: published %.1f Hz", s.publish_hz))
       .Field(Sprintf("DCP %.1f Hz", s.telemetry_hz))
-      .Field(s.render_hz >= 0 ? Sprintf("rendered %.1f Hz", s.render_hz) : "rendered ? (no status from esg_renderer)");
-  flow.Line("latency: input to DCP " + (s.input_to_dcp_ms >= 0 ? Sprintf("%.1f ms", s.input_to_dcp_ms) : "?"))
+      .Field(s.render_hz >= 0 ? Sprintf("rendered %.1f Hz", s.render_hz)
+                              : "rendered ? (no status from esg_renderer)");
+  flow.Line("latency: input to DCP " +
+            (s.input_to_dcp_ms >= 0 ? Sprintf("%.1f ms", s.input_to_dcp_ms) : "?"))
       .Field("input to rendered frame " +
              (s.input_to_render_p50_ms >= 0
-                  ? Sprintf("p50 %.1f ms, p99 %.1f ms", s.input_to_render_p50_ms, s.input_to_render_p99_ms)
+                  ? Sprintf("p50 %.1f ms, p99 %.1f ms", s.input_to_render_p50_ms,
+                            s.input_to_render_p99_ms)
                   : std::string("? (no status from esg_renderer)")));
   flow.Line(Sprintf("inputs clamped to their range: %ld", s.clamped_inputs));
   if (s.key_actions >= 0) flow.Field(Sprintf("keys pressed: %ld", s.key_actions));
@@ -246,11 +276,14 @@ void HelpLines(const StatusSnapshot& s, Flow& flow) {
 
 // Too small for the screen: say so, in what room there is.
 std::string TooSmallScreen(const StatusSnapshot& s, int width, int height) {
-  std::vector<std::string> L = {"rmslab operator station",
-                                Sprintf("terminal %dx%d: needs %dx%d", width, height, kMinWidth, kMinHeight)};
-  if (s.telemetry) L.push_back(Sprintf("MODE %d%s%s", s.telemetry->mode, s.telemetry->acquired ? " ACQ" : "",
-                                       s.telemetry->docked ? " DOCK" : ""));
-  if (s.guidance) L.push_back(Sprintf("to go %.2f ft %.1f deg", s.guidance->distance_ft, s.guidance->angle_deg));
+  std::vector<std::string> L = {
+      "rmslab operator station",
+      Sprintf("terminal %dx%d: needs %dx%d", width, height, kMinWidth, kMinHeight)};
+  if (s.telemetry)
+    L.push_back(Sprintf("MODE %d%s%s", s.telemetry->mode, s.telemetry->acquired ? " ACQ" : "",
+                        s.telemetry->docked ? " DOCK" : ""));
+  if (s.guidance)
+    L.push_back(Sprintf("to go %.2f ft %.1f deg", s.guidance->distance_ft, s.guidance->angle_deg));
   std::string out;
   for (int i = 0; i < std::min<int>(height, static_cast<int>(L.size())); ++i) {
     out += L[i].substr(0, static_cast<std::size_t>(std::max(width, 1))) + "\n";
@@ -270,9 +303,13 @@ struct Section {
 std::vector<Section> BuildSections(const StatusSnapshot& s, const LabConfig& config, int width) {
   std::vector<Section> sections;
   const std::string title = "rmslab operator station -- " + s.source;
-  const std::string right = Sprintf("t %.1f s  frame %06lld", s.session_s, static_cast<long long>(s.frame));
+  const std::string right =
+      Sprintf("t %.1f s  frame %06lld", s.session_s, static_cast<long long>(s.frame));
   sections.push_back(
-      {0, {title + std::string(std::max<int>(1, width - static_cast<int>(title.size() + right.size())), ' ') + right}});
+      {0,
+       {title +
+        std::string(std::max<int>(1, width - static_cast<int>(title.size() + right.size())), ' ') +
+        right}});
   // Each section's lines are written while it is the last one (a Flow
   // points into it).
   auto add = [&](int priority, const auto& lines) {
@@ -281,8 +318,11 @@ std::vector<Section> BuildSections(const StatusSnapshot& s, const LabConfig& con
     lines(flow);
   };
   add(0, [&](Flow& f) {
-    if (s.telemetry) ModeLines(s, f);
-    else f.Line("MODE ?  (no telemetry from dynamics_proc since the start, the last reset or restore)");
+    if (s.telemetry)
+      ModeLines(s, f);
+    else
+      f.Line(
+          "MODE ?  (no telemetry from dynamics_proc since the start, the last reset or restore)");
   });
   if (s.telemetry) add(s.telemetry->collisions ? 0 : 1, [&](Flow& f) { CollisionLines(s, f); });
   if (s.hand) add(0, [&](Flow& f) { ControlLines(s, f); });
@@ -305,7 +345,8 @@ int LinesUsed(const std::vector<Section>& sections) {
 
 }  // namespace
 
-std::string RenderStatusScreen(const StatusSnapshot& s, const LabConfig& config, int width, int height) {
+std::string RenderStatusScreen(const StatusSnapshot& s, const LabConfig& config, int width,
+                               int height) {
   if (width < kMinWidth || height < kMinHeight) return TooSmallScreen(s, width, height);
   std::vector<Section> sections = BuildSections(s, config, width);
   // Drop the least important sections until the events pane has 3 lines.
@@ -328,7 +369,8 @@ std::string RenderStatusScreen(const StatusSnapshot& s, const LabConfig& config,
   L.push_back("--- events and log ---");
   const std::size_t first = s.log.size() > static_cast<std::size_t>(pane) ? s.log.size() - pane : 0;
   for (std::size_t i = first; i < s.log.size(); ++i) L.push_back(s.log[i]);
-  for (std::size_t i = s.log.size() - first; i < static_cast<std::size_t>(pane); ++i) L.push_back("");
+  for (std::size_t i = s.log.size() - first; i < static_cast<std::size_t>(pane); ++i)
+    L.push_back("");
   if (help) L.insert(L.end(), help->lines.begin(), help->lines.end());
   std::string out;
   for (auto& l : L) {
@@ -366,8 +408,12 @@ class LineSink : public spdlog::sinks::base_sink<std::mutex> {
     localtime_r(&t, &tm);
     char hms[16];
     std::strftime(hms, sizeof hms, "%H:%M:%S", &tm);
-    const std::string level = msg.level == spdlog::level::info ? "" : std::string(spdlog::level::to_string_view(msg.level).data()) + ": ";
-    brief_.push_back(std::string(hms) + " " + level + std::string(msg.payload.data(), msg.payload.size()));
+    const std::string level =
+        msg.level == spdlog::level::info
+            ? ""
+            : std::string(spdlog::level::to_string_view(msg.level).data()) + ": ";
+    brief_.push_back(std::string(hms) + " " + level +
+                     std::string(msg.payload.data(), msg.payload.size()));
   }
   void flush_() override {}
 
@@ -378,7 +424,8 @@ class LineSink : public spdlog::sinks::base_sink<std::mutex> {
 // The terminal's size (columns, rows), or 100 x 48 when it cannot be asked.
 std::pair<int, int> TerminalSize() {
   winsize ws{};
-  if (ioctl(STDOUT_FILENO, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 0 && ws.ws_row > 0) return {ws.ws_col, ws.ws_row};
+  if (ioctl(STDOUT_FILENO, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 0 && ws.ws_row > 0)
+    return {ws.ws_col, ws.ws_row};
   return {100, 48};
 }
 }  // namespace
@@ -389,7 +436,8 @@ struct StatusScreen::LogCapture {
   std::shared_ptr<LineSink> lines;
 };
 
-StatusScreen::StatusScreen(const LabConfig& config) : config_(config), capture_(std::make_unique<LogCapture>()) {
+StatusScreen::StatusScreen(const LabConfig& config)
+    : config_(config), capture_(std::make_unique<LogCapture>()) {
   capture_->logger = spdlog::default_logger();
   capture_->saved = capture_->logger->sinks();
   capture_->lines = std::make_shared<LineSink>();
@@ -409,7 +457,8 @@ StatusScreen::~StatusScreen() {
 
 void StatusScreen::Draw(StatusSnapshot s) {
   const auto [width, height] = TerminalSize();
-  for (std::string& line : capture_->lines->Last(static_cast<std::size_t>(height))) s.log.push_back(std::move(line));
+  for (std::string& line : capture_->lines->Last(static_cast<std::size_t>(height)))
+    s.log.push_back(std::move(line));
   const std::string text = RenderStatusScreen(s, config_, width, height);
   std::string frame = "\x1b[H";
   std::istringstream is(text);

@@ -9,22 +9,24 @@ namespace rms::operator_station {
 
 std::optional<Counter> TelemetryProblem(const dcp_telemetry_t& m) {
   constexpr std::int64_t kMaxFrame = std::int64_t{1} << 48, kMaxTimeUs = std::int64_t{1} << 62;
-  if (m.frame < 0 || m.input_frame < 0 || m.frame >= kMaxFrame || m.input_frame >= kMaxFrame) return Counter::kDroppedTelemetryFrame;
+  if (m.frame < 0 || m.input_frame < 0 || m.frame >= kMaxFrame || m.input_frame >= kMaxFrame)
+    return Counter::kDroppedTelemetryFrame;
   if (m.send_time_us < 0 || m.send_time_us >= kMaxTimeUs || m.input_send_time_us < 0 ||
       m.input_send_time_us >= kMaxTimeUs)
     return Counter::kDroppedTelemetryTime;
   if (m.mode < 1 || m.mode > 3) return Counter::kDroppedTelemetryMode;
   const std::uint32_t defined = (1u << wire::collision_bits::kCount) - 1;
-  if ((static_cast<std::uint32_t>(m.collisions) & ~defined) || (static_cast<std::uint32_t>(m.slave_collisions) & ~defined))
+  if ((static_cast<std::uint32_t>(m.collisions) & ~defined) ||
+      (static_cast<std::uint32_t>(m.slave_collisions) & ~defined))
     return Counter::kDroppedTelemetryCollisionBits;
   bool finite = true;
   auto all = [&](const double* v, int n) {
     for (int i = 0; i < n; ++i) finite = finite && std::isfinite(v[i]);
   };
   all(m.acquisition_margin_ft, 6);
-  for (double x : {m.finger_gap_ft, m.palm_to_bar_ft, m.bay_clearance_ft, m.envelope_margin_ft, m.dock_distance_ft,
-                   m.dock_angle_deg,
-                   m.master_shoulder_height_ft, m.slave_shoulder_height_ft, m.master_finger, m.slave_finger})
+  for (double x : {m.finger_gap_ft, m.palm_to_bar_ft, m.bay_clearance_ft, m.envelope_margin_ft,
+                   m.dock_distance_ft, m.dock_angle_deg, m.master_shoulder_height_ft,
+                   m.slave_shoulder_height_ft, m.master_finger, m.slave_finger})
     finite = finite && std::isfinite(x);
   all(m.plane_n, 9);
   all(m.plane_d_ft, 3);

@@ -48,7 +48,8 @@ namespace {
 // before's, at most 1e6; InputError "WHERE: why" otherwise.
 double LineTime(std::string_view tok, double prev_t, const std::string& where) {
   double t = 0;
-  if (!ParseDouble(tok, &t)) throw InputError(where + ": '" + std::string(tok) + "' is not a time in seconds");
+  if (!ParseDouble(tok, &t))
+    throw InputError(where + ": '" + std::string(tok) + "' is not a time in seconds");
   if (t < 0) throw InputError(where + ": time " + std::string(tok) + " is negative");
   if (t < prev_t) {
     throw InputError(where + ": time " + std::string(tok) +
@@ -61,8 +62,8 @@ double LineTime(std::string_view tok, double prev_t, const std::string& where) {
 }  // namespace
 
 // One item of a line at time t: reset, end, or key=value.
-void Timeline::AddItem(double t, std::string_view item, const InputCalibrations& cal, const std::string& where,
-                       bool* end) {
+void Timeline::AddItem(double t, std::string_view item, const InputCalibrations& cal,
+                       const std::string& where, bool* end) {
   auto fail = [&](const std::string& why) -> void { throw InputError(where + ": " + why); };
   if (item == "reset") {
     resets_.push_back(t);
@@ -73,7 +74,8 @@ void Timeline::AddItem(double t, std::string_view item, const InputCalibrations&
     return;
   }
   const std::size_t eq = item.find('=');
-  if (eq == std::string_view::npos) fail("'" + std::string(item) + "' is not key=value, reset or end");
+  if (eq == std::string_view::npos)
+    fail("'" + std::string(item) + "' is not key=value, reset or end");
   const std::string key(item.substr(0, eq));
   const std::string_view val = item.substr(eq + 1);
   if (key == "camera") {
@@ -86,25 +88,31 @@ void Timeline::AddItem(double t, std::string_view item, const InputCalibrations&
   }
   if (key == "overlay" || key == "crosshairs") {
     auto& steps = key == "overlay" ? overlay_ : crosshairs_;
-    if (val == "on" || val == "1") steps.emplace_back(t, true);
-    else if (val == "off" || val == "0") steps.emplace_back(t, false);
-    else fail(std::string(key) + " must be on or off, got '" + std::string(val) + "'");
+    if (val == "on" || val == "1")
+      steps.emplace_back(t, true);
+    else if (val == "off" || val == "0")
+      steps.emplace_back(t, false);
+    else
+      fail(std::string(key) + " must be on or off, got '" + std::string(val) + "'");
     return;
   }
   const int idx = AnalogInputIndex(key);
   if (idx < 0) fail("unknown key '" + key + "' (known: " + KnownKeys() + ")");
   double v = 0;
-  if (!ParseDouble(val, &v)) fail("value '" + std::string(val) + "' for '" + key + "' is not a number");
+  if (!ParseDouble(val, &v))
+    fail("value '" + std::string(val) + "' for '" + key + "' is not a number");
   const InputCalibration& c = cal[idx];
   if (v < c.min || v > c.max) {
     std::ostringstream w;
-    w << where << ": " << key << "=" << v << " is outside [" << c.min << ", " << c.max << "] " << c.unit
-      << "; it will be clamped";
+    w << where << ": " << key << "=" << v << " is outside [" << c.min << ", " << c.max << "] "
+      << c.unit << "; it will be clamped";
     warnings_.push_back(w.str());
   }
   auto& keys = analog_[idx];
-  if (!keys.empty() && keys.back().t == t) keys.back().v = v;
-  else keys.push_back({t, v});
+  if (!keys.empty() && keys.back().t == t)
+    keys.back().v = v;
+  else
+    keys.push_back({t, v});
 }
 
 Timeline Timeline::Parse(std::string_view text, const std::string& source,
@@ -121,7 +129,8 @@ Timeline Timeline::Parse(std::string_view text, const std::string& source,
     std::string_view line = text.substr(pos, nl - pos);
     pos = nl + 1;
     ++line_no;
-    if (const std::size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
+    if (const std::size_t hash = line.find('#'); hash != std::string_view::npos)
+      line = line.substr(0, hash);
     std::vector<std::string_view> tok = SplitWs(line);
     if (tok.empty()) continue;
     const std::string where = source + ":" + std::to_string(line_no);
@@ -129,14 +138,16 @@ Timeline Timeline::Parse(std::string_view text, const std::string& source,
     const double t = LineTime(tok[0], prev_t, where);
     prev_t = t;
     tl.end_time_ = t;
-    if (tok.size() == 1) throw InputError(where + ": a time with nothing to do (expected key=value, reset or end)");
+    if (tok.size() == 1)
+      throw InputError(where + ": a time with nothing to do (expected key=value, reset or end)");
     for (std::size_t i = 1; i < tok.size(); ++i) tl.AddItem(t, tok[i], cal, where, &have_end);
   }
   if (tl.end_time_ <= 0.0) throw InputError(source + ": the timeline must last longer than 0 s");
   // Implicit keyframes at t = 0 with the initial values.
   for (int i = 0; i < kNumAnalogInputs; ++i) {
     auto& keys = tl.analog_[i];
-    if (keys.empty() || keys.front().t > 0.0) keys.insert(keys.begin(), {0.0, tl.initial_.value[i]});
+    if (keys.empty() || keys.front().t > 0.0)
+      keys.insert(keys.begin(), {0.0, tl.initial_.value[i]});
   }
   return tl;
 }

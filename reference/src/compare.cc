@@ -14,17 +14,28 @@ namespace rms::reference {
 namespace {
 const char* DeciderName(dynamics_proc::Decider d) {
   switch (d) {
-    case dynamics_proc::Decider::kVertexOfAInB: return "vertex of A in B";
-    case dynamics_proc::Decider::kVertexOfBInA: return "vertex of B in A";
-    case dynamics_proc::Decider::kFaceOfBSeparates: return "face of B separates";
-    case dynamics_proc::Decider::kFaceOfASeparates: return "face of A separates";
-    case dynamics_proc::Decider::kEdgeOfAPiercesB: return "edge of A pierces B";
-    case dynamics_proc::Decider::kEdgeOfBPiercesA: return "edge of B pierces A";
-    case dynamics_proc::Decider::kNoEdgePierces: return "no edge pierces";
-    case dynamics_proc::Decider::kNonFinite: return "invalid";
-    case dynamics_proc::Decider::kSpheresApart: return "bounding spheres apart";
-    case dynamics_proc::Decider::kHintPlane: return "previous plane separates";
-    case dynamics_proc::Decider::kBoxesApart: return "bounding boxes apart";
+    case dynamics_proc::Decider::kVertexOfAInB:
+      return "vertex of A in B";
+    case dynamics_proc::Decider::kVertexOfBInA:
+      return "vertex of B in A";
+    case dynamics_proc::Decider::kFaceOfBSeparates:
+      return "face of B separates";
+    case dynamics_proc::Decider::kFaceOfASeparates:
+      return "face of A separates";
+    case dynamics_proc::Decider::kEdgeOfAPiercesB:
+      return "edge of A pierces B";
+    case dynamics_proc::Decider::kEdgeOfBPiercesA:
+      return "edge of B pierces A";
+    case dynamics_proc::Decider::kNoEdgePierces:
+      return "no edge pierces";
+    case dynamics_proc::Decider::kNonFinite:
+      return "invalid";
+    case dynamics_proc::Decider::kSpheresApart:
+      return "bounding spheres apart";
+    case dynamics_proc::Decider::kHintPlane:
+      return "previous plane separates";
+    case dynamics_proc::Decider::kBoxesApart:
+      return "bounding boxes apart";
   }
   return "?";
 }
@@ -42,7 +53,8 @@ Pair DrawPair(PairGenerator& gen, long n, double scale, double band_rel) {
     std::uniform_real_distribution<double> lg(0.0, 2.0);
     std::uniform_int_distribution<int> sg(0, 15);
     const int k = sg(gen.rng());
-    const double mag = (k < 2 ? 0.5 : 1.01) * band_rel * std::pow(10.0, k < 2 ? -lg(gen.rng()) : lg(gen.rng()));
+    const double mag =
+        (k < 2 ? 0.5 : 1.01) * band_rel * std::pow(10.0, k < 2 ? -lg(gen.rng()) : lg(gen.rng()));
     p = gen.NearParallelEdges(scale, k % 2 ? mag : -mag);
   } else {
     p = gen.Next(scale, boxes_only);
@@ -66,22 +78,25 @@ bool ReferenceHit(const Pair& p, long n, int exact_every, CompareStats* st) {
   bool hit = BoxesIntersect(p.a.box, p.b.box);
   if ((exact_every > 0 && n % exact_every == 0) || p.kind.rfind("near-parallel", 0) == 0) {
     ++st->exact_checked;
-    hit = ExactHullsIntersect(p.a.v, p.b.v);  // near contact the long double test may differ; exact wins
+    hit = ExactHullsIntersect(p.a.v,
+                              p.b.v);  // near contact the long double test may differ; exact wins
   }
   return hit;
 }
 
 // The DCP's verdict and plane against the reference's, within the band
 // (docs/collision.md "Tolerance rule": 1000 x tau).
-void Judge(const Pair& p, const dynamics_proc::CollisionResult& r, bool ref_hit, long n, double scale,
-           double band_rel, const Topology& topo, CompareStats* st) {
+void Judge(const Pair& p, const dynamics_proc::CollisionResult& r, bool ref_hit, long n,
+           double scale, double band_rel, const Topology& topo, CompareStats* st) {
   const double band = 1000.0 * dynamics_proc::ToleranceFt(p.a.hex, p.b.hex, band_rel / 1000.0);
   const double s = std::max(p.a.hex.scale, p.b.hex.scale);
   if (r.verdict == dynamics_proc::Verdict::kInvalid) {
     ++st->invalid;
     if (st->examples.size() < 10) {
-      st->examples.push_back("pair " + std::to_string(n) + " (" + p.kind + ", scale " + std::to_string(scale) +
-                             "): invalid: " + dynamics_proc::HexProblemName(p.a.hex.valid ? p.b.hex.problem : p.a.hex.problem));
+      st->examples.push_back(
+          "pair " + std::to_string(n) + " (" + p.kind + ", scale " + std::to_string(scale) +
+          "): invalid: " +
+          dynamics_proc::HexProblemName(p.a.hex.valid ? p.b.hex.problem : p.a.hex.problem));
     }
     return;
   }
@@ -103,9 +118,10 @@ void Judge(const Pair& p, const dynamics_proc::CollisionResult& r, bool ref_hit,
     if (st->examples.size() < 10) {
       std::ostringstream os;
       os.precision(17);
-      os << "pair " << n << " (" << p.kind << ", scale " << scale << "): dcp " << (dcp_hit ? "collide" : "separate")
-         << " by '" << DeciderName(r.decider) << "', reference " << (ref_hit ? "intersect" : "disjoint")
-         << ", separation " << sep << " = " << sep / s << " x scale (band " << band / s << " x scale)";
+      os << "pair " << n << " (" << p.kind << ", scale " << scale << "): dcp "
+         << (dcp_hit ? "collide" : "separate") << " by '" << DeciderName(r.decider)
+         << "', reference " << (ref_hit ? "intersect" : "disjoint") << ", separation " << sep
+         << " = " << sep / s << " x scale (band " << band / s << " x scale)";
       st->examples.push_back(os.str());
     }
   } else if (!dcp_hit) {
@@ -151,8 +167,8 @@ std::string Describe(const CompareStats& s) {
      << " checked exactly): " << s.disagree_outside << " disagreements outside the band, "
      << s.disagree_in_band << " inside it; " << s.invalid << " invalid; separating planes missing "
      << s.plane_missing << ", wrong " << s.plane_wrong << "\n";
-  os << "  DCP " << 1e9 * s.dcp_seconds / s.pairs << " ns/pair, reference " << 1e9 * s.ref_seconds / s.pairs
-     << " ns/pair (timed inside the test loop)\n";
+  os << "  DCP " << 1e9 * s.dcp_seconds / s.pairs << " ns/pair, reference "
+     << 1e9 * s.ref_seconds / s.pairs << " ns/pair (timed inside the test loop)\n";
   os << "  kinds:";
   for (const auto& [k, n] : s.pairs_by_kind) os << " " << k << " " << n << ";";
   os << "\n  disagreements inside the band, by kind:";

@@ -3,7 +3,6 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Gmpq.h>
 #include <CGAL/Interval_nt.h>
-
 #include <atomic>
 #include <utility>
 #include <vector>
@@ -125,7 +124,8 @@ bool AxisSeparates(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eig
 
 long ExactFallbacks() { return g_fallbacks.load(); }
 
-bool ExactHullsIntersect(const std::array<Eigen::Vector3d, 8>& a, const std::array<Eigen::Vector3d, 8>& b) {
+bool ExactHullsIntersect(const std::array<Eigen::Vector3d, 8>& a,
+                         const std::array<Eigen::Vector3d, 8>& b) {
   const Hull ha = ExactHull(a), hb = ExactHull(b);
   // Facet normals: n = (j - i) x (k - i).
   for (const auto* hv : {&ha, &hb}) {

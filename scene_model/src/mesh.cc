@@ -1,12 +1,11 @@
 #include "rms/scene_model/mesh.h"
 
-#include <cmath>
-
 #include <Eigen/Geometry>
+#include <cmath>
 
 namespace rms::scene_model {
 
-void Mesh::AddTri(Eigen::Vector3f a, Eigen::Vector3f b, Eigen::Vector3f c,
+void Mesh::AddTri(const Eigen::Vector3f& a, Eigen::Vector3f b, Eigen::Vector3f c,
                   const Eigen::Vector3f& outward, const Rgb& rgb) {
   Eigen::Vector3f n = (b - a).cross(c - a);
   if (n.dot(outward) < 0) {
@@ -48,12 +47,18 @@ void Mesh::AddBoxInterior(const Eigen::Vector3f& lo, const Eigen::Vector3f& hi,
   const auto P = [&](int i, int j, int k) {
     return Eigen::Vector3f(i ? hi.x() : lo.x(), j ? hi.y() : lo.y(), k ? hi.z() : lo.z());
   };
-  if (!(skip & 1)) AddQuad(P(0, 0, 0), P(0, 1, 0), P(0, 1, 1), P(0, 0, 1), Eigen::Vector3f::UnitX(), rgb[0]);
-  if (!(skip & 2)) AddQuad(P(1, 0, 0), P(1, 1, 0), P(1, 1, 1), P(1, 0, 1), -Eigen::Vector3f::UnitX(), rgb[1]);
-  if (!(skip & 4)) AddQuad(P(0, 0, 0), P(1, 0, 0), P(1, 0, 1), P(0, 0, 1), Eigen::Vector3f::UnitY(), rgb[2]);
-  if (!(skip & 8)) AddQuad(P(0, 1, 0), P(1, 1, 0), P(1, 1, 1), P(0, 1, 1), -Eigen::Vector3f::UnitY(), rgb[3]);
-  if (!(skip & 16)) AddQuad(P(0, 0, 0), P(1, 0, 0), P(1, 1, 0), P(0, 1, 0), Eigen::Vector3f::UnitZ(), rgb[4]);
-  if (!(skip & 32)) AddQuad(P(0, 0, 1), P(1, 0, 1), P(1, 1, 1), P(0, 1, 1), -Eigen::Vector3f::UnitZ(), rgb[5]);
+  if (!(skip & 1))
+    AddQuad(P(0, 0, 0), P(0, 1, 0), P(0, 1, 1), P(0, 0, 1), Eigen::Vector3f::UnitX(), rgb[0]);
+  if (!(skip & 2))
+    AddQuad(P(1, 0, 0), P(1, 1, 0), P(1, 1, 1), P(1, 0, 1), -Eigen::Vector3f::UnitX(), rgb[1]);
+  if (!(skip & 4))
+    AddQuad(P(0, 0, 0), P(1, 0, 0), P(1, 0, 1), P(0, 0, 1), Eigen::Vector3f::UnitY(), rgb[2]);
+  if (!(skip & 8))
+    AddQuad(P(0, 1, 0), P(1, 1, 0), P(1, 1, 1), P(0, 1, 1), -Eigen::Vector3f::UnitY(), rgb[3]);
+  if (!(skip & 16))
+    AddQuad(P(0, 0, 0), P(1, 0, 0), P(1, 1, 0), P(0, 1, 0), Eigen::Vector3f::UnitZ(), rgb[4]);
+  if (!(skip & 32))
+    AddQuad(P(0, 0, 1), P(1, 0, 1), P(1, 1, 1), P(0, 1, 1), -Eigen::Vector3f::UnitZ(), rgb[5]);
 }
 
 void Mesh::AddCylinder(const Eigen::Vector3f& p0, const Eigen::Vector3f& p1, float radius,
@@ -80,8 +85,8 @@ void Mesh::AddCylinder(const Eigen::Vector3f& p0, const Eigen::Vector3f& p1, flo
   }
 }
 
-void Mesh::AddFrustum(const Eigen::Vector3f& p0, const Eigen::Vector3f& p1, float r0, float r1, int sides,
-                      const Rgb& rgb) {
+void Mesh::AddFrustum(const Eigen::Vector3f& p0, const Eigen::Vector3f& p1, float r0, float r1,
+                      int sides, const Rgb& rgb) {
   const Eigen::Vector3f w = (p1 - p0).normalized();
   const Eigen::Vector3f helper =
       std::abs(w.x()) < 0.9f ? Eigen::Vector3f::UnitX() : Eigen::Vector3f::UnitY();
@@ -90,7 +95,8 @@ void Mesh::AddFrustum(const Eigen::Vector3f& p0, const Eigen::Vector3f& p1, floa
   for (int i = 0; i < sides; ++i) {
     const float t0 = 2.0f * static_cast<float>(M_PI) * i / sides;
     const float t1 = 2.0f * static_cast<float>(M_PI) * (i + 1) / sides;
-    const Eigen::Vector3f d0 = std::cos(t0) * u + std::sin(t0) * v, d1 = std::cos(t1) * u + std::sin(t1) * v;
+    const Eigen::Vector3f d0 = std::cos(t0) * u + std::sin(t0) * v,
+                          d1 = std::cos(t1) * u + std::sin(t1) * v;
     const Eigen::Vector3f out = (d0 + d1) * (r0 + r1) * 0.5f + (r0 - r1) * w;
     AddQuad(p0 + r0 * d0, p0 + r0 * d1, p1 + r1 * d1, p1 + r1 * d0, out, rgb);
     AddTri(p0, p0 + r0 * d0, p0 + r0 * d1, -w, rgb);

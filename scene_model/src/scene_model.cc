@@ -12,12 +12,12 @@ using V = Eigen::Vector3f;
 
 std::string_view ClusterName(int id) {
   static constexpr std::array<std::string_view, kNumClusters> kNames = {
-      "floor",        "wall_port",    "wall_stbd",  "bulkhead_fwd", "bulkhead_aft", "sill_port",
-      "sill_stbd",    "side_port",    "side_stbd",  "cabin",        "aft_fuselage", "tail",
-      "wing_port",    "wing_stbd",    "door_port",  "door_stbd",    "cae_module",   "cae_array",    "dock_target",
-      "post",         "shoulder",     "upper_boom", "elbow",        "lower_boom",   "wrist",
-      "eff_hex_1",    "eff_hex_2",    "eff_hex_3",  "payload_body", "bar",          "bar_post_a",
-      "bar_post_b",   "probe",        "grapple_target"};
+      "floor",       "wall_port",  "wall_stbd", "bulkhead_fwd",  "bulkhead_aft", "sill_port",
+      "sill_stbd",   "side_port",  "side_stbd", "cabin",         "aft_fuselage", "tail",
+      "wing_port",   "wing_stbd",  "door_port", "door_stbd",     "cae_module",   "cae_array",
+      "dock_target", "post",       "shoulder",  "upper_boom",    "elbow",        "lower_boom",
+      "wrist",       "eff_hex_1",  "eff_hex_2", "eff_hex_3",     "payload_body", "bar",
+      "bar_post_a",  "bar_post_b", "probe",     "grapple_target"};
   return id >= 0 && id < kNumClusters ? kNames[id] : "?";
 }
 
@@ -27,7 +27,9 @@ Eigen::Vector3d GrappleTargetCentre_P(const PayloadConfig& p) {
           p.p_PoBar_P_ft.z() - 0.5 * p.bar_size_P_ft.z() - 0.1};
 }
 
-double PayloadTopFlat_P(const PayloadConfig& p) { return 0.5 * p.diameter_ft * std::cos(M_PI / 16); }
+double PayloadTopFlat_P(const PayloadConfig& p) {
+  return 0.5 * p.diameter_ft * std::cos(M_PI / 16);
+}
 
 BarPostBoxes BarPosts_P(const PayloadConfig& p) {
   BarPostBoxes b;
@@ -79,7 +81,8 @@ void Disc(Mesh* m, const V& centre, const V& n, float radius, int sides, const R
   const V helper = std::abs(n.x()) < 0.9f ? V::UnitX() : V::UnitY();
   const V u = n.cross(helper).normalized(), v = n.cross(u);
   for (int i = 0; i < sides; ++i) {
-    const float a0 = 2.0f * static_cast<float>(M_PI) * i / sides, a1 = 2.0f * static_cast<float>(M_PI) * (i + 1) / sides;
+    const float a0 = 2.0f * static_cast<float>(M_PI) * i / sides,
+                a1 = 2.0f * static_cast<float>(M_PI) * (i + 1) / sides;
     m->AddTri(centre, centre + radius * (std::cos(a0) * u + std::sin(a0) * v),
               centre + radius * (std::cos(a1) * u + std::sin(a1) * v), n, rgb);
   }
@@ -92,17 +95,27 @@ struct ShuttleDims {
 // The cargo bay's interior faces (its top face c is open), the longerons'
 // tops and the mid fuselage's sides.
 void BuildBay(const ShuttleDims& d, std::array<Cluster, kNumClusters>* c) {
-  auto quad = [&](ClusterId id, V a, V b, V cc, V dd, V out, Rgb rgb) { (*c)[id].mesh.AddQuad(a, b, cc, dd, out, rgb); };
-  quad(kFloor, V(0, -d.hw, -d.D), V(d.L, -d.hw, -d.D), V(d.L, d.hw, -d.D), V(0, d.hw, -d.D), V(0, 0, 1), kBayFloor);
-  quad(kWallPort, V(0, -d.hw, -d.D), V(d.L, -d.hw, -d.D), V(d.L, -d.hw, 0), V(0, -d.hw, 0), V(0, 1, 0), kBayWall);
-  quad(kWallStbd, V(0, d.hw, -d.D), V(d.L, d.hw, -d.D), V(d.L, d.hw, 0), V(0, d.hw, 0), V(0, -1, 0), kBayWall);
-  quad(kBulkheadFwd, V(0, -d.hw, -d.D), V(0, d.hw, -d.D), V(0, d.hw, 0), V(0, -d.hw, 0), V(1, 0, 0), kBulkhead);
-  quad(kBulkheadAft, V(d.L, -d.hw, -d.D), V(d.L, d.hw, -d.D), V(d.L, d.hw, 0), V(d.L, -d.hw, 0), V(-1, 0, 0), kBulkhead);
+  auto quad = [&](ClusterId id, const V& a, const V& b, const V& cc, const V& dd, const V& out,
+                  Rgb rgb) { (*c)[id].mesh.AddQuad(a, b, cc, dd, out, rgb); };
+  quad(kFloor, V(0, -d.hw, -d.D), V(d.L, -d.hw, -d.D), V(d.L, d.hw, -d.D), V(0, d.hw, -d.D),
+       V(0, 0, 1), kBayFloor);
+  quad(kWallPort, V(0, -d.hw, -d.D), V(d.L, -d.hw, -d.D), V(d.L, -d.hw, 0), V(0, -d.hw, 0),
+       V(0, 1, 0), kBayWall);
+  quad(kWallStbd, V(0, d.hw, -d.D), V(d.L, d.hw, -d.D), V(d.L, d.hw, 0), V(0, d.hw, 0), V(0, -1, 0),
+       kBayWall);
+  quad(kBulkheadFwd, V(0, -d.hw, -d.D), V(0, d.hw, -d.D), V(0, d.hw, 0), V(0, -d.hw, 0), V(1, 0, 0),
+       kBulkhead);
+  quad(kBulkheadAft, V(d.L, -d.hw, -d.D), V(d.L, d.hw, -d.D), V(d.L, d.hw, 0), V(d.L, -d.hw, 0),
+       V(-1, 0, 0), kBulkhead);
   // The longerons' tops and the mid fuselage's sides.
-  quad(kSillPort, V(0, -d.sill, 0), V(d.L, -d.sill, 0), V(d.L, -d.hw, 0), V(0, -d.hw, 0), V(0, 0, 1), kWhite);
-  quad(kSillStbd, V(0, d.hw, 0), V(d.L, d.hw, 0), V(d.L, d.sill, 0), V(0, d.sill, 0), V(0, 0, 1), kWhite);
-  quad(kSidePort, V(0, -d.sill, 0), V(d.L, -d.sill, 0), V(d.L, -d.sill, d.belly), V(0, -d.sill, d.belly), V(0, -1, 0), kWhite);
-  quad(kSideStbd, V(0, d.sill, 0), V(d.L, d.sill, 0), V(d.L, d.sill, d.belly), V(0, d.sill, d.belly), V(0, 1, 0), kWhite);
+  quad(kSillPort, V(0, -d.sill, 0), V(d.L, -d.sill, 0), V(d.L, -d.hw, 0), V(0, -d.hw, 0),
+       V(0, 0, 1), kWhite);
+  quad(kSillStbd, V(0, d.hw, 0), V(d.L, d.hw, 0), V(d.L, d.sill, 0), V(0, d.sill, 0), V(0, 0, 1),
+       kWhite);
+  quad(kSidePort, V(0, -d.sill, 0), V(d.L, -d.sill, 0), V(d.L, -d.sill, d.belly),
+       V(0, -d.sill, d.belly), V(0, -1, 0), kWhite);
+  quad(kSideStbd, V(0, d.sill, 0), V(d.L, d.sill, 0), V(d.L, d.sill, d.belly),
+       V(0, d.sill, d.belly), V(0, 1, 0), kWhite);
 }
 
 void BuildCabin(const ShuttleDims& d, std::array<Cluster, kNumClusters>* c) {
@@ -115,18 +128,18 @@ void BuildCabin(const ShuttleDims& d, std::array<Cluster, kNumClusters>* c) {
   const V ea(xa, -cw, d.belly), eb(xa, cw, d.belly), ec(xa, cw, top), ed(xa, -cw, top);
   const V an(xn, -2.5f, -12.0f), bn(xn, 2.5f, -12.0f), cn(xn, 2.5f, -6.0f), dn(xn, -2.5f, -6.0f);
   Hull h{&m, V((x0 + xa + 2 * xn) / 4, 0, (d.belly + top) / 2)};
-  h.Quad(ea, eb, ec, ed, kWhite);       // aft face
-  h.Quad(a, b, eb, ea, kTile);          // belly
-  h.Quad(dd, cc, ec, ed, kWhite);       // roof
-  h.Quad(a, dd, ed, ea, kWhite);        // port side
-  h.Quad(b, cc, ec, eb, kWhite);        // starboard side
-  h.Quad(a, b, bn, an, kTile);          // nose, underside
+  h.Quad(ea, eb, ec, ed, kWhite);  // aft face
+  h.Quad(a, b, eb, ea, kTile);     // belly
+  h.Quad(dd, cc, ec, ed, kWhite);  // roof
+  h.Quad(a, dd, ed, ea, kWhite);   // port side
+  h.Quad(b, cc, ec, eb, kWhite);   // starboard side
+  h.Quad(a, b, bn, an, kTile);     // nose, underside
   h.Quad(b, cc, cn, bn, kWhite);
   h.Quad(cc, dd, dn, cn, kWhite);
   h.Quad(dd, a, an, dn, kWhite);
-  h.Quad(an, bn, cn, dn, kTile);        // nose tip
+  h.Quad(an, bn, cn, dn, kTile);  // nose tip
   m.SetDecal(true);
-  for (float sg : {-1.0f, 1.0f}) {      // aft flight deck windows
+  for (float sg : {-1.0f, 1.0f}) {  // aft flight deck windows
     const float y0 = sg * 0.6f, y1 = sg * 3.2f, x = xa + kDecalOffset;
     m.AddQuad(V(x, y0, 1.2f), V(x, y1, 1.2f), V(x, y1, 4.2f), V(x, y0, 4.2f), V(1, 0, 0), kWindow);
   }
@@ -135,8 +148,8 @@ void BuildCabin(const ShuttleDims& d, std::array<Cluster, kNumClusters>* c) {
   if (up.z() < 0) up = -up;  // the sloping roof's outward normal
   const V side = (dd - cc).normalized(), fwd = (cn - cc).normalized();
   const V w0 = cc + 0.15f * (cn - cc) + kDecalOffset * up;
-  m.AddQuad(w0 + 1.0f * side, w0 + 1.0f * side + 2.5f * fwd, w0 + (2 * cw - 1.0f) * side + 2.5f * fwd,
-            w0 + (2 * cw - 1.0f) * side, up, kWindow);
+  m.AddQuad(w0 + 1.0f * side, w0 + 1.0f * side + 2.5f * fwd,
+            w0 + (2 * cw - 1.0f) * side + 2.5f * fwd, w0 + (2 * cw - 1.0f) * side, up, kWindow);
   m.SetDecal(false);
 }
 
@@ -146,11 +159,13 @@ void BuildAftFuselage(const ShuttleDims& d, std::array<Cluster, kNumClusters>* c
   const float xa = d.L + 0.05f, xe = d.L + 18.0f;
   m.AddBox(V(xa, -d.sill, d.belly), V(xe, d.sill, 2.0f), kWhite);
   m.SetDecal(true);
-  for (const V& e : {V(xe + kDecalOffset, 0, -3), V(xe + kDecalOffset, -4.5f, -10), V(xe + kDecalOffset, 4.5f, -10)}) {
+  for (const V& e : {V(xe + kDecalOffset, 0, -3), V(xe + kDecalOffset, -4.5f, -10),
+                     V(xe + kDecalOffset, 4.5f, -10)}) {
     Disc(&m, e, V(1, 0, 0), 2.6f, 10, kEngine);
   }
   m.SetDecal(false);
-  (*c)[kTail].mesh.AddExtrusion({V(d.L + 4, -0.8f, 2 + kGap), V(xe + 4, -0.8f, 2 + kGap), V(xe + 10, -0.8f, 30), V(xe + 2, -0.8f, 30)},
+  (*c)[kTail].mesh.AddExtrusion({V(d.L + 4, -0.8f, 2 + kGap), V(xe + 4, -0.8f, 2 + kGap),
+                                 V(xe + 10, -0.8f, 30), V(xe + 2, -0.8f, 30)},
                                 V(0, 1.6f, 0), kWhite);
 }
 
@@ -160,8 +175,12 @@ void BuildWings(const ShuttleDims& d, std::array<Cluster, kNumClusters>* c) {
     Mesh& m = (*c)[sg < 0 ? kWingPort : kWingStbd].mesh;
     const float z0 = d.belly + 1.0f, z1 = d.belly + 2.6f;
     const float root = d.sill + kGap;
-    const V p0(15, sg * root, 0), p1(d.L + 15, sg * root, 0), p2(d.L + 15, sg * 39, 0), p3(d.L + 6, sg * 39, 0);
-    const auto at = [](V p, float z) { p.z() = z; return p; };
+    const V p0(15, sg * root, 0), p1(d.L + 15, sg * root, 0), p2(d.L + 15, sg * 39, 0),
+        p3(d.L + 6, sg * 39, 0);
+    const auto at = [](V p, float z) {
+      p.z() = z;
+      return p;
+    };
     m.AddQuad(at(p0, z1), at(p1, z1), at(p2, z1), at(p3, z1), V(0, 0, 1), kWhite);
     m.AddQuad(at(p0, z0), at(p1, z0), at(p2, z0), at(p3, z0), V(0, 0, -1), kTile);
     m.AddQuad(at(p0, z0), at(p3, z0), at(p3, z1), at(p0, z1), V(-1, sg * 0.6f, 0), kWhite);
@@ -170,7 +189,8 @@ void BuildWings(const ShuttleDims& d, std::array<Cluster, kNumClusters>* c) {
   }
 }
 
-void BuildDoors(const ShuttleConfig& s, const ShuttleDims& d, std::array<Cluster, kNumClusters>* c) {
+void BuildDoors(const ShuttleConfig& s, const ShuttleDims& d,
+                std::array<Cluster, kNumClusters>* c) {
   // The payload bay doors, open by door_open_deg about the hinge at each
   // longeron: thin slabs. Closed, a door reaches inboard with its radiators
   // facing down; opening turns it up and over, so at 175 deg the radiators
@@ -179,9 +199,10 @@ void BuildDoors(const ShuttleConfig& s, const ShuttleDims& d, std::array<Cluster
   const float width = d.hw + 2.5f, thick = 0.1f;
   for (float sg : {-1.0f, 1.0f}) {
     Mesh& m = (*c)[sg < 0 ? kDoorPort : kDoorStbd].mesh;
-    const V dir(0, -sg * std::cos(phi), std::sin(phi));       // from the hinge across the door
-    const V n_in(0, -sg * std::sin(phi), -std::cos(phi));     // the radiator side's normal
-    const V a(0, sg * d.sill, 0.1f), b(d.L, sg * d.sill, 0.1f), cc = b + width * dir, dd = a + width * dir;
+    const V dir(0, -sg * std::cos(phi), std::sin(phi));    // from the hinge across the door
+    const V n_in(0, -sg * std::sin(phi), -std::cos(phi));  // the radiator side's normal
+    const V a(0, sg * d.sill, 0.1f), b(d.L, sg * d.sill, 0.1f), cc = b + width * dir,
+                                                                dd = a + width * dir;
     const V back = -thick * n_in;  // the outer skin, one thickness behind the radiators
     Hull h{&m, (a + cc) * 0.5f + 0.5f * back};
     h.Quad(a, b, cc, dd, kRadiator);
@@ -195,7 +216,8 @@ void BuildDoors(const ShuttleConfig& s, const ShuttleDims& d, std::array<Cluster
 
 void BuildShuttle(const ShuttleConfig& s, std::array<Cluster, kNumClusters>* c) {
   const ShuttleDims d{static_cast<float>(s.bay_length_ft), static_cast<float>(s.bay_width_ft / 2),
-                      static_cast<float>(s.bay_depth_ft), static_cast<float>(s.bay_width_ft / 2) + 2.0f,
+                      static_cast<float>(s.bay_depth_ft),
+                      static_cast<float>(s.bay_width_ft / 2) + 2.0f,
                       -static_cast<float>(s.bay_depth_ft) - 5.0f};
   BuildBay(d, c);
   BuildCabin(d, c);
@@ -217,7 +239,8 @@ void BuildCae(const CaeConfig& cae, std::array<Cluster, kNumClusters>* c) {
   m.AddExtrusion(hex, V(0, 0, 2 * hl), kCaeRgb);
   m.SetDecal(true);  // the docking port on face c (y_C = 0), facing out (-y_C)
   const float pr = static_cast<float>(cae.port_diameter_ft / 2);
-  Disc(&m, V(0, -kDecalOffset, 0), V(0, -1, 0), 1.25f * pr, 16, kTargetWhite);  // a white rim round the port
+  Disc(&m, V(0, -kDecalOffset, 0), V(0, -1, 0), 1.25f * pr, 16,
+       kTargetWhite);  // a white rim round the port
   Disc(&m, V(0, -2 * kDecalOffset, 0), V(0, -1, 0), pr, 16, kPort);
   // The docking target beside the port (docs/scene.md "Targets"): a black
   // disc with a white rim on face c, and a white cross standing off it, so
@@ -229,14 +252,16 @@ void BuildCae(const CaeConfig& cae, std::array<Cluster, kNumClusters>* c) {
   // Its standoff: a white plate with a black cross, kDockTargetStandoffFt
   // out from face c (the post that would hold it is left out).
   Mesh& t = (*c)[kDockTarget].mesh;
-  const float so = static_cast<float>(kDockTargetStandoffFt), half = 0.3f, thick = 0.05f, arm = 0.25f, bar = 0.04f;
+  const float so = static_cast<float>(kDockTargetStandoffFt), half = 0.3f, thick = 0.05f,
+              arm = 0.25f, bar = 0.04f;
   t.AddBox(at + V(-half, -so - thick, -half), at + V(half, -so, half), kTargetWhite);
   t.SetDecal(true);
   const float y = -so - thick - kDecalOffset;
-  t.AddQuad(at + V(-arm, y, -bar), at + V(arm, y, -bar), at + V(arm, y, bar), at + V(-arm, y, bar), V(0, -1, 0),
-            kTargetBlack);
+  t.AddQuad(at + V(-arm, y, -bar), at + V(arm, y, -bar), at + V(arm, y, bar), at + V(-arm, y, bar),
+            V(0, -1, 0), kTargetBlack);
   t.AddQuad(at + V(-bar, y - kDecalOffset, -arm), at + V(bar, y - kDecalOffset, -arm),
-            at + V(bar, y - kDecalOffset, arm), at + V(-bar, y - kDecalOffset, arm), V(0, -1, 0), kTargetBlack);
+            at + V(bar, y - kDecalOffset, arm), at + V(-bar, y - kDecalOffset, arm), V(0, -1, 0),
+            kTargetBlack);
   t.SetDecal(false);
   // The solar array on a boom above the module's far side.
   (*c)[kCaeArray].mesh.AddBox(V(-35, fl + 0.6f, -6), V(35, fl + 0.8f, 6), kPanel);
@@ -248,15 +273,21 @@ void BuildArm(const LabConfig& cfg, std::array<Cluster, kNumClusters>* c) {
   const float r = static_cast<float>(arm.boom_diameter_ft / 2);
   const float rs = static_cast<float>(kShoulderRadiusFt), re = static_cast<float>(kElbowRadiusFt),
               rw = static_cast<float>(kWristRadiusFt);
-  (*c)[kPost].mesh.AddBox(V(-0.6f, -0.6f, 0), V(0.6f, 0.6f, 1), kWhite);  // unit height, placed with clearances
+  (*c)[kPost].mesh.AddBox(V(-0.6f, -0.6f, 0), V(0.6f, 0.6f, 1),
+                          kWhite);  // unit height, placed with clearances
   (*c)[kShoulder].mesh.AddCylinder(V(0, -rs, 0), V(0, rs, 0), rs, 12, kJoint);
-  (*c)[kUpperBoom].mesh.AddCylinder(V(rs + kGap, 0, 0), V(static_cast<float>(arm.upper_boom_ft) - re - kGap, 0, 0), r, 12, kBoom);
+  (*c)[kUpperBoom].mesh.AddCylinder(
+      V(rs + kGap, 0, 0), V(static_cast<float>(arm.upper_boom_ft) - re - kGap, 0, 0), r, 12, kBoom);
   (*c)[kElbow].mesh.AddCylinder(V(0, -re, 0), V(0, re, 0), re, 12, kJoint);
-  (*c)[kLowerBoom].mesh.AddCylinder(V(re + kGap, 0, 0), V(static_cast<float>(arm.lower_boom_ft - kWristClearanceFt), 0, 0),
-                                    0.9f * r, 12, kBoom);
-  (*c)[kWrist].mesh.AddCylinder(V(-rw, 0, 0), V(static_cast<float>(arm.wrist_to_palm_ft) - kGap, 0, 0), rw, 10, kJoint);
-  const float L = static_cast<float>(ee.palm_length_ft), W = static_cast<float>(ee.palm_half_width_ft),
-              H = static_cast<float>(ee.palm_half_height_ft), fl = static_cast<float>(ee.finger_length_ft),
+  (*c)[kLowerBoom].mesh.AddCylinder(
+      V(re + kGap, 0, 0), V(static_cast<float>(arm.lower_boom_ft - kWristClearanceFt), 0, 0),
+      0.9f * r, 12, kBoom);
+  (*c)[kWrist].mesh.AddCylinder(
+      V(-rw, 0, 0), V(static_cast<float>(arm.wrist_to_palm_ft) - kGap, 0, 0), rw, 10, kJoint);
+  const float L = static_cast<float>(ee.palm_length_ft),
+              W = static_cast<float>(ee.palm_half_width_ft),
+              H = static_cast<float>(ee.palm_half_height_ft),
+              fl = static_cast<float>(ee.finger_length_ft),
               t = static_cast<float>(ee.finger_thickness_ft);
   (*c)[kEffHex1].mesh.AddBox(V(0, -W, -H), V(L, W, H), kPalm);
   (*c)[kEffHex2].mesh.AddBox(V(L + kGap, W - t, -H), V(L + fl, W, H), kFinger);
@@ -280,15 +311,18 @@ void BuildPayload(const PayloadConfig& p, std::array<Cluster, kNumClusters>* c) 
     t.AddBox(at + V(-half, -half, -thick), at + V(half, half, 0), kTargetWhite);
     t.SetDecal(true);
     const float z = at.z() + kDecalOffset;
-    t.AddQuad(V(at.x() - arm, at.y() - bar, z), V(at.x() + arm, at.y() - bar, z), V(at.x() + arm, at.y() + bar, z),
-              V(at.x() - arm, at.y() + bar, z), V(0, 0, 1), kTargetBlack);
-    t.AddQuad(V(at.x() - bar, at.y() - arm, z + kDecalOffset), V(at.x() + bar, at.y() - arm, z + kDecalOffset),
-              V(at.x() + bar, at.y() + arm, z + kDecalOffset), V(at.x() - bar, at.y() + arm, z + kDecalOffset),
-              V(0, 0, 1), kTargetBlack);
+    t.AddQuad(V(at.x() - arm, at.y() - bar, z), V(at.x() + arm, at.y() - bar, z),
+              V(at.x() + arm, at.y() + bar, z), V(at.x() - arm, at.y() + bar, z), V(0, 0, 1),
+              kTargetBlack);
+    t.AddQuad(V(at.x() - bar, at.y() - arm, z + kDecalOffset),
+              V(at.x() + bar, at.y() - arm, z + kDecalOffset),
+              V(at.x() + bar, at.y() + arm, z + kDecalOffset),
+              V(at.x() - bar, at.y() + arm, z + kDecalOffset), V(0, 0, 1), kTargetBlack);
     t.SetDecal(false);
     // The disc on the body's facet under it (the facet next to the top flat).
     Mesh& body = (*c)[kPayloadBody].mesh;
-    const float a = static_cast<float>(M_PI / 2 + 2 * phase);  // the facet's middle: 22.5 deg from the top
+    const float a =
+        static_cast<float>(M_PI / 2 + 2 * phase);  // the facet's middle: 22.5 deg from the top
     const V n(std::cos(a) * (at.x() < 0 ? 1.0f : -1.0f), 0, std::sin(a));
     const float facet_r = r * std::cos(phase);  // the facets' distance from the axis
     // Where the line from the plate straight down (-z_P) meets the facet.
@@ -303,12 +337,13 @@ void BuildPayload(const PayloadConfig& p, std::array<Cluster, kNumClusters>* c) 
   const BarPostBoxes posts = BarPosts_P(p);
   for (int k = 0; k < posts.count; ++k) {
     const V lo = F(posts.centre_P[k] - posts.half_P), hi = F(posts.centre_P[k] + posts.half_P);
-    (*c)[k ? kBarPostB : kBarPostA].mesh.AddBox(V(lo.x(), lo.y(), lo.z() + kGap), V(hi.x(), hi.y(), hi.z() - kGap),
-                                                 kBarRgb);
+    (*c)[k ? kBarPostB : kBarPostA].mesh.AddBox(V(lo.x(), lo.y(), lo.z() + kGap),
+                                                V(hi.x(), hi.y(), hi.z() - kGap), kBarRgb);
   }
   const float pr = static_cast<float>(p.probe_diameter_ft / 2);
-  (*c)[kProbe].mesh.AddFrustum(V(0, hl + kGap, 0), V(0, hl + static_cast<float>(p.probe_length_ft), 0), pr, 0.6f * pr, 10,
-                               kProbeRgb);
+  (*c)[kProbe].mesh.AddFrustum(V(0, hl + kGap, 0),
+                               V(0, hl + static_cast<float>(p.probe_length_ft), 0), pr, 0.6f * pr,
+                               10, kProbeRgb);
 }
 
 // Unique (within tolerance) unit directions, up to sign when `signless`.
@@ -326,7 +361,8 @@ void FillHullData(Cluster* c) {
   for (const Triangle& t : c->mesh.triangles()) {
     for (const V* v : {&t.a, &t.b, &t.c}) {
       const Eigen::Vector3d p = v->cast<double>();
-      if (std::none_of(c->points.begin(), c->points.end(), [&](const auto& q) { return (q - p).norm() < 1e-6; })) {
+      if (std::none_of(c->points.begin(), c->points.end(),
+                       [&](const auto& q) { return (q - p).norm() < 1e-6; })) {
         c->points.push_back(p);
       }
     }
@@ -395,9 +431,12 @@ ClusterPoses ComputeClusterPoses(const LabConfig& config, const ScenePose& f) {
   p.present[kPost] = post_len > 0;
   const Eigen::Affine3d X_RF3 = aff(arm.X_RF3), X_RS2 = aff(arm.X_RS2);
   for (int i = 0; i < kNumClusters; ++i) {
-    if (i <= kDoorStbd) p.X_RC[i] = Eigen::Affine3d::Identity();
-    else if (i <= kDockTarget) p.X_RC[i] = X_RC;
-    else if (i >= kPayloadBody) p.X_RC[i] = X_RP;
+    if (i <= kDoorStbd)
+      p.X_RC[i] = Eigen::Affine3d::Identity();
+    else if (i <= kDockTarget)
+      p.X_RC[i] = X_RC;
+    else if (i >= kPayloadBody)
+      p.X_RC[i] = X_RP;
   }
   p.X_RC[kPost] = post;
   p.X_RC[kShoulder] = aff(arm.X_RF1);
@@ -407,8 +446,8 @@ ClusterPoses ComputeClusterPoses(const LabConfig& config, const ScenePose& f) {
   p.X_RC[kWrist] = aff(arm.X_RF6);
   p.X_RC[kEffHex1] = X_RS2;
   p.X_RC[kEffHex2] = X_RS2;
-  p.X_RC[kEffHex3] =
-      X_RS2 * Eigen::Translation3d(0, MovingFingerCentreY2(config.end_effector, f.finger_gap_ft), 0);
+  p.X_RC[kEffHex3] = X_RS2 * Eigen::Translation3d(
+                                 0, MovingFingerCentreY2(config.end_effector, f.finger_gap_ft), 0);
   return p;
 }
 

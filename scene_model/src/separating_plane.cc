@@ -20,7 +20,8 @@ void Range(const PosedHull& h, const Eigen::Vector3d& n, double* lo, double* hi)
 }
 
 // Frame coherence: last frame's plane, if it still separates.
-bool HintSeparates(const PosedHull& a, const PosedHull& b, const SeparatingPlane& hint, double eps) {
+bool HintSeparates(const PosedHull& a, const PosedHull& b, const SeparatingPlane& hint,
+                   double eps) {
   double alo, ahi, blo, bhi;
   Range(a, hint.n_R, &alo, &ahi);
   Range(b, hint.n_R, &blo, &bhi);
@@ -47,8 +48,9 @@ PosedHull PoseHull(const Cluster& c, const Eigen::Affine3d& X_RC) {
   return h;
 }
 
-std::optional<SeparatingPlane> FindSeparatingPlane(const PosedHull& a, const PosedHull& b, double eps,
-                                                   const SeparatingPlane* hint, int* axes_tried) {
+std::optional<SeparatingPlane> FindSeparatingPlane(const PosedHull& a, const PosedHull& b,
+                                                   double eps, const SeparatingPlane* hint,
+                                                   int* axes_tried) {
   int tried = 0;
   double best_gap = -std::numeric_limits<double>::infinity();
   SeparatingPlane best;

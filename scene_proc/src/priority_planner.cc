@@ -2,21 +2,23 @@
 
 #include <algorithm>
 #include <optional>
-
 #include <spdlog/spdlog.h>
 
 namespace rms::scene_proc {
 
-using scene_model::ClusterFrame;
 using scene_model::PosedHull;
 using scene_model::SeparatingPlane;
 
 const char* PlaneSourceName(PlaneSource s) {
   switch (s) {
-    case PlaneSource::kFixed: return "fixed";
-    case PlaneSource::kRigid: return "rigid";
-    case PlaneSource::kDcp: return "DCP";
-    case PlaneSource::kDynamic: return "dynamic";
+    case PlaneSource::kFixed:
+      return "fixed";
+    case PlaneSource::kRigid:
+      return "rigid";
+    case PlaneSource::kDcp:
+      return "DCP";
+    case PlaneSource::kDynamic:
+      return "dynamic";
   }
   return "?";
 }
@@ -28,12 +30,17 @@ namespace {
 int RigidGroup(scene_model::ClusterFrame f) {
   switch (f) {
     case scene_model::ClusterFrame::kReference:
-    case scene_model::ClusterFrame::kCae: return 0;
-    case scene_model::ClusterFrame::kPayload: return 1;
+    case scene_model::ClusterFrame::kCae:
+      return 0;
+    case scene_model::ClusterFrame::kPayload:
+      return 1;
     case scene_model::ClusterFrame::kF6:
-    case scene_model::ClusterFrame::kSystemTwo: return 2;
-    case scene_model::ClusterFrame::kF3: return 3;
-    default: return -1;  // scaled (the post) or alone
+    case scene_model::ClusterFrame::kSystemTwo:
+      return 2;
+    case scene_model::ClusterFrame::kF3:
+      return 3;
+    default:
+      return -1;  // scaled (the post) or alone
   }
 }
 
@@ -50,10 +57,14 @@ PriorityPlanner::PriorityPlanner(const scene_model::SceneModel& model) : model_(
   for (int p = 0; p < scene_model::kNumPairs; ++p) {
     const auto [a, b] = scene_model::PairOf(p);
     const int ga = RigidGroup(model[a].frame), gb = RigidGroup(model[b].frame);
-    if (scene_model::DcpPairSlot(p) >= 0) source_[p] = PlaneSource::kDcp;
-    else if (ga == 0 && gb == 0) source_[p] = PlaneSource::kFixed;
-    else if (ga >= 0 && ga == gb) source_[p] = PlaneSource::kRigid;
-    else source_[p] = PlaneSource::kDynamic;
+    if (scene_model::DcpPairSlot(p) >= 0)
+      source_[p] = PlaneSource::kDcp;
+    else if (ga == 0 && gb == 0)
+      source_[p] = PlaneSource::kFixed;
+    else if (ga >= 0 && ga == gb)
+      source_[p] = PlaneSource::kRigid;
+    else
+      source_[p] = PlaneSource::kDynamic;
   }
 }
 
@@ -61,14 +72,16 @@ PriorityPlanner::PriorityPlanner(const scene_model::SceneModel& model) : model_(
 // from that frame's poses, and moves with the pair's first cluster after
 // (the eye is carried back into that frame's pose). False when no plane
 // separates the pair: it becomes dynamic.
-bool PriorityPlanner::FixedPlaneBit(int p, const scene_model::ClusterPoses& poses, const Eigen::Vector3d& eye,
-                                    const scene_model::PosedHull& ha, const scene_model::PosedHull& hb, bool* bit) {
+bool PriorityPlanner::FixedPlaneBit(int p, const scene_model::ClusterPoses& poses,
+                                    const Eigen::Vector3d& eye, const scene_model::PosedHull& ha,
+                                    const scene_model::PosedHull& hb, bool* bit) {
   const int a = scene_model::PairOf(p).first;
   if (!have_last_[p]) {
     const std::optional<scene_model::SeparatingPlane> plane =
         scene_model::FindSeparatingPlane(ha, hb, PlaneTolerance(ha, hb), nullptr);
     if (!plane) {
-      spdlog::warn("no plane separates {} and {}: the scene model overlaps", scene_model::ClusterName(a),
+      spdlog::warn("no plane separates {} and {}: the scene model overlaps",
+                   scene_model::ClusterName(a),
                    scene_model::ClusterName(scene_model::PairOf(p).second));
       source_[p] = PlaneSource::kDynamic;
       return false;
@@ -78,14 +91,16 @@ bool PriorityPlanner::FixedPlaneBit(int p, const scene_model::ClusterPoses& pose
     have_last_[p] = true;
   }
   const Eigen::Affine3d& X_now = poses.X_RC[a];
-  const Eigen::Vector3d eye_then = X_RA_found_[p] * (X_now.linear().transpose() * (eye - X_now.translation()));
+  const Eigen::Vector3d eye_then =
+      X_RA_found_[p] * (X_now.linear().transpose() * (eye - X_now.translation()));
   *bit = last_[p].SignedDistanceFt(eye_then) < 0;
   return true;
 }
 
-scene_model::PriorityBits PriorityPlanner::Compute(const scene_model::ClusterPoses& poses, const Eigen::Vector3d& eye,
-                                                   const std::array<scene_model::SeparatingPlane, 3>& dcp_planes,
-                                                   std::uint32_t dcp_valid, Counters* counters) {
+scene_model::PriorityBits PriorityPlanner::Compute(
+    const scene_model::ClusterPoses& poses, const Eigen::Vector3d& eye,
+    const std::array<scene_model::SeparatingPlane, 3>& dcp_planes, std::uint32_t dcp_valid,
+    Counters* counters) {
   std::array<std::optional<scene_model::PosedHull>, scene_model::kNumClusters> hulls;
   auto hull = [&](int c) -> const scene_model::PosedHull& {
     if (!hulls[c]) hulls[c] = scene_model::PoseHull(model_[c], poses.X_RC[c]);

@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <spdlog/spdlog.h>
 
-#include "rms/wire/channels.h"
 #include "rms/base/check.h"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/esg_frame_t.hpp"
+#include "rms/wire/channels.h"
 #include "rms/wire/frame_receiver.h"
 #include "rms/wire/message_io.h"
 #include "rms/wire/priority_words.h"
@@ -14,7 +14,9 @@
 namespace rms::scene_proc {
 
 VisualSceneProgram::VisualSceneProgram(const LabConfig& config)
-    : config_(config), model_(scene_model::BuildSceneModel(config)), planner_(model_),
+    : config_(config),
+      model_(scene_model::BuildSceneModel(config)),
+      planner_(model_),
       dt_s_(1.0 / config.session.frame_rate_hz) {}
 
 namespace {
@@ -23,7 +25,8 @@ double Toward(double current, double target, double max_step) {
 }
 }  // namespace
 
-wire::EsgFrameData VisualSceneProgram::Step(const wire::DcpFrameData& dcp, std::uint32_t frame_count, Counters* counters) {
+wire::EsgFrameData VisualSceneProgram::Step(const wire::DcpFrameData& dcp,
+                                            std::uint32_t frame_count, Counters* counters) {
   const int station = dcp.control.camera_station;
   const CameraStationConfig& cam = config_.cameras[station - 1];
   // The selected station's drive slews toward the command, clamped to its limits.
@@ -35,7 +38,8 @@ wire::EsgFrameData VisualSceneProgram::Step(const wire::DcpFrameData& dcp, std::
   drv.zoom = Toward(drv.zoom, std::clamp(dcp.camera_zoom, 0.0, 1.0), cam.zoom_rate_per_s * dt_s_);
 
   const arm::ArmPose arm = arm::ComputeArmPose(config_.arm, dcp.arm, dcp.shoulder_height_ft);
-  const CameraView view = ComputeCameraView(config_, station, drv.pan_deg, drv.tilt_deg, drv.zoom, arm, nullptr);
+  const CameraView view =
+      ComputeCameraView(config_, station, drv.pan_deg, drv.tilt_deg, drv.zoom, arm, nullptr);
   wire::EsgFrameData e;
   e.frame_count = frame_count;
   e.control = dcp.control;
@@ -49,8 +53,10 @@ wire::EsgFrameData VisualSceneProgram::Step(const wire::DcpFrameData& dcp, std::
   e.R_RP = dcp.R_RP;
   // Visual priority from the words as the ESG will read them.
   const wire::EsgFrameData sent = wire::UnpackEsgWords(wire::PackEsgWords(e, nullptr));
-  const scene_model::ClusterPoses poses = scene_model::ComputeClusterPoses(config_, sent.scene_pose());
-  const scene_model::PriorityBits bits = planner_.Compute(poses, sent.p_RoEye_R_ft, dcp.planes, dcp.plane_valid, counters);
+  const scene_model::ClusterPoses poses =
+      scene_model::ComputeClusterPoses(config_, sent.scene_pose());
+  const scene_model::PriorityBits bits =
+      planner_.Compute(poses, sent.p_RoEye_R_ft, dcp.planes, dcp.plane_valid, counters);
   wire::PackPriority(bits, &e.control, &e.priority_words);
   return e;
 }

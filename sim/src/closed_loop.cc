@@ -3,13 +3,14 @@
 #include <deque>
 #include <optional>
 
-#include "rms/dynamics_proc/dynamics_proc.h"
 #include "rms/dynamics_proc/dynamic_collision_program.h"
+#include "rms/dynamics_proc/dynamics_proc.h"
 #include "rms/wire/input_block.h"
 
 namespace rms::sim {
 
-ClosedLoopResult FlyAutopilot(const LabConfig& config, const operator_station::AutopilotOptions& options, int max_frames,
+ClosedLoopResult FlyAutopilot(const LabConfig& config,
+                              const operator_station::AutopilotOptions& options, int max_frames,
                               int latency_frames, std::vector<wire::OperatorInputs>* inputs) {
   ClosedLoopResult r;
   operator_station::Autopilot pilot(config, options);
@@ -25,7 +26,8 @@ ClosedLoopResult FlyAutopilot(const LabConfig& config, const operator_station::A
     out.frame = f;
     out.input_frame = f;
     dcp_telemetry_t tm = dynamics_proc::MakeTelemetry(program.status(), out);
-    if (tm.mode >= 1 && tm.mode <= 3 && r.modes_entered[tm.mode] == 0 && f > 0) r.modes_entered[tm.mode] = f;
+    if (tm.mode >= 1 && tm.mode <= 3 && r.modes_entered[tm.mode] == 0 && f > 0)
+      r.modes_entered[tm.mode] = f;
     if (tm.docked && !r.docked) {
       r.docked = true;
       r.dock_distance_ft = tm.dock_distance_ft;

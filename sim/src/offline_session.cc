@@ -6,7 +6,8 @@ namespace rms::sim {
 
 OfflineSession::OfflineSession(const LabConfig& config, operator_station::Timeline timeline)
     : config_(config), timeline_(std::move(timeline)), program_(config) {
-  for (int s = 0; s < kNumCameraStations; ++s) scenes_.push_back(std::make_unique<scene_proc::VisualSceneProgram>(config));
+  for (int s = 0; s < kNumCameraStations; ++s)
+    scenes_.push_back(std::make_unique<scene_proc::VisualSceneProgram>(config));
 }
 
 bool OfflineSession::Next() {
@@ -23,7 +24,9 @@ bool OfflineSession::Next() {
   for (int s = 1; s <= kNumCameraStations; ++s) {
     wire::DcpFrameData d = dcp_;
     d.control.camera_station = s;
-    esg_[s - 1] = wire::UnpackEsgWords(wire::PackEsgWords(scenes_[s - 1]->Step(d, static_cast<std::uint32_t>(frame_ & 0xFFFFFF), &scene_counters_), nullptr));
+    esg_[s - 1] = wire::UnpackEsgWords(wire::PackEsgWords(
+        scenes_[s - 1]->Step(d, static_cast<std::uint32_t>(frame_ & 0xFFFFFF), &scene_counters_),
+        nullptr));
   }
   ++frame_;
   return true;

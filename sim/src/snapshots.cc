@@ -19,11 +19,13 @@ namespace {
 // The live window's guidance panel as the operator station would fill it
 // from this frame's telemetry (a by-hand session in manual augmented control).
 operator_state_t StateOf(const LabConfig& config, const OfflineSession& s,
-                              operator_station::CommandFrame frame) {
+                         operator_station::CommandFrame frame) {
   const dcp_telemetry_t t = dynamics_proc::MakeTelemetry(s.status(), s.dcp());
   const operator_station::ArmState arm = operator_station::ArmStateFrom(t);
-  if (frame == operator_station::CommandFrame::kPayload && arm.mode == 1) frame = operator_station::CommandFrame::kEndEffector;
-  const operator_station::Guidance g = operator_station::ComputeGuidance(operator_station::MakeGuidanceGeometry(config), arm, frame);
+  if (frame == operator_station::CommandFrame::kPayload && arm.mode == 1)
+    frame = operator_station::CommandFrame::kEndEffector;
+  const operator_station::Guidance g =
+      operator_station::ComputeGuidance(operator_station::MakeGuidanceGeometry(config), arm, frame);
   operator_state_t m{};
   m.source = operator_state_t::SOURCE_BY_HAND;
   m.control_mode = 2;
@@ -55,8 +57,8 @@ std::vector<Shot> ParseShots(const std::vector<std::string>& specs) {
   for (const std::string& spec : specs) {
     Shot sh;
     char name[256] = {};
-    if (std::sscanf(spec.c_str(), "%lf:%d:%255s", &sh.t, &sh.station, name) != 3 || sh.station < 1 ||
-        sh.station > kNumCameraStations) {
+    if (std::sscanf(spec.c_str(), "%lf:%d:%255s", &sh.t, &sh.station, name) != 3 ||
+        sh.station < 1 || sh.station > kNumCameraStations) {
       throw InputError("--shot '" + spec + "': must be TIME:STATION:NAME, station 1..8");
     }
     sh.name = name;
@@ -86,7 +88,8 @@ struct Camera {
 
 }  // namespace
 
-std::array<double, kNumCameraStations> StationTimes(const LabConfig& config, const operator_station::Timeline& tl,
+std::array<double, kNumCameraStations> StationTimes(const LabConfig& config,
+                                                    const operator_station::Timeline& tl,
                                                     std::optional<double> at_time_s) {
   constexpr int kN = kNumCameraStations;
   std::array<double, kN> when{};
@@ -110,13 +113,15 @@ std::array<double, kNumCameraStations> StationTimes(const LabConfig& config, con
   }
   for (int s = 0; s < kN; ++s) {
     when[s] = first[s] < 0 ? tl.end_time() : 0.5 * (first[s] + last[s]);
-    if (first[s] < 0) std::fprintf(stderr, "station %d is never selected: shown at the end\n", s + 1);
+    if (first[s] < 0)
+      std::fprintf(stderr, "station %d is never selected: shown at the end\n", s + 1);
   }
   return when;
 }
 
 void ContactSheet(const LabConfig& config, const operator_station::Timeline& tl,
-                  const std::array<double, kNumCameraStations>& when, int columns, const PictureOptions& o) {
+                  const std::array<double, kNumCameraStations>& when, int columns,
+                  const PictureOptions& o) {
   constexpr int kN = kNumCameraStations;
   Camera camera(config, o);
   const int rows = (kN + columns - 1) / columns;
@@ -135,10 +140,12 @@ void ContactSheet(const LabConfig& config, const operator_station::Timeline& tl,
       const int x0 = ((s - 1) % columns) * o.width, y0 = ((s - 1) / columns) * o.height;
       for (int y = 0; y < o.height; ++y) {
         std::memcpy(&sheet[(static_cast<std::size_t>(y0 + y) * sheet_w + x0) * 4],
-                    &img[static_cast<std::size_t>(y) * o.width * 4], static_cast<std::size_t>(o.width) * 4);
+                    &img[static_cast<std::size_t>(y) * o.width * 4],
+                    static_cast<std::size_t>(o.width) * 4);
       }
-      std::printf("%s: station %d (%s) at t = %.2f s, frame %lld\n", path.c_str(), s, config.cameras[s - 1].name.c_str(),
-                  session.t_s(), static_cast<long long>(session.frame()));
+      std::printf("%s: station %d (%s) at t = %.2f s, frame %lld\n", path.c_str(), s,
+                  config.cameras[s - 1].name.c_str(), session.t_s(),
+                  static_cast<long long>(session.frame()));
       done[s - 1] = true;
     }
   }
@@ -146,8 +153,9 @@ void ContactSheet(const LabConfig& config, const operator_station::Timeline& tl,
   std::printf("%s/stations.png: the contact sheet, %dx%d\n", o.out_dir.c_str(), sheet_w, sheet_h);
 }
 
-void TakeShots(const LabConfig& config, const operator_station::Timeline& tl, const std::vector<std::string>& shots,
-               operator_station::CommandFrame frame, const PictureOptions& o) {
+void TakeShots(const LabConfig& config, const operator_station::Timeline& tl,
+               const std::vector<std::string>& shots, operator_station::CommandFrame frame,
+               const PictureOptions& o) {
   std::vector<Shot> list = ParseShots(shots);
   Camera camera(config, o);
   OfflineSession session(config, tl);

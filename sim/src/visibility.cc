@@ -17,11 +17,13 @@ namespace {
 
 // The nearest hit (distance along the unit ray) of a ray from the eye with a
 // cluster's faces (Moller-Trumbore on each triangle), or +inf.
-double NearestHit(const scene_model::Cluster& c, const Eigen::Affine3d& X, const Eigen::Vector3d& o, const Eigen::Vector3d& d) {
+double NearestHit(const scene_model::Cluster& c, const Eigen::Affine3d& X, const Eigen::Vector3d& o,
+                  const Eigen::Vector3d& d) {
   double best = std::numeric_limits<double>::infinity();
   for (const scene_model::Triangle& t : c.mesh.triangles()) {
     if (t.decal) continue;
-    const Eigen::Vector3d a = X * t.a.cast<double>(), b = X * t.b.cast<double>(), cc = X * t.c.cast<double>();
+    const Eigen::Vector3d a = X * t.a.cast<double>(), b = X * t.b.cast<double>(),
+                          cc = X * t.c.cast<double>();
     const Eigen::Vector3d e1 = b - a, e2 = cc - a, p = d.cross(e2);
     const double det = e1.dot(p);
     if (std::abs(det) < 1e-14) continue;
@@ -50,8 +52,11 @@ struct PixelJudge {
   bool PriorityWins(int cp, int cd, int px, int py, double dx, double dy) const {
     const double inf = std::numeric_limits<double>::infinity();
     const double tan_half = std::tan(0.5 * f.fov_deg * M_PI / 180.0);
-    const double xn = 2.0 * (px + 0.5 + dx) / width - 1.0, yn = 1.0 - 2.0 * (py + 0.5 + dy) / height;
-    const Eigen::Vector3d dir = (f.R_RE * Eigen::Vector3d(1.0, xn * tan_half * width / height, -yn * tan_half)).normalized();
+    const double xn = 2.0 * (px + 0.5 + dx) / width - 1.0,
+                 yn = 1.0 - 2.0 * (py + 0.5 + dy) / height;
+    const Eigen::Vector3d dir =
+        (f.R_RE * Eigen::Vector3d(1.0, xn * tan_half * width / height, -yn * tan_half))
+            .normalized();
     const double tp = cp < 0 ? inf : NearestHit(model[cp], poses.X_RC[cp], f.p_RoEye_R_ft, dir);
     const double td = cd < 0 ? inf : NearestHit(model[cd], poses.X_RC[cd], f.p_RoEye_R_ft, dir);
     return tp <= td && tp < inf;
@@ -77,8 +82,10 @@ VisibilityReport CompareVisibility(const LabConfig& config, const VisibilityOpti
   OfflineSession session(config, operator_station::Timeline::Load(o.timeline, config.inputs));
   auto ga = esg_renderer::CreateGlContext(esg_renderer::ParseGlBackend(o.gl), o.width, o.height);
   auto gb = esg_renderer::CreateGlContext(esg_renderer::ParseGlBackend(o.gl), o.width, o.height);
-  esg_renderer::FrameRenderer prio(config, ga.get(), {.visibility = esg_renderer::Visibility::kPriority, .id_colors = true});
-  esg_renderer::FrameRenderer depth(config, gb.get(), {.visibility = esg_renderer::Visibility::kDepth, .id_colors = true});
+  esg_renderer::FrameRenderer prio(
+      config, ga.get(), {.visibility = esg_renderer::Visibility::kPriority, .id_colors = true});
+  esg_renderer::FrameRenderer depth(
+      config, gb.get(), {.visibility = esg_renderer::Visibility::kDepth, .id_colors = true});
   const scene_model::SceneModel model = scene_model::BuildSceneModel(config);
   VisibilityReport report;
   const std::size_t n = static_cast<std::size_t>(o.width) * o.height;
@@ -97,7 +104,8 @@ VisibilityReport CompareVisibility(const LabConfig& config, const VisibilityOpti
       for (std::size_t i = 0; i < n; ++i) {
         if (std::memcmp(&a[4 * i], b + 4 * i, 3) == 0) continue;
         ++diff;
-        const int cp = esg_renderer::ClusterOfColor(&a[4 * i]), cd = esg_renderer::ClusterOfColor(b + 4 * i);
+        const int cp = esg_renderer::ClusterOfColor(&a[4 * i]),
+                  cd = esg_renderer::ClusterOfColor(b + 4 * i);
         if (o.explain) ++report.pairs[{s, cp, cd}];
         if (!poses) poses = scene_model::ComputeClusterPoses(config, f.scene_pose());
         PixelJudge{model, *poses, f, o.width, o.height}.Judge(cp, cd, i, &pc);

@@ -3,23 +3,23 @@
 // and docks; a collision holds the arm and then releases it; reset returns
 // to Mode 1. The session's LCM log and summary.json show each mode change and
 // collision as it happened.
-#include <gtest/gtest.h>
-
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 #include <nlohmann/json.hpp>
 
-#include "rms/mission/mission_plan.h"
-#include "rms/mission/arm_ik.h"
-#include "rms/wire/channels.h"
 #include "rms/base/config.h"
-#include "rms/wire/control_word.h"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
-#include "rms/wire/message_io.h"
+#include "rms/mission/arm_ik.h"
+#include "rms/mission/mission_plan.h"
 #include "rms/scene_model/scene_model.h"
+#include "rms/wire/channels.h"
+#include "rms/wire/control_word.h"
+#include "rms/wire/message_io.h"
+
 #include "subprocess.h"
 
 namespace rms {
@@ -45,9 +45,21 @@ Session RunLab(const std::string& timeline, double speed, const std::string& tag
   Session s;
   s.dir = testing::MakeTempDir(tag) + "/session";
   const std::string log = s.dir + ".lab.log";
-  std::vector<std::string> argv = {SourcePath("scripts/lab"), "demo", "--no-build", "--out", s.dir,
-                                   "--speed", std::to_string(speed), "--lcm-url", testing::UniqueLcmUrl(port_base),
-                                   "--png-every", "0", "--width", "160", "--height", "120"};
+  std::vector<std::string> argv = {SourcePath("scripts/lab"),
+                                   "demo",
+                                   "--no-build",
+                                   "--out",
+                                   s.dir,
+                                   "--speed",
+                                   std::to_string(speed),
+                                   "--lcm-url",
+                                   testing::UniqueLcmUrl(port_base),
+                                   "--png-every",
+                                   "0",
+                                   "--width",
+                                   "160",
+                                   "--height",
+                                   "120"};
   if (!timeline.empty()) {
     argv.push_back("--timeline");
     argv.push_back(timeline);
@@ -156,14 +168,16 @@ TEST(DcpSession, ACollisionHoldsThenReleasesAndResetReturnsToMode1) {
       // Never below the body's top: the fingers' tips stay above it.
       const double tip = s.telemetry[i].p_RoA_R_ft[2] - config.end_effector.palm_length_ft -
                          config.end_effector.finger_length_ft;
-      EXPECT_GT(tip, config.payload.p_RoPo_R_ft.z() + scene_model::PayloadTopFlat_P(config.payload));  // the 16-gon's top flat
+      EXPECT_GT(tip, config.payload.p_RoPo_R_ft.z() +
+                         scene_model::PayloadTopFlat_P(config.payload));  // the 16-gon's top flat
     }
   }
   ASSERT_GT(held, 10);
   ASSERT_LT(last_held + 30, static_cast<int>(s.telemetry.size()));
   const dcp_telemetry_t& after = s.telemetry[last_held + 30];
   EXPECT_FALSE(after.held);
-  for (int k = 0; k < 6; ++k) EXPECT_DOUBLE_EQ(after.slave_angles_deg[k], after.master_angles_deg[k]);
+  for (int k = 0; k < 6; ++k)
+    EXPECT_DOUBLE_EQ(after.slave_angles_deg[k], after.master_angles_deg[k]);
   // Acquired, then reset: 1 -> 2 -> 1, payload back in the bay.
   const auto& mc = s.summary["mode_changes"];
   ASSERT_EQ(mc.size(), 2u) << mc.dump();
@@ -200,7 +214,8 @@ TEST(DcpSession, TheLabDemosAutopilotAcquiresExtractsAndDocks) {
   EXPECT_GT(total, 30.0);
   EXPECT_LT(total, 180.0);
   EXPECT_EQ(s.summary["held_frames"], 0);
-  for (const auto& [kind, c] : s.summary["collisions_by_kind"].items()) EXPECT_EQ(c["events"], 0) << kind;
+  for (const auto& [kind, c] : s.summary["collisions_by_kind"].items())
+    EXPECT_EQ(c["events"], 0) << kind;
   // The telemetry agrees: the last frames say docked, and the autopilot's
   // command is what the slave did all along.
   ASSERT_FALSE(s.telemetry.empty());

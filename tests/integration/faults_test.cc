@@ -5,13 +5,12 @@
 // The launcher restarts each one; the DCP resumes from its last state (the
 // payload attached), not from Mode 1; the others count the gap; the
 // autopilot still docks; the LCM log keeps what was sent.
-#include <gtest/gtest.h>
-
 #include <signal.h>
 
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <thread>
 
@@ -26,7 +25,8 @@ using testing::SourcePath;
 using testing::Subprocess;
 
 // Waits until `path` contains `text` (or the lab ends); true if found.
-bool WaitForText(const std::string& path, const std::string& text, Subprocess& lab, double timeout_s) {
+bool WaitForText(const std::string& path, const std::string& text, Subprocess& lab,
+                 double timeout_s) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
   while (std::chrono::steady_clock::now() < end && lab.Running()) {
     if (ReadFile(path).find(text) != std::string::npos) return true;
@@ -47,13 +47,15 @@ TEST(Faults, EachProcessKilledIsRestartedTheDcpResumesAndTheAutopilotDocks) {
   const std::string tmp = testing::MakeTempDir("faults");
   const std::string out = tmp + "/session";
   const std::string url = testing::UniqueLcmUrl(8400);
-  Subprocess lab({SourcePath("scripts/lab"), "demo", "--no-build", "--out", out, "--lcm-url", url, "--png-every",
-                  "0", "--no-video", "--width", "320", "--height", "240"},
+  Subprocess lab({SourcePath("scripts/lab"), "demo", "--no-build", "--out", out, "--lcm-url", url,
+                  "--png-every", "0", "--no-video", "--width", "320", "--height", "240"},
                  tmp + "/lab.log", {std::string("RMSLAB_BUILD=") + RMSLAB_BUILD_DIR});
-  ASSERT_TRUE(WaitForText(out + "/logs/operator_station.log", "autopilot", lab, 60)) << ReadFile(tmp + "/lab.log");
+  ASSERT_TRUE(WaitForText(out + "/logs/operator_station.log", "autopilot", lab, 60))
+      << ReadFile(tmp + "/lab.log");
   std::this_thread::sleep_for(std::chrono::seconds(5));  // Mode 1, on the approach
   ASSERT_TRUE(Kill(out, "operator_station"));
-  ASSERT_TRUE(WaitForText(out + "/logs/dynamics_proc.log", "Mode 1 -> Mode 2", lab, 90)) << ReadFile(tmp + "/lab.log");
+  ASSERT_TRUE(WaitForText(out + "/logs/dynamics_proc.log", "Mode 1 -> Mode 2", lab, 90))
+      << ReadFile(tmp + "/lab.log");
   std::this_thread::sleep_for(std::chrono::seconds(2));  // the payload lifted a little
   ASSERT_TRUE(Kill(out, "dynamics_proc"));
   std::this_thread::sleep_for(std::chrono::seconds(3));
@@ -84,14 +86,19 @@ TEST(Faults, EachProcessKilledIsRestartedTheDcpResumesAndTheAutopilotDocks) {
   // restart within a frame period loses nothing; the ESG's restart (longer:
   // it opens a GL context) shows as frames the scene sent and nobody drew.
   const auto& d = s["frames"]["dropped"];
-  std::printf("frames lost: operator->DCP %ld, DCP->scene %ld, scene->ESG %ld; logged ESG frames missing %ld\n",
-              d["operator_to_dcp"].get<long>(), d["dcp_to_scene"].get<long>(), d["scene_to_esg"].get<long>(),
-              s["log"]["esg_frames_missing"].get<long>());
-  EXPECT_LT(d["operator_to_dcp"].get<long>() + d["dcp_to_scene"].get<long>() + d["scene_to_esg"].get<long>(), 30);
+  std::printf(
+      "frames lost: operator->DCP %ld, DCP->scene %ld, scene->ESG %ld; logged ESG frames missing "
+      "%ld\n",
+      d["operator_to_dcp"].get<long>(), d["dcp_to_scene"].get<long>(),
+      d["scene_to_esg"].get<long>(), s["log"]["esg_frames_missing"].get<long>());
+  EXPECT_LT(d["operator_to_dcp"].get<long>() + d["dcp_to_scene"].get<long>() +
+                d["scene_to_esg"].get<long>(),
+            30);
   // The log kept everything that was sent: every operator frame the
   // stations counted is in it (the status reports lag a second behind a
   // killed run's last frames, hence the margin).
-  EXPECT_GE(s["log"]["operator_frames"].get<long>(), s["frames"]["operator_published"].get<long>() * 95 / 100);
+  EXPECT_GE(s["log"]["operator_frames"].get<long>(),
+            s["frames"]["operator_published"].get<long>() * 95 / 100);
   fs::remove_all(tmp);
 }
 

@@ -4,29 +4,29 @@
 // NaN and out-of-range values, stale frame numbers, and a flood. Every
 // process counts what it dropped and why, keeps its frame rate and exits
 // cleanly.
-#include <gtest/gtest.h>
-
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <random>
 #include <thread>
 
-#include "lab_processes.h"
-#include "rms/wire/channels.h"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/esg_frame_t.hpp"
-#include "rms/wire/input_block.h"
-#include "rms/transport/lcm_interface.h"
-#include "rms/wire/message_io.h"
 #include "rms/operator_input_t.hpp"
 #include "rms/process_status_t.hpp"
 #include "rms/session_control_t.hpp"
+#include "rms/transport/lcm_interface.h"
+#include "rms/wire/channels.h"
+#include "rms/wire/input_block.h"
+#include "rms/wire/message_io.h"
+
+#include "lab_processes.h"
 #include "subprocess.h"
 
 namespace rms {
@@ -39,7 +39,9 @@ nlohmann::json Counters(const std::string& path) {
   if (!f) return nlohmann::json::object();
   return nlohmann::json::parse(f).value("counters", nlohmann::json::object());
 }
-std::int64_t Get(const nlohmann::json& c, const std::string& k) { return c.value(k, std::int64_t{0}); }
+std::int64_t Get(const nlohmann::json& c, const std::string& k) {
+  return c.value(k, std::int64_t{0});
+}
 
 struct Attacker {
   transport::UdpLcm* lcm = nullptr;
@@ -169,7 +171,8 @@ struct Attacker {
     // Random bytes.
     std::vector<std::uint8_t> junk(1 + rng() % 300);
     for (auto& b : junk) b = static_cast<std::uint8_t>(rng());
-    for (const char* ch : {kOperatorInput, kDcpFrame, kEsgFrame, kDcpTelemetry, kStatus, kControl}) SendRaw(ch, junk);
+    for (const char* ch : {kOperatorInput, kDcpFrame, kEsgFrame, kDcpTelemetry, kStatus, kControl})
+      SendRaw(ch, junk);
   }
 
   void Flood(int n) {
@@ -187,7 +190,8 @@ TEST(HostileTraffic, EveryProcessCountsWhatItDroppedAndKeepsItsFrameRate) {
   const std::string dir = testing::MakeTempDir("hostile");
   const std::string url = testing::UniqueLcmUrl(8300);
   const std::string timeline = dir + "/six_seconds.tl";
-  std::ofstream(timeline) << "0.0 camera=8\n6.0 shoulder_yaw=20 shoulder_pitch=30 elbow_pitch=-40 finger=1\n6.0 end\n";
+  std::ofstream(timeline)
+      << "0.0 camera=8\n6.0 shoulder_yaw=20 shoulder_pitch=30 elbow_pitch=-40 finger=1\n6.0 end\n";
   LabProcesses lab(dir, url);
   std::string error;
   ASSERT_TRUE(lab.Start(&error)) << error;
@@ -196,7 +200,8 @@ TEST(HostileTraffic, EveryProcessCountsWhatItDroppedAndKeepsItsFrameRate) {
   o.url = url;
   transport::UdpLcm listen(o), attack_lcm(o);
   long esg_frames = 0;
-  listen.Subscribe(wire::channels::kEsgFrame, [&](const void*, int, std::int64_t) { ++esg_frames; });
+  listen.Subscribe(wire::channels::kEsgFrame,
+                   [&](const void*, int, std::int64_t) { ++esg_frames; });
 
   Attacker attacker;
   attacker.lcm = &attack_lcm;
@@ -224,12 +229,13 @@ TEST(HostileTraffic, EveryProcessCountsWhatItDroppedAndKeepsItsFrameRate) {
   const auto dcp = Counters(dir + "/dynamics_proc.json");
   const auto scene = Counters(dir + "/scene_proc.json");
   const auto esg = Counters(dir + "/esg_renderer.json");
-  std::printf("operator_station: %s\ndynamics_proc: %s\nscene_proc: %s\nesg_renderer: %s\n", op.dump().c_str(),
-              dcp.dump().c_str(), scene.dump().c_str(), esg.dump().c_str());
+  std::printf("operator_station: %s\ndynamics_proc: %s\nscene_proc: %s\nesg_renderer: %s\n",
+              op.dump().c_str(), dcp.dump().c_str(), scene.dump().c_str(), esg.dump().c_str());
   // Each process counted each kind it was sent, by reason.
-  for (const auto& [name, c] : {std::pair{"dynamics_proc", dcp}, {"scene_proc", scene}, {"esg_renderer", esg}}) {
-    for (const char* k : {"dropped.wrong_type", "dropped.truncated", "dropped.bad_word", "dropped.stale",
-                          "dropped.bad_frame"}) {
+  for (const auto& [name, c] :
+       {std::pair{"dynamics_proc", dcp}, {"scene_proc", scene}, {"esg_renderer", esg}}) {
+    for (const char* k : {"dropped.wrong_type", "dropped.truncated", "dropped.bad_word",
+                          "dropped.stale", "dropped.bad_frame"}) {
       if (std::string(name) != "dynamics_proc" && std::string(k) == "dropped.bad_frame") continue;
       EXPECT_GT(Get(c, k), 0) << name << " " << k;
     }
@@ -237,8 +243,9 @@ TEST(HostileTraffic, EveryProcessCountsWhatItDroppedAndKeepsItsFrameRate) {
   EXPECT_GT(Get(dcp, "dropped.bad_word"), 0);
   EXPECT_GT(Get(esg, "dropped.word_count") + Get(esg, "dropped.too_large"), 0);
   EXPECT_GT(Get(dcp, "dropped.control_malformed"), 0);
-  for (const char* k : {"dropped.telemetry_wrong_type", "dropped.telemetry_truncated", "dropped.telemetry_non_finite",
-                        "dropped.telemetry_mode", "dropped.status_malformed", "dropped.control_malformed"}) {
+  for (const char* k : {"dropped.telemetry_wrong_type", "dropped.telemetry_truncated",
+                        "dropped.telemetry_non_finite", "dropped.telemetry_mode",
+                        "dropped.status_malformed", "dropped.control_malformed"}) {
     EXPECT_GT(Get(op, k), 0) << "operator_station " << k;
   }
   // It kept its frame rate: every operator frame became a DCP frame and an

@@ -4,23 +4,23 @@
 // command frame (seen in the DCP's telemetry), the camera key switches the
 // ESG's camera, the status screen shows guidance and follows the terminal's
 // size, and Q quits.
-#include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <Eigen/Core>
 #include <filesystem>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 #include <regex>
 
-#include <Eigen/Core>
-#include <nlohmann/json.hpp>
-
-#include "lab_processes.h"
-#include "rms/wire/channels.h"
-#include "rms/wire/control_word.h"
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/esg_frame_t.hpp"
-#include "rms/transport/lcm_interface.h"
-#include "rms/wire/message_io.h"
 #include "rms/operator_state_t.hpp"
+#include "rms/transport/lcm_interface.h"
+#include "rms/wire/channels.h"
+#include "rms/wire/control_word.h"
+#include "rms/wire/message_io.h"
+
+#include "lab_processes.h"
 #include "subprocess.h"
 #include "tmux.h"
 
@@ -61,17 +61,18 @@ TEST(KeyboardSession, APressIsOneIncrementAndTheScreenShowsGuidance) {
   };
 
   Tmux tmux(dir);
-  const std::string cmd = testing::BuildPath("operator_station/operator_station") + " --lcm-url '" + lab.url() +
-                          "' --keyboard --no-gamepad --no-spacemouse --stats " + dir + "/op.json 2>" + dir +
-                          "/op.log; echo $? >" + dir + "/op.rc";
+  const std::string cmd = testing::BuildPath("operator_station/operator_station") + " --lcm-url '" +
+                          lab.url() + "' --keyboard --no-gamepad --no-spacemouse --stats " + dir +
+                          "/op.json 2>" + dir + "/op.log; echo $? >" + dir + "/op.rc";
   ASSERT_EQ(tmux.Start(cmd, 120, 45), 0);
   for (int i = 0; i < 100 && !(tm && state); ++i) pump(0.1);
-  ASSERT_TRUE(tm.has_value()) << "no telemetry: the station did not start?\n" << testing::ReadFile(dir + "/op.log");
+  ASSERT_TRUE(tm.has_value()) << "no telemetry: the station did not start?\n"
+                              << testing::ReadFile(dir + "/op.log");
   ASSERT_TRUE(state.has_value()) << "no RMS_OPERATOR_STATE";
   EXPECT_EQ(state->control_mode, 2);   // manual augmented
   EXPECT_EQ(state->command_frame, 1);  // end effector
   EXPECT_TRUE(state->guidance_valid);
-  EXPECT_EQ(state->target, 1);         // the grasp
+  EXPECT_EQ(state->target, 1);  // the grasp
   EXPECT_EQ(camera_in_esg, 1);
   const Eigen::Vector3d A0(tm->p_RoA_R_ft[0], tm->p_RoA_R_ft[1], tm->p_RoA_R_ft[2]);
 
@@ -86,7 +87,8 @@ TEST(KeyboardSession, APressIsOneIncrementAndTheScreenShowsGuidance) {
   ASSERT_EQ(tmux.Send({"w", "w", "w", "w", "w", "w", "w", "w", "w", "w"}), 0);
   // 5 ft; slowly at first: from the straight arm (its reach's singular
   // direction) the elbow must bend first, at its 8 deg/s.
-  for (int i = 0; i < 150 && !(state && state->hand_rate[0] == 0.0 && tm->p_RoA_R_ft[0] < A0.x() - 4.0); ++i) {
+  for (int i = 0;
+       i < 150 && !(state && state->hand_rate[0] == 0.0 && tm->p_RoA_R_ft[0] < A0.x() - 4.0); ++i) {
     pump(0.1);
   }
   pump(0.5);
@@ -103,15 +105,19 @@ TEST(KeyboardSession, APressIsOneIncrementAndTheScreenShowsGuidance) {
   EXPECT_LT((A2 - A1).norm(), 1e-6) << "the arm ran on after its increment";
   const std::string screen = tmux.Capture();
   SCOPED_TRACE(screen);
-  for (const char* want : {"rmslab operator station -- by hand", "MODE 1 ACQUISITION", "CONTROL manual augmented",
-                           "frame: orbiter", "GUIDANCE to the grasp on the bar receptacle", "camera 3 elbow",
-                           "devices: keyboard (this terminal)", "input to DCP", "short by", "command frame"}) {
-    EXPECT_NE(screen.find(want), std::string::npos) << "\"" << want << "\" not on the screen:\n" << screen;
+  for (const char* want :
+       {"rmslab operator station -- by hand", "MODE 1 ACQUISITION", "CONTROL manual augmented",
+        "frame: orbiter", "GUIDANCE to the grasp on the bar receptacle", "camera 3 elbow",
+        "devices: keyboard (this terminal)", "input to DCP", "short by", "command frame"}) {
+    EXPECT_NE(screen.find(want), std::string::npos) << "\"" << want << "\" not on the screen:\n"
+                                                    << screen;
   }
   // The rates measured over the last second: about the frame rate (a loaded
   // machine may run a little slow).
   std::smatch m;
-  ASSERT_TRUE(std::regex_search(screen, m, std::regex(R"(rates: published ([\d.]+) Hz\s+DCP ([\d.]+) Hz)"))) << screen;
+  ASSERT_TRUE(
+      std::regex_search(screen, m, std::regex(R"(rates: published ([\d.]+) Hz\s+DCP ([\d.]+) Hz)")))
+      << screen;
   EXPECT_NEAR(std::stod(m[1]), 30.0, 4.0) << screen;
   EXPECT_NEAR(std::stod(m[2]), 30.0, 4.0) << screen;
   // The screen follows the terminal: narrower, no line is wider.

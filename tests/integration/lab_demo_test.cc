@@ -1,17 +1,17 @@
 // scripts/lab demo as a user runs it (a short timeline): the session folder
 // holds an LCM log of every channel that lcm-logplayer plays, each process's
 // log, PNG frames, the session's video and summary.json.
-#include <gtest/gtest.h>
-
 #include <filesystem>
+#include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 #include <map>
 #include <nlohmann/json.hpp>
 
-#include "rms/wire/channels.h"
 #include "rms/esg_frame_t.hpp"
 #include "rms/transport/lcm_interface.h"
+#include "rms/wire/channels.h"
 #include "rms/wire/message_io.h"
+
 #include "subprocess.h"
 
 namespace rms {
@@ -32,21 +32,24 @@ TEST(LabDemo, TheSessionFolderHoldsLogVideoFramesProcessLogsAndSummary) {
   ASSERT_EQ(lab.Wait(120), 0) << testing::ReadFile(tmp + "/lab.log");
 
   // Process logs.
-  for (const char* p : {"operator_station", "dynamics_proc", "scene_proc", "esg_renderer", "lcm-logger"}) {
+  for (const char* p :
+       {"operator_station", "dynamics_proc", "scene_proc", "esg_renderer", "lcm-logger"}) {
     EXPECT_TRUE(fs::exists(out + "/logs/" + p + ".log")) << p;
   }
   EXPECT_NE(testing::ReadFile(out + "/logs/esg_renderer.log").find("rendered"), std::string::npos);
 
   // PNG frames: 91 frames, every 30th -> frames 0, 30, 60, 90.
   int pngs = 0;
-  for (const auto& e : fs::directory_iterator(out + "/frames")) pngs += e.path().extension() == ".png";
+  for (const auto& e : fs::directory_iterator(out + "/frames"))
+    pngs += e.path().extension() == ".png";
   EXPECT_GE(pngs, 3);
 
   // The session's video: one frame per frame number, at the render size.
   ASSERT_TRUE(fs::exists(out + "/session.mp4"));
   {
-    Subprocess probe({"/usr/bin/ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0", "-show_entries",
-                      "stream=nb_read_frames,width,height", "-of", "csv=p=0", out + "/session.mp4"},
+    Subprocess probe({"/usr/bin/ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0",
+                      "-show_entries", "stream=nb_read_frames,width,height", "-of", "csv=p=0",
+                      out + "/session.mp4"},
                      tmp + "/ffprobe.log");
     ASSERT_EQ(probe.Wait(60), 0) << testing::ReadFile(tmp + "/ffprobe.log");
     EXPECT_EQ(testing::ReadFile(tmp + "/ffprobe.log"), "320,240,91\n");
@@ -89,7 +92,8 @@ TEST(LabDemo, TheSessionFolderHoldsLogVideoFramesProcessLogsAndSummary) {
     esg_frame_t m;
     esg_frames += wire::SafeDecode(d, n, &m) == wire::DecodeError::kNone;
   });
-  Subprocess player({"/usr/bin/lcm-logplayer", "-s", "10", "-l", play_url, out + "/lcmlog"}, tmp + "/player.log");
+  Subprocess player({"/usr/bin/lcm-logplayer", "-s", "10", "-l", play_url, out + "/lcmlog"},
+                    tmp + "/player.log");
   while (player.Running()) lcm.HandleSubscriptions(20);
   for (int i = 0; i < 10; ++i) lcm.HandleSubscriptions(20);
   EXPECT_EQ(player.Wait(1), 0) << testing::ReadFile(tmp + "/player.log");

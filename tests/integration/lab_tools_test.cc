@@ -5,25 +5,26 @@
 // monitor shows its traffic; a frozen session holds, steps and resumes with
 // nothing lost; a checkpoint restores the DCP and a session can start from
 // one.
-#include <gtest/gtest.h>
 #include <signal.h>
 
 #include <filesystem>
 #include <fstream>
+#include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <regex>
 
-#include "lab_processes.h"
-#include "rms/wire/channels.h"
 #include "rms/base/config.h"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/esg_frame_t.hpp"
 #include "rms/transport/lcm_interface.h"
+#include "rms/wire/channels.h"
 #include "rms/wire/message_io.h"
+
+#include "lab_processes.h"
 #include "subprocess.h"
 
 namespace rms {
@@ -44,9 +45,10 @@ class RecordedSession : public ::testing::Test {
   static void SetUpTestSuite() {
     tmp_ = new std::string(testing::MakeTempDir("recorded"));
     dir_ = new std::string(*tmp_ + "/session");
-    const ScriptRun r = Script({SourcePath("scripts/lab"), "demo", "--no-build", "--out", *dir_, "--speed", "4", "--lcm-url",
-                          testing::UniqueLcmUrl(9100), "--png-every", "200", "--width", "160", "--height", "120"},
-                         *tmp_ + "/lab.log");
+    const ScriptRun r = Script({SourcePath("scripts/lab"), "demo", "--no-build", "--out", *dir_,
+                                "--speed", "4", "--lcm-url", testing::UniqueLcmUrl(9100),
+                                "--png-every", "200", "--width", "160", "--height", "120"},
+                               *tmp_ + "/lab.log");
     ASSERT_EQ(r.rc, 0) << r.out;
   }
   static void TearDownTestSuite() {
@@ -67,8 +69,10 @@ TEST_F(RecordedSession, TheManifestSaysWhatRanWhereAndWhen) {
   EXPECT_EQ(m["config"]["file"], "config.toml");
   EXPECT_EQ(m["config"]["sha256"].get<std::string>().size(), 64u);
   EXPECT_NE(m["software"]["version"].get<std::string>().find("rmslab"), std::string::npos);
-  EXPECT_EQ(m["software"]["commit"].get<std::string>().size(), 40u);  // the tests run in a git checkout
-  for (const char* p : {"operator_station", "dynamics_proc", "scene_proc", "esg_renderer", "lcm-logger"}) {
+  EXPECT_EQ(m["software"]["commit"].get<std::string>().size(),
+            40u);  // the tests run in a git checkout
+  for (const char* p :
+       {"operator_station", "dynamics_proc", "scene_proc", "esg_renderer", "lcm-logger"}) {
     EXPECT_EQ(m["hosts"][p], "localhost") << p;
   }
   EXPECT_GT(m["started_us"].get<std::int64_t>(), 1700000000000000);
@@ -76,14 +80,16 @@ TEST_F(RecordedSession, TheManifestSaysWhatRanWhereAndWhen) {
 }
 
 TEST_F(RecordedSession, ItReSimulatesBitForBit) {
-  const ScriptRun r = Script({SourcePath("scripts/lab"), "resim", *dir_, "--no-build"}, *tmp_ + "/resim.log");
+  const ScriptRun r =
+      Script({SourcePath("scripts/lab"), "resim", *dir_, "--no-build"}, *tmp_ + "/resim.log");
   EXPECT_EQ(r.rc, 0) << r.out;
   const auto s = nlohmann::json::parse(ReadFile(*dir_ + "/summary.json"));
   const std::string want = std::to_string(s["frames"]["dcp_published"].get<int>()) + " of " +
                            std::to_string(s["frames"]["dcp_published"].get<int>()) +
                            " recorded frames identical, word for word";
   EXPECT_NE(r.out.find(want), std::string::npos) << r.out;
-  EXPECT_EQ(r.out.find("resim: "), std::string::npos) << "progress lines with no terminal to show them";
+  EXPECT_EQ(r.out.find("resim: "), std::string::npos)
+      << "progress lines with no terminal to show them";
 }
 
 TEST_F(RecordedSession, ALongerArmFaresOtherwiseAndTheComparisonSaysWhy) {
@@ -96,8 +102,9 @@ TEST_F(RecordedSession, ALongerArmFaresOtherwiseAndTheComparisonSaysWhy) {
   const std::string long_arm = *tmp_ + "/long_arm.toml";
   std::ofstream(long_arm) << cfg;
   const std::string out = *tmp_ + "/long_arm_session";
-  const ScriptRun r = Script({SourcePath("scripts/lab"), "resim", *dir_, "--no-build", "--config", long_arm, "--out", out},
-                       *tmp_ + "/resim_long.log");
+  const ScriptRun r = Script(
+      {SourcePath("scripts/lab"), "resim", *dir_, "--no-build", "--config", long_arm, "--out", out},
+      *tmp_ + "/resim_long.log");
   ASSERT_EQ(r.rc, 0) << r.out;
   const auto summary = nlohmann::json::parse(ReadFile(out + "/summary.json"));
   EXPECT_FALSE(summary["docked"].get<bool>());
@@ -118,18 +125,20 @@ TEST_F(RecordedSession, ALongerArmFaresOtherwiseAndTheComparisonSaysWhy) {
 
 TEST_F(RecordedSession, ItReplaysThroughTheSceneAndTheRendererToTheSameFrames) {
   const std::string out = *tmp_ + "/replay";
-  const ScriptRun r = Script({SourcePath("scripts/lab"), "replay", *dir_, "--no-build", "--out", out, "--speed", "4", "--width",
-                        "160", "--height", "120", "--lcm-url", testing::UniqueLcmUrl(9200)},
-                       *tmp_ + "/replay.log");
+  const ScriptRun r =
+      Script({SourcePath("scripts/lab"), "replay", *dir_, "--no-build", "--out", out, "--speed",
+              "4", "--width", "160", "--height", "120", "--lcm-url", testing::UniqueLcmUrl(9200)},
+             *tmp_ + "/replay.log");
   ASSERT_EQ(r.rc, 0) << r.out;
   const auto c = nlohmann::json::parse(ReadFile(out + "/replay_comparison.json"));
   EXPECT_GT(c["recorded"].get<int>(), 1000);
   EXPECT_EQ(c["identical"], c["recorded"]);
   EXPECT_EQ(c["missing"], 0);
   // The replay's video: one frame per frame number.
-  Subprocess probe({"/usr/bin/ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0", "-show_entries",
-                    "stream=nb_read_frames", "-of", "csv=p=0", out + "/session.mp4"},
-                   *tmp_ + "/ffprobe.log");
+  Subprocess probe(
+      {"/usr/bin/ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0",
+       "-show_entries", "stream=nb_read_frames", "-of", "csv=p=0", out + "/session.mp4"},
+      *tmp_ + "/ffprobe.log");
   ASSERT_EQ(probe.Wait(60), 0);
   // A loaded machine may drop a video frame; if so it is counted, and the
   // replay said so (docs/esg.md "Video").
@@ -142,7 +151,8 @@ TEST_F(RecordedSession, ItReplaysThroughTheSceneAndTheRendererToTheSameFrames) {
 }
 
 TEST_F(RecordedSession, ItExportsEveryChannelToCsvWithUnits) {
-  const ScriptRun r = Script({SourcePath("scripts/lab"), "export", *dir_, "--out", *tmp_ + "/csv"}, *tmp_ + "/export.log");
+  const ScriptRun r = Script({SourcePath("scripts/lab"), "export", *dir_, "--out", *tmp_ + "/csv"},
+                             *tmp_ + "/export.log");
   ASSERT_EQ(r.rc, 0) << r.out;
   const auto s = nlohmann::json::parse(ReadFile(*dir_ + "/summary.json"));
   auto lines = [](const std::string& path) {
@@ -189,22 +199,26 @@ TEST_F(RecordedSession, ItExportsEveryChannelToCsvWithUnits) {
 }
 
 TEST_F(RecordedSession, ItsReportOpensInABrowserWithPlots) {
-  const ScriptRun r = Script({SourcePath("scripts/lab"), "report", *dir_, "--out", *tmp_ + "/report.html"}, *tmp_ + "/report.log");
+  const ScriptRun r =
+      Script({SourcePath("scripts/lab"), "report", *dir_, "--out", *tmp_ + "/report.html"},
+             *tmp_ + "/report.log");
   ASSERT_EQ(r.rc, 0) << r.out;
   const std::string html = ReadFile(*tmp_ + "/report.html");
-  for (const char* want : {"<h2>Attempts</h2>", "The operator's scorecard", "docked at, ft", "Losses",
-                           "lost by the record: RMS_DCP_FRAME", "refused by the processes: late",
-                           "Frame times and latency", "The configuration's tolerances", "Chart.js v3",
-                           "data:image/png;base64,"}) {
+  for (const char* want :
+       {"<h2>Attempts</h2>", "The operator's scorecard", "docked at, ft", "Losses",
+        "lost by the record: RMS_DCP_FRAME", "refused by the processes: late",
+        "Frame times and latency", "The configuration's tolerances", "Chart.js v3",
+        "data:image/png;base64,"}) {
     EXPECT_NE(html.find(want), std::string::npos) << want;
   }
   EXPECT_EQ(html.find("<script src="), std::string::npos) << "not self-contained";
   EXPECT_EQ(html.find("<pre>"), std::string::npos) << "raw JSON in the report";
   // A real browser: headless Chromium draws the charts (path top and side,
   // joints, distance to goal, timeline; no inputs plot for the autopilot).
-  Subprocess chrome({"/usr/bin/chromium", "--headless=new", "--no-sandbox", "--disable-gpu", "--virtual-time-budget=5000",
-                     "--dump-dom", "file://" + *tmp_ + "/report.html"},
-                    *tmp_ + "/dom.html");
+  Subprocess chrome(
+      {"/usr/bin/chromium", "--headless=new", "--no-sandbox", "--disable-gpu",
+       "--virtual-time-budget=5000", "--dump-dom", "file://" + *tmp_ + "/report.html"},
+      *tmp_ + "/dom.html");
   ASSERT_EQ(chrome.Wait(120), 0) << ReadFile(*tmp_ + "/dom.html").substr(0, 2000);
   const std::string dom = ReadFile(*tmp_ + "/dom.html");
   EXPECT_NE(dom.find("data-charts-rendered=\"5\""), std::string::npos)
@@ -240,13 +254,14 @@ struct Listener {
   std::optional<dcp_telemetry_t> telemetry;
 };
 
-std::vector<dcp_frame_t> FlyShortTimeline(const std::string& dir, const std::string& url, bool freeze) {
+std::vector<dcp_frame_t> FlyShortTimeline(const std::string& dir, const std::string& url,
+                                          bool freeze) {
   testing::LabProcesses lab(dir, url);
   std::string error;
   EXPECT_TRUE(lab.Start(&error)) << error;
   Listener l(url);
-  Subprocess op({testing::BuildPath("operator_station/operator_station"), "--lcm-url", url, "--timeline",
-                 SourcePath("scripts/timelines/short.tl")},
+  Subprocess op({testing::BuildPath("operator_station/operator_station"), "--lcm-url", url,
+                 "--timeline", SourcePath("scripts/timelines/short.tl")},
                 dir + "/op.log");
   auto control = [&](std::vector<std::string> args) {
     args.insert(args.begin(), {testing::BuildPath("tools/rms_control"), "--lcm-url", url});
@@ -270,7 +285,8 @@ std::vector<dcp_frame_t> FlyShortTimeline(const std::string& dir, const std::str
   EXPECT_EQ(op.Wait(1), 0) << ReadFile(dir + "/op.log");
   EXPECT_TRUE(lab.Stop(&error)) << error;
   // Nothing lost: every frame, in order, through to the ESG.
-  for (std::size_t i = 0; i < l.dcp.size(); ++i) EXPECT_EQ(l.dcp[i].frame, static_cast<std::int64_t>(i));
+  for (std::size_t i = 0; i < l.dcp.size(); ++i)
+    EXPECT_EQ(l.dcp[i].frame, static_cast<std::int64_t>(i));
   for (std::size_t i = 0; i < l.esg.size(); ++i) EXPECT_EQ(l.esg[i], static_cast<std::int64_t>(i));
   EXPECT_EQ(l.esg.size(), l.dcp.size());
   return l.dcp;
@@ -288,7 +304,8 @@ TEST(SessionControl, AFrozenSessionHoldsStepsAndResumesWithNothingLost) {
   ASSERT_EQ(frozen.size(), plain.size());
   for (std::size_t i = 0; i < plain.size(); ++i) {
     ASSERT_EQ(frozen[i].input_frame, plain[i].input_frame) << i;
-    for (int k = 0; k < 12; ++k) ASSERT_EQ(frozen[i].arm_words[k], plain[i].arm_words[k]) << "frame " << i;
+    for (int k = 0; k < 12; ++k)
+      ASSERT_EQ(frozen[i].arm_words[k], plain[i].arm_words[k]) << "frame " << i;
     ASSERT_EQ(frozen[i].control_word, plain[i].control_word) << i;
     for (int k = 0; k < 17; ++k) ASSERT_EQ(frozen[i].state_words[k], plain[i].state_words[k]) << i;
   }
@@ -304,9 +321,10 @@ TEST(SessionControl, ACheckpointRestoresTheDcpAndASessionStartsFromOne) {
     std::string error;
     ASSERT_TRUE(lab.Start(&error)) << error;
     Listener l(url);
-    Subprocess op({testing::BuildPath("operator_station/operator_station"), "--lcm-url", url, "--autopilot", "--rate",
-                   "150", "--hold", "--checkpoint-dir", dir + "/checkpoints"},
-                  dir + "/op.log");
+    Subprocess op(
+        {testing::BuildPath("operator_station/operator_station"), "--lcm-url", url, "--autopilot",
+         "--rate", "150", "--hold", "--checkpoint-dir", dir + "/checkpoints"},
+        dir + "/op.log");
     auto control = [&](std::vector<std::string> args) {
       args.insert(args.begin(), {testing::BuildPath("tools/rms_control"), "--lcm-url", url});
       Subprocess c(args, dir + "/control.log");
@@ -337,14 +355,16 @@ TEST(SessionControl, ACheckpointRestoresTheDcpAndASessionStartsFromOne) {
     op.Signal(SIGINT);
     op.Wait(10);
     ASSERT_TRUE(lab.Stop(&error)) << error;
-    EXPECT_NE(ReadFile(dir + "/dynamics_proc.log").find("restored the DCP's state"), std::string::npos);
+    EXPECT_NE(ReadFile(dir + "/dynamics_proc.log").find("restored the DCP's state"),
+              std::string::npos);
   }
   // A new session from the checkpoint: it starts in Mode 3 and docks without
   // ever acquiring.
-  const ScriptRun r = Script({SourcePath("scripts/lab"), "demo", "--no-build", "--out", dir + "/from_checkpoint", "--restore", cp,
-                        "--speed", "4", "--lcm-url", testing::UniqueLcmUrl(9600), "--png-every", "0", "--no-video",
-                        "--width", "160", "--height", "120"},
-                       dir + "/lab.log");
+  const ScriptRun r =
+      Script({SourcePath("scripts/lab"), "demo", "--no-build", "--out", dir + "/from_checkpoint",
+              "--restore", cp, "--speed", "4", "--lcm-url", testing::UniqueLcmUrl(9600),
+              "--png-every", "0", "--no-video", "--width", "160", "--height", "120"},
+             dir + "/lab.log");
   ASSERT_EQ(r.rc, 0) << r.out;
   const auto s = nlohmann::json::parse(ReadFile(dir + "/from_checkpoint/summary.json"));
   EXPECT_TRUE(s["docked"].get<bool>());
@@ -365,16 +385,19 @@ TEST(Monitor, ShowsEveryChannelsTrafficWithRates) {
   ASSERT_TRUE(lab.Start(&error)) << error;
   // A timeline longer than the monitor listens, however late either starts
   // on a loaded machine; stopped once the monitor is done.
-  Subprocess op({testing::BuildPath("operator_station/operator_station"), "--lcm-url", url, "--timeline",
-                 SourcePath("scripts/timelines/mission.tl")},
+  Subprocess op({testing::BuildPath("operator_station/operator_station"), "--lcm-url", url,
+                 "--timeline", SourcePath("scripts/timelines/mission.tl")},
                 dir + "/op.log");
-  const ScriptRun m = Script({SourcePath("scripts/lab"), "monitor", "--lcm-url", url, "--for", "2.5"}, dir + "/monitor.log", 30);
+  const ScriptRun m =
+      Script({SourcePath("scripts/lab"), "monitor", "--lcm-url", url, "--for", "2.5"},
+             dir + "/monitor.log", 30);
   op.Signal(SIGINT);
   const int op_rc = op.Wait(10);
   EXPECT_TRUE(op_rc == 0 || op_rc == 130) << op_rc;  // done, or stopped by the SIGINT
   ASSERT_TRUE(lab.Stop(&error)) << error;
   ASSERT_EQ(m.rc, 0) << m.out;
-  for (const char* ch : {"RMS_OPERATOR_INPUT", "RMS_DCP_FRAME", "RMS_DCP_TELEMETRY", "RMS_ESG_FRAME"}) {
+  for (const char* ch :
+       {"RMS_OPERATOR_INPUT", "RMS_DCP_FRAME", "RMS_DCP_TELEMETRY", "RMS_ESG_FRAME"}) {
     const std::regex row(std::string(ch) + R"(\s+(\d+)\s+([\d.]+)\s+[\d.]+\s+(\d+)\s+0\s)");
     std::smatch mm;
     ASSERT_TRUE(std::regex_search(m.out, mm, row)) << ch << " not shown:\n" << m.out;

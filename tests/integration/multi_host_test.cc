@@ -2,11 +2,11 @@
 // bridge (scripts/netns-lab) stand for a lab's machines; a lab file puts
 // each process on its own host and scripts/lab demo runs the whole task
 // across them over multicast with TTL 1.
-#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
+#include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include "subprocess.h"
@@ -43,28 +43,31 @@ class NetnsLab {
 // A lab file with one process a host (the recorder beside the operator
 // station), on a group and port of its own, TTL 1.
 std::string WriteLabFile(const NetnsLab& net, const std::string& dir) {
-  const std::string lab_file = dir + "/lab.toml";
+  std::string lab_file = dir + "/lab.toml";
   std::ofstream(lab_file) << "[hosts]\n"
                           << "operator_station = \"" << net.host(1) << "\"\n"
                           << "dynamics_proc = \"" << net.host(2) << "\"\n"
                           << "scene_proc = \"" << net.host(3) << "\"\n"
                           << "esg_renderer = \"" << net.host(4) << "\"\n"
                           << "recorder = \"" << net.host(1) << "\"\n"
-                          << "[lcm]\ngroup = \"239.255.76.68\"\nport = 7668\nttl = 1\n[remote]\nroot = \"\"\nbuild = \"\"\n";
+                          << "[lcm]\ngroup = \"239.255.76.68\"\nport = 7668\nttl = "
+                             "1\n[remote]\nroot = \"\"\nbuild = \"\"\n";
   return lab_file;
 }
 
 // scripts/lab demo across the lab's hosts: the autopilot at 4x, small frames.
 Subprocess FlyAcross(const std::string& lab_file, const std::string& dir) {
-  return Subprocess({SourcePath("scripts/lab"), "demo", "--no-build", "--lab", lab_file, "--out", dir + "/session",
-                     "--speed", "4", "--png-every", "0", "--no-video", "--width", "160", "--height", "120"},
+  return Subprocess({SourcePath("scripts/lab"), "demo", "--no-build", "--lab", lab_file, "--out",
+                     dir + "/session", "--speed", "4", "--png-every", "0", "--no-video", "--width",
+                     "160", "--height", "120"},
                     dir + "/lab.log", {std::string("RMSLAB_BUILD=") + RMSLAB_BUILD_DIR});
 }
 
 TEST(MultiHost, ASessionRunsAcrossNamespaceHosts) {
   const std::string dir = testing::MakeTempDir("hosts");
   NetnsLab net("rt" + std::to_string(getpid() % 100000), dir);
-  ASSERT_TRUE(net.ok()) << "network namespaces could not be made (root, iproute2):\n" << ReadFile(dir + "/netns.log");
+  ASSERT_TRUE(net.ok()) << "network namespaces could not be made (root, iproute2):\n"
+                        << ReadFile(dir + "/netns.log");
   const std::string lab_file = WriteLabFile(net, dir);
   Subprocess lab = FlyAcross(lab_file, dir);
   ASSERT_EQ(lab.Wait(300), 0) << ReadFile(dir + "/lab.log");
@@ -87,11 +90,12 @@ TEST(MultiHost, ASessionRunsAcrossNamespaceHosts) {
   std::string bad = ReadFile(lab_file);
   bad.replace(bad.find(net.host(3)), net.host(3).size(), "netns:no-such-host");
   std::ofstream(dir + "/bad.toml") << bad;
-  Subprocess refused({SourcePath("scripts/lab"), "demo", "--no-build", "--lab", dir + "/bad.toml", "--out",
-                      dir + "/never"},
+  Subprocess refused({SourcePath("scripts/lab"), "demo", "--no-build", "--lab", dir + "/bad.toml",
+                      "--out", dir + "/never"},
                      dir + "/bad.log", {std::string("RMSLAB_BUILD=") + RMSLAB_BUILD_DIR});
   EXPECT_NE(refused.Wait(60), 0);
-  EXPECT_NE(ReadFile(dir + "/bad.log").find("netns:no-such-host: no such network namespace"), std::string::npos)
+  EXPECT_NE(ReadFile(dir + "/bad.log").find("netns:no-such-host: no such network namespace"),
+            std::string::npos)
       << ReadFile(dir + "/bad.log");
   EXPECT_FALSE(fs::exists(dir + "/never/lcmlog"));
   net.Down();
@@ -108,7 +112,8 @@ TEST(MultiHost, OverALossyLinkEveryGapIsCountedAndTheAutopilotStillDocks) {
   NetnsLab net("ls" + std::to_string(getpid() % 100000), dir);
   ASSERT_TRUE(net.ok()) << ReadFile(dir + "/netns.log");
   const std::string prefix = net.host(1).substr(6, net.host(1).size() - 8);
-  Subprocess impair({SourcePath("scripts/netns-lab"), "impair", prefix, "2", "loss=5", "dup=1"}, dir + "/impair.log");
+  Subprocess impair({SourcePath("scripts/netns-lab"), "impair", prefix, "2", "loss=5", "dup=1"},
+                    dir + "/impair.log");
   ASSERT_EQ(impair.Wait(30), 0) << ReadFile(dir + "/impair.log");
   std::printf("%s", ReadFile(dir + "/impair.log").c_str());
   const std::string lab_file = WriteLabFile(net, dir);
@@ -116,15 +121,20 @@ TEST(MultiHost, OverALossyLinkEveryGapIsCountedAndTheAutopilotStillDocks) {
   ASSERT_EQ(lab.Wait(300), 0) << ReadFile(dir + "/lab.log");
   const auto s = nlohmann::json::parse(ReadFile(dir + "/session/summary.json"));
   EXPECT_TRUE(s["docked"].get<bool>()) << ReadFile(dir + "/lab.log");
-  const auto dcp = nlohmann::json::parse(ReadFile(dir + "/session/stats/dynamics_proc.json"))["counters"];
-  const auto scene = nlohmann::json::parse(ReadFile(dir + "/session/stats/scene_proc.json"))["counters"];
+  const auto dcp =
+      nlohmann::json::parse(ReadFile(dir + "/session/stats/dynamics_proc.json"))["counters"];
+  const auto scene =
+      nlohmann::json::parse(ReadFile(dir + "/session/stats/scene_proc.json"))["counters"];
   const long op_sent = s["frames"]["operator_published"], dcp_sent = s["frames"]["dcp_published"],
              scene_sent = s["frames"]["esg_published"];
-  const long dcp_missing = dcp.value("input.missing", 0L), scene_missing = scene.value("dcp.missing", 0L);
+  const long dcp_missing = dcp.value("input.missing", 0L),
+             scene_missing = scene.value("dcp.missing", 0L);
   const long dups = dcp.value("dropped.duplicate", 0L) + scene.value("dropped.duplicate", 0L);
-  std::printf("operator frames %ld -> DCP processed %ld (counted missing %ld); DCP frames %ld -> scene %ld (counted "
-              "missing %ld); duplicates dropped %ld\n",
-              op_sent, dcp_sent, dcp_missing, dcp_sent, scene_sent, scene_missing, dups);
+  std::printf(
+      "operator frames %ld -> DCP processed %ld (counted missing %ld); DCP frames %ld -> scene %ld "
+      "(counted "
+      "missing %ld); duplicates dropped %ld\n",
+      op_sent, dcp_sent, dcp_missing, dcp_sent, scene_sent, scene_missing, dups);
   // Frames were lost both ways, and every one was seen missing (but the
   // last ones, which no later frame reveals).
   EXPECT_GT(op_sent - dcp_sent, 0);
@@ -134,7 +144,8 @@ TEST(MultiHost, OverALossyLinkEveryGapIsCountedAndTheAutopilotStillDocks) {
   EXPECT_GT(dups, 0);
   // The ESG drew every frame the scene sent: the picture stays on the last
   // good frame through a gap.
-  EXPECT_EQ(s["frames"]["rendered"].get<long>() + s["frames"]["superseded"].get<long>(), scene_sent);
+  EXPECT_EQ(s["frames"]["rendered"].get<long>() + s["frames"]["superseded"].get<long>(),
+            scene_sent);
   net.Down();
   fs::remove_all(dir);
 }

@@ -5,15 +5,15 @@
 //
 // The suite flies the acquisition. The whole flight -- acquire, extract,
 // dock -- is the long test (tests/long/scripted_operator_docks_test.cc).
-#include <gtest/gtest.h>
+#include "scripted_operator.h"
 
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include "hand_session.h"
-#include "scripted_operator.h"
 #include "subprocess.h"
 #include "tmux.h"
 
@@ -33,8 +33,8 @@ TEST(ScriptedOperator, AcquiresThePayloadByHandReadingOnlyTheStatusScreen) {
   testing::ScriptedOperator op(session.tmux.get(), kReactionS);
   const testing::FlightReport r = op.Fly(/*acquire_only=*/true, kTimeBudgetS);
   std::ofstream(session.dir + "/transcript.txt") << Transcript(r);
-  std::printf("acquired: %s at %.1f s of session time, %d key actions\n", r.acquired ? "yes" : "no", r.acquired_t_s,
-              r.key_actions);
+  std::printf("acquired: %s at %.1f s of session time, %d key actions\n", r.acquired ? "yes" : "no",
+              r.acquired_t_s, r.key_actions);
   EXPECT_TRUE(r.acquired) << r.failure << "\n" << Transcript(r) << session.tmux->Capture();
   EXPECT_LE(r.key_actions, kKeyBudget / 2) << Transcript(r);
   const nlohmann::json summary = session.Quit();

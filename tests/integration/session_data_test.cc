@@ -4,13 +4,13 @@
 // restarted, and a freeze, re-simulates word for word; its summary lists
 // every attempt; a log that misses the session's start re-simulates from
 // the DCP's state logged later, and one that lacks every state says so.
-#include <gtest/gtest.h>
 #include <signal.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -41,7 +41,9 @@ class CpuLoad {
     const long cores = std::max(1L, sysconf(_SC_NPROCESSORS_ONLN));
     for (long i = 0; i < cores; ++i) {
       busy_.push_back(std::make_unique<Subprocess>(
-          std::vector<std::string>{"/usr/bin/timeout", "300", "/bin/sh", "-c", "while :; do :; done"}, dir + "/busy.log"));
+          std::vector<std::string>{"/usr/bin/timeout", "300", "/bin/sh", "-c",
+                                   "while :; do :; done"},
+          dir + "/busy.log"));
     }
     std::printf("CPU load: %ld busy processes\n", cores);
   }
@@ -74,7 +76,8 @@ int PidOf(const std::string& out, const std::string& process) {
   return (f >> pid) ? pid : -1;
 }
 
-ScriptRun Control(const std::string& out, const std::vector<std::string>& args, const std::string& log) {
+ScriptRun Control(const std::string& out, const std::vector<std::string>& args,
+                  const std::string& log) {
   std::vector<std::string> cmd = {SourcePath("scripts/lab"), "control", "--session", out};
   cmd.insert(cmd.end(), args.begin(), args.end());
   return Script(cmd, log, 60);
@@ -84,7 +87,8 @@ ScriptRun Control(const std::string& out, const std::vector<std::string>& args, 
 void CopyWithLog(const std::string& from, const std::string& to,
                  const std::function<bool(const lcm::LogEvent&, std::int64_t first_us)>& keep) {
   fs::create_directories(to);
-  for (const char* f : {"manifest.json", "config.toml"}) fs::copy_file(from + "/" + f, to + "/" + f);
+  for (const char* f : {"manifest.json", "config.toml"})
+    fs::copy_file(from + "/" + f, to + "/" + f);
   fs::copy(from + "/run", to + "/run", fs::copy_options::recursive);
   lcm::LogFile in(from + "/lcmlog", "r"), out(to + "/lcmlog", "w");
   std::int64_t first = -1;
@@ -102,15 +106,20 @@ class HandFlownSession : public ::testing::Test {
     out_ = new std::string(*tmp_ + "/session");
     CpuLoad load(*tmp_);
     Tmux tmux(*tmp_);
-    const std::string cmd = "RMSLAB_BUILD=" RMSLAB_BUILD_DIR " " + SourcePath("scripts/lab") +
-                            " demo --by-hand --no-build --out " + *out_ + " --lcm-url '" +
-                            testing::UniqueLcmUrl(9700) +
-                            "' --png-every 0 --no-video --width 160 --height 120 --subject ann --note 'first try' >" +
-                            *tmp_ + "/lab.log 2>&1; echo $? >" + *tmp_ + "/lab.rc";
+    const std::string cmd =
+        "RMSLAB_BUILD=" RMSLAB_BUILD_DIR " " + SourcePath("scripts/lab") +
+        " demo --by-hand --no-build --out " + *out_ + " --lcm-url '" + testing::UniqueLcmUrl(9700) +
+        "' --png-every 0 --no-video --width 160 --height 120 --subject ann --note 'first try' >" +
+        *tmp_ + "/lab.log 2>&1; echo $? >" + *tmp_ + "/lab.rc";
     ASSERT_EQ(tmux.Start(cmd, 120, 45), 0);
     const std::string op_log = *out_ + "/logs/operator_station.log";
-    ASSERT_TRUE(WaitFor([&] { return (PidOf(*out_, "operator_station") > 0 && fs::exists(op_log)) ||
-                                      fs::exists(*tmp_ + "/lab.rc"); }, 90) && !fs::exists(*tmp_ + "/lab.rc"))
+    ASSERT_TRUE(WaitFor(
+                    [&] {
+                      return (PidOf(*out_, "operator_station") > 0 && fs::exists(op_log)) ||
+                             fs::exists(*tmp_ + "/lab.rc");
+                    },
+                    90) &&
+                !fs::exists(*tmp_ + "/lab.rc"))
         << ReadFile(*tmp_ + "/lab.log");
     Sleep(2.0);
     auto press = [&](const std::string& key, int n, double each_s) {
@@ -124,7 +133,8 @@ class HandFlownSession : public ::testing::Test {
     Sleep(1.0);
     press("BSpace", 1, 1.0);  // reset: attempt 2
     press("s", 3, 0.3);
-    ASSERT_EQ(Control(*out_, {"checkpoint", "cp1"}, *tmp_ + "/cp.log").rc, 0) << ReadFile(*tmp_ + "/cp.log");
+    ASSERT_EQ(Control(*out_, {"checkpoint", "cp1"}, *tmp_ + "/cp.log").rc, 0)
+        << ReadFile(*tmp_ + "/cp.log");
     press("a", 4, 0.3);
     ASSERT_EQ(Control(*out_, {"restore", "cp1", "--run"}, *tmp_ + "/restore.log").rc, 0)
         << ReadFile(*tmp_ + "/restore.log");  // attempt 3
@@ -132,7 +142,9 @@ class HandFlownSession : public ::testing::Test {
     const int dcp = PidOf(*out_, "dynamics_proc");
     ASSERT_GT(dcp, 0);
     kill(dcp, SIGKILL);  // the launcher restarts it; it resumes its last state
-    ASSERT_TRUE(WaitFor([&] { return PidOf(*out_, "dynamics_proc") > 0 && PidOf(*out_, "dynamics_proc") != dcp; }, 60));
+    ASSERT_TRUE(WaitFor(
+        [&] { return PidOf(*out_, "dynamics_proc") > 0 && PidOf(*out_, "dynamics_proc") != dcp; },
+        60));
     Sleep(2.0);
     press("d", 3, 0.3);
     press("p", 1, 1.5);  // freeze, a step, run
@@ -140,7 +152,8 @@ class HandFlownSession : public ::testing::Test {
     press("p", 1, 1.0);
     press("e", 2, 0.3);
     press("Q", 1, 0.5);
-    ASSERT_TRUE(WaitFor([&] { return fs::exists(*tmp_ + "/lab.rc"); }, 120)) << ReadFile(*tmp_ + "/lab.log");
+    ASSERT_TRUE(WaitFor([&] { return fs::exists(*tmp_ + "/lab.rc"); }, 120))
+        << ReadFile(*tmp_ + "/lab.log");
     EXPECT_EQ(ReadFile(*tmp_ + "/lab.rc"), "0\n") << ReadFile(*tmp_ + "/lab.log");
   }
   static void TearDownTestSuite() {
@@ -155,7 +168,8 @@ std::string* HandFlownSession::tmp_ = nullptr;
 std::string* HandFlownSession::out_ = nullptr;
 
 TEST_F(HandFlownSession, ReSimulatesWordForWord) {
-  const ScriptRun r = Script({SourcePath("scripts/lab"), "resim", *out_, "--no-build"}, *tmp_ + "/resim.log", 120);
+  const ScriptRun r =
+      Script({SourcePath("scripts/lab"), "resim", *out_, "--no-build"}, *tmp_ + "/resim.log", 120);
   EXPECT_EQ(r.rc, 0) << r.out;
   EXPECT_NE(r.out.find("identical, word for word"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("note:"), std::string::npos) << r.out;
@@ -190,11 +204,15 @@ TEST_F(HandFlownSession, ALogThatMissesTheStartReSimulatesFromALaterState) {
   // The recorder started 6 s late: the DCP's start and its first states are
   // not in the log; the first periodic state (every 5 s of frames) is.
   const std::string late = *tmp_ + "/late";
-  CopyWithLog(*out_, late, [](const lcm::LogEvent& ev, std::int64_t first) { return ev.timestamp - first > 6000000; });
-  const ScriptRun r = Script({SourcePath("scripts/lab"), "resim", late, "--no-build"}, *tmp_ + "/late.log", 120);
+  CopyWithLog(*out_, late, [](const lcm::LogEvent& ev, std::int64_t first) {
+    return ev.timestamp - first > 6000000;
+  });
+  const ScriptRun r =
+      Script({SourcePath("scripts/lab"), "resim", late, "--no-build"}, *tmp_ + "/late.log", 120);
   EXPECT_EQ(r.rc, 0) << r.out;
   EXPECT_NE(r.out.find("identical, word for word"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("not re-simulated: the log starts at DCP frame"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("not re-simulated: the log starts at DCP frame"), std::string::npos)
+      << r.out;
 }
 
 TEST_F(HandFlownSession, ALogWithoutTheDcpsStateSaysWhatIsMissing) {
@@ -202,7 +220,8 @@ TEST_F(HandFlownSession, ALogWithoutTheDcpsStateSaysWhatIsMissing) {
   CopyWithLog(*out_, bare, [](const lcm::LogEvent& ev, std::int64_t first) {
     return ev.timestamp - first > 3000000 && ev.channel.rfind("RMS_DCP_STATE", 0) != 0;
   });
-  const ScriptRun r = Script({SourcePath("scripts/lab"), "resim", bare, "--no-build"}, *tmp_ + "/bare.log", 120);
+  const ScriptRun r =
+      Script({SourcePath("scripts/lab"), "resim", bare, "--no-build"}, *tmp_ + "/bare.log", 120);
   EXPECT_NE(r.rc, 0) << r.out;
   EXPECT_NE(r.out.find("holds no RMS_DCP_STATE"), std::string::npos) << r.out;
 }
@@ -228,17 +247,20 @@ nlohmann::json ReportData(const std::string& html) {
   if (a == std::string::npos) return nullptr;
   const auto b = html.find(";\n</script>", a);
   std::string j = html.substr(a + key.size(), b - a - key.size());
-  for (std::size_t p = j.find("<\\/"); p != std::string::npos; p = j.find("<\\/", p)) j.replace(p, 3, "</");
+  for (std::size_t p = j.find("<\\/"); p != std::string::npos; p = j.find("<\\/", p))
+    j.replace(p, 3, "</");
   return nlohmann::json::parse(j);
 }
 
 TEST_F(HandFlownSession, ItsReportShowsEveryAttemptThePathAndTheTimeline) {
   const std::string page = *tmp_ + "/report.html";
-  const ScriptRun r = Script({SourcePath("scripts/lab"), "report", *out_, "--out", page}, *tmp_ + "/report.log", 120);
+  const ScriptRun r = Script({SourcePath("scripts/lab"), "report", *out_, "--out", page},
+                             *tmp_ + "/report.log", 120);
   ASSERT_EQ(r.rc, 0) << r.out;
   const std::string html = ReadFile(page);
-  for (const char* want : {"<h2>Attempts</h2>", "The operator's scorecard", "The configuration's tolerances",
-                           "<td>reset</td>", "<td>restore", "ann", "first try", "Frames", "Losses and refusals"}) {
+  for (const char* want :
+       {"<h2>Attempts</h2>", "The operator's scorecard", "The configuration's tolerances",
+        "<td>reset</td>", "<td>restore", "ann", "first try", "Frames", "Losses and refusals"}) {
     EXPECT_NE(html.find(want), std::string::npos) << want;
   }
   EXPECT_EQ(html.find("<pre>"), std::string::npos) << "raw JSON in the report";
@@ -252,11 +274,13 @@ TEST_F(HandFlownSession, ItsReportShowsEveryAttemptThePathAndTheTimeline) {
   EXPECT_TRUE(d["series"]["inputs"].is_object()) << "by hand: the inputs are plotted";
   std::set<std::string> kinds;
   for (const auto& e : d["events"]) kinds.insert(e["kind"].get<std::string>());
-  for (const char* k : {"reset", "restore", "freeze", "restart"}) EXPECT_TRUE(kinds.count(k)) << k << " not in the timeline";
+  for (const char* k : {"reset", "restore", "freeze", "restart"})
+    EXPECT_TRUE(kinds.count(k)) << k << " not in the timeline";
   EXPECT_GE(d["attempts"].size(), 3u);
   const std::string dom = BrowserDom(page, *tmp_ + "/report_dom.html");
   EXPECT_GE(ChartsRendered(dom), 6) << dom.substr(0, 1500);
-  for (const char* want : {"End effector path", "Joint angles", "Operator inputs", "Event timeline"}) {
+  for (const char* want :
+       {"End effector path", "Joint angles", "Operator inputs", "Event timeline"}) {
     EXPECT_NE(dom.find(want), std::string::npos) << want;
   }
 }
@@ -265,10 +289,11 @@ TEST_F(HandFlownSession, CompareShowsTheSubjectsLearningCurveAndAReSimulationApa
   // A second session of the same subject (a timeline), and the first flown
   // again with another design (a re-simulation: a session of its own).
   const std::string second = *tmp_ + "/second";
-  const ScriptRun s2 = Script({SourcePath("scripts/lab"), "demo", "--no-build", "--out", second, "--timeline",
-                               SourcePath("scripts/timelines/short.tl"), "--lcm-url", testing::UniqueLcmUrl(9750),
-                               "--png-every", "0", "--no-video", "--width", "160", "--height", "120", "--subject", "ann"},
-                              *tmp_ + "/second.log", 120);
+  const ScriptRun s2 = Script(
+      {SourcePath("scripts/lab"), "demo", "--no-build", "--out", second, "--timeline",
+       SourcePath("scripts/timelines/short.tl"), "--lcm-url", testing::UniqueLcmUrl(9750),
+       "--png-every", "0", "--no-video", "--width", "160", "--height", "120", "--subject", "ann"},
+      *tmp_ + "/second.log", 120);
   ASSERT_EQ(s2.rc, 0) << s2.out;
   const std::string wide = *tmp_ + "/wide.toml";
   {
@@ -278,11 +303,13 @@ TEST_F(HandFlownSession, CompareShowsTheSubjectsLearningCurveAndAReSimulationApa
     cfg.replace(at, cfg.find('\n', at) - at, "dock_distance_ft = 0.5");
     std::ofstream(wide) << cfg;
   }
-  const ScriptRun rs = Script({SourcePath("scripts/lab"), "resim", *out_, "--no-build", "--config", wide, "--out",
-                               *tmp_ + "/wide"}, *tmp_ + "/wide.log", 120);
+  const ScriptRun rs = Script({SourcePath("scripts/lab"), "resim", *out_, "--no-build", "--config",
+                               wide, "--out", *tmp_ + "/wide"},
+                              *tmp_ + "/wide.log", 120);
   ASSERT_EQ(rs.rc, 0) << rs.out;
-  const ScriptRun c = Script({SourcePath("scripts/lab"), "compare", *out_, second, *tmp_ + "/wide", "--no-build",
-                              "--out", *tmp_ + "/compare"}, *tmp_ + "/compare.log", 120);
+  const ScriptRun c = Script({SourcePath("scripts/lab"), "compare", *out_, second, *tmp_ + "/wide",
+                              "--no-build", "--out", *tmp_ + "/compare"},
+                             *tmp_ + "/compare.log", 120);
   ASSERT_EQ(c.rc, 0) << c.out;
   const std::string csv = ReadFile(*tmp_ + "/compare/compare.csv");
   std::istringstream rows(csv);
@@ -302,28 +329,34 @@ TEST_F(HandFlownSession, CompareShowsTheSubjectsLearningCurveAndAReSimulationApa
   const std::string html = ReadFile(*tmp_ + "/compare/compare.html");
   const auto a = html.find("window.RMS_COMPARE = ");
   ASSERT_NE(a, std::string::npos);
-  const auto data = nlohmann::json::parse(html.substr(a + 21, html.find(";\n</script>", a) - a - 21));
+  const auto data =
+      nlohmann::json::parse(html.substr(a + 21, html.find(";\n</script>", a) - a - 21));
   ASSERT_TRUE(data["subjects"].contains("ann")) << data["subjects"].dump();
-  EXPECT_EQ(data["subjects"]["ann"].size(), 2u) << "the subject's two sessions, not the re-simulation";
+  EXPECT_EQ(data["subjects"]["ann"].size(), 2u)
+      << "the subject's two sessions, not the re-simulation";
   const std::string dom = BrowserDom(*tmp_ + "/compare/compare.html", *tmp_ + "/compare_dom.html");
   EXPECT_GE(ChartsRendered(dom), 2) << dom.substr(0, 1500);
 }
 
 TEST_F(HandFlownSession, ItsMcapExportHoldsEveryMessageAndEachMatchesItsSchema) {
   const std::string mcap = *tmp_ + "/session.mcap";
-  const ScriptRun r = Script({SourcePath("scripts/lab"), "export", *out_, "--mcap", "--out", mcap, "--no-build"},
-                             *tmp_ + "/mcap.log", 120);
+  const ScriptRun r =
+      Script({SourcePath("scripts/lab"), "export", *out_, "--mcap", "--out", mcap, "--no-build"},
+             *tmp_ + "/mcap.log", 120);
   ASSERT_EQ(r.rc, 0) << r.out;
   // Read back with the MCAP library, every message validated against its
   // channel's JSON schema (tools/mcap/check_mcap.mjs: @mcap/core, ajv).
-  Subprocess check({"/usr/bin/node", SourcePath("tools/mcap/check_mcap.mjs"), mcap}, *tmp_ + "/mcap_check.log");
+  Subprocess check({"/usr/bin/node", SourcePath("tools/mcap/check_mcap.mjs"), mcap},
+                   *tmp_ + "/mcap_check.log");
   ASSERT_EQ(check.Wait(120), 0) << ReadFile(*tmp_ + "/mcap_check.log");
   const std::string out = ReadFile(*tmp_ + "/mcap_check.log");
-  const auto j = nlohmann::json::parse(out.substr(out.find('{'), out.rfind('}') - out.find('{') + 1));
+  const auto j =
+      nlohmann::json::parse(out.substr(out.find('{'), out.rfind('}') - out.find('{') + 1));
   EXPECT_EQ(j["invalid"], 0);
   const auto summary = nlohmann::json::parse(ReadFile(*out_ + "/summary.json"));
-  for (const char* ch : {"RMS_OPERATOR_INPUT", "RMS_OPERATOR_STATE", "RMS_DCP_FRAME", "RMS_DCP_TELEMETRY",
-                         "RMS_DCP_STATE", "RMS_ESG_FRAME", "RMS_STATUS", "RMS_CONTROL"}) {
+  for (const char* ch :
+       {"RMS_OPERATOR_INPUT", "RMS_OPERATOR_STATE", "RMS_DCP_FRAME", "RMS_DCP_TELEMETRY",
+        "RMS_DCP_STATE", "RMS_ESG_FRAME", "RMS_STATUS", "RMS_CONTROL"}) {
     ASSERT_TRUE(j["channels"].contains(ch)) << ch << ": " << out;
     EXPECT_EQ(j["channels"][ch], summary["log"]["by_channel"][ch]) << ch;
   }
@@ -345,10 +378,13 @@ TEST(CommandLines, UsageErrorsExitTwoAndAControlCommandNobodyAnswersFails) {
     const ScriptRun r = Script(cmd, tmp + "/usage.log", 60);
     EXPECT_EQ(r.rc, 2) << cmd[0] << " " << cmd[1 % cmd.size()] << ": " << r.out;
   }
-  const ScriptRun h = Script({testing::BuildPath("tools/rms_resim"), "--help"}, tmp + "/help.log", 60);
+  const ScriptRun h =
+      Script({testing::BuildPath("tools/rms_resim"), "--help"}, tmp + "/help.log", 60);
   EXPECT_EQ(h.rc, 0);
-  const ScriptRun c = Script({SourcePath("scripts/lab"), "control", "--lcm-url", testing::UniqueLcmUrl(9790),
-                              "--session-id", "0x0000000000000777", "freeze"}, tmp + "/nobody.log", 60);
+  const ScriptRun c =
+      Script({SourcePath("scripts/lab"), "control", "--lcm-url", testing::UniqueLcmUrl(9790),
+              "--session-id", "0x0000000000000777", "freeze"},
+             tmp + "/nobody.log", 60);
   EXPECT_EQ(c.rc, 1) << c.out;
   EXPECT_NE(c.out.find("no operator station of session"), std::string::npos) << c.out;
   fs::remove_all(tmp);

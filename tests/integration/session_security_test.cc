@@ -9,8 +9,6 @@
 // tools write to a full device. Each is refused, survived or reported.
 #include <fcntl.h>
 #include <signal.h>
-#include <sys/mount.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -20,32 +18,35 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <regex>
+#include <sys/mount.h>
+#include <sys/stat.h>
 #include <thread>
 
-#include "live_session.h"
-#include "session_files.h"
-#include "rms/wire/channels.h"
-#include "rms/wire/control_word.h"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
-#include "rms/transport/lcm_interface.h"
-#include "rms/wire/message_io.h"
 #include "rms/operator_input_t.hpp"
 #include "rms/process_status_t.hpp"
 #include "rms/sender_t.hpp"
 #include "rms/session_control_t.hpp"
+#include "rms/transport/lcm_interface.h"
+#include "rms/wire/channels.h"
+#include "rms/wire/control_word.h"
+#include "rms/wire/message_io.h"
+
+#include "live_session.h"
+#include "session_files.h"
 #include "subprocess.h"
 
 namespace rms {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::Counter;
 using testing::LiveSession;
 using testing::ReadFile;
+using testing::ReadJson;
 using testing::Script;
 using testing::SourcePath;
-using testing::Counter;
-using testing::ReadJson;
 
 std::int64_t Reason(const nlohmann::json& summary, const std::string& reason) {
   return summary["ignored"]["by_reason"].value(reason, 0L);
@@ -142,12 +143,14 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
   const int dcp_pid = s.pid("dynamics_proc"), op_pid = s.pid("operator_station");
   ASSERT_GT(dcp_pid, 0);
   ASSERT_GT(op_pid, 0);
-  std::printf("session %s, dynamics_proc pid %d, attacker's stranger id %s\n", wire::FormatSessionId(id).c_str(), dcp_pid,
+  std::printf("session %s, dynamics_proc pid %d, attacker's stranger id %s\n",
+              wire::FormatSessionId(id).c_str(), dcp_pid,
               wire::FormatSessionId(stranger_id).c_str());
   const std::string cps = s.out() + "/checkpoints";
   Peer peer(s.url());
   const transport::Sender stranger{stranger_id, sender_t::PROCESS_CONTROL, 4242};
-  const transport::Sender insider{id, sender_t::PROCESS_CONTROL, static_cast<std::int32_t>(getpid())};
+  const transport::Sender insider{id, sender_t::PROCESS_CONTROL,
+                                  static_cast<std::int32_t>(getpid())};
 
   // A stranger's freeze is ignored: the DCP's frames go on.
   const std::int64_t before = peer.Listen(0.5);
@@ -165,11 +168,13 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
     big << std::string(2 << 20, ' ');
   }
   ASSERT_EQ(mkfifo((cps + "/fifo.json").c_str(), 0644), 0);
-  for (const char* name : {"../../escaped.json", "../escaped.json", "/tmp/escaped.json", "link.json", "big.json"}) {
+  for (const char* name :
+       {"../../escaped.json", "../escaped.json", "/tmp/escaped.json", "link.json", "big.json"}) {
     peer.Control(session_control_t::CHECKPOINT, name, insider);
   }
   peer.Listen(1.0);  // the rate limit's burst
-  for (const char* name : {"/dev/zero", "../run/dcp_state.json", "link.json", "big.json", "fifo.json"}) {
+  for (const char* name :
+       {"/dev/zero", "../run/dcp_state.json", "link.json", "big.json", "fifo.json"}) {
     peer.Control(session_control_t::RESTORE, name, insider);
     peer.Listen(0.6);
   }
@@ -177,7 +182,8 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
   EXPECT_FALSE(fs::exists(s.out() + "/escaped.json"));
   EXPECT_FALSE(fs::exists("/tmp/escaped.json"));
   EXPECT_FALSE(fs::exists(tmp + "/via_link.json")) << "a checkpoint was written through a link";
-  EXPECT_EQ(fs::file_size(cps + "/big.json"), std::uintmax_t{2} << 20) << "a checkpoint was written over a file";
+  EXPECT_EQ(fs::file_size(cps + "/big.json"), std::uintmax_t{2} << 20)
+      << "a checkpoint was written over a file";
 
   // A flood: at most a few a second are acted on.
   for (int i = 0; i < 300; ++i) {
@@ -199,7 +205,8 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
     peer.ForgeTelemetry(now + 2 + i, as_stranger_dcp);
     peer.ForgeTelemetry(now + 2 + i, as_fake_pid);
     peer.ForgeTelemetry(now - 200 + i, as_dcp);
-    peer.Listen(0.003);  // paced: a burst would overrun the recorder's socket, and the test would test that
+    peer.Listen(
+        0.003);  // paced: a burst would overrun the recorder's socket, and the test would test that
   }
   // DCP frames as the DCP itself, for numbers it has sent, saying otherwise:
   // the numbers are disputed, and neither version is believed.
@@ -244,10 +251,12 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
   far.send_time_us = transport::WallTimeUs();
   peer.Send(wire::channels::kOperatorInput, far, {id, sender_t::PROCESS_OPERATOR_STATION, op_pid});
 
-  ASSERT_TRUE(testing::WaitForFile(cps + "/good.json", 10)) << "a valid checkpoint after the flood was not written";
+  ASSERT_TRUE(testing::WaitForFile(cps + "/good.json", 10))
+      << "a valid checkpoint after the flood was not written";
   // rms_control says so when it cannot: an existing name.
-  const auto again = Script({testing::BuildPath("tools/rms_control"), "--session", s.out(), "checkpoint", "good"},
-                            tmp + "/control.log", 30);
+  const auto again =
+      Script({testing::BuildPath("tools/rms_control"), "--session", s.out(), "checkpoint", "good"},
+             tmp + "/control.log", 30);
   EXPECT_EQ(again.rc, 1) << again.out;
   EXPECT_NE(again.out.find("exists already"), std::string::npos) << again.out;
   ASSERT_EQ(s.Wait(240), 0) << ReadFile(s.log());
@@ -259,7 +268,8 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
   EXPECT_LE(files, 2u + 8u);
   const std::string out = s.out();
   EXPECT_GE(Counter(out, "dynamics_proc", "control.rate_limited"), 250);
-  EXPECT_GE(Counter(out, "dynamics_proc", "control.refused"), 5);  // the paths, the link, the file, the device
+  EXPECT_GE(Counter(out, "dynamics_proc", "control.refused"),
+            5);  // the paths, the link, the file, the device
   EXPECT_GE(Counter(out, "operator_station", "control.refused"), 3);
   EXPECT_GE(Counter(out, "dynamics_proc", "dropped.other_session"), 2);
   EXPECT_GE(Counter(out, "dynamics_proc", "dropped.far_ahead"), 1);
@@ -270,9 +280,11 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
   // The summary: the real flight, and what it left out.
   const nlohmann::json sum = ReadJson(out + "/summary.json");
   ASSERT_TRUE(sum.contains("docked")) << ReadFile(s.log());
-  std::printf("ignored: %s\ndocking: %s\n", sum["ignored"].dump().c_str(), sum["docking"].dump().c_str());
+  std::printf("ignored: %s\ndocking: %s\n", sum["ignored"].dump().c_str(),
+              sum["docking"].dump().c_str());
   EXPECT_TRUE(sum["docked"].get<bool>());
-  EXPECT_GT(sum["docking"]["distance_ft"].get<double>(), 0.05) << "the forged docking distance was believed";
+  EXPECT_GT(sum["docking"]["distance_ft"].get<double>(), 0.05)
+      << "the forged docking distance was believed";
   EXPECT_FALSE(sum["docking"]["after_restore"].get<bool>()) << "every restore was refused";
   EXPECT_EQ(sum["mode_changes"].size(), 2u) << sum["mode_changes"].dump();
   EXPECT_GE(Reason(sum, "other_session"), 90 + 1);
@@ -283,9 +295,11 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
   EXPECT_GE(Reason(sum, "dcp_frame_out_of_sequence"), 3);
   // No record loss made up from the forgeries (those would be 30 or 3 a
   // channel); the flood of control messages may cost the recorder a datagram.
-  for (const auto& [ch, r] : sum["record"]["by_channel"].items()) EXPECT_LE(r["lost"].get<long>(), 2) << ch;
+  for (const auto& [ch, r] : sum["record"]["by_channel"].items())
+    EXPECT_LE(r["lost"].get<long>(), 2) << ch;
   bool listed = false;
-  for (const auto& o : sum["ignored"]["other_sessions"]) listed |= o.get<std::string>() == wire::FormatSessionId(stranger_id);
+  for (const auto& o : sum["ignored"]["other_sessions"])
+    listed |= o.get<std::string>() == wire::FormatSessionId(stranger_id);
   EXPECT_TRUE(listed) << "the stranger's session is not listed";
   const auto& fr = sum["frames"];
   EXPECT_GE(fr["rendered"].get<long>(), 0);
@@ -307,12 +321,14 @@ TEST(SessionSecurity, ASecondSessionOnTheAddressIsRefusedOrWithShareNetworkBothD
   ASSERT_TRUE(first.WaitRunning(60)) << ReadFile(first.log());
 
   fs::create_directories(tmp + "/b");
-  const auto refused = Script({SourcePath("scripts/lab"), "demo", "--no-build", "--out", tmp + "/b/session",
-                               "--lcm-url", url, "--png-every", "0", "--no-video"},
-                              tmp + "/b/lab.log", 60);
+  const auto refused =
+      Script({SourcePath("scripts/lab"), "demo", "--no-build", "--out", tmp + "/b/session",
+              "--lcm-url", url, "--png-every", "0", "--no-video"},
+             tmp + "/b/lab.log", 60);
   EXPECT_NE(refused.rc, 0) << refused.out;
   EXPECT_NE(refused.out.find("another session is"), std::string::npos) << refused.out;
-  EXPECT_NE(refused.out.find(wire::FormatSessionId(first.session_id())), std::string::npos) << refused.out;
+  EXPECT_NE(refused.out.find(wire::FormatSessionId(first.session_id())), std::string::npos)
+      << refused.out;
   EXPECT_NE(refused.out.find("--channel-suffix"), std::string::npos) << refused.out;
   EXPECT_FALSE(fs::exists(tmp + "/b/session/lcmlog"));
 
@@ -324,8 +340,9 @@ TEST(SessionSecurity, ASecondSessionOnTheAddressIsRefusedOrWithShareNetworkBothD
   ASSERT_EQ(second.Wait(240), 0) << ReadFile(second.log());
   for (const LiveSession* x : {&first, &second}) {
     const nlohmann::json sum = ReadJson(x->out() + "/summary.json");
-    std::printf("%s: docked %s at %s; ignored %s\n", x->out().c_str(), sum.value("docked", false) ? "yes" : "no",
-                sum["docking"].dump().c_str(), sum["ignored"].dump().c_str());
+    std::printf("%s: docked %s at %s; ignored %s\n", x->out().c_str(),
+                sum.value("docked", false) ? "yes" : "no", sum["docking"].dump().c_str(),
+                sum["ignored"].dump().c_str());
     EXPECT_TRUE(sum.value("docked", false));
     EXPECT_EQ(sum["mode_changes"].size(), 2u);
     EXPECT_EQ(sum["session_id"].get<std::string>(), wire::FormatSessionId(x->session_id()));
@@ -345,14 +362,19 @@ TEST(SessionSecurity, KillingTheLauncherLeavesNoProcessAndASummary) {
   ASSERT_TRUE(s.WaitRunning(60)) << ReadFile(s.log());
   Sleep(2);
   const std::vector<int> kids = s.children();
-  ASSERT_GE(kids.size(), 5u) << ReadFile(s.out() + "/run/children");  // four processes and the recorder
+  ASSERT_GE(kids.size(), 5u) << ReadFile(s.out() +
+                                         "/run/children");  // four processes and the recorder
   for (int p : kids) ASSERT_TRUE(ProcessAlive(p)) << p;
   // The reaper killed first: the launcher starts it again.
-  const auto reaper = Script({"/usr/bin/pgrep", "-f", "rmslab_launcher.reaper --session " + s.out()}, tmp + "/pgrep.log", 10);
+  const auto reaper =
+      Script({"/usr/bin/pgrep", "-f", "rmslab_launcher.reaper --session " + s.out()},
+             tmp + "/pgrep.log", 10);
   ASSERT_EQ(reaper.rc, 0) << "no reaper running";
   kill(std::stoi(reaper.out), SIGKILL);
   const auto end_r = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-  while (ReadFile(s.log()).find("the reaper") == std::string::npos && std::chrono::steady_clock::now() < end_r) Sleep(0.1);
+  while (ReadFile(s.log()).find("the reaper") == std::string::npos &&
+         std::chrono::steady_clock::now() < end_r)
+    Sleep(0.1);
   ASSERT_NE(ReadFile(s.log()).find("starting it again"), std::string::npos) << ReadFile(s.log());
   Sleep(0.5);
   // A pid in run/children that is no longer the session's (reused by another
@@ -370,9 +392,11 @@ TEST(SessionSecurity, KillingTheLauncherLeavesNoProcessAndASummary) {
     std::erase_if(left, [](int p) { return !ProcessAlive(p); });
     Sleep(0.1);
   }
-  EXPECT_TRUE(left.empty()) << left.size() << " of the session's processes still run, e.g. pid " << left.front();
+  EXPECT_TRUE(left.empty()) << left.size() << " of the session's processes still run, e.g. pid "
+                            << left.front();
   EXPECT_TRUE(bystander.Running()) << "the reaper signalled a process that is not the session's";
-  ASSERT_TRUE(testing::WaitForFile(s.out() + "/summary.json", 30)) << ReadFile(s.out() + "/logs/reaper.log");
+  ASSERT_TRUE(testing::WaitForFile(s.out() + "/summary.json", 30))
+      << ReadFile(s.out() + "/logs/reaper.log");
   const nlohmann::json sum = ReadJson(s.out() + "/summary.json");
   EXPECT_GT(sum["log"]["dcp_frames"].get<long>(), 0);
   EXPECT_NE(ReadFile(s.out() + "/run/exit_codes").find("launcher 137"), std::string::npos);
@@ -398,18 +422,20 @@ TEST(SessionSecurity, BadInputIsRefusedBeforeAnythingStartsWithTheReasonShown) {
     latin1 << "\xff\xfe[session]\n";
     std::ofstream(tmp + "/a_file") << "x";
   }
-  const std::vector<Case> cases = {{{"--config", tmp + "/bad.toml"}, "boom_lenght_ft"},
-                                   {{"--width", "0"}, "width"},
-                                   {{"--channel-suffix", "X.*"}, "--channel-suffix"},
-                                   {{"--config", tmp + "/latin1.toml"}, "not TOML"},
-                                   {{"--lcm-url", "garbage"}, "--lcm-url 'garbage'"},
-                                   {{"--lcm-url", "udpm://10.1.2.3:7667?ttl=0"}, "not an IPv4 multicast group"},
-                                   {{"--out", tmp + "/a_file/session"}, "cannot make the session's folder"}};
+  const std::vector<Case> cases = {
+      {{"--config", tmp + "/bad.toml"}, "boom_lenght_ft"},
+      {{"--width", "0"}, "width"},
+      {{"--channel-suffix", "X.*"}, "--channel-suffix"},
+      {{"--config", tmp + "/latin1.toml"}, "not TOML"},
+      {{"--lcm-url", "garbage"}, "--lcm-url 'garbage'"},
+      {{"--lcm-url", "udpm://10.1.2.3:7667?ttl=0"}, "not an IPv4 multicast group"},
+      {{"--out", tmp + "/a_file/session"}, "cannot make the session's folder"}};
   int n = 0;
   for (const auto& c : cases) {
     const std::string out = tmp + "/s" + std::to_string(n++);
-    std::vector<std::string> argv = {SourcePath("scripts/lab"), "demo", "--no-build", "--out", out, "--lcm-url",
-                                     testing::UniqueLcmUrl(8660)};
+    std::vector<std::string> argv = {
+        SourcePath("scripts/lab"),  "demo", "--no-build", "--out", out, "--lcm-url",
+        testing::UniqueLcmUrl(8660)};
     argv.insert(argv.end(), c.args.begin(), c.args.end());  // a later --out or --lcm-url wins
     const auto r = Script(argv, out + ".log", 60);
     EXPECT_EQ(r.rc, 2) << r.out;
@@ -456,9 +482,10 @@ TEST(SessionSecurity, ADiskTooSmallForTheSessionIsRefusedAtStart) {
   SmallDisk disk(tmp + "/disk", 8);
   if (!disk.mounted()) GTEST_SKIP() << "cannot mount a tmpfs here (not root?)";
   std::printf("a tmpfs of 8 MB at %s/disk\n", tmp.c_str());
-  const auto r = Script({SourcePath("scripts/lab"), "demo", "--no-build", "--out", tmp + "/disk/session", "--lcm-url",
-                         testing::UniqueLcmUrl(8680), "--png-every", "0", "--no-video"},
-                        tmp + "/lab.log", 60);
+  const auto r =
+      Script({SourcePath("scripts/lab"), "demo", "--no-build", "--out", tmp + "/disk/session",
+              "--lcm-url", testing::UniqueLcmUrl(8680), "--png-every", "0", "--no-video"},
+             tmp + "/lab.log", 60);
   EXPECT_NE(r.rc, 0) << r.out;
   EXPECT_NE(r.out.find("not enough free space"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("MB free"), std::string::npos) << r.out;
@@ -493,7 +520,9 @@ TEST(SessionSecurity, ADiskThatFillsStopsTheSessionAndTheSummaryIsWrittenElsewhe
   const std::string said = ReadFile(s.log());
   std::printf("%s\n", said.c_str());
   EXPECT_NE(rc, 0);
-  EXPECT_TRUE(said.find("nearly full") != std::string::npos || said.find("is full") != std::string::npos) << said;
+  EXPECT_TRUE(said.find("nearly full") != std::string::npos ||
+              said.find("is full") != std::string::npos)
+      << said;
   const auto at = said.find("written to ");
   ASSERT_NE(at, std::string::npos) << "no summary written elsewhere: " << said;
   const std::string where = said.substr(at + 11, said.find(" instead", at) - at - 11);
@@ -505,7 +534,8 @@ TEST(SessionSecurity, ADiskThatFillsStopsTheSessionAndTheSummaryIsWrittenElsewhe
 // Every tool exits non-zero when it cannot write its output whole.
 TEST(SessionSecurity, ToolsExitNonZeroWhenTheirOutputCannotBeWritten) {
   const std::string tmp = testing::MakeTempDir("dev_full");
-  LiveSession s(tmp, testing::UniqueLcmUrl(8700), {"--timeline", SourcePath("scripts/timelines/short.tl")});
+  LiveSession s(tmp, testing::UniqueLcmUrl(8700),
+                {"--timeline", SourcePath("scripts/timelines/short.tl")});
   ASSERT_EQ(s.Wait(120), 0) << ReadFile(s.log());
   const std::string tool = testing::BuildPath("tools/rms_session");
   const auto sum = Script({tool, "summary", s.out(), "--out", "/dev/full"}, tmp + "/t1.log", 60);

@@ -1,25 +1,25 @@
 // The four real executables over real LCM (UDP multicast on loopback): ESG
 // frames arrive in order, each at most 64 valid 24-bit words, and the
 // renderer's images show the arm where the kinematics put it.
-#include <gtest/gtest.h>
-
 #include <signal.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <gtest/gtest.h>
 #include <map>
 
-#include "rms/esg_renderer/renderer.h"
-#include "rms/esg_renderer/png_io.h"
 #include "rms/arm/kinematics.h"
-#include "rms/wire/channels.h"
-#include "pinhole.h"
 #include "rms/base/config.h"
 #include "rms/esg_frame_t.hpp"
+#include "rms/esg_renderer/png_io.h"
+#include "rms/esg_renderer/renderer.h"
 #include "rms/transport/lcm_interface.h"
+#include "rms/wire/channels.h"
 #include "rms/wire/message_io.h"
 #include "rms/wire/word_blocks.h"
+
+#include "pinhole.h"
 #include "subprocess.h"
 
 namespace rms {
@@ -37,9 +37,13 @@ class Session : public ::testing::Test {
   ~Session() override { std::filesystem::remove_all(dir); }
 
   std::unique_ptr<Subprocess> Start(const std::string& name, std::vector<std::string> args) {
-    std::vector<std::string> argv = {BuildPath(name + "/" + name), "--lcm-url", url,
-                                     "--stats", dir + "/" + name + ".json",
-                                     "--ready-file", dir + "/" + name + ".ready"};
+    std::vector<std::string> argv = {BuildPath(name + "/" + name),
+                                     "--lcm-url",
+                                     url,
+                                     "--stats",
+                                     dir + "/" + name + ".json",
+                                     "--ready-file",
+                                     dir + "/" + name + ".ready"};
     argv.insert(argv.end(), args.begin(), args.end());
     return std::make_unique<Subprocess>(argv, dir + "/" + name + ".log");
   }
@@ -56,8 +60,9 @@ TEST_F(Session, FourProcessesOverLcmRenderTheArmWhereTheKinematicsPutIt) {
   auto scene = Start("scene_proc", {});
   auto dcp = Start("dynamics_proc", {});
   for (const char* p : {"esg_renderer", "scene_proc", "dynamics_proc"}) {
-    ASSERT_TRUE(testing::WaitForFile(dir + "/" + p + ".ready", 15)) << p << ":\n"
-                                                                    << testing::ReadFile(dir + "/" + p + ".log");
+    ASSERT_TRUE(testing::WaitForFile(dir + "/" + p + ".ready", 15))
+        << p << ":\n"
+        << testing::ReadFile(dir + "/" + p + ".log");
   }
 
   // This test listens to the ESG frames too, over the same real LCM.
@@ -76,9 +81,10 @@ TEST_F(Session, FourProcessesOverLcmRenderTheArmWhereTheKinematicsPutIt) {
   });
   lcm.HandleSubscriptions(0);
 
-  Subprocess op({BuildPath("operator_station/operator_station"), "--lcm-url", url, "--timeline",
-                 SourcePath("scripts/timelines/short.tl"), "--stats", dir + "/operator_station.json"},
-                dir + "/operator_station.log");
+  Subprocess op(
+      {BuildPath("operator_station/operator_station"), "--lcm-url", url, "--timeline",
+       SourcePath("scripts/timelines/short.tl"), "--stats", dir + "/operator_station.json"},
+      dir + "/operator_station.log");
   while (op.Running()) lcm.HandleSubscriptions(20);
   ASSERT_EQ(op.Wait(1), 0) << testing::ReadFile(dir + "/operator_station.log");
   for (int i = 0; i < 25; ++i) lcm.HandleSubscriptions(20);  // the last frames in flight
@@ -118,15 +124,16 @@ TEST_F(Session, FourProcessesOverLcmRenderTheArmWhereTheKinematicsPutIt) {
     ASSERT_EQ(img.width, kW);
     ASSERT_EQ(img.height, kH);
     const arm::ArmPose arm = arm::ComputeArmPose(config.arm, f.arm, f.shoulder_height_ft);
-    for (const auto& [p, id] : {std::pair{0.5 * (arm.p_RoS_R + arm.p_RoE_R), scene_model::kUpperBoom},
-                                std::pair{0.5 * (arm.p_RoE_R + arm.p_RoW_R), scene_model::kLowerBoom}}) {
+    for (const auto& [p, id] :
+         {std::pair{0.5 * (arm.p_RoS_R + arm.p_RoE_R), scene_model::kUpperBoom},
+          std::pair{0.5 * (arm.p_RoE_R + arm.p_RoW_R), scene_model::kLowerBoom}}) {
       int x = 0, y = 0;
       ASSERT_TRUE(Project(f, p, kW, kH, &x, &y)) << name;
       const std::uint8_t* px = img.at(x, y);
       const scene_model::Rgb want = esg_renderer::IdColor(id);
       EXPECT_TRUE(px[0] == want[0] && px[1] == want[1] && px[2] == want[2])
-          << name << ": " << scene_model::ClusterName(id) << " expected at (" << x << ", " << y << "), found rgb "
-          << int(px[0]) << "," << int(px[1]) << "," << int(px[2]);
+          << name << ": " << scene_model::ClusterName(id) << " expected at (" << x << ", " << y
+          << "), found rgb " << int(px[0]) << "," << int(px[1]) << "," << int(px[2]);
       if (id == scene_model::kLowerBoom) boom_pixels.emplace_back(x, y);
     }
     ++checked;
@@ -157,7 +164,8 @@ TEST_F(Session, EveryExecutableExplainsItselfAndRefusesABadConfig) {
     EXPECT_NE(h.find("--lcm-url"), std::string::npos) << exe << h;
     EXPECT_NE(h.find("--config"), std::string::npos) << exe << h;
 
-    std::vector<std::string> argv = {BuildPath(std::string(exe) + "/" + exe), "--config", bad, "--lcm-url", url};
+    std::vector<std::string> argv = {BuildPath(std::string(exe) + "/" + exe), "--config", bad,
+                                     "--lcm-url", url};
     if (std::string(exe) == "operator_station") {
       argv.insert(argv.end(), {"--timeline", SourcePath("scripts/timelines/short.tl")});
     }

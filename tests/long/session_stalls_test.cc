@@ -38,7 +38,8 @@ TEST(SessionStallsLong, EachProcessAndTheRecorderStoppedIsSurvivedAndReported) {
   LiveSession s(tmp, testing::UniqueLcmUrl(8720));
   ASSERT_TRUE(s.WaitRunning(60)) << ReadFile(s.log());
   Sleep(2);
-  for (const char* p : {"dynamics_proc", "scene_proc", "esg_renderer", "lcm-logger", "operator_station"}) {
+  for (const char* p :
+       {"dynamics_proc", "scene_proc", "esg_renderer", "lcm-logger", "operator_station"}) {
     const int pid = s.pid(p);
     ASSERT_GT(pid, 0) << p;
     std::printf("SIGSTOP %s (pid %d) for 4 s\n", p, pid);
@@ -50,7 +51,8 @@ TEST(SessionStallsLong, EachProcessAndTheRecorderStoppedIsSurvivedAndReported) {
   ASSERT_EQ(s.Wait(300), 0) << ReadFile(s.log());
   const std::string out = s.out();
   const nlohmann::json sum = ReadJson(out + "/summary.json");
-  std::printf("refused %s\nrecord %s\n", sum["frames"]["refused"].dump().c_str(), sum["record"].dump().c_str());
+  std::printf("refused %s\nrecord %s\n", sum["frames"]["refused"].dump().c_str(),
+              sum["record"].dump().c_str());
   EXPECT_TRUE(sum.value("docked", false));
   // The DCP stopped 4 s: what waited for it was dropped, not run in a burst
   // (a burst would overflow the receivers downstream: their gaps stay small).
@@ -64,16 +66,19 @@ TEST(SessionStallsLong, EachProcessAndTheRecorderStoppedIsSurvivedAndReported) {
     const auto& r = sum["record"]["by_channel"][ch];
     EXPECT_EQ(r["published"].get<long>() - r["logged"].get<long>(), r["lost"].get<long>()) << ch;
   }
-  const auto brief = Script({testing::BuildPath("tools/rms_session"), "summary", out, "--brief", "--out",
-                             tmp + "/summary.json"},
+  const auto brief = Script({testing::BuildPath("tools/rms_session"), "summary", out, "--brief",
+                             "--out", tmp + "/summary.json"},
                             tmp + "/brief.log", 60);
   EXPECT_NE(brief.out.find("the record lost"), std::string::npos) << brief.out;
   // ... and in the report, apart from the link's losses.
-  const auto report = Script({testing::BuildPath("tools/rms_report"), out, "--out", tmp + "/report.html"},
-                             tmp + "/report.log", 120);
+  const auto report =
+      Script({testing::BuildPath("tools/rms_report"), out, "--out", tmp + "/report.html"},
+             tmp + "/report.log", 120);
   ASSERT_EQ(report.rc, 0) << report.out;
   const std::string html = ReadFile(tmp + "/report.html");
-  EXPECT_TRUE(std::regex_search(html, std::regex("lost by the record: RMS_DCP_FRAME \\(of [0-9]+ published\\)</td><td>[1-9]")))
+  EXPECT_TRUE(std::regex_search(
+      html,
+      std::regex("lost by the record: RMS_DCP_FRAME \\(of [0-9]+ published\\)</td><td>[1-9]")))
       << html.substr(html.find("<h2>Losses"), 1500);
   fs::remove_all(tmp);
 }

@@ -1,23 +1,23 @@
 // The UDP transport: real LCM multicast on the machine's loopback (label
 // network): delivery, senders stamped, other sessions and impostors dropped,
 // a bad URL refused with the fix.
-#include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 #include <thread>
-#include <unistd.h>
 
-#include "rms/wire/channels.h"
 #include "rms/base/check.h"
 #include "rms/esg_frame_t.hpp"
-#include "rms/transport/lcm_interface.h"
-#include "rms/wire/message_io.h"
 #include "rms/operator_input_t.hpp"
 #include "rms/process_status_t.hpp"
 #include "rms/sender_t.hpp"
+#include "rms/transport/lcm_interface.h"
+#include "rms/wire/channels.h"
+#include "rms/wire/message_io.h"
 
 namespace rms {
 namespace {
@@ -65,7 +65,8 @@ TEST(UdpLcm, MessagesAreStampedWithTheirSenderAndOtherSessionsAreDropped) {
   for (int i = 0; i < 10; ++i) {
     operator_input_t m{};
     m.frame = i;
-    m.sender.session_id = 0x7777;  // whatever the caller left there, the transport's sender goes out
+    m.sender.session_id =
+        0x7777;  // whatever the caller left there, the transport's sender goes out
     ASSERT_TRUE(transport::PublishMessage(a, wire::channels::kOperatorInput, m));
     ASSERT_TRUE(transport::PublishMessage(b, wire::channels::kOperatorInput, m));
   }
@@ -133,7 +134,8 @@ TEST(SessionSenders, AnImpostorIsDroppedWhileThePublisherSendsAndARestartIsTaken
   EXPECT_EQ(rx.other_sender_dropped(), 5);
   EXPECT_EQ(statuses.size(), 5u);
   // The publisher falls silent (it ended); its restart is taken.
-  std::this_thread::sleep_for(std::chrono::microseconds(transport::LcmInterface::kPublisherSilenceUs + 100000));
+  std::this_thread::sleep_for(
+      std::chrono::microseconds(transport::LcmInterface::kPublisherSilenceUs + 100000));
   ASSERT_TRUE(transport::PublishMessage(restarted, wire::channels::kOperatorInput, m));
   drain(7);
   ASSERT_EQ(inputs.size(), 7u);

@@ -5,11 +5,10 @@
 #include <unistd.h>
 
 #include <filesystem>
-#include <memory>
-#include <string>
-
 #include <gtest/gtest.h>
+#include <memory>
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "scripted_operator.h"
 #include "subprocess.h"
@@ -17,19 +16,21 @@
 
 namespace rms::testing {
 
-inline constexpr double kReactionS = 0.3;    // after every look at the screen
-inline constexpr int kKeyBudget = 100;       // key actions for the whole flight
+inline constexpr double kReactionS = 0.3;      // after every look at the screen
+inline constexpr int kKeyBudget = 100;         // key actions for the whole flight
 inline constexpr double kTimeBudgetS = 150.0;  // session time for the whole flight
 
 struct HandSession {
   std::string dir, out;
   std::unique_ptr<Tmux> tmux;
-  explicit HandSession(const std::string& tag, int port) : dir(MakeTempDir(tag)), out(dir + "/session") {
+  explicit HandSession(const std::string& tag, int port)
+      : dir(MakeTempDir(tag)), out(dir + "/session") {
     tmux = std::make_unique<Tmux>(dir);
     // As a person starts it from the README, on a private port.
-    const std::string cmd = "RMSLAB_BUILD=" + std::string(RMSLAB_BUILD_DIR) + " " + SourcePath("scripts/lab") +
-                            " demo --by-hand --no-build --no-video --png-every 0 --out " + out + " --lcm-url '" +
-                            UniqueLcmUrl(port) + "' 2>" + dir + "/lab.log; echo $? >" + dir + "/lab.rc";
+    const std::string cmd =
+        "RMSLAB_BUILD=" + std::string(RMSLAB_BUILD_DIR) + " " + SourcePath("scripts/lab") +
+        " demo --by-hand --no-build --no-video --png-every 0 --out " + out + " --lcm-url '" +
+        UniqueLcmUrl(port) + "' 2>" + dir + "/lab.log; echo $? >" + dir + "/lab.rc";
     tmux->Start(cmd, 132, 50);
   }
   // Q, and the launcher's summary.

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "rms/transport/lcm_interface.h"
+
 #include "subprocess.h"
 
 namespace rms::testing {
@@ -15,7 +16,8 @@ namespace rms::testing {
 class LabProcesses {
  public:
   // dir: where logs and stats go. esg_args: extra esg_renderer arguments.
-  LabProcesses(std::string dir, std::string url, std::vector<std::string> esg_args = {"--width", "160", "--height", "120"});
+  LabProcesses(std::string dir, std::string url,
+               std::vector<std::string> esg_args = {"--width", "160", "--height", "120"});
   ~LabProcesses();
 
   // Starts esg_renderer, scene_proc, dynamics_proc (its checkpoints in
@@ -24,7 +26,8 @@ class LabProcesses {
   bool Start(std::string* error);
   // Runs operator_station on `timeline` (extra args appended) to its end,
   // calling lcm.HandleSubscriptions all along; returns its exit code.
-  int Fly(transport::UdpLcm& lcm, const std::string& timeline, const std::vector<std::string>& extra = {});
+  int Fly(transport::UdpLcm& lcm, const std::string& timeline,
+          const std::vector<std::string>& extra = {});
   // SIGINT to the three; returns true when all exit 0 (logs in `error` if not).
   bool Stop(std::string* error);
 

@@ -11,13 +11,26 @@
 
 namespace rms::testing {
 
-LiveSession::LiveSession(const std::string& dir, const std::string& url, const std::vector<std::string>& extra)
+LiveSession::LiveSession(const std::string& dir, const std::string& url,
+                         const std::vector<std::string>& extra)
     : out_(dir + "/session"), url_(url), log_(dir + "/lab.log") {
-  std::vector<std::string> argv = {SourcePath("scripts/lab"), "demo",   "--no-build", "--out",   out_,
-                                   "--lcm-url",               url,      "--png-every", "0",      "--no-video",
-                                   "--width",                 "160",    "--height",    "120"};
+  std::vector<std::string> argv = {SourcePath("scripts/lab"),
+                                   "demo",
+                                   "--no-build",
+                                   "--out",
+                                   out_,
+                                   "--lcm-url",
+                                   url,
+                                   "--png-every",
+                                   "0",
+                                   "--no-video",
+                                   "--width",
+                                   "160",
+                                   "--height",
+                                   "120"};
   argv.insert(argv.end(), extra.begin(), extra.end());
-  lab_ = std::make_unique<Subprocess>(argv, log_, std::vector<std::string>{std::string("RMSLAB_BUILD=") + BuildPath("")});
+  lab_ = std::make_unique<Subprocess>(
+      argv, log_, std::vector<std::string>{std::string("RMSLAB_BUILD=") + BuildPath("")});
 }
 
 bool LiveSession::WaitRunning(double timeout_s) {

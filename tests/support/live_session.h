@@ -15,7 +15,8 @@ class LiveSession {
  public:
   // Starts scripts/lab demo --no-build --out DIR/session --lcm-url URL with
   // small frames, no PNG, no video, and `extra` arguments.
-  LiveSession(const std::string& dir, const std::string& url, const std::vector<std::string>& extra = {});
+  LiveSession(const std::string& dir, const std::string& url,
+              const std::vector<std::string>& extra = {});
   // Until the operator station is up (in run/pids); false if the
   // launcher ended first or timeout_s passed.
   bool WaitRunning(double timeout_s = 60);

@@ -56,57 +56,70 @@ Screen ParseScreen(const std::string& text) {
   s.acquired = text.find("acquired YES") != std::string::npos;
   s.docked = text.find("docked YES") != std::string::npos;
   s.held = text.find("arm HELD") != std::string::npos;
-  if (std::regex_search(text, m, std::regex(R"(frame: (end effector|orbiter|payload))"))) s.frame = m[1];
+  if (std::regex_search(text, m, std::regex(R"(frame: (end effector|orbiter|payload))")))
+    s.frame = m[1];
   s.vernier = text.find("scale: VERNIER") != std::string::npos;
-  const std::regex moving(R"(\b(x|y|z|roll|pitch|yaw) ([+-][\d.]+) (?:ft|deg)/s(?: \(([\d.]+) (?:ft|deg) to go\))?)");
-  for (auto it = std::sregex_iterator(text.begin(), text.end(), moving); it != std::sregex_iterator(); ++it) {
+  const std::regex moving(
+      R"(\b(x|y|z|roll|pitch|yaw) ([+-][\d.]+) (?:ft|deg)/s(?: \(([\d.]+) (?:ft|deg) to go\))?)");
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), moving);
+       it != std::sregex_iterator(); ++it) {
     const int a = AxisIndex((*it)[1]);
     s.rate[a] = std::stod((*it)[2]);
     if ((*it)[3].matched) s.to_go[a] = std::stod((*it)[3]);
   }
   s.guidance = text.find("GUIDANCE") != std::string::npos;
   const std::regex offset(R"(\b(x|y|z) (forward|back|right|left|down|up) ([\d.]+) ft)");
-  for (auto it = std::sregex_iterator(text.begin(), text.end(), offset); it != std::sregex_iterator(); ++it) {
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), offset);
+       it != std::sregex_iterator(); ++it) {
     const std::string w = (*it)[2];
     const double sign = w == "forward" || w == "right" || w == "down" ? 1.0 : -1.0;
     s.offset[AxisIndex((*it)[1])] = sign * std::stod((*it)[3]);
   }
   const std::regex turn(R"(\b(roll|pitch|yaw) (right|left|up|down) ([\d.]+) deg)");
-  for (auto it = std::sregex_iterator(text.begin(), text.end(), turn); it != std::sregex_iterator(); ++it) {
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), turn); it != std::sregex_iterator();
+       ++it) {
     const std::string w = (*it)[2];
     const double sign = w == "right" || w == "up" ? 1.0 : -1.0;
     s.offset[AxisIndex((*it)[1])] = sign * std::stod((*it)[3]);
   }
   const std::regex cond(R"(\[([x ])\] ([1-6]) [A-Za-z0-9 :]+?(holds|short) by ([\d.]+) ft)");
-  for (auto it = std::sregex_iterator(text.begin(), text.end(), cond); it != std::sregex_iterator(); ++it) {
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), cond); it != std::sregex_iterator();
+       ++it) {
     const int i = std::stoi((*it)[2]) - 1;
     s.condition[i] = (*it)[1] == "x";
     s.margin[i] = ((*it)[3] == "holds" ? 1.0 : -1.0) * std::stod((*it)[4]);
   }
-  if (std::regex_search(text, m, std::regex(R"(the finger would stop at ([\d.]+) ft: (below|NOT))"))) {
+  if (std::regex_search(text, m,
+                        std::regex(R"(the finger would stop at ([\d.]+) ft: (below|NOT))"))) {
     s.close_gap = std::stod(m[1]);
     s.close_ok = m[2] == "below";
   }
-  if (std::regex_search(text, m, std::regex(R"(clear of the bay by ([\d.]+) ft)"))) s.bay_clearance = std::stod(m[1]);
+  if (std::regex_search(text, m, std::regex(R"(clear of the bay by ([\d.]+) ft)")))
+    s.bay_clearance = std::stod(m[1]);
   if (std::regex_search(text, m, std::regex(R"(in the bay: ([\d.]+) ft to lift it clear)"))) {
     s.bay_clearance = -std::stod(m[1]);
   }
-  if (std::regex_search(text, m, std::regex(R"(DOCKING distance ([\d.]+) ft)"))) s.dock_distance = std::stod(m[1]);
-  if (std::regex_search(text, m, std::regex(R"(angle ([\d.]+) deg \(<=)"))) s.dock_angle = std::stod(m[1]);
+  if (std::regex_search(text, m, std::regex(R"(DOCKING distance ([\d.]+) ft)")))
+    s.dock_distance = std::stod(m[1]);
+  if (std::regex_search(text, m, std::regex(R"(angle ([\d.]+) deg \(<=)")))
+    s.dock_angle = std::stod(m[1]);
   return s;
 }
 
-ScriptedOperator::ScriptedOperator(Tmux* tmux, double reaction_s) : tmux_(tmux), reaction_s_(reaction_s) {}
+ScriptedOperator::ScriptedOperator(Tmux* tmux, double reaction_s)
+    : tmux_(tmux), reaction_s_(reaction_s) {}
 
-void ScriptedOperator::Note(const std::string& line) { report_.transcript.push_back(Fmt("%6.1f s  ", last_.t_s) + line); }
+void ScriptedOperator::Note(const std::string& line) {
+  report_.transcript.push_back(Fmt("%6.1f s  ", last_.t_s) + line);
+}
 
 Screen ScriptedOperator::Look() {
   last_ = ParseScreen(tmux_->Capture());
   return last_;
 }
 
-void ScriptedOperator::Press(const std::vector<std::string>& keys, const std::string& why, double pulse_s,
-                             const std::vector<std::string>& then) {
+void ScriptedOperator::Press(const std::vector<std::string>& keys, const std::string& why,
+                             double pulse_s, const std::vector<std::string>& then) {
   // A person acts a reaction time after seeing what they act on.
   SleepS(reaction_s_);
   tmux_->Send(keys);
@@ -124,7 +137,8 @@ void ScriptedOperator::Press(const std::vector<std::string>& keys, const std::st
   SleepS(0.12);
 }
 
-bool ScriptedOperator::Drive(const Screen& s, const std::vector<Goal>& goals, const std::string& why) {
+bool ScriptedOperator::Drive(const Screen& s, const std::vector<Goal>& goals,
+                             const std::string& why) {
   // Coarse for the long way, vernier for the last foot or so; changing the
   // scale stops every motion, so it is a press of its own. (With
   // hysteresis: coarse covers 0.9 ft and 3.4 deg while a press is on its
@@ -138,7 +152,8 @@ bool ScriptedOperator::Drive(const Screen& s, const std::vector<Goal>& goals, co
     worst = std::max(worst, std::abs(g.error));
   }
   const bool done = worst_ft == 0.0 && worst_deg == 0.0;
-  const bool want_vernier = s.vernier ? (worst_ft < 2.5 && worst_deg < 12.0) : (worst_ft < 1.2 && worst_deg < 5.0);
+  const bool want_vernier =
+      s.vernier ? (worst_ft < 2.5 && worst_deg < 12.0) : (worst_ft < 1.2 && worst_deg < 5.0);
   if (!done && want_vernier != s.vernier) {
     Press({"v"}, s.vernier ? "coarse for the long way" : "vernier for the last of it");
     return false;
@@ -161,14 +176,18 @@ bool ScriptedOperator::Drive(const Screen& s, const std::vector<Goal>& goals, co
       keys.push_back(against);  // going the wrong way: stop it, start again next time
     } else if (m != 0.0) {
       const double travel = std::abs(m) * latency;
-      if (std::abs(e) <= travel + 0.5 * g.tol) keys.push_back(against);                  // stop it in time
-      else if (left < 1.2 * travel && std::abs(e) > left + g.tol) keys.push_back(toward);  // keep it going
+      if (std::abs(e) <= travel + 0.5 * g.tol)
+        keys.push_back(against);  // stop it in time
+      else if (left < 1.2 * travel && std::abs(e) > left + g.tol)
+        keys.push_back(toward);  // keep it going
     } else {
       // Still. Far: start it (and stop it when it gets there). Near: a
       // tap and its stop, timed, one axis at a time.
       const double rate = g.axis < 3 ? (s.vernier ? 0.2 : 2.0) : (s.vernier ? 0.8 : 8.0);
-      if (std::abs(e) > 3 * rate * latency) keys.push_back(toward);
-      else if (!pulse || std::abs(e) / g.tol > std::abs(pulse->error) / pulse->tol) pulse = &g, pulse_rate = rate;
+      if (std::abs(e) > 3 * rate * latency)
+        keys.push_back(toward);
+      else if (!pulse || std::abs(e) / g.tol > std::abs(pulse->error) / pulse->tol)
+        pulse = &g, pulse_rate = rate;
     }
   }
   if (!keys.empty()) {
@@ -204,7 +223,8 @@ bool ScriptedOperator::Acquire(double limit_s) {
       SleepS(0.1);
       continue;
     }
-    if (s.t_s > limit_s) return report_.failure = "no acquisition by " + Fmt("%.0f s", limit_s), false;
+    if (s.t_s > limit_s)
+      return report_.failure = "no acquisition by " + Fmt("%.0f s", limit_s), false;
     if (s.mode >= 2) {
       Note("acquired");
       return true;
@@ -221,18 +241,23 @@ bool ScriptedOperator::Acquire(double limit_s) {
         goals = {{3, o[3], 1.0}, {4, o[4], 1.0}, {5, o[5], 1.0}};
         break;
       case kHover:  // to a point above the grasp, the fingers either side of the bar's line
-        goals = {{0, o[0] - kHoverFt, 0.15}, {1, o[1], 0.04}, {2, o[2], 0.1}, {3, o[3], 1.0}, {4, o[4], 1.0},
+        goals = {{0, o[0] - kHoverFt, 0.15},
+                 {1, o[1], 0.04},
+                 {2, o[2], 0.1},
+                 {3, o[3], 1.0},
+                 {4, o[4], 1.0},
                  {5, o[5], 1.0}};
         break;
       case kDescend:  // straight down onto the bar
-        goals = {{0, o[0], 0.05}, {1, o[1], 0.04}, {2, o[2], 0.1}, {3, o[3], 1.0}, {4, o[4], 1.0}, {5, o[5], 1.0}};
+        goals = {{0, o[0], 0.05}, {1, o[1], 0.04}, {2, o[2], 0.1},
+                 {3, o[3], 1.0},  {4, o[4], 1.0},  {5, o[5], 1.0}};
         break;
       case kClose: {
         bool ready = s.close_ok;
         for (int i : {0, 1, 2, 4, 5}) ready = ready && s.margin[i] > 0;
         if (!ready) {
-          Note("not ready to close (conditions " + Conditions(s) + Fmt(", the finger would stop at %.3f ft)", s.close_gap) +
-               ": align again");
+          Note("not ready to close (conditions " + Conditions(s) +
+               Fmt(", the finger would stop at %.3f ft)", s.close_gap) + ": align again");
           stage = kDescend;
           continue;
         }
@@ -253,22 +278,27 @@ bool ScriptedOperator::Acquire(double limit_s) {
     static const char* kStage[] = {"turn", "to the hover point", "descend", "", ""};
     if (Drive(s, goals, kStage[stage])) {
       stage = static_cast<Stage>(stage + 1);
-      Note(stage == kHover ? "square to the bar" : stage == kDescend ? "over the bar" : "at the grasp");
+      Note(stage == kHover     ? "square to the bar"
+           : stage == kDescend ? "over the bar"
+                               : "at the grasp");
     }
   }
 }
 
 bool ScriptedOperator::Extract(double limit_s) {
-  if (!WaitForFrame("orbiter", limit_s)) return report_.failure = "the orbiter frame would not come", false;
+  if (!WaitForFrame("orbiter", limit_s))
+    return report_.failure = "the orbiter frame would not come", false;
   while (true) {
     const Screen s = Look();
-    if (s.t_s > limit_s) return report_.failure = "not out of the bay by " + Fmt("%.0f s", limit_s), false;
+    if (s.t_s > limit_s)
+      return report_.failure = "not out of the bay by " + Fmt("%.0f s", limit_s), false;
     if (s.mode == 3 && s.bay_clearance > 2.0) {
       Note("clear of the bay");
       return true;
     }
     // Straight up (the orbiter's -z), until 3 ft clear.
-    Drive(s, {{2, -(3.0 - s.bay_clearance), 0.3}, {0, 0.0, 1.0}, {1, 0.0, 1.0}}, "lift it out of the bay");
+    Drive(s, {{2, -(3.0 - s.bay_clearance), 0.3}, {0, 0.0, 1.0}, {1, 0.0, 1.0}},
+          "lift it out of the bay");
   }
 }
 
@@ -303,20 +333,25 @@ bool ScriptedOperator::Dock(double limit_s) {
         break;
       case kAlign:  // payload axes: y along the probe; on the port's axis, short of it
         if (s.frame != "payload") {
-          if (!WaitForFrame("payload", limit_s)) return report_.failure = "the payload frame would not come", false;
+          if (!WaitForFrame("payload", limit_s))
+            return report_.failure = "the payload frame would not come", false;
           continue;
         }
-        goals = {{0, o[0], 0.05}, {2, o[2], 0.05}, {1, o[1] - kAlignFt, 0.3}, {3, o[3], 0.8}, {4, o[4], 0.8},
-                 {5, o[5], 0.8}};
+        goals = {{0, o[0], 0.05}, {2, o[2], 0.05}, {1, o[1] - kAlignFt, 0.3},
+                 {3, o[3], 0.8},  {4, o[4], 0.8},  {5, o[5], 0.8}};
         break;
       case kIn:  // in along the probe until it docks (0.25 ft, 2 deg 32 min)
-        goals = {{0, o[0], 0.05}, {2, o[2], 0.05}, {1, o[1], 0.05}, {3, o[3], 0.8}, {4, o[4], 0.8}, {5, o[5], 0.8}};
+        goals = {{0, o[0], 0.05}, {2, o[2], 0.05}, {1, o[1], 0.05},
+                 {3, o[3], 0.8},  {4, o[4], 0.8},  {5, o[5], 0.8}};
         break;
     }
-    static const char* kStage[] = {"below the port", "turn the probe up", "onto the port's axis", "in"};
+    static const char* kStage[] = {"below the port", "turn the probe up", "onto the port's axis",
+                                   "in"};
     if (Drive(s, goals, kStage[stage]) && stage != kIn) {
       stage = static_cast<Stage>(stage + 1);
-      Note(stage == kTurn ? "below the port" : stage == kAlign ? "probe square to the port" : "on the axis");
+      Note(stage == kTurn    ? "below the port"
+           : stage == kAlign ? "probe square to the port"
+                             : "on the axis");
     }
   }
 }

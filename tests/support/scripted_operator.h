@@ -18,11 +18,11 @@ namespace rms::testing {
 // The status screen, read as a person reads it (operator_station's
 // status_screen.cc writes it).
 struct Screen {
-  bool valid = false;         // the station's screen is up
-  double t_s = 0.0;           // session time
-  int mode = 0;               // 1..3 (0: no telemetry shown)
+  bool valid = false;  // the station's screen is up
+  double t_s = 0.0;    // session time
+  int mode = 0;        // 1..3 (0: no telemetry shown)
   bool acquired = false, docked = false, held = false;
-  std::string frame;          // "end effector", "orbiter", "payload"
+  std::string frame;  // "end effector", "orbiter", "payload"
   bool vernier = false;
   // Per axis x, y, z, roll, pitch, yaw: the commanded rate (signed, ft/s
   // or deg/s) and what is still to go of the increment in flight.
@@ -42,19 +42,19 @@ Screen ParseScreen(const std::string& text);
 
 struct FlightReport {
   bool acquired = false, docked = false;
-  double acquired_t_s = -1, docked_t_s = -1;  // session time
-  int key_actions = 0;       // keys pressed in all
-  int key_actions_acquire = 0;  // up to acquisition
+  double acquired_t_s = -1, docked_t_s = -1;        // session time
+  int key_actions = 0;                              // keys pressed in all
+  int key_actions_acquire = 0;                      // up to acquisition
   double dock_distance_ft = 0, dock_angle_deg = 0;  // as the screen showed them when docked
-  std::string failure;       // why it stopped short, if it did
-  std::vector<std::string> transcript;  // what it saw and did, line by line
+  std::string failure;                              // why it stopped short, if it did
+  std::vector<std::string> transcript;              // what it saw and did, line by line
 };
 
 class ScriptedOperator {
  public:
   // tmux: a terminal in which `scripts/lab demo --by-hand` (or
   // operator_station --keyboard) is running with the default bindings.
-  ScriptedOperator(Tmux* tmux, double reaction_s = 0.3);
+  explicit ScriptedOperator(Tmux* tmux, double reaction_s = 0.3);
   // Flies from the initial state: acquires, and unless acquire_only, lifts
   // the payload out of the bay and docks it. Gives up at `limit_s` of
   // session time.

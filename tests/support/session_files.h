@@ -3,9 +3,8 @@
 // process's stats (docs/sessions.md "The session folder").
 #include <cstdint>
 #include <fstream>
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 namespace rms::testing {
 
@@ -20,7 +19,10 @@ inline nlohmann::json ReadJson(const std::string& path) {
   }
 }
 // A counter of a process's stats (SESSION/stats/PROCESS.json), 0 when absent.
-inline std::int64_t Counter(const std::string& session, const std::string& process, const std::string& name) {
-  return ReadJson(session + "/stats/" + process + ".json").value("counters", nlohmann::json::object()).value(name, 0L);
+inline std::int64_t Counter(const std::string& session, const std::string& process,
+                            const std::string& name) {
+  return ReadJson(session + "/stats/" + process + ".json")
+      .value("counters", nlohmann::json::object())
+      .value(name, 0L);
 }
 }  // namespace rms::testing

@@ -3,8 +3,6 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
-#include <sys/file.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -15,6 +13,8 @@
 #include <mutex>
 #include <sstream>
 #include <stdexcept>
+#include <sys/file.h>
+#include <sys/wait.h>
 #include <thread>
 
 extern char** environ;
@@ -30,10 +30,12 @@ Subprocess::Subprocess(const std::vector<std::string>& argv, const std::string& 
   // extra_env entries ("KEY=value") replace the inherited ones of that key.
   auto overridden = [&](const std::string& kv) {
     const std::string key = kv.substr(0, kv.find('=') + 1);
-    for (const auto& e : extra_env) if (e.compare(0, key.size(), key) == 0) return true;
+    for (const auto& e : extra_env)
+      if (e.compare(0, key.size(), key) == 0) return true;
     return false;
   };
-  for (char** e = environ; *e; ++e) if (!overridden(*e)) env_store.emplace_back(*e);
+  for (char** e = environ; *e; ++e)
+    if (!overridden(*e)) env_store.emplace_back(*e);
   for (const auto& e : extra_env) env_store.push_back(e);
   std::vector<char*> env;
   for (auto& e : env_store) env.push_back(e.data());
@@ -95,7 +97,8 @@ std::string ReadFile(const std::string& path) {
 }
 
 std::string MakeTempDir(const std::string& tag) {
-  std::string tmpl = (std::filesystem::temp_directory_path() / ("rmslab_" + tag + "_XXXXXX")).string();
+  std::string tmpl =
+      (std::filesystem::temp_directory_path() / ("rmslab_" + tag + "_XXXXXX")).string();
   if (mkdtemp(tmpl.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
   return tmpl;
 }
@@ -111,11 +114,12 @@ std::string UniqueLcmUrl(int base) {
   std::lock_guard<std::mutex> lock(mu);
   if (const auto it = claimed.find(base); it != claimed.end()) return it->second;
   constexpr int kFirst = 17000, kCount = 8000;
-  const int start = static_cast<int>((static_cast<unsigned>(getpid()) * 131u + static_cast<unsigned>(base)) % kCount);
+  const int start = static_cast<int>(
+      (static_cast<unsigned>(getpid()) * 131u + static_cast<unsigned>(base)) % kCount);
   for (int i = 0; i < kCount; ++i) {
     const int port = kFirst + (start + i) % kCount;
-    const std::string path = std::filesystem::temp_directory_path().string() + "/rmslab-test-port-" +
-                             std::to_string(port) + ".lock";
+    const std::string path = std::filesystem::temp_directory_path().string() +
+                             "/rmslab-test-port-" + std::to_string(port) + ".lock";
     const int fd = open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
     if (fd < 0) continue;
     if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
@@ -138,6 +142,8 @@ ScriptRun Script(const std::vector<std::string>& argv, const std::string& log, d
 }
 
 std::string BuildPath(const std::string& rel) { return std::string(RMSLAB_BUILD_DIR) + "/" + rel; }
-std::string SourcePath(const std::string& rel) { return std::string(RMSLAB_SOURCE_DIR) + "/" + rel; }
+std::string SourcePath(const std::string& rel) {
+  return std::string(RMSLAB_SOURCE_DIR) + "/" + rel;
+}
 
 }  // namespace rms::testing

@@ -2,9 +2,8 @@
 // Runs a real executable for integration tests: stdout and stderr to a log
 // file, signals, waits with a timeout, and SIGKILL on destruction so a failed
 // test leaves no orphans.
-#include <sys/types.h>
-
 #include <string>
+#include <sys/types.h>
 #include <vector>
 
 namespace rms::testing {
@@ -34,7 +33,8 @@ struct ScriptRun {
   int rc = -1;
   std::string out;
 };
-ScriptRun Script(const std::vector<std::string>& argv, const std::string& log, double timeout_s = 300);
+ScriptRun Script(const std::vector<std::string>& argv, const std::string& log,
+                 double timeout_s = 300);
 
 bool WaitForFile(const std::string& path, double timeout_s);
 std::string ReadFile(const std::string& path);

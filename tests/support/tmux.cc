@@ -8,7 +8,8 @@
 
 namespace rms::testing {
 
-Tmux::Tmux(std::string dir) : dir_(std::move(dir)), socket_("rmslab_test_" + std::to_string(getpid())) {}
+Tmux::Tmux(std::string dir)
+    : dir_(std::move(dir)), socket_("rmslab_test_" + std::to_string(getpid())) {}
 
 Tmux::~Tmux() { Stop(); }
 
@@ -28,7 +29,8 @@ int Tmux::Run(std::vector<std::string> args) {
 }
 
 int Tmux::Start(const std::string& command, int width, int height) {
-  return Run({"new-session", "-d", "-s", "op", "-x", std::to_string(width), "-y", std::to_string(height), command});
+  return Run({"new-session", "-d", "-s", "op", "-x", std::to_string(width), "-y",
+              std::to_string(height), command});
 }
 
 int Tmux::Send(const std::vector<std::string>& keys) {
@@ -45,7 +47,8 @@ std::string Tmux::Capture() {
 }
 
 int Tmux::Resize(int width, int height) {
-  return Run({"resize-window", "-t", "op", "-x", std::to_string(width), "-y", std::to_string(height)});
+  return Run(
+      {"resize-window", "-t", "op", "-x", std::to_string(width), "-y", std::to_string(height)});
 }
 
 }  // namespace rms::testing

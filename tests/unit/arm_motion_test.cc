@@ -3,12 +3,12 @@
 // point of resolution and angular velocity give that motion; near singular
 // poses the joints move smoothly (no jumps); a joint at its limit stops
 // there and is reported.
-#include <gtest/gtest.h>
+#include "rms/operator_station/arm_motion.h"
 
 #include <cstdio>
+#include <gtest/gtest.h>
 #include <random>
 
-#include "rms/operator_station/arm_motion.h"
 #include "rms/arm/kinematics.h"
 #include "rms/base/config.h"
 
@@ -31,7 +31,8 @@ class ArmMotion : public ::testing::Test {
 // A pose well inside the workspace and away from singularities.
 JointAngles RandomPose(std::mt19937& rng) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  return {40 * u(rng), 50 + 25 * u(rng), -80 + 30 * u(rng), -40 + 40 * u(rng), 40 * u(rng), 90 * u(rng)};
+  return {40 * u(rng),       50 + 25 * u(rng), -80 + 30 * u(rng),
+          -40 + 40 * u(rng), 40 * u(rng),      90 * u(rng)};
 }
 
 TEST_F(ArmMotion, TheJacobianIsTheForwardKinematicsDerivative) {
@@ -62,7 +63,7 @@ TEST_F(ArmMotion, ACommandedVelocityGivesThatVelocity) {
   const double dt = 1.0 / 30;
   for (int k = 0; k < 30; ++k) {
     const JointAngles q = RandomPose(rng);
-    const Eigen::Vector3d v(u(rng), u(rng), u(rng));                  // ft/s, up to 1.7
+    const Eigen::Vector3d v(u(rng), u(rng), u(rng));  // ft/s, up to 1.7
     const Eigen::Vector3d w = Eigen::Vector3d(u(rng), u(rng), u(rng)) * 4 * kDeg;  // up to 7 deg/s
     const RateResult r = ResolveRate(config.arm, limits, q, h, por, v, w, dt);
     ASSERT_EQ(r.at_limit, 0u);
@@ -88,8 +89,10 @@ TEST_F(ArmMotion, NearSingularPosesTheJointsMoveWithoutJumps) {
     for (int axis = 0; axis < 6; ++axis) {
       for (double sign : {-1.0, 1.0}) {
         Eigen::Vector3d v = Eigen::Vector3d::Zero(), w = Eigen::Vector3d::Zero();
-        if (axis < 3) v[axis] = sign * 2.0;
-        else w[axis - 3] = sign * 8.0 * kDeg;
+        if (axis < 3)
+          v[axis] = sign * 2.0;
+        else
+          w[axis - 3] = sign * 8.0 * kDeg;
         JointAngles q = q0;
         JointAngles prev_rate{};
         std::uint32_t prev_limits = 0;
@@ -98,7 +101,8 @@ TEST_F(ArmMotion, NearSingularPosesTheJointsMoveWithoutJumps) {
           const RateResult r = ResolveRate(config.arm, limits, q, h, por, v, w, dt);
           for (int i = 0; i < 6; ++i) {
             ASSERT_LE(std::abs(r.q_deg[i] - q[i]), limits.rate_deg_s[i] * dt + 1e-9)
-                << "start " << q0[1] << "/" << q0[4] << " axis " << axis << " frame " << f << " joint " << i;
+                << "start " << q0[1] << "/" << q0[4] << " axis " << axis << " frame " << f
+                << " joint " << i;
             // (A joint stopping at its limit changes the rates at once, rightly.)
             if (f > 0 && r.at_limit == prev_limits) {
               biggest_change = std::max(biggest_change, std::abs(r.rate_deg_s[i] - prev_rate[i]));
@@ -118,7 +122,8 @@ TEST_F(ArmMotion, NearSingularPosesTheJointsMoveWithoutJumps) {
   // direction) bends the elbow and then moves the point that way.
   JointAngles q = {0, 0, 0, 0, 0, 0};
   const Eigen::Vector3d p0 = Point(q);
-  for (int f = 0; f < 150; ++f) q = ResolveRate(config.arm, limits, q, h, por, {-1.0, 0, 0}, {0, 0, 0}, dt).q_deg;
+  for (int f = 0; f < 150; ++f)
+    q = ResolveRate(config.arm, limits, q, h, por, {-1.0, 0, 0}, {0, 0, 0}, dt).q_deg;
   EXPECT_LT(q[2], -5.0) << "the elbow stayed straight";
   EXPECT_LT(Point(q).x() - p0.x(), -1.0) << "the arm did not come in";
 }
@@ -140,7 +145,8 @@ TEST_F(ArmMotion, AJointAtItsLimitStopsThereAndIsReported) {
   EXPECT_TRUE(stopped);
   EXPECT_DOUBLE_EQ(q[4], limits.max_deg[4]);
   // Every joint at its limit or not: a command back out moves it again.
-  const RateResult back = ResolveRate(config.arm, limits, q, h, por, Eigen::Vector3d::Zero(), -w, dt);
+  const RateResult back =
+      ResolveRate(config.arm, limits, q, h, por, Eigen::Vector3d::Zero(), -w, dt);
   EXPECT_LT(back.q_deg[4], limits.max_deg[4]);
   EXPECT_EQ(back.at_limit & (1u << 4), 0u);
 }
@@ -151,7 +157,8 @@ TEST_F(ArmMotion, JointMovesArriveTogetherAtTheirRates) {
   int frames = 0;
   while (!StepJointsToward(&q, target, limits.rate_deg_s, 0.1) && frames < 1000) ++frames;
   for (int i = 0; i < 6; ++i) EXPECT_NEAR(WrapDeg(q[i] - target[i]), 0.0, 1e-9);
-  EXPECT_EQ(frames, 141);  // 170 deg at 12 deg/s, 1.2 deg a step: 141 steps short, the 142nd arrives
+  EXPECT_EQ(frames,
+            141);  // 170 deg at 12 deg/s, 1.2 deg a step: 141 steps short, the 142nd arrives
 }
 
 }  // namespace

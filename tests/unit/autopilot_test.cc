@@ -2,15 +2,14 @@
 // the input block's words, the telemetry one frame late as over LCM): it
 // docks from the default state and from perturbed initial states, and
 // relieves the collisions it runs into.
-#include <gtest/gtest.h>
-
 #include <cstdio>
+#include <gtest/gtest.h>
 #include <random>
 
-#include "rms/sim/closed_loop.h"
 #include "rms/arm/kinematics.h"
-#include "rms/mission/mission_geometry.h"
 #include "rms/base/config.h"
+#include "rms/mission/mission_geometry.h"
+#include "rms/sim/closed_loop.h"
 
 namespace rms {
 namespace {
@@ -29,8 +28,10 @@ TEST(Autopilot, DocksFromTheDefaultState) {
   const LabConfig c = LoadConfig(DefaultConfigPath());
   const auto r = sim::FlyAutopilot(c, {}, kMaxFrames);
   ExpectDocked(r, c);
-  std::printf("docked after %.1f s: distance %.4f ft, angle %.4f deg; modes 2 at %.1f s, 3 at %.1f s\n", r.time_s,
-              r.dock_distance_ft, r.dock_angle_deg, r.modes_entered[2] / 30.0, r.modes_entered[3] / 30.0);
+  std::printf(
+      "docked after %.1f s: distance %.4f ft, angle %.4f deg; modes 2 at %.1f s, 3 at %.1f s\n",
+      r.time_s, r.dock_distance_ft, r.dock_angle_deg, r.modes_entered[2] / 30.0,
+      r.modes_entered[3] / 30.0);
   EXPECT_EQ(r.autopilot.Get(Counter::kAutopilotCollisionsRelieved), 0);
 }
 
@@ -47,11 +48,13 @@ bool PayloadFitsTheBay(const LabConfig& c) {
   const double r = p.diameter_ft / 2, hl = p.length_ft / 2, pr = p.probe_diameter_ft / 2;
   for (int k = 0; k < 32; ++k) {
     const double a = 2 * M_PI * k / 32;
-    for (const Eigen::Vector3d& q : {Eigen::Vector3d(r * std::cos(a), -hl, r * std::sin(a)),
-                                     Eigen::Vector3d(r * std::cos(a), hl, r * std::sin(a)),
-                                     Eigen::Vector3d(pr * std::cos(a), hl + p.probe_length_ft, pr * std::sin(a))}) {
+    for (const Eigen::Vector3d& q :
+         {Eigen::Vector3d(r * std::cos(a), -hl, r * std::sin(a)),
+          Eigen::Vector3d(r * std::cos(a), hl, r * std::sin(a)),
+          Eigen::Vector3d(pr * std::cos(a), hl + p.probe_length_ft, pr * std::sin(a))}) {
       const Eigen::Vector3d v = p.R_RP * q + p.p_RoPo_R_ft;
-      if (v.x() < 0.05 || v.x() > c.shuttle.bay_length_ft - 0.05 || std::abs(v.y()) > c.shuttle.bay_width_ft / 2 - 0.05 ||
+      if (v.x() < 0.05 || v.x() > c.shuttle.bay_length_ft - 0.05 ||
+          std::abs(v.y()) > c.shuttle.bay_width_ft / 2 - 0.05 ||
           v.z() < -c.shuttle.bay_depth_ft + 0.05) {
         return false;
       }
@@ -105,13 +108,16 @@ TEST(Autopilot, DocksFromRandomPerturbations) {
     c.inputs[kShoulderHeight].initial = h;
     c.inputs[kFinger].initial = finger;
     char what[160];
-    std::snprintf(what, sizeof what, "case %d: payload moved (%.2f, %.2f) ft, yaw %.1f deg; shoulder %.2f ft; finger %.2f",
-                  k, d.x(), d.y(), yaw, h, finger);
+    std::snprintf(
+        what, sizeof what,
+        "case %d: payload moved (%.2f, %.2f) ft, yaw %.1f deg; shoulder %.2f ft; finger %.2f", k,
+        d.x(), d.y(), yaw, h, finger);
     SCOPED_TRACE(what);
     const auto r = sim::FlyAutopilot(c, {}, kMaxFrames);
     ExpectDocked(r, c);
-    std::printf("%s: %s after %.1f s (%.3f ft, %.3f deg)\n", what, r.docked ? "docked" : r.failure.c_str(), r.time_s,
-                r.dock_distance_ft, r.dock_angle_deg);
+    std::printf("%s: %s after %.1f s (%.3f ft, %.3f deg)\n", what,
+                r.docked ? "docked" : r.failure.c_str(), r.time_s, r.dock_distance_ft,
+                r.dock_angle_deg);
   }
 }
 
@@ -154,18 +160,21 @@ TEST(Autopilot, DocksWithoutACollisionFromRandomArmStarts) {
   int flown = 0;
   for (int k = 0; k < 200 && flown < 20; ++k) {
     LabConfig c = c0;
-    const std::array<double, 6> q = {30 * u(rng), 20 + 25 * u(rng), -60 + 40 * u(rng),
-                                     -60 + 40 * u(rng), 20 * u(rng), 90 * u(rng)};
+    const std::array<double, 6> q = {30 * u(rng),       20 + 25 * u(rng), -60 + 40 * u(rng),
+                                     -60 + 40 * u(rng), 20 * u(rng),      90 * u(rng)};
     for (int i = 0; i < 6; ++i) c.inputs[i].initial = q[i];
     // Only starts that are physically possible: nothing of the arm in the payload or the orbiter.
-    if (!mission::Interpenetration(c, model, q, c.inputs[kShoulderHeight].initial, c.end_effector.finger_gap_open_ft,
-                                   arm::MakeIsometry(c.payload.R_RP, c.payload.p_RoPo_R_ft), mission::PayloadState::kInBay)
+    if (!mission::Interpenetration(c, model, q, c.inputs[kShoulderHeight].initial,
+                                   c.end_effector.finger_gap_open_ft,
+                                   arm::MakeIsometry(c.payload.R_RP, c.payload.p_RoPo_R_ft),
+                                   mission::PayloadState::kInBay)
              .empty()) {
       continue;
     }
     ++flown;
     char what[128];
-    std::snprintf(what, sizeof what, "start %.1f %.1f %.1f %.1f %.1f %.1f", q[0], q[1], q[2], q[3], q[4], q[5]);
+    std::snprintf(what, sizeof what, "start %.1f %.1f %.1f %.1f %.1f %.1f", q[0], q[1], q[2], q[3],
+                  q[4], q[5]);
     SCOPED_TRACE(what);
     const auto r = sim::FlyAutopilot(c, {}, kMaxFrames);
     ExpectDocked(r, c);

@@ -1,12 +1,12 @@
 // The DCP's collision algorithm (report IV.A.1): hand-made cases, then
 // agreement with the independent references on generated pairs.
-#include <gtest/gtest.h>
+#include "rms/dynamics_proc/collision.h"
 
 #include <cmath>
 #include <cstdio>
+#include <gtest/gtest.h>
 #include <limits>
 
-#include "rms/dynamics_proc/collision.h"
 #include "rms/reference/compare.h"
 #include "rms/reference/generators.h"
 
@@ -19,13 +19,14 @@ using Eigen::Vector3d;
 Hexahedron AxisBox(const Vector3d& lo, const Vector3d& hi) {
   // Face a at x = lo.x (U = +X), b at y = lo.y, c at z = lo.z.
   const Vector3d c = 0.5 * (lo + hi), h = 0.5 * (hi - lo);
-  return MakeBox(Vector3d(lo.x(), c.y(), c.z()), Vector3d::UnitX(), Vector3d::UnitY(), Vector3d::UnitZ(),
-                 2 * h.x(), h.y(), h.z());
+  return MakeBox(Vector3d(lo.x(), c.y(), c.z()), Vector3d::UnitX(), Vector3d::UnitY(),
+                 Vector3d::UnitZ(), 2 * h.x(), h.y(), h.z());
 }
 
 TEST(Hexahedron, TheReportsVertexNumberingAndFaceLetters) {
   // EFF HEX 1 at A = 0 with UX2, UY2, UZ2 = X, Y, Z: the report's v1..v4.
-  const Hexahedron h = MakeBox(Vector3d::Zero(), Vector3d::UnitX(), Vector3d::UnitY(), Vector3d::UnitZ(), 3.0, 1.0, 2.0);
+  const Hexahedron h = MakeBox(Vector3d::Zero(), Vector3d::UnitX(), Vector3d::UnitY(),
+                               Vector3d::UnitZ(), 3.0, 1.0, 2.0);
   EXPECT_EQ(h.vertex(0), Vector3d(0, -1, -2));  // v1 = A - W UY2 - H UZ2
   EXPECT_EQ(h.vertex(1), Vector3d(0, -1, 2));   // v2 = A - W UY2 + H UZ2
   EXPECT_EQ(h.vertex(2), Vector3d(3, -1, -2));  // v3 = A - W UY2 - H UZ2 + L UX2
@@ -38,7 +39,8 @@ TEST(Hexahedron, TheReportsVertexNumberingAndFaceLetters) {
   EXPECT_EQ(FaceLetter(kFaceD), 'd');
   // Every vertex lies on its three faces.
   for (int i = 0; i < 8; ++i)
-    for (int f : kVertexFaces[i]) EXPECT_NEAR(h.Beyond(f, h.x[i], h.y[i], h.z[i]), 0.0, 1e-12) << i << f;
+    for (int f : kVertexFaces[i])
+      EXPECT_NEAR(h.Beyond(f, h.x[i], h.y[i], h.z[i]), 0.0, 1e-12) << i << f;
   // A general hexahedron from the same vertices has the same planes.
   std::array<Vector3d, 8> v;
   for (int i = 0; i < 8; ++i) v[i] = h.vertex(i);
@@ -52,10 +54,11 @@ TEST(Hexahedron, TheReportsVertexNumberingAndFaceLetters) {
 
 TEST(Hexahedron, LocationWordsSayWhichFacesAPointIsBeyond) {
   const Hexahedron h = AxisBox(Vector3d(0, 0, 0), Vector3d(1, 1, 1));
-  EXPECT_EQ(h.Word(Vector3d(0.5, 0.5, 0.5), 1e-12), 0);                  // inside: six zeros
-  EXPECT_EQ(h.Word(Vector3d(2, 0.5, 0.5), 1e-12), FaceBit(kFaceD));      // beyond x = 1
-  EXPECT_EQ(h.Word(Vector3d(-1, -1, 2), 1e-12), FaceBit(kFaceA) | FaceBit(kFaceB) | FaceBit(kFaceF));
-  EXPECT_EQ(h.Word(Vector3d(1, 0.5, 0.5), 1e-12), 0);                    // on a face: FALSE side
+  EXPECT_EQ(h.Word(Vector3d(0.5, 0.5, 0.5), 1e-12), 0);              // inside: six zeros
+  EXPECT_EQ(h.Word(Vector3d(2, 0.5, 0.5), 1e-12), FaceBit(kFaceD));  // beyond x = 1
+  EXPECT_EQ(h.Word(Vector3d(-1, -1, 2), 1e-12),
+            FaceBit(kFaceA) | FaceBit(kFaceB) | FaceBit(kFaceF));
+  EXPECT_EQ(h.Word(Vector3d(1, 0.5, 0.5), 1e-12), 0);  // on a face: FALSE side
 }
 
 TEST(Collide, VertexInsideAndFaceSeparation) {
@@ -110,8 +113,10 @@ TEST(Collide, BoundingBoxesApartDecideWhereTheSpheresOverlap) {
 TEST(Collide, TouchingCountsAsCollision) {
   const Hexahedron a = AxisBox(Vector3d(0, 0, 0), Vector3d(1, 1, 1));
   EXPECT_EQ(Collide(a, AxisBox(Vector3d(1, 0, 0), Vector3d(2, 1, 1))).verdict, Verdict::kCollide);
-  EXPECT_EQ(Collide(a, AxisBox(Vector3d(1, 1, 1), Vector3d(2, 2, 2))).verdict, Verdict::kCollide);  // a corner
-  EXPECT_EQ(Collide(a, AxisBox(Vector3d(1 + 1e-9, 0, 0), Vector3d(2, 1, 1))).verdict, Verdict::kSeparate);
+  EXPECT_EQ(Collide(a, AxisBox(Vector3d(1, 1, 1), Vector3d(2, 2, 2))).verdict,
+            Verdict::kCollide);  // a corner
+  EXPECT_EQ(Collide(a, AxisBox(Vector3d(1 + 1e-9, 0, 0), Vector3d(2, 1, 1))).verdict,
+            Verdict::kSeparate);
 }
 
 TEST(Collide, ARodThroughASlabNeedsTheEdgeTestInBothDirections) {
@@ -139,7 +144,8 @@ TEST(Collide, AnEdgeThatStopsShortOfTheSolidIsNotACollision) {
   std::array<Vector3d, 8> v;
   // A thin hexahedron along that edge: every vertex within 0.01 of it.
   const Vector3d p0(2, 2, 2), p1(1.12, 0.8, 0.8);
-  const Vector3d u = (p1 - p0).normalized(), side = u.cross(Vector3d::UnitZ()).normalized(), up = u.cross(side);
+  const Vector3d u = (p1 - p0).normalized(), side = u.cross(Vector3d::UnitZ()).normalized(),
+                 up = u.cross(side);
   const Hexahedron needle = MakeBox(p0, u, side, up, (p1 - p0).norm(), 0.005, 0.005);
   const CollisionResult r = Collide(needle, cube);
   EXPECT_EQ(r.verdict, Verdict::kSeparate) << static_cast<int>(r.decider);
@@ -173,12 +179,15 @@ TEST(Collide, NearParallelEdgesJustOutsideTheBandGetTheExactVerdict) {
   for (double scale : {1e-3, 1.0, 1e4}) {
     for (int i = 0; i < 2000; ++i) {
       const bool apart = i % 2 == 0;
-      const reference::Pair p = gen.NearParallelEdges(scale, (apart ? 1 : -1) * k(gen.rng()) * 1e-9);
+      const reference::Pair p =
+          gen.NearParallelEdges(scale, (apart ? 1 : -1) * k(gen.rng()) * 1e-9);
       const CollisionResult r = Collide(p.a.hex, p.b.hex);
       ASSERT_NE(r.verdict, Verdict::kInvalid);
       ++pairs;
       if ((r.verdict == Verdict::kCollide) == apart) {
-        if (++wrong < 5) ADD_FAILURE() << "scale " << scale << " pair " << i << (apart ? " apart" : " overlapping");
+        if (++wrong < 5)
+          ADD_FAILURE() << "scale " << scale << " pair " << i
+                        << (apart ? " apart" : " overlapping");
       }
     }
   }
@@ -192,13 +201,17 @@ TEST(Hexahedron, SmallSolidsFarFromTheOriginAreAnsweredAndDegenerateOnesRefusedW
   std::mt19937_64 rng(seed);
   for (int i = 0; i < 500; ++i) {
     const Vector3d at = 1e4 * reference::RandomRotation(rng).col(0);
-    const reference::Solid g = reference::General(at, reference::RandomShear(rng, 0.5), Vector3d(5e-4, 3e-4, 4e-4), 0.7);
+    const reference::Solid g =
+        reference::General(at, reference::RandomShear(rng, 0.5), Vector3d(5e-4, 3e-4, 4e-4), 0.7);
     ASSERT_TRUE(g.hex.valid) << i << ": " << HexProblemName(g.hex.problem);
-    const reference::Solid b = reference::Box(at, reference::RandomRotation(rng), Vector3d(5e-4, 2e-4, 3e-4));
+    const reference::Solid b =
+        reference::Box(at, reference::RandomRotation(rng), Vector3d(5e-4, 2e-4, 3e-4));
     ASSERT_TRUE(b.hex.valid) << i << ": " << HexProblemName(b.hex.problem);
     // A copy moved by 2 x its size is separate; by a tenth of it, collides.
-    const reference::Solid far = reference::Box(at + Vector3d(2e-3, 0, 0), reference::RandomRotation(rng), Vector3d(5e-4, 2e-4, 3e-4));
-    const reference::Solid near = reference::Box(at + Vector3d(1e-4, 0, 0), reference::RandomRotation(rng), Vector3d(5e-4, 2e-4, 3e-4));
+    const reference::Solid far = reference::Box(
+        at + Vector3d(2e-3, 0, 0), reference::RandomRotation(rng), Vector3d(5e-4, 2e-4, 3e-4));
+    const reference::Solid near = reference::Box(
+        at + Vector3d(1e-4, 0, 0), reference::RandomRotation(rng), Vector3d(5e-4, 2e-4, 3e-4));
     EXPECT_EQ(Collide(b.hex, far.hex).verdict, Verdict::kSeparate);
     EXPECT_EQ(Collide(b.hex, near.hex).verdict, Verdict::kCollide);
   }
@@ -206,13 +219,17 @@ TEST(Hexahedron, SmallSolidsFarFromTheOriginAreAnsweredAndDegenerateOnesRefusedW
   for (const Vector3d& at : {Vector3d(0, 0, 0), Vector3d(1e4, -1e4, 1e4)}) {
     std::array<Vector3d, 8> cube;
     for (int i = 0; i < 8; ++i)
-      cube[i] = at + 1e-3 * Vector3d(reference::kVertexSigns[i][0], reference::kVertexSigns[i][1], reference::kVertexSigns[i][2]);
+      cube[i] = at + 1e-3 * Vector3d(reference::kVertexSigns[i][0], reference::kVertexSigns[i][1],
+                                     reference::kVertexSigns[i][2]);
     EXPECT_EQ(FromVertices(cube).problem, HexProblem::kNone);
     auto flat = cube;
     for (auto& v : flat) v.z() = at.z();
     EXPECT_EQ(FromVertices(flat).problem, HexProblem::kDegenerateFace);
-    auto thin = cube;  // 1e-18 thick: below what rounding resolves at 1e4 ft (and 1e-9 x scale at 0)
-    for (int i = 0; i < 8; ++i) thin[i].z() = at.z() + (reference::kVertexSigns[i][2] > 0 ? 1e-18 * std::max(1.0, at.norm()) : 0.0);
+    auto thin =
+        cube;  // 1e-18 thick: below what rounding resolves at 1e4 ft (and 1e-9 x scale at 0)
+    for (int i = 0; i < 8; ++i)
+      thin[i].z() =
+          at.z() + (reference::kVertexSigns[i][2] > 0 ? 1e-18 * std::max(1.0, at.norm()) : 0.0);
     const HexProblem tp = FromVertices(thin).problem;
     EXPECT_TRUE(tp == HexProblem::kFlat || tp == HexProblem::kDegenerateFace) << HexProblemName(tp);
     auto twisted = cube;
@@ -228,10 +245,15 @@ TEST(Hexahedron, SmallSolidsFarFromTheOriginAreAnsweredAndDegenerateOnesRefusedW
     huge[5] = Vector3d(1e200, 0, 0);
     EXPECT_EQ(FromVertices(huge).problem, HexProblem::kOverflow);
   }
-  EXPECT_STREQ(HexProblemName(HexProblem::kNonConvex), "not convex: a vertex beyond a face's plane");
-  EXPECT_EQ(MakeBox(Vector3d::Zero(), Vector3d::UnitX(), Vector3d::UnitY(), Vector3d::UnitZ(), 0.0, 1, 1).problem,
-            HexProblem::kBadDimension);
-  EXPECT_EQ(MakeBox(Vector3d(1e4, 0, 0), Vector3d::UnitX(), Vector3d::UnitY(), Vector3d::UnitZ(), 1e-14, 1, 1).problem,
+  EXPECT_STREQ(HexProblemName(HexProblem::kNonConvex),
+               "not convex: a vertex beyond a face's plane");
+  EXPECT_EQ(
+      MakeBox(Vector3d::Zero(), Vector3d::UnitX(), Vector3d::UnitY(), Vector3d::UnitZ(), 0.0, 1, 1)
+          .problem,
+      HexProblem::kBadDimension);
+  EXPECT_EQ(MakeBox(Vector3d(1e4, 0, 0), Vector3d::UnitX(), Vector3d::UnitY(), Vector3d::UnitZ(),
+                    1e-14, 1, 1)
+                .problem,
             HexProblem::kFlat);
 }
 

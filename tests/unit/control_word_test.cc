@@ -1,7 +1,8 @@
+#include "rms/wire/control_word.h"
+
 #include <gtest/gtest.h>
 
 #include "rms/base/check.h"
-#include "rms/wire/control_word.h"
 
 namespace rms {
 namespace {
@@ -43,7 +44,8 @@ TEST(ControlWord, FieldsLandInTheDocumentedBits) {
   EXPECT_EQ(wire::PackControlWord(cw), (1u << 8) | (0x5u << 14) | (0x7Fu << 17));
   cw = {};
   cw.collision = cw.receptacle_collision = cw.acquired = cw.reset = cw.overlay = true;
-  EXPECT_EQ(wire::PackControlWord(cw), (1u << 8) | (1u << 10) | (1u << 11) | (1u << 12) | (1u << 3) | (1u << 4));
+  EXPECT_EQ(wire::PackControlWord(cw),
+            (1u << 8) | (1u << 10) | (1u << 11) | (1u << 12) | (1u << 3) | (1u << 4));
   cw = {};
   cw.crosshairs = true;
   EXPECT_EQ(wire::PackControlWord(cw), (1u << 8) | (1u << 5));

@@ -1,14 +1,14 @@
-#include <gtest/gtest.h>
+#include "rms/base/counters.h"
 
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
+#include <gtest/gtest.h>
 #include <random>
 #include <regex>
 #include <set>
 #include <sstream>
 
-#include "rms/base/counters.h"
 #include "rms/session/session_summary.h"
 #include "rms/wire/collision_bits.h"
 #include "rms/wire/frame_receiver.h"
@@ -54,7 +54,8 @@ TEST(SequenceTracker, AFarFutureFrameCannotLockTheStream) {
   wire::SequenceTracker none;
   EXPECT_EQ(none.Accept(forged), V::kFirst);  // nothing to tell it by yet
   std::int64_t f = 200;
-  for (int i = 1; i < wire::SequenceTracker::kResyncAfter; ++i) EXPECT_EQ(none.Accept(f++), V::kStale) << i;
+  for (int i = 1; i < wire::SequenceTracker::kResyncAfter; ++i)
+    EXPECT_EQ(none.Accept(f++), V::kStale) << i;
   EXPECT_EQ(none.Accept(f), V::kResync);
   EXPECT_EQ(none.last(), f);
   EXPECT_EQ(none.Accept(f + 1), V::kNext);
@@ -80,7 +81,8 @@ TEST(LateFrameFilter, DropsWhatWaitedBeyondTheLinksDelayAndFollowsAClockOffset) 
   std::int64_t now = 50'000'000;
   for (int i = 0; i < 60; ++i, now += 33333) EXPECT_FALSE(late.TooLate(now - offset - 1500, now));
   // Stopped for 8 s: the queued frames are 8 s (down to 0.2 s) old when handled.
-  for (int i = 0; i < 234; ++i) EXPECT_TRUE(late.TooLate(now - offset - 8'000'000 + i * 33333, now)) << i;
+  for (int i = 0; i < 234; ++i)
+    EXPECT_TRUE(late.TooLate(now - offset - 8'000'000 + i * 33333, now)) << i;
   EXPECT_FALSE(late.TooLate(now - offset - 2000, now));
   // Jitter within the limit passes.
   EXPECT_FALSE(late.TooLate(now - offset - 90000, now));
@@ -130,7 +132,8 @@ TEST(Counters, TheTableNamesEveryCounterOnceAndTheDocsListIt) {
   std::set<std::string_view> names;
   for (const CounterInfo& info : kCounterTable) {
     EXPECT_TRUE(names.insert(info.name).second) << info.name;
-    EXPECT_TRUE(std::regex_match(std::string(info.name), std::regex("[a-z_]+(\\.[a-z0-9_-]+)*"))) << info.name;
+    EXPECT_TRUE(std::regex_match(std::string(info.name), std::regex("[a-z_]+(\\.[a-z0-9_-]+)*")))
+        << info.name;
     EXPECT_FALSE(info.processes.empty()) << info.name;
     EXPECT_FALSE(info.meaning.empty()) << info.name;
     EXPECT_EQ(CounterNamed(info.name), info.id);
@@ -143,7 +146,8 @@ TEST(Counters, TheTableNamesEveryCounterOnceAndTheDocsListIt) {
   std::stringstream docs;
   docs << f.rdbuf();
   EXPECT_NE(docs.str().find(CounterTableMarkdown()), std::string::npos)
-      << "docs/sessions.md \"Process counters\" is not the table: build/tools/rms_session counters prints it";
+      << "docs/sessions.md \"Process counters\" is not the table: build/tools/rms_session counters "
+         "prints it";
 }
 
 }  // namespace
@@ -160,8 +164,8 @@ TEST(SequenceTracker, ReorderedFramesAreCountedMissingThenDroppedAsStale) {
   std::vector<wire::SequenceTracker::Verdict> v;
   for (std::int64_t f : {10, 11, 13, 12, 14, 16, 15, 15, 17}) v.push_back(t.Accept(f));
   using V = wire::SequenceTracker::Verdict;
-  EXPECT_EQ(v, (std::vector<V>{V::kFirst, V::kNext, V::kGap, V::kStale, V::kNext, V::kGap, V::kStale, V::kStale,
-                               V::kNext}));
+  EXPECT_EQ(v, (std::vector<V>{V::kFirst, V::kNext, V::kGap, V::kStale, V::kNext, V::kGap,
+                               V::kStale, V::kStale, V::kNext}));
   EXPECT_EQ(t.received(), 6);  // 10 11 13 14 16 17
   EXPECT_EQ(t.missing(), 2);   // 12 and 15, overtaken
   EXPECT_EQ(t.stale(), 3);
@@ -176,7 +180,8 @@ namespace {
 // summary trusts"): the longest increasing run, so forgeries far ahead or
 // behind fall off it while gaps (frames lost) and restarts stay on it.
 TEST(LongestIncreasingRun, KeepsTheRealSequenceAndDropsForgeriesAheadAndBehind) {
-  const std::vector<std::int64_t> frames = {0, 1, 2, 500000, 500001, 3, 4, 7, 8, 1, 2, 9, 10, 10, 11};
+  const std::vector<std::int64_t> frames = {0, 1, 2, 500000, 500001, 3,  4, 7,
+                                            8, 1, 2, 9,      10,     10, 11};
   const std::vector<std::size_t> run = session::LongestIncreasingRun(frames);
   std::vector<std::int64_t> kept;
   for (std::size_t i : run) kept.push_back(frames[i]);

@@ -3,20 +3,20 @@
 // frames, resets, the finger against the bar, Mode 3 over the bay, refused
 // inputs and checkpoints. Each of these failed before the motion test, the
 // edge-triggered reset and the essential contact were built.
-#include <gtest/gtest.h>
-
 #include <cmath>
 #include <fstream>
+#include <gtest/gtest.h>
 #include <sstream>
 
-#include "dcp_fixture.h"
-#include "rms/dynamics_proc/dcp_models.h"
-#include "rms/dynamics_proc/dynamic_collision_program.h"
-#include "rms/mission/mission_plan.h"
-#include "rms/mission/arm_ik.h"
 #include "rms/base/check.h"
 #include "rms/base/config.h"
+#include "rms/dynamics_proc/dcp_models.h"
+#include "rms/dynamics_proc/dynamic_collision_program.h"
+#include "rms/mission/arm_ik.h"
+#include "rms/mission/mission_plan.h"
 #include "rms/scene_model/scene_model.h"
+
+#include "dcp_fixture.h"
 
 namespace rms::dynamics_proc {
 namespace {
@@ -62,7 +62,8 @@ TEST_F(DcpEdges, AFastCommandThroughTheBarBetweenTwoFramesIsHeld) {
   EXPECT_TRUE(dcp.status().held);
   EXPECT_TRUE(dcp.status().motion_collision);
   EXPECT_GT(dcp.status().substeps, 1);
-  EXPECT_TRUE(dcp.status().collisions & (wire::collision_bits::kRecptMask | wire::collision_bits::kEffHexBarPost));
+  EXPECT_TRUE(dcp.status().collisions &
+              (wire::collision_bits::kRecptMask | wire::collision_bits::kEffHexBarPost));
   EXPECT_TRUE(out.control.collision);  // a finger striking the bar is detrimental
   for (int i = 0; i < 6; ++i) EXPECT_EQ(dcp.status().slave.angles_deg[i], left.value[i]);
 }
@@ -93,7 +94,8 @@ TEST_F(DcpEdges, TheBarsPostsAreCollisionModels) {
     post_hit = dcp.status().collisions & wire::collision_bits::kEffHexBarPost;
   }
   EXPECT_TRUE(post_hit);
-  EXPECT_FALSE(dcp.status().collisions & wire::collision_bits::kRecptMask) << "the bar itself is not touched";
+  EXPECT_FALSE(dcp.status().collisions & wire::collision_bits::kRecptMask)
+      << "the bar itself is not touched";
   EXPECT_TRUE(dcp.status().held);
 }
 
@@ -121,12 +123,15 @@ TEST_F(DcpEdges, InMode3ThePayloadCannotBeLoweredBackThroughTheBayWalls) {
   // Lifted clear (Mode 3), moved 2 ft outboard of the starboard wall,
   // lowered 6 ft: the vertices over the wall stop at the sill.
   DynamicCollisionProgram dcp(config);
-  const double r = scene_model::PayloadTopFlat_P(config.payload);  // the 16-gon's flats from its axis
+  const double r =
+      scene_model::PayloadTopFlat_P(config.payload);  // the 16-gon's flats from its axis
   const double lift = -(config.payload.p_RoPo_R_ft.z() - r) + 0.5;
   AcquireAndMove(&dcp, Vector3d(0, 0, lift));
   ASSERT_EQ(dcp.mode(), 3);
   const Vector3d over_wall(0, 0.5 * config.shuttle.bay_width_ft - r + 2.0, lift);
-  for (int f = 1; f <= 40; ++f) dcp.Step(Inputs(Shifted(geo.X_RS2_grasp, over_wall * f / 40 + Vector3d(0, 0, lift) * (1 - f / 40.0)), 1.0));
+  for (int f = 1; f <= 40; ++f)
+    dcp.Step(Inputs(
+        Shifted(geo.X_RS2_grasp, over_wall * f / 40 + Vector3d(0, 0, lift) * (1 - f / 40.0)), 1.0));
   ASSERT_FALSE(dcp.status().held);
   int held = 0;
   for (int f = 1; f <= 40; ++f) {
@@ -174,7 +179,8 @@ TEST_F(DcpEdges, AResetWhoseArmPoseWouldCollideIsRefused) {
   EXPECT_EQ(dcp.mode(), 2);
   EXPECT_TRUE(dcp.status().acquired);
   // Up 1 ft first: the reset is taken.
-  for (int f = 1; f <= 14; ++f) dcp.Step(Inputs(Shifted(geo.X_RS2_grasp, Vector3d(0, 0, -0.4 + 0.1 * f)), 1.0));
+  for (int f = 1; f <= 14; ++f)
+    dcp.Step(Inputs(Shifted(geo.X_RS2_grasp, Vector3d(0, 0, -0.4 + 0.1 * f)), 1.0));
   in = Inputs(Shifted(geo.X_RS2_grasp, Vector3d(0, 0, 1.0)), 1.0);
   in.reset = true;
   dcp.Step(in);
@@ -192,12 +198,15 @@ TEST_F(DcpEdges, TheFingerStopsAtTheBarAndAcquisitionNeedsItThere) {
   for (int i = 0; i < 6; ++i) EXPECT_TRUE(dcp.status().acquisition[i]) << i;
   // Closing on: acquisition when the finger reaches the bar, and the finger
   // never closes into it.
-  for (int f = 1; f <= 30 && dcp.mode() == 1; ++f) dcp.Step(Inputs(geo.X_RS2_grasp, Lever(0.55) + f * 0.01));
+  for (int f = 1; f <= 30 && dcp.mode() == 1; ++f)
+    dcp.Step(Inputs(geo.X_RS2_grasp, Lever(0.55) + f * 0.01));
   ASSERT_EQ(dcp.mode(), 2);
   const Hexahedron bar = MakeBar(config.payload, X_RP_bay());
-  const EndEffectorModel ee = MakeEndEffector(config.end_effector, dcp.status().X_RS2, dcp.status().finger_gap_ft);
+  const EndEffectorModel ee =
+      MakeEndEffector(config.end_effector, dcp.status().X_RS2, dcp.status().finger_gap_ft);
   double least = 1e9;
-  for (int i = 0; i < 8; ++i) least = std::min(least, ee.hex[2].Beyond(kFaceE, bar.x[i], bar.y[i], bar.z[i]));
+  for (int i = 0; i < 8; ++i)
+    least = std::min(least, ee.hex[2].Beyond(kFaceE, bar.x[i], bar.y[i], bar.z[i]));
   EXPECT_GE(least, -kFingerContactToleranceFt);
   EXPECT_LE(least, kFingerContactToleranceFt);
 }
@@ -224,7 +233,8 @@ TEST_F(DcpEdges, TheFingerClosingOnTheBarIsEssentialAndThePalmStrikingItIsDetrim
   DynamicCollisionProgram palm(config);
   bool struck = false;
   for (int f = 0; f <= 30 && !struck; ++f) {
-    const wire::DcpFrameData out = palm.Step(Inputs(Shifted(geo.X_RS2_grasp, 0.3 * X2 * f / 30), 0.0));
+    const wire::DcpFrameData out =
+        palm.Step(Inputs(Shifted(geo.X_RS2_grasp, 0.3 * X2 * f / 30), 0.0));
     if (palm.status().collisions & wire::collision_bits::kEffHexRecpt) {
       struck = true;
       EXPECT_TRUE(out.control.collision);
@@ -244,7 +254,8 @@ TEST_F(DcpEdges, OpeningTheFingerBeforeDockingLetsThePayloadGoWhereItIs) {
   EXPECT_EQ(dcp.mode(), 1);
   EXPECT_FALSE(dcp.status().acquired);
   // The arm moves away; the payload stays.
-  for (int f = 1; f <= 20; ++f) dcp.Step(Inputs(Shifted(geo.X_RS2_grasp, Vector3d(0, 0, 1.0 + 0.1 * f)), 0.0));
+  for (int f = 1; f <= 20; ++f)
+    dcp.Step(Inputs(Shifted(geo.X_RS2_grasp, Vector3d(0, 0, 1.0 + 0.1 * f)), 0.0));
   EXPECT_LT((dcp.X_RP().translation() - held_at).norm(), 1e-9);
 }
 
@@ -272,7 +283,8 @@ TEST_F(DcpEdges, ACheckpointMissingItsLastKeyLeavesTheStateUnchanged) {
   nlohmann::json cp = nlohmann::json::parse(saved.SaveState().dump());
   cp.erase("planes_ee_body");
   DynamicCollisionProgram other(config);
-  for (int f = 0; f <= 10; ++f) other.Step(Inputs(Shifted(geo.X_RS2_grasp, Vector3d(-3, 0, 3)), 0.2));
+  for (int f = 0; f <= 10; ++f)
+    other.Step(Inputs(Shifted(geo.X_RS2_grasp, Vector3d(-3, 0, 3)), 0.2));
   const std::string before = other.SaveState().dump();
   const int mode = other.mode();
   EXPECT_THROW(other.RestoreState(cp), InputError);
@@ -286,11 +298,12 @@ TEST_F(DcpEdges, ACheckpointMissingItsLastKeyLeavesTheStateUnchanged) {
   // States the program could not reach: refused, nothing changed.
   const nlohmann::json good = nlohmann::json::parse(saved.SaveState().dump());
   std::vector<nlohmann::json> bad(5, good);
-  bad[0]["acquired"] = false;                              // Mode 2 without acquisition
-  bad[1]["contact_gap_ft"] = 2.0;                          // above the gap at acquisition
-  bad[2]["X_S2P"][0] = 2.0;                                // not a rigid pose
-  bad[3]["slave"]["angles_deg"][1] = good["slave"]["angles_deg"][1].get<double>() - 30.0;  // the palm in the bay
-  bad[4]["released"] = true;                               // released, not docked
+  bad[0]["acquired"] = false;      // Mode 2 without acquisition
+  bad[1]["contact_gap_ft"] = 2.0;  // above the gap at acquisition
+  bad[2]["X_S2P"][0] = 2.0;        // not a rigid pose
+  bad[3]["slave"]["angles_deg"][1] =
+      good["slave"]["angles_deg"][1].get<double>() - 30.0;  // the palm in the bay
+  bad[4]["released"] = true;                                // released, not docked
   for (std::size_t i = 0; i < bad.size(); ++i) {
     try {
       other.RestoreState(bad[i]);
@@ -334,7 +347,10 @@ TEST(DcpModels, WhatIsTestedIsWhatIsDrawn) {
     int cluster;
     std::vector<const Hexahedron*> tested;
   };
-  std::vector<Part> parts = {{scene_model::kPayloadBody, {}}, {scene_model::kBar, {&bar}}, {scene_model::kBarPostA, {&posts[0]}}, {scene_model::kBarPostB, {&posts[1]}}};
+  std::vector<Part> parts = {{scene_model::kPayloadBody, {}},
+                             {scene_model::kBar, {&bar}},
+                             {scene_model::kBarPostA, {&posts[0]}},
+                             {scene_model::kBarPostB, {&posts[1]}}};
   for (const Hexahedron& s : payload.body) parts[0].tested.push_back(&s);
   for (const Part& part : parts) {
     double worst = 0;
@@ -342,11 +358,13 @@ TEST(DcpModels, WhatIsTestedIsWhatIsDrawn) {
       for (const Eigen::Vector3f* v : {&t.a, &t.b, &t.c}) {
         // The union's surface: outside all (distance to the nearest) or inside one.
         double d = 1e30;
-        for (const Hexahedron* h : part.tested) d = std::min(d, SurfaceDistance(*h, v->cast<double>()));
+        for (const Hexahedron* h : part.tested)
+          d = std::min(d, SurfaceDistance(*h, v->cast<double>()));
         worst = std::max(worst, std::abs(d));
       }
     }
-    std::printf("%s: drawn vs tested, worst %.2g ft\n", std::string(scene_model::ClusterName(part.cluster)).c_str(), worst);
+    std::printf("%s: drawn vs tested, worst %.2g ft\n",
+                std::string(scene_model::ClusterName(part.cluster)).c_str(), worst);
     EXPECT_LE(worst, 0.05) << scene_model::ClusterName(part.cluster);
   }
 }

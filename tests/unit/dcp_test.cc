@@ -1,29 +1,29 @@
 // The Dynamic Collision Program's phases (report IV.A.3) and its collision
 // response, frame by frame in process.
-#include <gtest/gtest.h>
-
-#include <cstdio>
-#include <random>
+#include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <gtest/gtest.h>
+#include <random>
 #include <sstream>
-#include <unistd.h>
 
-#include "dcp_fixture.h"
-#include "rms/dynamics_proc/dcp_models.h"
-#include "rms/dynamics_proc/dynamic_collision_program.h"
-#include "rms/mission/mission_plan.h"
-#include "rms/mission/arm_ik.h"
 #include "rms/base/check.h"
-#include "rms/wire/checkpoint.h"
 #include "rms/base/config.h"
 #include "rms/dcp_frame_t.hpp"
-#include "rms/scene_model/scene_model.h"
-#include "rms/wire/word_blocks.h"
+#include "rms/dynamics_proc/dcp_models.h"
+#include "rms/dynamics_proc/dynamic_collision_program.h"
+#include "rms/mission/arm_ik.h"
+#include "rms/mission/mission_plan.h"
 #include "rms/operator_station/timeline.h"
+#include "rms/scene_model/scene_model.h"
+#include "rms/wire/checkpoint.h"
+#include "rms/wire/word_blocks.h"
+
+#include "dcp_fixture.h"
 
 namespace rms::dynamics_proc {
 namespace {
@@ -84,14 +84,17 @@ TEST_F(Dcp, EachConditionsMarginAgreesWithItAndIsADistance) {
   int checked = 0;
   for (int k = 0; k < 2000; ++k) {
     Isometry3d X = Shifted(G, Vector3d(0.6 * u(rng), 0.4 * u(rng), 0.8 * u(rng)));
-    X.linear() = X.linear() * Eigen::AngleAxisd(0.1 * u(rng), Vector3d(u(rng), u(rng), u(rng)).normalized()).toRotationMatrix();
+    X.linear() =
+        X.linear() * Eigen::AngleAxisd(0.1 * u(rng), Vector3d(u(rng), u(rng), u(rng)).normalized())
+                         .toRotationMatrix();
     const double gap = 0.45 + 0.3 * (u(rng) + 1) / 2;
     const AcquisitionCheck c = Check(X, gap);
     for (int i = 0; i < 6; ++i) {
       if (std::abs(c.margin_ft[i]) < 1e-9) continue;
       // Condition 3 allows the bar within the contact tolerance behind face e.
       const double threshold = i == 2 ? -kFingerContactToleranceFt : 0.0;
-      EXPECT_EQ(c.holds[i], c.margin_ft[i] > threshold) << "pose " << k << " condition " << i + 1 << " margin " << c.margin_ft[i];
+      EXPECT_EQ(c.holds[i], c.margin_ft[i] > threshold)
+          << "pose " << k << " condition " << i + 1 << " margin " << c.margin_ft[i];
       ++checked;
     }
   }
@@ -100,7 +103,8 @@ TEST_F(Dcp, EachConditionsMarginAgreesWithItAndIsADistance) {
   const Vector3d X2 = G.linear().col(0);
   const AcquisitionCheck a = Check(G, 0.55), b = Check(Shifted(G, -0.1 * X2), 0.55);
   EXPECT_NEAR(a.margin_ft[4] - b.margin_ft[4], 0.1, 1e-9);
-  EXPECT_NEAR(b.margin_ft[0] - a.margin_ft[0], 0.1, 1e-9);  // condition 1: the BAR further beyond face d
+  EXPECT_NEAR(b.margin_ft[0] - a.margin_ft[0], 0.1,
+              1e-9);  // condition 1: the BAR further beyond face d
   // Condition 5 is a distance: the BAR far behind the palm is not within TPOB.
   const AcquisitionCheck far = Check(Shifted(G, 20.0 * X2), 0.55);
   EXPECT_LT(far.palm_to_bar_ft, -19.0);
@@ -129,15 +133,18 @@ TEST_F(Dcp, DockingNeedsTheEnvelopeTheDistanceAndTheAngle) {
   Isometry3d tilted = geo.X_RP_dock;
   const Vector3d tip = config.cae.p_RoCo_R_ft - 0.05 * yC;
   tilted.linear() = Eigen::AngleAxisd(3.0 * M_PI / 180, side).toRotationMatrix() * tilted.linear();
-  tilted.translation() = tip + Eigen::AngleAxisd(3.0 * M_PI / 180, side).toRotationMatrix() * (geo.X_RP_dock.translation() - tip);
+  tilted.translation() = tip + Eigen::AngleAxisd(3.0 * M_PI / 180, side).toRotationMatrix() *
+                                   (geo.X_RP_dock.translation() - tip);
   const DockingCheck tilt = check(tilted);
   EXPECT_NEAR(tilt.angle_deg, 3.0, 1e-6);
   EXPECT_LT(tilt.distance_ft, 0.25);
   EXPECT_FALSE(tilt.docked);
   // 2 deg passes.
   Isometry3d tilted2 = geo.X_RP_dock;
-  tilted2.linear() = Eigen::AngleAxisd(2.0 * M_PI / 180, side).toRotationMatrix() * tilted2.linear();
-  tilted2.translation() = tip + Eigen::AngleAxisd(2.0 * M_PI / 180, side).toRotationMatrix() * (geo.X_RP_dock.translation() - tip);
+  tilted2.linear() =
+      Eigen::AngleAxisd(2.0 * M_PI / 180, side).toRotationMatrix() * tilted2.linear();
+  tilted2.translation() = tip + Eigen::AngleAxisd(2.0 * M_PI / 180, side).toRotationMatrix() *
+                                    (geo.X_RP_dock.translation() - tip);
   EXPECT_TRUE(check(tilted2).docked);
   // Beyond face c (the probe's tip inside the CAE): out of the envelope.
   EXPECT_FALSE(check(Shifted(geo.X_RP_dock, 0.2 * yC)).in_envelope);
@@ -147,20 +154,23 @@ TEST_F(Dcp, TheShippedMissionTimelineIsThePlannersForTheDefaultConfig) {
   std::ifstream f(std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl");
   std::stringstream ss;
   ss << f.rdbuf();
-  EXPECT_EQ(ss.str(), mission::FormatTimeline(mission::PlanMission(config), mission::kMissionHeader))
+  EXPECT_EQ(ss.str(),
+            mission::FormatTimeline(mission::PlanMission(config), mission::kMissionHeader))
       << "regenerate: build/tools/rms_mission --out scripts/timelines/mission.tl";
 }
 
 TEST_F(Dcp, TheMissionTimelineAcquiresExtractsAndDocks) {
   const std::string text = mission::FormatTimeline(mission::PlanMission(config), "");
-  const operator_station::Timeline tl = operator_station::Timeline::Parse(text, "mission", config.inputs);
+  const operator_station::Timeline tl =
+      operator_station::Timeline::Parse(text, "mission", config.inputs);
   DynamicCollisionProgram dcp(config);
   std::vector<int> modes;
   int frames = 0;
   for (double t = 0; t <= tl.end_time(); t += 1.0 / 30.0, ++frames) {
     const wire::DcpFrameData out = dcp.Step(tl.Sample(t));
     if (modes.empty() || modes.back() != out.control.mode) modes.push_back(out.control.mode);
-    EXPECT_EQ(dcp.status().slave_collisions, 0u) << "the slave never stands in collision, t = " << t;
+    EXPECT_EQ(dcp.status().slave_collisions, 0u)
+        << "the slave never stands in collision, t = " << t;
     EXPECT_EQ(dcp.status().collisions, 0u) << "the planned mission never collides, t = " << t;
   }
   EXPECT_EQ(modes, (std::vector<int>{1, 2, 3}));
@@ -190,18 +200,22 @@ TEST_F(Dcp, ACollisionHoldsTheSlaveAtContactAndReleasesIt) {
     // The slave's end effector never penetrates the body.
     const EndEffectorModel ee = MakeEndEffector(config.end_effector, st.X_RS2, st.finger_gap_ft);
     for (const Hexahedron& h : ee.hex)
-      for (const Hexahedron& strip : payload.body) ASSERT_NE(Collide(h, strip).verdict, Verdict::kCollide) << "frame " << f;
+      for (const Hexahedron& strip : payload.body)
+        ASSERT_NE(Collide(h, strip).verdict, Verdict::kCollide) << "frame " << f;
     lowest = std::min(lowest, st.X_RS2.translation().z());
   }
   EXPECT_GT(held, 30);
   // Contact: the fingers' tips stopped within one frame's travel of the body's top.
-  const double finger_tip = lowest - config.end_effector.palm_length_ft - config.end_effector.finger_length_ft;
-  const double body_top = config.payload.p_RoPo_R_ft.z() + scene_model::PayloadTopFlat_P(config.payload);  // the 16-gon's top flat
+  const double finger_tip =
+      lowest - config.end_effector.palm_length_ft - config.end_effector.finger_length_ft;
+  const double body_top = config.payload.p_RoPo_R_ft.z() +
+                          scene_model::PayloadTopFlat_P(config.payload);  // the 16-gon's top flat
   EXPECT_GT(finger_tip, body_top);
   EXPECT_LT(finger_tip, body_top + 5.0 / 90 + 1e-6);
   // Released: back above, the slave follows the master exactly.
   EXPECT_FALSE(dcp.status().held);
-  for (int i = 0; i < 6; ++i) EXPECT_EQ(dcp.status().slave.angles_deg[i], dcp.status().master.angles_deg[i]);
+  for (int i = 0; i < 6; ++i)
+    EXPECT_EQ(dcp.status().slave.angles_deg[i], dcp.status().master.angles_deg[i]);
 }
 
 TEST_F(Dcp, TheFingerStopsOnTheBarWhileTheArmFollows) {
@@ -243,7 +257,8 @@ TEST_F(Dcp, InMode2APayloadVertexBeyondABayWallHoldsTheArm) {
     }
   }
   EXPECT_GT(held, 10);
-  EXPECT_LT(dcp.status().X_RP.translation().y() + scene_model::PayloadTopFlat_P(config.payload),  // the 16-gon's side flat
+  EXPECT_LT(dcp.status().X_RP.translation().y() +
+                scene_model::PayloadTopFlat_P(config.payload),  // the 16-gon's side flat
             0.5 * config.shuttle.bay_width_ft + 1e-9);
   EXPECT_EQ(dcp.mode(), 2);
 }
@@ -252,7 +267,8 @@ TEST_F(Dcp, ResetReturnsToMode1AndTheInitialState) {
   DynamicCollisionProgram dcp(config);
   for (int f = 0; f <= 30; ++f) dcp.Step(Inputs(geo.X_RS2_grasp, f / 30.0));
   ASSERT_EQ(dcp.mode(), 2);
-  for (int f = 1; f <= 30; ++f) dcp.Step(Inputs(Shifted(geo.X_RS2_grasp, Vector3d(0, 0, 0.2 * f)), 1.0));
+  for (int f = 1; f <= 30; ++f)
+    dcp.Step(Inputs(Shifted(geo.X_RS2_grasp, Vector3d(0, 0, 0.2 * f)), 1.0));
   ASSERT_GT(dcp.X_RP().translation().z(), config.payload.p_RoPo_R_ft.z() + 5.0);
   wire::OperatorInputs in = Inputs(Shifted(geo.X_RS2_grasp, Vector3d(0, 0, 6)), 0.0);
   in.reset = true;
@@ -268,7 +284,8 @@ TEST_F(Dcp, ACheckpointRestoresTheStateExactly) {
   // At every phase of the mission: save, go on; restore into a fresh DCP and
   // go on with the same inputs: the same outputs, word for word.
   const std::string text = mission::FormatTimeline(mission::PlanMission(config), "");
-  const operator_station::Timeline tl = operator_station::Timeline::Parse(text, "mission", config.inputs);
+  const operator_station::Timeline tl =
+      operator_station::Timeline::Parse(text, "mission", config.inputs);
   std::vector<wire::OperatorInputs> inputs;
   for (double t = 0; t <= tl.end_time(); t += 1.0 / 30.0) inputs.push_back(tl.Sample(t));
   for (std::size_t at : {std::size_t{100}, std::size_t{500}, std::size_t{800}, std::size_t{1300}}) {
@@ -283,13 +300,17 @@ TEST_F(Dcp, ACheckpointRestoresTheStateExactly) {
     restored.RestoreState(saved);
     EXPECT_EQ(restored.mode(), live.mode()) << "at frame " << at;
     for (int i = 0; i < 6; ++i) {
-      EXPECT_EQ(restored.status().acquisition[i], live.status().acquisition[i]) << at << " condition " << i + 1;
-      EXPECT_DOUBLE_EQ(restored.status().acquisition_margin_ft[i], live.status().acquisition_margin_ft[i]) << at;
+      EXPECT_EQ(restored.status().acquisition[i], live.status().acquisition[i])
+          << at << " condition " << i + 1;
+      EXPECT_DOUBLE_EQ(restored.status().acquisition_margin_ft[i],
+                       live.status().acquisition_margin_ft[i])
+          << at;
     }
     EXPECT_DOUBLE_EQ(restored.status().dock_distance_ft, live.status().dock_distance_ft) << at;
     EXPECT_DOUBLE_EQ(restored.status().bay_clearance_ft, live.status().bay_clearance_ft) << at;
     if (live.mode() >= 2) {
-      for (int i = 0; i < 6; ++i) EXPECT_FALSE(live.status().acquisition[i]) << "not evaluated after acquisition";
+      for (int i = 0; i < 6; ++i)
+        EXPECT_FALSE(live.status().acquisition[i]) << "not evaluated after acquisition";
     }
     for (std::size_t k = at; k < inputs.size(); ++k) {
       const wire::DcpFrameData a = live.Step(inputs[k]), b = restored.Step(inputs[k]);
@@ -298,8 +319,10 @@ TEST_F(Dcp, ACheckpointRestoresTheStateExactly) {
       wire::PackDcpFrame(b, &wb, nullptr);
       ASSERT_EQ(std::memcmp(wa.arm_words, wb.arm_words, sizeof wa.arm_words), 0) << at << "+" << k;
       ASSERT_EQ(wa.control_word, wb.control_word) << at << "+" << k;
-      ASSERT_EQ(std::memcmp(wa.state_words, wb.state_words, sizeof wa.state_words), 0) << at << "+" << k;
-      ASSERT_EQ(std::memcmp(wa.plane_words, wb.plane_words, sizeof wa.plane_words), 0) << at << "+" << k;
+      ASSERT_EQ(std::memcmp(wa.state_words, wb.state_words, sizeof wa.state_words), 0)
+          << at << "+" << k;
+      ASSERT_EQ(std::memcmp(wa.plane_words, wb.plane_words, sizeof wa.plane_words), 0)
+          << at << "+" << k;
     }
     EXPECT_TRUE(restored.status().docked);
   }
@@ -341,10 +364,13 @@ TEST(CheckpointFolderTest, NamesOnlyNewFilesNoLinksAndASizeCap) {
   fs::create_directories(root / "elsewhere");
   const wire::CheckpointFolder folder((root / "checkpoints").string());
   wire::Checkpoint c;
-  c.dcp = dynamics_proc::DynamicCollisionProgram(LoadConfig(std::string(RMSLAB_SOURCE_DIR) + "/config/rmslab.toml")).SaveState();
+  c.dcp = dynamics_proc::DynamicCollisionProgram(
+              LoadConfig(std::string(RMSLAB_SOURCE_DIR) + "/config/rmslab.toml"))
+              .SaveState();
   folder.Write("good.json", c);
   EXPECT_EQ(folder.Read("good.json").dcp, c.dcp);
-  for (const char* bad : {"../x.json", "/tmp/x.json", "a/b.json", ".hidden.json", "x.txt", "x\n.json", ""}) {
+  for (const char* bad :
+       {"../x.json", "/tmp/x.json", "a/b.json", ".hidden.json", "x.txt", "x\n.json", ""}) {
     EXPECT_THROW(folder.Write(bad, c), InputError) << bad;
     EXPECT_THROW(folder.Read(bad), InputError) << bad;
   }
@@ -352,7 +378,8 @@ TEST(CheckpointFolderTest, NamesOnlyNewFilesNoLinksAndASizeCap) {
   fs::create_symlink(root / "elsewhere" / "t.json", root / "checkpoints" / "link.json");
   EXPECT_THROW(folder.Write("link.json", c), InputError);
   EXPECT_FALSE(fs::exists(root / "elsewhere" / "t.json"));
-  std::ofstream(root / "checkpoints" / "big.json") << std::string(wire::kMaxCheckpointBytes + 1, ' ');
+  std::ofstream(root / "checkpoints" / "big.json")
+      << std::string(wire::kMaxCheckpointBytes + 1, ' ');
   EXPECT_THROW(folder.Read("big.json"), InputError);
   // The folder swapped for a link to elsewhere: refused, nothing written there.
   fs::rename(root / "checkpoints", root / "moved");

@@ -5,27 +5,28 @@
 // (hold to move, release to stop, a silent window lets go); a gamepad
 // through SDL2's virtual joystick; a 3D mouse through libspnav talking to a
 // stand-in spacenavd; clamping with a report; and the status screen.
-#include <gtest/gtest.h>
-#include <SDL2/SDL.h>
-#include <sys/socket.h>
-#include <sys/un.h>
+#include "rms/operator_station/devices.h"
+
 #include <unistd.h>
 
+#include <SDL2/SDL.h>
 #include <cstdlib>
 #include <deque>
 #include <fstream>
+#include <gtest/gtest.h>
 #include <regex>
 #include <sstream>
+#include <sys/socket.h>
+#include <sys/un.h>
 #include <thread>
 
-#include "rms/operator_station/bindings.h"
-#include "rms/operator_station/devices.h"
-#include "rms/operator_station/guidance.h"
-#include "rms/operator_station/hand_controllers.h"
 #include "rms/arm/kinematics.h"
 #include "rms/base/check.h"
 #include "rms/base/config.h"
 #include "rms/mission/mission_geometry.h"
+#include "rms/operator_station/bindings.h"
+#include "rms/operator_station/guidance.h"
+#include "rms/operator_station/hand_controllers.h"
 #include "rms/operator_station/status_screen.h"
 
 namespace rms::operator_station {
@@ -61,8 +62,9 @@ class Devices : public ::testing::Test {
     dcp_telemetry_t t{};
     t.mode = static_cast<std::int8_t>(mode);
     const Eigen::Isometry3d X = X_RS2(in);
-    const Eigen::Isometry3d P = mode == 1 ? arm::MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft)
-                                          : X * mission::PlanGeometry(config).X_S2P;
+    const Eigen::Isometry3d P =
+        mode == 1 ? arm::MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft)
+                  : X * mission::PlanGeometry(config).X_S2P;
     for (int i = 0; i < 3; ++i) {
       t.p_RoA_R_ft[i] = X.translation()[i];
       t.p_RoPo_R_ft[i] = P.translation()[i];
@@ -122,19 +124,27 @@ TEST_F(Devices, TheBindingsFileIsReadAndBadOnesAreRefusedNamingTheKey) {
   };
   const Case cases[] = {
       {"w = \"thc_x+\"", "w = \"thc_w+\"", "key 'keyboard.keys.w': unknown action \"thc_w+\""},
-      {"w = \"thc_x+\"", "w = \"shoulder_yaw+\"", "key 'keyboard.keys.w': \"shoulder_yaw+\": the arm's joints move"},
+      {"w = \"thc_x+\"", "w = \"shoulder_yaw+\"",
+       "key 'keyboard.keys.w': \"shoulder_yaw+\": the arm's joints move"},
       {"deadband = 0.12", "deadband = 1.5", "key 'conditioning.deadband': must be <= 0.9"},
       {"finger = 0.5 ", "finger = -0.5 ", "key 'conditioning.max_rate.finger': must be > 0"},
-      {"vernier_ft_s = 0.2", "vernier_ft_s = 3.0", "key 'rates.vernier_ft_s': must be less than rates.coarse_ft_s"},
-      {"mode = \"manual_augmented\"", "mode = \"auto\"", "key 'control.mode': must be \"manual_augmented\""},
-      {"frame = \"end_effector\"", "frame = \"payload\"", "key 'control.frame': must be \"end_effector\" or \"orbiter\""},
-      {"leftx = \"thc_y\"", "leftz = \"thc_y\"", "key 'gamepad.axes.leftz': is not an SDL game controller axis"},
-      {"start = \"stop\"", "start = \"quit\"", "key 'gamepad.buttons.start': quit is for the keyboards only"},
-      {"\ntx = \"thc_y\"", "\ntx = \"camera_pan\"", "key 'spacemouse.axes.tx': must name a hand-controller axis"},
+      {"vernier_ft_s = 0.2", "vernier_ft_s = 3.0",
+       "key 'rates.vernier_ft_s': must be less than rates.coarse_ft_s"},
+      {"mode = \"manual_augmented\"", "mode = \"auto\"",
+       "key 'control.mode': must be \"manual_augmented\""},
+      {"frame = \"end_effector\"", "frame = \"payload\"",
+       "key 'control.frame': must be \"end_effector\" or \"orbiter\""},
+      {"leftx = \"thc_y\"", "leftz = \"thc_y\"",
+       "key 'gamepad.axes.leftz': is not an SDL game controller axis"},
+      {"start = \"stop\"", "start = \"quit\"",
+       "key 'gamepad.buttons.start': quit is for the keyboards only"},
+      {"\ntx = \"thc_y\"", "\ntx = \"camera_pan\"",
+       "key 'spacemouse.axes.tx': must name a hand-controller axis"},
       {"full_scale = 350.0", "fullscale = 350.0", "key 'spacemouse.full_scale': missing"},
       {"coarse_ft = 5.0", "coarse_ft = 0", "key 'keyboard.increment.coarse_ft': must be > 0"},
       {"[spacemouse.buttons]", "[spacemouse.buttons]\nextra = 1", "key 'spacemouse.buttons.extra'"},
-      {"Q = \"quit\"", "Q = \"quit\"\nq = \"stop\"\n\" \" = \"stop\"", "key 'keyboard.keys. ': is not a key"},
+      {"Q = \"quit\"", "Q = \"quit\"\nq = \"stop\"\n\" \" = \"stop\"",
+       "key 'keyboard.keys. ': is not a key"},
       {"v = \"vernier\"\n", "", "key 'keyboard.keys': no key is bound to vernier"},
       {"s = \"thc_x-\"", "s = \"camera_1\"", "key 'keyboard.keys': no key is bound to thc_x-"},
       {"Q = \"quit\"\n", "", "key 'keyboard.keys': no key is bound to quit"},
@@ -144,7 +154,8 @@ TEST_F(Devices, TheBindingsFileIsReadAndBadOnesAreRefusedNamingTheKey) {
       ParseBindings(Replace(good, c.from, c.to), "bindings.toml");
       ADD_FAILURE() << "accepted: " << c.to;
     } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find("bindings.toml: " + c.message), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("bindings.toml: " + c.message), std::string::npos)
+          << e.what();
     }
   }
 }
@@ -177,10 +188,12 @@ TEST_F(Devices, ManualAugmentedMovesThePointOfResolutionAlongEachFramesAxes) {
       const Eigen::Vector3d v = (X1 * por - X0 * por) / kDt;
       const Eigen::Vector3d w = RotationVector(X1.linear() * X0.linear().transpose()) / kDt;
       Eigen::Vector3d v_want = Eigen::Vector3d::Zero(), w_want = Eigen::Vector3d::Zero();
-      if (axis < 3) v_want = R_RF.col(axis) * b.rates.coarse_ft_s;
-      else w_want = R_RF.col(axis - 3) * b.rates.coarse_deg_s * kDeg;
-      SCOPED_TRACE(std::string(CommandFrameName(c.frame)) + " frame, Mode " + std::to_string(c.mode) + ", " +
-                   std::string(kHandAxisNames[axis]));
+      if (axis < 3)
+        v_want = R_RF.col(axis) * b.rates.coarse_ft_s;
+      else
+        w_want = R_RF.col(axis - 3) * b.rates.coarse_deg_s * kDeg;
+      SCOPED_TRACE(std::string(CommandFrameName(c.frame)) + " frame, Mode " +
+                   std::to_string(c.mode) + ", " + std::string(kHandAxisNames[axis]));
       if (hc.status().rate_limited) {
         // A joint at its rate: slower, the direction kept.
         const double k = axis < 3 ? v.norm() / v_want.norm() : w.norm() / w_want.norm();
@@ -192,7 +205,8 @@ TEST_F(Devices, ManualAugmentedMovesThePointOfResolutionAlongEachFramesAxes) {
       EXPECT_LT((v - v_want).norm(), 0.01 * b.rates.coarse_ft_s);
       EXPECT_LT((w - w_want).norm(), 0.01 * b.rates.coarse_deg_s * kDeg);
       EXPECT_EQ(hc.status().frame, c.frame);
-      EXPECT_DOUBLE_EQ(hc.status().rate[axis], axis < 3 ? b.rates.coarse_ft_s : b.rates.coarse_deg_s);
+      EXPECT_DOUBLE_EQ(hc.status().rate[axis],
+                       axis < 3 ? b.rates.coarse_ft_s : b.rates.coarse_deg_s);
     }
   }
 }
@@ -296,7 +310,8 @@ TEST_F(Devices, TheLiveWindowsHeldKeysMoveAndReleasedOnesStopAtOnce) {
   std::int64_t seq = 0;
   for (int f = 0; f < 30; ++f) {
     window->SetNow(now += 33333);
-    if (f % 3 == 2) window->Receive({++seq, {'w'}, {}, true}, now);  // the window's heartbeat while held
+    if (f % 3 == 2)
+      window->Receive({++seq, {'w'}, {}, true}, now);  // the window's heartbeat while held
     in = hc.Step(kDt, &t);
   }
   EXPECT_DOUBLE_EQ(hc.status().rate[kThcX], bindings.rates.coarse_ft_s);
@@ -359,7 +374,8 @@ TEST_F(Devices, StopHoldsUntilReleasedDockedHoldsAndFrozenTakesStopAndSteps) {
   in = frame({'w'});
   for (int f = 0; f < 10; ++f) {
     const wire::OperatorInputs next = frame({'w'});
-    for (int i = 0; i < 6; ++i) EXPECT_EQ(next.value[i], in.value[i]) << "a held key acts after the stop";
+    for (int i = 0; i < 6; ++i)
+      EXPECT_EQ(next.value[i], in.value[i]) << "a held key acts after the stop";
   }
   frame({});  // let go, press again: it moves
   frame({'w'}, {'w'});
@@ -575,7 +591,8 @@ class FakeSpacenavd {
 };
 
 TEST_F(Devices, A3DMouseIsBothHandControllers) {
-  const std::string sock = ::testing::TempDir() + "/rmslab_spnav_" + std::to_string(getpid()) + ".sock";
+  const std::string sock =
+      ::testing::TempDir() + "/rmslab_spnav_" + std::to_string(getpid()) + ".sock";
   FakeSpacenavd daemon(sock);
   setenv("SPNAV_SOCKET", sock.c_str(), 1);
   std::string why;
@@ -652,13 +669,30 @@ TEST_F(Devices, TheStatusScreenShowsGuidanceMarginsAndFollowsTheWidth) {
   s.devices = {"keyboard (this terminal)", "gamepad: none (no gamepad or joystick found)"};
   for (int i = 0; i < 50; ++i) s.log.push_back("event " + std::to_string(i));
   const std::string screen = RenderStatusScreen(s, config, 120, 50);
-  for (const char* want : {"frame 001234", "MODE 1 ACQUISITION", "HELD", "eff_hex_1-payload",
-                           "[x] 1 BAR beyond palm face d", "holds by 0.250 ft", "short by 1.500 ft",
-                           "palm to BAR 20.750 ft", "finger gap 0.587 ft", "x forward 3.25 ft (w)",
-                           "y left 0.50 ft (a)", "z down 1.00 ft (f)", "roll left 12.0 deg (u)",
-                           "pitch up 30.0 deg (k)", "CONTROL manual augmented", "frame: end effector",
-                           "distance 31.500 ft", "camera 4 wrist", "zoom 0.30", "published 30.0 Hz",
-                           "DCP 29.9 Hz", "input to DCP 1.2 ms", "p50 3.1 ms, p99 5.5 ms", "gamepad: none",
+  for (const char* want : {"frame 001234",
+                           "MODE 1 ACQUISITION",
+                           "HELD",
+                           "eff_hex_1-payload",
+                           "[x] 1 BAR beyond palm face d",
+                           "holds by 0.250 ft",
+                           "short by 1.500 ft",
+                           "palm to BAR 20.750 ft",
+                           "finger gap 0.587 ft",
+                           "x forward 3.25 ft (w)",
+                           "y left 0.50 ft (a)",
+                           "z down 1.00 ft (f)",
+                           "roll left 12.0 deg (u)",
+                           "pitch up 30.0 deg (k)",
+                           "CONTROL manual augmented",
+                           "frame: end effector",
+                           "distance 31.500 ft",
+                           "camera 4 wrist",
+                           "zoom 0.30",
+                           "published 30.0 Hz",
+                           "DCP 29.9 Hz",
+                           "input to DCP 1.2 ms",
+                           "p50 3.1 ms, p99 5.5 ms",
+                           "gamepad: none",
                            "event 49"}) {
     EXPECT_NE(screen.find(want), std::string::npos) << "missing \"" << want << "\" in\n" << screen;
   }
@@ -671,7 +705,8 @@ TEST_F(Devices, TheStatusScreenShowsGuidanceMarginsAndFollowsTheWidth) {
     for (std::string l; std::getline(is, l); ++lines) EXPECT_LE(static_cast<int>(l.size()), w) << l;
     EXPECT_LE(lines, h) << sc;
     EXPECT_NE(sc.find("GUIDANCE"), std::string::npos) << sc;
-    EXPECT_NE(sc.find("event 49"), std::string::npos) << "the newest event is shown at " << w << "x" << h;
+    EXPECT_NE(sc.find("event 49"), std::string::npos)
+        << "the newest event is shown at " << w << "x" << h;
   }
   // Narrow: the conditions by number and tag, still with their margins.
   const std::string narrow = RenderStatusScreen(s, config, 80, 40);

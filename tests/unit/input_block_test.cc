@@ -1,11 +1,11 @@
-#include <gtest/gtest.h>
+#include "rms/wire/input_block.h"
 
 #include <cmath>
+#include <gtest/gtest.h>
 #include <random>
 
 #include "rms/base/check.h"
 #include "rms/base/config.h"
-#include "rms/wire/input_block.h"
 #include "rms/wire/word_codec.h"
 
 namespace rms {
@@ -34,7 +34,8 @@ TEST_F(InputBlock, RandomInputsRoundTripWithinHalfACount) {
     for (std::int32_t w : words) ASSERT_TRUE(wire::IsValidWord(w));
     const wire::OperatorInputs out = wire::DecodeInputs(words, config.inputs, &c);
     for (int i = 0; i < kNumAnalogInputs; ++i) {
-      ASSERT_LE(std::abs(out.value[i] - in.value[i]), 0.5 * std::abs(config.inputs[i].units_per_count) + 1e-12)
+      ASSERT_LE(std::abs(out.value[i] - in.value[i]),
+                0.5 * std::abs(config.inputs[i].units_per_count) + 1e-12)
           << kAnalogInputNames[i];
     }
     ASSERT_EQ(out.camera_station, in.camera_station);
@@ -63,7 +64,7 @@ TEST_F(InputBlock, OutOfRangeInputsAreClampedAndReported) {
 TEST_F(InputBlock, CountsBeyondTheConverterAndBeyondTheRangeAreClampedAtTheDcp) {
   std::array<std::int32_t, wire::kInputWords> w{};
   w[kShoulderHeight] = static_cast<std::int32_t>(wire::FromSigned(100000));  // beyond ADC16
-  w[kFinger] = static_cast<std::int32_t>(wire::FromSigned(-5000));          // finger < 0
+  w[kFinger] = static_cast<std::int32_t>(wire::FromSigned(-5000));           // finger < 0
   Counters c;
   const wire::OperatorInputs in = wire::DecodeInputs(w, config.inputs, &c);
   EXPECT_EQ(c.Get(Counter::kClampedAdcShoulderHeight), 1);

@@ -1,9 +1,9 @@
 // Forward kinematics against poses computed by hand (docs/kinematics.md).
-#include <gtest/gtest.h>
+#include "rms/arm/kinematics.h"
 
+#include <gtest/gtest.h>
 #include <random>
 
-#include "rms/arm/kinematics.h"
 #include "rms/base/config.h"
 
 namespace rms {
@@ -25,7 +25,8 @@ class Kinematics : public ::testing::Test {
   ArmGeometry arm;
 };
 
-#define EXPECT_VEC_NEAR(a, b, tol) EXPECT_LT(((a) - (b)).norm(), tol) << (a).transpose() << " vs " << (b).transpose()
+#define EXPECT_VEC_NEAR(a, b, tol) \
+  EXPECT_LT(((a) - (b)).norm(), tol) << (a).transpose() << " vs " << (b).transpose()
 
 TEST_F(Kinematics, ZeroAnglesLayTheArmAftAlongXr) {
   const arm::ArmPose p = Pose({0, 0, 0, 0, 0, 0}, 3.0);
@@ -90,8 +91,8 @@ TEST_F(Kinematics, TheDemoGraspPoseComputedByHand) {
   def.upper_boom_ft = 20.9;
   def.lower_boom_ft = 23.2;
   def.wrist_to_palm_ft = 6.15;
-  const arm::ArmPose p =
-      arm::ComputeArmPose(def, arm::SinCosFromDegrees({16.19, 52.93, -84.89, -58.04, 0, -73.81}), 3.0);
+  const arm::ArmPose p = arm::ComputeArmPose(
+      def, arm::SinCosFromDegrees({16.19, 52.93, -84.89, -58.04, 0, -73.81}), 3.0);
   EXPECT_VEC_NEAR(p.p_RoW_R, Vector3d(32.50, 0.0, 7.39), 0.02);
   EXPECT_VEC_NEAR(p.X_RS2.translation(), Vector3d(32.50, 0.0, 1.24), 0.02);
   EXPECT_VEC_NEAR(p.X_RS2.linear().col(0), Vector3d(0, 0, -1), 1e-3);
@@ -155,7 +156,8 @@ TEST(ArmIk, ForwardOfInverseIsTheTargetPose) {
     for (mission::Elbow elbow : {mission::Elbow::kUp, mission::Elbow::kDown}) {
       const auto s = mission::SolveArmIk(config.arm, p.X_RS2, height, elbow);
       ASSERT_TRUE(s.has_value());
-      const arm::ArmPose q = arm::ComputeArmPose(config.arm, arm::SinCosFromDegrees(s->angles_deg), height);
+      const arm::ArmPose q =
+          arm::ComputeArmPose(config.arm, arm::SinCosFromDegrees(s->angles_deg), height);
       ASSERT_LT((q.X_RS2.translation() - p.X_RS2.translation()).norm(), 1e-7);
       ASSERT_LT((q.X_RS2.linear() - p.X_RS2.linear()).norm(), 1e-7);
       ++solved;
@@ -166,7 +168,8 @@ TEST(ArmIk, ForwardOfInverseIsTheTargetPose) {
 
 TEST(ArmIk, OutOfReachHasNoSolution) {
   const LabConfig config = LoadConfig(DefaultConfigPath());
-  const auto X = mission::EndEffectorPose(Eigen::Vector3d(200, 0, 0), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY());
+  const auto X = mission::EndEffectorPose(Eigen::Vector3d(200, 0, 0), Eigen::Vector3d::UnitX(),
+                                          Eigen::Vector3d::UnitY());
   EXPECT_FALSE(mission::SolveArmIk(config.arm, X, 3.0).has_value());
 }
 

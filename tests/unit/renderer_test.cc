@@ -2,18 +2,19 @@
 // identity colours, the pixel where an independent pinhole projection of the
 // kinematics puts an arm part has that part's colour. Both GL backends draw
 // the same pixels; priority mode (no depth buffer) draws what depth mode does.
-#include <gtest/gtest.h>
+#include "rms/esg_renderer/renderer.h"
 
 #include <cmath>
+#include <gtest/gtest.h>
 
-#include "rms/scene_proc/camera_stations.h"
-#include "rms/esg_renderer/gl_context.h"
-#include "pinhole.h"
-#include "rms/esg_renderer/renderer.h"
 #include "rms/base/config.h"
 #include "rms/esg_renderer/draw_order.h"
+#include "rms/esg_renderer/gl_context.h"
 #include "rms/scene_model/scene_model.h"
+#include "rms/scene_proc/camera_stations.h"
 #include "rms/scene_proc/visual_scene_program.h"
+
+#include "pinhole.h"
 
 namespace rms::esg_renderer {
 namespace {
@@ -23,11 +24,13 @@ using testing::Project;
 class Renderer : public ::testing::Test {
  protected:
   static constexpr int kW = 320, kH = 240;
-  Renderer() : gl(CreateGlContext(GlBackend::kOsMesa, kW, kH)), renderer(config, gl.get(), RenderOptions{.id_colors = true}) {}
+  Renderer()
+      : gl(CreateGlContext(GlBackend::kOsMesa, kW, kH)),
+        renderer(config, gl.get(), RenderOptions{.id_colors = true}) {}
 
   // A frame as scene_proc makes it (view, priority bits) for a pose.
-  wire::EsgFrameData Frame(std::array<double, 6> deg, int station, double height = 3.0, double pan = 0, double tilt = 0,
-                     double zoom = 0) {
+  wire::EsgFrameData Frame(std::array<double, 6> deg, int station, double height = 3.0,
+                           double pan = 0, double tilt = 0, double zoom = 0) {
     scene_proc::VisualSceneProgram vs(config);
     wire::DcpFrameData d;
     d.arm = arm::SinCosFromDegrees(deg);
@@ -61,11 +64,13 @@ TEST_F(Renderer, ArmPartsAppearWhereTheKinematicsPutThem) {
     renderer.Render(f);
     const std::uint8_t* px = renderer.pixels();
     const arm::ArmPose arm = arm::ComputeArmPose(config.arm, f.arm, f.shoulder_height_ft);
-    for (const auto& [p, id] : {std::pair{0.5 * (arm.p_RoS_R + arm.p_RoE_R), scene_model::kUpperBoom},
-                                std::pair{0.5 * (arm.p_RoE_R + arm.p_RoW_R), scene_model::kLowerBoom}}) {
+    for (const auto& [p, id] :
+         {std::pair{0.5 * (arm.p_RoS_R + arm.p_RoE_R), scene_model::kUpperBoom},
+          std::pair{0.5 * (arm.p_RoE_R + arm.p_RoW_R), scene_model::kLowerBoom}}) {
       int x = 0, y = 0;
       ASSERT_TRUE(Project(f, p, kW, kH, &x, &y));
-      EXPECT_EQ(PixelAt(px, x, y), IdColor(id)) << scene_model::ClusterName(id) << " at " << x << "," << y;
+      EXPECT_EQ(PixelAt(px, x, y), IdColor(id))
+          << scene_model::ClusterName(id) << " at " << x << "," << y;
     }
   }
 }
@@ -89,7 +94,9 @@ TEST_F(Renderer, SpaceIsBlackAndTheBayFloorIsTheFloor) {
   int x = 0, y = 0;
   ASSERT_TRUE(Project(f, Eigen::Vector3d(12.0, 4.0, -12.0), kW, kH, &x, &y));
   EXPECT_EQ(PixelAt(px, x, y), IdColor(scene_model::kFloor));
-  ASSERT_TRUE(Project(f, f.p_RoEye_R_ft + 100 * (f.R_RE.col(0) - 0.6 * f.R_RE.col(2) + 0.55 * f.R_RE.col(1)), kW, kH, &x, &y));
+  ASSERT_TRUE(Project(
+      f, f.p_RoEye_R_ft + 100 * (f.R_RE.col(0) - 0.6 * f.R_RE.col(2) + 0.55 * f.R_RE.col(1)), kW,
+      kH, &x, &y));
   EXPECT_EQ(PixelAt(px, x, y), (scene_model::Rgb{0, 0, 0}));
 }
 
@@ -128,10 +135,12 @@ TEST_F(Renderer, TheEglBackendDrawsTheSamePixels) {
 
 TEST_F(Renderer, PriorityModeDrawsWhatTheDepthBufferDraws) {
   std::unique_ptr<GlContext> gl2 = CreateGlContext(GlBackend::kOsMesa, kW, kH);
-  FrameRenderer depth(config, gl2.get(), RenderOptions{.visibility = Visibility::kDepth, .id_colors = true});
+  FrameRenderer depth(config, gl2.get(),
+                      RenderOptions{.visibility = Visibility::kDepth, .id_colors = true});
   int frames = 0;
   for (int station = 1; station <= 8; ++station) {
-    for (const auto& deg : {std::array<double, 6>{16, 53, -85, -58, 0, -74}, std::array<double, 6>{0, 30, -10, 0, 0, 0}}) {
+    for (const auto& deg : {std::array<double, 6>{16, 53, -85, -58, 0, -74},
+                            std::array<double, 6>{0, 30, -10, 0, 0, 0}}) {
       const wire::EsgFrameData f = Frame(deg, station);
       renderer.Render(f);
       const std::vector<std::uint8_t> prio(renderer.pixels(), renderer.pixels() + kW * kH * 4);

@@ -3,21 +3,20 @@
 // pan, tilt and zoom move the image the right way; the camera drives slew at
 // their rates; visual priority (no depth buffer) draws exactly what the
 // depth buffer does, from every station, over the whole mission.
-#include <gtest/gtest.h>
-
 #include <cmath>
 #include <cstring>
 #include <fstream>
-#include <sstream>
+#include <gtest/gtest.h>
 #include <map>
 #include <set>
+#include <sstream>
 
-#include "rms/esg_renderer/gl_context.h"
-#include "rms/sim/offline_session.h"
-#include "rms/sim/visibility.h"
-#include "rms/sim/priority_table.h"
-#include "rms/esg_renderer/renderer.h"
 #include "rms/base/config.h"
+#include "rms/esg_renderer/gl_context.h"
+#include "rms/esg_renderer/renderer.h"
+#include "rms/sim/offline_session.h"
+#include "rms/sim/priority_table.h"
+#include "rms/sim/visibility.h"
 
 namespace rms {
 namespace {
@@ -42,9 +41,12 @@ class Scene : public ::testing::Test {
     return n;
   }
   // The mission's frames at these times (s), from every station.
-  std::map<double, std::array<wire::EsgFrameData, kNumCameraStations>> AtTimes(std::set<double> times) {
-    sim::OfflineSession s(config, operator_station::Timeline::Load(std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl",
-                                                         config.inputs));
+  std::map<double, std::array<wire::EsgFrameData, kNumCameraStations>> AtTimes(
+      const std::set<double>& times) {
+    sim::OfflineSession s(
+        config,
+        operator_station::Timeline::Load(
+            std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl", config.inputs));
     std::map<double, std::array<wire::EsgFrameData, kNumCameraStations>> out;
     while (s.Next()) {
       for (double t : times) {
@@ -70,24 +72,51 @@ TEST_F(Scene, EachStationShowsWhatItShould) {
     std::vector<int> hides;
   };
   const std::vector<Expect> expects = {
-      {11, 1, {scene_model::kFloor, scene_model::kPayloadBody, scene_model::kEffHex1, scene_model::kWrist}, {scene_model::kCaeModule}},                 // aft flight deck, overhead
-      {11, 2, {scene_model::kFloor, scene_model::kPayloadBody, scene_model::kTail}, {}},                                       // aft flight deck, port aft
-      {11, 3, {scene_model::kLowerBoom, scene_model::kPayloadBody}, {scene_model::kUpperBoom}},                                // elbow, looking along the lower boom
-      {11, 4, {scene_model::kEffHex1, scene_model::kEffHex2, scene_model::kEffHex3, scene_model::kBar, scene_model::kPayloadBody}, {scene_model::kCaeModule}},      // wrist: fingers about the bar
-      {11, 5, {scene_model::kPayloadBody, scene_model::kBulkheadAft, scene_model::kEffHex1}, {scene_model::kBulkheadFwd}},                 // bay, forward bulkhead, looking aft
-      {11, 6, {scene_model::kPayloadBody, scene_model::kProbe, scene_model::kBulkheadFwd, scene_model::kCabin}, {scene_model::kBulkheadAft}},           // bay, aft bulkhead, looking forward
-      {24, 8, {scene_model::kCaeModule, scene_model::kTail, scene_model::kPayloadBody, scene_model::kWingStbd, scene_model::kDoorStbd}, {}},            // external
-      {41, 7, {scene_model::kProbe, scene_model::kPayloadBody}, {}},                                              // CAE port: the probe docked
-      {41, 1, {scene_model::kFloor}, {scene_model::kPayloadBody}},                                                // the payload has left the bay
+      {11,
+       1,
+       {scene_model::kFloor, scene_model::kPayloadBody, scene_model::kEffHex1, scene_model::kWrist},
+       {scene_model::kCaeModule}},  // aft flight deck, overhead
+      {11,
+       2,
+       {scene_model::kFloor, scene_model::kPayloadBody, scene_model::kTail},
+       {}},  // aft flight deck, port aft
+      {11,
+       3,
+       {scene_model::kLowerBoom, scene_model::kPayloadBody},
+       {scene_model::kUpperBoom}},  // elbow, looking along the lower boom
+      {11,
+       4,
+       {scene_model::kEffHex1, scene_model::kEffHex2, scene_model::kEffHex3, scene_model::kBar,
+        scene_model::kPayloadBody},
+       {scene_model::kCaeModule}},  // wrist: fingers about the bar
+      {11,
+       5,
+       {scene_model::kPayloadBody, scene_model::kBulkheadAft, scene_model::kEffHex1},
+       {scene_model::kBulkheadFwd}},  // bay, forward bulkhead, looking aft
+      {11,
+       6,
+       {scene_model::kPayloadBody, scene_model::kProbe, scene_model::kBulkheadFwd,
+        scene_model::kCabin},
+       {scene_model::kBulkheadAft}},  // bay, aft bulkhead, looking forward
+      {24,
+       8,
+       {scene_model::kCaeModule, scene_model::kTail, scene_model::kPayloadBody,
+        scene_model::kWingStbd, scene_model::kDoorStbd},
+       {}},                                                           // external
+      {41, 7, {scene_model::kProbe, scene_model::kPayloadBody}, {}},  // CAE port: the probe docked
+      {41, 1, {scene_model::kFloor}, {scene_model::kPayloadBody}},  // the payload has left the bay
       {41, 3, {scene_model::kLowerBoom, scene_model::kPayloadBody, scene_model::kCaeModule}, {}},
   };
   for (const Expect& e : expects) {
     const auto seen = Seen(frames.at(e.t)[e.station - 1]);
     for (int c : e.shows) {
-      EXPECT_GT(seen.count(c) ? seen.at(c) : 0, 20) << "t " << e.t << " station " << e.station << " should show " << scene_model::ClusterName(c);
+      EXPECT_GT(seen.count(c) ? seen.at(c) : 0, 20)
+          << "t " << e.t << " station " << e.station << " should show "
+          << scene_model::ClusterName(c);
     }
     for (int c : e.hides) {
-      EXPECT_EQ(seen.count(c), 0u) << "t " << e.t << " station " << e.station << " should not show " << scene_model::ClusterName(c);
+      EXPECT_EQ(seen.count(c), 0u) << "t " << e.t << " station " << e.station << " should not show "
+                                   << scene_model::ClusterName(c);
     }
   }
 }
@@ -101,8 +130,9 @@ struct Blob {
 
 TEST_F(Scene, PanTiltAndZoomMoveTheImageTheRightWay) {
   const auto frames = AtTimes({11.0});
-  sim::OfflineSession s(config, operator_station::Timeline::Load(std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl",
-                                                       config.inputs));
+  sim::OfflineSession s(
+      config, operator_station::Timeline::Load(
+                  std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl", config.inputs));
   while (s.Next() && s.t_s() < 11.0 - 1e-9) {
   }
   auto look = [&](double pan, double tilt, double zoom) {
@@ -137,7 +167,8 @@ TEST_F(Scene, PanTiltAndZoomMoveTheImageTheRightWay) {
   EXPECT_GT(up.y, home.y + 10) << "tilt up: the scene moves down";
   const Blob in = look(0, 0, 0.5);
   EXPECT_GT(in.pixels, 1.5 * home.pixels) << "zoom in: objects grow";
-  EXPECT_GT(std::hypot(in.x - kW / 2.0, in.y - kH / 2.0), std::hypot(home.x - kW / 2.0, home.y - kH / 2.0))
+  EXPECT_GT(std::hypot(in.x - kW / 2.0, in.y - kH / 2.0),
+            std::hypot(home.x - kW / 2.0, home.y - kH / 2.0))
       << "zoom in: objects move out from the centre";
 }
 
@@ -186,8 +217,9 @@ TEST_F(Scene, APlaneSeparatesEveryPairOfClustersThroughoutTheMission) {
   // A pair with no separating plane interpenetrates (the arm through the
   // orbiter, say): visual priority can then not be right, and the mission
   // flies through something solid.
-  sim::OfflineSession s(config, operator_station::Timeline::Load(std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl",
-                                                       config.inputs));
+  sim::OfflineSession s(
+      config, operator_station::Timeline::Load(
+                  std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl", config.inputs));
   long frames = 0;
   while (s.Next()) ++frames;
   EXPECT_EQ(frames, 1351);
@@ -200,14 +232,16 @@ TEST_F(Scene, NoCameraEverSitsInsideASolid) {
   // error that back-face culling hides. Every 5th frame of the mission, every
   // station, every solid cluster.
   const scene_model::SceneModel model = scene_model::BuildSceneModel(config);
-  sim::OfflineSession s(config, operator_station::Timeline::Load(std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl",
-                                                       config.inputs));
+  sim::OfflineSession s(
+      config, operator_station::Timeline::Load(
+                  std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl", config.inputs));
   long checked = 0;
   while (s.Next()) {
     if (s.frame() % 5) continue;
     for (int st = 1; st <= kNumCameraStations; ++st) {
       const wire::EsgFrameData& f = s.esg(st);
-      const scene_model::ClusterPoses poses = scene_model::ComputeClusterPoses(config, f.scene_pose());
+      const scene_model::ClusterPoses poses =
+          scene_model::ComputeClusterPoses(config, f.scene_pose());
       for (int c = 0; c < scene_model::kNumClusters; ++c) {
         if (!poses.present[c] || model[c].flat) continue;
         ++checked;
@@ -217,8 +251,9 @@ TEST_F(Scene, NoCameraEverSitsInsideASolid) {
         for (const scene_model::Triangle& t : model[c].mesh.triangles()) {
           if (!t.decal) max_out_ft = std::max(max_out_ft, t.n.dot(p - t.a));
         }
-        EXPECT_GT(max_out_ft, 0.0f) << "station " << st << " (" << config.cameras[st - 1].name << ") is inside "
-                                    << scene_model::ClusterName(c) << " at frame " << s.frame();
+        EXPECT_GT(max_out_ft, 0.0f)
+            << "station " << st << " (" << config.cameras[st - 1].name << ") is inside "
+            << scene_model::ClusterName(c) << " at frame " << s.frame();
       }
     }
   }
@@ -229,8 +264,8 @@ TEST_F(Scene, ThePriorityTableInTheDocsIsWhatTheCodeComputes) {
   std::ifstream in(std::string(RMSLAB_SOURCE_DIR) + "/docs/priority-table.md");
   std::stringstream shipped;
   shipped << in.rdbuf();
-  EXPECT_EQ(shipped.str(), sim::PriorityTableMarkdown(
-                               config, std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl"))
+  EXPECT_EQ(shipped.str(), sim::PriorityTableMarkdown(config, std::string(RMSLAB_SOURCE_DIR) +
+                                                                  "/scripts/timelines/mission.tl"))
       << "regenerate: build/tools/rms_priority_table > docs/priority-table.md";
 }
 

@@ -1,8 +1,9 @@
+#include "rms/operator_station/timeline.h"
+
 #include <gtest/gtest.h>
 
 #include "rms/base/check.h"
 #include "rms/base/config.h"
-#include "rms/operator_station/timeline.h"
 
 namespace rms::operator_station {
 namespace {
@@ -49,7 +50,8 @@ TEST_F(TimelineTest, DiscreteKeysStepAndResetIsOneFrame) {
 }
 
 TEST_F(TimelineTest, ErrorsNameTheLineAndTheProblem) {
-  EXPECT_NE(ErrorOf("0 camera=1\n1 sholder_yaw=3\n").find("t.tl:2: unknown key 'sholder_yaw'"), std::string::npos);
+  EXPECT_NE(ErrorOf("0 camera=1\n1 sholder_yaw=3\n").find("t.tl:2: unknown key 'sholder_yaw'"),
+            std::string::npos);
   EXPECT_NE(ErrorOf("2 camera=1\n1 camera=2\n").find("t.tl:2:"), std::string::npos);
   EXPECT_NE(ErrorOf("2 camera=1\n1 camera=2\n").find("time order"), std::string::npos);
   EXPECT_NE(ErrorOf("0 finger=lots\n").find("not a number"), std::string::npos);
@@ -69,7 +71,8 @@ TEST_F(TimelineTest, OutOfRangeValuesAreAcceptedWithAWarning) {
 
 TEST_F(TimelineTest, TheShippedTimelinesParse) {
   for (const char* name : {"mission.tl", "tour.tl", "short.tl"}) {
-    const Timeline tl = Timeline::Load(std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/" + name, config.inputs);
+    const Timeline tl = Timeline::Load(
+        std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/" + name, config.inputs);
     EXPECT_GT(tl.end_time(), 0.0);
     EXPECT_TRUE(tl.warnings().empty()) << name;
   }

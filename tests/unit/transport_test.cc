@@ -1,30 +1,31 @@
 // The transport interface: the log-backed implementation is deterministic and
 // network-free (the UDP one: tests/network/udp_lcm_test.cc); SafeDecode classifies
 // hostile bytes without throwing.
-#include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 #include <thread>
-#include <unistd.h>
 
-#include "rms/wire/channels.h"
 #include "rms/base/check.h"
 #include "rms/esg_frame_t.hpp"
-#include "rms/transport/lcm_interface.h"
-#include "rms/wire/message_io.h"
 #include "rms/operator_input_t.hpp"
 #include "rms/process_status_t.hpp"
 #include "rms/sender_t.hpp"
+#include "rms/transport/lcm_interface.h"
+#include "rms/wire/channels.h"
+#include "rms/wire/message_io.h"
 
 namespace rms {
 namespace {
 
 std::string TempPath(const std::string& name) {
   return (std::filesystem::temp_directory_path() /
-          ("rmslab_" + std::to_string(getpid()) + "_" + name)).string();
+          ("rmslab_" + std::to_string(getpid()) + "_" + name))
+      .string();
 }
 
 TEST(LogLcm, RecordsAndReplaysInOrderWithTimestampsAndSuffix) {
@@ -95,18 +96,22 @@ TEST(SafeDecode, ClassifiesHostileBytesWithoutThrowing) {
   m.words = {1, 2, 3};
   std::vector<std::uint8_t> good = wire::EncodeMessage(m);
   esg_frame_t out;
-  EXPECT_EQ(wire::SafeDecode(good.data(), static_cast<int>(good.size()), &out), wire::DecodeError::kNone);
+  EXPECT_EQ(wire::SafeDecode(good.data(), static_cast<int>(good.size()), &out),
+            wire::DecodeError::kNone);
   // Wrong type: an operator input block on the ESG channel.
   operator_input_t other{};
   std::vector<std::uint8_t> o = wire::EncodeMessage(other);
-  EXPECT_EQ(wire::SafeDecode(o.data(), static_cast<int>(o.size()), &out), wire::DecodeError::kWrongType);
+  EXPECT_EQ(wire::SafeDecode(o.data(), static_cast<int>(o.size()), &out),
+            wire::DecodeError::kWrongType);
   // Truncated.
-  EXPECT_EQ(wire::SafeDecode(good.data(), static_cast<int>(good.size()) - 1, &out), wire::DecodeError::kTruncated);
+  EXPECT_EQ(wire::SafeDecode(good.data(), static_cast<int>(good.size()) - 1, &out),
+            wire::DecodeError::kTruncated);
   EXPECT_EQ(wire::SafeDecode(good.data(), 4, &out), wire::DecodeError::kTruncated);
   // Trailing bytes.
   std::vector<std::uint8_t> longer = good;
   longer.push_back(0);
-  EXPECT_EQ(wire::SafeDecode(longer.data(), static_cast<int>(longer.size()), &out), wire::DecodeError::kTrailingBytes);
+  EXPECT_EQ(wire::SafeDecode(longer.data(), static_cast<int>(longer.size()), &out),
+            wire::DecodeError::kTrailingBytes);
   // Too large: beyond the type's largest encoding (64 words, from
   // esg_frame_t.lcm's MAX_WORDS), refused before decoding.
   EXPECT_EQ(lcm_limits::kMaxEncodedSize<esg_frame_t>, 8 + wire::kSenderBytes + 40 + 2 + 4 * 64);
@@ -114,7 +119,8 @@ TEST(SafeDecode, ClassifiesHostileBytesWithoutThrowing) {
   big.num_words = 65;
   big.words.assign(65, 0);
   std::vector<std::uint8_t> b = wire::EncodeMessage(big);
-  EXPECT_EQ(wire::SafeDecode(b.data(), static_cast<int>(b.size()), &out), wire::DecodeError::kTooLarge);
+  EXPECT_EQ(wire::SafeDecode(b.data(), static_cast<int>(b.size()), &out),
+            wire::DecodeError::kTooLarge);
   // Within the size limit but beyond a count's bound: a status report with
   // more counters than MAX_COUNTERS, each name empty.
   process_status_t many{};
@@ -124,25 +130,29 @@ TEST(SafeDecode, ClassifiesHostileBytesWithoutThrowing) {
   std::vector<std::uint8_t> mb = wire::EncodeMessage(many);
   ASSERT_LE(static_cast<int>(mb.size()), lcm_limits::kMaxEncodedSize<process_status_t>);
   process_status_t many_out;
-  EXPECT_EQ(wire::SafeDecode(mb.data(), static_cast<int>(mb.size()), &many_out), wire::DecodeError::kBadCount);
+  EXPECT_EQ(wire::SafeDecode(mb.data(), static_cast<int>(mb.size()), &many_out),
+            wire::DecodeError::kBadCount);
   // The same at its bound decodes.
   many.num_counters = process_status_t::MAX_COUNTERS;
   many.counter_names.resize(many.num_counters);
   many.counter_values.resize(many.num_counters);
   mb = wire::EncodeMessage(many);
-  EXPECT_EQ(wire::SafeDecode(mb.data(), static_cast<int>(mb.size()), &many_out), wire::DecodeError::kNone);
+  EXPECT_EQ(wire::SafeDecode(mb.data(), static_cast<int>(mb.size()), &many_out),
+            wire::DecodeError::kNone);
   // A negative word count (int16 after the fingerprint, the sender and five
   // int64s) makes lcm-gen's decoder throw.
   constexpr int kCountAt = 8 + wire::kSenderBytes + 40;
   std::vector<std::uint8_t> neg = good;
   neg[kCountAt] = 0xFF;
   neg[kCountAt + 1] = 0xFE;
-  EXPECT_EQ(wire::SafeDecode(neg.data(), static_cast<int>(neg.size()), &out), wire::DecodeError::kBadCount);
+  EXPECT_EQ(wire::SafeDecode(neg.data(), static_cast<int>(neg.size()), &out),
+            wire::DecodeError::kBadCount);
   // A string length of zero in a status report.
   process_status_t s{};
   s.process = "x";
   std::vector<std::uint8_t> sb = wire::EncodeMessage(s);
-  sb[8 + wire::kSenderBytes + 8 + 3] = 0;  // length of "process" (4-byte big-endian after the sender and send_time_us) -> 0
+  sb[8 + wire::kSenderBytes + 8 + 3] =
+      0;  // length of "process" (4-byte big-endian after the sender and send_time_us) -> 0
   process_status_t so;
   const wire::DecodeError e = wire::SafeDecode(sb.data(), static_cast<int>(sb.size()), &so);
   EXPECT_NE(e, wire::DecodeError::kNone);

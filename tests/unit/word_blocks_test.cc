@@ -1,10 +1,10 @@
-#include <gtest/gtest.h>
+#include "rms/wire/word_blocks.h"
 
+#include <gtest/gtest.h>
 #include <random>
 
 #include "rms/base/check.h"
 #include "rms/dcp_frame_t.hpp"
-#include "rms/wire/word_blocks.h"
 
 namespace rms {
 namespace {
@@ -90,7 +90,9 @@ TEST(EsgFrame, MalformedFramesAreRefusedNamingTheWord) {
   {
     auto w = good;
     w.push_back(0);
-    EXPECT_NE(ErrorOf(w).find("this layout has " + std::to_string(wire::esg_words::kCount)), std::string::npos) << ErrorOf(w);
+    EXPECT_NE(ErrorOf(w).find("this layout has " + std::to_string(wire::esg_words::kCount)),
+              std::string::npos)
+        << ErrorOf(w);
   }
   {
     auto w = good;

@@ -1,13 +1,13 @@
 // The word codec: exhaustive over the 2^24 words where the space allows,
 // property tests (fixed, printed seeds) elsewhere.
-#include <gtest/gtest.h>
+#include "rms/wire/word_codec.h"
 
 #include <cmath>
+#include <gtest/gtest.h>
 #include <limits>
 #include <random>
 
 #include "rms/base/check.h"
-#include "rms/wire/word_codec.h"
 
 namespace rms::wire {
 namespace {
@@ -27,7 +27,8 @@ void ExhaustiveRoundTrip(const wire::FixedFormat& f) {
       // Refusal throws; check the words next to the range and a stride of the
       // rest (16 million exceptions would take most of a minute).
       if (raw == f.raw_min - 1 || raw == f.raw_max + 1 || i % 4099 == 0) {
-        ASSERT_THROW(wire::Decode(f, static_cast<std::int32_t>(w)), InputError) << wire::FormatWord(w);
+        ASSERT_THROW(wire::Decode(f, static_cast<std::int32_t>(w)), InputError)
+            << wire::FormatWord(w);
       }
       continue;
     }
@@ -138,7 +139,8 @@ TEST(WordCodec, ExactEncodeErrorNamesTheFormatAndRange) {
     EXPECT_NE(m.find("-2048"), std::string::npos) << m;
   }
   // Within half an LSB of the end rounds to the end and is accepted.
-  EXPECT_EQ(wire::EncodeExact(wire::kSC22, wire::kSC22.max_value() + 0.49 * wire::kSC22.lsb()), 0x7FFFFFu);
+  EXPECT_EQ(wire::EncodeExact(wire::kSC22, wire::kSC22.max_value() + 0.49 * wire::kSC22.lsb()),
+            0x7FFFFFu);
 }
 
 TEST(WordCodec, NonFiniteInputIsAnError) {
@@ -151,9 +153,14 @@ TEST(WordCodec, NonFiniteInputIsAnError) {
 }
 
 TEST(WordCodec, TiesRoundAwayFromZero) {
-  EXPECT_EQ(wire::RawUnchecked(wire::kFT12, wire::Encode(wire::kFT12, 0.5 * wire::kFT12.lsb()).word), 1);
-  EXPECT_EQ(wire::RawUnchecked(wire::kFT12, wire::Encode(wire::kFT12, -0.5 * wire::kFT12.lsb()).word), -1);
-  EXPECT_EQ(wire::RawUnchecked(wire::kFT12, wire::Encode(wire::kFT12, 0.4999 * wire::kFT12.lsb()).word), 0);
+  EXPECT_EQ(
+      wire::RawUnchecked(wire::kFT12, wire::Encode(wire::kFT12, 0.5 * wire::kFT12.lsb()).word), 1);
+  EXPECT_EQ(
+      wire::RawUnchecked(wire::kFT12, wire::Encode(wire::kFT12, -0.5 * wire::kFT12.lsb()).word),
+      -1);
+  EXPECT_EQ(
+      wire::RawUnchecked(wire::kFT12, wire::Encode(wire::kFT12, 0.4999 * wire::kFT12.lsb()).word),
+      0);
 }
 
 TEST(WordCodec, BamWrapsAnyAngle) {

@@ -8,26 +8,26 @@
 // from elsewhere copies it into that folder first. restore freezes the
 // session first (so no frame is in flight), restores the DCP's state and the
 // operator station's inputs, and leaves the session frozen unless --run.
-#include <CLI/CLI.hpp>
-#include "rms/base/command_line.h"
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <chrono>
-#include <map>
-#include <functional>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
+#include <map>
 #include <thread>
 
-#include "rms/wire/channels.h"
 #include "rms/base/check.h"
-#include "rms/wire/checkpoint.h"
-#include "rms/transport/lcm_interface.h"
-#include "rms/wire/message_io.h"
-#include "rms/sender_t.hpp"
+#include "rms/base/command_line.h"
 #include "rms/process_status_t.hpp"
-#include "rms/session_control_t.hpp"
+#include "rms/sender_t.hpp"
 #include "rms/session/session_summary.h"
+#include "rms/session_control_t.hpp"
+#include "rms/transport/lcm_interface.h"
+#include "rms/wire/channels.h"
+#include "rms/wire/checkpoint.h"
+#include "rms/wire/message_io.h"
 
 namespace fs = std::filesystem;
 
@@ -36,7 +36,8 @@ namespace {
 // "before_dock" -> "before_dock.json"; then checked as a name.
 std::string CheckpointName(std::string name) {
   if (name.find('/') != std::string::npos) {
-    throw rms::InputError("'" + name + "' is a path: give a checkpoint's name (it is saved in the session's "
+    throw rms::InputError("'" + name +
+                          "' is a path: give a checkpoint's name (it is saved in the session's "
                           "checkpoints folder)");
   }
   if (name.size() < 5 || name.compare(name.size() - 5, 5, ".json") != 0) name += ".json";
@@ -48,9 +49,11 @@ std::string CheckpointName(std::string name) {
 // elsewhere copied in under a new name.
 std::string RestoreName(const std::string& what, const std::string& folder) {
   if (what.find('/') == std::string::npos && !fs::exists(what)) return CheckpointName(what);
-  if (!fs::is_regular_file(what)) throw rms::InputError("no checkpoint '" + what + "' (a name, or a file)");
+  if (!fs::is_regular_file(what))
+    throw rms::InputError("no checkpoint '" + what + "' (a name, or a file)");
   if (folder.empty()) {
-    throw rms::InputError("restoring the file '" + what + "' needs --session DIR: it is copied into the session's "
+    throw rms::InputError("restoring the file '" + what +
+                          "' needs --session DIR: it is copied into the session's "
                           "checkpoints folder first");
   }
   (void)rms::wire::ReadCheckpoint(what);  // a real checkpoint, or a clear error now
@@ -60,10 +63,12 @@ std::string RestoreName(const std::string& what, const std::string& folder) {
   }
   stem = "restore-" + stem.substr(0, 40);
   std::string name = stem + ".json";
-  for (int i = 2; fs::exists(fs::path(folder) / name); ++i) name = stem + "-" + std::to_string(i) + ".json";
+  for (int i = 2; fs::exists(fs::path(folder) / name); ++i)
+    name = stem + "-" + std::to_string(i) + ".json";
   rms::wire::CheckpointFolder::ValidateName(name);
   fs::copy_file(what, fs::path(folder) / name);
-  std::printf("copied %s into the session as %s\n", what.c_str(), (fs::path(folder) / name).c_str());
+  std::printf("copied %s into the session as %s\n", what.c_str(),
+              (fs::path(folder) / name).c_str());
   return name;
 }
 
@@ -77,7 +82,8 @@ namespace {
 class ControlLink {
  public:
   ControlLink(const rms::transport::LcmOptions& options, std::int64_t session_id) : lcm_(options) {
-    lcm_.SetSender({session_id, rms::sender_t::PROCESS_CONTROL, static_cast<std::int32_t>(getpid())});
+    lcm_.SetSender(
+        {session_id, rms::sender_t::PROCESS_CONTROL, static_cast<std::int32_t>(getpid())});
     lcm_.Subscribe(rms::wire::channels::kStatus, [this](const void* d, int n, std::int64_t) {
       rms::process_status_t st;
       if (rms::wire::SafeDecode(d, n, &st) != rms::wire::DecodeError::kNone) return;
@@ -92,7 +98,8 @@ class ControlLink {
     m.sequence = sequence_++;
     m.command = command;
     m.name = name;
-    if (!rms::transport::PublishMessage(lcm_, rms::wire::channels::kControl, m)) throw std::runtime_error("cannot publish");
+    if (!rms::transport::PublishMessage(lcm_, rms::wire::channels::kControl, m))
+      throw std::runtime_error("cannot publish");
   }
   // Handles messages until done() or `seconds` pass; done()'s last answer.
   bool ListenUntil(double seconds, const std::function<bool()>& done) {
@@ -127,31 +134,38 @@ void SayWhereSent(const rms::transport::LcmOptions& options, std::int64_t id);
 
 // Nobody answered: said, and a failure (docs/sessions.md "Command lines").
 int NobodyThere(const rms::transport::LcmOptions& options, std::int64_t id, const char* process) {
-  std::fprintf(stderr,
-               "rms_control: no %s of session %s is running on %s%s (no status report heard in 2.5 s): nothing "
-               "was sent\n",
-               process, id ? rms::wire::FormatSessionId(id).c_str() : "(none)", options.url.c_str(),
-               options.channel_suffix.empty() ? "" : (" with suffix " + options.channel_suffix).c_str());
+  std::fprintf(
+      stderr,
+      "rms_control: no %s of session %s is running on %s%s (no status report heard in 2.5 s): "
+      "nothing "
+      "was sent\n",
+      process, id ? rms::wire::FormatSessionId(id).c_str() : "(none)", options.url.c_str(),
+      options.channel_suffix.empty() ? "" : (" with suffix " + options.channel_suffix).c_str());
   return 1;
 }
 
 // FREEZE, RUN, STEP: confirmed by the operator station's counts (it is the
 // session's clock).
-int Clock(ControlLink& link, std::int8_t command, int steps, const rms::transport::LcmOptions& options, std::int64_t id) {
-  const rms::Counter what = command == rms::session_control_t::FREEZE ? rms::Counter::kControlFreezes
-                            : command == rms::session_control_t::RUN  ? rms::Counter::kControlRuns
-                                                                      : rms::Counter::kControlSteps;
+int Clock(ControlLink& link, std::int8_t command, int steps,
+          const rms::transport::LcmOptions& options, std::int64_t id) {
+  const rms::Counter what = command == rms::session_control_t::FREEZE
+                                ? rms::Counter::kControlFreezes
+                            : command == rms::session_control_t::RUN ? rms::Counter::kControlRuns
+                                                                     : rms::Counter::kControlSteps;
   if (!link.WaitForCounts("operator_station")) return NobodyThere(options, id, "operator station");
   const std::int64_t before = link.Count(what, "operator_station");
   for (int i = 0; i < steps; ++i) link.Send(command);
   SayWhereSent(options, id);
   const int seen = link.reports("operator_station");
   const bool done = link.ListenUntil(3.0, [&] {
-    return link.reports("operator_station") > seen && link.Count(what, "operator_station") >= before + steps;
+    return link.reports("operator_station") > seen &&
+           link.Count(what, "operator_station") >= before + steps;
   });
   if (!done) {
-    std::fprintf(stderr, "rms_control: the operator station did not confirm the command within 3 s (see the "
-                         "session's logs/operator_station.log)\n");
+    std::fprintf(
+        stderr,
+        "rms_control: the operator station did not confirm the command within 3 s (see the "
+        "session's logs/operator_station.log)\n");
     return 1;
   }
   std::printf("done (the operator station confirms)\n");
@@ -159,43 +173,55 @@ int Clock(ControlLink& link, std::int8_t command, int steps, const rms::transpor
 }
 
 void SayWhereSent(const rms::transport::LcmOptions& options, std::int64_t id) {
-  std::printf("sent to %s%s, session %s\n", options.url.c_str(),
-              options.channel_suffix.empty() ? "" : (" (suffix " + options.channel_suffix + ")").c_str(),
-              id ? rms::wire::FormatSessionId(id).c_str() : "none (only processes of no session take it)");
+  std::printf(
+      "sent to %s%s, session %s\n", options.url.c_str(),
+      options.channel_suffix.empty() ? "" : (" (suffix " + options.channel_suffix + ")").c_str(),
+      id ? rms::wire::FormatSessionId(id).c_str() : "none (only processes of no session take it)");
 }
 
 // CHECKPOINT, confirmed when there is a session folder: the DCP writes the
 // file within a frame or two, or its counts say it refused.
-int Checkpoint(ControlLink& link, const std::string& name, const std::string& folder, const rms::transport::LcmOptions& options,
-               std::int64_t id) {
+int Checkpoint(ControlLink& link, const std::string& name, const std::string& folder,
+               const rms::transport::LcmOptions& options, std::int64_t id) {
   if (!link.WaitForCounts()) return NobodyThere(options, id, "dynamics_proc");
   const std::int64_t saved0 = link.Count(rms::Counter::kControlCheckpoints);
-  auto refusals = [&link] { return link.Count(rms::Counter::kControlRefused) + link.Count(rms::Counter::kControlRateLimited); };
+  auto refusals = [&link] {
+    return link.Count(rms::Counter::kControlRefused) +
+           link.Count(rms::Counter::kControlRateLimited);
+  };
   const std::int64_t refused0 = refusals();
   link.Send(rms::session_control_t::CHECKPOINT, name);
   SayWhereSent(options, id);
   if (folder.empty()) {  // no folder to look in: the DCP's counts say
     const int seen0 = link.reports();
-    link.ListenUntil(3.0, [&] { return link.reports() > seen0 && link.Count(rms::Counter::kControlCheckpoints) + refusals() > saved0 + refused0; });
+    link.ListenUntil(3.0, [&] {
+      return link.reports() > seen0 &&
+             link.Count(rms::Counter::kControlCheckpoints) + refusals() > saved0 + refused0;
+    });
     if (link.Count(rms::Counter::kControlCheckpoints) > saved0) {
       std::printf("saved %s (dynamics_proc confirms)\n", name.c_str());
       return 0;
     }
-    std::fprintf(stderr, "rms_control: dynamics_proc did not save checkpoint %s (%s)\n", name.c_str(),
-                 refusals() > refused0 ? "refused" : "no word from it within 3 s");
+    std::fprintf(stderr, "rms_control: dynamics_proc did not save checkpoint %s (%s)\n",
+                 name.c_str(), refusals() > refused0 ? "refused" : "no word from it within 3 s");
     return 1;
   }
   const fs::path p = fs::path(folder) / name;
   const int seen = link.reports();
-  link.ListenUntil(3.0, [&] { return fs::exists(p) || (link.reports() > seen && refusals() > refused0); });
+  link.ListenUntil(
+      3.0, [&] { return fs::exists(p) || (link.reports() > seen && refusals() > refused0); });
   if (!fs::exists(p) && refusals() > refused0) {
-    std::fprintf(stderr, "rms_control: dynamics_proc refused checkpoint %s (see the session's logs/dynamics_proc.log)\n",
+    std::fprintf(stderr,
+                 "rms_control: dynamics_proc refused checkpoint %s (see the session's "
+                 "logs/dynamics_proc.log)\n",
                  name.c_str());
     return 1;
   }
   if (!fs::exists(p)) {
-    std::fprintf(stderr, "rms_control: %s did not appear within 3 s (see the session's logs/dynamics_proc.log)\n",
-                 p.c_str());
+    std::fprintf(
+        stderr,
+        "rms_control: %s did not appear within 3 s (see the session's logs/dynamics_proc.log)\n",
+        p.c_str());
     return 1;
   }
   std::printf("saved %s\n", p.c_str());
@@ -203,11 +229,12 @@ int Checkpoint(ControlLink& link, const std::string& name, const std::string& fo
 }
 
 // FREEZE, RESTORE (and RUN with --run), confirmed by the DCP's counts.
-int Restore(ControlLink& link, const std::string& name, bool then_run, const rms::transport::LcmOptions& options,
-            std::int64_t id) {
+int Restore(ControlLink& link, const std::string& name, bool then_run,
+            const rms::transport::LcmOptions& options, std::int64_t id) {
   auto pause = [] { std::this_thread::sleep_for(std::chrono::milliseconds(300)); };
   if (!link.WaitForCounts()) return NobodyThere(options, id, "dynamics_proc");
-  const std::int64_t restores0 = link.Count(rms::Counter::kControlRestores), refused0 = link.Count(rms::Counter::kControlRefused),
+  const std::int64_t restores0 = link.Count(rms::Counter::kControlRestores),
+                     refused0 = link.Count(rms::Counter::kControlRefused),
                      limited0 = link.Count(rms::Counter::kControlRateLimited);
   link.Send(rms::session_control_t::FREEZE);
   pause();  // the last frames through the pipeline
@@ -224,29 +251,40 @@ int Restore(ControlLink& link, const std::string& name, bool then_run, const rms
                                      link.Count(rms::Counter::kControlRateLimited) > limited0);
   });
   if (link.Count(rms::Counter::kControlRestores) > restores0) {
-    std::printf("restored from %s (dynamics_proc confirms)%s\n", name.c_str(), then_run ? "" : "; frozen: run resumes");
+    std::printf("restored from %s (dynamics_proc confirms)%s\n", name.c_str(),
+                then_run ? "" : "; frozen: run resumes");
     return 0;
   }
-  std::fprintf(stderr, "rms_control: dynamics_proc did not restore %s (%s; see the session's logs/dynamics_proc.log)\n",
+  std::fprintf(stderr,
+               "rms_control: dynamics_proc did not restore %s (%s; see the session's "
+               "logs/dynamics_proc.log)\n",
                name.c_str(),
-               link.Count(rms::Counter::kControlRateLimited) > limited0 ? "too many checkpoint commands a second: try again"
-               : link.Count(rms::Counter::kControlRefused) > refused0    ? "refused"
-                                                             : "no word from it within 3 s");
+               link.Count(rms::Counter::kControlRateLimited) > limited0
+                   ? "too many checkpoint commands a second: try again"
+               : link.Count(rms::Counter::kControlRefused) > refused0
+                   ? "refused"
+                   : "no word from it within 3 s");
   return 1;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"rmslab rms_control: freeze, run, step, checkpoint or restore a running session (RMS_CONTROL)"};
+  CLI::App app{
+      "rmslab rms_control: freeze, run, step, checkpoint or restore a running session "
+      "(RMS_CONTROL)"};
   rms::transport::LcmOptions lcm_options;
   std::string session_dir, session_id;
   app.add_option("--session", session_dir,
-                 "The session's folder: its LCM URL, channel suffix, id and checkpoints folder come from it")
+                 "The session's folder: its LCM URL, channel suffix, id and checkpoints folder "
+                 "come from it")
       ->check(CLI::ExistingDirectory);
-  app.add_option("--lcm-url", lcm_options.url, "LCM URL of the session (without --session)")->capture_default_str();
-  app.add_option("--channel-suffix", lcm_options.channel_suffix, "The session's channel suffix (without --session)");
-  app.add_option("--session-id", session_id, "The session's id, from its manifest.json (without --session)");
+  app.add_option("--lcm-url", lcm_options.url, "LCM URL of the session (without --session)")
+      ->capture_default_str();
+  app.add_option("--channel-suffix", lcm_options.channel_suffix,
+                 "The session's channel suffix (without --session)");
+  app.add_option("--session-id", session_id,
+                 "The session's id, from its manifest.json (without --session)");
   app.require_subcommand(1);
   int steps = 1;
   std::string what;
@@ -255,19 +293,27 @@ int main(int argc, char** argv) {
   auto* run = app.add_subcommand("run", "Run a frozen session again");
   auto* step = app.add_subcommand("step", "While frozen: N more frames (default 1)");
   step->add_option("n", steps, "Frames")->check(CLI::Range(1, 100000));
-  auto* checkpoint = app.add_subcommand("checkpoint", "dynamics_proc saves its state as NAME in the session's checkpoints folder");
-  checkpoint->add_option("name", what, "Checkpoint name (letters, digits, _ - .; .json is added)")->required();
-  auto* restore = app.add_subcommand(
-      "restore", "Freeze, then restore the DCP's state (and the operator's inputs) from a checkpoint NAME, or a FILE");
-  restore->add_option("checkpoint", what, "A checkpoint's name in the session, or a checkpoint file")->required();
+  auto* checkpoint = app.add_subcommand(
+      "checkpoint", "dynamics_proc saves its state as NAME in the session's checkpoints folder");
+  checkpoint->add_option("name", what, "Checkpoint name (letters, digits, _ - .; .json is added)")
+      ->required();
+  auto* restore = app.add_subcommand("restore",
+                                     "Freeze, then restore the DCP's state (and the operator's "
+                                     "inputs) from a checkpoint NAME, or a FILE");
+  restore
+      ->add_option("checkpoint", what, "A checkpoint's name in the session, or a checkpoint file")
+      ->required();
   restore->add_flag("--run", then_run, "Run again after restoring");
   if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   try {
     std::string folder;
-    std::int64_t id = session_id.empty() ? 0 : rms::transport::ParseSessionId(session_id, "--session-id");
+    std::int64_t id =
+        session_id.empty() ? 0 : rms::transport::ParseSessionId(session_id, "--session-id");
     if (!session_dir.empty()) {
       const rms::session::SessionInfo s = rms::session::ReadSessionInfo(session_dir);
-      if (s.lcm_url.empty()) throw rms::InputError(session_dir + " ran on no network (a re-simulation): nothing to control");
+      if (s.lcm_url.empty())
+        throw rms::InputError(session_dir +
+                              " ran on no network (a re-simulation): nothing to control");
       lcm_options.url = s.lcm_url;
       lcm_options.channel_suffix = s.channel_suffix;
       id = s.session_id;
@@ -277,8 +323,8 @@ int main(int argc, char** argv) {
     if (checkpoint->parsed()) {
       name = CheckpointName(what);
       if (!folder.empty() && fs::exists(fs::path(folder) / name)) {
-        std::fprintf(stderr, "rms_control: checkpoint %s exists already in %s: give another name\n", name.c_str(),
-                     folder.c_str());
+        std::fprintf(stderr, "rms_control: checkpoint %s exists already in %s: give another name\n",
+                     name.c_str(), folder.c_str());
         return 1;
       }
     }

@@ -16,7 +16,8 @@ int main(int argc, char** argv) {
   double for_s = 0.0;
   app.add_option("--lcm-url", lcm_options.url, "LCM URL of the session")->capture_default_str();
   app.add_option("--channel-suffix", lcm_options.channel_suffix, "The session's channel suffix");
-  app.add_option("--for", for_s, "Listen this many seconds, print one snapshot and exit (0: live, until Ctrl-C)")
+  app.add_option("--for", for_s,
+                 "Listen this many seconds, print one snapshot and exit (0: live, until Ctrl-C)")
       ->check(CLI::NonNegativeNumber);
   if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   rms::transport::InstallStopHandlers();

@@ -4,19 +4,24 @@
 #include <filesystem>
 #include <iostream>
 
-#include "rms/report/compare.h"
-#include "rms/report/report.h"
 #include "rms/base/check.h"
 #include "rms/base/command_line.h"
 #include "rms/base/text.h"
+#include "rms/report/compare.h"
+#include "rms/report/report.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"rmslab rms_compare: the scorecards of several sessions side by side and each subject's learning "
-               "curve, as compare.html and compare.csv"};
+  CLI::App app{
+      "rmslab rms_compare: the scorecards of several sessions side by side and each subject's "
+      "learning "
+      "curve, as compare.html and compare.csv"};
   std::vector<std::string> sessions;
   std::string out = "compare", chart_js = rms::report::DefaultChartJsPath();
-  app.add_option("sessions", sessions, "Session folders")->required()->check(CLI::ExistingDirectory);
-  app.add_option("--out", out, "The folder for compare.html and compare.csv")->capture_default_str();
+  app.add_option("sessions", sessions, "Session folders")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  app.add_option("--out", out, "The folder for compare.html and compare.csv")
+      ->capture_default_str();
   app.add_option("--chart-js", chart_js, "Chart.js to embed")->capture_default_str();
   if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   try {

@@ -1,17 +1,20 @@
 // rms_report: a session's report as one self-contained HTML file.
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
-#include "rms/base/command_line.h"
 #include <fstream>
 #include <functional>
-#include <unistd.h>
 #include <iostream>
 
+#include "rms/base/command_line.h"
 #include "rms/base/text.h"
 #include "rms/report/report.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"rmslab rms_report: one self-contained HTML report of a session (phases, collisions, docking, "
-               "timing, plots)"};
+  CLI::App app{
+      "rmslab rms_report: one self-contained HTML report of a session (phases, collisions, "
+      "docking, "
+      "timing, plots)"};
   std::string session, out, chart_js = rms::report::DefaultChartJsPath();
   app.add_option("session", session, "Session folder")->required()->check(CLI::ExistingDirectory);
   app.add_option("--out", out, "The HTML file (default SESSION/report.html)");
@@ -20,7 +23,8 @@ int main(int argc, char** argv) {
   try {
     if (out.empty()) out = session + "/report.html";
     std::function<void(const std::string&)> progress;  // only to a person at a terminal
-    if (isatty(STDERR_FILENO)) progress = [](const std::string& line) { std::cerr << line << "\n"; };
+    if (isatty(STDERR_FILENO))
+      progress = [](const std::string& line) { std::cerr << line << "\n"; };
     const std::string html = rms::report::MakeReport(session, chart_js, progress, out);
     rms::WriteWholeFile(out, html);
     std::cout << out << "\n";

@@ -35,15 +35,19 @@ Command Summary(CLI::App& app) {
     bool brief = false;
   };
   auto o = std::make_shared<O>();
-  CLI::App* c = app.add_subcommand("summary", "Write SESSION/summary.json from the session's log and stats");
+  CLI::App* c =
+      app.add_subcommand("summary", "Write SESSION/summary.json from the session's log and stats");
   c->add_option("session", o->dir, "Session folder")->required()->check(CLI::ExistingDirectory);
   c->add_option("--out", o->out, "Output file (default SESSION/summary.json)");
   c->add_flag("--brief", o->brief, "Print a few human-readable lines instead of the JSON");
   return {c, [o] {
             const auto j = session::Summarize(o->dir);
-            rms::WriteWholeFile(o->out.empty() ? o->dir + "/summary.json" : o->out, j.dump(2) + "\n");
-            if (o->brief) session::PrintBrief(j, std::cout);
-            else std::cout << j.dump(2) << "\n";
+            rms::WriteWholeFile(o->out.empty() ? o->dir + "/summary.json" : o->out,
+                                j.dump(2) + "\n");
+            if (o->brief)
+              session::PrintBrief(j, std::cout);
+            else
+              std::cout << j.dump(2) << "\n";
             return 0;
           }};
 }
@@ -55,7 +59,8 @@ Command Manifest(CLI::App& app) {
     session::ManifestFields f;
   };
   auto o = std::make_shared<O>();
-  CLI::App* c = app.add_subcommand("manifest", "Write SESSION/manifest.json: config, software, hosts, start");
+  CLI::App* c =
+      app.add_subcommand("manifest", "Write SESSION/manifest.json: config, software, hosts, start");
   session::ManifestFields& f = o->f;
   c->add_option("session", o->dir, "Session folder")->required()->check(CLI::ExistingDirectory);
   c->add_option("--pilot", f.pilot, "autopilot, timeline, by-hand, replay")->required();
@@ -72,7 +77,8 @@ Command Manifest(CLI::App& app) {
   c->add_option("--kind", f.kind, "live, replay or re-simulation")->capture_default_str();
   c->add_option("--parent", f.parent, "A replay's recorded session");
   return {c, [o] {
-            rms::WriteWholeFile(o->dir + "/manifest.json", session::MakeManifest(o->dir, o->f).dump(2) + "\n");
+            rms::WriteWholeFile(o->dir + "/manifest.json",
+                                session::MakeManifest(o->dir, o->f).dump(2) + "\n");
             return 0;
           }};
 }
@@ -80,9 +86,14 @@ Command Manifest(CLI::App& app) {
 // compare-esg: replayed ESG frames against recorded ones.
 Command CompareEsg(CLI::App& app) {
   auto o = std::make_shared<std::pair<std::string, std::string>>();
-  CLI::App* c = app.add_subcommand("compare-esg", "Compare a replay's ESG frames with the recorded session's");
-  c->add_option("original", o->first, "The recorded session")->required()->check(CLI::ExistingDirectory);
-  c->add_option("replay", o->second, "The replay's session folder")->required()->check(CLI::ExistingDirectory);
+  CLI::App* c = app.add_subcommand("compare-esg",
+                                   "Compare a replay's ESG frames with the recorded session's");
+  c->add_option("original", o->first, "The recorded session")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  c->add_option("replay", o->second, "The replay's session folder")
+      ->required()
+      ->check(CLI::ExistingDirectory);
   return {c, [o] {
             const auto r = session::CompareEsgFrames(o->first, o->second);
             std::cout << r.dump(2) << "\n";
@@ -97,10 +108,12 @@ Command Export(CLI::App& app) {
     bool jsonl = false;
   };
   auto o = std::make_shared<O>();
-  CLI::App* c = app.add_subcommand("export", "Every channel of SESSION's log to CSV, decoded, with units");
+  CLI::App* c =
+      app.add_subcommand("export", "Every channel of SESSION's log to CSV, decoded, with units");
   c->add_option("session", o->dir, "Session folder")->required()->check(CLI::ExistingDirectory);
   c->add_option("--out", o->out, "Folder for the CSV files (default SESSION/csv)");
-  c->add_flag("--jsonl", o->jsonl, "Instead: every message as a JSON line on stdout (for the MCAP writer)");
+  c->add_flag("--jsonl", o->jsonl,
+              "Instead: every message as a JSON line on stdout (for the MCAP writer)");
   return {c, [o] {
             if (o->jsonl) {
               std::ios::sync_with_stdio(false);
@@ -114,8 +127,10 @@ Command Export(CLI::App& app) {
             }
             // Progress only to a person at a terminal (docs/sessions.md "Command lines").
             std::function<void(const std::string&)> progress;
-            if (isatty(STDERR_FILENO)) progress = [](const std::string& line) { std::cerr << line << "\n"; };
-            const auto files = session::ExportCsv(o->dir, o->out.empty() ? o->dir + "/csv" : o->out, progress);
+            if (isatty(STDERR_FILENO))
+              progress = [](const std::string& line) { std::cerr << line << "\n"; };
+            const auto files =
+                session::ExportCsv(o->dir, o->out.empty() ? o->dir + "/csv" : o->out, progress);
             for (const auto& [f, n] : files) std::cout << f << ": " << n << " rows\n";
             return 0;
           }};
@@ -124,7 +139,8 @@ Command Export(CLI::App& app) {
 // folder: a new session folder (the one writer of them; scripts/lab demo and replay).
 Command Folder(CLI::App& app) {
   auto dir = std::make_shared<std::string>();
-  CLI::App* c = app.add_subcommand("folder", "Make a new session folder and print its absolute path");
+  CLI::App* c =
+      app.add_subcommand("folder", "Make a new session folder and print its absolute path");
   c->add_option("dir", *dir, "The folder")->required();
   return {c, [dir] {
             std::cout << session::CreateSessionFolder(*dir) << "\n";
@@ -135,7 +151,8 @@ Command Folder(CLI::App& app) {
 // labfile: a lab's host layout, checked, as JSON for scripts/lab.
 Command LabFile(CLI::App& app) {
   auto path = std::make_shared<std::string>();
-  CLI::App* c = app.add_subcommand("labfile", "Check a lab file (docs/sessions.md) and print it as JSON");
+  CLI::App* c =
+      app.add_subcommand("labfile", "Check a lab file (docs/sessions.md) and print it as JSON");
   c->add_option("file", *path, "Lab file")->required()->check(CLI::ExistingFile);
   return {c, [path] {
             std::cout << session::LabFileJson(session::LoadLabFile(*path)).dump(2) << "\n";
@@ -146,10 +163,13 @@ Command LabFile(CLI::App& app) {
 // probe: who else is on an address (scripts/lab, before a session starts).
 Command Probe(CLI::App& app) {
   auto o = std::make_shared<std::pair<std::string, double>>("", 1.2);
-  CLI::App* c = app.add_subcommand(
-      "probe", "Listen on an LCM address and print, as JSON, every rmslab session heard there (docs/security.md)");
+  CLI::App* c = app.add_subcommand("probe",
+                                   "Listen on an LCM address and print, as JSON, every rmslab "
+                                   "session heard there (docs/security.md)");
   c->add_option("--lcm-url", o->first, "The address")->required();
-  c->add_option("--seconds", o->second, "How long to listen")->capture_default_str()->check(CLI::Range(0.1, 60.0));
+  c->add_option("--seconds", o->second, "How long to listen")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 60.0));
   return {c, [o] {
             std::cout << session::ProbeAddress(o->first, o->second).dump(2) << "\n";
             return 0;
@@ -158,7 +178,8 @@ Command Probe(CLI::App& app) {
 
 // counters: every counter a process reports, as docs/sessions.md lists them.
 Command Counters(CLI::App& app) {
-  CLI::App* c = app.add_subcommand("counters", "Print every process counter with its meaning (markdown)");
+  CLI::App* c =
+      app.add_subcommand("counters", "Print every process counter with its meaning (markdown)");
   return {c, [] {
             std::cout << rms::CounterTableMarkdown();
             return 0;
@@ -170,8 +191,9 @@ Command Counters(CLI::App& app) {
 int main(int argc, char** argv) {
   CLI::App app{"rmslab session tools"};
   app.require_subcommand(1);
-  const std::vector<Command> commands = {Summary(app), Manifest(app), CompareEsg(app), Export(app),
-                                         Folder(app),  LabFile(app),  Probe(app),      Counters(app)};
+  const std::vector<Command> commands = {Summary(app), Manifest(app), CompareEsg(app),
+                                         Export(app),  Folder(app),   LabFile(app),
+                                         Probe(app),   Counters(app)};
   if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   try {
     for (const Command& c : commands) {

@@ -15,7 +15,9 @@
 #include "rms/sim/snapshots.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"rmslab rms_snapshot: one picture from each camera station over a mission, and a contact sheet"};
+  CLI::App app{
+      "rmslab rms_snapshot: one picture from each camera station over a mission, and a contact "
+      "sheet"};
   std::string config_path = rms::DefaultConfigPath();
   std::string timeline = std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl";
   rms::sim::PictureOptions o;
@@ -23,18 +25,28 @@ int main(int argc, char** argv) {
   std::optional<double> at_time;
   app.add_option("--config", config_path, "Configuration file")->capture_default_str();
   app.add_option("--timeline", timeline, "Timeline to fly")->capture_default_str();
-  app.add_option("--out-dir", o.out_dir, "Directory for station_N.png and stations.png")->capture_default_str();
-  app.add_option("--time", at_time, "All stations at this time (s) instead of each at its first visit");
-  app.add_option("--width", o.width, "Width of each picture")->capture_default_str()->check(CLI::Range(64, 4096));
-  app.add_option("--height", o.height, "Height of each picture")->capture_default_str()->check(CLI::Range(48, 4096));
-  app.add_option("--columns", columns, "Pictures a row in the contact sheet")->capture_default_str()->check(CLI::Range(1, 8));
+  app.add_option("--out-dir", o.out_dir, "Directory for station_N.png and stations.png")
+      ->capture_default_str();
+  app.add_option("--time", at_time,
+                 "All stations at this time (s) instead of each at its first visit");
+  app.add_option("--width", o.width, "Width of each picture")
+      ->capture_default_str()
+      ->check(CLI::Range(64, 4096));
+  app.add_option("--height", o.height, "Height of each picture")
+      ->capture_default_str()
+      ->check(CLI::Range(48, 4096));
+  app.add_option("--columns", columns, "Pictures a row in the contact sheet")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 8));
   app.add_option("--gl", o.gl, "GL backend: osmesa or egl")->capture_default_str();
   std::vector<std::string> shots;
   app.add_option("--shot", shots,
-                 "T:STATION:NAME: one picture at time T (s) from STATION into NAME.png, crosshairs on, with the "
+                 "T:STATION:NAME: one picture at time T (s) from STATION into NAME.png, crosshairs "
+                 "on, with the "
                  "window's guidance panel (repeat for more)");
   std::string guidance_frame = "end_effector";
-  app.add_option("--guidance-frame", guidance_frame, "The guidance panel's command frame: end_effector, orbiter, payload")
+  app.add_option("--guidance-frame", guidance_frame,
+                 "The guidance panel's command frame: end_effector, orbiter, payload")
       ->capture_default_str()
       ->check(CLI::IsMember({"end_effector", "orbiter", "payload"}));
   if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
@@ -42,7 +54,8 @@ int main(int argc, char** argv) {
     const rms::LabConfig config = rms::LoadConfig(config_path);
     const auto tl = rms::operator_station::Timeline::Load(timeline, config.inputs);
     if (!shots.empty()) {
-      rms::sim::TakeShots(config, tl, shots, *rms::operator_station::ParseCommandFrame(guidance_frame), o);
+      rms::sim::TakeShots(config, tl, shots,
+                          *rms::operator_station::ParseCommandFrame(guidance_frame), o);
       return 0;
     }
     rms::sim::ContactSheet(config, tl, rms::sim::StationTimes(config, tl, at_time), columns, o);

@@ -3,13 +3,13 @@
 #include <cctype>
 #include <cerrno>
 #include <chrono>
-#include <cstring>
 #include <cstdlib>
+#include <cstring>
 #include <lcm/lcm-cpp.hpp>
 #include <spdlog/spdlog.h>
 
-#include "rms/wire/channels.h"
 #include "rms/base/check.h"
+#include "rms/wire/channels.h"
 #include "rms/wire/message_io.h"
 
 namespace rms::transport {
@@ -39,8 +39,12 @@ std::int64_t ParseSessionId(const std::string& text, const std::string& what) {
   const bool hex = text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X');
   const std::string digits = hex ? text.substr(2) : text;
   bool ok = !digits.empty() && digits.size() <= (hex ? 16u : 19u);
-  for (char c : digits) ok = ok && (hex ? std::isxdigit(static_cast<unsigned char>(c)) : std::isdigit(static_cast<unsigned char>(c)));
-  if (!ok) throw InputError(what + "='" + text + "': not a session id (decimal, or 0x and up to 16 hex digits)");
+  for (char c : digits)
+    ok = ok && (hex ? std::isxdigit(static_cast<unsigned char>(c))
+                    : std::isdigit(static_cast<unsigned char>(c)));
+  if (!ok)
+    throw InputError(what + "='" + text +
+                     "': not a session id (decimal, or 0x and up to 16 hex digits)");
   return static_cast<std::int64_t>(std::strtoull(digits.c_str(), nullptr, hex ? 16 : 10));
 }
 
@@ -55,7 +59,9 @@ bool LcmInterface::Admit(const std::string& channel, const void* data, int size)
   std::int64_t fp = 0, id = 0;
   // Only rmslab messages carry a sender; anything else goes on to be
   // refused by the decoder (dropped.wrong_type), as before.
-  if (!wire::ReadFingerprint(data, size, &fp) || !wire::IsRmslabFingerprint(fp) || !wire::ReadSessionId(data, size, &id)) return true;
+  if (!wire::ReadFingerprint(data, size, &fp) || !wire::IsRmslabFingerprint(fp) ||
+      !wire::ReadSessionId(data, size, &id))
+    return true;
   if (id == sender_.session_id) return AdmitPublisher(channel, data, size);
   ++other_session_dropped_;
   if (other_sessions_[id]++ == 0) {
@@ -63,8 +69,10 @@ bool LcmInterface::Admit(const std::string& channel, const void* data, int size)
     std::int32_t pid = 0;
     wire::ReadSenderProcess(data, size, &process, &pid);
     spdlog::warn(
-        "{}: a message of another session (session {}, {} pid {}) -- dropped, as every one of it will be "
-        "(dropped.other_session). Two sessions share this address: give each its own --channel-suffix or "
+        "{}: a message of another session (session {}, {} pid {}) -- dropped, as every one of it "
+        "will be "
+        "(dropped.other_session). Two sessions share this address: give each its own "
+        "--channel-suffix or "
         "--lcm-url (docs/security.md)",
         channel, wire::FormatSessionId(id), wire::ProcessCodeName(process), pid);
   }
@@ -79,8 +87,9 @@ bool LcmInterface::Admit(const std::string& channel, const void* data, int size)
 bool LcmInterface::AdmitPublisher(const std::string& channel, const void* data, int size) {
   std::string_view base = channel;  // per message: no allocation
   if (!suffix_.empty() && base.size() >= suffix_.size()) base.remove_suffix(suffix_.size());
-  if (base != wire::channels::kOperatorInput && base != wire::channels::kDcpFrame && base != wire::channels::kEsgFrame &&
-      base != wire::channels::kDcpTelemetry && base != wire::channels::kOperatorState && base != wire::channels::kWindowKeys &&
+  if (base != wire::channels::kOperatorInput && base != wire::channels::kDcpFrame &&
+      base != wire::channels::kEsgFrame && base != wire::channels::kDcpTelemetry &&
+      base != wire::channels::kOperatorState && base != wire::channels::kWindowKeys &&
       base != wire::channels::kDcpState) {
     return true;  // RMS_STATUS and RMS_CONTROL have several publishers
   }
@@ -100,15 +109,17 @@ bool LcmInterface::AdmitPublisher(const std::string& channel, const void* data, 
     if (!p.warned) {
       p.warned = true;
       spdlog::warn(
-          "{}: a message of this session from {} pid {} while its publisher ({} pid {}) is sending -- dropped, "
-          "as every one will be while it sends (dropped.other_sender): someone with this session's id is "
+          "{}: a message of this session from {} pid {} while its publisher ({} pid {}) is sending "
+          "-- dropped, "
+          "as every one will be while it sends (dropped.other_sender): someone with this session's "
+          "id is "
           "impersonating a process (docs/security.md)",
           channel, wire::ProcessCodeName(process), pid, wire::ProcessCodeName(p.process), p.pid);
     }
     return false;
   }
-  spdlog::info("{}: a new publisher, {} pid {}, after {} ms of silence from pid {} (a restart)", channel,
-               wire::ProcessCodeName(process), pid, (now - p.last_us) / 1000, p.pid);
+  spdlog::info("{}: a new publisher, {} pid {}, after {} ms of silence from pid {} (a restart)",
+               channel, wire::ProcessCodeName(process), pid, (now - p.last_us) / 1000, p.pid);
   p = Publisher{process, pid, now, false};
   return true;
 }

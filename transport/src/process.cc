@@ -1,28 +1,27 @@
 #include "rms/transport/process.h"
 
-#include "rms/base/command_line.h"
-
-#include <cerrno>
-#include <cstdio>
-#include <thread>
-#include <cstdlib>
-#include <cstring>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <cerrno>
 #include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <spdlog/sinks/stdout_sinks.h>
 #include <spdlog/spdlog.h>
-#include <unistd.h>
+#include <thread>
 
 #include "rms/base/check.h"
+#include "rms/base/command_line.h"
+#include "rms/base/config.h"
 #include "rms/base/text.h"
 #include "rms/base/version.h"
-#include "rms/wire/channels.h"
-#include "rms/base/config.h"
-#include "rms/wire/message_io.h"
 #include "rms/process_status_t.hpp"
+#include "rms/wire/channels.h"
+#include "rms/wire/message_io.h"
 
 namespace rms::transport {
 
@@ -44,11 +43,14 @@ void AddCommonOptions(CLI::App& app, CommonOptions* o) {
   app.add_option("--log-level", o->log_level, "trace, debug, info, warn, error")
       ->capture_default_str()
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
-  app.add_option("--session-id", o->session_id,
-                 "The session this process belongs to (default: $RMSLAB_SESSION_ID; none: takes every session's "
-                 "messages); messages of other sessions are dropped and counted (docs/security.md)");
+  app.add_option(
+      "--session-id", o->session_id,
+      "The session this process belongs to (default: $RMSLAB_SESSION_ID; none: takes every "
+      "session's "
+      "messages); messages of other sessions are dropped and counted (docs/security.md)");
   app.add_flag("--check", o->check,
-               "Check the configuration (and this process's own files), say what is wrong, and exit (0: good)");
+               "Check the configuration (and this process's own files), say what is wrong, and "
+               "exit (0: good)");
   app.set_version_flag("--version", VersionString(), "Print the software version and exit");
 }
 
@@ -76,8 +78,9 @@ int ProcessMain(CLI::App& app, int argc, char** argv, const std::string& process
   }
   try {
     const LabConfig config = LoadConfig(common->config_path);
-    const std::int64_t session =
-        common->session_id.empty() ? SessionIdFromEnv() : ParseSessionId(common->session_id, "--session-id");
+    const std::int64_t session = common->session_id.empty()
+                                     ? SessionIdFromEnv()
+                                     : ParseSessionId(common->session_id, "--session-id");
     UdpLcm lcm(common->lcm);
     lcm.SetSender({session, wire::ProcessCode(process), static_cast<std::int32_t>(getpid())});
     if (session != 0) spdlog::info("session {}", wire::FormatSessionId(session));
@@ -142,7 +145,8 @@ void WriteReadyFile(const std::string& path) {
     f.close();
     if (!f) throw InputError("cannot write the ready file '" + tmp + "'");
   }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw InputError("cannot create the ready file '" + path + "'");
+  if (std::rename(tmp.c_str(), path.c_str()) != 0)
+    throw InputError("cannot create the ready file '" + path + "'");
 }
 
 StatusReporter::StatusReporter(LcmInterface* lcm, std::string process)
@@ -152,18 +156,21 @@ StatusReporter::StatusReporter(LcmInterface* lcm, std::string process)
   host_ = buf;
 }
 
-void StatusReporter::Tick(std::int64_t frame, const Counters& counters, const LatencyMap& latencies) {
+void StatusReporter::Tick(std::int64_t frame, const Counters& counters,
+                          const LatencyMap& latencies) {
   const std::int64_t now = lcm_->NowUs();
   if (now - last_us_ < 1000000) return;
   last_us_ = now;
   Publish(frame, counters, latencies, false);
 }
 
-void StatusReporter::Final(std::int64_t frame, const Counters& counters, const LatencyMap& latencies) {
+void StatusReporter::Final(std::int64_t frame, const Counters& counters,
+                           const LatencyMap& latencies) {
   Publish(frame, counters, latencies, true);
 }
 
-void StatusReporter::Publish(std::int64_t frame, const Counters& counters, const LatencyMap& latencies, bool final) {
+void StatusReporter::Publish(std::int64_t frame, const Counters& counters,
+                             const LatencyMap& latencies, bool final) {
   process_status_t m;
   m.send_time_us = lcm_->NowUs();
   m.process = process_.substr(0, process_status_t::MAX_PROCESS_BYTES);
@@ -181,11 +188,14 @@ void StatusReporter::Publish(std::int64_t frame, const Counters& counters, const
 }
 
 void NoteTransportCounters(const LcmInterface& lcm, Counters* counters) {
-  if (const std::int64_t n = lcm.other_session_dropped(); n > 0) counters->Set(Counter::kDroppedOtherSession, n);
-  if (const std::int64_t n = lcm.other_sender_dropped(); n > 0) counters->Set(Counter::kDroppedOtherSender, n);
+  if (const std::int64_t n = lcm.other_session_dropped(); n > 0)
+    counters->Set(Counter::kDroppedOtherSession, n);
+  if (const std::int64_t n = lcm.other_sender_dropped(); n > 0)
+    counters->Set(Counter::kDroppedOtherSender, n);
 }
 
-std::map<std::string, std::int64_t> StatusFigures(const Counters& counters, const LatencyMap& latencies) {
+std::map<std::string, std::int64_t> StatusFigures(const Counters& counters,
+                                                  const LatencyMap& latencies) {
   std::map<std::string, std::int64_t> out = counters.ByName();
   for (const auto& [name, h] : latencies) {
     const std::string p = "latency." + name + ".";
@@ -199,7 +209,8 @@ std::map<std::string, std::int64_t> StatusFigures(const Counters& counters, cons
 
 void RunNodeLoop(LcmInterface& lcm, const std::string& process, Counters& counters,
                  const LatencyMap& latencies, const std::function<std::int64_t()>& last_frame,
-                 const std::function<void()>& after_wait, const std::string& stats_path, int wait_ms) {
+                 const std::function<void()>& after_wait, const std::string& stats_path,
+                 int wait_ms) {
   StatusReporter status(&lcm, process);
   while (!StopRequested()) {
     if (lcm.HandleSubscriptions(wait_ms) < 0) counters.Add(Counter::kTransportErrors);
@@ -236,7 +247,8 @@ wire::FrameClock SessionFrameClock(double rate_hz) {
   char* end = nullptr;
   const long long epoch = std::strtoll(v, &end, 10);
   if (*end != '\0' || epoch <= 0) {
-    throw InputError(std::string("RMSLAB_SESSION_EPOCH_US='") + v + "': not a time in us since 1970");
+    throw InputError(std::string("RMSLAB_SESSION_EPOCH_US='") + v +
+                     "': not a time in us since 1970");
   }
   c.epoch_us = epoch;
   c.max_rate_hz = rate_hz * kMaxSessionSpeed;
@@ -258,7 +270,8 @@ std::int64_t FirstFrameNumber(double rate_hz) {
   char* end = nullptr;
   const long long epoch = std::strtoll(v, &end, 10);
   if (*end != '\0' || epoch <= 0) {
-    throw InputError(std::string("RMSLAB_SESSION_EPOCH_US='") + v + "': not a time in us since 1970");
+    throw InputError(std::string("RMSLAB_SESSION_EPOCH_US='") + v +
+                     "': not a time in us since 1970");
   }
   const std::int64_t now = WallTimeUs();
   if (now <= epoch) return 0;

@@ -1,13 +1,13 @@
 #include "rms/wire/checkpoint.h"
 
 #include <fcntl.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <sys/stat.h>
 
 #include "rms/base/check.h"
 #include "rms/base/text.h"
@@ -26,7 +26,8 @@ std::string CheckpointText(const Checkpoint& c) {
   j["input_frame"] = c.input_frame;
   j["config"] = c.config;
   nlohmann::ordered_json in;
-  for (int i = 0; i < kNumAnalogInputs; ++i) in[std::string(kAnalogInputNames[i])] = c.inputs.value[i];
+  for (int i = 0; i < kNumAnalogInputs; ++i)
+    in[std::string(kAnalogInputNames[i])] = c.inputs.value[i];
   in["camera_station"] = c.inputs.camera_station;
   in["overlay"] = c.inputs.overlay;
   in["crosshairs"] = c.inputs.crosshairs;
@@ -40,11 +41,14 @@ namespace {
 // Reads an open file: a regular one of at most kMaxCheckpointBytes, or refused.
 std::string ReadOpenFile(int fd, const std::string& path) {
   struct stat st {};
-  if (fstat(fd, &st) != 0) throw InputError("cannot read checkpoint '" + path + "': " + std::strerror(errno));
-  if (!S_ISREG(st.st_mode)) throw InputError("checkpoint '" + path + "' is not a regular file: refused");
+  if (fstat(fd, &st) != 0)
+    throw InputError("cannot read checkpoint '" + path + "': " + std::strerror(errno));
+  if (!S_ISREG(st.st_mode))
+    throw InputError("checkpoint '" + path + "' is not a regular file: refused");
   if (st.st_size > kMaxCheckpointBytes) {
-    throw InputError("checkpoint '" + path + "' is " + std::to_string(st.st_size) + " bytes, more than any checkpoint (" +
-                     std::to_string(kMaxCheckpointBytes) + "): refused");
+    throw InputError("checkpoint '" + path + "' is " + std::to_string(st.st_size) +
+                     " bytes, more than any checkpoint (" + std::to_string(kMaxCheckpointBytes) +
+                     "): refused");
   }
   std::string text(static_cast<std::size_t>(st.st_size), '\0');
   std::size_t got = 0;
@@ -83,40 +87,48 @@ void CheckpointFolder::ValidateName(const std::string& name) {
   bool ok = !name.empty() && name.size() <= 64 && name[0] != '.' && name.size() > 5 &&
             name.compare(name.size() - 5, 5, ".json") == 0;
   for (char ch : name) {
-    ok = ok && ((ch >= 'A' && ch <= 'Z') || (ch >= 'a' && ch <= 'z') || (ch >= '0' && ch <= '9') || ch == '_' ||
-                ch == '-' || ch == '.');
+    ok = ok && ((ch >= 'A' && ch <= 'Z') || (ch >= 'a' && ch <= 'z') || (ch >= '0' && ch <= '9') ||
+                ch == '_' || ch == '-' || ch == '.');
   }
   if (!ok) {
     std::string shown;  // printable only: a name must not write lines of its own into a log
     for (char ch : name.substr(0, 80)) {
-      shown += (ch >= 0x20 && ch < 0x7f) ? std::string(1, ch) : Sprintf("\\x%02x", static_cast<unsigned char>(ch));
+      shown += (ch >= 0x20 && ch < 0x7f) ? std::string(1, ch)
+                                         : Sprintf("\\x%02x", static_cast<unsigned char>(ch));
     }
     throw InputError("checkpoint name '" + shown +
-                     "' refused: a name (not a path) of 1 to 64 letters, digits, '_', '-' or '.', ending in .json, "
+                     "' refused: a name (not a path) of 1 to 64 letters, digits, '_', '-' or '.', "
+                     "ending in .json, "
                      "not starting with '.'");
   }
 }
 
 int CheckpointFolder::OpenDir() const {
-  if (dir_.empty()) throw InputError("no checkpoints folder was given to this process (--checkpoint-dir): refused");
+  if (dir_.empty())
+    throw InputError("no checkpoints folder was given to this process (--checkpoint-dir): refused");
   // The folder itself, never through a link (one planted in its place while
   // the session runs would send checkpoints elsewhere).
   const int fd = open(dir_.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
   struct stat st {};
-  if (fd < 0 && (errno == ELOOP || errno == ENOTDIR) && lstat(dir_.c_str(), &st) == 0 && S_ISLNK(st.st_mode)) {
+  if (fd < 0 && (errno == ELOOP || errno == ENOTDIR) && lstat(dir_.c_str(), &st) == 0 &&
+      S_ISLNK(st.st_mode)) {
     throw InputError("the checkpoints folder '" + dir_ + "' is a symbolic link: refused");
   }
-  if (fd < 0) throw InputError("cannot open the checkpoints folder '" + dir_ + "': " + std::strerror(errno));
+  if (fd < 0)
+    throw InputError("cannot open the checkpoints folder '" + dir_ + "': " + std::strerror(errno));
   return fd;
 }
 
 void CheckpointFolder::Write(const std::string& name, const Checkpoint& c) const {
   ValidateName(name);
   const Fd dir{OpenDir()};
-  const Fd f{openat(dir.fd, name.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644)};
+  const Fd f{
+      openat(dir.fd, name.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644)};
   if (f.fd < 0) {
-    if (errno == EEXIST) throw InputError("checkpoint '" + name + "' exists already in " + dir_ + ": not replaced");
-    throw InputError("cannot write checkpoint '" + name + "' in " + dir_ + ": " + std::strerror(errno));
+    if (errno == EEXIST)
+      throw InputError("checkpoint '" + name + "' exists already in " + dir_ + ": not replaced");
+    throw InputError("cannot write checkpoint '" + name + "' in " + dir_ + ": " +
+                     std::strerror(errno));
   }
   const std::string text = CheckpointText(c);
   std::size_t put = 0;
@@ -126,7 +138,8 @@ void CheckpointFolder::Write(const std::string& name, const Checkpoint& c) const
     if (n <= 0) {
       const std::string why = std::strerror(errno);
       unlinkat(dir.fd, name.c_str(), 0);  // no half-written checkpoint left behind
-      throw InputError("cannot write checkpoint '" + name + "' in " + dir_ + ": " + why);
+      throw InputError(Sprintf("cannot write checkpoint '%s' in %s: %s", name.c_str(), dir_.c_str(),
+                               why.c_str()));
     }
     put += static_cast<std::size_t>(n);
   }
@@ -138,7 +151,8 @@ Checkpoint CheckpointFolder::Read(const std::string& name) const {
   const Fd f{openat(dir.fd, name.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC)};
   if (f.fd < 0) {
     if (errno == ELOOP) throw InputError("checkpoint '" + name + "' is a symbolic link: refused");
-    throw InputError("cannot read checkpoint '" + name + "' in " + dir_ + ": " + std::strerror(errno));
+    throw InputError("cannot read checkpoint '" + name + "' in " + dir_ + ": " +
+                     std::strerror(errno));
   }
   return ParseCheckpoint(ReadOpenFile(f.fd, PathOf(name)), PathOf(name));
 }
@@ -151,7 +165,8 @@ Checkpoint ParseCheckpoint(std::string_view text, const std::string& path) {
     throw InputError("checkpoint '" + path + "' is not JSON: " + e.what());
   }
   if (!j.is_object() || j.value("format", "") != kFormat) {
-    throw InputError("checkpoint '" + path + "': not an rmslab checkpoint (\"format\" must be \"" + kFormat + "\")");
+    throw InputError("checkpoint '" + path + "': not an rmslab checkpoint (\"format\" must be \"" +
+                     kFormat + "\")");
   }
   Checkpoint c;
   try {
@@ -160,14 +175,17 @@ Checkpoint ParseCheckpoint(std::string_view text, const std::string& path) {
     c.input_frame = j.at("input_frame").get<std::int64_t>();
     c.config = j.at("config").get<std::string>();
     const auto& o = j.at("operator_inputs");
-    for (int i = 0; i < kNumAnalogInputs; ++i) c.inputs.value[i] = o.at(std::string(kAnalogInputNames[i])).get<double>();
+    for (int i = 0; i < kNumAnalogInputs; ++i)
+      c.inputs.value[i] = o.at(std::string(kAnalogInputNames[i])).get<double>();
     c.inputs.camera_station = o.at("camera_station").get<int>();
     c.inputs.overlay = o.at("overlay").get<bool>();
     c.inputs.crosshairs = o.value("crosshairs", false);  // absent before the crosshairs switch
     c.dcp = j.at("dcp");
   } catch (const std::exception& e) {
-    std::string why = e.what();  // nlohmann's "[json.exception.out_of_range.403] key 'x' not found" -> the key
-    if (why.rfind("[json.exception.", 0) == 0 && why.find("] ") != std::string::npos) why = why.substr(why.find("] ") + 2);
+    std::string why =
+        e.what();  // nlohmann's "[json.exception.out_of_range.403] key 'x' not found" -> the key
+    if (why.rfind("[json.exception.", 0) == 0 && why.find("] ") != std::string::npos)
+      why = why.substr(why.find("] ") + 2);
     throw InputError("checkpoint '" + path + "': not a valid checkpoint (" + why + ")");
   }
   return c;

@@ -24,8 +24,10 @@ SequenceTracker::Verdict SequenceTracker::Refuse(std::int64_t frame, Verdict why
     last_ = frame;
     return Verdict::kResync;
   }
-  if (why == Verdict::kStale) ++stale_;
-  else ++far_ahead_;
+  if (why == Verdict::kStale)
+    ++stale_;
+  else
+    ++far_ahead_;
   return why;
 }
 

@@ -32,7 +32,8 @@ std::array<std::int32_t, kInputWords> EncodeInputs(const OperatorInputs& in,
   std::array<std::int32_t, kInputWords> words{};
   for (int i = 0; i < kNumAnalogInputs; ++i) {
     double v = in.value[i];
-    if (!std::isfinite(v)) throw InputError("input '" + std::string(kAnalogInputNames[i]) + "' is not a finite number");
+    if (!std::isfinite(v))
+      throw InputError("input '" + std::string(kAnalogInputNames[i]) + "' is not a finite number");
     v = ClampCounted(v, cal[i].min, cal[i].max, ClampedCounter(i), counters);
     const double counts = v / cal[i].units_per_count + cal[i].zero_count;
     const wire::Encoded e = wire::Encode(wire::kADC16, counts);

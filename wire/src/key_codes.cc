@@ -8,9 +8,18 @@ struct KeyNameCode {
   int code;
 };
 constexpr KeyNameCode kKeyNames[] = {
-    {"space", ' '},         {"plus", '+'},       {"minus", '-'},           {"up", kKeyUp},
-    {"down", kKeyDown},     {"left", kKeyLeft},  {"right", kKeyRight},     {"pageup", kKeyPageUp},
-    {"pagedown", kKeyPageDown}, {"backspace", kKeyBackspace}, {"tab", kKeyTab}, {"enter", kKeyEnter},
+    {"space", ' '},
+    {"plus", '+'},
+    {"minus", '-'},
+    {"up", kKeyUp},
+    {"down", kKeyDown},
+    {"left", kKeyLeft},
+    {"right", kKeyRight},
+    {"pageup", kKeyPageUp},
+    {"pagedown", kKeyPageDown},
+    {"backspace", kKeyBackspace},
+    {"tab", kKeyTab},
+    {"enter", kKeyEnter},
 };
 }  // namespace
 

@@ -24,8 +24,8 @@ std::uint64_t ReadBigEndian(const std::uint8_t* b, int n) {
 
 bool IsRmslabFingerprint(std::int64_t fp) {
   static const std::int64_t kTypes[] = {
-      operator_input_t::getHash(), dcp_frame_t::getHash(),       esg_frame_t::getHash(),
-      process_status_t::getHash(), dcp_telemetry_t::getHash(),   session_control_t::getHash(),
+      operator_input_t::getHash(), dcp_frame_t::getHash(),      esg_frame_t::getHash(),
+      process_status_t::getHash(), dcp_telemetry_t::getHash(),  session_control_t::getHash(),
       window_keys_t::getHash(),    operator_state_t::getHash(),
   };
   for (std::int64_t t : kTypes) {
@@ -36,7 +36,8 @@ bool IsRmslabFingerprint(std::int64_t fp) {
 
 bool ReadSessionId(const void* data, int size, std::int64_t* session_id) {
   if (size < 8 + kSenderBytes) return false;
-  *session_id = static_cast<std::int64_t>(ReadBigEndian(static_cast<const std::uint8_t*>(data) + 8, 8));
+  *session_id =
+      static_cast<std::int64_t>(ReadBigEndian(static_cast<const std::uint8_t*>(data) + 8, 8));
   return true;
 }
 
@@ -84,12 +85,14 @@ std::int8_t ProcessCode(std::string_view name) {
 
 const char* DecodeErrorName(DecodeError e) {
   switch (e) {
-    case DecodeError::kNone: return "none";
+    case DecodeError::kNone:
+      return "none";
     case DecodeError::kTooLarge:
     case DecodeError::kWrongType:
     case DecodeError::kTruncated:
     case DecodeError::kTrailingBytes:
-    case DecodeError::kBadCount: return kDecodeErrorNames[static_cast<int>(e) - 1].data();
+    case DecodeError::kBadCount:
+      return kDecodeErrorNames[static_cast<int>(e) - 1].data();
   }
   return "unknown";
 }

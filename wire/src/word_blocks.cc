@@ -104,13 +104,16 @@ void PackDcpFrame(const DcpFrameData& in, dcp_frame_t* out, Counters* c) {
   PutArm(out->arm_words, in.arm, c);
   out->control_word = static_cast<std::int32_t>(PackControlWord(in.control));
   for (int p = 0; p < 3; ++p) {
-    for (int k = 0; k < 3; ++k) out->plane_words[4 * p + k] = Put(wire::kSC22, in.planes[p].n_R[k], Counter::kSaturatedPlane, c);
+    for (int k = 0; k < 3; ++k)
+      out->plane_words[4 * p + k] =
+          Put(wire::kSC22, in.planes[p].n_R[k], Counter::kSaturatedPlane, c);
     out->plane_words[4 * p + 3] = Put(wire::kFT12, in.planes[p].d_ft, Counter::kSaturatedPlane, c);
   }
   RMS_CHECK(in.plane_valid <= 7);
   out->plane_status = static_cast<std::int32_t>(in.plane_valid);
   auto* s = out->state_words;
-  s[dcp_state::kShoulderHeight] = Put(wire::kFT12, in.shoulder_height_ft, Counter::kSaturatedShoulderHeight, c);
+  s[dcp_state::kShoulderHeight] =
+      Put(wire::kFT12, in.shoulder_height_ft, Counter::kSaturatedShoulderHeight, c);
   s[dcp_state::kFingerGap] = Put(wire::kFT12, in.finger_gap_ft, Counter::kSaturatedFingerGap, c);
   s[dcp_state::kCameraPan] = static_cast<std::int32_t>(wire::EncodeAngleBam(in.camera_pan_deg));
   s[dcp_state::kCameraTilt] = static_cast<std::int32_t>(wire::EncodeAngleBam(in.camera_tilt_deg));
@@ -146,7 +149,8 @@ DcpFrameData UnpackDcpFrame(const dcp_frame_t& m) {
   d.camera_pan_deg = s.Angle(dcp_state::kCameraPan);
   d.camera_tilt_deg = s.Angle(dcp_state::kCameraTilt);
   d.camera_zoom = s.Get(wire::kSC22, dcp_state::kCameraZoom);
-  if (!(d.camera_zoom >= 0.0 && d.camera_zoom <= 1.0)) s.Fail(dcp_state::kCameraZoom, "zoom must be in [0, 1]");
+  if (!(d.camera_zoom >= 0.0 && d.camera_zoom <= 1.0))
+    s.Fail(dcp_state::kCameraZoom, "zoom must be in [0, 1]");
   d.p_RoPo_R_ft = s.Vec3(dcp_state::kPayloadPos);
   d.R_RP = s.Rot(dcp_state::kPayloadRot);
   return d;
@@ -160,7 +164,8 @@ std::vector<std::int32_t> PackEsgWords(const EsgFrameData& in, Counters* c) {
   w[ew::kFrameCount] = static_cast<std::int32_t>(in.frame_count & wire::kWordMask);
   w[ew::kControl] = static_cast<std::int32_t>(PackControlWord(in.control));
   PutArm(w.begin() + ew::kArm, in.arm, c);
-  w[ew::kShoulderHeight] = Put(wire::kFT12, in.shoulder_height_ft, Counter::kSaturatedShoulderHeight, c);
+  w[ew::kShoulderHeight] =
+      Put(wire::kFT12, in.shoulder_height_ft, Counter::kSaturatedShoulderHeight, c);
   w[ew::kFingerGap] = Put(wire::kFT12, in.finger_gap_ft, Counter::kSaturatedFingerGap, c);
   PutVec3(w.begin() + ew::kEye, in.p_RoEye_R_ft, Counter::kSaturatedEye, c);
   PutRot(w.begin() + ew::kView, in.R_RE, Counter::kSaturatedView, c);
@@ -178,7 +183,8 @@ EsgFrameData UnpackEsgWords(std::span<const std::int32_t> w) {
   namespace ew = esg_words;
   if (w.size() != static_cast<std::size_t>(ew::kCount)) {
     throw InputError("ESG frame has " + std::to_string(w.size()) + " words; this layout has " +
-                     std::to_string(ew::kCount) + " (at most " + std::to_string(kEsgMaxWords) + ")");
+                     std::to_string(ew::kCount) + " (at most " + std::to_string(kEsgMaxWords) +
+                     ")");
   }
   const int bad = wire::FirstInvalidWord(w);
   if (bad >= 0) {
@@ -196,7 +202,8 @@ EsgFrameData UnpackEsgWords(std::span<const std::int32_t> w) {
   d.p_RoEye_R_ft = r.Vec3(ew::kEye);
   d.R_RE = r.Rot(ew::kView);
   d.fov_deg = r.Angle(ew::kFov);
-  if (!(d.fov_deg > 0.0 && d.fov_deg < 180.0)) r.Fail(ew::kFov, "field of view must be in (0, 180) deg");
+  if (!(d.fov_deg > 0.0 && d.fov_deg < 180.0))
+    r.Fail(ew::kFov, "field of view must be in (0, 180) deg");
   d.p_RoPo_R_ft = r.Vec3(ew::kPayloadPos);
   d.R_RP = r.Rot(ew::kPayloadRot);
   for (int i = 0; i < ew::kPriorityCount; ++i) d.priority_words[i] = w[ew::kPriority + i];

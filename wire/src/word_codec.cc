@@ -15,8 +15,12 @@ int FirstInvalidWord(std::span<const std::int32_t> words) {
 }
 
 double FixedFormat::lsb() const { return std::ldexp(1.0, -frac_bits); }
-double FixedFormat::min_value() const { return std::ldexp(static_cast<double>(raw_min), -frac_bits); }
-double FixedFormat::max_value() const { return std::ldexp(static_cast<double>(raw_max), -frac_bits); }
+double FixedFormat::min_value() const {
+  return std::ldexp(static_cast<double>(raw_min), -frac_bits);
+}
+double FixedFormat::max_value() const {
+  return std::ldexp(static_cast<double>(raw_max), -frac_bits);
+}
 
 namespace {
 
@@ -47,8 +51,14 @@ Encoded Encode(const FixedFormat& f, double value) {
   if (scaled >= static_cast<double>(f.raw_max) + 0.5) return {RawToWord(f, f.raw_max), true};
   std::int64_t raw = std::llround(scaled);  // ties away from zero
   bool saturated = false;
-  if (raw < f.raw_min) { raw = f.raw_min; saturated = true; }
-  if (raw > f.raw_max) { raw = f.raw_max; saturated = true; }
+  if (raw < f.raw_min) {
+    raw = f.raw_min;
+    saturated = true;
+  }
+  if (raw > f.raw_max) {
+    raw = f.raw_max;
+    saturated = true;
+  }
   return {RawToWord(f, raw), saturated};
 }
 
@@ -77,7 +87,8 @@ std::int32_t DecodeRaw(const FixedFormat& f, std::int32_t carried) {
 
 double Decode(const FixedFormat& f, std::int32_t carried) {
   // Divided by 2^frac_bits: exact (a power of two), as ldexp.
-  return static_cast<double>(DecodeRaw(f, carried)) / static_cast<double>(std::int64_t{1} << f.frac_bits);
+  return static_cast<double>(DecodeRaw(f, carried)) /
+         static_cast<double>(std::int64_t{1} << f.frac_bits);
 }
 
 double RoundTrip(const FixedFormat& f, double value) {

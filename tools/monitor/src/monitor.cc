@@ -15,13 +15,13 @@
 #include "rms/process_status_t.hpp"
 #include "rms/session_control_t.hpp"
 #include "rms/transport/process.h"
+#include "rms/window_keys_t.hpp"
 #include "rms/wire/channels.h"
 #include "rms/wire/collision_bits.h"
 #include "rms/wire/control_word.h"
 #include "rms/wire/key_codes.h"
 #include "rms/wire/message_io.h"
 #include "rms/wire/word_blocks.h"
-#include "rms/window_keys_t.hpp"
 
 namespace rms::monitor {
 
@@ -45,7 +45,8 @@ bool Input(const void* d, int n, ChannelStats* c) {
   if (wire::SafeDecode(d, n, &m) != wire::DecodeError::kNone) return false;
   c->numbered = true;
   c->frames.Accept(m.frame);
-  c->last = Sprintf("frame %lld, discrete word %06x", static_cast<long long>(m.frame), static_cast<unsigned>(m.words[11]));
+  c->last = Sprintf("frame %lld, discrete word %06x", static_cast<long long>(m.frame),
+                    static_cast<unsigned>(m.words[11]));
   return true;
 }
 
@@ -56,9 +57,11 @@ bool DcpFrame(const void* d, int n, ChannelStats* c) {
   c->frames.Accept(m.frame);
   try {
     const wire::ControlWord w = wire::UnpackControlWord(m.control_word);
-    c->last = Sprintf("frame %lld (input %lld), mode %d, camera %d%s%s%s%s", static_cast<long long>(m.frame),
-                  static_cast<long long>(m.input_frame), w.mode, w.camera_station, w.collision ? ", COLL" : "",
-                  w.receptacle_collision ? ", RECPT" : "", w.acquired ? ", ACQ" : "", w.docked ? ", DOCK" : "");
+    c->last = Sprintf("frame %lld (input %lld), mode %d, camera %d%s%s%s%s",
+                      static_cast<long long>(m.frame), static_cast<long long>(m.input_frame),
+                      w.mode, w.camera_station, w.collision ? ", COLL" : "",
+                      w.receptacle_collision ? ", RECPT" : "", w.acquired ? ", ACQ" : "",
+                      w.docked ? ", DOCK" : "");
   } catch (const std::exception&) {
     return false;
   }
@@ -70,10 +73,12 @@ bool Telemetry(const void* d, int n, ChannelStats* c) {
   if (wire::SafeDecode(d, n, &m) != wire::DecodeError::kNone) return false;
   c->numbered = true;
   c->frames.Accept(m.frame);
-  const std::string coll = wire::CollisionNames(static_cast<std::uint32_t>(m.collisions), ",", "none");
-  c->last = Sprintf("frame %lld, mode %d%s, A (%.2f, %.2f, %.2f) ft, dock %.3f ft / %.2f deg, collisions %s",
-                static_cast<long long>(m.frame), m.mode, m.held ? " HELD" : "", m.p_RoA_R_ft[0], m.p_RoA_R_ft[1],
-                m.p_RoA_R_ft[2], m.dock_distance_ft, m.dock_angle_deg, coll.c_str());
+  const std::string coll =
+      wire::CollisionNames(static_cast<std::uint32_t>(m.collisions), ",", "none");
+  c->last = Sprintf(
+      "frame %lld, mode %d%s, A (%.2f, %.2f, %.2f) ft, dock %.3f ft / %.2f deg, collisions %s",
+      static_cast<long long>(m.frame), m.mode, m.held ? " HELD" : "", m.p_RoA_R_ft[0],
+      m.p_RoA_R_ft[1], m.p_RoA_R_ft[2], m.dock_distance_ft, m.dock_angle_deg, coll.c_str());
   return true;
 }
 
@@ -84,9 +89,11 @@ bool EsgFrame(const void* d, int n, ChannelStats* c) {
   c->frames.Accept(m.frame);
   try {
     const wire::EsgFrameData e = wire::UnpackEsgWords(m.words);
-    c->last = Sprintf("frame %lld (DCP %lld), %d words, camera %d, eye (%.1f, %.1f, %.1f) ft, fov %.1f deg",
-                  static_cast<long long>(m.frame), static_cast<long long>(m.dcp_frame), m.num_words,
-                  e.control.camera_station, e.p_RoEye_R_ft.x(), e.p_RoEye_R_ft.y(), e.p_RoEye_R_ft.z(), e.fov_deg);
+    c->last = Sprintf(
+        "frame %lld (DCP %lld), %d words, camera %d, eye (%.1f, %.1f, %.1f) ft, fov %.1f deg",
+        static_cast<long long>(m.frame), static_cast<long long>(m.dcp_frame), m.num_words,
+        e.control.camera_station, e.p_RoEye_R_ft.x(), e.p_RoEye_R_ft.y(), e.p_RoEye_R_ft.z(),
+        e.fov_deg);
   } catch (const std::exception&) {
     return false;
   }
@@ -96,8 +103,8 @@ bool EsgFrame(const void* d, int n, ChannelStats* c) {
 bool OperatorState(const void* d, int n, ChannelStats* c) {
   operator_state_t m{};
   if (wire::SafeDecode(d, n, &m) != wire::DecodeError::kNone) return false;
-  c->last = Sprintf("frame %lld, source %d, to go %.2f ft / %.1f deg", static_cast<long long>(m.frame), m.source,
-                    m.distance_ft, m.angle_deg);
+  c->last = Sprintf("frame %lld, source %d, to go %.2f ft / %.1f deg",
+                    static_cast<long long>(m.frame), m.source, m.distance_ft, m.angle_deg);
   return true;
 }
 
@@ -109,8 +116,8 @@ bool WindowKeys(const void* d, int n, ChannelStats* c) {
     if (!held.empty()) held += ' ';
     held += wire::KeyName(k);
   }
-  c->last = Sprintf("#%lld held: %s%s", static_cast<long long>(m.sequence), held.empty() ? "none" : held.c_str(),
-                    m.focused ? "" : " (window not focused)");
+  c->last = Sprintf("#%lld held: %s%s", static_cast<long long>(m.sequence),
+                    held.empty() ? "none" : held.c_str(), m.focused ? "" : " (window not focused)");
   return true;
 }
 
@@ -118,8 +125,8 @@ bool Control(const void* d, int n, ChannelStats* c) {
   session_control_t m;
   if (wire::SafeDecode(d, n, &m) != wire::DecodeError::kNone) return false;
   static const char* kNames[] = {"?", "freeze", "run", "step", "checkpoint", "restore"};
-  c->last = Sprintf("#%lld %s %s", static_cast<long long>(m.sequence), m.command >= 1 && m.command <= 5 ? kNames[m.command] : "?",
-                m.name.c_str());
+  c->last = Sprintf("#%lld %s %s", static_cast<long long>(m.sequence),
+                    m.command >= 1 && m.command <= 5 ? kNames[m.command] : "?", m.name.c_str());
   return true;
 }
 
@@ -135,12 +142,14 @@ void Monitor::On(const char* channel, Decode decode) {
   });
 }
 
-Monitor::Monitor(transport::LcmInterface* lcm, transport::LcmOptions options) : lcm_(lcm), options_(std::move(options)) {
+Monitor::Monitor(transport::LcmInterface* lcm, transport::LcmOptions options)
+    : lcm_(lcm), options_(std::move(options)) {
   On(wire::channels::kOperatorInput, Input);
   On(wire::channels::kDcpFrame, DcpFrame);
   On(wire::channels::kDcpTelemetry, Telemetry);
   On(wire::channels::kEsgFrame, EsgFrame);
-  On(wire::channels::kStatus, [this](const void* d, int n, ChannelStats* c) { return Status(d, n, c); });
+  On(wire::channels::kStatus,
+     [this](const void* d, int n, ChannelStats* c) { return Status(d, n, c); });
   On(wire::channels::kOperatorState, OperatorState);
   On(wire::channels::kWindowKeys, WindowKeys);
   On(wire::channels::kControl, Control);
@@ -156,11 +165,14 @@ bool Monitor::Status(const void* d, int n, ChannelStats* c) {
     const std::string k(CounterName(c));
     return v.count(k) ? v[k] : 0;
   };
-  processes_[m.process] = Sprintf("%-16s on %s (pid %d): frame %lld, published %lld, late %lld, missing %lld%s",
-                             m.process.c_str(), m.host.c_str(), m.pid, static_cast<long long>(m.frame),
-                             static_cast<long long>(get(Counter::kPublished)), static_cast<long long>(get(Counter::kFramesLate)),
-                             static_cast<long long>(get(Counter::kInputMissing) + get(Counter::kDcpMissing) + get(Counter::kEsgMissing)),
-                             m.final ? " (final)" : "");
+  processes_[m.process] =
+      Sprintf("%-16s on %s (pid %d): frame %lld, published %lld, late %lld, missing %lld%s",
+              m.process.c_str(), m.host.c_str(), m.pid, static_cast<long long>(m.frame),
+              static_cast<long long>(get(Counter::kPublished)),
+              static_cast<long long>(get(Counter::kFramesLate)),
+              static_cast<long long>(get(Counter::kInputMissing)) + get(Counter::kDcpMissing) +
+                  get(Counter::kEsgMissing),
+              m.final ? " (final)" : "");
   c->last = Sprintf("%zu processes reporting", processes_.size());
   return true;
 }
@@ -169,12 +181,14 @@ std::string Monitor::Render() const {
   std::ostringstream os;
   os << "rmslab monitor: " << options_.url
      << (options_.channel_suffix.empty() ? "" : " suffix " + options_.channel_suffix) << "\n";
-  os << Sprintf("%-22s %9s %8s %9s %7s %9s  %s\n", "channel", "messages", "rate Hz", "kB", "gaps", "malformed", "latest");
+  os << Sprintf("%-22s %9s %8s %9s %7s %9s  %s\n", "channel", "messages", "rate Hz", "kB", "gaps",
+                "malformed", "latest");
   for (const auto& [name, c] : channels_) {
-    os << Sprintf("%-22s %9lld %8.1f %9.1f %7s %9lld  %s\n", (name + options_.channel_suffix).c_str(),
-                  static_cast<long long>(c.messages), c.hz, c.bytes / 1024.0,
-                  c.numbered ? std::to_string(c.frames.missing()).c_str() : "-", static_cast<long long>(c.malformed),
-                  c.last.c_str());
+    os << Sprintf("%-22s %9lld %8.1f %9.1f %7s %9lld  %s\n",
+                  (name + options_.channel_suffix).c_str(), static_cast<long long>(c.messages),
+                  c.hz, c.bytes / 1024.0,
+                  c.numbered ? std::to_string(c.frames.missing()).c_str() : "-",
+                  static_cast<long long>(c.malformed), c.last.c_str());
   }
   os << "processes:\n";
   for (const auto& [p, line] : processes_) os << "  " << line << "\n";

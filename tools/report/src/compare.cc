@@ -4,13 +4,12 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
-#include <nlohmann/json.hpp>
-
-#include "rms/report/report.h"
 #include "rms/base/check.h"
 #include "rms/base/text.h"
+#include "rms/report/report.h"
 #include "rms/session/session_summary.h"
 
 namespace fs = std::filesystem;
@@ -26,11 +25,13 @@ struct Session {
 };
 
 Session Load(const std::string& dir) {
-  if (!fs::exists(fs::path(dir) / "lcmlog")) throw InputError(dir + ": not a session folder (no lcmlog)");
+  if (!fs::exists(fs::path(dir) / "lcmlog"))
+    throw InputError(dir + ": not a session folder (no lcmlog)");
   Session s;
   s.dir = dir;
   s.name = fs::absolute(dir).lexically_normal().filename().string();
-  if (s.name.empty()) s.name = fs::absolute(dir).lexically_normal().parent_path().filename().string();
+  if (s.name.empty())
+    s.name = fs::absolute(dir).lexically_normal().parent_path().filename().string();
   if (std::ifstream f(fs::path(dir) / "manifest.json"); f) {
     try {
       const auto m = nlohmann::json::parse(f);
@@ -54,11 +55,16 @@ Session Load(const std::string& dir) {
 std::string Esc(const std::string& v) {
   std::string o;
   for (char c : v) {
-    if (c == '<') o += "&lt;";
-    else if (c == '>') o += "&gt;";
-    else if (c == '&') o += "&amp;";
-    else if (c == '"') o += "&quot;";
-    else o += c;
+    if (c == '<')
+      o += "&lt;";
+    else if (c == '>')
+      o += "&gt;";
+    else if (c == '&')
+      o += "&amp;";
+    else if (c == '"')
+      o += "&quot;";
+    else
+      o += c;
   }
   return o;
 }
@@ -80,7 +86,8 @@ nlohmann::ordered_json Figures(const nlohmann::ordered_json& a) {
   const auto& sc = a["scorecard"];
   const auto& d = a["docking"];
   std::int64_t actions = 0;
-  for (const auto& [dev, n] : sc["inputs"]["actions_by_device"].items()) actions += n.get<std::int64_t>();
+  for (const auto& [dev, n] : sc["inputs"]["actions_by_device"].items())
+    actions += n.get<std::int64_t>();
   return {{"index", a["index"]},
           {"started_by", a["started_by"]},
           {"outcome", a["outcome"]},
@@ -113,27 +120,52 @@ nlohmann::ordered_json Best(const Session& s) {
   const auto& attempts = s.summary["attempts"];
   if (attempts.empty()) return nullptr;
   const int result = s.summary.value("result_attempt", static_cast<int>(attempts.size()));
-  return Figures(attempts[static_cast<std::size_t>(std::clamp<int>(result, 1, attempts.size()) - 1)]);
+  return Figures(
+      attempts[static_cast<std::size_t>(std::clamp<int>(result, 1, attempts.size()) - 1)]);
 }
 
 std::string Csv(const std::vector<Session>& sessions) {
   std::ostringstream c;
-  static const char* const kColumns[] = {
-      "index", "started_by", "outcome", "task_time_s", "acquisition_s", "extraction_s", "maneuvering_s", "docking_s",
-      "collisions", "held_s", "dock_distance_ft", "dock_angle_deg", "least_ee_payload_ft", "least_payload_bay_ft",
-      "least_payload_cae_ft", "near_d3y_s", "near_tpob_s", "near_dock_distance_s", "near_dock_angle_s", "actions",
-      "reversals", "multi_axis_share", "rate_limited_s", "finger_closures", "closures_not_acquiring"};
+  static const char* const kColumns[] = {"index",
+                                         "started_by",
+                                         "outcome",
+                                         "task_time_s",
+                                         "acquisition_s",
+                                         "extraction_s",
+                                         "maneuvering_s",
+                                         "docking_s",
+                                         "collisions",
+                                         "held_s",
+                                         "dock_distance_ft",
+                                         "dock_angle_deg",
+                                         "least_ee_payload_ft",
+                                         "least_payload_bay_ft",
+                                         "least_payload_cae_ft",
+                                         "near_d3y_s",
+                                         "near_tpob_s",
+                                         "near_dock_distance_s",
+                                         "near_dock_angle_s",
+                                         "actions",
+                                         "reversals",
+                                         "multi_axis_share",
+                                         "rate_limited_s",
+                                         "finger_closures",
+                                         "closures_not_acquiring"};
   c << "session,subject,note,kind,started_utc,resimulation_of,attempt_count";
   for (const char* k : kColumns) c << "," << (std::string(k) == "index" ? "attempt" : k);
   c << "\n";
   for (const Session& s : sessions) {
     for (const auto& a : s.summary["attempts"]) {
-      c << CsvField(s.name) << "," << CsvField(s.subject) << "," << CsvField(s.note) << "," << s.kind << ","
-        << s.started_utc << "," << CsvField(s.parent) << "," << s.summary["attempts"].size();
+      c << CsvField(s.name) << "," << CsvField(s.subject) << "," << CsvField(s.note) << ","
+        << s.kind << "," << s.started_utc << "," << CsvField(s.parent) << ","
+        << s.summary["attempts"].size();
       const auto fig = Figures(a);
       for (const char* k : kColumns) {
         const auto& v = fig[k];
-        c << "," << (v.is_string() ? CsvField(v.get<std::string>()) : v.is_number() ? Num(v, 6) : std::string());
+        c << ","
+          << (v.is_string()   ? CsvField(v.get<std::string>())
+              : v.is_number() ? Num(v, 6)
+                              : std::string());
       }
       c << "\n";
     }
@@ -143,29 +175,38 @@ std::string Csv(const std::vector<Session>& sessions) {
 
 std::string Table(const std::vector<Session>& sessions) {
   std::ostringstream h;
-  h << "<h2>Sessions side by side</h2>\n<p>Each session's result: its last attempt that docked, or else its last "
-       "attempt. Times are session time.</p>\n<table><tr><th>session</th><th>subject</th><th>note</th><th>kind</th>"
-       "<th>started (UTC)</th><th>attempts</th><th>outcome</th><th>task time, s</th><th>acquisition, s</th>"
-       "<th>extraction, s</th><th>manoeuvring, s</th><th>docking, s</th><th>collisions</th><th>arm held, s</th>"
-       "<th>docked at, ft</th><th>docked at, deg</th><th>actions</th><th>reversals</th><th>more than one axis</th>"
+  h << "<h2>Sessions side by side</h2>\n<p>Each session's result: its last attempt that docked, or "
+       "else its last "
+       "attempt. Times are session "
+       "time.</p>\n<table><tr><th>session</th><th>subject</th><th>note</th><th>kind</th>"
+       "<th>started (UTC)</th><th>attempts</th><th>outcome</th><th>task time, "
+       "s</th><th>acquisition, s</th>"
+       "<th>extraction, s</th><th>manoeuvring, s</th><th>docking, s</th><th>collisions</th><th>arm "
+       "held, s</th>"
+       "<th>docked at, ft</th><th>docked at, deg</th><th>actions</th><th>reversals</th><th>more "
+       "than one axis</th>"
        "<th>closures not acquiring</th></tr>";
   for (const Session& s : sessions) {
     const auto b = Best(s);
-    h << "<tr><td>" << Esc(s.name) << "</td><td>" << Esc(s.subject) << "</td><td>" << Esc(s.note) << "</td><td>"
-      << Esc(s.kind) << (s.parent.empty() ? "" : " of " + Esc(fs::path(s.parent).filename().string())) << "</td><td>"
-      << Esc(s.started_utc) << "</td><td>" << s.summary["attempts"].size() << "</td>";
+    h << "<tr><td>" << Esc(s.name) << "</td><td>" << Esc(s.subject) << "</td><td>" << Esc(s.note)
+      << "</td><td>" << Esc(s.kind)
+      << (s.parent.empty() ? "" : " of " + Esc(fs::path(s.parent).filename().string()))
+      << "</td><td>" << Esc(s.started_utc) << "</td><td>" << s.summary["attempts"].size()
+      << "</td>";
     if (b.is_null()) {
       h << "<td colspan=\"14\">no DCP frame in the log</td></tr>";
       continue;
     }
     h << "<td>" << Esc(b["outcome"].get<std::string>()) << "</td>";
-    for (const char* k : {"task_time_s", "acquisition_s", "extraction_s", "maneuvering_s", "docking_s"}) {
+    for (const char* k :
+         {"task_time_s", "acquisition_s", "extraction_s", "maneuvering_s", "docking_s"}) {
       h << "<td>" << (b[k].is_null() ? "-" : Num(b[k], 2)) << "</td>";
     }
     h << "<td>" << b["collisions"] << "</td><td>" << Num(b["held_s"], 2) << "</td><td>"
       << (b["dock_distance_ft"].is_null() ? "-" : Num(b["dock_distance_ft"], 4)) << "</td><td>"
-      << (b["dock_angle_deg"].is_null() ? "-" : Num(b["dock_angle_deg"], 3)) << "</td><td>" << b["actions"] << "</td><td>"
-      << b["reversals"] << "</td><td>" << HumanNumber(100 * b["multi_axis_share"].get<double>(), 1) << "%</td><td>"
+      << (b["dock_angle_deg"].is_null() ? "-" : Num(b["dock_angle_deg"], 3)) << "</td><td>"
+      << b["actions"] << "</td><td>" << b["reversals"] << "</td><td>"
+      << HumanNumber(100 * b["multi_axis_share"].get<double>(), 1) << "%</td><td>"
       << b["closures_not_acquiring"] << "</td></tr>";
   }
   h << "</table>\n";
@@ -187,28 +228,43 @@ Comparison CompareSessions(const std::vector<std::string>& dirs, const std::stri
     const Session& s = sessions[i];
     nlohmann::ordered_json attempts = nlohmann::ordered_json::array();
     for (const auto& a : s.summary["attempts"]) attempts.push_back(Figures(a));
-    data["sessions"].push_back({{"name", s.name}, {"subject", s.subject}, {"note", s.note}, {"started_utc", s.started_utc},
-                                {"kind", s.kind}, {"attempts", attempts}, {"best", Best(s)}});
+    data["sessions"].push_back({{"name", s.name},
+                                {"subject", s.subject},
+                                {"note", s.note},
+                                {"started_utc", s.started_utc},
+                                {"kind", s.kind},
+                                {"attempts", attempts},
+                                {"best", Best(s)}});
     // A learning curve is the subject's own sessions (not other designs' re-simulations).
-    if (s.kind != "re-simulation") subjects[s.subject.empty() ? "(no subject)" : s.subject].push_back(i);
+    if (s.kind != "re-simulation")
+      subjects[s.subject.empty() ? "(no subject)" : s.subject].push_back(i);
   }
   data["subjects"] = subjects;
   std::ifstream js(chart_js_path);
-  if (!js) throw InputError("cannot read Chart.js at '" + chart_js_path + "' (libjs-chart.js; scripts/install-deps)");
+  if (!js)
+    throw InputError("cannot read Chart.js at '" + chart_js_path +
+                     "' (libjs-chart.js; scripts/install-deps)");
   std::stringstream chart_js;
   chart_js << js.rdbuf();
   const std::string charts = ChartsScript("compare_charts.js");
   const std::string json = ScriptJson(data);
   std::ostringstream h;
-  h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>rmslab: " << sessions.size()
-    << " sessions compared</title>\n<style>body{font-family:sans-serif;max-width:1300px;margin:1em auto;color:#222}"
-       "table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #bbb;padding:3px 6px;text-align:left}"
+  h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>rmslab: "
+    << sessions.size()
+    << " sessions compared</title>\n<style>body{font-family:sans-serif;max-width:1300px;margin:1em "
+       "auto;color:#222}"
+       "table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #bbb;padding:3px "
+       "6px;text-align:left}"
        "th{background:#eee}</style>\n<script>\n"
-    << chart_js.str() << "\n</script>\n</head><body>\n<h1>" << sessions.size() << " sessions compared</h1>\n"
-    << "<p>Made by <code>scripts/lab compare</code> from the session folders alone; the figures are each session's "
+    << chart_js.str() << "\n</script>\n</head><body>\n<h1>" << sessions.size()
+    << " sessions compared</h1>\n"
+    << "<p>Made by <code>scripts/lab compare</code> from the session folders alone; the figures "
+       "are each session's "
        "summary (docs/sessions.md). compare.csv beside this page has a row an attempt.</p>\n"
-    << Table(sessions) << "<h2>Learning curves</h2>\n<div id=\"rms-charts\"></div>\n<script>\nwindow.RMS_COMPARE = "
-    << json << ";\n</script>\n<script>\n" << charts << "\n</script>\n</body></html>\n";
+    << Table(sessions)
+    << "<h2>Learning curves</h2>\n<div id=\"rms-charts\"></div>\n<script>\nwindow.RMS_COMPARE = "
+    << json << ";\n</script>\n<script>\n"
+    << charts << "\n</script>\n</body></html>\n";
   return {h.str(), Csv(sessions)};
 }
 

@@ -1,32 +1,32 @@
 #include "rms/report/report.h"
 
+#include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <lcm/lcm-cpp.hpp>
 #include <map>
+#include <set>
 #include <sstream>
 
-#include "rms/wire/channels.h"
 #include "rms/base/check.h"
-#include "rms/wire/collision_bits.h"
+#include "rms/base/config.h"
+#include "rms/base/text.h"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/esg_frame_t.hpp"
-#include "rms/wire/message_io.h"
 #include "rms/operator_input_t.hpp"
-#include "rms/base/config.h"
 #include "rms/operator_state_t.hpp"
 #include "rms/process_status_t.hpp"
-#include "rms/session_control_t.hpp"
-#include "rms/base/text.h"
 #include "rms/session/session_log.h"
 #include "rms/session/session_summary.h"
-#include <Eigen/Dense>
-#include <array>
-#include <functional>
-#include <set>
+#include "rms/session_control_t.hpp"
+#include "rms/wire/channels.h"
+#include "rms/wire/collision_bits.h"
+#include "rms/wire/message_io.h"
 
 namespace fs = std::filesystem;
 
@@ -40,11 +40,20 @@ std::string Html(const std::string& s) {
   std::string o;
   for (char c : s) {
     switch (c) {
-      case '<': o += "&lt;"; break;
-      case '>': o += "&gt;"; break;
-      case '&': o += "&amp;"; break;
-      case '"': o += "&quot;"; break;
-      default: o += c;
+      case '<':
+        o += "&lt;";
+        break;
+      case '>':
+        o += "&gt;";
+        break;
+      case '&':
+        o += "&amp;";
+        break;
+      case '"':
+        o += "&quot;";
+        break;
+      default:
+        o += c;
     }
   }
   return o;
@@ -69,11 +78,11 @@ double Pct(std::vector<double> v, double q) {
 // of its plots, its events, and the operator's frame intervals outside
 // freezes.
 struct Traces {
-  nlohmann::json t_s = nlohmann::json::array(), mode = nlohmann::json::array(), attempt = nlohmann::json::array(),
-                 p_ft = nlohmann::json::array(), payload_ft = nlohmann::json::array(),
-                 joints_deg = nlohmann::json::array(), finger = nlohmann::json::array(),
-                 goal_ft = nlohmann::json::array(), dock_angle_deg = nlohmann::json::array(),
-                 inputs = nlohmann::json::array();
+  nlohmann::json t_s = nlohmann::json::array(), mode = nlohmann::json::array(),
+                 attempt = nlohmann::json::array(), p_ft = nlohmann::json::array(),
+                 payload_ft = nlohmann::json::array(), joints_deg = nlohmann::json::array(),
+                 finger = nlohmann::json::array(), goal_ft = nlohmann::json::array(),
+                 dock_angle_deg = nlohmann::json::array(), inputs = nlohmann::json::array();
   bool by_hand = false;
   nlohmann::json events = nlohmann::json::array();
   std::vector<double> intervals_ms, to_dcp_ms, to_esg_ms;
@@ -117,14 +126,16 @@ struct TraceReader {
     if (m.mode != 1) return std::abs(m.dock_distance_ft);
     Eigen::Matrix3d R_RP;
     for (int i = 0; i < 9; ++i) R_RP(i / 3, i % 3) = m.R_RP[i];
-    const Eigen::Vector3d bar = Eigen::Vector3d(m.p_RoPo_R_ft[0], m.p_RoPo_R_ft[1], m.p_RoPo_R_ft[2]) +
-                                R_RP * config.payload.p_PoBar_P_ft;
+    const Eigen::Vector3d bar =
+        Eigen::Vector3d(m.p_RoPo_R_ft[0], m.p_RoPo_R_ft[1], m.p_RoPo_R_ft[2]) +
+        R_RP * config.payload.p_PoBar_P_ft;
     return (Eigen::Vector3d(m.p_RoA_R_ft[0], m.p_RoA_R_ft[1], m.p_RoA_R_ft[2]) - bar).norm();
   }
   void Telemetry(const dcp_telemetry_t& m, double t_s) {
     ++t.frames;
     if (m.mode != last_mode) {
-      if (last_mode != 0) Event(t_s, "mode", "Mode " + std::to_string(last_mode) + " -> " + std::to_string(m.mode));
+      if (last_mode != 0)
+        Event(t_s, "mode", "Mode " + std::to_string(last_mode) + " -> " + std::to_string(m.mode));
       last_mode = m.mode;
     }
     const auto bits = static_cast<std::uint32_t>(m.collisions);
@@ -146,21 +157,27 @@ struct TraceReader {
     t.joints_deg.push_back(std::vector<double>(m.slave_angles_deg, m.slave_angles_deg + 6));
     t.finger.push_back(m.slave_finger);
     t.goal_ft.push_back(Goal(m));
-    t.dock_angle_deg.push_back(m.mode == 1 ? nlohmann::json(nullptr) : nlohmann::json(m.dock_angle_deg));
+    t.dock_angle_deg.push_back(m.mode == 1 ? nlohmann::json(nullptr)
+                                           : nlohmann::json(m.dock_angle_deg));
     t.inputs.push_back(std::vector<double>(hand.begin(), hand.end()));
   }
   void Finish(double t_s) {
     for (int b = 0; b < wire::collision_bits::kCount; ++b) {
-      if (last_bits & (1u << b)) Event(bit_since[b], "collision", wire::CollisionName(b) + std::string(" (to the end)"), t_s - bit_since[b]);
+      if (last_bits & (1u << b))
+        Event(bit_since[b], "collision", wire::CollisionName(b) + std::string(" (to the end)"),
+              t_s - bit_since[b]);
     }
     if (last_held) Event(held_since, "hold", "arm held (to the end)", t_s - held_since);
     for (const auto& a : attempts) {
       if (a["started_by"] == "start") continue;
       Event(a["start_s"].get<double>(), a["started_by"] == "reset" ? "reset" : "restore",
-            a["started_by"].get<std::string>() + " (attempt " + std::to_string(a["index"].get<int>()) + ")");
+            a["started_by"].get<std::string>() + " (attempt " +
+                std::to_string(a["index"].get<int>()) + ")");
     }
     std::stable_sort(t.events.begin(), t.events.end(),
-                     [](const nlohmann::json& x, const nlohmann::json& y) { return x["t_s"].get<double>() < y["t_s"].get<double>(); });
+                     [](const nlohmann::json& x, const nlohmann::json& y) {
+                       return x["t_s"].get<double>() < y["t_s"].get<double>();
+                     });
   }
   void Control(const session_control_t& m, std::int64_t log_us, double t_s) {
     if (m.command == session_control_t::FREEZE && !frozen) {
@@ -187,7 +204,8 @@ struct TraceReader {
   }
   void Status(const process_status_t& m, double t_s) {
     const auto it = status_pid.find(m.process);
-    if (it != status_pid.end() && it->second != m.pid) Event(t_s, "restart", m.process + " restarted");
+    if (it != status_pid.end() && it->second != m.pid)
+      Event(t_s, "restart", m.process + " restarted");
     status_pid[m.process] = m.pid;
   }
   void OperatorState(const operator_state_t& m) {
@@ -197,15 +215,16 @@ struct TraceReader {
   }
 };
 
-Traces ReadTraces(const std::string& dir, const LabConfig& config, const nlohmann::ordered_json& summary) {
+Traces ReadTraces(const std::string& dir, const LabConfig& config,
+                  const nlohmann::ordered_json& summary) {
   session::SessionLog log(dir);
   TraceReader r(config, summary["attempts"]);
   const long frames = summary.value("telemetry_frames", 0L);
   r.every = static_cast<std::size_t>(std::max(1L, frames / 3000 + 1));
   const double rate = config.session.frame_rate_hz;
   double last_t = 0;
-  log.Read({wire::channels::kDcpTelemetry, wire::channels::kControl, wire::channels::kOperatorInput, wire::channels::kEsgFrame,
-            wire::channels::kStatus, wire::channels::kOperatorState},
+  log.Read({wire::channels::kDcpTelemetry, wire::channels::kControl, wire::channels::kOperatorInput,
+            wire::channels::kEsgFrame, wire::channels::kStatus, wire::channels::kOperatorState},
            [&](const session::LogMessage& ev) {
              if (ev.base == wire::channels::kDcpTelemetry) {
                dcp_telemetry_t m{};
@@ -221,7 +240,8 @@ Traces ReadTraces(const std::string& dir, const LabConfig& config, const nlohman
                if (log.Decode(ev, &m)) r.Input(m);
              } else if (ev.base == wire::channels::kEsgFrame) {
                esg_frame_t m{};
-               if (log.Decode(ev, &m)) r.t.to_esg_ms.push_back((ev.log_us - m.input_send_time_us) / 1000.0);
+               if (log.Decode(ev, &m))
+                 r.t.to_esg_ms.push_back((ev.log_us - m.input_send_time_us) / 1000.0);
              } else if (ev.base == wire::channels::kStatus) {
                process_status_t m;
                if (log.Decode(ev, &m)) r.Status(m, ev.session_time_s);
@@ -241,19 +261,24 @@ std::string LossesSection(const nlohmann::ordered_json& s) {
   std::ostringstream h;
   h << "<h2>Losses and refusals</h2>\n<table><tr><th>what</th><th>frames or messages</th></tr>";
   auto row = [&h](const std::string& what, const nlohmann::ordered_json& n) {
-    h << "<tr><td>" << Html(what) << "</td><td>" << (n.is_number() ? n.dump() : std::string("-")) << "</td></tr>";
+    h << "<tr><td>" << Html(what) << "</td><td>" << (n.is_number() ? n.dump() : std::string("-"))
+      << "</td></tr>";
   };
   const auto empty = nlohmann::ordered_json::object();
-  auto part = [&empty](const nlohmann::ordered_json& j, const char* a, const char* b) -> const nlohmann::ordered_json& {
-    if (!j.contains(a) || !j[a].is_object() || !j[a].contains(b) || !j[a][b].is_object()) return empty;
+  auto part = [&empty](const nlohmann::ordered_json& j, const char* a,
+                       const char* b) -> const nlohmann::ordered_json& {
+    if (!j.contains(a) || !j[a].is_object() || !j[a].contains(b) || !j[a][b].is_object())
+      return empty;
     return j[a][b];
   };
   for (const auto& [k, v] : part(s, "frames", "dropped").items()) {
     row((k.rfind("malformed", 0) == 0 ? "malformed, dropped: " : "lost on the link: ") + k, v);
   }
-  for (const auto& [k, v] : part(s, "frames", "refused").items()) row("refused by the processes: " + k, v);
+  for (const auto& [k, v] : part(s, "frames", "refused").items())
+    row("refused by the processes: " + k, v);
   for (const auto& [ch, r] : part(s, "record", "by_channel").items()) {
-    row("lost by the record: " + ch + " (of " + r.value("published", nlohmann::ordered_json()).dump() + " published)",
+    row("lost by the record: " + ch + " (of " +
+            r.value("published", nlohmann::ordered_json()).dump() + " published)",
         r.value("lost", nlohmann::ordered_json()));
   }
   for (const auto& [k, v] : part(s, "ignored", "by_reason").items()) {
@@ -268,9 +293,9 @@ std::string StatsRow(const std::string& name, const std::vector<double>& v) {
   double mean = 0;
   for (double x : v) mean += x;
   mean /= v.size();
-  return "<tr><td>" + Html(name) + "</td><td>" + std::to_string(v.size()) + "</td><td>" + F(mean, 2) + "</td><td>" +
-         F(Pct(v, 0.5), 2) + "</td><td>" + F(Pct(v, 0.99), 2) + "</td><td>" + F(*std::max_element(v.begin(), v.end()), 2) +
-         "</td></tr>";
+  return "<tr><td>" + Html(name) + "</td><td>" + std::to_string(v.size()) + "</td><td>" +
+         F(mean, 2) + "</td><td>" + F(Pct(v, 0.5), 2) + "</td><td>" + F(Pct(v, 0.99), 2) +
+         "</td><td>" + F(*std::max_element(v.begin(), v.end()), 2) + "</td></tr>";
 }
 
 }  // namespace
@@ -315,11 +340,15 @@ std::string SessionSection(const nlohmann::ordered_json& m, const nlohmann::orde
   field("kind", m.value("kind", nlohmann::ordered_json()));
   field("re-simulation of", m.value("resimulation_of", nlohmann::ordered_json()));
   field("started (UTC)", m.value("started_utc", nlohmann::ordered_json()));
-  if (m.contains("software")) field("software", m["software"].value("version", nlohmann::ordered_json()));
-  if (m.contains("config")) field("configuration", m["config"].value("source", m["config"].value("file", nlohmann::ordered_json())));
+  if (m.contains("software"))
+    field("software", m["software"].value("version", nlohmann::ordered_json()));
+  if (m.contains("config"))
+    field("configuration",
+          m["config"].value("source", m["config"].value("file", nlohmann::ordered_json())));
   if (m.contains("hosts")) {
     std::string hosts;
-    for (const auto& [p, host] : m["hosts"].items()) hosts += (hosts.empty() ? "" : ", ") + p + " on " + host.get<std::string>();
+    for (const auto& [p, host] : m["hosts"].items())
+      hosts += (hosts.empty() ? "" : ", ") + p + " on " + host.get<std::string>();
     field("hosts", hosts);
   }
   if (s.contains("duration_s")) h << Row("wall time", {Cell(s["duration_s"], " s", 1)});
@@ -331,9 +360,12 @@ std::string TolerancesSection(const LabConfig& c) {
   std::ostringstream h;
   h << "<h2>The configuration's tolerances</h2>\n<table>";
   h << Row("D3Y (acquisition: the finger gap below)", {HumanNumber(c.dcp.d3y_ft, 4) + " ft"});
-  h << Row("TPOB (acquisition: EFF HEX 1 face d to the BAR's face c within)", {HumanNumber(c.dcp.tpob_ft, 4) + " ft"});
-  h << Row("docking distance (probe tip to port centre, at most)", {HumanNumber(c.dcp.dock_distance_ft, 4) + " ft"});
-  h << Row("docking angle (probe axis to port axis, at most)", {HumanNumber(c.dcp.dock_angle_deg, 4) + " deg"});
+  h << Row("TPOB (acquisition: EFF HEX 1 face d to the BAR's face c within)",
+           {HumanNumber(c.dcp.tpob_ft, 4) + " ft"});
+  h << Row("docking distance (probe tip to port centre, at most)",
+           {HumanNumber(c.dcp.dock_distance_ft, 4) + " ft"});
+  h << Row("docking angle (probe axis to port axis, at most)",
+           {HumanNumber(c.dcp.dock_angle_deg, 4) + " deg"});
   h << Row("frame rate", {HumanNumber(c.session.frame_rate_hz, 2) + " Hz"});
   h << "</table>\n";
   return h.str();
@@ -342,34 +374,43 @@ std::string TolerancesSection(const LabConfig& c) {
 std::string AttemptsSection(const nlohmann::ordered_json& s) {
   std::ostringstream h;
   const auto& attempts = s["attempts"];
-  h << "<h2>Attempts</h2>\n<p>The start, each reset and each restore begins an attempt. Times are session time (the "
-       "operator's frames over the frame rate): they stand still in a freeze and read as flown at any speed.</p>\n";
+  h << "<h2>Attempts</h2>\n<p>The start, each reset and each restore begins an attempt. Times are "
+       "session time (the "
+       "operator's frames over the frame rate): they stand still in a freeze and read as flown at "
+       "any speed.</p>\n";
   if (attempts.empty()) return h.str() + "<p>No DCP frame in the log: no attempt.</p>\n";
-  h << "<table><tr><th>attempt</th><th>started by</th><th>start, s</th><th>duration, s</th><th>outcome</th>"
-       "<th>acquisition, s</th><th>extraction, s</th><th>manoeuvring, s</th><th>docking, s</th><th>collisions</th>"
+  h << "<table><tr><th>attempt</th><th>started by</th><th>start, s</th><th>duration, "
+       "s</th><th>outcome</th>"
+       "<th>acquisition, s</th><th>extraction, s</th><th>manoeuvring, s</th><th>docking, "
+       "s</th><th>collisions</th>"
        "<th>arm held, s</th><th>docked at, ft</th><th>docked at, deg</th></tr>";
   for (const auto& a : attempts) {
     const auto& ph = a["phase_durations_s"];
     const auto& d = a["docking"];
     h << "<tr><td>" << a["index"] << "</td><td>" << Cell(a["started_by"])
-      << (a.contains("restored") ? " " + Cell(a["restored"]) : "") << "</td><td>" << Cell(a["start_s"], "", 2)
-      << "</td><td>" << Cell(a["duration_s"], "", 2) << "</td><td class=\""
-      << (a["outcome"] == "docked" ? "ok" : "bad") << "\">" << Cell(a["outcome"]) << "</td>";
+      << (a.contains("restored") ? " " + Cell(a["restored"]) : "") << "</td><td>"
+      << Cell(a["start_s"], "", 2) << "</td><td>" << Cell(a["duration_s"], "", 2)
+      << "</td><td class=\"" << (a["outcome"] == "docked" ? "ok" : "bad") << "\">"
+      << Cell(a["outcome"]) << "</td>";
     for (const char* p : {"acquisition", "extraction", "maneuvering", "docking"}) {
-      h << "<td>" << (ph[p].is_null() ? std::string(a["started_in_mode"].get<int>() > 1 && std::string(p) == "acquisition"
-                                                         ? "before this attempt" : "not reached")
-                                      : Cell(ph[p], "", 2))
+      h << "<td>"
+        << (ph[p].is_null()
+                ? std::string(a["started_in_mode"].get<int>() > 1 && std::string(p) == "acquisition"
+                                  ? "before this attempt"
+                                  : "not reached")
+                : Cell(ph[p], "", 2))
         << "</td>";
     }
-    h << "<td>" << a["collisions"]["events"] << "</td><td>" << Cell(a["holds"]["arm"]["duration_s"], "", 2) << "</td><td>"
-      << (d.is_object() ? Cell(d["distance_ft"], "", 4) : "-") << "</td><td>" << (d.is_object() ? Cell(d["angle_deg"], "", 3) : "-")
-      << "</td></tr>";
+    h << "<td>" << a["collisions"]["events"] << "</td><td>"
+      << Cell(a["holds"]["arm"]["duration_s"], "", 2) << "</td><td>"
+      << (d.is_object() ? Cell(d["distance_ft"], "", 4) : "-") << "</td><td>"
+      << (d.is_object() ? Cell(d["angle_deg"], "", 3) : "-") << "</td></tr>";
   }
   h << "</table>\n";
   const auto& t = s["totals"];
-  h << "<p>In all: " << t["attempts"] << " attempts (" << t["resets"] << " resets, " << t["restores"] << " restores), "
-    << t["attempts_docked"] << " docked, " << t["collisions"] << " collisions, " << t["restarts"]
-    << " process restarts.</p>\n";
+  h << "<p>In all: " << t["attempts"] << " attempts (" << t["resets"] << " resets, "
+    << t["restores"] << " restores), " << t["attempts_docked"] << " docked, " << t["collisions"]
+    << " collisions, " << t["restarts"] << " process restarts.</p>\n";
   return h.str();
 }
 
@@ -380,35 +421,46 @@ std::string ScorecardSection(const nlohmann::ordered_json& s) {
   h << "<h2>The operator's scorecard</h2>\n<table><tr><th>attempt</th>";
   for (const auto& a : attempts) h << "<th>" << a["index"] << "</th>";
   h << "</tr>";
-  auto line = [&](const std::string& th, const std::function<std::string(const nlohmann::ordered_json&)>& f) {
+  auto line = [&](const std::string& th,
+                  const std::function<std::string(const nlohmann::ordered_json&)>& f) {
     std::vector<std::string> cells;
     for (const auto& a : attempts) cells.push_back(f(a["scorecard"]));
     h << Row(th, cells);
   };
-  line("task time (start to docked), s", [](const auto& c) { return Cell(c["task_time_s"], "", 2); });
-  line("least clearance, point A to the payload's surface, ft",
-       [](const auto& c) { return Cell(c["least_clearance_ft"]["end_effector_to_payload"], "", 3); });
+  line("task time (start to docked), s",
+       [](const auto& c) { return Cell(c["task_time_s"], "", 2); });
+  line("least clearance, point A to the payload's surface, ft", [](const auto& c) {
+    return Cell(c["least_clearance_ft"]["end_effector_to_payload"], "", 3);
+  });
   line("least clearance, payload to the bay's walls and floor (Mode 2), ft",
        [](const auto& c) { return Cell(c["least_clearance_ft"]["payload_to_bay"], "", 3); });
   line("least clearance, payload to the CAE's port face (Mode 3), ft",
        [](const auto& c) { return Cell(c["least_clearance_ft"]["payload_to_cae"], "", 3); });
-  for (const auto& [k, label] : std::vector<std::pair<std::string, std::string>>{
-           {"d3y", "D3Y"}, {"tpob", "TPOB"}, {"dock_distance", "the docking distance"}, {"dock_angle", "the docking angle"}}) {
-    line("time within 10% of " + label + ", s", [k = k](const auto& c) { return Cell(c["near_tolerance_s"][k], "", 2); });
+  for (const auto& [k, label] :
+       std::vector<std::pair<std::string, std::string>>{{"d3y", "D3Y"},
+                                                        {"tpob", "TPOB"},
+                                                        {"dock_distance", "the docking distance"},
+                                                        {"dock_angle", "the docking angle"}}) {
+    line("time within 10% of " + label + ", s",
+         [k = k](const auto& c) { return Cell(c["near_tolerance_s"][k], "", 2); });
   }
   line("finger closures / that did not acquire", [](const auto& c) {
     return Cell(c["finger_closures"]) + " / " + Cell(c["closures_not_acquiring"]);
   });
   line("actions by device", [](const auto& c) {
     std::string out;
-    for (const auto& [dev, n] : c["inputs"]["actions_by_device"].items()) out += (out.empty() ? "" : "<br>") + Html(dev) + ": " + n.dump();
+    for (const auto& [dev, n] : c["inputs"]["actions_by_device"].items())
+      out += (out.empty() ? "" : "<br>") + Html(dev) + ": " + n.dump();
     return out.empty() ? std::string("-") : out;
   });
-  line("reversals (an axis commanded back the other way)", [](const auto& c) { return Cell(c["inputs"]["reversals"]); });
+  line("reversals (an axis commanded back the other way)",
+       [](const auto& c) { return Cell(c["inputs"]["reversals"]); });
   line("time moving, s", [](const auto& c) { return Cell(c["inputs"]["moving_s"], "", 2); });
-  line("share of it moving more than one axis at once",
-       [](const auto& c) { return HumanNumber(100 * c["inputs"]["multi_axis_share"].template get<double>(), 1) + "%"; });
-  line("time slowed at a joint's rate limit, s", [](const auto& c) { return Cell(c["inputs"]["rate_limited_s"], "", 2); });
+  line("share of it moving more than one axis at once", [](const auto& c) {
+    return HumanNumber(100 * c["inputs"]["multi_axis_share"].template get<double>(), 1) + "%";
+  });
+  line("time slowed at a joint's rate limit, s",
+       [](const auto& c) { return Cell(c["inputs"]["rate_limited_s"], "", 2); });
   h << "</table>\n<table><tr><th>collisions by kind (events, s)</th>";
   for (const auto& a : attempts) h << "<th>" << a["index"] << "</th>";
   h << "</tr>";
@@ -420,7 +472,8 @@ std::string ScorecardSection(const nlohmann::ordered_json& s) {
     std::vector<std::string> cells;
     for (const auto& a : attempts) {
       const auto& b = a["collisions"]["by_kind"];
-      cells.push_back(b.contains(k) ? b[k]["events"].dump() + ", " + Cell(b[k]["duration_s"], "", 2) : "-");
+      cells.push_back(b.contains(k) ? b[k]["events"].dump() + ", " + Cell(b[k]["duration_s"], "", 2)
+                                    : "-");
     }
     h << Row(Html(k), cells);
   }
@@ -431,17 +484,20 @@ std::string ScorecardSection(const nlohmann::ordered_json& s) {
 
 std::string TimingSection(const nlohmann::ordered_json& s, const Traces& t) {
   std::ostringstream h;
-  h << "<h2>Frame times and latency</h2>\n<table><tr><th>what</th><th>n</th><th>mean, ms</th><th>p50, ms</th>"
+  h << "<h2>Frame times and latency</h2>\n<table><tr><th>what</th><th>n</th><th>mean, "
+       "ms</th><th>p50, ms</th>"
        "<th>p99, ms</th><th>max, ms</th></tr>";
   h << StatsRow("operator frame interval (freezes left out)", t.intervals_ms);
   h << StatsRow("operator input to DCP output (logged)", t.to_dcp_ms);
   h << StatsRow("operator input to ESG frame (logged)", t.to_esg_ms);
   h << "</table>\n";
   if (t.longest_stall_ms > 3000.0 / 30) {
-    h << "<p class=\"bad\">The longest operator frame interval outside a freeze: " << HumanNumber(t.longest_stall_ms, 0)
-      << " ms at " << HumanNumber(t.longest_stall_at_s, 1) << " s: a stall (the station did not run for that long).</p>\n";
+    h << "<p class=\"bad\">The longest operator frame interval outside a freeze: "
+      << HumanNumber(t.longest_stall_ms, 0) << " ms at " << HumanNumber(t.longest_stall_at_s, 1)
+      << " s: a stall (the station did not run for that long).</p>\n";
   }
-  h << "<table><tr><th>process</th><th>frames lost on the way in</th><th>late</th><th>too late, dropped</th>"
+  h << "<table><tr><th>process</th><th>frames lost on the way in</th><th>late</th><th>too late, "
+       "dropped</th>"
        "<th>malformed</th><th>links: p50 / p99 / max, ms</th></tr>";
   if (s.contains("timing")) {
     for (const auto& [proc, v] : s["timing"].items()) {
@@ -449,14 +505,16 @@ std::string TimingSection(const nlohmann::ordered_json& s, const Traces& t) {
       std::string links;
       if (v.contains("latency")) {
         for (const auto& [link, l] : v["latency"].items()) {
-          links += (links.empty() ? "" : "<br>") + Html(link) + ": " + Cell(l["p50_ms"], "", 2) + " / " +
-                   Cell(l["p99_ms"], "", 2) + " / " + Cell(l["max_ms"], "", 2);
+          links += (links.empty() ? "" : "<br>") + Html(link) + ": " + Cell(l["p50_ms"], "", 2) +
+                   " / " + Cell(l["p99_ms"], "", 2) + " / " + Cell(l["max_ms"], "", 2);
         }
       }
-      h << "<tr><td>" << Html(proc) << "</td><td>" << Cell(v.value("dropped_frames", nlohmann::ordered_json()))
-        << "</td><td>" << Cell(v.value("late_frames", nlohmann::ordered_json())) << "</td><td>"
+      h << "<tr><td>" << Html(proc) << "</td><td>"
+        << Cell(v.value("dropped_frames", nlohmann::ordered_json())) << "</td><td>"
+        << Cell(v.value("late_frames", nlohmann::ordered_json())) << "</td><td>"
         << Cell(v.value("too_late_dropped", nlohmann::ordered_json())) << "</td><td>"
-        << Cell(v.value("malformed", nlohmann::ordered_json())) << "</td><td>" << (links.empty() ? "-" : links) << "</td></tr>";
+        << Cell(v.value("malformed", nlohmann::ordered_json())) << "</td><td>"
+        << (links.empty() ? "-" : links) << "</td></tr>";
     }
   }
   h << "</table>\n";
@@ -497,7 +555,8 @@ std::string FramesSection(const fs::path& root, const fs::path& report_dir, doub
     const std::string href = fs::relative(fs::absolute(video), fs::absolute(report_dir)).string();
     h << "<p>The session's video: <a href=\"" << Html(href) << "\">" << Html(href) << "</a>.</p>\n";
   } else {
-    h << "<p>No video in the session folder (it was run with --no-video, or the renderer ran on another host).</p>\n";
+    h << "<p>No video in the session folder (it was run with --no-video, or the renderer ran on "
+         "another host).</p>\n";
   }
   if (pngs.empty()) return h.str() + "<p>No PNG frames (--png-every 0).</p>\n";
   const std::size_t n = std::min<std::size_t>(8, pngs.size());
@@ -512,8 +571,9 @@ std::string FramesSection(const fs::path& root, const fs::path& report_dir, doub
     if (bytes > 4u << 20) break;
     const std::string stem = p.stem().string();
     const long frame = std::strtol(stem.substr(stem.find('_') + 1).c_str(), nullptr, 10);
-    h << "<figure><img alt=\"" << Html(stem) << "\" src=\"data:image/png;base64," << Base64(ss.str())
-      << "\"><figcaption>frame " << frame << ", " << HumanNumber(frame / rate_hz, 1) << " s</figcaption></figure>";
+    h << "<figure><img alt=\"" << Html(stem) << "\" src=\"data:image/png;base64,"
+      << Base64(ss.str()) << "\"><figcaption>frame " << frame << ", "
+      << HumanNumber(frame / rate_hz, 1) << " s</figcaption></figure>";
   }
   h << "</div>\n";
   return h.str();
@@ -531,13 +591,15 @@ nlohmann::json Box(const std::vector<Eigen::Vector3d>& pts) {
 nlohmann::json Geometry(const LabConfig& c) {
   const ShuttleConfig& s = c.shuttle;
   nlohmann::json g;
-  g["bay"] = Box({{0, -s.bay_width_ft / 2, -s.bay_depth_ft}, {s.bay_length_ft, s.bay_width_ft / 2, 0}});
+  g["bay"] =
+      Box({{0, -s.bay_width_ft / 2, -s.bay_depth_ft}, {s.bay_length_ft, s.bay_width_ft / 2, 0}});
   // The CAE, a hexagonal prism in C (x_C +-rc, y_C 0..across flats, z_C +-length/2).
   const double fl = c.cae.across_flats_ft, rc = fl / std::sqrt(3.0), hl = c.cae.length_ft / 2;
   std::vector<Eigen::Vector3d> corners;
   for (double x : {-rc, rc}) {
     for (double y : {0.0, fl}) {
-      for (double z : {-hl, hl}) corners.push_back(c.cae.p_RoCo_R_ft + c.cae.R_RC * Eigen::Vector3d(x, y, z));
+      for (double z : {-hl, hl})
+        corners.push_back(c.cae.p_RoCo_R_ft + c.cae.R_RC * Eigen::Vector3d(x, y, z));
     }
   }
   g["cae"] = Box(corners);
@@ -565,8 +627,10 @@ LabConfig SessionConfig(const fs::path& root) {
 
 const char* kStyle =
     "<style>body{font-family:sans-serif;max-width:1200px;margin:1em auto;color:#222}"
-    "table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #bbb;padding:3px 8px;text-align:left;"
-    "vertical-align:top}th{background:#eee}.ok{color:#070}.bad{color:#a00}.thumbs{display:flex;flex-wrap:wrap}"
+    "table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #bbb;padding:3px "
+    "8px;text-align:left;"
+    "vertical-align:top}th{background:#eee}.ok{color:#070}.bad{color:#a00}.thumbs{display:flex;"
+    "flex-wrap:wrap}"
     "figure{margin:4px}figure img{width:240px}</style>\n";
 
 }  // namespace
@@ -575,19 +639,23 @@ std::string ScriptJson(const nlohmann::json& j) {
   std::string s = j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   std::string out;
   for (std::size_t i = 0; i < s.size(); ++i) {
-    if (s[i] == '<' && i + 1 < s.size() && s[i + 1] == '/') out += "<\\";
-    else out += s[i];
+    if (s[i] == '<' && i + 1 < s.size() && s[i + 1] == '/')
+      out += "<\\";
+    else
+      out += s[i];
   }
   return out;
 }
 
 std::string ChartsScript(const std::string& name) {
   const std::string dir = std::string(RMSLAB_SOURCE_DIR) + "/tools/report/";
-  return ReadText(dir + "chart_page.js", "the charts' page helpers") + "\n" + ReadText(dir + name, "the page's charts");
+  return ReadText(dir + "chart_page.js", "the charts' page helpers") + "\n" +
+         ReadText(dir + name, "the page's charts");
 }
 
 std::string MakeReport(const std::string& session_dir, const std::string& chart_js_path,
-                       const std::function<void(const std::string&)>& progress, const std::string& out_path) {
+                       const std::function<void(const std::string&)>& progress,
+                       const std::string& out_path) {
   const fs::path root(session_dir);
   auto say = [&](const std::string& s) {
     if (progress) progress(s);
@@ -595,7 +663,8 @@ std::string MakeReport(const std::string& session_dir, const std::string& chart_
   say("report: the summary");
   const nlohmann::ordered_json s = session::Summarize(session_dir);
   const nlohmann::ordered_json manifest = ReadManifest(root);
-  const std::string chart_js = ReadText(chart_js_path, "Chart.js (Debian package libjs-chart.js; scripts/install-deps)");
+  const std::string chart_js =
+      ReadText(chart_js_path, "Chart.js (Debian package libjs-chart.js; scripts/install-deps)");
   const std::string charts = ChartsScript("report_charts.js");
   const LabConfig config = SessionConfig(root);
   say("report: reading the log");
@@ -604,30 +673,48 @@ std::string MakeReport(const std::string& session_dir, const std::string& chart_
 
   nlohmann::json data;
   data["title"] = s.value("session", root.filename().string());
-  data["series"] = {{"t_s", t.t_s}, {"mode", t.mode}, {"attempt", t.attempt}, {"p_ft", t.p_ft},
-                    {"payload_ft", t.payload_ft}, {"joints_deg", t.joints_deg},
-                    {"joint_names", {"shoulder yaw", "shoulder pitch", "elbow pitch", "wrist pitch", "wrist yaw", "wrist roll"}},
-                    {"finger", t.finger}, {"distance_to_goal_ft", t.goal_ft}, {"dock_angle_deg", t.dock_angle_deg}};
-  data["series"]["inputs"] = t.by_hand ? nlohmann::json{{"names", {"x", "y", "z", "roll", "pitch", "yaw"}},
-                                                        {"values", t.inputs},
-                                                        {"unit", "fraction of full rate (-1..1)"}}
-                                       : nlohmann::json(nullptr);
+  data["series"] = {
+      {"t_s", t.t_s},
+      {"mode", t.mode},
+      {"attempt", t.attempt},
+      {"p_ft", t.p_ft},
+      {"payload_ft", t.payload_ft},
+      {"joints_deg", t.joints_deg},
+      {"joint_names",
+       {"shoulder yaw", "shoulder pitch", "elbow pitch", "wrist pitch", "wrist yaw", "wrist roll"}},
+      {"finger", t.finger},
+      {"distance_to_goal_ft", t.goal_ft},
+      {"dock_angle_deg", t.dock_angle_deg}};
+  data["series"]["inputs"] =
+      t.by_hand ? nlohmann::json{{"names", {"x", "y", "z", "roll", "pitch", "yaw"}},
+                                 {"values", t.inputs},
+                                 {"unit", "fraction of full rate (-1..1)"}}
+                : nlohmann::json(nullptr);
   data["geometry"] = Geometry(config);
   data["events"] = t.events;
   data["attempts"] = nlohmann::json::array();
-  for (const auto& a : s["attempts"]) data["attempts"].push_back({{"index", a["index"]}, {"start_s", a["start_s"]}, {"end_s", a["end_s"]}});
+  for (const auto& a : s["attempts"])
+    data["attempts"].push_back(
+        {{"index", a["index"]}, {"start_s", a["start_s"]}, {"end_s", a["end_s"]}});
 
   std::ostringstream h;
   const std::string name = data["title"].get<std::string>();
-  h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>rmslab session " << Html(name)
-    << "</title>\n" << kStyle << "<script>\n" << chart_js << "\n</script>\n</head><body>\n";
+  h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>rmslab session "
+    << Html(name) << "</title>\n"
+    << kStyle << "<script>\n"
+    << chart_js << "\n</script>\n</head><body>\n";
   h << "<h1>rmslab session " << Html(name) << "</h1>\n";
-  h << "<p>Made by <code>scripts/lab report</code> from the session folder alone: its LCM log, its processes' "
-       "statistics and its manifest. One self-contained file: the plots are drawn by Chart.js, embedded.</p>\n";
-  h << SessionSection(manifest, s) << TolerancesSection(config) << AttemptsSection(s) << ScorecardSection(s);
+  h << "<p>Made by <code>scripts/lab report</code> from the session folder alone: its LCM log, its "
+       "processes' "
+       "statistics and its manifest. One self-contained file: the plots are drawn by Chart.js, "
+       "embedded.</p>\n";
+  h << SessionSection(manifest, s) << TolerancesSection(config) << AttemptsSection(s)
+    << ScorecardSection(s);
   h << "<h2>Plots</h2>\n<div id=\"rms-charts\"></div>\n";
-  h << "<script>\nwindow.RMS_REPORT = " << ScriptJson(data) << ";\n</script>\n<script>\n" << charts << "\n</script>\n";
-  h << FramesSection(root, out_path.empty() ? root : fs::path(out_path).parent_path(), config.session.frame_rate_hz);
+  h << "<script>\nwindow.RMS_REPORT = " << ScriptJson(data) << ";\n</script>\n<script>\n"
+    << charts << "\n</script>\n";
+  h << FramesSection(root, out_path.empty() ? root : fs::path(out_path).parent_path(),
+                     config.session.frame_rate_hz);
   h << LossesSection(s) << TimingSection(s, t);
   h << "</body></html>\n";
   return h.str();

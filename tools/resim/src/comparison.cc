@@ -2,9 +2,8 @@
 
 #include <map>
 #include <sstream>
-#include <vector>
-
 #include <toml++/toml.h>
+#include <vector>
 
 #include "rms/base/text.h"
 
@@ -50,13 +49,16 @@ bool SameTelemetry(dcp_telemetry_t a, dcp_telemetry_t b, std::string* what) {
 namespace {
 
 // Every key of a TOML file as "a.b.c" -> value text.
-void Flatten(const toml::node& n, const std::string& prefix, std::map<std::string, std::string>* out) {
+void Flatten(const toml::node& n, const std::string& prefix,
+             std::map<std::string, std::string>* out) {
   if (const toml::table* t = n.as_table()) {
-    for (auto&& [k, v] : *t) Flatten(v, prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str()), out);
+    for (auto&& [k, v] : *t)
+      Flatten(v, prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str()), out);
   } else if (const toml::array* a = n.as_array()) {
     bool tables = !a->empty() && a->front().is_table();
     if (tables) {
-      for (std::size_t i = 0; i < a->size(); ++i) Flatten(*a->get(i), prefix + "[" + std::to_string(i) + "]", out);
+      for (std::size_t i = 0; i < a->size(); ++i)
+        Flatten(*a->get(i), prefix + "[" + std::to_string(i) + "]", out);
     } else {
       std::ostringstream os;
       os << *a;
@@ -84,7 +86,8 @@ nlohmann::ordered_json ConfigChanges(const std::string& a_path, const std::strin
   }
   for (const auto& [k, v] : b) {
     const auto it = a.find(k);
-    if (it == a.end() || it->second != v) changes.push_back({{"key", k}, {"recorded", it == a.end() ? "" : it->second}, {"now", v}});
+    if (it == a.end() || it->second != v)
+      changes.push_back({{"key", k}, {"recorded", it == a.end() ? "" : it->second}, {"now", v}});
   }
   return changes;
 }

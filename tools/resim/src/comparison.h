@@ -2,9 +2,8 @@
 // Re-simulation's comparisons (docs/sessions.md "Re-simulation"): a DCP
 // frame and its telemetry word for word against the recorded ones, and two
 // configuration files key by key.
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"

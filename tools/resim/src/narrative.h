@@ -5,7 +5,6 @@
 // in sentences, from the DCP's own tests at the moments that mattered.
 #include <cstdint>
 #include <map>
-
 #include <nlohmann/json.hpp>
 
 #include "rms/base/config.h"

@@ -11,7 +11,8 @@ namespace rms::resim {
 Recording ReadRecording(session::SessionLog& log) {
   Recording r;
   r.suffix = log.suffix();
-  log.Read({wire::channels::kOperatorInput, wire::channels::kDcpFrame, wire::channels::kDcpTelemetry, wire::channels::kDcpState},
+  log.Read({wire::channels::kOperatorInput, wire::channels::kDcpFrame,
+            wire::channels::kDcpTelemetry, wire::channels::kDcpState},
            [&](const session::LogMessage& ev) {
              if (ev.base == wire::channels::kOperatorInput) {
                operator_input_t m;
@@ -43,7 +44,8 @@ Recording ReadRecording(session::SessionLog& log) {
     for (const std::size_t i : run) kept.push_back(r.dcp_frames[i]);
     // A state keeps its place: the number of kept frames before it.
     for (auto& st : r.states) {
-      st.before = static_cast<std::size_t>(std::lower_bound(run.begin(), run.end(), st.before) - run.begin());
+      st.before = static_cast<std::size_t>(std::lower_bound(run.begin(), run.end(), st.before) -
+                                           run.begin());
     }
     r.dcp_frames = std::move(kept);
   }
@@ -53,7 +55,8 @@ Recording ReadRecording(session::SessionLog& log) {
 namespace {
 
 std::string Frames(std::int64_t a, std::int64_t b) {
-  return a == b ? "DCP frame " + std::to_string(a) : "DCP frames " + std::to_string(a) + ".." + std::to_string(b);
+  return a == b ? "DCP frame " + std::to_string(a)
+                : "DCP frames " + std::to_string(a) + ".." + std::to_string(b);
 }
 
 // Where the re-simulation can start: the state logged before the first
@@ -70,20 +73,24 @@ const LoggedState* StartState(const Recording& r, Plan* plan) {
   const std::int64_t first = r.dcp_frames.front().frame;
   if (r.states.empty()) {
     if (first == 0) return nullptr;
-    throw InputError("the log starts at DCP frame " + std::to_string(first) +
-                     " and holds no RMS_DCP_STATE: the DCP's state there is not in it (the log misses the "
-                     "session's start, and was recorded before the DCP logged its state), so nothing can be "
-                     "re-simulated");
+    throw InputError(
+        "the log starts at DCP frame " + std::to_string(first) +
+        " and holds no RMS_DCP_STATE: the DCP's state there is not in it (the log misses the "
+        "session's start, and was recorded before the DCP logged its state), so nothing can be "
+        "re-simulated");
   }
   start = &r.states.front();
   if (start->before >= r.dcp_frames.size()) {
-    throw InputError("the log's only RMS_DCP_STATE comes after its last DCP frame: nothing to re-simulate from");
+    throw InputError(
+        "the log's only RMS_DCP_STATE comes after its last DCP frame: nothing to re-simulate from");
   }
   plan->first = start->before;
   const std::int64_t skipped_to = r.dcp_frames[plan->first].frame - 1;
-  plan->note = Frames(first, skipped_to) + " not re-simulated: the log starts at DCP frame " + std::to_string(first) +
-               " without the DCP's state there; re-simulated from the state it logged before DCP frame " +
-               std::to_string(r.dcp_frames[plan->first].frame);
+  plan->note =
+      Frames(first, skipped_to) + " not re-simulated: the log starts at DCP frame " +
+      std::to_string(first) +
+      " without the DCP's state there; re-simulated from the state it logged before DCP frame " +
+      std::to_string(r.dcp_frames[plan->first].frame);
   return start;
 }
 
@@ -120,17 +127,20 @@ Plan MakePlan(const Recording& r) {
       // that the log does not show: unambiguous only if exactly that many
       // were logged.
       std::vector<std::int64_t> between;
-      for (auto it = r.inputs.upper_bound(prev_input); it != r.inputs.end() && it->first < f.input_frame; ++it) {
+      for (auto it = r.inputs.upper_bound(prev_input);
+           it != r.inputs.end() && it->first < f.input_frame; ++it) {
         between.push_back(it->first);
       }
       if (static_cast<std::int64_t>(between.size()) != lost) {
         throw InputError("the log lost " + Frames(prev_frame + 1, f.frame - 1) +
-                         " and which operator frames they answered cannot be told (" + std::to_string(between.size()) +
+                         " and which operator frames they answered cannot be told (" +
+                         std::to_string(between.size()) +
                          " logged between): the re-simulation cannot be exact");
       }
       for (const std::int64_t in : between) plan.steps.push_back({nullptr, in, false});
     } else if (lost < 0) {
-      throw InputError("DCP frame " + std::to_string(f.frame) + " follows " + Frames(prev_frame, prev_frame) +
+      throw InputError("DCP frame " + std::to_string(f.frame) + " follows " +
+                       Frames(prev_frame, prev_frame) +
                        " with no RMS_DCP_STATE between to say why: the log cannot be re-simulated");
     }
     plan.steps.push_back({nullptr, f.input_frame, false});

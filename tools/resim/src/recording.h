@@ -29,10 +29,10 @@ struct LoggedState {
 
 struct Recording {
   std::string suffix;
-  std::map<std::int64_t, RecordedInput> inputs;      // by operator frame
-  std::vector<dcp_frame_t> dcp_frames;               // in log order
+  std::map<std::int64_t, RecordedInput> inputs;       // by operator frame
+  std::vector<dcp_frame_t> dcp_frames;                // in log order
   std::map<std::int64_t, dcp_telemetry_t> telemetry;  // by DCP frame
-  std::vector<LoggedState> states;                   // in log order
+  std::vector<LoggedState> states;                    // in log order
 };
 
 // The channels re-simulation needs, read from the log (the DCP's increasing
@@ -45,7 +45,7 @@ Recording ReadRecording(session::SessionLog& log);
 struct Step {
   const dcp_state_t* state = nullptr;
   std::int64_t input_frame = -1;  // -1: a state only
-  bool first = false;             // the state the re-simulation starts from (taken, whatever its reason)
+  bool first = false;  // the state the re-simulation starts from (taken, whatever its reason)
 };
 
 struct Plan {

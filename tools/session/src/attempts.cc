@@ -1,9 +1,8 @@
 #include "attempts.h"
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
-
-#include <Eigen/Core>
 
 #include "rms/wire/collision_bits.h"
 
@@ -11,7 +10,8 @@ namespace rms::session {
 
 namespace {
 
-constexpr double kNear = 0.10;  // "near a tolerance": within 10 % of it, either side (docs/sessions.md "Scorecard")
+constexpr double kNear =
+    0.10;  // "near a tolerance": within 10 % of it, either side (docs/sessions.md "Scorecard")
 
 Eigen::Vector3d V(const double* p) { return {p[0], p[1], p[2]}; }
 
@@ -22,9 +22,13 @@ double Extent(const Eigen::Vector3d& n, const Eigen::Vector3d& axis, double r, d
   return r * std::sqrt(1.0 - c * c) + hl * c;
 }
 
-bool Near(double value, double limit) { return limit > 0 && std::abs(value - limit) <= kNear * limit; }
+bool Near(double value, double limit) {
+  return limit > 0 && std::abs(value - limit) <= kNear * limit;
+}
 
-nlohmann::ordered_json OrNull(double v) { return v < 0 ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(v); }
+nlohmann::ordered_json OrNull(double v) {
+  return v < 0 ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(v);
+}
 
 }  // namespace
 
@@ -63,11 +67,14 @@ void AttemptLog::Clearances(const dcp_telemetry_t& m, Attempt* a) const {
     const ShuttleConfig& s = config_.shuttle;
     const struct {
       Eigen::Vector3d p0, n;
-    } planes[] = {{{0, 0, -s.bay_depth_ft}, {0, 0, 1}},  {{0, -s.bay_width_ft / 2, 0}, {0, 1, 0}},
-                  {{0, s.bay_width_ft / 2, 0}, {0, -1, 0}}, {{0, 0, 0}, {1, 0, 0}},
+    } planes[] = {{{0, 0, -s.bay_depth_ft}, {0, 0, 1}},
+                  {{0, -s.bay_width_ft / 2, 0}, {0, 1, 0}},
+                  {{0, s.bay_width_ft / 2, 0}, {0, -1, 0}},
+                  {{0, 0, 0}, {1, 0, 0}},
                   {{s.bay_length_ft, 0, 0}, {-1, 0, 0}}};
     if (c.z() - Extent({0, 0, 1}, axis, r, hl) < 0) {  // some of it still below the sills
-      for (const auto& pl : planes) least(&a->least_payload_bay_ft, pl.n.dot(c - pl.p0) - Extent(pl.n, axis, r, hl));
+      for (const auto& pl : planes)
+        least(&a->least_payload_bay_ft, pl.n.dot(c - pl.p0) - Extent(pl.n, axis, r, hl));
     }
   } else if (m.mode == 3) {
     // The payload's body to the CAE's port face (face c, y_C = 0, facing -y_C).
@@ -77,8 +84,10 @@ void AttemptLog::Clearances(const dcp_telemetry_t& m, Attempt* a) const {
 }
 
 void AttemptLog::ObserveFrame(const dcp_telemetry_t& m, bool reset, double t_s) {
-  if (attempts_.empty()) Begin(m, "start", t_s);
-  else if (reset && !last_reset_) Begin(m, "reset", t_s);
+  if (attempts_.empty())
+    Begin(m, "start", t_s);
+  else if (reset && !last_reset_)
+    Begin(m, "reset", t_s);
   else if (!pending_restore_.empty()) {
     Begin(m, "restore", t_s);
     attempts_.back().restored = pending_restore_;
@@ -102,13 +111,15 @@ void AttemptLog::ObserveFrame(const dcp_telemetry_t& m, bool reset, double t_s) 
                  {"within_tolerance", m.dock_distance_ft <= config_.dcp.dock_distance_ft &&
                                           m.dock_angle_deg <= config_.dcp.dock_angle_deg}};
   }
-  if (m.mode == 3 && (a.best_dock_distance_ft < 0 || m.dock_distance_ft < a.best_dock_distance_ft)) {
+  if (m.mode == 3 &&
+      (a.best_dock_distance_ft < 0 || m.dock_distance_ft < a.best_dock_distance_ft)) {
     a.best_dock_distance_ft = m.dock_distance_ft;
     a.best_dock_angle_deg = m.dock_angle_deg;
   }
   // Detrimental collisions only: the finger resting on the bar is the essential contact.
-  const auto bits = wire::DetrimentalCollisions(static_cast<std::uint32_t>(m.collisions), m.finger_held, m.held,
-                                                m.master_finger > m.slave_finger);
+  const auto bits =
+      wire::DetrimentalCollisions(static_cast<std::uint32_t>(m.collisions), m.finger_held, m.held,
+                                  m.master_finger > m.slave_finger);
   for (int b = 0; b < wire::collision_bits::kCount; ++b) {
     if (!(bits & (1u << b))) continue;
     ++a.collisions[b].frames;
@@ -164,7 +175,9 @@ nlohmann::ordered_json AttemptLog::AttemptJson(const Attempt& a) const {
   const double rate = config_.session.frame_rate_hz;
   const std::size_t i = static_cast<std::size_t>(a.index - 1);
   const double end_s = i + 1 < attempts_.size() ? attempts_[i + 1].start_s : a.last_s + 1.0 / rate;
-  auto span = [](double from, double to) { return from < 0 || to < 0 ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(to - from); };
+  auto span = [](double from, double to) {
+    return from < 0 || to < 0 ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(to - from);
+  };
   const double acq_from = a.start_mode == 1 ? a.start_s : -1;
   const double ext_from = a.start_mode == 2 ? a.start_s : a.t_acquired;
   const double man_from = a.start_mode == 3 ? a.start_s : a.t_clear;
@@ -179,40 +192,67 @@ nlohmann::ordered_json AttemptLog::AttemptJson(const Attempt& a) const {
   j["frames"] = a.frames;
   j["first_frame"] = a.start_frame;
   j["last_frame"] = a.last_frame;
-  j["outcome"] = a.t_docked >= 0 ? "docked" : a.t_clear >= 0 ? "cleared the bay" : a.t_acquired >= 0 ? "acquired" : a.start_mode > 1 ? "not docked" : "not acquired";
-  j["reached_s"] = {{"acquired", OrNull(a.t_acquired)}, {"clear_of_bay", OrNull(a.t_clear)},
-                    {"in_envelope", OrNull(a.t_envelope)}, {"docked", OrNull(a.t_docked)}};
-  j["phase_durations_s"] = {{"acquisition", span(acq_from, a.t_acquired)}, {"extraction", span(ext_from, a.t_clear)},
-                            {"maneuvering", span(man_from, a.t_envelope)}, {"docking", span(a.t_envelope, a.t_docked)}};
+  j["outcome"] = a.t_docked >= 0     ? "docked"
+                 : a.t_clear >= 0    ? "cleared the bay"
+                 : a.t_acquired >= 0 ? "acquired"
+                 : a.start_mode > 1  ? "not docked"
+                                     : "not acquired";
+  j["reached_s"] = {{"acquired", OrNull(a.t_acquired)},
+                    {"clear_of_bay", OrNull(a.t_clear)},
+                    {"in_envelope", OrNull(a.t_envelope)},
+                    {"docked", OrNull(a.t_docked)}};
+  j["phase_durations_s"] = {{"acquisition", span(acq_from, a.t_acquired)},
+                            {"extraction", span(ext_from, a.t_clear)},
+                            {"maneuvering", span(man_from, a.t_envelope)},
+                            {"docking", span(a.t_envelope, a.t_docked)}};
   j["docking"] = a.docking;
-  j["closest_to_docking"] = a.best_dock_distance_ft < 0 ? nlohmann::ordered_json(nullptr)
-                                : nlohmann::ordered_json{{"distance_ft", a.best_dock_distance_ft}, {"angle_deg", a.best_dock_angle_deg}};
+  j["closest_to_docking"] = a.best_dock_distance_ft < 0
+                                ? nlohmann::ordered_json(nullptr)
+                                : nlohmann::ordered_json{{"distance_ft", a.best_dock_distance_ft},
+                                                         {"angle_deg", a.best_dock_angle_deg}};
   nlohmann::ordered_json col = nlohmann::ordered_json::object();
   std::int64_t col_events = 0;
   for (int b = 0; b < wire::collision_bits::kCount; ++b) {
     const Run& r = a.collisions[b];
     col_events += r.events;
-    if (r.events) col[wire::CollisionName(b)] = {{"events", r.events}, {"frames", r.frames}, {"duration_s", r.frames / rate}};
+    if (r.events)
+      col[wire::CollisionName(b)] = {
+          {"events", r.events}, {"frames", r.frames}, {"duration_s", r.frames / rate}};
   }
   j["collisions"] = {{"events", col_events}, {"by_kind", col}};
-  j["holds"] = {{"arm", {{"events", a.held.events}, {"frames", a.held.frames}, {"duration_s", a.held.frames / rate}}},
-                {"finger", {{"events", a.finger_held.events}, {"frames", a.finger_held.frames}, {"duration_s", a.finger_held.frames / rate}}}};
+  j["holds"] = {{"arm",
+                 {{"events", a.held.events},
+                  {"frames", a.held.frames},
+                  {"duration_s", a.held.frames / rate}}},
+                {"finger",
+                 {{"events", a.finger_held.events},
+                  {"frames", a.finger_held.frames},
+                  {"duration_s", a.finger_held.frames / rate}}}};
   nlohmann::ordered_json devices = nlohmann::ordered_json::object();
   for (std::size_t d = 0; d < a.device_names.size() && d < a.device_actions_now.size(); ++d) {
-    devices[a.device_names[d]] = a.device_actions_now[d] - (d < a.device_actions_start.size() ? a.device_actions_start[d] : 0);
+    devices[a.device_names[d]] =
+        a.device_actions_now[d] -
+        (d < a.device_actions_start.size() ? a.device_actions_start[d] : 0);
   }
   j["scorecard"] = {
-      {"task_time_s", a.t_docked < 0 ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(a.t_docked - a.start_s)},
-      {"least_clearance_ft", {{"end_effector_to_payload", OrNull(a.least_ee_payload_ft)},
-                              {"payload_to_bay", OrNull(a.least_payload_bay_ft)},
-                              {"payload_to_cae", OrNull(a.least_payload_cae_ft)}}},
-      {"near_tolerance_s", {{"d3y", a.near_d3y / rate}, {"tpob", a.near_tpob / rate},
-                            {"dock_distance", a.near_dock_distance / rate}, {"dock_angle", a.near_dock_angle / rate}}},
-      {"inputs", {{"actions_by_device", devices},
-                  {"reversals", a.reversals},
-                  {"moving_s", a.moving_frames / rate},
-                  {"multi_axis_share", a.moving_frames ? static_cast<double>(a.multi_axis_frames) / a.moving_frames : 0.0},
-                  {"rate_limited_s", a.rate_limited_frames / rate}}},
+      {"task_time_s", a.t_docked < 0 ? nlohmann::ordered_json(nullptr)
+                                     : nlohmann::ordered_json(a.t_docked - a.start_s)},
+      {"least_clearance_ft",
+       {{"end_effector_to_payload", OrNull(a.least_ee_payload_ft)},
+        {"payload_to_bay", OrNull(a.least_payload_bay_ft)},
+        {"payload_to_cae", OrNull(a.least_payload_cae_ft)}}},
+      {"near_tolerance_s",
+       {{"d3y", a.near_d3y / rate},
+        {"tpob", a.near_tpob / rate},
+        {"dock_distance", a.near_dock_distance / rate},
+        {"dock_angle", a.near_dock_angle / rate}}},
+      {"inputs",
+       {{"actions_by_device", devices},
+        {"reversals", a.reversals},
+        {"moving_s", a.moving_frames / rate},
+        {"multi_axis_share",
+         a.moving_frames ? static_cast<double>(a.multi_axis_frames) / a.moving_frames : 0.0},
+        {"rate_limited_s", a.rate_limited_frames / rate}}},
       {"finger_closures", a.closures},
       {"closures_not_acquiring", a.closures - a.closures_acquired}};
   return j;

@@ -5,10 +5,9 @@
 // durations, collisions and holds, outcome, docking figures, least
 // clearances, time near each tolerance, and the operator's inputs.
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "rms/base/config.h"
 #include "rms/dcp_telemetry_t.hpp"
@@ -24,7 +23,9 @@ class AttemptLog {
   void ObserveFrame(const dcp_telemetry_t& m, bool reset, double t_s);
   // A restore the DCP logged (RMS_DCP_STATE RESTORE): the next frame starts
   // an attempt.
-  void ObserveRestore(const std::string& what) { pending_restore_ = what.empty() ? "restore" : what; }
+  void ObserveRestore(const std::string& what) {
+    pending_restore_ = what.empty() ? "restore" : what;
+  }
   // The operator station's state a frame (inputs, devices).
   void ObserveOperator(const operator_state_t& m);
   // A restart of a process (counted in the totals and the current attempt).

@@ -18,18 +18,22 @@ void FrameLines(const Json& j, std::ostream& os) {
   const auto& fr = j["frames"];
   std::int64_t dropped = 0;
   for (const auto& [k, v] : fr["dropped"].items()) dropped += v.get<std::int64_t>();
-  os << "frames: operator " << fr["operator_published"] << ", DCP " << fr["dcp_published"] << ", ESG "
-     << fr["esg_published"] << ", rendered " << fr["rendered"] << ", PNG " << fr["png_written"] << "; dropped "
-     << dropped << "\n";
+  os << "frames: operator " << fr["operator_published"] << ", DCP " << fr["dcp_published"]
+     << ", ESG " << fr["esg_published"] << ", rendered " << fr["rendered"] << ", PNG "
+     << fr["png_written"] << "; dropped " << dropped << "\n";
   if (!j["log"]["stats_from_log"].empty()) {
-    os << "counts of " << j["log"]["stats_from_log"].dump() << " from their last status reports in the log "
-       << "(they wrote no stats file at exit: a full disk, a crash): the counts end where the record ends\n";
+    os << "counts of " << j["log"]["stats_from_log"].dump()
+       << " from their last status reports in the log "
+       << "(they wrote no stats file at exit: a full disk, a crash): the counts end where the "
+          "record ends\n";
   }
   const auto& r = fr["refused"];
-  if (r.value("other_session", 0) + r.value("other_sender", 0) + r.value("late", 0) + r.value("far_ahead", 0) > 0) {
-    os << "refused by the processes: " << r["other_session"] << " of other sessions, " << r["other_sender"]
-       << " from an impostor with this session's id, " << r["late"] << " too late to act on (a stall), "
-       << r["far_ahead"] << " with impossible frame numbers\n";
+  if (r.value("other_session", 0) + r.value("other_sender", 0) + r.value("late", 0) +
+          r.value("far_ahead", 0) >
+      0) {
+    os << "refused by the processes: " << r["other_session"] << " of other sessions, "
+       << r["other_sender"] << " from an impostor with this session's id, " << r["late"]
+       << " too late to act on (a stall), " << r["far_ahead"] << " with impossible frame numbers\n";
   }
 }
 
@@ -37,25 +41,31 @@ void FrameLines(const Json& j, std::ostream& os) {
 void LossLines(const Json& j, std::ostream& os) {
   const auto& fr = j["frames"];
   if (j["record"].value("lost", 0) > 0) {
-    os << "the record lost " << j["record"]["lost"] << " frames (the recorder fell behind, was stopped or its "
+    os << "the record lost " << j["record"]["lost"]
+       << " frames (the recorder fell behind, was stopped or its "
        << "disk filled):";
     for (const auto& [ch, r] : j["record"]["by_channel"].items()) {
-      if (r["lost"].get<std::int64_t>() > 0) os << " " << ch << " " << r["lost"] << " of " << r["published"];
+      if (r["lost"].get<std::int64_t>() > 0)
+        os << " " << ch << " " << r["lost"] << " of " << r["published"];
     }
     os << "\n";
   }
   if (j["ignored"].value("total", 0) > 0) {
-    os << "left out " << j["ignored"]["total"] << " logged messages (another session's, or not believed):";
+    os << "left out " << j["ignored"]["total"]
+       << " logged messages (another session's, or not believed):";
     for (const auto& [why, n] : j["ignored"]["by_reason"].items()) os << " " << why << " " << n;
-    if (!j["ignored"]["other_sessions"].empty()) os << " (sessions " << j["ignored"]["other_sessions"].dump() << ")";
+    if (!j["ignored"]["other_sessions"].empty())
+      os << " (sessions " << j["ignored"]["other_sessions"].dump() << ")";
     os << "\n";
   }
   if (fr.value("superseded", 0) > 0) {
-    os << "renderer: " << fr["superseded"] << " frames overtaken by a newer one before they were drawn "
+    os << "renderer: " << fr["superseded"]
+       << " frames overtaken by a newer one before they were drawn "
        << "(superseded): not drawn; the video repeats the image before them\n";
   }
   if (fr.value("video_dropped", 0) > 0) {
-    os << "video: " << fr["video_dropped"] << " frames dropped (the encoder fell behind; the video is "
+    os << "video: " << fr["video_dropped"]
+       << " frames dropped (the encoder fell behind; the video is "
        << "short of the session by as much)\n";
   }
   if (j["latency"].contains("input_to_render")) {
@@ -67,8 +77,10 @@ void LossLines(const Json& j, std::ostream& os) {
 
 // The modes in turn, acquisition and docking, collisions.
 void OutcomeLines(const Json& j, std::ostream& os) {
-  if (j["log"].value("dcp_frames", 0) == 0) os << "modes: none (no DCP frame in the log)";
-  else os << "modes 1";
+  if (j["log"].value("dcp_frames", 0) == 0)
+    os << "modes: none (no DCP frame in the log)";
+  else
+    os << "modes 1";
   std::size_t shown = 0;
   for (const auto& mc : j["mode_changes"]) {
     if (++shown > 8) {
@@ -83,9 +95,10 @@ void OutcomeLines(const Json& j, std::ostream& os) {
     os << " (" << HumanNumber(j["docking"]["distance_ft"].get<double>()) << " ft, "
        << HumanNumber(j["docking"]["angle_deg"].get<double>(), 2) << " deg)";
   }
-  if (!j["docking"].is_null() && j["docking"].value("after_restore", false)) os << " after a restore";
-  os << "\ncollisions " << j["collisions"].size() << ", frames held " << j["held_frames"] << "; LCM log events "
-     << j["log"]["events"] << "\n";
+  if (!j["docking"].is_null() && j["docking"].value("after_restore", false))
+    os << " after a restore";
+  os << "\ncollisions " << j["collisions"].size() << ", frames held " << j["held_frames"]
+     << "; LCM log events " << j["log"]["events"] << "\n";
 }
 
 // Attempts, session control, faults.
@@ -94,8 +107,9 @@ void SessionLines(const Json& j, std::ostream& os) {
     os << "attempts: " << j["attempts"].size() << " (";
     for (std::size_t i = 0; i < j["attempts"].size(); ++i) {
       const auto& a = j["attempts"][i];
-      os << (i ? "; " : "") << a["index"] << " from the " << a["started_by"].get<std::string>() << " at "
-         << HumanNumber(a["start_s"].get<double>()) << " s: " << a["outcome"].get<std::string>();
+      os << (i ? "; " : "") << a["index"] << " from the " << a["started_by"].get<std::string>()
+         << " at " << HumanNumber(a["start_s"].get<double>())
+         << " s: " << a["outcome"].get<std::string>();
     }
     os << ")\n";
   }
@@ -107,13 +121,14 @@ void SessionLines(const Json& j, std::ostream& os) {
     os << "\n";
   }
   if (!j["ignored"].value("session_id_checked", true)) {
-    os << "this session has no id (made before session ids): every message in its log was read as its own\n";
+    os << "this session has no id (made before session ids): every message in its log was read as "
+          "its own\n";
   }
   if (j.contains("restarts") && !j["restarts"].empty()) {
     os << "restarted after a fault:";
     for (const auto& r : j["restarts"]) {
-      os << " " << r["process"].get<std::string>() << " (exit " << r["exit_code"] << ", up again in "
-         << r["restart_s"].get<double>() << " s)";
+      os << " " << r["process"].get<std::string>() << " (exit " << r["exit_code"]
+         << ", up again in " << r["restart_s"].get<double>() << " s)";
     }
     os << "\n";
   }

@@ -1,32 +1,32 @@
 #include "rms/session/export_csv.h"
 
-#include <charconv>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
-#include <cstring>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <lcm/lcm-cpp.hpp>
 #include <map>
 #include <memory>
 
-#include "rms/wire/acquisition_conditions.h"
-#include "rms/wire/channels.h"
 #include "rms/base/check.h"
 #include "rms/base/config.h"
-#include "rms/wire/control_word.h"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/esg_frame_t.hpp"
-#include "rms/wire/input_block.h"
-#include "rms/wire/message_io.h"
 #include "rms/operator_input_t.hpp"
 #include "rms/process_status_t.hpp"
 #include "rms/session/session_log.h"
-#include "rms/session_control_t.hpp"
-#include "rms/wire/word_blocks.h"
 #include "rms/session/session_summary.h"
+#include "rms/session_control_t.hpp"
+#include "rms/wire/acquisition_conditions.h"
+#include "rms/wire/channels.h"
+#include "rms/wire/control_word.h"
+#include "rms/wire/input_block.h"
+#include "rms/wire/message_io.h"
+#include "rms/wire/word_blocks.h"
 
 namespace fs = std::filesystem;
 
@@ -37,7 +37,8 @@ namespace {
 // One CSV file: a header row of "name [unit]" columns, then rows.
 class Csv {
  public:
-  Csv(const fs::path& path, std::vector<std::string> columns) : path_(path), f_(path), n_(columns.size()) {
+  Csv(const fs::path& path, const std::vector<std::string>& columns)
+      : path_(path), f_(path), n_(columns.size()) {
     if (!f_) throw InputError("cannot write '" + path.string() + "'");
     Row(columns);
   }
@@ -67,7 +68,8 @@ class Csv {
       const int err = errno ? errno : EIO;
       std::error_code ec;
       if (fs::is_regular_file(path_, ec)) fs::remove(path_, ec);  // no partial CSV left behind
-      throw InputError("could not write all of '" + path_.string() + "' (" + std::strerror(err) + ")");
+      throw InputError("could not write all of '" + path_.string() + "' (" + std::strerror(err) +
+                       ")");
     }
   }
 
@@ -89,18 +91,20 @@ std::string B(bool v) { return v ? "1" : "0"; }
 
 double Deg(const arm::SinCos& a) { return std::atan2(a.s, a.c) * 180.0 / M_PI; }
 
-void Add(std::vector<std::string>* v, std::initializer_list<std::string> xs) { v->insert(v->end(), xs); }
+void Add(std::vector<std::string>* v, std::initializer_list<std::string> xs) {
+  v->insert(v->end(), xs);
+}
 
 std::vector<std::string> ControlColumns(const std::string& p) {
-  return {p + "camera_station", p + "reset", p + "overlay", p + "mode", p + "collision", p + "receptacle_collision",
-          p + "acquired", p + "docked"};
+  return {p + "camera_station",       p + "reset",    p + "overlay", p + "mode", p + "collision",
+          p + "receptacle_collision", p + "acquired", p + "docked"};
 }
 void ControlCells(std::vector<std::string>* v, const wire::ControlWord& c) {
-  Add(v, {I(c.camera_station), B(c.reset), B(c.overlay), I(c.mode), B(c.collision), B(c.receptacle_collision),
-          B(c.acquired), B(c.docked)});
+  Add(v, {I(c.camera_station), B(c.reset), B(c.overlay), I(c.mode), B(c.collision),
+          B(c.receptacle_collision), B(c.acquired), B(c.docked)});
 }
 const char* kAngle[6] = {"shoulder_yaw [deg]", "shoulder_pitch [deg]", "elbow_pitch [deg]",
-                         "wrist_pitch [deg]", "wrist_yaw [deg]", "wrist_roll [deg]"};
+                         "wrist_pitch [deg]",  "wrist_yaw [deg]",      "wrist_roll [deg]"};
 
 std::vector<std::string> Vec3Columns(const std::string& name, const std::string& unit) {
   return {name + "_x [" + unit + "]", name + "_y [" + unit + "]", name + "_z [" + unit + "]"};
@@ -136,18 +140,21 @@ void AddPoseColumns(std::vector<std::string>* cols, const std::string& p, const 
 }
 
 std::vector<std::string> DcpColumns() {
-  std::vector<std::string> cols = {"log_time [us]", "session_time [s]", "frame", "send_time [us]", "input_frame", "input_send_time [us]"};
+  std::vector<std::string> cols = {"log_time [us]",  "session_time [s]", "frame",
+                                   "send_time [us]", "input_frame",      "input_send_time [us]"};
   cols.insert(cols.end(), kAngle, kAngle + 6);
   for (const auto& c : ControlColumns("")) cols.push_back(c);
   AddPlaneColumns(&cols);
-  Add(&cols, {"shoulder_height [ft]", "finger_gap [ft]", "camera_pan [deg]", "camera_tilt [deg]", "camera_zoom [1]"});
+  Add(&cols, {"shoulder_height [ft]", "finger_gap [ft]", "camera_pan [deg]", "camera_tilt [deg]",
+              "camera_zoom [1]"});
   AddPoseColumns(&cols, "p_RoPo_R", "R_RP");
   return cols;
 }
 
 std::vector<std::string> EsgColumns() {
-  std::vector<std::string> cols = {"log_time [us]", "session_time [s]", "frame", "send_time [us]", "dcp_frame", "input_frame",
-                                   "input_send_time [us]", "num_words", "frame_count"};
+  std::vector<std::string> cols = {"log_time [us]",        "session_time [s]", "frame",
+                                   "send_time [us]",       "dcp_frame",        "input_frame",
+                                   "input_send_time [us]", "num_words",        "frame_count"};
   for (const auto& c : ControlColumns("")) cols.push_back(c);
   Add(&cols, {"priority_dynamic", "priority_fixed"});
   cols.insert(cols.end(), kAngle, kAngle + 6);
@@ -155,21 +162,35 @@ std::vector<std::string> EsgColumns() {
   AddPoseColumns(&cols, "p_RoEye_R", "R_RE");
   cols.push_back("fov [deg]");
   AddPoseColumns(&cols, "p_RoPo_R", "R_RP");
-  for (int w = 0; w < wire::esg_words::kPriorityCount; ++w) cols.push_back("priority_word_" + std::to_string(w) + " [hex]");
+  for (int w = 0; w < wire::esg_words::kPriorityCount; ++w)
+    cols.push_back("priority_word_" + std::to_string(w) + " [hex]");
   return cols;
 }
 
 std::vector<std::string> TelemetryColumns() {
-  std::vector<std::string> cols = {"log_time [us]", "session_time [s]", "frame", "send_time [us]", "input_frame", "input_send_time [us]",
-                                   "mode", "acquired", "docked", "held", "finger_held", "collisions [bits]",
+  std::vector<std::string> cols = {"log_time [us]",
+                                   "session_time [s]",
+                                   "frame",
+                                   "send_time [us]",
+                                   "input_frame",
+                                   "input_send_time [us]",
+                                   "mode",
+                                   "acquired",
+                                   "docked",
+                                   "held",
+                                   "finger_held",
+                                   "collisions [bits]",
                                    "slave_collisions [bits]"};
-  for (int i = 1; i <= wire::kNumAcquisitionConditions; ++i) cols.push_back("acquisition_condition_" + std::to_string(i));
-  Add(&cols, {"finger_gap [ft]", "palm_to_bar [ft]", "probe_in_envelope", "dock_distance [ft]", "dock_angle [deg]"});
+  for (int i = 1; i <= wire::kNumAcquisitionConditions; ++i)
+    cols.push_back("acquisition_condition_" + std::to_string(i));
+  Add(&cols, {"finger_gap [ft]", "palm_to_bar [ft]", "probe_in_envelope", "dock_distance [ft]",
+              "dock_angle [deg]"});
   AddPlaneColumns(&cols);
   for (const char* w : {"master_", "slave_"}) {
     for (const char* a : kAngle) cols.push_back(std::string(w) + a);
   }
-  Add(&cols, {"master_shoulder_height [ft]", "slave_shoulder_height [ft]", "master_finger [1]", "slave_finger [1]"});
+  Add(&cols, {"master_shoulder_height [ft]", "slave_shoulder_height [ft]", "master_finger [1]",
+              "slave_finger [1]"});
   AddPoseColumns(&cols, "p_RoA_R", "R_RS2");
   AddPoseColumns(&cols, "p_RoPo_R", "R_RP");
   return cols;
@@ -188,13 +209,14 @@ void AddMat(std::vector<std::string>* row, const Eigen::Matrix3d& m) {
 template <class Msg>
 Msg Decoded(const LogMessage& msg) {
   Msg m{};
-  if (wire::SafeDecode(msg.data, msg.size, &m) != wire::DecodeError::kNone) throw InputError("malformed");
+  if (wire::SafeDecode(msg.data, msg.size, &m) != wire::DecodeError::kNone)
+    throw InputError("malformed");
   return m;
 }
 
 // Each channel's row; t and st: the log time and the session time, as written.
-std::vector<std::string> InputRow(const LogMessage& msg, const std::string& t, const std::string& st,
-                                  const LabConfig& config) {
+std::vector<std::string> InputRow(const LogMessage& msg, const std::string& t,
+                                  const std::string& st, const LabConfig& config) {
   const auto m = Decoded<operator_input_t>(msg);
   std::array<std::int32_t, wire::kInputWords> words{};
   std::copy(m.words, m.words + wire::kInputWords, words.begin());
@@ -205,27 +227,38 @@ std::vector<std::string> InputRow(const LogMessage& msg, const std::string& t, c
   return row;
 }
 
-std::vector<std::string> DcpRow(const LogMessage& msg, const std::string& t, const std::string& st) {
+std::vector<std::string> DcpRow(const LogMessage& msg, const std::string& t,
+                                const std::string& st) {
   const auto m = Decoded<dcp_frame_t>(msg);
   const wire::DcpFrameData d = wire::UnpackDcpFrame(m);
-  std::vector<std::string> row = {t, st, I(m.frame), I(m.send_time_us), I(m.input_frame), I(m.input_send_time_us)};
+  std::vector<std::string> row = {
+      t, st, I(m.frame), I(m.send_time_us), I(m.input_frame), I(m.input_send_time_us)};
   for (int i = 0; i < 6; ++i) row.push_back(N(Deg(d.arm[i])));
   ControlCells(&row, d.control);
   for (int k = 0; k < 3; ++k) {
-    Add(&row, {B((d.plane_valid >> k) & 1), N(d.planes[k].n_R.x()), N(d.planes[k].n_R.y()), N(d.planes[k].n_R.z()),
-               N(d.planes[k].d_ft)});
+    Add(&row, {B((d.plane_valid >> k) & 1), N(d.planes[k].n_R.x()), N(d.planes[k].n_R.y()),
+               N(d.planes[k].n_R.z()), N(d.planes[k].d_ft)});
   }
-  Add(&row, {N(d.shoulder_height_ft), N(d.finger_gap_ft), N(d.camera_pan_deg), N(d.camera_tilt_deg), N(d.camera_zoom)});
+  Add(&row, {N(d.shoulder_height_ft), N(d.finger_gap_ft), N(d.camera_pan_deg), N(d.camera_tilt_deg),
+             N(d.camera_zoom)});
   AddVec3(&row, d.p_RoPo_R_ft);
   AddMat(&row, d.R_RP);
   return row;
 }
 
-std::vector<std::string> EsgRow(const LogMessage& msg, const std::string& t, const std::string& st) {
+std::vector<std::string> EsgRow(const LogMessage& msg, const std::string& t,
+                                const std::string& st) {
   const auto m = Decoded<esg_frame_t>(msg);
   const wire::EsgFrameData d = wire::UnpackEsgWords(m.words);
-  std::vector<std::string> row = {t, st, I(m.frame), I(m.send_time_us), I(m.dcp_frame), I(m.input_frame),
-                                  I(m.input_send_time_us), I(m.num_words), I(d.frame_count)};
+  std::vector<std::string> row = {t,
+                                  st,
+                                  I(m.frame),
+                                  I(m.send_time_us),
+                                  I(m.dcp_frame),
+                                  I(m.input_frame),
+                                  I(m.input_send_time_us),
+                                  I(m.num_words),
+                                  I(d.frame_count)};
   ControlCells(&row, d.control);
   Add(&row, {I(d.control.priority_dynamic), I(d.control.priority_fixed)});
   for (int i = 0; i < 6; ++i) row.push_back(N(Deg(d.arm[i])));
@@ -243,21 +276,34 @@ std::vector<std::string> EsgRow(const LogMessage& msg, const std::string& t, con
   return row;
 }
 
-std::vector<std::string> TelemetryRow(const LogMessage& msg, const std::string& t, const std::string& st) {
+std::vector<std::string> TelemetryRow(const LogMessage& msg, const std::string& t,
+                                      const std::string& st) {
   const auto m = Decoded<dcp_telemetry_t>(msg);
-  std::vector<std::string> row = {t, st, I(m.frame), I(m.send_time_us), I(m.input_frame), I(m.input_send_time_us),
-                                  I(m.mode), B(m.acquired), B(m.docked), B(m.held), B(m.finger_held),
-                                  I(m.collisions), I(m.slave_collisions)};
-  for (int i = 0; i < wire::kNumAcquisitionConditions; ++i) row.push_back(B(m.acquisition_conditions[i]));
+  std::vector<std::string> row = {t,
+                                  st,
+                                  I(m.frame),
+                                  I(m.send_time_us),
+                                  I(m.input_frame),
+                                  I(m.input_send_time_us),
+                                  I(m.mode),
+                                  B(m.acquired),
+                                  B(m.docked),
+                                  B(m.held),
+                                  B(m.finger_held),
+                                  I(m.collisions),
+                                  I(m.slave_collisions)};
+  for (int i = 0; i < wire::kNumAcquisitionConditions; ++i)
+    row.push_back(B(m.acquisition_conditions[i]));
   Add(&row, {N(m.finger_gap_ft), N(m.palm_to_bar_ft), B(m.probe_in_envelope), N(m.dock_distance_ft),
              N(m.dock_angle_deg)});
   for (int k = 0; k < 3; ++k) {
-    Add(&row, {B(m.plane_valid[k]), N(m.plane_n[3 * k]), N(m.plane_n[3 * k + 1]), N(m.plane_n[3 * k + 2]),
-               N(m.plane_d_ft[k])});
+    Add(&row, {B(m.plane_valid[k]), N(m.plane_n[3 * k]), N(m.plane_n[3 * k + 1]),
+               N(m.plane_n[3 * k + 2]), N(m.plane_d_ft[k])});
   }
   for (int i = 0; i < 6; ++i) row.push_back(N(m.master_angles_deg[i]));
   for (int i = 0; i < 6; ++i) row.push_back(N(m.slave_angles_deg[i]));
-  Add(&row, {N(m.master_shoulder_height_ft), N(m.slave_shoulder_height_ft), N(m.master_finger), N(m.slave_finger)});
+  Add(&row, {N(m.master_shoulder_height_ft), N(m.slave_shoulder_height_ft), N(m.master_finger),
+             N(m.slave_finger)});
   for (int i = 0; i < 3; ++i) row.push_back(N(m.p_RoA_R_ft[i]));
   for (int i = 0; i < 9; ++i) row.push_back(N(m.R_RS2[i]));
   for (int i = 0; i < 3; ++i) row.push_back(N(m.p_RoPo_R_ft[i]));
@@ -273,9 +319,10 @@ struct ChannelFiles {
         dcp(out / "dcp_frame.csv", DcpColumns()),
         esg(out / "esg_frame.csv", EsgColumns()),
         tm(out / "dcp_telemetry.csv", TelemetryColumns()),
-        st(out / "status.csv", {"log_time [us]", "session_time [s]", "send_time [us]", "process", "host", "pid",
-                                "frame", "final", "counter", "value"}),
-        ctl(out / "control.csv", {"log_time [us]", "session_time [s]", "send_time [us]", "sequence", "command", "name"}) {}
+        st(out / "status.csv", {"log_time [us]", "session_time [s]", "send_time [us]", "process",
+                                "host", "pid", "frame", "final", "counter", "value"}),
+        ctl(out / "control.csv", {"log_time [us]", "session_time [s]", "send_time [us]", "sequence",
+                                  "command", "name"}) {}
 
   void Write(const LogMessage& msg, const LabConfig& config) {
     const std::string_view base = msg.base;
@@ -291,22 +338,23 @@ struct ChannelFiles {
     } else if (base == wire::channels::kStatus) {
       const auto m = Decoded<process_status_t>(msg);
       for (int i = 0; i < m.num_counters; ++i) {
-        st.Row({t, st_s, I(m.send_time_us), m.process, m.host, I(m.pid), I(m.frame), B(m.final), m.counter_names[i],
-                I(m.counter_values[i])});
+        st.Row({t, st_s, I(m.send_time_us), m.process, m.host, I(m.pid), I(m.frame), B(m.final),
+                m.counter_names[i], I(m.counter_values[i])});
       }
     } else if (base == wire::channels::kControl) {
       const auto m = Decoded<session_control_t>(msg);
       static const char* kNames[] = {"?", "freeze", "run", "step", "checkpoint", "restore"};
-      ctl.Row({t, st_s, I(m.send_time_us), I(m.sequence), m.command >= 1 && m.command <= 5 ? kNames[m.command] : "?",
-               m.name});
+      ctl.Row({t, st_s, I(m.send_time_us), I(m.sequence),
+               m.command >= 1 && m.command <= 5 ? kNames[m.command] : "?", m.name});
     }
   }
 };
 
 }  // namespace
 
-std::vector<std::pair<std::string, long>> ExportCsv(const std::string& session_dir, const std::string& out_dir,
-                                                    const std::function<void(const std::string&)>& progress) {
+std::vector<std::pair<std::string, long>> ExportCsv(
+    const std::string& session_dir, const std::string& out_dir,
+    const std::function<void(const std::string&)>& progress) {
   const fs::path root(session_dir), out(out_dir);
   const LabConfig config = LoadConfig((root / "config.toml").string());
   fs::create_directories(out);
@@ -314,7 +362,8 @@ std::vector<std::pair<std::string, long>> ExportCsv(const std::string& session_d
   long skipped = 0, events = 0;
   SessionLog log(session_dir);  // only the session's own messages (docs/security.md)
   log.Read({}, [&](const LogMessage& msg) {
-    if (progress && ++events % 100000 == 0) progress("export: " + std::to_string(events) + " messages");
+    if (progress && ++events % 100000 == 0)
+      progress("export: " + std::to_string(events) + " messages");
     try {
       files.Write(msg, config);
     } catch (const std::exception&) {

@@ -1,8 +1,6 @@
 // ExportJsonLines (export_csv.h): the session's log as JSON lines for MCAP.
 #include <ostream>
 
-#include "rms/session/export_csv.h"
-#include "rms/wire/channels.h"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_state_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
@@ -11,9 +9,11 @@
 #include "rms/operator_input_t.hpp"
 #include "rms/operator_state_t.hpp"
 #include "rms/process_status_t.hpp"
+#include "rms/session/export_csv.h"
+#include "rms/session/session_log.h"
 #include "rms/session_control_t.hpp"
 #include "rms/window_keys_t.hpp"
-#include "rms/session/session_log.h"
+#include "rms/wire/channels.h"
 
 namespace rms::session {
 
@@ -43,16 +43,26 @@ long ExportJsonLines(const std::string& session_dir, std::ostream& out, long* ma
   log.Read({}, [&](const LogMessage& ev) {
     bool ok = false;
     const std::string_view b = ev.base;
-    if (b == wire::channels::kOperatorInput) ok = Line<operator_input_t>(log, ev, "rms.operator_input_t", out);
-    else if (b == wire::channels::kOperatorState) ok = Line<operator_state_t>(log, ev, "rms.operator_state_t", out);
-    else if (b == wire::channels::kDcpFrame) ok = Line<dcp_frame_t>(log, ev, "rms.dcp_frame_t", out);
-    else if (b == wire::channels::kDcpTelemetry) ok = Line<dcp_telemetry_t>(log, ev, "rms.dcp_telemetry_t", out);
-    else if (b == wire::channels::kDcpState) ok = Line<dcp_state_t>(log, ev, "rms.dcp_state_t", out);
-    else if (b == wire::channels::kEsgFrame) ok = Line<esg_frame_t>(log, ev, "rms.esg_frame_t", out);
-    else if (b == wire::channels::kStatus) ok = Line<process_status_t>(log, ev, "rms.process_status_t", out);
-    else if (b == wire::channels::kControl) ok = Line<session_control_t>(log, ev, "rms.session_control_t", out);
-    else if (b == wire::channels::kWindowKeys) ok = Line<window_keys_t>(log, ev, "rms.window_keys_t", out);
-    else return;
+    if (b == wire::channels::kOperatorInput)
+      ok = Line<operator_input_t>(log, ev, "rms.operator_input_t", out);
+    else if (b == wire::channels::kOperatorState)
+      ok = Line<operator_state_t>(log, ev, "rms.operator_state_t", out);
+    else if (b == wire::channels::kDcpFrame)
+      ok = Line<dcp_frame_t>(log, ev, "rms.dcp_frame_t", out);
+    else if (b == wire::channels::kDcpTelemetry)
+      ok = Line<dcp_telemetry_t>(log, ev, "rms.dcp_telemetry_t", out);
+    else if (b == wire::channels::kDcpState)
+      ok = Line<dcp_state_t>(log, ev, "rms.dcp_state_t", out);
+    else if (b == wire::channels::kEsgFrame)
+      ok = Line<esg_frame_t>(log, ev, "rms.esg_frame_t", out);
+    else if (b == wire::channels::kStatus)
+      ok = Line<process_status_t>(log, ev, "rms.process_status_t", out);
+    else if (b == wire::channels::kControl)
+      ok = Line<session_control_t>(log, ev, "rms.session_control_t", out);
+    else if (b == wire::channels::kWindowKeys)
+      ok = Line<window_keys_t>(log, ev, "rms.window_keys_t", out);
+    else
+      return;
     n += ok;
   });
   if (malformed) *malformed = log.malformed();

@@ -1,7 +1,6 @@
 #include "rms/session/lab_file.h"
 
 #include <cstdio>
-
 #include <fstream>
 #include <sstream>
 
@@ -12,12 +11,15 @@ namespace rms::session {
 
 namespace {
 
-constexpr const char* kProcesses[] = {"operator_station", "dynamics_proc", "scene_proc", "esg_renderer", "recorder"};
+constexpr const char* kProcesses[] = {"operator_station", "dynamics_proc", "scene_proc",
+                                      "esg_renderer", "recorder"};
 
 bool ValidName(const std::string& s) {
   if (s.empty()) return false;
   for (char c : s) {
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.' || c == '@')) return false;
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.' ||
+          c == '@'))
+      return false;
   }
   return true;
 }
@@ -31,7 +33,9 @@ bool LabFile::all_local() const {
   return true;
 }
 
-LabFile LoadLabFile(const std::string& path) { return ParseLabFile(ReadTextFile(path, "the lab file"), path); }
+LabFile LoadLabFile(const std::string& path) {
+  return ParseLabFile(ReadTextFile(path, "the lab file"), path);
+}
 
 LabFile ParseLabFile(std::string_view text, const std::string& path) {
   LabFile lab;
@@ -45,7 +49,9 @@ LabFile ParseLabFile(std::string_view text, const std::string& path) {
       const std::string v = h.String(p);
       const bool ok = v == "localhost" || (v.rfind("netns:", 0) == 0 && ValidName(v.substr(6))) ||
                       (v.rfind("ssh:", 0) == 0 && ValidName(v.substr(4)));
-      if (!ok) h.Fail(p, "must be \"localhost\", \"netns:NAME\" or \"ssh:[USER@]HOST\", got \"" + v + "\"");
+      if (!ok)
+        h.Fail(p,
+               "must be \"localhost\", \"netns:NAME\" or \"ssh:[USER@]HOST\", got \"" + v + "\"");
       lab.hosts[p] = v;
     }
     h.Finish();
@@ -57,10 +63,15 @@ LabFile ParseLabFile(std::string_view text, const std::string& path) {
     {
       int a[4] = {-1, -1, -1, -1};
       char tail = 0;
-      const bool dotted = std::sscanf(lab.group.c_str(), "%d.%d.%d.%d%c", &a[0], &a[1], &a[2], &a[3], &tail) == 4;
+      const bool dotted =
+          std::sscanf(lab.group.c_str(), "%d.%d.%d.%d%c", &a[0], &a[1], &a[2], &a[3], &tail) == 4;
       bool ok = dotted && a[0] >= 224 && a[0] <= 239;
       for (int k = 1; k < 4; ++k) ok = ok && a[k] >= 0 && a[k] <= 255;
-      if (!ok) l.Fail("group", "must be an IPv4 multicast address (224.0.0.0 .. 239.255.255.255; 239.x.x.x for a lab), got \"" + lab.group + "\"");
+      if (!ok)
+        l.Fail("group",
+               "must be an IPv4 multicast address (224.0.0.0 .. 239.255.255.255; 239.x.x.x for a "
+               "lab), got \"" +
+                   lab.group + "\"");
     }
     lab.port = static_cast<int>(l.Number("port", 1024, 65535));
     lab.ttl = static_cast<int>(l.Number("ttl", 0, 255));

@@ -3,11 +3,11 @@
 #include <filesystem>
 #include <fstream>
 
-#include "rms/wire/channels.h"
 #include "rms/base/check.h"
-#include "rms/wire/message_io.h"
 #include "rms/sender_t.hpp"
 #include "rms/session/session_summary.h"
+#include "rms/wire/channels.h"
+#include "rms/wire/message_io.h"
 
 namespace fs = std::filesystem;
 
@@ -18,16 +18,19 @@ namespace {
 // Who publishes each channel (docs/protocol.md "Channels").
 bool Publishes(const std::string& base, std::int8_t process) {
   using S = sender_t;
-  if (base == wire::channels::kOperatorInput || base == wire::channels::kOperatorState) return process == S::PROCESS_OPERATOR_STATION;
-  if (base == wire::channels::kDcpFrame || base == wire::channels::kDcpTelemetry || base == wire::channels::kDcpState) {
+  if (base == wire::channels::kOperatorInput || base == wire::channels::kOperatorState)
+    return process == S::PROCESS_OPERATOR_STATION;
+  if (base == wire::channels::kDcpFrame || base == wire::channels::kDcpTelemetry ||
+      base == wire::channels::kDcpState) {
     return process == S::PROCESS_DYNAMICS;
   }
   if (base == wire::channels::kEsgFrame) return process == S::PROCESS_SCENE;
   if (base == wire::channels::kWindowKeys) return process == S::PROCESS_ESG;
-  if (base == wire::channels::kControl) return process == S::PROCESS_CONTROL || process == S::PROCESS_OPERATOR_STATION;
+  if (base == wire::channels::kControl)
+    return process == S::PROCESS_CONTROL || process == S::PROCESS_OPERATOR_STATION;
   if (base == wire::channels::kStatus) {
-    return process == S::PROCESS_OPERATOR_STATION || process == S::PROCESS_DYNAMICS || process == S::PROCESS_SCENE ||
-           process == S::PROCESS_ESG;
+    return process == S::PROCESS_OPERATOR_STATION || process == S::PROCESS_DYNAMICS ||
+           process == S::PROCESS_SCENE || process == S::PROCESS_ESG;
   }
   return false;
 }
@@ -48,7 +51,8 @@ const char* SenderCheck::Ignore(const std::string& base, const void* data, int s
   std::int64_t id = 0;
   std::int8_t process = 0;
   std::int32_t pid = 0;
-  if (!wire::ReadSessionId(data, size, &id) || !wire::ReadSenderProcess(data, size, &process, &pid)) {
+  if (!wire::ReadSessionId(data, size, &id) ||
+      !wire::ReadSenderProcess(data, size, &process, &pid)) {
     why = "no_sender";
   } else if (id != session_id_) {
     why = "other_session";
@@ -85,9 +89,10 @@ nlohmann::ordered_json SenderCheck::Json() const {
   j["pids_checked_for"] = nlohmann::ordered_json::array();
   j["pids_not_checked_for"] = nlohmann::ordered_json::array();
   if (!pids_.empty()) {
-    for (std::int8_t p : {sender_t::PROCESS_OPERATOR_STATION, sender_t::PROCESS_DYNAMICS, sender_t::PROCESS_SCENE,
-                          sender_t::PROCESS_ESG}) {
-      j[pids_.count(p) ? "pids_checked_for" : "pids_not_checked_for"].push_back(wire::ProcessCodeName(p));
+    for (std::int8_t p : {sender_t::PROCESS_OPERATOR_STATION, sender_t::PROCESS_DYNAMICS,
+                          sender_t::PROCESS_SCENE, sender_t::PROCESS_ESG}) {
+      j[pids_.count(p) ? "pids_checked_for" : "pids_not_checked_for"].push_back(
+          wire::ProcessCodeName(p));
     }
   }
   return j;

@@ -5,10 +5,10 @@
 #include <filesystem>
 #include <lcm/lcm-cpp.hpp>
 
-#include "rms/wire/channels.h"
 #include "rms/base/check.h"
 #include "rms/base/config.h"
 #include "rms/session/session_summary.h"
+#include "rms/wire/channels.h"
 
 namespace fs = std::filesystem;
 
@@ -59,12 +59,15 @@ void SessionLog::Read(std::initializer_list<std::string_view> channels,
     last_us_ = ev->timestamp;
     std::string_view channel = ev->channel;
     if (!suffix_.empty()) {
-      if (channel.size() <= suffix_.size() || channel.substr(channel.size() - suffix_.size()) != suffix_) continue;
+      if (channel.size() <= suffix_.size() ||
+          channel.substr(channel.size() - suffix_.size()) != suffix_)
+        continue;
       channel.remove_suffix(suffix_.size());
     }
     // Only the channels asked for are looked at (and the operator's, for the
     // session time): the rest are skipped before any decoding.
-    const bool wanted = channels.size() == 0 || std::find(channels.begin(), channels.end(), channel) != channels.end();
+    const bool wanted = channels.size() == 0 ||
+                        std::find(channels.begin(), channels.end(), channel) != channels.end();
     const bool input = channel == wire::channels::kOperatorInput;
     if (!wanted && !input) continue;
     const std::string base(channel);
@@ -85,7 +88,9 @@ void SessionLog::Read(std::initializer_list<std::string_view> channels,
   const long at = good_end;
   std::error_code ec;
   const auto size = fs::file_size(log_path_, ec);
-  unread_bytes_ = (at >= 0 && !ec && static_cast<std::int64_t>(size) > at) ? static_cast<std::int64_t>(size) - at : 0;
+  unread_bytes_ = (at >= 0 && !ec && static_cast<std::int64_t>(size) > at)
+                      ? static_cast<std::int64_t>(size) - at
+                      : 0;
 }
 
 }  // namespace rms::session

@@ -1,39 +1,41 @@
 #include "rms/session/session_summary.h"
 
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <lcm/lcm-cpp.hpp>
-#include <algorithm>
 #include <map>
 #include <set>
-#include <ctime>
-#include <unistd.h>
-#include <array>
 
-#include "rms/wire/channels.h"
-#include "rms/base/config.h"
-#include "rms/wire/collision_bits.h"
 #include "rms/base/check.h"
-#include "rms/wire/control_word.h"
+#include "rms/base/config.h"
 #include "rms/base/counters.h"
+#include "rms/base/text.h"
+#include "rms/base/version.h"
 #include "rms/dcp_frame_t.hpp"
+#include "rms/dcp_state_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/esg_frame_t.hpp"
-#include "rms/wire/message_io.h"
 #include "rms/operator_input_t.hpp"
 #include "rms/operator_state_t.hpp"
 #include "rms/process_status_t.hpp"
-#include "rms/transport/lcm_interface.h"
-#include "rms/transport/process.h"
 #include "rms/sender_t.hpp"
-#include "rms/session_control_t.hpp"
-#include "rms/base/text.h"
-#include "rms/base/version.h"
-#include "attempts.h"
 #include "rms/session/sender_check.h"
 #include "rms/session/session_log.h"
-#include "rms/dcp_state_t.hpp"
+#include "rms/session_control_t.hpp"
+#include "rms/transport/lcm_interface.h"
+#include "rms/transport/process.h"
+#include "rms/wire/channels.h"
+#include "rms/wire/collision_bits.h"
+#include "rms/wire/control_word.h"
+#include "rms/wire/message_io.h"
+
+#include "attempts.h"
 
 namespace fs = std::filesystem;
 
@@ -83,11 +85,14 @@ class HandControlLog {
     if (key != last_key_) {
       static const char* kModes[3] = {"?", "single joint", "manual augmented"};
       static const char* kFrames[4] = {"?", "end effector", "orbiter", "payload"};
-      changes_.push_back({{"time_s", t_s},
-                          {"frame", m.frame},
-                          {"control_mode", kModes[m.control_mode >= 1 && m.control_mode <= 2 ? m.control_mode : 0]},
-                          {"command_frame", kFrames[m.command_frame >= 1 && m.command_frame <= 3 ? m.command_frame : 0]},
-                          {"scale", m.vernier ? "vernier" : "coarse"}});
+      changes_.push_back(
+          {{"time_s", t_s},
+           {"frame", m.frame},
+           {"control_mode",
+            kModes[m.control_mode >= 1 && m.control_mode <= 2 ? m.control_mode : 0]},
+           {"command_frame",
+            kFrames[m.command_frame >= 1 && m.command_frame <= 3 ? m.command_frame : 0]},
+           {"scale", m.vernier ? "vernier" : "coarse"}});
       last_key_ = key;
     }
     key_actions_ = std::max<std::int64_t>(key_actions_, m.key_actions);
@@ -112,9 +117,10 @@ class HandControlLog {
 }  // namespace
 
 std::string BaseChannel(const std::string& channel) {
-  for (const char* base : {wire::channels::kOperatorInput, wire::channels::kOperatorState, wire::channels::kWindowKeys,
-                           wire::channels::kDcpTelemetry, wire::channels::kDcpFrame, wire::channels::kEsgFrame, wire::channels::kStatus,
-                           wire::channels::kControl, wire::channels::kDcpState}) {
+  for (const char* base :
+       {wire::channels::kOperatorInput, wire::channels::kOperatorState, wire::channels::kWindowKeys,
+        wire::channels::kDcpTelemetry, wire::channels::kDcpFrame, wire::channels::kEsgFrame,
+        wire::channels::kStatus, wire::channels::kControl, wire::channels::kDcpState}) {
     if (channel.rfind(base, 0) == 0) return base;
   }
   return channel;
@@ -128,11 +134,14 @@ std::vector<std::size_t> LongestIncreasingRun(const std::vector<std::int64_t>& v
     const auto it = std::lower_bound(tails.begin(), tails.end(), v[i],
                                      [&v](std::size_t a, std::int64_t x) { return v[a] < x; });
     if (it != tails.begin()) parent[i] = static_cast<std::ptrdiff_t>(*(it - 1));
-    if (it == tails.end()) tails.push_back(i);
-    else *it = i;
+    if (it == tails.end())
+      tails.push_back(i);
+    else
+      *it = i;
   }
   std::vector<std::size_t> run;
-  for (std::ptrdiff_t i = tails.empty() ? -1 : static_cast<std::ptrdiff_t>(tails.back()); i >= 0; i = parent[i]) {
+  for (std::ptrdiff_t i = tails.empty() ? -1 : static_cast<std::ptrdiff_t>(tails.back()); i >= 0;
+       i = parent[i]) {
     run.push_back(static_cast<std::size_t>(i));
   }
   std::reverse(run.begin(), run.end());
@@ -172,7 +181,8 @@ DcpFrames ReadDcpFrames(SessionLog& log) {
     try {
       const DcpFrameRecord r{m.input_frame, wire::UnpackControlWord(m.control_word)};
       const auto [it, fresh] = first.emplace(m.frame, r);
-      if (!fresh && (it->second.input_frame != r.input_frame || it->second.word != r.word)) disputed.insert(m.frame);
+      if (!fresh && (it->second.input_frame != r.input_frame || it->second.word != r.word))
+        disputed.insert(m.frame);
       numbers.push_back(m.frame);
       records.push_back(r);
     } catch (const InputError&) {
@@ -210,8 +220,11 @@ class TelemetryLog {
     // (Phases and docking are each attempt's: AttemptLog.)
     if (m.mode != last_mode_) {
       if (last_mode_ != 0) {
-        mode_changes.push_back({{"frame", m.frame}, {"time_s", m.input_frame / rate_hz_}, {"log_time_s", t_s},
-                                {"from", last_mode_}, {"to", m.mode}});
+        mode_changes.push_back({{"frame", m.frame},
+                                {"time_s", m.input_frame / rate_hz_},
+                                {"log_time_s", t_s},
+                                {"from", last_mode_},
+                                {"to", m.mode}});
       }
       last_mode_ = m.mode;
     }
@@ -219,8 +232,9 @@ class TelemetryLog {
     docked = docked || m.docked;
     held_frames += m.held;
     // Detrimental collisions only: the finger resting on the bar is the essential contact.
-    const auto bits = wire::DetrimentalCollisions(static_cast<std::uint32_t>(m.collisions), m.finger_held, m.held,
-                                                m.master_finger > m.slave_finger);
+    const auto bits =
+        wire::DetrimentalCollisions(static_cast<std::uint32_t>(m.collisions), m.finger_held, m.held,
+                                    m.master_finger > m.slave_finger);
     for (int b = 0; b < kCollisionBits; ++b) {
       const bool on = bits & (1u << b), was = last_bits_ & (1u << b);
       if (on && !was) {
@@ -245,7 +259,8 @@ class TelemetryLog {
   nlohmann::ordered_json ByKind() const {
     nlohmann::ordered_json by_kind = nlohmann::ordered_json::object();
     for (const auto& [kind, t] : totals_) {
-      by_kind[kind] = {{"events", static_cast<std::int64_t>(t[0])}, {"frames", static_cast<std::int64_t>(t[1])},
+      by_kind[kind] = {{"events", static_cast<std::int64_t>(t[0])},
+                       {"frames", static_cast<std::int64_t>(t[1])},
                        {"duration_s", t[2]}};
     }
     return by_kind;
@@ -305,8 +320,8 @@ struct LogScan {
   std::string last_restore_name;
 };
 
-void ScanTelemetry(const LogMessage& ev, const std::map<std::int64_t, DcpFrameRecord>& dcp, SenderCheck* check,
-                   LogScan* s) {
+void ScanTelemetry(const LogMessage& ev, const std::map<std::int64_t, DcpFrameRecord>& dcp,
+                   SenderCheck* check, LogScan* s) {
   dcp_telemetry_t m{};
   if (wire::SafeDecode(ev.data, ev.size, &m) != wire::DecodeError::kNone) {
     ++s->malformed;
@@ -355,8 +370,8 @@ void ScanControl(const LogMessage& ev, LogScan* s) {
   s->control.push_back(e);
 }
 
-void ScanFrameNumbers(const std::string& base, const LogMessage& ev, const std::map<std::int64_t, DcpFrameRecord>& dcp,
-                      LogScan* s) {
+void ScanFrameNumbers(const std::string& base, const LogMessage& ev,
+                      const std::map<std::int64_t, DcpFrameRecord>& dcp, LogScan* s) {
   if (base == wire::channels::kOperatorState) {
     operator_state_t m;
     if (wire::SafeDecode(ev.data, ev.size, &m) == wire::DecodeError::kNone) {
@@ -367,8 +382,10 @@ void ScanFrameNumbers(const std::string& base, const LogMessage& ev, const std::
     }
   } else if (base == wire::channels::kOperatorInput) {
     operator_input_t m;
-    if (wire::SafeDecode(ev.data, ev.size, &m) == wire::DecodeError::kNone) s->input.Accept(m.frame);
-    else ++s->malformed;
+    if (wire::SafeDecode(ev.data, ev.size, &m) == wire::DecodeError::kNone)
+      s->input.Accept(m.frame);
+    else
+      ++s->malformed;
   } else if (base == wire::channels::kDcpFrame) {
     // Only the frames of the increasing run (ReadDcpFrames) count.
     dcp_frame_t m;
@@ -381,8 +398,10 @@ void ScanFrameNumbers(const std::string& base, const LogMessage& ev, const std::
     }
   } else if (base == wire::channels::kEsgFrame) {
     esg_frame_t m;
-    if (wire::SafeDecode(ev.data, ev.size, &m) == wire::DecodeError::kNone) s->esg.Accept(m.frame);
-    else ++s->malformed;
+    if (wire::SafeDecode(ev.data, ev.size, &m) == wire::DecodeError::kNone)
+      s->esg.Accept(m.frame);
+    else
+      ++s->malformed;
   }
 }
 
@@ -396,7 +415,8 @@ void ScanState(const LogMessage& ev, LogScan* s) {
   if (m.reason == dcp_state_t::RESTORE) s->attempts->ObserveRestore(s->last_restore_name);
 }
 
-LogScan ScanLog(SessionLog& log, const std::map<std::int64_t, DcpFrameRecord>& dcp, AttemptLog* attempts) {
+LogScan ScanLog(SessionLog& log, const std::map<std::int64_t, DcpFrameRecord>& dcp,
+                AttemptLog* attempts) {
   LogScan s;
   s.attempts = attempts;
   s.rate_hz = log.frame_rate_hz();
@@ -405,11 +425,16 @@ LogScan ScanLog(SessionLog& log, const std::map<std::int64_t, DcpFrameRecord>& d
   log.Read({}, [&](const LogMessage& ev) {
     if (s.first_us < 0) s.first_us = log.first_us();
     ++s.by_channel[std::string(ev.channel)];
-    if (ev.base == wire::channels::kDcpTelemetry) ScanTelemetry(ev, dcp, check, &s);
-    else if (ev.base == wire::channels::kStatus) ScanStatus(ev, &s);
-    else if (ev.base == wire::channels::kControl) ScanControl(ev, &s);
-    else if (ev.base == wire::channels::kDcpState) ScanState(ev, &s);
-    else ScanFrameNumbers(std::string(ev.base), ev, dcp, &s);
+    if (ev.base == wire::channels::kDcpTelemetry)
+      ScanTelemetry(ev, dcp, check, &s);
+    else if (ev.base == wire::channels::kStatus)
+      ScanStatus(ev, &s);
+    else if (ev.base == wire::channels::kControl)
+      ScanControl(ev, &s);
+    else if (ev.base == wire::channels::kDcpState)
+      ScanState(ev, &s);
+    else
+      ScanFrameNumbers(std::string(ev.base), ev, dcp, &s);
   });
   s.events = log.events();
   s.first_us = log.first_us();
@@ -437,8 +462,9 @@ bool Plausible(const std::map<std::string, std::int64_t>& run, double duration_s
 // Each process's stats file (the last run's), with the counts of earlier
 // runs (ended in a fault, restarted by the launcher) that only RMS_STATUS in
 // the log kept (counts only: not the mode, not latency percentiles).
-std::map<std::string, nlohmann::json> MergedStats(const fs::path& root, const StatusRuns& st, double duration_s,
-                                                  double rate_hz, SenderCheck* check) {
+std::map<std::string, nlohmann::json> MergedStats(const fs::path& root, const StatusRuns& st,
+                                                  double duration_s, double rate_hz,
+                                                  SenderCheck* check) {
   std::map<std::string, nlohmann::json> stats;
   for (const char* p : {"operator_station", "dynamics_proc", "scene_proc", "esg_renderer"}) {
     stats[p] = ReadJson(root / "stats" / (std::string(p) + ".json"));
@@ -481,8 +507,11 @@ nlohmann::ordered_json Restarts(const fs::path& root) {
   int n = 0, rc = 0;
   double down = 0, ready = 0;
   while (f >> name >> n >> rc >> down >> ready) {
-    restarts.push_back(
-        {{"process", name}, {"restart", n}, {"exit_code", rc}, {"signal", rc > 128 ? rc - 128 : 0}, {"restart_s", ready - down}});
+    restarts.push_back({{"process", name},
+                        {"restart", n},
+                        {"exit_code", rc},
+                        {"signal", rc > 128 ? rc - 128 : 0},
+                        {"restart_s", ready - down}});
   }
   return restarts;
 }
@@ -499,7 +528,8 @@ void AddMission(const LogScan& s, nlohmann::ordered_json* out) {
 // (docs/protocol.md): too late to act on, of another session, beyond the
 // session's clock.
 constexpr rms::Counter kRefused[] = {rms::Counter::kDroppedLate, rms::Counter::kDroppedOtherSession,
-                                     rms::Counter::kDroppedOtherSender, rms::Counter::kDroppedFarAhead};
+                                     rms::Counter::kDroppedOtherSender,
+                                     rms::Counter::kDroppedFarAhead};
 
 std::int64_t Malformed(const nlohmann::json& st) {
   std::int64_t n = SumPrefix(st, kDroppedPrefix);
@@ -508,8 +538,8 @@ std::int64_t Malformed(const nlohmann::json& st) {
 }
 
 nlohmann::ordered_json FramesJson(const std::map<std::string, nlohmann::json>& stats) {
-  const auto &op = stats.at("operator_station"), &dcp = stats.at("dynamics_proc"), &scene = stats.at("scene_proc"),
-             &esg = stats.at("esg_renderer");
+  const auto &op = stats.at("operator_station"), &dcp = stats.at("dynamics_proc"),
+             &scene = stats.at("scene_proc"), &esg = stats.at("esg_renderer");
   nlohmann::ordered_json frames;
   frames["operator_published"] = CounterOf(op, rms::Counter::kPublished);
   frames["dcp_published"] = CounterOf(dcp, rms::Counter::kPublished);
@@ -532,8 +562,10 @@ nlohmann::ordered_json FramesJson(const std::map<std::string, nlohmann::json>& s
   };
   nlohmann::ordered_json refused = nlohmann::ordered_json::object();
   for (rms::Counter c : kRefused) {
-    const std::string reason(CounterName(c).substr(kDroppedPrefix.size()));  // "late", "other_session", ...
-    refused[reason] = CounterOf(op, c) + CounterOf(dcp, c) + CounterOf(scene, c) + CounterOf(esg, c);
+    const std::string reason(
+        CounterName(c).substr(kDroppedPrefix.size()));  // "late", "other_session", ...
+    refused[reason] =
+        CounterOf(op, c) + CounterOf(dcp, c) + CounterOf(scene, c) + CounterOf(esg, c);
   }
   frames["refused"] = refused;
   frames["clamped_inputs"] = {{"operator_station", SumPrefix(op, kClampedPrefix)},
@@ -556,9 +588,10 @@ nlohmann::ordered_json Links(const nlohmann::json& st) {
 // Timing health, by process: frames lost on the way in (from the frame
 // numbers), frames late (more than a frame period after the operator sent
 // them), malformed ones dropped, and each link's latency.
-nlohmann::ordered_json TimingJson(const std::map<std::string, nlohmann::json>& stats, double rate_hz) {
-  const auto &op = stats.at("operator_station"), &dcp = stats.at("dynamics_proc"), &scene = stats.at("scene_proc"),
-             &esg = stats.at("esg_renderer");
+nlohmann::ordered_json TimingJson(const std::map<std::string, nlohmann::json>& stats,
+                                  double rate_hz) {
+  const auto &op = stats.at("operator_station"), &dcp = stats.at("dynamics_proc"),
+             &scene = stats.at("scene_proc"), &esg = stats.at("esg_renderer");
   nlohmann::ordered_json timing;
   timing["frame_period_ms"] = 1000.0 / rate_hz;
   timing["operator_station"] = {{"late_frames", CounterOf(op, rms::Counter::kFramesLate)}};
@@ -585,24 +618,31 @@ nlohmann::ordered_json TimingJson(const std::map<std::string, nlohmann::json>& s
 // its publisher says it sent against those the log holds -- frames the
 // recorder lost (it fell behind, was stopped, or its disk filled), distinct
 // from frames lost on the way between the processes.
-nlohmann::ordered_json RecordJson(const std::map<std::string, nlohmann::json>& stats, const LogScan& s) {
+nlohmann::ordered_json RecordJson(const std::map<std::string, nlohmann::json>& stats,
+                                  const LogScan& s) {
   struct Row {
     const char* channel;
     std::int64_t published, logged;
   };
   const Row rows[] = {
-      {wire::channels::kOperatorInput, CounterOf(stats.at("operator_station"), rms::Counter::kPublished), s.input.received()},
-      {wire::channels::kDcpFrame, CounterOf(stats.at("dynamics_proc"), rms::Counter::kPublished), s.dcp.received()},
-      {wire::channels::kDcpTelemetry, CounterOf(stats.at("dynamics_proc"), rms::Counter::kPublished),
+      {wire::channels::kOperatorInput,
+       CounterOf(stats.at("operator_station"), rms::Counter::kPublished), s.input.received()},
+      {wire::channels::kDcpFrame, CounterOf(stats.at("dynamics_proc"), rms::Counter::kPublished),
+       s.dcp.received()},
+      {wire::channels::kDcpTelemetry,
+       CounterOf(stats.at("dynamics_proc"), rms::Counter::kPublished),
        static_cast<std::int64_t>(s.telemetry_logged.size())},
-      {wire::channels::kEsgFrame, CounterOf(stats.at("scene_proc"), rms::Counter::kPublished), s.esg.received()},
+      {wire::channels::kEsgFrame, CounterOf(stats.at("scene_proc"), rms::Counter::kPublished),
+       s.esg.received()},
   };
   nlohmann::ordered_json r;
   std::int64_t lost = 0;
   for (const Row& row : rows) {
-    if (row.published <= 0) continue;  // no count from the publisher: nothing to hold the log against
+    if (row.published <= 0)
+      continue;  // no count from the publisher: nothing to hold the log against
     const std::int64_t l = std::max<std::int64_t>(0, row.published - row.logged);
-    r["by_channel"][row.channel] = {{"published", row.published}, {"logged", row.logged}, {"lost", l}};
+    r["by_channel"][row.channel] = {
+        {"published", row.published}, {"logged", row.logged}, {"lost", l}};
     lost += l;
   }
   r["lost"] = lost;
@@ -652,10 +692,11 @@ LabConfig SessionConfig(const fs::path& root) {
 }
 
 // Which session, how long, the mission and who flew it.
-void AddSessionFields(const fs::path& root, const LogScan& s, double duration_s, std::int64_t session_id,
-                      nlohmann::ordered_json* j) {
+void AddSessionFields(const fs::path& root, const LogScan& s, double duration_s,
+                      std::int64_t session_id, nlohmann::ordered_json* j) {
   (*j)["session"] = fs::absolute(root).lexically_normal().filename().string();
-  if ((*j)["session"].get<std::string>().empty()) (*j)["session"] = fs::absolute(root).parent_path().filename().string();
+  if ((*j)["session"].get<std::string>().empty())
+    (*j)["session"] = fs::absolute(root).parent_path().filename().string();
   if (session_id != 0) (*j)["session_id"] = wire::FormatSessionId(session_id);
   (*j)["duration_s"] = duration_s;
   AddMission(s, j);
@@ -672,7 +713,8 @@ void AddResult(nlohmann::ordered_json* j) {
   (*j)["docking"] = nullptr;
   nlohmann::ordered_json result = nullptr;
   for (const auto& a : (*j)["attempts"]) {
-    if (a["outcome"] == "docked" || result.is_null() || !(result["outcome"] == "docked")) result = a;
+    if (a["outcome"] == "docked" || result.is_null() || !(result["outcome"] == "docked"))
+      result = a;
   }
   if (!result.is_object()) return;
   (*j)["result_attempt"] = result["index"];
@@ -680,7 +722,8 @@ void AddResult(nlohmann::ordered_json* j) {
   (*j)["docking"] = result["docking"];
   // A docking a restore brought (a checkpoint saved just before it): said,
   // not hidden (docs/security.md "What the summary trusts").
-  if ((*j)["docking"].is_object()) (*j)["docking"]["after_restore"] = result["started_by"] == "restore";
+  if ((*j)["docking"].is_object())
+    (*j)["docking"]["after_restore"] = result["started_by"] == "restore";
 }
 
 // Each link's latency from the processes' stats, ms.
@@ -741,8 +784,9 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
   if (j["by_hand"].is_object()) {
     // The station's own count has the last key too (a quit ends it before
     // another state message goes out).
-    j["by_hand"]["key_actions"] = std::max(j["by_hand"]["key_actions"].get<std::int64_t>(),
-                                           CounterOf(stats.at("operator_station"), rms::Counter::kKeyActions));
+    j["by_hand"]["key_actions"] =
+        std::max(j["by_hand"]["key_actions"].get<std::int64_t>(),
+                 CounterOf(stats.at("operator_station"), rms::Counter::kKeyActions));
   }
   j["collisions"] = s.telemetry.collisions;
   j["collisions_by_kind"] = s.telemetry.ByKind();
@@ -759,13 +803,16 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
 }
 
 nlohmann::ordered_json MakeManifest(const std::string& dir, const ManifestFields& f) {
-  const std::string &pilot = f.pilot, &url = f.url, &suffix = f.suffix, &config_sha256 = f.config_sha256,
-                    &timeline = f.timeline, &restore = f.restore, &command = f.command;
+  const std::string &pilot = f.pilot, &url = f.url, &suffix = f.suffix,
+                    &config_sha256 = f.config_sha256, &timeline = f.timeline, &restore = f.restore,
+                    &command = f.command;
   const std::vector<std::string>& hosts = f.hosts;
   nlohmann::ordered_json j;
   j["format"] = "rmslab-session-1";
   j["session"] = fs::absolute(dir).lexically_normal().filename().string();
-  if (!f.session_id.empty()) j["session_id"] = wire::FormatSessionId(transport::ParseSessionId(f.session_id, "--session-id"));
+  if (!f.session_id.empty())
+    j["session_id"] =
+        wire::FormatSessionId(transport::ParseSessionId(f.session_id, "--session-id"));
   const std::int64_t now = transport::WallTimeUs();
   const std::time_t secs = static_cast<std::time_t>(now / 1000000);
   char utc[32];
@@ -781,14 +828,17 @@ nlohmann::ordered_json MakeManifest(const std::string& dir, const ManifestFields
   if (!restore.empty()) j["restored_from"] = restore;
   j["config"] = {{"file", "config.toml"}, {"sha256", config_sha256}};
   if (!f.config_source.empty()) j["config"]["source"] = f.config_source;
-  j["software"] = {{"version", VersionString()}, {"project", Version().project}, {"describe", Version().describe},
-                   {"commit", Version().commit}, {"build_type", Version().build_type}, {"compiler", Version().compiler}};
+  j["software"] = {{"version", VersionString()},         {"project", Version().project},
+                   {"describe", Version().describe},     {"commit", Version().commit},
+                   {"build_type", Version().build_type}, {"compiler", Version().compiler}};
   char host[256] = {};
   gethostname(host, sizeof host - 1);
   j["lab_host"] = host;
   if (!url.empty()) j["lcm"] = {{"url", url}, {"channel_suffix", suffix}};
   nlohmann::ordered_json layout = nlohmann::ordered_json::object();
-  for (const char* p : {"operator_station", "dynamics_proc", "scene_proc", "esg_renderer", "lcm-logger"}) layout[p] = "localhost";
+  for (const char* p :
+       {"operator_station", "dynamics_proc", "scene_proc", "esg_renderer", "lcm-logger"})
+    layout[p] = "localhost";
   for (const std::string& h : hosts) {
     const auto eq = h.find('=');
     if (eq == std::string::npos) throw InputError("--host must be PROCESS=HOST, got '" + h + "'");
@@ -801,7 +851,9 @@ nlohmann::ordered_json MakeManifest(const std::string& dir, const ManifestFields
 
 nlohmann::ordered_json ProbeAddress(const std::string& url, double seconds) {
   lcm::LCM lcm(url);
-  if (!lcm.good()) throw transport::TransportError("cannot listen on '" + url + "' (no route for multicast? scripts/lab adds one)");
+  if (!lcm.good())
+    throw transport::TransportError("cannot listen on '" + url +
+                                    "' (no route for multicast? scripts/lab adds one)");
   struct Heard {
     std::map<std::string, std::int64_t> channels;
     std::set<std::string> senders;
@@ -814,7 +866,9 @@ nlohmann::ordered_json ProbeAddress(const std::string& url, double seconds) {
       std::int8_t process = 0;
       std::int32_t pid = 0;
       const int n = static_cast<int>(rb->data_size);
-      if (!wire::ReadFingerprint(rb->data, n, &fp) || !wire::IsRmslabFingerprint(fp) || !wire::ReadSessionId(rb->data, n, &id)) return;
+      if (!wire::ReadFingerprint(rb->data, n, &fp) || !wire::IsRmslabFingerprint(fp) ||
+          !wire::ReadSessionId(rb->data, n, &id))
+        return;
       wire::ReadSenderProcess(rb->data, n, &process, &pid);
       Heard& h = (*out)[id];
       ++h.channels[channel];
@@ -831,7 +885,9 @@ nlohmann::ordered_json ProbeAddress(const std::string& url, double seconds) {
   j["seconds"] = seconds;
   j["sessions"] = nlohmann::ordered_json::array();
   for (const auto& [id, h] : sessions) {
-    j["sessions"].push_back({{"session_id", wire::FormatSessionId(id)}, {"channels", h.channels}, {"senders", h.senders}});
+    j["sessions"].push_back({{"session_id", wire::FormatSessionId(id)},
+                             {"channels", h.channels},
+                             {"senders", h.senders}});
   }
   return j;
 }
@@ -848,18 +904,23 @@ SessionInfo ReadSessionInfo(const std::string& dir) {
       s.lcm_url = j.at("lcm").value("url", "");
       s.channel_suffix = j.at("lcm").value("channel_suffix", "");
     }
-    if (j.contains("session_id")) s.session_id = transport::ParseSessionId(j.at("session_id").get<std::string>(), p.string() + " session_id");
+    if (j.contains("session_id"))
+      s.session_id = transport::ParseSessionId(j.at("session_id").get<std::string>(),
+                                               p.string() + " session_id");
   } catch (const InputError&) {
     throw;
   } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(p.string() + ": not valid JSON (at byte " + std::to_string(e.byte) + "): not a session's manifest");
+    throw InputError(p.string() + ": not valid JSON (at byte " + std::to_string(e.byte) +
+                     "): not a session's manifest");
   } catch (const std::exception& e) {
-    throw InputError(p.string() + ": not a session's manifest (" + std::string(e.what()).substr(std::string(e.what()).find(']') + 1) + ")");
+    throw InputError(p.string() + ": not a session's manifest (" +
+                     std::string(e.what()).substr(std::string(e.what()).find(']') + 1) + ")");
   }
   return s;
 }
 
-nlohmann::ordered_json CompareEsgFrames(const std::string& original_dir, const std::string& replay_dir) {
+nlohmann::ordered_json CompareEsgFrames(const std::string& original_dir,
+                                        const std::string& replay_dir) {
   auto read = [](const std::string& dir) {
     std::map<std::int64_t, esg_frame_t> by_dcp;
     SessionLog log(dir);  // each session's own ESG frames
@@ -880,8 +941,10 @@ nlohmann::ordered_json CompareEsgFrames(const std::string& original_dir, const s
       if (first.empty()) first = "DCP frame " + std::to_string(dcp_frame) + ": not replayed";
       continue;
     }
-    if (it->second.frame == m.frame && it->second.words == m.words) ++identical;
-    else if (first.empty()) first = "DCP frame " + std::to_string(dcp_frame) + ": words differ";
+    if (it->second.frame == m.frame && it->second.words == m.words)
+      ++identical;
+    else if (first.empty())
+      first = "DCP frame " + std::to_string(dcp_frame) + ": words differ";
   }
   nlohmann::ordered_json j;
   j["recorded"] = static_cast<std::int64_t>(a.size());

@@ -14,9 +14,8 @@
 // System Two (X2, Y2, Z2) = F6's axes, origin at point A = W + wrist_to_palm X_F6.
 // Positive pitch raises a link (tips its X toward +Z); positive yaw turns X
 // toward +Y; with all angles zero the arm lies along +X_R (aft).
-#include <array>
-
 #include <Eigen/Geometry>
+#include <array>
 
 #include "rms/base/config.h"
 

@@ -26,8 +26,8 @@ enum AnalogInput : int {
 
 // Names used in config [inputs.NAME], timelines and counters.
 inline constexpr std::array<std::string_view, kNumAnalogInputs> kAnalogInputNames = {
-    "shoulder_yaw", "shoulder_pitch", "elbow_pitch", "wrist_pitch", "wrist_yaw", "wrist_roll",
-    "finger",       "shoulder_height", "camera_pan", "camera_tilt", "camera_zoom"};
+    "shoulder_yaw", "shoulder_pitch",  "elbow_pitch", "wrist_pitch", "wrist_yaw",  "wrist_roll",
+    "finger",       "shoulder_height", "camera_pan",  "camera_tilt", "camera_zoom"};
 
 // Returns the index of the named input, or -1.
 int AnalogInputIndex(std::string_view name);

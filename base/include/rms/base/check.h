@@ -23,13 +23,13 @@ class InputError : public std::runtime_error {
 
 }  // namespace rms
 
-#define RMS_CHECK(cond)                                                   \
-  do {                                                                    \
+#define RMS_CHECK(cond)                                                        \
+  do {                                                                         \
     if (!(cond)) ::rms::AbortOnBrokenInvariant(#cond, __FILE__, __LINE__, ""); \
   } while (0)
 
-#define RMS_CHECK_MSG(cond, msg)                                           \
-  do {                                                                     \
+#define RMS_CHECK_MSG(cond, msg)                                                \
+  do {                                                                          \
     if (!(cond)) ::rms::AbortOnBrokenInvariant(#cond, __FILE__, __LINE__, msg); \
   } while (0)
 

@@ -5,12 +5,11 @@
 // config/rmslab.toml is the default. Loading validates everything and refuses
 // the file with the key and the reason (rms::InputError) on the first problem,
 // unknown keys included.
+#include <Eigen/Geometry>
 #include <array>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <Eigen/Geometry>
 
 #include "rms/base/analog_inputs.h"
 
@@ -34,10 +33,10 @@ struct ShuttleConfig {
 // [arm]: the vertical fixed arm and the booms. docs/kinematics.md.
 struct ArmGeometry {
   Eigen::Vector3d p_RoB_R_ft = Eigen::Vector3d::Zero();  // foot B of the vertical fixed arm, in R
-  double upper_boom_ft = 0;                 // shoulder S to elbow E
-  double lower_boom_ft = 0;                 // elbow E to wrist W
-  double wrist_to_palm_ft = 0;              // wrist W to point A (System Two origin)
-  double boom_diameter_ft = 0;              // rendering
+  double upper_boom_ft = 0;                              // shoulder S to elbow E
+  double lower_boom_ft = 0;                              // elbow E to wrist W
+  double wrist_to_palm_ft = 0;                           // wrist W to point A (System Two origin)
+  double boom_diameter_ft = 0;                           // rendering
   // The joints' travel, shoulder yaw .. wrist roll, deg (the arm as flown:
   // docs/config.md). The operator station's motions (hand controllers,
   // autopilot) stop a joint at its limit and say so; the DCP takes what it is
@@ -53,9 +52,9 @@ struct EndEffectorConfig {
   double palm_half_width_ft = 0;    // W of EFF HEX 1, along Y2
   double palm_half_height_ft = 0;   // H of EFF HEX 1, along Z2
   double finger_length_ft = 0;      // EFF HEX 2/3 extent beyond the palm along X2
-  double finger_thickness_ft = 0;  // EFF HEX 2/3 thickness along Y2
+  double finger_thickness_ft = 0;   // EFF HEX 2/3 thickness along Y2
   double finger_gap_open_ft = 0;    // gap between faces b (HEX 2) and e (HEX 3), finger lever 0
-  double finger_gap_closed_ft = 0; // the same gap, finger lever 1 (fully closed)
+  double finger_gap_closed_ft = 0;  // the same gap, finger lever 1 (fully closed)
 };
 
 // [payload]: the payload body, its bar receptacle (BAR / RECPT) and docking
@@ -68,7 +67,7 @@ struct PayloadConfig {
   double probe_diameter_ft = 0;
   double probe_length_ft = 0;
   Eigen::Vector3d p_RoPo_R_ft = Eigen::Vector3d::Zero();  // body centre in the bay (Mode 1)
-  Eigen::Matrix3d R_RP = Eigen::Matrix3d::Identity();  // from y_axis, z_axis
+  Eigen::Matrix3d R_RP = Eigen::Matrix3d::Identity();     // from y_axis, z_axis
   // The bar receptacle (BAR), a box in P: centre, and extents along x_P, y_P, z_P.
   Eigen::Vector3d p_PoBar_P_ft = Eigen::Vector3d::Zero();
   Eigen::Vector3d bar_size_P_ft = Eigen::Vector3d::Zero();
@@ -92,10 +91,11 @@ inline constexpr double kReleaseOpeningFt = 0.05;
 
 // [dcp]: the Dynamic Collision Program's selected values (report IV.A.3).
 struct DcpConfig {
-  double d3y_ft = 0;            // D3Y: acquisition needs the finger gap below this
-  double tpob_ft = 0;           // TPOB: acquisition needs EFF HEX 1's face d within this of the BAR's face c
+  double d3y_ft = 0;   // D3Y: acquisition needs the finger gap below this
+  double tpob_ft = 0;  // TPOB: acquisition needs EFF HEX 1's face d within this of the BAR's face c
   double dock_distance_ft = 0;  // docking: port centre to probe tip centre at most this
-  double dock_angle_deg = 0;    // docking: angle between the probe's and the port's y axes at most this
+  double dock_angle_deg =
+      0;  // docking: angle between the probe's and the port's y axes at most this
 };
 
 // [[cameras]]: one of the eight camera stations. docs/scene.md.
@@ -104,10 +104,10 @@ struct CameraStationConfig {
   std::string name;
   CameraMount mount = CameraMount::kShuttle;
   Eigen::Vector3d p_MoCam_M_ft = Eigen::Vector3d::Zero();  // position in the mount frame
-  Eigen::Vector3d p_MoAim_M_ft = Eigen::Vector3d::Zero(); // default aim point, mount frame
+  Eigen::Vector3d p_MoAim_M_ft = Eigen::Vector3d::Zero();  // default aim point, mount frame
   double pan_min_deg = 0, pan_max_deg = 0;
   double tilt_min_deg = 0, tilt_max_deg = 0;
-  double fov_min_deg = 0, fov_max_deg = 0;  // vertical field of view at zoom 1 and 0
+  double fov_min_deg = 0, fov_max_deg = 0;         // vertical field of view at zoom 1 and 0
   double pan_rate_deg_s = 0, tilt_rate_deg_s = 0;  // the camera drive's slew rates
   double zoom_rate_per_s = 0;                      // zoom lever travel per second
 };

@@ -208,7 +208,8 @@ inline constexpr int kNumCounters = static_cast<int>(Counter::kNumCounters);
 struct CounterInfo {
   Counter id;
   std::string_view name;       // on RMS_STATUS and in stats/PROCESS.json
-  std::string_view processes;  // who counts it: O operator_station, D dynamics_proc, S scene_proc, E esg_renderer
+  std::string_view processes;  // who counts it: O operator_station, D dynamics_proc, S scene_proc,
+                               // E esg_renderer
   std::string_view meaning;
 };
 
@@ -217,20 +218,17 @@ inline constexpr std::array<CounterInfo, kNumCounters> kCounterTable = {{
      "messages published on the process's output channel"},
     {Counter::kPublishFailed, "publish_failed", "O, D, S, E",
      "messages the transport refused to send, or beyond their type's bounds"},
-    {Counter::kReceived, "received", "D, S, E",
-     "messages received on the process's input channel"},
+    {Counter::kReceived, "received", "D, S, E", "messages received on the process's input channel"},
     {Counter::kGaps, "gaps", "D, S, E",
-     "times a frame number skipped ahead (the frames are in input.missing, dcp.missing, esg.missing)"},
+     "times a frame number skipped ahead (the frames are in input.missing, dcp.missing, "
+     "esg.missing)"},
     {Counter::kResyncs, "resyncs", "O, D, S, E",
-     "frame numbering followed again after 30 frames beyond the last in a row (docs/protocol.md \"Frame numbers\")"},
-    {Counter::kTransportErrors, "transport_errors", "O, D, S, E",
-     "LCM receive errors"},
-    {Counter::kInputMissing, "input.missing", "D",
-     "operator frames lost on the way in"},
-    {Counter::kDcpMissing, "dcp.missing", "S",
-     "DCP frames lost on the way in"},
-    {Counter::kEsgMissing, "esg.missing", "E",
-     "ESG frames lost on the way in"},
+     "frame numbering followed again after 30 frames beyond the last in a row (docs/protocol.md "
+     "\"Frame numbers\")"},
+    {Counter::kTransportErrors, "transport_errors", "O, D, S, E", "LCM receive errors"},
+    {Counter::kInputMissing, "input.missing", "D", "operator frames lost on the way in"},
+    {Counter::kDcpMissing, "dcp.missing", "S", "DCP frames lost on the way in"},
+    {Counter::kEsgMissing, "esg.missing", "E", "ESG frames lost on the way in"},
     {Counter::kDroppedTooLarge, "dropped.too_large", "D, S, E",
      "input frames dropped: larger than any message of its type"},
     {Counter::kDroppedWrongType, "dropped.wrong_type", "D, S, E",
@@ -358,17 +356,23 @@ inline constexpr std::array<CounterInfo, kNumCounters> kCounterTable = {{
     {Counter::kClampedAdcCameraZoom, "clamped.adc.camera_zoom", "D",
      "converter counts of camera_zoom clamped to ADC16"},
     {Counter::kJointLimitShoulderYaw, "joint_limit.shoulder_yaw", "O",
-     "hand-controller commands that met the limit of shoulder_yaw (config arm.joint_min_deg, joint_max_deg)"},
+     "hand-controller commands that met the limit of shoulder_yaw (config arm.joint_min_deg, "
+     "joint_max_deg)"},
     {Counter::kJointLimitShoulderPitch, "joint_limit.shoulder_pitch", "O",
-     "hand-controller commands that met the limit of shoulder_pitch (config arm.joint_min_deg, joint_max_deg)"},
+     "hand-controller commands that met the limit of shoulder_pitch (config arm.joint_min_deg, "
+     "joint_max_deg)"},
     {Counter::kJointLimitElbowPitch, "joint_limit.elbow_pitch", "O",
-     "hand-controller commands that met the limit of elbow_pitch (config arm.joint_min_deg, joint_max_deg)"},
+     "hand-controller commands that met the limit of elbow_pitch (config arm.joint_min_deg, "
+     "joint_max_deg)"},
     {Counter::kJointLimitWristPitch, "joint_limit.wrist_pitch", "O",
-     "hand-controller commands that met the limit of wrist_pitch (config arm.joint_min_deg, joint_max_deg)"},
+     "hand-controller commands that met the limit of wrist_pitch (config arm.joint_min_deg, "
+     "joint_max_deg)"},
     {Counter::kJointLimitWristYaw, "joint_limit.wrist_yaw", "O",
-     "hand-controller commands that met the limit of wrist_yaw (config arm.joint_min_deg, joint_max_deg)"},
+     "hand-controller commands that met the limit of wrist_yaw (config arm.joint_min_deg, "
+     "joint_max_deg)"},
     {Counter::kJointLimitWristRoll, "joint_limit.wrist_roll", "O",
-     "hand-controller commands that met the limit of wrist_roll (config arm.joint_min_deg, joint_max_deg)"},
+     "hand-controller commands that met the limit of wrist_roll (config arm.joint_min_deg, "
+     "joint_max_deg)"},
     {Counter::kSaturatedArm, "saturated.arm", "D, S",
      "values clamped to the range of their word format: arm"},
     {Counter::kSaturatedCameraZoom, "saturated.camera_zoom", "D, S",
@@ -387,10 +391,10 @@ inline constexpr std::array<CounterInfo, kNumCounters> kCounterTable = {{
      "values clamped to the range of their word format: shoulder_height"},
     {Counter::kSaturatedView, "saturated.view", "D, S",
      "values clamped to the range of their word format: view"},
-    {Counter::kFramesTotal, "frames.total", "O",
-     "frames published"},
+    {Counter::kFramesTotal, "frames.total", "O", "frames published"},
     {Counter::kFramesLate, "frames.late", "O, D, S, E",
-     "O: frames published after their deadline; D, S, E: frames reaching the process more than a frame period after the operator sent them"},
+     "O: frames published after their deadline; D, S, E: frames reaching the process more than a "
+     "frame period after the operator sent them"},
     {Counter::kFramesHeld, "frames.held", "D",
      "frames the slave arm held its last collision-free pose"},
     {Counter::kFramesFingerHeld, "frames.finger_held", "D",
@@ -401,10 +405,8 @@ inline constexpr std::array<CounterInfo, kNumCounters> kCounterTable = {{
      "frames held because the motion needed more than 4096 substeps"},
     {Counter::kFramesEssentialContact, "frames.essential_contact", "D",
      "frames with the movable finger on the BAR (the essential contact)"},
-    {Counter::kMode, "mode", "D",
-     "the current mode (1, 2, 3)"},
-    {Counter::kModeChanges, "mode_changes", "D",
-     "mode changes"},
+    {Counter::kMode, "mode", "D", "the current mode (1, 2, 3)"},
+    {Counter::kModeChanges, "mode_changes", "D", "mode changes"},
     {Counter::kCollisionsEffHex1Recpt, "collisions.eff_hex_1-recpt", "D",
      "collisions eff_hex_1-recpt begun"},
     {Counter::kCollisionsEffHex2Recpt, "collisions.eff_hex_2-recpt", "D",
@@ -429,12 +431,10 @@ inline constexpr std::array<CounterInfo, kNumCounters> kCounterTable = {{
      "collisions payload-bay_e begun"},
     {Counter::kCollisionsPayloadBayF, "collisions.payload-bay_f", "D",
      "collisions payload-bay_f begun"},
-    {Counter::kCollisionsPayloadCae, "collisions.payload-cae", "D",
-     "collisions payload-cae begun"},
+    {Counter::kCollisionsPayloadCae, "collisions.payload-cae", "D", "collisions payload-cae begun"},
     {Counter::kCollisionsEffHexBarPost, "collisions.eff_hex-bar_post", "D",
      "collisions eff_hex-bar_post begun"},
-    {Counter::kCollisionsNonFinite, "collisions.non-finite", "D",
-     "collisions non-finite begun"},
+    {Counter::kCollisionsNonFinite, "collisions.non-finite", "D", "collisions non-finite begun"},
     {Counter::kCollisionFramesEffHex1Recpt, "collision_frames.eff_hex_1-recpt", "D",
      "frames in collision eff_hex_1-recpt"},
     {Counter::kCollisionFramesEffHex2Recpt, "collision_frames.eff_hex_2-recpt", "D",
@@ -473,54 +473,41 @@ inline constexpr std::array<CounterInfo, kNumCounters> kCounterTable = {{
      "payloads let go by opening the finger before docking"},
     {Counter::kResumed, "resumed", "D",
      "this run resumed from the state file (docs/sessions.md \"Faults\")"},
-    {Counter::kStateFileWrites, "state_file.writes", "D",
-     "state file writes"},
-    {Counter::kStateFileErrors, "state_file.errors", "D",
-     "state file writes that failed"},
+    {Counter::kStateFileWrites, "state_file.writes", "D", "state file writes"},
+    {Counter::kStateFileErrors, "state_file.errors", "D", "state file writes that failed"},
     {Counter::kStatePublished, "state.published", "D",
      "RMS_DCP_STATE messages sent (docs/protocol.md)"},
-    {Counter::kControlFreezes, "control.freezes", "O",
-     "freezes taken (RMS_CONTROL)"},
-    {Counter::kControlRuns, "control.runs", "O",
-     "runs taken"},
-    {Counter::kControlSteps, "control.steps", "O",
-     "steps taken"},
-    {Counter::kControlCheckpoints, "control.checkpoints", "D",
-     "checkpoints saved"},
-    {Counter::kControlRestores, "control.restores", "O, D",
-     "restores taken"},
+    {Counter::kControlFreezes, "control.freezes", "O", "freezes taken (RMS_CONTROL)"},
+    {Counter::kControlRuns, "control.runs", "O", "runs taken"},
+    {Counter::kControlSteps, "control.steps", "O", "steps taken"},
+    {Counter::kControlCheckpoints, "control.checkpoints", "D", "checkpoints saved"},
+    {Counter::kControlRestores, "control.restores", "O, D", "restores taken"},
     {Counter::kControlRefused, "control.refused", "O, D",
      "checkpoint and restore commands refused (docs/security.md \"The control channel\")"},
     {Counter::kControlRateLimited, "control.rate_limited", "O, D",
      "checkpoint and restore commands beyond 2 a second"},
     {Counter::kFrozenInputsIgnored, "frozen.inputs_ignored", "O",
      "operator inputs ignored while frozen"},
-    {Counter::kRestarted, "restarted", "O",
-     "this run was a restart by the launcher"},
-    {Counter::kKeyActions, "key_actions", "O",
-     "key presses that acted"},
+    {Counter::kRestarted, "restarted", "O", "this run was a restart by the launcher"},
+    {Counter::kKeyActions, "key_actions", "O", "key presses that acted"},
     {Counter::kIncrementsBlocked, "increments.blocked", "O",
      "key increments given up when the arm stalled (at a limit, a singularity or a hold)"},
     {Counter::kSingleJointPressesIgnored, "single_joint.presses_ignored", "O",
      "presses on a translation or rotation key in single-joint control"},
     {Counter::kControlModeChanges, "control.mode_changes", "O",
      "changes between manual augmented and single-joint control"},
-    {Counter::kControlFrameChanges, "control.frame_changes", "O",
-     "changes of the command frame"},
+    {Counter::kControlFrameChanges, "control.frame_changes", "O", "changes of the command frame"},
     {Counter::kControlScaleChanges, "control.scale_changes", "O",
      "changes between coarse and vernier"},
-    {Counter::kControlStops, "control.stops", "O",
-     "stops of every motion (space)"},
-    {Counter::kDeviceDisconnected, "device.disconnected", "O",
-     "devices that went away"},
+    {Counter::kControlStops, "control.stops", "O", "stops of every motion (space)"},
+    {Counter::kDeviceDisconnected, "device.disconnected", "O", "devices that went away"},
     {Counter::kTelemetryStale, "telemetry.stale", "O",
      "telemetry duplicated or older than the last taken"},
     {Counter::kTelemetryBeforeReset, "telemetry.before_reset", "O",
      "telemetry from before a reset ignored"},
     {Counter::kWindowKeysTimeouts, "window.keys_timeouts", "O",
      "the live window's held keys released after it fell silent"},
-    {Counter::kAutopilotDocked, "autopilot.docked", "O",
-     "the autopilot docked"},
+    {Counter::kAutopilotDocked, "autopilot.docked", "O", "the autopilot docked"},
     {Counter::kAutopilotCollisionsRelieved, "autopilot.collisions_relieved", "O",
      "collisions the autopilot relieved"},
     {Counter::kAutopilotGraspCorrections, "autopilot.grasp_corrections", "O",
@@ -539,34 +526,24 @@ inline constexpr std::array<CounterInfo, kNumCounters> kCounterTable = {{
      "cluster pairs no plane separated: ordered by distance"},
     {Counter::kPriorityCyclesBroken, "priority.cycles_broken", "E",
      "priority cycles broken when ordering clusters"},
-    {Counter::kRendered, "rendered", "E",
-     "frames rendered"},
-    {Counter::kRenderedScenes, "rendered.scenes", "E",
-     "scenes drawn (frames whose words changed)"},
+    {Counter::kRendered, "rendered", "E", "frames rendered"},
+    {Counter::kRenderedScenes, "rendered.scenes", "E", "scenes drawn (frames whose words changed)"},
     {Counter::kSkippedUnchanged, "skipped.unchanged", "E",
      "frames whose words did not change: the last image reused"},
     {Counter::kSuperseded, "superseded", "E",
      "frames overtaken by a newer one before they were drawn"},
-    {Counter::kClustersDrawn, "clusters.drawn", "E",
-     "clusters drawn"},
+    {Counter::kClustersDrawn, "clusters.drawn", "E", "clusters drawn"},
     {Counter::kClustersCulled, "clusters.culled", "E",
      "clusters outside the view volume, not drawn"},
-    {Counter::kTrianglesSubmitted, "triangles.submitted", "E",
-     "triangles sent to GL"},
-    {Counter::kPngWritten, "png_written", "E",
-     "PNG frames written"},
-    {Counter::kPngFailed, "png_failed", "E",
-     "PNG frames that could not be written"},
-    {Counter::kVideoFrames, "video.frames", "E",
-     "frames sent to the video encoder"},
+    {Counter::kTrianglesSubmitted, "triangles.submitted", "E", "triangles sent to GL"},
+    {Counter::kPngWritten, "png_written", "E", "PNG frames written"},
+    {Counter::kPngFailed, "png_failed", "E", "PNG frames that could not be written"},
+    {Counter::kVideoFrames, "video.frames", "E", "frames sent to the video encoder"},
     {Counter::kVideoDropped, "video.dropped", "E",
      "frames the video encoder could not take (docs/esg.md \"Video\")"},
-    {Counter::kWindowFrames, "window.frames", "E",
-     "frames shown in the live window"},
-    {Counter::kWindowKeysMessages, "window.keys_messages", "E",
-     "RMS_WINDOW_KEYS messages sent"},
-    {Counter::kWindowKeysPressed, "window.keys_pressed", "E",
-     "key presses in the live window"},
+    {Counter::kWindowFrames, "window.frames", "E", "frames shown in the live window"},
+    {Counter::kWindowKeysMessages, "window.keys_messages", "E", "RMS_WINDOW_KEYS messages sent"},
+    {Counter::kWindowKeysPressed, "window.keys_pressed", "E", "key presses in the live window"},
 }};
 
 constexpr bool CounterTableInOrder() {
@@ -575,13 +552,18 @@ constexpr bool CounterTableInOrder() {
   }
   return true;
 }
-static_assert(CounterTableInOrder(), "kCounterTable lists every Counter once, in the enumeration's order");
+static_assert(CounterTableInOrder(),
+              "kCounterTable lists every Counter once, in the enumeration's order");
 
-constexpr std::string_view CounterName(Counter c) { return kCounterTable[static_cast<int>(c)].name; }
+constexpr std::string_view CounterName(Counter c) {
+  return kCounterTable[static_cast<int>(c)].name;
+}
 // The counter of that name, or nothing.
 std::optional<Counter> CounterNamed(std::string_view name);
 // The i-th member of a family that starts at `first`.
-constexpr Counter CounterAt(Counter first, int i) { return static_cast<Counter>(static_cast<int>(first) + i); }
+constexpr Counter CounterAt(Counter first, int i) {
+  return static_cast<Counter>(static_cast<int>(first) + i);
+}
 
 // Every message dropped (dropped.*) and every input clamped (clamped.*):
 // contiguous families, first through last, and their names' prefix.
@@ -602,22 +584,31 @@ constexpr bool FamilyIsPrefix(Counter first, Counter last, std::string_view pref
 static_assert(FamilyIsPrefix(kDroppedFirst, kDroppedLast, kDroppedPrefix));
 static_assert(FamilyIsPrefix(kClampedFirst, kClampedLast, kClampedPrefix));
 // clamped.INPUT and clamped.adc.INPUT for an analog input (AnalogInput).
-constexpr Counter ClampedCounter(int input) { return CounterAt(Counter::kClampedShoulderYaw, input); }
-constexpr Counter ClampedAdcCounter(int input) { return CounterAt(Counter::kClampedAdcShoulderYaw, input); }
+constexpr Counter ClampedCounter(int input) {
+  return CounterAt(Counter::kClampedShoulderYaw, input);
+}
+constexpr Counter ClampedAdcCounter(int input) {
+  return CounterAt(Counter::kClampedAdcShoulderYaw, input);
+}
 // joint_limit.JOINT for the six joints (AnalogInput 0-5).
-constexpr Counter JointLimitCounter(int joint) { return CounterAt(Counter::kJointLimitShoulderYaw, joint); }
+constexpr Counter JointLimitCounter(int joint) {
+  return CounterAt(Counter::kJointLimitShoulderYaw, joint);
+}
 
-constexpr bool FamilyFollows(Counter first, std::string_view prefix, const std::string_view* members, int count) {
+constexpr bool FamilyFollows(Counter first, std::string_view prefix,
+                             const std::string_view* members, int count) {
   for (int i = 0; i < count; ++i) {
     const std::string_view n = CounterName(CounterAt(first, i));
     if (n.substr(0, prefix.size()) != prefix || n.substr(prefix.size()) != members[i]) return false;
   }
   return true;
 }
-static_assert(FamilyFollows(Counter::kClampedShoulderYaw, "clamped.", kAnalogInputNames.data(), kNumAnalogInputs));
-static_assert(FamilyFollows(Counter::kClampedAdcShoulderYaw, "clamped.adc.", kAnalogInputNames.data(),
+static_assert(FamilyFollows(Counter::kClampedShoulderYaw, "clamped.", kAnalogInputNames.data(),
                             kNumAnalogInputs));
-static_assert(FamilyFollows(Counter::kJointLimitShoulderYaw, "joint_limit.", kAnalogInputNames.data(), 6));
+static_assert(FamilyFollows(Counter::kClampedAdcShoulderYaw, "clamped.adc.",
+                            kAnalogInputNames.data(), kNumAnalogInputs));
+static_assert(FamilyFollows(Counter::kJointLimitShoulderYaw, "joint_limit.",
+                            kAnalogInputNames.data(), 6));
 
 // A process's counters: one slot a counter. Only the counters it has touched
 // (added to or set, even to 0) are reported.
@@ -673,7 +664,8 @@ class LatencyHistogram {
 // stage when it reaches it more than one frame period after the operator
 // sent it. Adds the end-to-end latency to `histogram` and counts
 // frames.late.
-void RecordEndToEnd(std::int64_t latency_us, double frame_rate_hz, LatencyHistogram* histogram, Counters* counters);
+void RecordEndToEnd(std::int64_t latency_us, double frame_rate_hz, LatencyHistogram* histogram,
+                    Counters* counters);
 
 // The counter table as markdown (docs/sessions.md "Process counters").
 std::string CounterTableMarkdown();

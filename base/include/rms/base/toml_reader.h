@@ -4,6 +4,7 @@
 // well-formed, and Finish() refuses keys nobody asked for. Errors are
 // rms::InputError naming the file, the key and the reason:
 //   "config/rmslab.toml: key 'arm.upper_boom_ft': must be > 0, got -3"
+#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -12,11 +13,9 @@
 #include <sstream>
 #include <string>
 #include <string_view>
+#include <toml++/toml.h>
 #include <utility>
 #include <vector>
-
-#include <Eigen/Core>
-#include <toml++/toml.h>
 
 #include "rms/base/check.h"
 
@@ -52,7 +51,8 @@ class TomlReader {
       // A key present under a near spelling is named: the likely typo.
       std::string near;
       for (auto&& [k, v] : *table_) {
-        if (!used_.count(std::string(k.str())) && EditDistance(k.str(), key) <= 2) near = std::string(k.str());
+        if (!used_.count(std::string(k.str())) && EditDistance(k.str(), key) <= 2)
+          near = std::string(k.str());
       }
       Fail(key, "missing (every key is required; see " + doc_ + ")" +
                     (near.empty() ? "" : "; the file has '" + Key(near) + "': misspelt?"));
@@ -87,7 +87,8 @@ class TomlReader {
   void CheckRange(std::string_view key, double v, double lo, double hi, bool open_lo) const {
     if (!std::isfinite(v)) Fail(key, "must be finite, got " + FormatNumber(v));
     if (open_lo ? !(v > lo) : !(v >= lo)) {
-      Fail(key, "must be " + std::string(open_lo ? "> " : ">= ") + FormatNumber(lo) + ", got " + FormatNumber(v));
+      Fail(key, "must be " + std::string(open_lo ? "> " : ">= ") + FormatNumber(lo) + ", got " +
+                    FormatNumber(v));
     }
     if (!(v <= hi)) Fail(key, "must be <= " + FormatNumber(hi) + ", got " + FormatNumber(v));
   }
@@ -164,8 +165,8 @@ class TomlReader {
   void Finish() const {
     for (auto&& [k, v] : *table_) {
       if (!used_.count(std::string(k.str()))) {
-        throw InputError(*source_ + ": key '" + Key(k.str()) +
-                         "': unknown key (misspelt? see " + doc_ + ")");
+        throw InputError(*source_ + ": key '" + Key(k.str()) + "': unknown key (misspelt? see " +
+                         doc_ + ")");
       }
     }
   }

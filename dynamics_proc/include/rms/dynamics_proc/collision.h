@@ -27,10 +27,9 @@
 // magnitude, scale the larger bounding-box diagonal of the pair, magnitude
 // its largest coordinate; docs/collision.md "Tolerance rule"). Invalid or
 // non-finite input is an error (kInvalid), never a verdict.
+#include <Eigen/Core>
 #include <array>
 #include <cstdint>
-
-#include <Eigen/Core>
 
 #include "rms/dynamics_proc/hexahedron.h"
 #include "rms/scene_model/separating_plane.h"
@@ -41,17 +40,18 @@ enum class Verdict : std::uint8_t { kSeparate, kCollide, kInvalid };
 
 // What decided the verdict.
 enum class Decider : std::uint8_t {
-  kVertexOfAInB,       // index: the vertex of A (0-7) whose word was all zeros
-  kVertexOfBInA,       // index: the vertex of B
-  kFaceOfBSeparates,   // index: the face of B (0-5) with a 1 in all of A's words
-  kFaceOfASeparates,   // index: the face of A
-  kEdgeOfAPiercesB,    // index: the edge of A (0-11); face: the face of B it pierces
-  kEdgeOfBPiercesA,    // index: the edge of B; face: the face of A
-  kNoEdgePierces,      // every edge test negative: separate
-  kNonFinite,          // invalid input
-  kSpheresApart,       // the bounding spheres are apart (before the report's test, when enabled)
-  kHintPlane,          // the hint plane (the previous frame's) still separates (when given)
-  kBoxesApart,         // the axis-aligned bounding boxes are apart (before the report's test, when enabled)
+  kVertexOfAInB,      // index: the vertex of A (0-7) whose word was all zeros
+  kVertexOfBInA,      // index: the vertex of B
+  kFaceOfBSeparates,  // index: the face of B (0-5) with a 1 in all of A's words
+  kFaceOfASeparates,  // index: the face of A
+  kEdgeOfAPiercesB,   // index: the edge of A (0-11); face: the face of B it pierces
+  kEdgeOfBPiercesA,   // index: the edge of B; face: the face of A
+  kNoEdgePierces,     // every edge test negative: separate
+  kNonFinite,         // invalid input
+  kSpheresApart,      // the bounding spheres are apart (before the report's test, when enabled)
+  kHintPlane,         // the hint plane (the previous frame's) still separates (when given)
+  kBoxesApart,        // the axis-aligned bounding boxes are apart (before the report's test, when
+                      // enabled)
 };
 
 struct CollideOptions {
@@ -72,7 +72,6 @@ struct CollideOptions {
   const scene_model::SeparatingPlane* hint = nullptr;
 };
 
-
 struct CollisionResult {
   Verdict verdict = Verdict::kInvalid;
   Decider decider = Decider::kNonFinite;
@@ -92,7 +91,8 @@ struct CollisionResult {
   int triple_products = 0;
 };
 
-CollisionResult Collide(const Hexahedron& a, const Hexahedron& b, const CollideOptions& options = {});
+CollisionResult Collide(const Hexahedron& a, const Hexahedron& b,
+                        const CollideOptions& options = {});
 
 // The pair's tolerance tau, ft: a distance (docs/collision.md "Tolerance rule").
 double ToleranceFt(const Hexahedron& a, const Hexahedron& b, double relative_tolerance = 1e-12);

@@ -3,13 +3,12 @@
 // Reference coordinates the report's way (Section IV.A.2): the three
 // System-Two unit vectors (or the payload's, the bay's, the CAE's) scaled by
 // the dimensions of the configuration. docs/collision.md has the figures.
+#include <Eigen/Geometry>
 #include <array>
 #include <string>
 
-#include <Eigen/Geometry>
-
-#include "rms/dynamics_proc/hexahedron.h"
 #include "rms/base/config.h"
+#include "rms/dynamics_proc/hexahedron.h"
 
 namespace rms::dynamics_proc {
 
@@ -29,7 +28,8 @@ Hexahedron MakeBar(const PayloadConfig& p, const Eigen::Isometry3d& X_RP);
 
 // The BAR's two posts in Reference coordinates: rms::BarPosts_P (the boxes
 // the scene draws), x_P, y_P, z_P as u, v, w. Returns how many (0 or 2).
-int MakeBarPosts(const PayloadConfig& p, const Eigen::Isometry3d& X_RP, std::array<Hexahedron, 2>* posts);
+int MakeBarPosts(const PayloadConfig& p, const Eigen::Isometry3d& X_RP,
+                 std::array<Hexahedron, 2>* posts);
 
 // The payload model (the report's Figure 8, reconstructed; docs/collision.md
 // "The payload"): the body is the drawn 16-sided prism round the cylinder
@@ -41,16 +41,17 @@ int MakeBarPosts(const PayloadConfig& p, const Eigen::Isometry3d& X_RP, std::arr
 inline constexpr int kBodySides = 16;
 inline constexpr int kBodyStrips = 7;
 inline constexpr int kBodyVertices = 2 * kBodySides;
-inline constexpr int kProbeFirst = kBodyVertices;      // V21
+inline constexpr int kProbeFirst = kBodyVertices;       // V21
 inline constexpr int kProbeTipFirst = kProbeFirst + 4;  // V31
 inline constexpr int kPayloadVertices = kProbeTipFirst + 6;
 struct PayloadModel {
   // Strip j between the 16-gon's vertex levels j and j + 1 from the top:
   // u = y_P (face d at the probe end), v = x_P, w = -z_P (c the strip's top).
   std::array<Hexahedron, kBodyStrips> body;
-  std::array<Eigen::Vector3d, kPayloadVertices> v;  // body (aft ring, then fore ring), V21..V24, V31..V36
-  Eigen::Vector3d probe_tip_centre;                 // centre of V31-V36
-  Eigen::Vector3d probe_axis;                       // y_P, the probe's y-axis
+  std::array<Eigen::Vector3d, kPayloadVertices>
+      v;                             // body (aft ring, then fore ring), V21..V24, V31..V36
+  Eigen::Vector3d probe_tip_centre;  // centre of V31-V36
+  Eigen::Vector3d probe_axis;        // y_P, the probe's y-axis
 };
 PayloadModel MakePayload(const PayloadConfig& p, const Eigen::Isometry3d& X_RP);
 // The payload vertex names: "B1" .. "B32" (the body), "V21" .. "V36".

@@ -21,19 +21,18 @@
 // so the operator can relieve it. A collision never shows as
 // interpenetration. The finger closing on the bar is the essential contact:
 // the finger stops on it and the acquisition conditions are met.
+#include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
 #include <memory>
-
-#include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
+#include "rms/arm/kinematics.h"
+#include "rms/base/config.h"
 #include "rms/dynamics_proc/collision.h"
 #include "rms/dynamics_proc/dcp_models.h"
-#include "rms/arm/kinematics.h"
 #include "rms/wire/acquisition_conditions.h"
 #include "rms/wire/collision_bits.h"
-#include "rms/base/config.h"
 #include "rms/wire/input_block.h"
 #include "rms/wire/word_blocks.h"
 
@@ -83,8 +82,9 @@ struct AcquisitionCheck {
   double palm_to_bar_ft = 0.0;  // signed: positive when the BAR's top is beyond face d
   bool all() const;
 };
-AcquisitionCheck CheckAcquisition(const DcpConfig& dcp, const EndEffectorModel& ee, const Hexahedron& bar,
-                                  double finger_gap_ft, double relative_tolerance = 1e-12);
+AcquisitionCheck CheckAcquisition(const DcpConfig& dcp, const EndEffectorModel& ee,
+                                  const Hexahedron& bar, double finger_gap_ft,
+                                  double relative_tolerance = 1e-12);
 
 // Docking (report IV.A.3): every probe vertex (V21-V24, V31-V36) in the
 // docking envelope -- beyond CAE face c, not beyond faces a, b, d, e -- and
@@ -92,13 +92,15 @@ AcquisitionCheck CheckAcquisition(const DcpConfig& dcp, const EndEffectorModel& 
 // probe's y axis within dock_angle_deg of the port's.
 struct DockingCheck {
   bool in_envelope = false;
-  double envelope_margin_ft = 0.0;  // least depth of a probe vertex inside the envelope (< 0: outside by)
+  double envelope_margin_ft =
+      0.0;  // least depth of a probe vertex inside the envelope (< 0: outside by)
   double distance_ft = 0.0;
   double angle_deg = 0.0;
   bool docked = false;
 };
-DockingCheck CheckDocking(const DcpConfig& dcp, const CaeConfig& cae, const Hexahedron& cae_front_half,
-                          const PayloadModel& payload, double relative_tolerance = 1e-12);
+DockingCheck CheckDocking(const DcpConfig& dcp, const CaeConfig& cae,
+                          const Hexahedron& cae_front_half, const PayloadModel& payload,
+                          double relative_tolerance = 1e-12);
 
 // The arm as commanded or as it is.
 struct ArmCommand {
@@ -112,24 +114,29 @@ struct DcpStatus {
   int mode = 1;
   bool acquired = false;
   bool docked = false;
-  bool released = false;               // docked and let go by the finger: the arm is free
+  bool released = false;  // docked and let go by the finger: the arm is free
   bool held = false;
   bool finger_held = false;
-  bool essential_contact = false;      // the movable finger closing onto the bar stopped on it (RECPT)
-  bool motion_collision = false;       // the command's pose is free but its motion from the slave's is not
-  bool too_fast = false;               // the motion needed more than kMaxSubsteps substeps: held
-  int substeps = 0;                    // poses tested for the motion this frame (1: the end pose alone)
-  bool reset_refused = false;          // a reset whose arm pose would collide with the reset scene: not taken
-  bool input_refused = false;          // a non-finite input: the frame holds the last command
-  bool let_go = false;                 // the finger opened and let the payload go before docking (Mode 1 again)
-  bool finger_contact = false;         // Mode 1: face e of EFF HEX 3 within kFingerContactToleranceFt of the BAR
+  bool essential_contact = false;  // the movable finger closing onto the bar stopped on it (RECPT)
+  bool motion_collision =
+      false;              // the command's pose is free but its motion from the slave's is not
+  bool too_fast = false;  // the motion needed more than kMaxSubsteps substeps: held
+  int substeps = 0;       // poses tested for the motion this frame (1: the end pose alone)
+  bool reset_refused =
+      false;  // a reset whose arm pose would collide with the reset scene: not taken
+  bool input_refused = false;  // a non-finite input: the frame holds the last command
+  bool let_go = false;  // the finger opened and let the payload go before docking (Mode 1 again)
+  bool finger_contact =
+      false;  // Mode 1: face e of EFF HEX 3 within kFingerContactToleranceFt of the BAR
   std::uint32_t collisions = 0;        // of the master's command
   std::uint32_t slave_collisions = 0;  // of the pose the slave holds
-  std::array<bool, wire::kNumAcquisitionConditions> acquisition{};   // the six conditions, report order (Mode 1; false after)
-  std::array<double, wire::kNumAcquisitionConditions> acquisition_margin_ft{};  // their margins (Mode 1; 0 after)
+  std::array<bool, wire::kNumAcquisitionConditions>
+      acquisition{};  // the six conditions, report order (Mode 1; false after)
+  std::array<double, wire::kNumAcquisitionConditions>
+      acquisition_margin_ft{};  // their margins (Mode 1; 0 after)
   double finger_gap_ft = 0.0;
   double palm_to_bar_ft = 0.0;
-  double bay_clearance_ft = 0.0;       // the lowest payload vertex above bay face c (> 0 for all: clear)
+  double bay_clearance_ft = 0.0;  // the lowest payload vertex above bay face c (> 0 for all: clear)
   bool probe_in_envelope = false;
   double envelope_margin_ft = 0.0;
   double dock_distance_ft = 0.0;
@@ -202,10 +209,10 @@ class DynamicCollisionProgram {
     arm::ArmPose pose{};
     double finger_gap_ft = 0.0;
     EndEffectorModel ee{};
-    std::array<CollisionResult, 3> ee_bar{};   // EFF HEX k against the BAR (Mode 1)
+    std::array<CollisionResult, 3> ee_bar{};  // EFF HEX k against the BAR (Mode 1)
     // EFF HEX k against the payload body's strip j, at [k * kBodyStrips + j] (Mode 1)
     std::array<CollisionResult, 3 * kBodyStrips> ee_body{};
-    std::uint32_t extra_collisions = 0;        // pairs outside the mode (mode_pairs_only false); unused
+    std::uint32_t extra_collisions = 0;  // pairs outside the mode (mode_pairs_only false); unused
     Eigen::Isometry3d X_RP = Eigen::Isometry3d::Identity();
     PayloadModel payload{};
     std::uint32_t collisions = 0;
@@ -253,8 +260,9 @@ class DynamicCollisionProgram {
   // for the words' rounding): when c0 + c1 cannot cover it, the midpoint is
   // tested, and each half in turn, down to kRefineDepth halvings. Returns the
   // first collision bits found, and where (*hit_s).
-  std::uint32_t Refine(const ArmCommand& from, const ArmCommand& to, double s0, double s1, double c0, double c1,
-                       double travel_ft, double slack_ft, int depth, double* hit_s);
+  std::uint32_t Refine(const ArmCommand& from, const ArmCommand& to, double s0, double s1,
+                       double c0, double c1, double travel_ft, double slack_ft, int depth,
+                       double* hit_s);
   // The bound on any model vertex's travel along the motion, ft.
   double TravelFt(const ArmCommand& from, const ArmCommand& to) const;
   // Each joint's reach: the farthest a moving vertex can be from its axis, ft.
@@ -316,12 +324,13 @@ class DynamicCollisionProgram {
   bool started_ = false;        // a frame has been made: commands are motions from the slave's pose
   ArmCommand initial_;          // the initial inputs' pose, where the slave starts
   std::array<Evaluation, 4> evaluations_;
-  Evaluation* slave_ = &evaluations_[0];  // the slave's (collision-free) evaluation
-  Evaluation* spare_ = &evaluations_[1];  // this frame's candidate
+  Evaluation* slave_ = &evaluations_[0];    // the slave's (collision-free) evaluation
+  Evaluation* spare_ = &evaluations_[1];    // this frame's candidate
   Evaluation* scratch_ = &evaluations_[2];  // substeps
   Evaluation* probe_ = &evaluations_[3];    // refinement between substeps
-  Eigen::Isometry3d X_S2P_ = Eigen::Isometry3d::Identity();       // payload in System Two, from acquisition
-  double payload_reach_ft_ = 0.0;  // held payload's farthest vertex from point A (travel bound)
+  Eigen::Isometry3d X_S2P_ =
+      Eigen::Isometry3d::Identity();  // payload in System Two, from acquisition
+  double payload_reach_ft_ = 0.0;     // held payload's farthest vertex from point A (travel bound)
   // Once acquired, the finger holds the bar: its gap stays between the gap at
   // which it touches the bar and the gap at acquisition.
   double contact_gap_ft_ = 0.0;

@@ -5,14 +5,14 @@
 // output frame per input block, counters and latency.
 #include <string>
 
-#include "rms/dynamics_proc/dynamic_collision_program.h"
-#include "rms/wire/checkpoint.h"
 #include "rms/base/counters.h"
-#include "rms/wire/frame_receiver.h"
-#include "rms/transport/lcm_interface.h"
 #include "rms/dcp_state_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
+#include "rms/dynamics_proc/dynamic_collision_program.h"
+#include "rms/transport/lcm_interface.h"
 #include "rms/transport/process.h"
+#include "rms/wire/checkpoint.h"
+#include "rms/wire/frame_receiver.h"
 
 namespace rms::dynamics_proc {
 
@@ -93,7 +93,8 @@ class DynamicsProc {
   std::string state_file_;
   wire::CheckpointFolder checkpoints_;
   wire::CheckpointRateLimit checkpoint_rate_;
-  std::optional<std::pair<std::int64_t, std::int64_t>> resume_;  // (DCP frame, input frame) of the state resumed
+  std::optional<std::pair<std::int64_t, std::int64_t>>
+      resume_;  // (DCP frame, input frame) of the state resumed
   std::int64_t state_written_us_ = 0;
   std::int64_t frames_since_state_ = 0;
   bool made_a_frame_ = false;
@@ -105,9 +106,9 @@ dcp_telemetry_t MakeTelemetry(const DcpStatus& status, const wire::DcpFrameData&
 
 // Main loop until SIGINT / SIGTERM. Returns the exit code.
 // restore_path: a checkpoint to start from ("" for the initial state).
-int RunDynamicsProc(const LabConfig& config, transport::LcmInterface& lcm, const std::string& stats_path,
-                    const std::string& ready_path, const std::string& restore_path,
-                    const std::string& state_file = "", const std::string& checkpoint_dir = "");
-
+int RunDynamicsProc(const LabConfig& config, transport::LcmInterface& lcm,
+                    const std::string& stats_path, const std::string& ready_path,
+                    const std::string& restore_path, const std::string& state_file = "",
+                    const std::string& checkpoint_dir = "");
 
 }  // namespace rms::dynamics_proc

@@ -16,11 +16,10 @@
 //
 // Storage is structure-of-arrays so the per-face loops over eight vertices
 // vectorise, and small (the hot data in seven cache lines).
-#include <array>
-#include <cstdint>
-
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
 
 namespace rms::dynamics_proc {
 
@@ -65,9 +64,14 @@ inline constexpr int OppositeFace(int f) { return (f + 3) % 6; }
 
 // The three faces meeting at each vertex.
 inline constexpr std::array<std::array<int, 3>, 8> kVertexFaces = {{
-    {kFaceA, kFaceB, kFaceC}, {kFaceA, kFaceB, kFaceF}, {kFaceD, kFaceB, kFaceC},
-    {kFaceA, kFaceE, kFaceF}, {kFaceA, kFaceE, kFaceC}, {kFaceD, kFaceB, kFaceF},
-    {kFaceD, kFaceE, kFaceF}, {kFaceD, kFaceE, kFaceC},
+    {kFaceA, kFaceB, kFaceC},
+    {kFaceA, kFaceB, kFaceF},
+    {kFaceD, kFaceB, kFaceC},
+    {kFaceA, kFaceE, kFaceF},
+    {kFaceA, kFaceE, kFaceC},
+    {kFaceD, kFaceB, kFaceF},
+    {kFaceD, kFaceE, kFaceF},
+    {kFaceD, kFaceE, kFaceC},
 }};
 
 // Each face's four vertices in order round it: counter-clockwise seen from
@@ -83,9 +87,18 @@ inline constexpr std::array<std::array<int, 4>, 6> kFaceVertices = {{
 
 // The twelve edges, each the meeting of two faces.
 inline constexpr std::array<std::array<int, 2>, 12> kEdges = {{
-    {0, 1}, {4, 3}, {0, 4}, {1, 3},  // a-b, a-e, a-c, a-f
-    {2, 5}, {7, 6}, {2, 7}, {5, 6},  // d-b, d-e, d-c, d-f
-    {0, 2}, {1, 5}, {4, 7}, {3, 6},  // b-c, b-f, e-c, e-f
+    {0, 1},
+    {4, 3},
+    {0, 4},
+    {1, 3},  // a-b, a-e, a-c, a-f
+    {2, 5},
+    {7, 6},
+    {2, 7},
+    {5, 6},  // d-b, d-e, d-c, d-f
+    {0, 2},
+    {1, 5},
+    {4, 7},
+    {3, 6},  // b-c, b-f, e-c, e-f
 }};
 
 struct Hexahedron {
@@ -122,7 +135,9 @@ struct Hexahedron {
   }
   // The location word of point p: bit f set when p is beyond face f by more than tau.
   LocationWord Word(double px, double py, double pz, double tau) const;
-  LocationWord Word(const Eigen::Vector3d& p, double tau) const { return Word(p.x(), p.y(), p.z(), tau); }
+  LocationWord Word(const Eigen::Vector3d& p, double tau) const {
+    return Word(p.x(), p.y(), p.z(), tau);
+  }
   // The location words of all eight vertices of `other` against this one's faces.
   std::array<LocationWord, 8> Words(const Hexahedron& other, double tau) const;
   // The same information face by face, the fast way: masks[f] has bit i set

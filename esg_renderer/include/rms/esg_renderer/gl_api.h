@@ -5,7 +5,6 @@
 // run time, so their gl* symbols never clash in one binary.
 #include <GL/gl.h>
 #include <GL/glext.h>
-
 #include <string>
 
 namespace rms::esg_renderer {
@@ -50,9 +49,9 @@ struct GlApi {
 
 template <class Getter>
 std::string GlApi::Load(Getter get, bool need_fbo) {
-#define RMS_GL_LOAD(field, name)                                        \
-  field = reinterpret_cast<decltype(field)>(get(name));                 \
-  if (!field) return name;
+#define RMS_GL_LOAD(field, name)                        \
+  field = reinterpret_cast<decltype(field)>(get(name)); \
+  if (!(field)) return name;
   RMS_GL_LOAD(Viewport, "glViewport")
   RMS_GL_LOAD(ClearColor, "glClearColor")
   RMS_GL_LOAD(Clear, "glClear")

@@ -5,16 +5,15 @@
 // word's OVERLAY bit is set; the crosshairs of the wrist and port cameras
 // when its CROSSHAIRS bit is set; and, in the live window only, the operator
 // station's guidance (RMS_OPERATOR_STATE).
+#include <Eigen/Core>
 #include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
 
-#include <Eigen/Core>
-
 #include "rms/base/config.h"
-#include "rms/scene_model/mesh.h"
 #include "rms/operator_state_t.hpp"
+#include "rms/scene_model/mesh.h"
 #include "rms/wire/word_blocks.h"
 
 namespace rms::esg_renderer {
@@ -23,11 +22,12 @@ namespace rms::esg_renderer {
 // left at (x, y), each dot `scale` pixels square, into an RGBA image.
 void DrawText(std::uint8_t* rgba, int width, int height, int x, int y, std::string_view text,
               const scene_model::Rgb& colour, int scale);
-void FillRect(std::uint8_t* rgba, int width, int height, int x0, int y0, int x1, int y1, const scene_model::Rgb& colour);
+void FillRect(std::uint8_t* rgba, int width, int height, int x0, int y0, int x1, int y1,
+              const scene_model::Rgb& colour);
 
 // A line from (x0, y0) to (x1, y1), `thick` pixels wide.
-void DrawLine(std::uint8_t* rgba, int width, int height, int x0, int y0, int x1, int y1, const scene_model::Rgb& colour,
-              int thick);
+void DrawLine(std::uint8_t* rgba, int width, int height, int x0, int y0, int x1, int y1,
+              const scene_model::Rgb& colour, int thick);
 
 // What the overlay needs of the configuration, from its static models.
 struct OverlayModel {
@@ -36,25 +36,27 @@ struct OverlayModel {
   // Where the grapple target's cross is, in System Two, when the end
   // effector holds the bar at the grasp: the wrist camera's crosshair.
   Eigen::Vector3d p_S2oT_S2 = Eigen::Vector3d::Zero();
-  Eigen::Vector3d p_RoPort_R = Eigen::Vector3d::Zero(); // the docking port's centre
-  Eigen::Vector3d y_port_R = Eigen::Vector3d::UnitZ();  // its axis, into the CAE
+  Eigen::Vector3d p_RoPort_R = Eigen::Vector3d::Zero();  // the docking port's centre
+  Eigen::Vector3d y_port_R = Eigen::Vector3d::UnitZ();   // its axis, into the CAE
   ArmGeometry arm;
 };
 OverlayModel MakeOverlayModel(const LabConfig& config);
 
 // Where a point in R appears in the frame's image, pixels (x right, y down);
 // false when it is behind the eye.
-bool ProjectToImage(const wire::EsgFrameData& frame, int width, int height, const Eigen::Vector3d& p_R, double* x,
-                    double* y);
+bool ProjectToImage(const wire::EsgFrameData& frame, int width, int height,
+                    const Eigen::Vector3d& p_R, double* x, double* y);
 
-void DrawOverlay(std::uint8_t* rgba, int width, int height, const wire::EsgFrameData& frame, const OverlayModel& model);
+void DrawOverlay(std::uint8_t* rgba, int width, int height, const wire::EsgFrameData& frame,
+                 const OverlayModel& model);
 
 // The crosshairs (control word CROSSHAIRS, docs/esg.md "Crosshairs"): on a
 // wrist camera, a cross where the grapple target's cross appears when the
 // end effector is at the grasp (align the two); on a camera at the CAE, the
 // port's axis out to 12 ft with a tick every 2 ft (the probe's tip rides
 // along it).
-void DrawCrosshairs(std::uint8_t* rgba, int width, int height, const wire::EsgFrameData& frame, const OverlayModel& model);
+void DrawCrosshairs(std::uint8_t* rgba, int width, int height, const wire::EsgFrameData& frame,
+                    const OverlayModel& model);
 
 // The operator station's guidance, a panel at the image's foot (the live
 // window only; docs/operator.md "Guidance").

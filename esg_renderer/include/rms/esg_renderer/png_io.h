@@ -14,7 +14,9 @@ struct Image {
   int width = 0;
   int height = 0;
   std::vector<std::uint8_t> rgb;  // 3 bytes a pixel, rows top to bottom
-  const std::uint8_t* at(int x, int y) const { return &rgb[(static_cast<std::size_t>(y) * width + x) * 3]; }
+  const std::uint8_t* at(int x, int y) const {
+    return &rgb[(static_cast<std::size_t>(y) * width + x) * 3];
+  }
 };
 // Reads an 8-bit RGB or RGBA PNG. Throws std::runtime_error.
 Image ReadPng(const std::string& path);

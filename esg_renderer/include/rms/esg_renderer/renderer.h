@@ -6,15 +6,14 @@
 // back to front in the order the frame's priority bits select, with no depth
 // buffer; depth mode uses a depth buffer instead and is the reference the
 // priority mode is measured against.
+#include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
 #include <vector>
 
-#include <Eigen/Geometry>
-
-#include "rms/esg_renderer/gl_context.h"
 #include "rms/base/config.h"
 #include "rms/esg_renderer/draw_order.h"
+#include "rms/esg_renderer/gl_context.h"
 #include "rms/scene_model/scene_model.h"
 #include "rms/wire/word_blocks.h"
 
@@ -24,9 +23,9 @@ enum class Visibility { kPriority, kDepth };
 
 struct RenderOptions {
   Visibility visibility = Visibility::kPriority;
-  bool id_colors = false;      // each cluster in its flat IdColor, unlit (tests and tools)
-  bool frustum_cull = true;    // skip clusters outside the view volume
-  bool backface_cull = true;   // skip faces turned away
+  bool id_colors = false;     // each cluster in its flat IdColor, unlit (tests and tools)
+  bool frustum_cull = true;   // skip clusters outside the view volume
+  bool backface_cull = true;  // skip faces turned away
 };
 
 // The GL matrices for a frame's view (column-major, for glLoadMatrixd).
@@ -40,10 +39,10 @@ int ClusterOfColor(const std::uint8_t* rgb);
 
 struct RenderStats {
   int clusters_drawn = 0;
-  int clusters_culled = 0;     // outside the view volume
-  int clusters_backfacing = 0; // flat clusters seen from behind
+  int clusters_culled = 0;      // outside the view volume
+  int clusters_backfacing = 0;  // flat clusters seen from behind
   int triangles_submitted = 0;
-  int cycles_broken = 0;       // priority cycles (none in a well-formed scene)
+  int cycles_broken = 0;  // priority cycles (none in a well-formed scene)
 };
 
 class FrameRenderer {
@@ -71,7 +70,7 @@ class FrameRenderer {
     std::vector<std::pair<int, int>> edges;  // pairs of indices into the model's points
     std::vector<float> xyz;          // 9 floats a triangle, cluster frame; base faces then decals
     std::vector<Eigen::Vector3f> n;  // a triangle's normal
-    std::vector<scene_model::Rgb> rgb;            // a triangle's colour
+    std::vector<scene_model::Rgb> rgb;  // a triangle's colour
     std::vector<std::uint8_t> colours;
   };
   void DrawCluster(GpuCluster& c, const Eigen::Affine3d& X_RC, const Eigen::Matrix4d& view);
@@ -81,8 +80,8 @@ class FrameRenderer {
                        const Eigen::Matrix4d& view, const Eigen::Matrix4d& P);
   // The clusters drawn in the order the frame's priority bits give.
   void DrawInOrder(const wire::EsgFrameData& f, const scene_model::ClusterPoses& poses,
-                   const std::array<ScreenBox, scene_model::kNumClusters>& boxes, const Eigen::Matrix4d& view,
-                   const Eigen::Matrix4d& P);
+                   const std::array<ScreenBox, scene_model::kNumClusters>& boxes,
+                   const Eigen::Matrix4d& view, const Eigen::Matrix4d& P);
 
   const LabConfig& config_;
   GlContext* context_;

@@ -4,11 +4,10 @@
 // shoulder pitch and elbow pitch (a two-link arm in the vertical plane through
 // the shoulder), and the wrist's rotation fixes the rest:
 //   R_F3^T R_RS2 = R_y(-theta4) R_z(theta5) R_x(theta6).
+#include <Eigen/Geometry>
 #include <array>
 #include <optional>
 #include <string>
-
-#include <Eigen/Geometry>
 
 #include "rms/base/config.h"
 

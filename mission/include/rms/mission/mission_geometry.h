@@ -5,10 +5,9 @@
 // where the payload docks at the CAE's port, and whether a pose puts the arm
 // or the payload into the orbiter or the CAE. docs/operator.md "The
 // autopilot" describes the geometry.
+#include <Eigen/Geometry>
 #include <array>
 #include <string>
-
-#include <Eigen/Geometry>
 
 #include "rms/base/config.h"
 #include "rms/scene_model/scene_model.h"
@@ -16,9 +15,9 @@
 namespace rms::mission {
 
 struct MissionGeometry {
-  Eigen::Isometry3d X_RS2_grasp;    // System Two at the grasp, the payload in the bay
-  Eigen::Isometry3d X_S2P;          // the payload in System Two once grasped
-  Eigen::Isometry3d X_RP_dock;      // the payload docked
+  Eigen::Isometry3d X_RS2_grasp;  // System Two at the grasp, the payload in the bay
+  Eigen::Isometry3d X_S2P;        // the payload in System Two once grasped
+  Eigen::Isometry3d X_RP_dock;    // the payload docked
   double shoulder_height_ft = 0;
 };
 
@@ -49,8 +48,9 @@ enum class PayloadState { kHeld, kInBay };
 // payload's when in the bay) -- "upper_boom runs into cabin" -- or "" when
 // all are clear. With margin_ft > 0, each must be apart by at least that
 // along some separating axis.
-std::string Interpenetration(const LabConfig& config, const scene_model::SceneModel& model, const std::array<double, 6>& angles_deg,
-                             double shoulder_height_ft, double finger_gap_ft, const Eigen::Isometry3d& X_RP,
+std::string Interpenetration(const LabConfig& config, const scene_model::SceneModel& model,
+                             const std::array<double, 6>& angles_deg, double shoulder_height_ft,
+                             double finger_gap_ft, const Eigen::Isometry3d& X_RP,
                              PayloadState payload = PayloadState::kHeld, double margin_ft = 0.0);
 
 }  // namespace rms::mission

@@ -5,11 +5,10 @@
 // payload's probe up under the CAE's port and rise to it (docking). Written as
 // a timeline (docs/timeline.md) by rms_mission; the geometry comes from the
 // configuration, so the plan follows any change an experimenter makes.
+#include <Eigen/Geometry>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Geometry>
 
 #include "rms/base/config.h"
 #include "rms/mission/mission_geometry.h"

@@ -16,11 +16,10 @@
 //  - SolveWithinLimits: the closed form (rms/arm_ik.h) kept within the limits.
 //
 // Angles in degrees, lengths in feet, the Reference frame R throughout.
+#include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
 #include <optional>
-
-#include <Eigen/Geometry>
 
 #include "rms/base/config.h"
 
@@ -63,12 +62,12 @@ struct ResolveOptions {
 };
 
 struct RateResult {
-  JointAngles q_deg{};            // the next frame's angles
-  JointAngles rate_deg_s{};       // what each joint does this frame
-  std::uint32_t at_limit = 0;     // bit i: joint i is stopped at a limit this frame
-  bool singular = false;          // damped: near a singular pose, some direction is slowed
-  bool rate_limited = false;      // scaled down to keep every joint within its rate
-  double sigma_min_ft = 0.0;      // the smallest weighted singular value, ft/rad
+  JointAngles q_deg{};                   // the next frame's angles
+  JointAngles rate_deg_s{};              // what each joint does this frame
+  std::uint32_t at_limit = 0;            // bit i: joint i is stopped at a limit this frame
+  bool singular = false;                 // damped: near a singular pose, some direction is slowed
+  bool rate_limited = false;             // scaled down to keep every joint within its rate
+  double sigma_min_ft = 0.0;             // the smallest weighted singular value, ft/rad
   Vector6d achieved = Vector6d::Zero();  // [v_Q ft/s; w rad/s], R, to first order
 };
 
@@ -76,21 +75,25 @@ struct RateResult {
 // and System Two to turn at w_R (rad/s), both in R. A zero command returns
 // q unchanged. Joints already beyond a limit may only move back.
 RateResult ResolveRate(const ArmGeometry& arm, const JointLimits& limits, const JointAngles& q_deg,
-                       double shoulder_height_ft, const Eigen::Vector3d& p_S2oQ_S2, const Eigen::Vector3d& v_R,
-                       const Eigen::Vector3d& w_R, double dt_s, const ResolveOptions& options = {});
+                       double shoulder_height_ft, const Eigen::Vector3d& p_S2oQ_S2,
+                       const Eigen::Vector3d& v_R, const Eigen::Vector3d& w_R, double dt_s,
+                       const ResolveOptions& options = {});
 
 // Moves *q toward `target` by at most each joint's rate over dt (the joint
 // with the longest way sets the pace; all arrive together). Angles wrap.
 // True once there.
-bool StepJointsToward(JointAngles* q, const JointAngles& target, const JointAngles& rate_deg_s, double dt_s);
+bool StepJointsToward(JointAngles* q, const JointAngles& target, const JointAngles& rate_deg_s,
+                      double dt_s);
 
 // Angles putting System Two at X_RS2 (elbow up), or nothing when out of
 // reach or beyond a joint limit.
 std::optional<JointAngles> SolveWithinLimits(const ArmGeometry& arm, const JointLimits& limits,
-                                             const Eigen::Isometry3d& X_RS2, double shoulder_height_ft);
+                                             const Eigen::Isometry3d& X_RS2,
+                                             double shoulder_height_ft);
 
 // System Two's pose for these angles.
-Eigen::Isometry3d ForwardPose(const ArmGeometry& arm, const JointAngles& q_deg, double shoulder_height_ft);
+Eigen::Isometry3d ForwardPose(const ArmGeometry& arm, const JointAngles& q_deg,
+                              double shoulder_height_ft);
 
 // Pose interpolation: the translation linearly, the rotation by slerp.
 Eigen::Isometry3d Interpolate(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, double s);

@@ -13,21 +13,20 @@
 // (translation at a speed, rotation by slerp at a rate) solved by inverse
 // kinematics every frame for the descent, the lift, the transfer and the
 // docking approach, slowed down wherever a joint would exceed its rate.
+#include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include <Eigen/Geometry>
-
-#include "rms/operator_station/arm_motion.h"
 #include "rms/base/config.h"
 #include "rms/base/counters.h"
 #include "rms/dcp_telemetry_t.hpp"
-#include "rms/wire/input_block.h"
 #include "rms/mission/mission_geometry.h"
+#include "rms/operator_station/arm_motion.h"
 #include "rms/scene_model/scene_model.h"
+#include "rms/wire/input_block.h"
 
 namespace rms::operator_station {
 
@@ -40,37 +39,37 @@ struct AutopilotOptions {
   double lift_margin_ft = 3.0;       // climb on this far after leaving the bay (Mode 3)
   double transfer_speed_ft_s = 2.0;  // to the pre-dock pose
   double turn_rate_deg_s = 8.0;      // System Two's rotation, at most
-  double predock_ft = 3.0;           // the pre-dock pose: this far below the dock along the port's axis
-  double dock_speed_ft_s = 0.25;     // the final approach
-  int max_collisions = 8;            // collisions relieved before giving up
-  int max_retries = 4;               // grasp or docking corrections before giving up
-  bool plan_clear_paths = true;      // check planned paths against the scene's solids (off: fly
-                                     // straight and relieve collisions as they come)
-  double clearance_ft = 0.5;         // planned paths keep this far from solids
-  double timeout_s = 600.0;          // of session time
-  bool cameras = true;               // switch camera stations as the phases go (the demo's tour)
+  double predock_ft = 3.0;  // the pre-dock pose: this far below the dock along the port's axis
+  double dock_speed_ft_s = 0.25;  // the final approach
+  int max_collisions = 8;         // collisions relieved before giving up
+  int max_retries = 4;            // grasp or docking corrections before giving up
+  bool plan_clear_paths = true;   // check planned paths against the scene's solids (off: fly
+                                  // straight and relieve collisions as they come)
+  double clearance_ft = 0.5;      // planned paths keep this far from solids
+  double timeout_s = 600.0;       // of session time
+  bool cameras = true;            // switch camera stations as the phases go (the demo's tour)
 };
 
 enum class AutopilotPhase {
   kWaitTelemetry,  // nothing heard from the DCP yet
   kReset,          // the DCP is not in its initial state: press reset
   kOpenFinger,
-  kApproach,       // joint move to the hover pose above the bar
-  kDescend,        // straight down onto the bar
-  kClose,          // close the finger until the DCP says acquired (Mode 2)
-  kLift,           // straight up out of the bay (Mode 3), then the margin
-  kTransfer,       // to the pre-dock pose under the port
-  kDock,           // along the port's axis until the DCP says docked
-  kDocked,         // hold
-  kRelieve,        // backing away from a collision, then back to the phase it interrupted
-  kResync,         // after a restored checkpoint: pick up the task where the telemetry says it is
+  kApproach,  // joint move to the hover pose above the bar
+  kDescend,   // straight down onto the bar
+  kClose,     // close the finger until the DCP says acquired (Mode 2)
+  kLift,      // straight up out of the bay (Mode 3), then the margin
+  kTransfer,  // to the pre-dock pose under the port
+  kDock,      // along the port's axis until the DCP says docked
+  kDocked,    // hold
+  kRelieve,   // backing away from a collision, then back to the phase it interrupted
+  kResync,    // after a restored checkpoint: pick up the task where the telemetry says it is
   kFailed,
 };
 const char* AutopilotPhaseName(AutopilotPhase p);
 
 class Autopilot {
  public:
-  Autopilot(const LabConfig& config, AutopilotOptions options = {});
+  explicit Autopilot(const LabConfig& config, AutopilotOptions options = {});
 
   // One frame: the inputs to publish, given the newest telemetry (nullptr
   // while there is none). Session time advances 1 / frame rate a call.
@@ -95,9 +94,9 @@ class Autopilot {
   // rate, all arriving together) or a straight line of System Two.
   struct Segment {
     bool joints = false;
-    std::array<double, 6> q{};                        // joints: the target
+    std::array<double, 6> q{};                             // joints: the target
     Eigen::Isometry3d X1 = Eigen::Isometry3d::Identity();  // line: the end pose
-    double speed_ft_s = 1.0;                          // line: translation speed
+    double speed_ft_s = 1.0;                               // line: translation speed
     // Filled when the segment starts.
     bool started = false;
     Eigen::Isometry3d X0 = Eigen::Isometry3d::Identity();
@@ -120,8 +119,8 @@ class Autopilot {
   // scene's solids by the planning margin? "" when clear, else what hits.
   std::string JointPathHits(const std::array<double, 6>& q0, const std::array<double, 6>& q1,
                             const dcp_telemetry_t& tm, mission::PayloadState payload) const;
-  std::string LinePathHits(const Eigen::Isometry3d& X0, const Eigen::Isometry3d& X1, const dcp_telemetry_t& tm,
-                           mission::PayloadState payload) const;
+  std::string LinePathHits(const Eigen::Isometry3d& X0, const Eigen::Isometry3d& X1,
+                           const dcp_telemetry_t& tm, mission::PayloadState payload) const;
   void Enter(AutopilotPhase p);
   // One frame of each phase (docs/operator.md "The autopilot").
   void StepWaitTelemetry(const dcp_telemetry_t& tm);
@@ -157,8 +156,9 @@ class Autopilot {
   AutopilotPhase resume_ = AutopilotPhase::kApproach;  // after a relief
   // Closed-loop state.
   Eigen::Isometry3d X_PS2_grasp_ = Eigen::Isometry3d::Identity();  // System Two at the grasp, in P
-  Eigen::Isometry3d X_S2P_ = Eigen::Isometry3d::Identity();        // the payload in System Two, as acquired
-  Eigen::Isometry3d X_RP_dock_ = Eigen::Isometry3d::Identity();    // the payload docked
+  Eigen::Isometry3d X_S2P_ =
+      Eigen::Isometry3d::Identity();  // the payload in System Two, as acquired
+  Eigen::Isometry3d X_RP_dock_ = Eigen::Isometry3d::Identity();  // the payload docked
   double margin_ft_ = 0.5;  // the approach's planning margin (0 when it starts closer)
   double mode3_height_ft_ = 0.0;
   bool seen_mode3_ = false;

@@ -31,9 +31,9 @@ enum class ActionKind {
   kVernier,     // coarse <-> vernier rates
   kJointNext,   // single joint: the next joint (wrist roll wraps to shoulder yaw)
   kJointPrev,
-  kQuit,        // stop the station (keyboards only)
-  kFreeze,      // freeze the session, or run it again (RMS_CONTROL)
-  kStep,        // while frozen: one frame (RMS_CONTROL)
+  kQuit,    // stop the station (keyboards only)
+  kFreeze,  // freeze the session, or run it again (RMS_CONTROL)
+  kStep,    // while frozen: one frame (RMS_CONTROL)
 };
 struct Action {
   ActionKind kind = ActionKind::kQuit;
@@ -60,7 +60,7 @@ struct AxisBinding {
 // The hand controllers' full-scale rates, coarse and vernier
 // (docs/operator.md "Rates").
 struct HandRates {
-  double coarse_ft_s = 0, coarse_deg_s = 0;    // manual augmented: translation, rotation
+  double coarse_ft_s = 0, coarse_deg_s = 0;  // manual augmented: translation, rotation
   double vernier_ft_s = 0, vernier_deg_s = 0;
   double joint_coarse_deg_s = 0, joint_vernier_deg_s = 0;  // single joint
 };
@@ -92,8 +92,9 @@ struct Bindings {
 
   // [keyboard]
   HandIncrements increments;
-  std::array<double, kNumAnalogInputs> key_step{};  // the direct inputs' step a press (joints unused)
-  std::map<int, Action> keys;                       // key code -> action
+  std::array<double, kNumAnalogInputs>
+      key_step{};              // the direct inputs' step a press (joints unused)
+  std::map<int, Action> keys;  // key code -> action
 
   // [gamepad] (SDL2 game controller names)
   std::map<std::string, AxisBinding> gamepad_axes;  // "leftx" -> axis

@@ -7,7 +7,7 @@
 namespace rms::operator_station {
 
 enum class ControlMode : int {
-  kSingleJoint = 1,      // one joint at a time, at a rate (the translational controller's x drives it)
+  kSingleJoint = 1,  // one joint at a time, at a rate (the translational controller's x drives it)
   kManualAugmented = 2,  // resolved rate: the hand controllers move the point of resolution
 };
 
@@ -15,16 +15,16 @@ enum class ControlMode : int {
 // and roll, pitch, yaw are about (docs/operator.md "Command frames").
 enum class CommandFrame : int {
   kEndEffector = 1,  // the wrist camera's view: x forward (X2), y image right, z image down
-  kOrbiter = 2,      // the orbiter's body axes: x to the nose (-X_R), y starboard (Y_R), z down (-Z_R)
-  kPayload = 3,      // the payload's axes x_P, y_P (toward the probe), z_P (toward the bar); once held
+  kOrbiter = 2,  // the orbiter's body axes: x to the nose (-X_R), y starboard (Y_R), z down (-Z_R)
+  kPayload = 3,  // the payload's axes x_P, y_P (toward the probe), z_P (toward the bar); once held
 };
 
 // The hand controllers' six axes: the translational controller's (THC) x,
 // y, z and the rotational one's (RHC) roll, pitch, yaw about the command
 // frame's x, y, z.
 enum HandAxis : int { kThcX = 0, kThcY, kThcZ, kRhcRoll, kRhcPitch, kRhcYaw, kNumHandAxes };
-inline constexpr std::string_view kHandAxisNames[kNumHandAxes] = {"thc_x",    "thc_y",     "thc_z",
-                                                                  "rhc_roll", "rhc_pitch", "rhc_yaw"};
+inline constexpr std::string_view kHandAxisNames[kNumHandAxes] = {
+    "thc_x", "thc_y", "thc_z", "rhc_roll", "rhc_pitch", "rhc_yaw"};
 
 std::string_view ControlModeName(ControlMode m);    // "single joint", "manual augmented"
 std::string_view CommandFrameName(CommandFrame f);  // "end effector", "orbiter", "payload"

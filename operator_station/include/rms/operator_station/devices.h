@@ -19,25 +19,26 @@
 #include <string>
 #include <vector>
 
-#include "rms/operator_station/bindings.h"
 #include "rms/base/counters.h"
+#include "rms/operator_station/bindings.h"
 #include "rms/wire/frame_numbers.h"
 #include "rms/wire/input_block.h"
 
 namespace rms::operator_station {
 
 struct Press {
-  int index = 0;      // the HandAxis, or the analog input
+  int index = 0;  // the HandAxis, or the analog input
   double sign = 1.0;
 };
 
 struct DeviceCommands {
-  std::array<double, kNumHandAxes> hand{};            // deflection, [-1, 1] each
-  std::vector<Press> hand_presses;                    // a terminal's presses, in order
-  std::array<double, kNumAnalogInputs> input_rate{};  // direct inputs: fraction of max rate, [-1, 1]
-  std::vector<Press> input_presses;                   // a terminal's presses of direct inputs
-  std::vector<Action> events;                         // camera, mode, stop, reset, ...
-  int key_actions = 0;                                // keys and buttons pressed this frame
+  std::array<double, kNumHandAxes> hand{};  // deflection, [-1, 1] each
+  std::vector<Press> hand_presses;          // a terminal's presses, in order
+  std::array<double, kNumAnalogInputs>
+      input_rate{};                  // direct inputs: fraction of max rate, [-1, 1]
+  std::vector<Press> input_presses;  // a terminal's presses of direct inputs
+  std::vector<Action> events;        // camera, mode, stop, reset, ...
+  int key_actions = 0;               // keys and buttons pressed this frame
 };
 
 class InputDevice {
@@ -61,7 +62,8 @@ double ApplyDeadband(double x, double band);
 // fly them).
 class KeyboardDevice : public InputDevice {
  public:
-  KeyboardDevice(const Bindings& bindings, std::function<int()> next_key, std::string where = "this terminal");
+  KeyboardDevice(const Bindings& bindings, std::function<int()> next_key,
+                 std::string where = "this terminal");
   std::string Describe() const override { return "keyboard (" + where_ + ")"; }
   void Poll(DeviceCommands* out) override;
   long unbound_keys() const { return unbound_; }
@@ -83,7 +85,8 @@ class WindowKeyboardDevice : public InputDevice {
     std::int64_t sequence = 0;
     std::vector<int> held, pressed;
     bool focused = true;
-    std::int32_t sender_pid = 0;  // the window's process (sender_t.pid); a new one numbers from 0 again
+    std::int32_t sender_pid =
+        0;  // the window's process (sender_t.pid); a new one numbers from 0 again
   };
   explicit WindowKeyboardDevice(const Bindings& bindings, std::int64_t timeout_us = 300000);
   std::string Describe() const override { return "keyboard (the live window)"; }

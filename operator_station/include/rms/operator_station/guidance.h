@@ -5,27 +5,28 @@
 // it to its target -- the grasp on the bar receptacle in Mode 1, the CAE's
 // docking port in Modes 2 and 3 -- in the command frame's axes, so that the
 // controller that reduces an offset is the one the offset names.
+#include <Eigen/Geometry>
 #include <array>
 
-#include <Eigen/Geometry>
-
-#include "rms/operator_station/control_modes.h"
 #include "rms/base/config.h"
 #include "rms/dcp_telemetry_t.hpp"
+#include "rms/operator_station/control_modes.h"
 
 namespace rms::operator_station {
 
 // What of the configuration guidance needs, computed once.
 struct GuidanceGeometry {
   Eigen::Matrix3d R_S2H = Eigen::Matrix3d::Identity();  // end-effector command axes in System Two
-  Eigen::Vector3d p_S2oG_S2 = Eigen::Vector3d::Zero();  // the grasp point: the bar's centre at the grasp
-  Eigen::Isometry3d X_RS2_grasp = Eigen::Isometry3d::Identity();  // System Two at the grasp (the mission's: the
-                                                        // wrist camera on the grapple target's side)
-  Eigen::Vector3d p_PoT_P = Eigen::Vector3d::Zero();    // the probe's tip centre, payload frame
-  Eigen::Vector3d p_RoPort_R = Eigen::Vector3d::Zero(); // the docking port's centre
-  Eigen::Vector3d y_port_R = Eigen::Vector3d::UnitZ();  // the port's axis (into the CAE)
+  Eigen::Vector3d p_S2oG_S2 =
+      Eigen::Vector3d::Zero();  // the grasp point: the bar's centre at the grasp
+  Eigen::Isometry3d X_RS2_grasp =
+      Eigen::Isometry3d::Identity();                  // System Two at the grasp (the mission's: the
+                                                      // wrist camera on the grapple target's side)
+  Eigen::Vector3d p_PoT_P = Eigen::Vector3d::Zero();  // the probe's tip centre, payload frame
+  Eigen::Vector3d p_RoPort_R = Eigen::Vector3d::Zero();  // the docking port's centre
+  Eigen::Vector3d y_port_R = Eigen::Vector3d::UnitZ();   // the port's axis (into the CAE)
   std::array<Eigen::Vector3d, 8> bar_P;                  // the BAR's corners, payload frame
-  double fixed_finger_face_Y2_ft = 0.0;                  // face b of EFF HEX 2 (the fixed finger's inside), Y2
+  double fixed_finger_face_Y2_ft = 0.0;  // face b of EFF HEX 2 (the fixed finger's inside), Y2
 };
 GuidanceGeometry MakeGuidanceGeometry(const LabConfig& config);
 
@@ -54,10 +55,12 @@ enum class GuidanceTarget : int { kGrasp = 1, kPort = 2 };
 struct Guidance {
   GuidanceTarget target = GuidanceTarget::kGrasp;
   CommandFrame frame = CommandFrame::kEndEffector;
-  Eigen::Vector3d offset_ft = Eigen::Vector3d::Zero();   // target - point of resolution, command axes
-  Eigen::Vector3d rotation_deg = Eigen::Vector3d::Zero(); // about x (roll), y (pitch), z (yaw) to align
-  double distance_ft = 0.0;                              // |offset|
-  double angle_deg = 0.0;                                // |rotation|
+  Eigen::Vector3d offset_ft =
+      Eigen::Vector3d::Zero();  // target - point of resolution, command axes
+  Eigen::Vector3d rotation_deg =
+      Eigen::Vector3d::Zero();  // about x (roll), y (pitch), z (yaw) to align
+  double distance_ft = 0.0;     // |offset|
+  double angle_deg = 0.0;       // |rotation|
   // Mode 2: the way out of the bay first -- straight up (+Z_R) until the
   // payload is kLeaveBayMarginFt clear -- in the command frame's axes.
   bool leave_bay = false;

@@ -25,14 +25,14 @@
 #include <string>
 #include <vector>
 
+#include "rms/base/config.h"
+#include "rms/base/counters.h"
+#include "rms/dcp_telemetry_t.hpp"
 #include "rms/operator_station/arm_motion.h"
 #include "rms/operator_station/bindings.h"
 #include "rms/operator_station/control_modes.h"
 #include "rms/operator_station/devices.h"
 #include "rms/operator_station/guidance.h"
-#include "rms/base/config.h"
-#include "rms/base/counters.h"
-#include "rms/dcp_telemetry_t.hpp"
 #include "rms/wire/input_block.h"
 
 namespace rms::operator_station {
@@ -43,13 +43,14 @@ struct HandStatus {
   ControlMode mode = ControlMode::kManualAugmented;
   CommandFrame frame = CommandFrame::kEndEffector;
   bool vernier = false;
-  int joint = 0;                              // single joint: which
-  std::array<double, kNumHandAxes> rate{};    // commanded: ft/s, deg/s (single joint: [0] deg/s)
-  std::array<double, kNumHandAxes> pending{}; // a terminal's increments still to fly: ft, deg
-  std::uint32_t at_limit = 0;                 // joints held at a limit
+  int joint = 0;                               // single joint: which
+  std::array<double, kNumHandAxes> rate{};     // commanded: ft/s, deg/s (single joint: [0] deg/s)
+  std::array<double, kNumHandAxes> pending{};  // a terminal's increments still to fly: ft, deg
+  std::uint32_t at_limit = 0;                  // joints held at a limit
   bool singular = false;
-  bool rate_limited = false;                  // slower than commanded: a joint at its rate
-  bool held_at_port = false;                  // docked: the CAE holds the payload and the arm until the finger opens
+  bool rate_limited = false;  // slower than commanded: a joint at its rate
+  bool held_at_port =
+      false;  // docked: the CAE holds the payload and the arm until the finger opens
   double sigma_min_ft = 0.0;
 };
 
@@ -63,7 +64,8 @@ class HandControllers {
   // telemetry: the DCP's newest (the mode, the payload held), or null.
   wire::OperatorInputs Step(double dt_s, const dcp_telemetry_t* telemetry);
   // Applies one frame's commands (Step does this after polling; tests too).
-  wire::OperatorInputs Apply(const DeviceCommands& cmd, double dt_s, const dcp_telemetry_t* telemetry);
+  wire::OperatorInputs Apply(const DeviceCommands& cmd, double dt_s,
+                             const dcp_telemetry_t* telemetry);
 
   bool quit() const { return quit_; }
   // Freeze / step asked for this frame (the station sends them on RMS_CONTROL).

@@ -10,25 +10,26 @@
 #include <string>
 #include <vector>
 
+#include "rms/base/config.h"
+#include "rms/base/counters.h"
+#include "rms/dcp_telemetry_t.hpp"
+#include "rms/operator_state_t.hpp"
 #include "rms/operator_station/autopilot.h"
 #include "rms/operator_station/bindings.h"
 #include "rms/operator_station/hand_controllers.h"
 #include "rms/operator_station/keyboard.h"
-#include "rms/base/config.h"
-#include "rms/base/counters.h"
-#include "rms/dcp_telemetry_t.hpp"
-#include "rms/wire/input_block.h"
-#include "rms/operator_state_t.hpp"
 #include "rms/operator_station/timeline.h"
+#include "rms/wire/input_block.h"
 
 namespace rms::operator_station {
 
 // What a source knows of this frame.
 struct Frame {
-  std::int64_t count = 0;          // frames this source has produced so far
-  double dt_s = 0.0;               // session time a frame (1 / the frame rate)
-  const dcp_telemetry_t* telemetry = nullptr;  // the DCP's newest (fresh since a reset or restore), or null
-  std::int64_t now_us = 0;         // the station's clock (the transport's)
+  std::int64_t count = 0;  // frames this source has produced so far
+  double dt_s = 0.0;       // session time a frame (1 / the frame rate)
+  const dcp_telemetry_t* telemetry =
+      nullptr;              // the DCP's newest (fresh since a reset or restore), or null
+  std::int64_t now_us = 0;  // the station's clock (the transport's)
 };
 
 // What a source asks of the session, besides its inputs.
@@ -86,10 +87,10 @@ class TimelineSource : public InputSource {
 };
 
 struct HandOptions {
-  std::string bindings_path;  // empty: config/bindings.toml
+  std::string bindings_path;       // empty: config/bindings.toml
   bool keyboard_required = false;  // --keyboard: this terminal's keyboard or refuse
   bool gamepad = true, spacemouse = true;
-  bool window = true;         // listen for the live window's keys (RMS_WINDOW_KEYS)
+  bool window = true;  // listen for the live window's keys (RMS_WINDOW_KEYS)
 };
 
 class HandSource : public InputSource {
@@ -121,7 +122,8 @@ class HandSource : public InputSource {
 
 class AutopilotSource : public InputSource {
  public:
-  AutopilotSource(const LabConfig& config, const AutopilotOptions& options, bool hold, bool resume_from_telemetry);
+  AutopilotSource(const LabConfig& config, const AutopilotOptions& options, bool hold,
+                  bool resume_from_telemetry);
   std::string Describe() const override;
   std::int8_t kind() const override { return operator_state_t::SOURCE_AUTOPILOT; }
   std::optional<wire::OperatorInputs> Next(const Frame& f) override;

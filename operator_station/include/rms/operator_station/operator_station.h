@@ -12,45 +12,50 @@
 #include <optional>
 #include <string>
 
-#include "rms/operator_station/guidance.h"
-#include "rms/operator_station/input_sources.h"
-#include "rms/wire/checkpoint.h"
 #include "rms/base/config.h"
 #include "rms/base/counters.h"
 #include "rms/dcp_telemetry_t.hpp"
-#include "rms/wire/input_block.h"
-#include "rms/transport/lcm_interface.h"
 #include "rms/operator_input_t.hpp"
-#include "rms/transport/process.h"
+#include "rms/operator_station/guidance.h"
+#include "rms/operator_station/input_sources.h"
 #include "rms/operator_station/session_events.h"
 #include "rms/operator_station/status_screen.h"
+#include "rms/transport/lcm_interface.h"
+#include "rms/transport/process.h"
+#include "rms/wire/checkpoint.h"
+#include "rms/wire/input_block.h"
 
 namespace rms::operator_station {
 
 struct OperatorOptions {
   std::string timeline_path;  // --timeline FILE
-  bool keyboard = false;      // --keyboard: by hand, the terminal's keyboard required (plus any other device)
-  bool manual = false;        // --manual: by hand with whatever devices are found
-  bool autopilot = false;     // --autopilot
-  bool autopilot_straight = false;  // --autopilot-straight: no path planning, relieve collisions as they come
+  bool keyboard =
+      false;  // --keyboard: by hand, the terminal's keyboard required (plus any other device)
+  bool manual = false;     // --manual: by hand with whatever devices are found
+  bool autopilot = false;  // --autopilot
+  bool autopilot_straight =
+      false;  // --autopilot-straight: no path planning, relieve collisions as they come
   std::string bindings_path;  // --bindings (default config/bindings.toml)
   bool gamepad = true;        // --no-gamepad: don't look for one
   bool spacemouse = true;     // --no-spacemouse: don't look for one
   bool window_keys = false;   // --window-keys: fly from the live window's keys (RMS_WINDOW_KEYS)
-  int status = -1;            // --status / --no-status (-1: on when by hand and stdout is a terminal)
-  double rate_hz = 0.0;       // --rate (0: config session.frame_rate_hz)
-  bool hold = false;          // --hold: keep publishing after the timeline's end / docking
-  double speed = 1.0;         // --speed: timeline seconds per wall-clock second (frames stay at the rate)
+  int status = -1;       // --status / --no-status (-1: on when by hand and stdout is a terminal)
+  double rate_hz = 0.0;  // --rate (0: config session.frame_rate_hz)
+  bool hold = false;     // --hold: keep publishing after the timeline's end / docking
+  double speed = 1.0;  // --speed: timeline seconds per wall-clock second (frames stay at the rate)
   std::int64_t max_frames = -1;  // --frames N: stop after N frames (-1: no limit)
-  std::string restore_path;   // --restore CHECKPOINT: start from its operator inputs (by hand, autopilot)
-  std::string checkpoint_dir; // --checkpoint-dir: RMS_CONTROL's RESTORE names a checkpoint here only
+  std::string
+      restore_path;  // --restore CHECKPOINT: start from its operator inputs (by hand, autopilot)
+  std::string
+      checkpoint_dir;  // --checkpoint-dir: RMS_CONTROL's RESTORE names a checkpoint here only
 };
 
 // Builds the numbered, time-stamped input blocks.
 class InputBlockBuilder {
  public:
   explicit InputBlockBuilder(const InputCalibrations& cal) : cal_(cal) {}
-  operator_input_t Build(const wire::OperatorInputs& in, std::int64_t send_time_us, Counters* counters);
+  operator_input_t Build(const wire::OperatorInputs& in, std::int64_t send_time_us,
+                         Counters* counters);
   std::int64_t next_frame() const { return next_frame_; }
   void set_next_frame(std::int64_t f) { next_frame_ = f; }
 
@@ -73,8 +78,8 @@ void CheckSourceFiles(const OperatorOptions& options, const LabConfig& config);
 
 class OperatorStation {
  public:
-  OperatorStation(const OperatorOptions& options, const LabConfig& config, transport::LcmInterface& lcm,
-                  std::unique_ptr<InputSource> source);
+  OperatorStation(const OperatorOptions& options, const LabConfig& config,
+                  transport::LcmInterface& lcm, std::unique_ptr<InputSource> source);
   // Runs until the source is done, quit or a stop signal; the exit code.
   int Run(const std::string& stats_path, const std::string& ready_path);
   const Counters& counters() const { return counters_; }
@@ -116,7 +121,8 @@ class OperatorStation {
   // refused (dropped.far_ahead), so one forged frame far ahead cannot make
   // every real one after it stale (docs/protocol.md "Frame numbers").
   wire::SequenceTracker telemetry_seq_;
-  std::int64_t fresh_from_input_frame_ = -1;  // telemetry answering an older input is from before a reset / restore
+  std::int64_t fresh_from_input_frame_ =
+      -1;  // telemetry answering an older input is from before a reset / restore
   struct RateMeter {
     void Tick(std::int64_t now_us);
     double hz() const { return hz_; }

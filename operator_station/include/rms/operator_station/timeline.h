@@ -35,7 +35,8 @@ class Timeline {
   const std::vector<std::string>& warnings() const { return warnings_; }
 
  private:
-  void AddItem(double t, std::string_view item, const InputCalibrations& cal, const std::string& where, bool* end);
+  void AddItem(double t, std::string_view item, const InputCalibrations& cal,
+               const std::string& where, bool* end);
   struct Key {
     double t;
     double v;

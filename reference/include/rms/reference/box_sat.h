@@ -1,10 +1,9 @@
 #pragma once
 // Reference for boxes: the 15-axis separating-axis test in long double
 // (independent of the DCP's algorithm). Closed boxes: touching intersects.
+#include <Eigen/Core>
 #include <array>
 #include <cmath>
-
-#include <Eigen/Core>
 
 namespace rms::reference {
 
@@ -12,7 +11,7 @@ using Vec3L = Eigen::Matrix<long double, 3, 1>;
 
 struct RefBox {
   Vec3L centre;
-  std::array<Vec3L, 3> axis;   // unit axes
+  std::array<Vec3L, 3> axis;  // unit axes
   std::array<long double, 3> half;
 };
 

@@ -10,13 +10,13 @@ namespace rms::reference {
 
 struct CompareStats {
   long pairs = 0;
-  long collide = 0;            // reference verdicts: intersecting pairs
-  long disagree_in_band = 0;   // |separation| <= band x scale
-  long disagree_outside = 0;   // must be zero
-  long invalid = 0;            // DCP said kInvalid on valid input: must be zero
-  long plane_missing = 0;      // separate, but no separating plane outside the band
-  long plane_wrong = 0;        // a plane that does not separate (beyond band)
-  long exact_checked = 0;      // pairs checked by the exact reference
+  long collide = 0;           // reference verdicts: intersecting pairs
+  long disagree_in_band = 0;  // |separation| <= band x scale
+  long disagree_outside = 0;  // must be zero
+  long invalid = 0;           // DCP said kInvalid on valid input: must be zero
+  long plane_missing = 0;     // separate, but no separating plane outside the band
+  long plane_wrong = 0;       // a plane that does not separate (beyond band)
+  long exact_checked = 0;     // pairs checked by the exact reference
   std::map<std::string, long> pairs_by_kind;
   std::map<std::string, long> in_band_by_kind;  // disagreements inside the band, by kind
   std::map<std::string, long> deciders;

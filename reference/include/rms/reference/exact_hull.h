@@ -6,13 +6,13 @@
 // arithmetic first (CGAL::Interval_nt), exact rationals (CGAL::Gmpq) when an
 // interval cannot decide. Hull facets come from CGAL's exact orientation
 // predicate. Independent of the DCP's algorithm.
-#include <array>
-
 #include <Eigen/Core>
+#include <array>
 
 namespace rms::reference {
 
-bool ExactHullsIntersect(const std::array<Eigen::Vector3d, 8>& a, const std::array<Eigen::Vector3d, 8>& b);
+bool ExactHullsIntersect(const std::array<Eigen::Vector3d, 8>& a,
+                         const std::array<Eigen::Vector3d, 8>& b);
 
 // How many axis decisions needed exact rationals (for the test's report).
 long ExactFallbacks();

@@ -3,15 +3,14 @@
 // references (fixed seeds; the tests print them). Each pair comes as the
 // DCP's Hexahedron and as the vertex arrays (and, for boxes, the exact box
 // parameters) the references take.
+#include <Eigen/Geometry>
 #include <array>
 #include <cmath>
 #include <random>
 #include <string>
 
-#include <Eigen/Geometry>
-
-#include "rms/reference/box_sat.h"
 #include "rms/dynamics_proc/hexahedron.h"
+#include "rms/reference/box_sat.h"
 #include "rms/reference/hull_distance.h"
 
 namespace rms::reference {
@@ -32,14 +31,22 @@ inline Topology StandardTopology() {
   Topology t;
   for (int f = 0; f < 6; ++f)
     for (int j = 0; j < 4; ++j) t.faces[f][j] = dynamics_proc::kFaceVertices[f][j];
-  for (int e = 0; e < 12; ++e) t.edges[e] = {dynamics_proc::kEdges[e][0], dynamics_proc::kEdges[e][1]};
+  for (int e = 0; e < 12; ++e)
+    t.edges[e] = {dynamics_proc::kEdges[e][0], dynamics_proc::kEdges[e][1]};
   return t;
 }
 
 // Sign pattern (u, v, w) of each vertex in the standard notation, u from
 // face a to d, v from b to e, w from c to f.
 inline constexpr std::array<std::array<int, 3>, 8> kVertexSigns = {{
-    {-1, -1, -1}, {-1, -1, 1}, {1, -1, -1}, {-1, 1, 1}, {-1, 1, -1}, {1, -1, 1}, {1, 1, 1}, {1, 1, -1},
+    {-1, -1, -1},
+    {-1, -1, 1},
+    {1, -1, -1},
+    {-1, 1, 1},
+    {-1, 1, -1},
+    {1, -1, 1},
+    {1, 1, 1},
+    {1, 1, -1},
 }};
 
 inline Eigen::Matrix3d RandomRotation(std::mt19937_64& rng) {
@@ -49,7 +56,8 @@ inline Eigen::Matrix3d RandomRotation(std::mt19937_64& rng) {
 
 // A box the report's way (MakeBox from the centre of face a), and its exact
 // description for the long double reference.
-inline Solid Box(const Eigen::Vector3d& centre, const Eigen::Matrix3d& R, const Eigen::Vector3d& half) {
+inline Solid Box(const Eigen::Vector3d& centre, const Eigen::Matrix3d& R,
+                 const Eigen::Vector3d& half) {
   Solid s;
   const Eigen::Vector3d U = R.col(0), V = R.col(1), W = R.col(2);
   s.hex = dynamics_proc::MakeBox(centre - half.x() * U, U, V, W, 2 * half.x(), half.y(), half.z());
@@ -66,11 +74,12 @@ inline Solid Box(const Eigen::Vector3d& centre, const Eigen::Matrix3d& R, const 
 // A general hexahedron: the box's vertices, face f shrunk toward its centre
 // by `taper` (a frustum; 1 keeps the box), then the linear map M (a shear
 // makes a skewed solid), then placed at `centre`.
-inline Solid General(const Eigen::Vector3d& centre, const Eigen::Matrix3d& M, const Eigen::Vector3d& half,
-                     double taper) {
+inline Solid General(const Eigen::Vector3d& centre, const Eigen::Matrix3d& M,
+                     const Eigen::Vector3d& half, double taper) {
   Solid s;
   for (int i = 0; i < 8; ++i) {
-    Eigen::Vector3d p(kVertexSigns[i][0] * half.x(), kVertexSigns[i][1] * half.y(), kVertexSigns[i][2] * half.z());
+    Eigen::Vector3d p(kVertexSigns[i][0] * half.x(), kVertexSigns[i][1] * half.y(),
+                      kVertexSigns[i][2] * half.z());
     if (kVertexSigns[i][2] > 0) {  // on face f (w+): toward its centre
       p.x() *= taper;
       p.y() *= taper;
@@ -123,16 +132,26 @@ class PairGenerator {
     const int kinds = boxes_only ? 7 : 10;
     const int k = static_cast<int>(counter_++ % kinds);
     switch (k) {
-      case 0: return RandomBoxes(scale);
-      case 1: return TouchingFaces(scale, true);
-      case 2: return TouchingFaces(scale, false);
-      case 3: return ParallelEdges(scale);
-      case 4: return Nested(scale);
-      case 5: return RodThroughSlab(scale);
-      case 6: return NearContactBoxes(scale);
-      case 7: return RandomGeneral(scale, /*taper=*/true, /*shear=*/false);
-      case 8: return RandomGeneral(scale, false, true);
-      default: return RandomGeneral(scale, true, true);
+      case 0:
+        return RandomBoxes(scale);
+      case 1:
+        return TouchingFaces(scale, true);
+      case 2:
+        return TouchingFaces(scale, false);
+      case 3:
+        return ParallelEdges(scale);
+      case 4:
+        return Nested(scale);
+      case 5:
+        return RodThroughSlab(scale);
+      case 6:
+        return NearContactBoxes(scale);
+      case 7:
+        return RandomGeneral(scale, /*taper=*/true, /*shear=*/false);
+      case 8:
+        return RandomGeneral(scale, false, true);
+      default:
+        return RandomGeneral(scale, true, true);
     }
   }
 
@@ -191,7 +210,8 @@ class PairGenerator {
   Pair TouchingFaces(double s, bool exact) {
     std::uniform_int_distribution<int> small(1, 8);
     const double unit = std::ldexp(1.0, static_cast<int>(std::floor(std::log2(s))));
-    Eigen::Vector3d ha(small(rng_), small(rng_), small(rng_)), hb(small(rng_), small(rng_), small(rng_));
+    Eigen::Vector3d ha(small(rng_), small(rng_), small(rng_)),
+        hb(small(rng_), small(rng_), small(rng_));
     ha *= unit / 16;
     hb *= unit / 16;
     std::uniform_int_distribution<int> off(-4, 4);
@@ -202,14 +222,16 @@ class PairGenerator {
     cb.x() += gap;
     const Eigen::Matrix3d R = exact ? Eigen::Matrix3d::Identity() : RandomRotation(rng_);
     const Eigen::Vector3d ca = exact ? Eigen::Vector3d::Zero() : RandomPos(s);
-    return {Box(ca, R, ha), Box(ca + R * cb, R, hb), exact ? "touching faces, exact" : "touching faces, rotated"};
+    return {Box(ca, R, ha), Box(ca + R * cb, R, hb),
+            exact ? "touching faces, exact" : "touching faces, rotated"};
   }
 
   Pair ParallelEdges(double s) {
     const Eigen::Matrix3d R = RandomRotation(rng_);
     const Eigen::Vector3d ha = RandomHalf(s), hb = RandomHalf(s);
     std::uniform_real_distribution<double> u(-1.1, 1.1);
-    const Eigen::Vector3d c(u(rng_) * (ha.x() + hb.x()), u(rng_) * (ha.y() + hb.y()), u(rng_) * (ha.z() + hb.z()));
+    const Eigen::Vector3d c(u(rng_) * (ha.x() + hb.x()), u(rng_) * (ha.y() + hb.y()),
+                            u(rng_) * (ha.z() + hb.z()));
     const Eigen::Vector3d ca = RandomPos(s);
     return {Box(ca, R, ha), Box(ca + R * c, R, hb), "parallel edges"};
   }
@@ -230,13 +252,16 @@ class PairGenerator {
     const Eigen::Matrix3d R = RandomRotation(rng_);
     const Eigen::Vector3d c = RandomPos(s);
     std::uniform_real_distribution<double> tilt(-0.3, 0.3), shift(-0.4, 0.4);
-    const Eigen::Matrix3d Rr = R * Eigen::AngleAxisd(tilt(rng_), Eigen::Vector3d::UnitX()).toRotationMatrix();
+    const Eigen::Matrix3d Rr =
+        R * Eigen::AngleAxisd(tilt(rng_), Eigen::Vector3d::UnitX()).toRotationMatrix();
     const Eigen::Vector3d slab = s * Eigen::Vector3d(0.5, 0.5, 0.05);
     const bool beams = counter_ % 3 == 0;
-    const Eigen::Vector3d rod = beams ? s * Eigen::Vector3d(0.05, 0.6, 0.05) : s * Eigen::Vector3d(0.04, 0.04, 0.6);
+    const Eigen::Vector3d rod =
+        beams ? s * Eigen::Vector3d(0.05, 0.6, 0.05) : s * Eigen::Vector3d(0.04, 0.04, 0.6);
     const Eigen::Vector3d slab_or_beam = beams ? s * Eigen::Vector3d(0.6, 0.05, 0.05) : slab;
     const Eigen::Vector3d off = R * Eigen::Vector3d(shift(rng_) * s, shift(rng_) * s, 0);
-    return {Box(c + off * (beams ? 0.1 : 1.0), Rr, rod), Box(c, R, slab_or_beam), beams ? "crossed beams" : "rod through slab"};
+    return {Box(c + off * (beams ? 0.1 : 1.0), Rr, rod), Box(c, R, slab_or_beam),
+            beams ? "crossed beams" : "rod through slab"};
   }
 
   // Random boxes moved until they nearly touch: the hard cases near contact.

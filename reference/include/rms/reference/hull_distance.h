@@ -5,11 +5,10 @@
 // overlap (the smallest overlap over the separating-axis candidates: face
 // normals and edge cross products). Used only to say whether a disagreement
 // lies inside the documented band, never for a verdict.
+#include <Eigen/Core>
 #include <algorithm>
 #include <array>
 #include <cmath>
-
-#include <Eigen/Core>
 
 namespace rms::reference {
 
@@ -77,13 +76,16 @@ struct Topology {
 inline long double HullDistance(const std::array<Eigen::Vector3d, 8>& A,
                                 const std::array<Eigen::Vector3d, 8>& B, const Topology& topo) {
   long double best = INFINITY;
-  auto vertex_faces = [&](const std::array<Eigen::Vector3d, 8>& P, const std::array<Eigen::Vector3d, 8>& Q) {
+  auto vertex_faces = [&](const std::array<Eigen::Vector3d, 8>& P,
+                          const std::array<Eigen::Vector3d, 8>& Q) {
     for (const auto& p : P) {
       for (const auto& f : topo.faces) {
         // Both diagonals' triangles cover a slightly non-planar quad.
-        for (const auto& tri : {std::array<int, 3>{f[0], f[1], f[2]}, std::array<int, 3>{f[0], f[2], f[3]},
-                                std::array<int, 3>{f[0], f[1], f[3]}, std::array<int, 3>{f[1], f[2], f[3]}}) {
-          best = std::min(best, PointTriangleDistance(L(p), L(Q[tri[0]]), L(Q[tri[1]]), L(Q[tri[2]])));
+        for (const auto& tri :
+             {std::array<int, 3>{f[0], f[1], f[2]}, std::array<int, 3>{f[0], f[2], f[3]},
+              std::array<int, 3>{f[0], f[1], f[3]}, std::array<int, 3>{f[1], f[2], f[3]}}) {
+          best =
+              std::min(best, PointTriangleDistance(L(p), L(Q[tri[0]]), L(Q[tri[1]]), L(Q[tri[2]])));
         }
       }
     }
@@ -92,7 +94,8 @@ inline long double HullDistance(const std::array<Eigen::Vector3d, 8>& A,
   vertex_faces(B, A);
   for (const auto& ea : topo.edges)
     for (const auto& eb : topo.edges)
-      best = std::min(best, SegmentSegmentDistance(L(A[ea[0]]), L(A[ea[1]]), L(B[eb[0]]), L(B[eb[1]])));
+      best = std::min(best,
+                      SegmentSegmentDistance(L(A[ea[0]]), L(A[ea[1]]), L(B[eb[0]]), L(B[eb[1]])));
   return best;
 }
 
@@ -106,12 +109,21 @@ inline long double PenetrationDepth(const std::array<Eigen::Vector3d, 8>& A,
     if (!(len > 1e-30L)) return;
     n /= len;
     long double alo = INFINITY, ahi = -INFINITY, blo = INFINITY, bhi = -INFINITY;
-    for (const auto& p : A) { const long double v = n.dot(L(p)); alo = std::min(alo, v); ahi = std::max(ahi, v); }
-    for (const auto& p : B) { const long double v = n.dot(L(p)); blo = std::min(blo, v); bhi = std::max(bhi, v); }
+    for (const auto& p : A) {
+      const long double v = n.dot(L(p));
+      alo = std::min(alo, v);
+      ahi = std::max(ahi, v);
+    }
+    for (const auto& p : B) {
+      const long double v = n.dot(L(p));
+      blo = std::min(blo, v);
+      bhi = std::max(bhi, v);
+    }
     best = std::min(best, std::min(ahi - blo, bhi - alo));
   };
   for (const auto* P : {&A, &B})
-    for (const auto& f : topo.faces) axis((L((*P)[f[2]]) - L((*P)[f[0]])).cross(L((*P)[f[3]]) - L((*P)[f[1]])));
+    for (const auto& f : topo.faces)
+      axis((L((*P)[f[2]]) - L((*P)[f[0]])).cross(L((*P)[f[3]]) - L((*P)[f[1]])));
   for (const auto& ea : topo.edges)
     for (const auto& eb : topo.edges)
       axis((L(A[ea[1]]) - L(A[ea[0]])).cross(L(B[eb[1]]) - L(B[eb[0]])));

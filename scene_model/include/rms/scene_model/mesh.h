@@ -3,11 +3,10 @@
 // one colour and one outward normal (the period's look: flat shading, no
 // textures). Builders take the outward direction and wind triangles to match,
 // so back-face culling and lighting are right by construction.
+#include <Eigen/Core>
 #include <array>
 #include <cstdint>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace rms::scene_model {
 
@@ -23,8 +22,8 @@ struct Triangle {
 class Mesh {
  public:
   // Adds triangle a, b, c wound so that its normal points along `outward`.
-  void AddTri(Eigen::Vector3f a, Eigen::Vector3f b, Eigen::Vector3f c, const Eigen::Vector3f& outward,
-              const Rgb& rgb);
+  void AddTri(const Eigen::Vector3f& a, Eigen::Vector3f b, Eigen::Vector3f c,
+              const Eigen::Vector3f& outward, const Rgb& rgb);
   // Adds the planar quad a, b, c, d (in order around it) facing `outward`.
   void AddQuad(const Eigen::Vector3f& a, const Eigen::Vector3f& b, const Eigen::Vector3f& c,
                const Eigen::Vector3f& d, const Eigen::Vector3f& outward, const Rgb& rgb);
@@ -42,8 +41,8 @@ class Mesh {
   void AddCylinder(const Eigen::Vector3f& p0, const Eigen::Vector3f& p1, float radius, int sides,
                    const Rgb& rgb, bool caps = true, float phase_rad = 0.0f);
   // A truncated cone of `sides` sides from p0 (radius r0) to p1 (radius r1).
-  void AddFrustum(const Eigen::Vector3f& p0, const Eigen::Vector3f& p1, float r0, float r1, int sides,
-                  const Rgb& rgb);
+  void AddFrustum(const Eigen::Vector3f& p0, const Eigen::Vector3f& p1, float r0, float r1,
+                  int sides, const Rgb& rgb);
   // A convex polygon prism: `outline` (counter-clockwise about +axis, in the
   // plane through p0) extruded by `axis`.
   void AddExtrusion(const std::vector<Eigen::Vector3f>& outline, const Eigen::Vector3f& axis,

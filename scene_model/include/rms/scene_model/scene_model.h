@@ -6,30 +6,58 @@
 // Generator (esg_renderer) draws them. Convex clusters draw correctly alone
 // with back faces culled; decals (windows, the port, engine bells) lie just
 // off a face and are drawn after the faces they mark.
+#include <Eigen/Geometry>
 #include <array>
 #include <string_view>
 #include <vector>
 
-#include <Eigen/Geometry>
-
+#include "rms/arm/kinematics.h"
 #include "rms/base/config.h"
 #include "rms/scene_model/mesh.h"
-#include "rms/arm/kinematics.h"
 
 namespace rms::scene_model {
 
 enum ClusterId : int {
   // The orbiter (fixed in R): the cargo bay's faces, the longerons' tops, the
   // fuselage sides, the cabin with its nose, the aft fuselage, tail, wings, doors.
-  kFloor = 0, kWallPort, kWallStbd, kBulkheadFwd, kBulkheadAft, kSillPort, kSillStbd,
-  kSidePort, kSideStbd, kCabin, kAftFuselage, kTail, kWingPort, kWingStbd, kDoorPort, kDoorStbd,
+  kFloor = 0,
+  kWallPort,
+  kWallStbd,
+  kBulkheadFwd,
+  kBulkheadAft,
+  kSillPort,
+  kSillStbd,
+  kSidePort,
+  kSideStbd,
+  kCabin,
+  kAftFuselage,
+  kTail,
+  kWingPort,
+  kWingStbd,
+  kDoorPort,
+  kDoorStbd,
   // The CAE (fixed in C): the module with its docking port, the solar array,
   // the docking target's standoff plate beside the port.
-  kCaeModule, kCaeArray, kDockTarget,
+  kCaeModule,
+  kCaeArray,
+  kDockTarget,
   // The arm.
-  kPost, kShoulder, kUpperBoom, kElbow, kLowerBoom, kWrist, kEffHex1, kEffHex2, kEffHex3,
+  kPost,
+  kShoulder,
+  kUpperBoom,
+  kElbow,
+  kLowerBoom,
+  kWrist,
+  kEffHex1,
+  kEffHex2,
+  kEffHex3,
   // The payload (frame P), with the grapple target's standoff plate beside the bar.
-  kPayloadBody, kBar, kBarPostA, kBarPostB, kProbe, kGrappleTarget,
+  kPayloadBody,
+  kBar,
+  kBarPostA,
+  kBarPostB,
+  kProbe,
+  kGrappleTarget,
   kNumClusters
 };
 
@@ -63,7 +91,9 @@ struct Cluster {
   std::vector<Eigen::Vector3d> normals;
   std::vector<Eigen::Vector3d> edges;
   bool flat = false;
-  bool is_static() const { return frame == ClusterFrame::kReference || frame == ClusterFrame::kCae; }
+  bool is_static() const {
+    return frame == ClusterFrame::kReference || frame == ClusterFrame::kCae;
+  }
 };
 
 struct SceneModel {

@@ -4,10 +4,9 @@
 // docs/collision.md); the Visual Scene Program finds the others between the
 // scene's convex clusters (docs/scene.md "Visual priority"); the ESG frame
 // and the DCP frame carry them (docs/protocol.md).
+#include <Eigen/Geometry>
 #include <optional>
 #include <vector>
-
-#include <Eigen/Geometry>
 
 namespace rms::scene_model {
 
@@ -37,7 +36,8 @@ PosedHull PoseHull(const Cluster& c, const Eigen::Affine3d& X_RC);
 // plane) is tried first. Candidate axes: the hint, the centroids' difference,
 // the face normals (and a flat cluster's in-plane edge normals), then the
 // cross products of the edge directions.
-std::optional<SeparatingPlane> FindSeparatingPlane(const PosedHull& a, const PosedHull& b, double eps_ft,
-                                                   const SeparatingPlane* hint, int* axes_tried = nullptr);
+std::optional<SeparatingPlane> FindSeparatingPlane(const PosedHull& a, const PosedHull& b,
+                                                   double eps_ft, const SeparatingPlane* hint,
+                                                   int* axes_tried = nullptr);
 
 }  // namespace rms::scene_model

@@ -30,12 +30,12 @@ Eigen::Matrix3d AimRotation(const Eigen::Vector3d& look_M);
 
 // Pan and tilt clamped to a station's limits; a clamp is counted
 // ("clamped.camera_pan", "clamped.camera_tilt") when counters is given.
-void ClampPanTilt(const CameraStationConfig& cam, double* pan_deg, double* tilt_deg, Counters* counters);
+void ClampPanTilt(const CameraStationConfig& cam, double* pan_deg, double* tilt_deg,
+                  Counters* counters);
 
 // The view of station `station` (1..8). Pan and tilt outside the station's
 // limits are clamped and counted ("clamped.camera_pan", "clamped.camera_tilt").
-CameraView ComputeCameraView(const LabConfig& config, int station, double pan_deg,
-                             double tilt_deg, double zoom, const arm::ArmPose& arm,
-                             Counters* counters);
+CameraView ComputeCameraView(const LabConfig& config, int station, double pan_deg, double tilt_deg,
+                             double zoom, const arm::ArmPose& arm, Counters* counters);
 
 }  // namespace rms::scene_proc

@@ -5,10 +5,9 @@
 // side of the pair's first cluster (rms/scene_model/cluster_pairs.h). The
 // planes of fixed or rigidly joined pairs are found once; the others every
 // frame, last frame's plane tried first; the DCP's three come with its frame.
+#include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
-
-#include <Eigen/Geometry>
 
 #include "rms/base/counters.h"
 #include "rms/scene_model/cluster_pairs.h"
@@ -32,7 +31,8 @@ class PriorityPlanner {
   // dcp_planes / dcp_valid: the DCP's three planes (valid bits 0-2).
   // Counters: "priority.dynamic_searches" (planes searched afresh),
   // "priority.unresolved" (pairs no plane separates: decided by distance).
-  scene_model::PriorityBits Compute(const scene_model::ClusterPoses& poses, const Eigen::Vector3d& p_RoEye_R,
+  scene_model::PriorityBits Compute(const scene_model::ClusterPoses& poses,
+                                    const Eigen::Vector3d& p_RoEye_R,
                                     const std::array<scene_model::SeparatingPlane, 3>& dcp_planes,
                                     std::uint32_t dcp_valid, Counters* counters);
   PlaneSource source(int pair) const { return source_[pair]; }
@@ -43,8 +43,9 @@ class PriorityPlanner {
   const Eigen::Affine3d& fixed_plane_pose(int pair) const { return X_RA_found_[pair]; }
 
  private:
-  bool FixedPlaneBit(int pair, const scene_model::ClusterPoses& poses, const Eigen::Vector3d& p_RoEye_R,
-                     const scene_model::PosedHull& a, const scene_model::PosedHull& b, bool* bit);
+  bool FixedPlaneBit(int pair, const scene_model::ClusterPoses& poses,
+                     const Eigen::Vector3d& p_RoEye_R, const scene_model::PosedHull& a,
+                     const scene_model::PosedHull& b, bool* bit);
   const scene_model::SceneModel& model_;
   std::array<PlaneSource, scene_model::kNumPairs> source_{};
   // kFixed / kRigid: the plane as found and the first cluster's pose then;

@@ -35,7 +35,7 @@ class SceneProc {
   std::int64_t next_frame_ = 0;
 };
 
-int RunSceneProc(const LabConfig& config, transport::LcmInterface& lcm, const std::string& stats_path,
-                 const std::string& ready_path);
+int RunSceneProc(const LabConfig& config, transport::LcmInterface& lcm,
+                 const std::string& stats_path, const std::string& ready_path);
 
 }  // namespace rms::scene_proc

@@ -5,11 +5,11 @@
 #include <cstdint>
 #include <string>
 
-#include "rms/scene_proc/camera_stations.h"
 #include "rms/base/config.h"
-#include "rms/scene_proc/priority_planner.h"
-#include "rms/scene_model/scene_model.h"
 #include "rms/base/counters.h"
+#include "rms/scene_model/scene_model.h"
+#include "rms/scene_proc/camera_stations.h"
+#include "rms/scene_proc/priority_planner.h"
 #include "rms/wire/word_blocks.h"
 
 namespace rms::scene_proc {
@@ -22,7 +22,8 @@ class VisualSceneProgram {
   explicit VisualSceneProgram(const LabConfig& config);
   // One frame: the ESG frame's content for this DCP frame, priority bits
   // included. Deterministic: the drives advance 1 / frame_rate a frame.
-  wire::EsgFrameData Step(const wire::DcpFrameData& dcp, std::uint32_t frame_count, Counters* counters);
+  wire::EsgFrameData Step(const wire::DcpFrameData& dcp, std::uint32_t frame_count,
+                          Counters* counters);
 
   struct Drive {
     double pan_deg = 0, tilt_deg = 0, zoom = 0;

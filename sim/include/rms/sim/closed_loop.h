@@ -8,30 +8,33 @@
 #include <string>
 #include <vector>
 
-#include "rms/operator_station/autopilot.h"
 #include "rms/base/config.h"
 #include "rms/base/counters.h"
 #include "rms/dcp_telemetry_t.hpp"
+#include "rms/operator_station/autopilot.h"
 
 namespace rms::sim {
 
 struct ClosedLoopResult {
   bool docked = false;
-  std::string failure;          // the autopilot's, or "frame limit"
+  std::string failure;  // the autopilot's, or "frame limit"
   int frames = 0;
   double time_s = 0.0;
   dcp_telemetry_t last{};       // the last telemetry
   double dock_distance_ft = 0;  // at the frame docking was declared
   double dock_angle_deg = 0;
-  int modes_entered[4] = {0, 0, 0, 0};  // frame each mode was first seen (0: never, mode 1 at start)
-  int held_frames = 0;          // frames the DCP held the slave arm (a collision)
-  Counters autopilot;           // the autopilot's counters
-  Counters dcp;                 // what the DCP counted (clamped inputs...)
+  int modes_entered[4] = {0, 0, 0,
+                          0};  // frame each mode was first seen (0: never, mode 1 at start)
+  int held_frames = 0;         // frames the DCP held the slave arm (a collision)
+  Counters autopilot;          // the autopilot's counters
+  Counters dcp;                // what the DCP counted (clamped inputs...)
 };
 
 // inputs: when given, receives each frame's operator inputs as the DCP
 // decoded them (for benchmarks that replay the flight).
-ClosedLoopResult FlyAutopilot(const LabConfig& config, const operator_station::AutopilotOptions& options, int max_frames,
-                              int latency_frames = 1, std::vector<wire::OperatorInputs>* inputs = nullptr);
+ClosedLoopResult FlyAutopilot(const LabConfig& config,
+                              const operator_station::AutopilotOptions& options, int max_frames,
+                              int latency_frames = 1,
+                              std::vector<wire::OperatorInputs>* inputs = nullptr);
 
 }  // namespace rms::sim

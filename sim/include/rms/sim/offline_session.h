@@ -7,12 +7,12 @@
 #include <array>
 #include <memory>
 
-#include "rms/dynamics_proc/dynamic_collision_program.h"
 #include "rms/base/config.h"
 #include "rms/base/counters.h"
-#include "rms/wire/word_blocks.h"
+#include "rms/dynamics_proc/dynamic_collision_program.h"
 #include "rms/operator_station/timeline.h"
 #include "rms/scene_proc/visual_scene_program.h"
+#include "rms/wire/word_blocks.h"
 
 namespace rms::sim {
 

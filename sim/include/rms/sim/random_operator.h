@@ -13,15 +13,16 @@
 namespace rms::sim {
 
 struct RandomOperatorOptions {
-  double step_fraction = 0.01;     // a frame's step, standard deviation, as a fraction of the range
-  double jump_probability = 0.002; // a channel jumps to a uniform random value
+  double step_fraction = 0.01;  // a frame's step, standard deviation, as a fraction of the range
+  double jump_probability = 0.002;     // a channel jumps to a uniform random value
   double outside_probability = 0.001;  // a channel is sent past its range by up to 10 %
   double reset_probability = 0.0005;   // the reset pushbutton
 };
 
 class RandomOperator {
  public:
-  RandomOperator(const InputCalibrations& cal, std::uint64_t seed, const RandomOperatorOptions& options = {});
+  RandomOperator(const InputCalibrations& cal, std::uint64_t seed,
+                 const RandomOperatorOptions& options = {});
   wire::OperatorInputs Next();
 
  private:

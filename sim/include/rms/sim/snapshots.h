@@ -23,16 +23,19 @@ struct PictureOptions {
 
 // When to show each station: at `at_time_s` for all, or in the middle of the
 // mission's first visit to it (the end for a station never selected, said).
-std::array<double, kNumCameraStations> StationTimes(const LabConfig& config, const operator_station::Timeline& tl,
+std::array<double, kNumCameraStations> StationTimes(const LabConfig& config,
+                                                    const operator_station::Timeline& tl,
                                                     std::optional<double> at_time_s);
 
 // out_dir/station_N.png each at its time, and out_dir/stations.png, `columns` a row.
 void ContactSheet(const LabConfig& config, const operator_station::Timeline& tl,
-                  const std::array<double, kNumCameraStations>& when, int columns, const PictureOptions& o);
+                  const std::array<double, kNumCameraStations>& when, int columns,
+                  const PictureOptions& o);
 
 // One picture a spec "T:STATION:NAME" (NAME.png at T s from STATION),
 // crosshairs on, with the guidance panel in `frame`; InputError for a bad spec.
-void TakeShots(const LabConfig& config, const operator_station::Timeline& tl, const std::vector<std::string>& shots,
-               operator_station::CommandFrame frame, const PictureOptions& o);
+void TakeShots(const LabConfig& config, const operator_station::Timeline& tl,
+               const std::vector<std::string>& shots, operator_station::CommandFrame frame,
+               const PictureOptions& o);
 
 }  // namespace rms::sim

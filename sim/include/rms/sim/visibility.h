@@ -14,11 +14,11 @@
 namespace rms::sim {
 
 struct VisibilityOptions {
-  std::string timeline;        // the mission flown
-  int every = 1;               // every Nth frame checked
+  std::string timeline;  // the mission flown
+  int every = 1;         // every Nth frame checked
   int width = 1024, height = 768;
-  std::string gl = "osmesa";   // GL backend
-  bool explain = false;        // count the cluster pairs on the differing pixels
+  std::string gl = "osmesa";  // GL backend
+  bool explain = false;       // count the cluster pairs on the differing pixels
 };
 
 struct StationVisibility {

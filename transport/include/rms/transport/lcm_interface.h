@@ -78,9 +78,7 @@ class LcmInterface {
   virtual std::int64_t NowUs() const = 0;
 
   const std::string& channel_suffix() const { return suffix_; }
-  std::string FullChannel(std::string_view channel) const {
-    return std::string(channel) + suffix_;
-  }
+  std::string FullChannel(std::string_view channel) const { return std::string(channel) + suffix_; }
 
   // This process on the wire (PublishMessage stamps it into every message).
   // With a session id other than 0, every rmslab message of another session

@@ -22,18 +22,16 @@ class App;
 namespace rms::transport {
 
 struct CommonOptions {
-  std::string config_path;  // --config (default: DefaultConfigPath())
-  LcmOptions lcm;           // --lcm-url, --channel-suffix, --queue-capacity
-  std::string stats_path;   // --stats FILE: final counters as JSON at exit
-  std::string ready_path;   // --ready-file FILE: created once subscribed and running
+  std::string config_path;         // --config (default: DefaultConfigPath())
+  LcmOptions lcm;                  // --lcm-url, --channel-suffix, --queue-capacity
+  std::string stats_path;          // --stats FILE: final counters as JSON at exit
+  std::string ready_path;          // --ready-file FILE: created once subscribed and running
   std::string log_level = "info";  // --log-level
-  bool check = false;       // --check: check the configuration (and the process's own files), then exit
-  std::string session_id;   // --session-id (default: RMSLAB_SESSION_ID, else 0: no session)
+  bool check = false;  // --check: check the configuration (and the process's own files), then exit
+  std::string session_id;  // --session-id (default: RMSLAB_SESSION_ID, else 0: no session)
 };
 
 void AddCommonOptions(CLI::App& app, CommonOptions* options);
-
-
 
 // The main() every process shares: adds the common options to `app`, parses
 // the command line, sets up logging and the stop signals, loads the
@@ -93,7 +91,8 @@ using LatencyMap = std::map<std::string, LatencyHistogram>;
 
 // What a status report carries, by name: the counters the process touched
 // and each link's latency as latency.LINK.count, .p50_us, .p99_us, .max_us.
-std::map<std::string, std::int64_t> StatusFigures(const Counters& counters, const LatencyMap& latencies);
+std::map<std::string, std::int64_t> StatusFigures(const Counters& counters,
+                                                  const LatencyMap& latencies);
 
 // Publishes process_status_t on RMS_STATUS once a second (transport time)
 // and once at exit.
@@ -104,7 +103,8 @@ class StatusReporter {
   void Final(std::int64_t frame, const Counters& counters, const LatencyMap& latencies = {});
 
  private:
-  void Publish(std::int64_t frame, const Counters& counters, const LatencyMap& latencies, bool final);
+  void Publish(std::int64_t frame, const Counters& counters, const LatencyMap& latencies,
+               bool final);
   LcmInterface* lcm_;
   std::string process_;
   std::string host_;
@@ -123,7 +123,8 @@ void NoteTransportCounters(const LcmInterface& lcm, Counters* counters);
 // stats_path is set).
 void RunNodeLoop(LcmInterface& lcm, const std::string& process, Counters& counters,
                  const LatencyMap& latencies, const std::function<std::int64_t()>& last_frame,
-                 const std::function<void()>& after_wait, const std::string& stats_path, int wait_ms = 100);
+                 const std::function<void()>& after_wait, const std::string& stats_path,
+                 int wait_ms = 100);
 
 // Writes {"process":..., "counters":{...}, "latency_us":{NAME:{count,p50,p99,max,mean}}}.
 void WriteStatsJson(const std::string& path, const std::string& process, const Counters& counters,

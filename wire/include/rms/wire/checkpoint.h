@@ -6,11 +6,10 @@
 // from where the arm is). JSON, doubles exact.
 #include <algorithm>
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
 #include <utility>
-
-#include <nlohmann/json.hpp>
 
 #include "rms/wire/input_block.h"
 

@@ -25,7 +25,7 @@ struct ControlWord {
   bool reset = false;
   bool overlay = false;
   bool crosshairs = false;
-  int mode = 1;            // 1..3
+  int mode = 1;  // 1..3
   bool collision = false;
   bool receptacle_collision = false;
   bool acquired = false;

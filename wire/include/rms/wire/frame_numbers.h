@@ -36,7 +36,7 @@ class SequenceTracker {
   // now_us: when it arrived (wall clock); only the clock check uses it.
   Verdict Accept(std::int64_t frame, std::int64_t now_us = 0);
   std::int64_t received() const { return received_; }
-  std::int64_t missing() const { return missing_; }   // frames never seen (sum of gaps)
+  std::int64_t missing() const { return missing_; }  // frames never seen (sum of gaps)
   std::int64_t duplicates() const { return duplicates_; }
   std::int64_t stale() const { return stale_; }
   std::int64_t far_ahead() const { return far_ahead_; }
@@ -50,8 +50,9 @@ class SequenceTracker {
   FrameClock clock_;
   bool started_ = false;
   std::int64_t last_ = -1, previous_ = -1;
-  std::int64_t received_ = 0, missing_ = 0, duplicates_ = 0, stale_ = 0, far_ahead_ = 0, resyncs_ = 0;
-  int refused_run_ = 0;            // refusals in a row, each after the one before
+  std::int64_t received_ = 0, missing_ = 0, duplicates_ = 0, stale_ = 0, far_ahead_ = 0,
+               resyncs_ = 0;
+  int refused_run_ = 0;  // refusals in a row, each after the one before
   std::int64_t refused_last_ = -1;
 };
 

@@ -6,11 +6,10 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <spdlog/spdlog.h>
 #include <string>
 #include <type_traits>
 #include <utility>
-
-#include <spdlog/spdlog.h>
 
 #include "rms/base/check.h"
 #include "rms/base/counters.h"
@@ -58,7 +57,8 @@ class LateFrameFilter {
   }
 
  private:
-  static constexpr std::int64_t kBucketUs = 5000000, kNone = std::numeric_limits<std::int64_t>::max();
+  static constexpr std::int64_t kBucketUs = 5000000,
+                                kNone = std::numeric_limits<std::int64_t>::max();
   std::int64_t limit_us_ = 0;
   std::int64_t bucket_start_us_ = 0, min_cur_ = kNone, min_prev_ = kNone;
 };
@@ -70,9 +70,8 @@ class LateFrameFilter {
 // content, or nothing when the message was dropped (and counted). Counts
 // "received" always.
 template <class Msg, class Unpack>
-auto ReceiveFrame(const void* data, int size, SequenceTracker* seq,
-                  Counters* counters, Unpack&& unpack, std::int64_t now_us = 0,
-                  LateFrameFilter* late = nullptr)
+auto ReceiveFrame(const void* data, int size, SequenceTracker* seq, Counters* counters,
+                  Unpack&& unpack, std::int64_t now_us = 0, LateFrameFilter* late = nullptr)
     -> std::optional<std::pair<Msg, std::invoke_result_t<Unpack, const Msg&>>> {
   using Content = std::invoke_result_t<Unpack, const Msg&>;
   counters->Add(Counter::kReceived);
@@ -111,39 +110,52 @@ auto ReceiveFrame(const void* data, int size, SequenceTracker* seq,
   }
   const std::int64_t before = seq->last();
   switch (seq->Accept(msg.frame, now_us)) {
-    case SequenceTracker::Verdict::kDuplicate: counters->Add(Counter::kDroppedDuplicate); return std::nullopt;
-    case SequenceTracker::Verdict::kStale: counters->Add(Counter::kDroppedStale); return std::nullopt;
+    case SequenceTracker::Verdict::kDuplicate:
+      counters->Add(Counter::kDroppedDuplicate);
+      return std::nullopt;
+    case SequenceTracker::Verdict::kStale:
+      counters->Add(Counter::kDroppedStale);
+      return std::nullopt;
     case SequenceTracker::Verdict::kFarAhead:
       // A frame number no sender of this session can have reached: refused.
       if (counters->Get(Counter::kDroppedFarAhead) == 0) {
-        spdlog::warn("frame {} refused: beyond what the session's clock allows (dropped.far_ahead)", msg.frame);
+        spdlog::warn("frame {} refused: beyond what the session's clock allows (dropped.far_ahead)",
+                     msg.frame);
       }
       counters->Add(Counter::kDroppedFarAhead);
       return std::nullopt;
     case SequenceTracker::Verdict::kResync:
       counters->Add(Counter::kResyncs);
-      spdlog::warn("frame numbers resynchronised: {} refused in a row, now following frame {} (the last accepted "
-                   "was {}; a sender restarted, or that frame was not real)",
-                   SequenceTracker::kResyncAfter, msg.frame, before);
+      spdlog::warn(
+          "frame numbers resynchronised: {} refused in a row, now following frame {} (the last "
+          "accepted "
+          "was {}; a sender restarted, or that frame was not real)",
+          SequenceTracker::kResyncAfter, msg.frame, before);
       break;
     case SequenceTracker::Verdict::kGap: {
       // Frames lost on the way (or while the sender was down): counted by
       // the caller from seq->missing(); a gap of several frames is said.
       counters->Add(Counter::kGaps);
       if (const std::int64_t n = msg.frame - seq->previous() - 1; n >= 3) {
-        spdlog::warn("gap: {} frames missing before frame {} (a lossy link or a restarted sender)", n, msg.frame);
+        spdlog::warn("gap: {} frames missing before frame {} (a lossy link or a restarted sender)",
+                     n, msg.frame);
       }
       break;
     }
-    default: break;
+    default:
+      break;
   }
   if (late && late->TooLate(msg.send_time_us, now_us)) {
     // In the sequence (not counted missing), but not acted on.
     counters->Add(Counter::kDroppedLate);
-    if (counters->Get(Counter::kDroppedLate) == 1 || counters->Get(Counter::kDroppedLate) % 1000 == 0) {
-      spdlog::warn("frame {} dropped: {} ms old, later than {} ms beyond the link's delay (dropped.late: {} so far; "
-                   "a stall, or a process that was stopped)",
-                   msg.frame, (now_us - msg.send_time_us) / 1000, late->limit_us() / 1000, counters->Get(Counter::kDroppedLate));
+    if (counters->Get(Counter::kDroppedLate) == 1 ||
+        counters->Get(Counter::kDroppedLate) % 1000 == 0) {
+      spdlog::warn(
+          "frame {} dropped: {} ms old, later than {} ms beyond the link's delay (dropped.late: {} "
+          "so far; "
+          "a stall, or a process that was stopped)",
+          msg.frame, (now_us - msg.send_time_us) / 1000, late->limit_us() / 1000,
+          counters->Get(Counter::kDroppedLate));
     }
     return std::nullopt;
   }

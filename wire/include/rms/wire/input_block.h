@@ -21,15 +21,17 @@ inline constexpr int kDiscreteWordIndex = 11;
 
 // Discrete word (word 11) bits. Bits 6-23 are reserved and must be zero.
 inline constexpr std::uint32_t kDiscreteCameraMask = 0x7;  // bits 0-2: camera station - 1
-inline constexpr std::uint32_t kDiscreteReset = 1u << 3;    // reset pushbutton (momentary)
-inline constexpr std::uint32_t kDiscreteOverlay = 1u << 4;  // overlay switch (frame counter, indicators)
-inline constexpr std::uint32_t kDiscreteCrosshairs = 1u << 5;  // crosshairs switch (wrist and port cameras)
+inline constexpr std::uint32_t kDiscreteReset = 1u << 3;   // reset pushbutton (momentary)
+inline constexpr std::uint32_t kDiscreteOverlay =
+    1u << 4;  // overlay switch (frame counter, indicators)
+inline constexpr std::uint32_t kDiscreteCrosshairs =
+    1u << 5;  // crosshairs switch (wrist and port cameras)
 inline constexpr std::uint32_t kDiscreteReservedMask = 0xFFFFC0u;
 
 // The operator's inputs in engineering units.
 struct OperatorInputs {
   std::array<double, kNumAnalogInputs> value{};  // units of each channel's calibration
-  int camera_station = 1;                         // 1..8
+  int camera_station = 1;                        // 1..8
   bool reset = false;
   bool overlay = true;
   bool crosshairs = false;

@@ -9,7 +9,15 @@
 namespace rms::wire {
 
 enum SpecialKey : int {
-  kKeyUp = 256, kKeyDown, kKeyLeft, kKeyRight, kKeyPageUp, kKeyPageDown, kKeyBackspace, kKeyTab, kKeyEnter
+  kKeyUp = 256,
+  kKeyDown,
+  kKeyLeft,
+  kKeyRight,
+  kKeyPageUp,
+  kKeyPageDown,
+  kKeyBackspace,
+  kKeyTab,
+  kKeyEnter
 };
 inline constexpr int kMaxKeyCode = kKeyEnter;
 

@@ -15,7 +15,6 @@
 #include "rms/base/counters.h"
 #include "rms/lcm_limits.h"
 
-
 namespace rms::wire {
 
 enum class DecodeError {
@@ -35,7 +34,9 @@ const char* DecodeErrorName(DecodeError e);
 // The counter a message dropped for `e` goes to (e != kNone): dropped.E on a
 // process's input channel, and the families of the operator station's
 // telemetry and window keys and the renderer's operator state.
-constexpr Counter DroppedCounter(DecodeError e) { return CounterAt(Counter::kDroppedTooLarge, static_cast<int>(e) - 1); }
+constexpr Counter DroppedCounter(DecodeError e) {
+  return CounterAt(Counter::kDroppedTooLarge, static_cast<int>(e) - 1);
+}
 constexpr Counter DroppedTelemetryCounter(DecodeError e) {
   return CounterAt(Counter::kDroppedTelemetryTooLarge, static_cast<int>(e) - 1);
 }
@@ -45,11 +46,12 @@ constexpr Counter DroppedWindowKeysCounter(DecodeError e) {
 constexpr Counter DroppedOperatorStateCounter(DecodeError e) {
   return CounterAt(Counter::kDroppedOperatorStateTooLarge, static_cast<int>(e) - 1);
 }
-static_assert(FamilyFollows(Counter::kDroppedTooLarge, "dropped.", kDecodeErrorNames.data(), kNumDecodeErrors));
-static_assert(FamilyFollows(Counter::kDroppedTelemetryTooLarge, "dropped.telemetry_", kDecodeErrorNames.data(),
+static_assert(FamilyFollows(Counter::kDroppedTooLarge, "dropped.", kDecodeErrorNames.data(),
                             kNumDecodeErrors));
-static_assert(FamilyFollows(Counter::kDroppedWindowKeysTooLarge, "dropped.window_keys_", kDecodeErrorNames.data(),
-                            kNumDecodeErrors));
+static_assert(FamilyFollows(Counter::kDroppedTelemetryTooLarge, "dropped.telemetry_",
+                            kDecodeErrorNames.data(), kNumDecodeErrors));
+static_assert(FamilyFollows(Counter::kDroppedWindowKeysTooLarge, "dropped.window_keys_",
+                            kDecodeErrorNames.data(), kNumDecodeErrors));
 static_assert(FamilyFollows(Counter::kDroppedOperatorStateTooLarge, "dropped.operator_state_",
                             kDecodeErrorNames.data(), kNumDecodeErrors));
 

@@ -16,7 +16,8 @@ namespace rms::wire {
 
 void PackPriority(const scene_model::PriorityBits& bits, ControlWord* cw,
                   std::array<std::int32_t, esg_words::kPriorityCount>* words);
-scene_model::PriorityBits UnpackPriority(const ControlWord& cw, std::span<const std::int32_t> priority_words);
+scene_model::PriorityBits UnpackPriority(const ControlWord& cw,
+                                         std::span<const std::int32_t> priority_words);
 // Where a pair's bit travels, for the priority table: "control word bit 14",
 // "ESG word 41 bit 0" (ESG frame word numbering, docs/protocol.md).
 std::string PriorityBitPlace(int pair);

@@ -42,8 +42,8 @@ struct FixedFormat {
   std::string_view unit;  // e.g. "ft"
   int frac_bits;          // LSB = 2^-frac_bits units
   bool is_signed;
-  std::int32_t raw_min;   // smallest raw value in range (may be narrower than 24 bits)
-  std::int32_t raw_max;   // largest raw value in range
+  std::int32_t raw_min;  // smallest raw value in range (may be narrower than 24 bits)
+  std::int32_t raw_max;  // largest raw value in range
 
   double lsb() const;
   double min_value() const;

@@ -15,6 +15,7 @@ struct Comparison {
 };
 
 // Throws rms::InputError naming a folder that is no session.
-Comparison CompareSessions(const std::vector<std::string>& session_dirs, const std::string& chart_js_path);
+Comparison CompareSessions(const std::vector<std::string>& session_dirs,
+                           const std::string& chart_js_path);
 
 }  // namespace rms::report

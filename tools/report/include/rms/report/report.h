@@ -5,9 +5,8 @@
 // and plots (mode timeline, distance to the goal, latency, frame intervals)
 // drawn in the browser by Chart.js (Debian's libjs-chart.js), embedded.
 #include <functional>
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 namespace rms::report {
 
@@ -16,7 +15,8 @@ std::string DefaultChartJsPath();
 // out_path: where the report goes (links to the session's video are made
 // relative to it).
 std::string MakeReport(const std::string& session_dir, const std::string& chart_js_path,
-                       const std::function<void(const std::string&)>& progress = {}, const std::string& out_path = "");
+                       const std::function<void(const std::string&)>& progress = {},
+                       const std::string& out_path = "");
 // JSON to embed in a <script> (the report's and the comparison's data):
 // "</" written "<\/" so it cannot end the script.
 std::string ScriptJson(const nlohmann::json& j);

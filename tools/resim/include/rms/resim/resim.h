@@ -7,9 +7,8 @@
 // session folder showing how the same inputs fare with that design, and a
 // comparison of the two.
 #include <functional>
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 namespace rms::resim {
 
@@ -22,21 +21,21 @@ struct ResimOptions {
 };
 
 struct ResimResult {
-  long frames = 0;             // DCP frames re-simulated
-  long compared = 0;           // recorded DCP frames compared
-  long identical = 0;          // ... identical word for word (and their telemetry field for field)
+  long frames = 0;     // DCP frames re-simulated
+  long compared = 0;   // recorded DCP frames compared
+  long identical = 0;  // ... identical word for word (and their telemetry field for field)
   std::string first_difference;  // where they first differ ("" if nowhere)
-  long skipped = 0;            // recorded DCP frames not re-simulated (the log lacks the state before them)
-  std::string note;            // ... said in words ("" if none)
-  std::string log_note;        // the log's end is no whole event ("" if it is)
-  long states_taken = 0;       // logged RMS_DCP_STATE taken (start, restores, resumes)
-  long states_checked = 0;     // periodic RMS_DCP_STATE the re-simulated state was checked against
-  std::string state_difference;  // the first of those that differed ("" if none)
-  double seconds = 0.0;        // wall time of the re-simulation, all of it
-  double read_seconds = 0.0;   // of which reading and decoding the session's log
-  double run_seconds = 0.0;    // of which the DCP over its LCM interface, frame by frame
-  double recorded_seconds = 0.0;  // the session's own duration (first to last input frame)
-  std::string out_dir;         // the new session (with another configuration)
+  long skipped = 0;  // recorded DCP frames not re-simulated (the log lacks the state before them)
+  std::string note;  // ... said in words ("" if none)
+  std::string log_note;     // the log's end is no whole event ("" if it is)
+  long states_taken = 0;    // logged RMS_DCP_STATE taken (start, restores, resumes)
+  long states_checked = 0;  // periodic RMS_DCP_STATE the re-simulated state was checked against
+  std::string state_difference;       // the first of those that differed ("" if none)
+  double seconds = 0.0;               // wall time of the re-simulation, all of it
+  double read_seconds = 0.0;          // of which reading and decoding the session's log
+  double run_seconds = 0.0;           // of which the DCP over its LCM interface, frame by frame
+  double recorded_seconds = 0.0;      // the session's own duration (first to last input frame)
+  std::string out_dir;                // the new session (with another configuration)
   nlohmann::ordered_json comparison;  // with another configuration: comparison.json
 };
 

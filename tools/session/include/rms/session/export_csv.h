@@ -13,8 +13,9 @@ namespace rms::session {
 
 // Returns each file written with its rows, and the count of malformed
 // messages skipped. Throws rms::InputError for an unreadable session.
-std::vector<std::pair<std::string, long>> ExportCsv(const std::string& session_dir, const std::string& out_dir,
-                                                    const std::function<void(const std::string&)>& progress = {});
+std::vector<std::pair<std::string, long>> ExportCsv(
+    const std::string& session_dir, const std::string& out_dir,
+    const std::function<void(const std::string&)>& progress = {});
 
 }  // namespace rms::session
 

@@ -4,10 +4,9 @@
 // hosts. Read strictly, as every configuration file: errors name the file,
 // the key and the reason.
 #include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
-
-#include <nlohmann/json.hpp>
 
 namespace rms::session {
 
@@ -17,11 +16,11 @@ struct LabFile {
   // "recorder" (lcm-logger) -> "localhost", "netns:NAME" (a network
   // namespace on this machine) or "ssh:[USER@]HOST".
   std::map<std::string, std::string> hosts;
-  int ttl = 1;              // LCM multicast TTL when not all on one host
+  int ttl = 1;                          // LCM multicast TTL when not all on one host
   std::string group = "239.255.76.67";  // LCM multicast group of the lab
   int port = 7667;                      // and its UDP port
-  std::string remote_root;  // rmslab on ssh hosts ("" = the same path as here)
-  std::string remote_build; // its build folder ("" = remote_root/build)
+  std::string remote_root;              // rmslab on ssh hosts ("" = the same path as here)
+  std::string remote_build;             // its build folder ("" = remote_root/build)
   bool all_local() const;
 };
 

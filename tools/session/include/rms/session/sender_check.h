@@ -9,10 +9,9 @@
 // reason, and the summary lists it.
 #include <cstdint>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <string>
-
-#include <nlohmann/json.hpp>
 
 namespace rms::session {
 

@@ -12,8 +12,8 @@
 #include <string_view>
 #include <vector>
 
-#include "rms/wire/message_io.h"
 #include "rms/session/sender_check.h"
+#include "rms/wire/message_io.h"
 
 namespace rms::session {
 
@@ -42,7 +42,8 @@ class SessionLog {
   // Every message of the session's own on `channels` (base names; empty:
   // every channel), in log order. Messages of other sessions and other
   // senders are counted in check() and skipped.
-  void Read(std::initializer_list<std::string_view> channels, const std::function<void(const LogMessage&)>& visit);
+  void Read(std::initializer_list<std::string_view> channels,
+            const std::function<void(const LogMessage&)>& visit);
 
   // Decodes a message; a malformed one is counted (malformed()) and false.
   template <class Msg>

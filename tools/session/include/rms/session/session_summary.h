@@ -4,10 +4,9 @@
 // Built from the session folder alone: the LCM log (lcmlog) and each
 // process's final counters (stats/*.json).
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 namespace rms::session {
 
@@ -31,12 +30,13 @@ std::string BaseChannel(const std::string& channel);
 // and the start time.
 struct ManifestFields {
   std::string pilot, url, suffix, config_sha256, timeline, restore, command;
-  std::string session_id;           // "0x..." (the launcher's random id; every message carries it)
-  std::vector<std::string> hosts;   // PROCESS=HOST
-  std::string subject, note;        // who flew it and the experimenter's note (scripts/lab demo --subject --note)
-  std::string kind = "live";        // "live", "replay" or "re-simulation"
-  std::string parent;               // a replay's or re-simulation's recorded session (absolute path)
-  std::string config_source;        // where config.toml came from
+  std::string session_id;          // "0x..." (the launcher's random id; every message carries it)
+  std::vector<std::string> hosts;  // PROCESS=HOST
+  std::string subject,
+      note;  // who flew it and the experimenter's note (scripts/lab demo --subject --note)
+  std::string kind = "live";  // "live", "replay" or "re-simulation"
+  std::string parent;         // a replay's or re-simulation's recorded session (absolute path)
+  std::string config_source;  // where config.toml came from
 };
 nlohmann::ordered_json MakeManifest(const std::string& session_dir, const ManifestFields& f);
 
@@ -60,6 +60,7 @@ nlohmann::ordered_json ProbeAddress(const std::string& url, double seconds);
 // A replay's ESG frames against the recorded ones, matched by the DCP frame
 // they were made from: {"recorded", "replayed", "identical", "missing",
 // "first_difference"}.
-nlohmann::ordered_json CompareEsgFrames(const std::string& original_dir, const std::string& replay_dir);
+nlohmann::ordered_json CompareEsgFrames(const std::string& original_dir,
+                                        const std::string& replay_dir);
 
 }  // namespace rms::session
