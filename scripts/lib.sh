@@ -11,11 +11,16 @@ rmslab_sudo() {
   if [ "$(id -u)" -eq 0 ]; then "$@"; elif command -v sudo >/dev/null; then sudo "$@"; else return 1; fi
 }
 
-# Configures (once) and builds the project in $RMSLAB_BUILD (Release).
-rmslab_build() {
+# Configures the project in $RMSLAB_BUILD (Release), once.
+rmslab_configure() {
   if [ ! -f "$RMSLAB_BUILD/build.ninja" ] && [ ! -f "$RMSLAB_BUILD/Makefile" ]; then
     cmake -S "$RMSLAB_ROOT" -B "$RMSLAB_BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
   fi
+}
+
+# Configures (once) and builds the project in $RMSLAB_BUILD (Release).
+rmslab_build() {
+  rmslab_configure
   cmake --build "$RMSLAB_BUILD" --parallel "$(nproc)"
 }
 

@@ -27,6 +27,7 @@ TOOLS = [
     "chromium",  # the report's browser test
     "ssh", "nsenter", "ping", "ip", "tc", "nft", "mount", "umount",  # hosts, namespaces, disks
     "ps", "pkill", "timeout", "jq", "python3", "flock",
+    "clang-format", "clang-tidy", "run-clang-tidy",  # scripts/lint
 ]
 
 
