@@ -204,7 +204,8 @@ void ConditionLines(const StatusSnapshot& s, const LabConfig& config, int width,
                    ? Sprintf("clear of the bay by %.2f ft", t.bay_clearance_ft)
                    : Sprintf("in the bay: %.2f ft to lift it clear", -t.bay_clearance_ft));
   } else {
-    flow.Line("ACQUISITION: acquired; the payload is held, out of the bay");
+    flow.Line("ACQUISITION: acquired; the payload is held, out of the bay")
+        .Field(Sprintf("clear of the bay by %.2f ft", t.bay_clearance_ft));
   }
   flow.Line(Sprintf("DOCKING distance %.3f ft (<= %.2f)", t.dock_distance_ft,
                     config.dcp.dock_distance_ft))
