@@ -1,6 +1,6 @@
 # Writes OUT, a C++ header with the source tree's version from git, and
 # rewrites it only when the version changed (so builds stay incremental).
-# Run at every build by the rms_version target (common/CMakeLists.txt).
+# Run at every build by the rms_version target (base/CMakeLists.txt).
 execute_process(COMMAND git describe --always --dirty --tags
                 WORKING_DIRECTORY "${SRC}" OUTPUT_VARIABLE describe
                 OUTPUT_STRIP_TRAILING_WHITESPACE ERROR_QUIET RESULT_VARIABLE rc)

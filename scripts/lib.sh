@@ -36,3 +36,8 @@ rmslab_ensure_multicast_route() {
     return 1
   fi
 }
+
+# Prints a script's usage: its opening comment block (after the #! line).
+rmslab_usage() {
+  awk 'NR == 1 { next } /^#/ { sub(/^# ?/, ""); print; next } { exit }' "$1"
+}

@@ -219,7 +219,7 @@ void ReadKeyboard(TomlReader& top, Bindings* b) {
   k.Finish();
   // What a person needs to fly and to end the session has a key: every
   // hand-controller axis both ways, the finger, stop, the scale, the mode,
-  // the frame and quit (docs/operator.md "The bindings file").
+  // the frame and quit (docs/operator.md "Bindings: config/bindings.toml").
   std::set<std::string> bound;
   for (const auto& [code, a] : b->keys) bound.insert(ActionName(a));
   std::string missing;

@@ -1,6 +1,6 @@
 // Attacks on a running session and the lab's bad luck, as issue 13 found
 // them (docs/security.md "Attacks and the tests that cover them",
-// docs/sessions.md "What can go wrong"): `scripts/lab demo` runs as a user
+// docs/sessions.md "Faults"): `scripts/lab demo` runs as a user
 // starts it while another program on its network -- a stranger, or an
 // insider who knows the session's id and pids -- sends control commands
 // that reach for the filesystem, forged telemetry and status, a frame number

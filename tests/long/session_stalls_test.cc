@@ -1,6 +1,6 @@
 // Stalls (long label: scripts/test leaves it out; ctest -L long runs it):
 // each process and the recorder stopped (SIGSTOP) for 4 s in turn while the
-// autopilot flies (docs/sessions.md "What can go wrong").
+// autopilot flies (docs/sessions.md "Faults").
 #include <signal.h>
 
 #include <chrono>

@@ -94,7 +94,7 @@ TEST(UdpLcm, MessagesAreStampedWithTheirSenderAndOtherSessionsAreDropped) {
   EXPECT_EQ(mine.other_session_dropped(), 10);
 }
 
-// docs/security.md "One publisher a channel": on a channel one process
+// docs/security.md "Sessions know each other": on a channel one process
 // publishes, another pid of the same session is dropped while the
 // publisher sends, and taken once it has been silent (a restart); RMS_STATUS
 // takes every process.

@@ -79,7 +79,7 @@ bool LcmInterface::Admit(const std::string& channel, const void* data, int size)
   return false;
 }
 
-// One publisher a channel (docs/security.md "One publisher a channel"): on
+// One publisher a channel (docs/security.md "Sessions know each other"): on
 // the channels that only one process of a session publishes, a message from
 // another pid is taken only once the current publisher has fallen silent (it
 // ended, and this is its restart); while it still sends, the other is an

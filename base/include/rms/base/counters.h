@@ -254,7 +254,7 @@ inline constexpr std::array<CounterInfo, kNumCounters> kCounterTable = {{
     {Counter::kDroppedFarAhead, "dropped.far_ahead", "O, D, S, E",
      "frames dropped: a frame number beyond the session's clock"},
     {Counter::kDroppedLate, "dropped.late", "D, S, E",
-     "frames dropped: waited too long to act on (docs/protocol.md \"Late frames\")"},
+     "frames dropped: waited too long to act on (docs/protocol.md \"Frame numbers and times\")"},
     {Counter::kDroppedOtherSession, "dropped.other_session", "O, D, S, E",
      "messages of another session (or of none) dropped (docs/protocol.md \"Senders\")"},
     {Counter::kDroppedOtherSender, "dropped.other_sender", "O, D, S, E",

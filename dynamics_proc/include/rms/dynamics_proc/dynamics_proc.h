@@ -70,8 +70,8 @@ class DynamicsProc {
   bool made_a_frame() const { return made_a_frame_; }
   // The first DCP frame number to publish (FirstFrameNumber).
   void set_next_frame(std::int64_t f) { next_frame_ = f; }
-  // A live session's receive checks (docs/protocol.md "Frame numbers",
-  // "Late frames"): input frame numbers beyond the session clock refused,
+  // A live session's receive checks (docs/protocol.md "Frame numbers and
+  // times"): input frame numbers beyond the session clock refused,
   // inputs that waited too long dropped. Off in re-simulation, which must
   // answer exactly the inputs the recorded DCP answered.
   void EnableLiveChecks(double frame_rate_hz);

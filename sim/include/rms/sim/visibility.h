@@ -1,7 +1,7 @@
 #pragma once
 // Visual priority (separating planes, no depth buffer: the ESG's way)
 // against the depth-buffer reference over a whole scripted mission, from
-// every camera station (docs/scene.md "Measured against a depth buffer"):
+// every camera station (docs/scene.md "Measured: priority against the depth buffer"):
 // each pixel on which the two disagree is judged by an exact ray cast
 // through its centre. rms_visibility prints it.
 #include <array>

@@ -90,7 +90,7 @@ class LcmInterface {
   std::int64_t other_session_dropped() const { return other_session_dropped_; }
   // Messages on a one-publisher channel from a pid other than its
   // publisher's while that one was still sending ("dropped.other_sender";
-  // docs/security.md "One publisher a channel").
+  // docs/security.md "Sessions know each other").
   std::int64_t other_sender_dropped() const { return other_sender_dropped_; }
 
   // A one-publisher channel takes another publisher (a restarted process's

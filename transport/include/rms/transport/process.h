@@ -83,7 +83,7 @@ void RequestStop();
 // The ready file launchers wait for (--ready-file): {"pid": N, "host": H},
 // written whole (a temporary file renamed), so a reader never sees half of
 // it; the launcher trusts the session's messages by these pids
-// (docs/sessions.md "Ready files"). Throws InputError when it cannot.
+// (docs/sessions.md "The launcher"). Throws InputError when it cannot.
 void WriteReadyFile(const std::string& path);
 
 // Latency histograms by link name, e.g. "input_to_dcp_us".

@@ -53,7 +53,7 @@ SessionInfo ReadSessionInfo(const std::string& session_dir);
 // Every rmslab session heard on an LCM address within `seconds`:
 // {"url", "seconds", "sessions": [{"session_id", "channels": {name: n},
 // "senders": ["dynamics_proc pid N", ...]}]} -- the launcher's look before it
-// starts a session there (docs/security.md "Stations sharing a network").
+// starts a session there (docs/sessions.md "Sharing a network").
 // Throws rms::TransportError when the address cannot be opened.
 nlohmann::ordered_json ProbeAddress(const std::string& url, double seconds);
 
