@@ -3,6 +3,7 @@
 import argparse
 import json
 import os
+import secrets
 import shutil
 import signal
 import subprocess
@@ -44,6 +45,10 @@ def add_arguments(p):
     p.add_argument("--channel-suffix", default="", help="appended to every channel: stations sharing a network")
     p.add_argument("--share-network", action="store_true",
                    help="start even when another session is on this address and channels")
+    p.add_argument("--instructor", nargs="?", const=8080, type=int, metavar="PORT",
+                   help="the instructor's station: a web page of live views, status, events and controls, "
+                        "served on PORT (default 8080; 0: any free port) of 127.0.0.1, or where the lab file "
+                        "says (docs/instructor.md)")
     p.add_argument("--no-build", action="store_true")
 
 
@@ -82,10 +87,13 @@ class Demo:
             raise LabError("--png-every: 0 (none) or more")
         self.rate = frame_rate_hz(a.config)
         self.pilot = "by-hand" if a.by_hand else "timeline" if a.timeline else "autopilot"
+        if a.instructor is not None and not 0 <= a.instructor <= 65535:
+            raise LabError(f"--instructor {a.instructor}: a port, 0..65535 (0: any free one)")
 
     def layout(self):
         a = self.a
-        self.hosts = {p: Host("localhost") for p in PROCESSES + ["recorder"]}
+        self.hosts = {p: Host("localhost") for p in PROCESSES + ["recorder", "instructor_station"]}
+        self.instructor_bind = "127.0.0.1"
         self.remote_bin = BUILD
         self.url = a.lcm_url or DEFAULT_URL
         if a.lab:
@@ -95,6 +103,8 @@ class Demo:
             lab = json.loads(r.stdout)
             for p, h in lab["hosts"].items():
                 self.hosts[p] = Host(h)
+            if lab.get("instructor_bind"):
+                self.instructor_bind = lab["instructor_bind"]
             if self.hosts["recorder"].remote:
                 raise LabError("the recorder must run here or in a netns (the session folder is here)")
             if a.by_hand and self.hosts["operator_station"].remote:
@@ -125,8 +135,32 @@ class Demo:
         dcp = [binary("dynamics_proc/dynamics_proc")] + common + (["--restore", a.restore] if a.restore else [])
         esg = [binary("esg_renderer/esg_renderer")] + common + ["--width", str(a.width), "--height", str(a.height),
                                                                  "--gl", a.gl, "--visibility", a.visibility]
-        session.precheck([("operator_station", op), ("dynamics_proc", dcp),
-                          ("scene_proc", [binary("scene_proc/scene_proc")] + common), ("esg_renderer", esg)])
+        checks = [("operator_station", op), ("dynamics_proc", dcp),
+                  ("scene_proc", [binary("scene_proc/scene_proc")] + common), ("esg_renderer", esg)]
+        if a.instructor is not None:
+            checks.append(("instructor_station", [binary("instructor_station/instructor_station")] + common +
+                           self.instructor_args()))
+        session.precheck(checks)
+
+    def instructor_args(self):
+        """The instructor station's own options (docs/instructor.md)."""
+        if not hasattr(self, "instructor_token"):
+            # Beyond loopback the page needs a token; on loopback its commands do.
+            self.instructor_token = secrets.token_hex(16)
+        return ["--bind", self.instructor_bind, "--port", str(self.a.instructor), "--token", self.instructor_token]
+
+    def start_instructor(self):
+        url_file = os.path.join(self.out, "run", "instructor.url")
+        extra = self.instructor_args() + ["--url-file", url_file,
+                                          "--checkpoint-dir", os.path.join(self.out, "checkpoints")]
+        self.sup.add(self.spec("instructor_station", extra))
+        err = self.sup.wait_ready(["instructor_station"])
+        if err:
+            raise LabError(err, 1)
+        url = open(url_file).read().strip()
+        where = "" if self.instructor_bind == "127.0.0.1" else \
+            f" (served on {self.instructor_bind}: give the token only to whom it is for)"
+        say(f"instructor's page: {url}{where}")
 
     def duration_s(self):
         if self.pilot == "timeline":
@@ -292,6 +326,8 @@ class Demo:
             raise LabError(err, 2 if "usage or configuration" in err else 1)
         if self.interrupted is not None:
             return
+        if self.a.instructor is not None:
+            self.start_instructor()
         time.sleep(0.2)
         flying = {"timeline": f"the timeline {os.path.basename(self.a.timeline or '')}",
                   "autopilot": "the autopilot",
@@ -325,7 +361,8 @@ class Demo:
         self.sup.stop(["operator_station"])
         if self.interrupted is None and self.sup.fatal is None:
             time.sleep(0.5)  # the last frames through the pipeline
-        self.sup.stop(["esg_renderer", "scene_proc", "dynamics_proc"])
+        self.sup.stop(["esg_renderer", "scene_proc", "dynamics_proc"] +
+                      (["instructor_station"] if self.a.instructor is not None else []))
         time.sleep(0.3)
         self.sup.stop(["lcm-logger"])
         self.sup.record_exit_codes()
@@ -387,7 +424,8 @@ def run(argv, command_line):
     if not a.no_build:
         install_and_build()
     require_built("operator_station/operator_station", "dynamics_proc/dynamics_proc", "scene_proc/scene_proc",
-                  "esg_renderer/esg_renderer", "tools/rms_session")
+                  "esg_renderer/esg_renderer", "tools/rms_session",
+                  *(["instructor_station/instructor_station"] if a.instructor is not None else []))
     d.layout()
     check_lcm_url(d.url)
     ensure_multicast_route()

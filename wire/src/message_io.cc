@@ -66,6 +66,7 @@ constexpr struct {
     {sender_t::PROCESS_ESG, "esg_renderer"},
     {sender_t::PROCESS_CONTROL, "rms_control"},
     {sender_t::PROCESS_TOOL, "tool"},
+    {sender_t::PROCESS_INSTRUCTOR, "instructor_station"},
 };
 }  // namespace
 

@@ -83,6 +83,20 @@ LabFile ParseLabFile(std::string_view text, const std::string& path) {
     lab.remote_build = r.String("build");
     r.Finish();
   }
+  if (root.contains("instructor")) {  // optional: docs/instructor.md "Beyond this host"
+    TomlReader i = top.Sub("instructor");
+    lab.instructor_bind = i.String("bind");
+    int a[4] = {-1, -1, -1, -1};
+    char tail = 0;
+    bool ok = std::sscanf(lab.instructor_bind.c_str(), "%d.%d.%d.%d%c", &a[0], &a[1], &a[2], &a[3],
+                          &tail) == 4;
+    for (int v : a) ok = ok && v >= 0 && v <= 255;
+    if (!ok) {
+      i.Fail("bind", "must be an IPv4 address of this host (\"0.0.0.0\": every one), got \"" +
+                         lab.instructor_bind + "\"");
+    }
+    i.Finish();
+  }
   top.Finish();
   return lab;
 }
@@ -96,6 +110,7 @@ nlohmann::ordered_json LabFileJson(const LabFile& lab) {
   j["all_local"] = lab.all_local();
   j["remote_root"] = lab.remote_root;
   j["remote_build"] = lab.remote_build;
+  j["instructor_bind"] = lab.instructor_bind;
   return j;
 }
 

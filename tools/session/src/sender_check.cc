@@ -26,11 +26,14 @@ bool Publishes(const std::string& base, std::int8_t process) {
   }
   if (base == wire::channels::kEsgFrame) return process == S::PROCESS_SCENE;
   if (base == wire::channels::kWindowKeys) return process == S::PROCESS_ESG;
-  if (base == wire::channels::kControl)
-    return process == S::PROCESS_CONTROL || process == S::PROCESS_OPERATOR_STATION;
+  if (base == wire::channels::kControl) {
+    return process == S::PROCESS_CONTROL || process == S::PROCESS_OPERATOR_STATION ||
+           process == S::PROCESS_INSTRUCTOR;
+  }
   if (base == wire::channels::kStatus) {
     return process == S::PROCESS_OPERATOR_STATION || process == S::PROCESS_DYNAMICS ||
-           process == S::PROCESS_SCENE || process == S::PROCESS_ESG;
+           process == S::PROCESS_SCENE || process == S::PROCESS_ESG ||
+           process == S::PROCESS_INSTRUCTOR;
   }
   return false;
 }

@@ -9,6 +9,8 @@ namespace rms::esg_renderer {
 
 // Writes RGBA (rows top to bottom) as an RGB PNG. Throws std::runtime_error.
 void WritePng(const std::string& path, int width, int height, const std::uint8_t* rgba);
+// The same PNG in memory (for a web page's image). Throws std::runtime_error.
+std::vector<std::uint8_t> EncodePng(int width, int height, const std::uint8_t* rgba);
 
 struct Image {
   int width = 0;

@@ -21,6 +21,9 @@ struct LabFile {
   int port = 7667;                      // and its UDP port
   std::string remote_root;              // rmslab on ssh hosts ("" = the same path as here)
   std::string remote_build;             // its build folder ("" = remote_root/build)
+  // [instructor] bind: where the instructor's page is served ("" = 127.0.0.1
+  // only; docs/instructor.md "Beyond this host"); optional.
+  std::string instructor_bind;
   bool all_local() const;
 };
 
@@ -28,7 +31,7 @@ LabFile LoadLabFile(const std::string& path);
 // The same from the file's text (path names it in errors).
 LabFile ParseLabFile(std::string_view text, const std::string& path);
 // {"hosts": {process: host}, "ttl", "group", "port", "all_local",
-// "remote_root", "remote_build"}: for the launcher (scripts/lab).
+// "remote_root", "remote_build", "instructor_bind"}: for the launcher (scripts/lab).
 nlohmann::ordered_json LabFileJson(const LabFile& lab);
 
 }  // namespace rms::session

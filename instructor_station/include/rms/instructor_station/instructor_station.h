@@ -1,0 +1,32 @@
+#pragma once
+// instructor_station: the instructor's station in a browser
+// (docs/instructor.md): joins the session over LCM, serves a web page with
+// live views of any camera station, the session's status and events, and
+// its controls (freeze, run, step, reset, checkpoint, restore, sent as
+// RMS_CONTROL commands so the log records them).
+#include <string>
+
+#include "rms/base/config.h"
+#include "rms/transport/lcm_interface.h"
+
+namespace rms::instructor_station {
+
+struct InstructorOptions {
+  std::string bind = "127.0.0.1";  // --bind ADDRESS: where the page is served
+  int port = 8080;                 // --port N (0: any free port)
+  std::string token;               // --token T: needed beyond loopback (docs/security.md)
+  std::string url_file;            // --url-file FILE: the page's URL written there once serving
+  std::string checkpoint_dir;      // --checkpoint-dir DIR: the session's checkpoints (listed)
+  int view_width = 512;            // --view-width: the views' size, pixels
+  int view_height = 384;           // --view-height
+  double view_rate_hz = 15.0;      // --view-rate: each view drawn at most this often
+};
+
+// Checks the options (throws InputError naming the option and the reason).
+void CheckOptions(const InstructorOptions& options);
+
+int RunInstructorStation(const LabConfig& config, transport::LcmInterface& lcm,
+                         const InstructorOptions& options, const std::string& stats_path,
+                         const std::string& ready_path);
+
+}  // namespace rms::instructor_station

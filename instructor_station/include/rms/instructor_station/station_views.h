@@ -1,0 +1,68 @@
+#pragma once
+// The live views a viewer of the web page asks for (docs/instructor.md
+// "Live views"): the operator's own view or any of the eight camera
+// stations, drawn by this process from the DCP frame with the scene's and
+// the ESG's own code (the Visual Scene Program, then FrameRenderer on the
+// frame's words, then the overlay), so the 64-word ESG frame stays the
+// operator's alone. Only the views someone watched in the last two seconds
+// are drawn, each at most `max_rate_hz`, each once per DCP frame.
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <vector>
+
+#include "rms/base/config.h"
+#include "rms/base/counters.h"
+#include "rms/esg_renderer/gl_context.h"
+#include "rms/esg_renderer/overlay.h"
+#include "rms/esg_renderer/renderer.h"
+#include "rms/scene_proc/camera_stations.h"
+#include "rms/scene_proc/visual_scene_program.h"
+#include "rms/wire/word_blocks.h"
+
+namespace rms::instructor_station {
+
+// 0: the operator's view (the station and camera drive the operator chose);
+// 1..8: that camera station at its default aim.
+inline constexpr int kOperatorView = 0;
+inline constexpr int kNumViews = rms::kNumCameraStations + 1;
+
+struct ViewImage {
+  std::int64_t frame = -1;        // the DCP frame it shows
+  std::vector<std::uint8_t> png;  // empty until first drawn
+};
+
+class StationViews {
+ public:
+  StationViews(const LabConfig& config, int width, int height, double max_rate_hz,
+               Counters* counters);
+  // From any thread: someone is watching `view` (0..8).
+  void Request(int view);
+  // The latest image of `view` (from any thread).
+  ViewImage Latest(int view) const;
+  // On the LCM thread, after each wait: steps every camera drive on a new DCP
+  // frame, draws the views watched that are due.
+  void Update(const wire::DcpFrameData& dcp);
+
+ private:
+  void Draw(int view, const wire::EsgFrameData& e, std::int64_t frame);
+
+  const LabConfig& config_;
+  int width_, height_;
+  std::chrono::nanoseconds min_interval_;
+  Counters* counters_;
+  std::unique_ptr<esg_renderer::GlContext> gl_;
+  std::unique_ptr<esg_renderer::FrameRenderer> renderer_;
+  esg_renderer::OverlayModel overlay_;
+  std::array<std::unique_ptr<scene_proc::VisualSceneProgram>, kNumViews> programs_;
+  std::int64_t last_frame_ = -1;
+  mutable std::mutex mu_;  // guards the two arrays below
+  std::array<std::chrono::steady_clock::time_point, kNumViews> watched_{};
+  std::array<ViewImage, kNumViews> images_;
+  std::array<std::chrono::steady_clock::time_point, kNumViews> drawn_at_{};
+};
+
+}  // namespace rms::instructor_station

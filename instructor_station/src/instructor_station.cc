@@ -1,0 +1,105 @@
+#include "rms/instructor_station/instructor_station.h"
+
+#include <cstdio>
+#include <random>
+#include <spdlog/spdlog.h>
+
+#include "rms/base/check.h"
+#include "rms/base/text.h"
+#include "rms/instructor_station/session_watch.h"
+#include "rms/instructor_station/station_views.h"
+#include "rms/instructor_station/web_server.h"
+#include "rms/session_control_t.hpp"
+#include "rms/transport/process.h"
+#include "rms/wire/channels.h"
+#include "rms/wire/message_io.h"
+
+namespace rms::instructor_station {
+
+namespace {
+
+// 128 bits from the system's entropy, as hex: the session's web token.
+std::string NewToken() {
+  std::random_device rd;
+  std::string t;
+  for (int i = 0; i < 4; ++i) t += Sprintf("%08x", rd());
+  return t;
+}
+
+bool Loopback(const std::string& host) {
+  return host == "127.0.0.1" || host == "localhost" || host == "::1";
+}
+
+}  // namespace
+
+void CheckOptions(const InstructorOptions& o) {
+  if (o.port < 0 || o.port > 65535)
+    throw InputError("--port " + std::to_string(o.port) + ": 0..65535");
+  if (o.view_width < 16 || o.view_height < 16 || o.view_width > 4096 || o.view_height > 4096 ||
+      o.view_width % 2 || o.view_height % 2) {
+    throw InputError("--view-width/--view-height " + std::to_string(o.view_width) + "x" +
+                     std::to_string(o.view_height) + ": even sizes, 16..4096");
+  }
+  if (!(o.view_rate_hz >= 0.5 && o.view_rate_hz <= 120))
+    throw InputError("--view-rate: 0.5..120 views a second");
+  if (!o.token.empty() && (o.token.size() < 16 || o.token.size() > 128))
+    throw InputError("--token: 16..128 characters");
+  for (char c : o.token) {
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_')
+      throw InputError("--token: letters, digits, - and _ only");
+  }
+  if (!Loopback(o.bind) && o.token.empty()) {
+    // Refused rather than made up: whoever opens it beyond this host needs
+    // to be given the token (docs/security.md "The instructor's page").
+    throw InputError("--bind " + o.bind + " serves beyond this host: give --token");
+  }
+}
+
+int RunInstructorStation(const LabConfig& config, transport::LcmInterface& lcm,
+                         const InstructorOptions& given, const std::string& stats_path,
+                         const std::string& ready_path) {
+  InstructorOptions options = given;
+  CheckOptions(options);
+  if (options.token.empty()) options.token = NewToken();
+  Counters counters;
+  SessionWatch watch(config, &lcm, &counters);
+  StationViews views(config, options.view_width, options.view_height, options.view_rate_hz,
+                     &counters);
+  ControlQueue controls;
+  WebServer server(config, options, &watch, &views, &controls, &counters);
+  const int port = server.Start();
+  const std::string host = options.bind == "0.0.0.0" ? "localhost" : options.bind;
+  const std::string url =
+      "http://" + host + ":" + std::to_string(port) + "/?token=" + options.token;
+  spdlog::info("instructor's page: {}", url);
+  if (!options.url_file.empty()) WriteWholeFile(options.url_file, url + "\n");
+  if (!ready_path.empty()) transport::WriteReadyFile(ready_path);
+  std::int64_t sequence = 0;
+  transport::RunNodeLoop(
+      lcm, "instructor_station", counters, {},
+      [&] {
+        const auto d = watch.LatestDcpFrame();
+        return d ? d->frame : std::int64_t{-1};
+      },
+      [&] {
+        if (auto d = watch.LatestDcpFrame()) views.Update(*d);
+        for (const ControlRequest& r : controls.Drain()) {
+          session_control_t m;
+          m.send_time_us = lcm.NowUs();
+          m.sequence = sequence++;
+          m.command = r.command;
+          m.name = r.name;
+          counters.Add(transport::PublishMessage(lcm, wire::channels::kControl, m)
+                           ? Counter::kPublished
+                           : Counter::kPublishFailed);
+        }
+        counters.Set(Counter::kHttpRequests, server.requests());
+        counters.Set(Counter::kHttpRefused, server.refused());
+        counters.Set(Counter::kControlSent, server.sent());
+      },
+      stats_path, 10);
+  server.Stop();
+  return 0;
+}
+
+}  // namespace rms::instructor_station

@@ -1,0 +1,189 @@
+#pragma once
+// The instructor's page (docs/instructor.md): one self-contained HTML file,
+// no outside scripts. It polls /api/status, /api/events and /api/path,
+// reloads each view's image as soon as the last one arrived, and sends the
+// controls to /api/control with the token from its own URL.
+namespace rms::instructor_station {
+
+inline constexpr const char* kPageHtml = R"PAGE(<!doctype html>
+<html lang="en"><head><meta charset="utf-8">
+<title>rmslab instructor station</title>
+<style>
+body { font: 14px system-ui, sans-serif; margin: 0; background: #111; color: #ddd; }
+header { padding: 6px 12px; background: #222; display: flex; gap: 18px; align-items: baseline; flex-wrap: wrap; }
+header b { font-size: 16px; }
+main { display: grid; grid-template-columns: 1fr 1fr 440px; gap: 10px; padding: 10px; }
+.pane { background: #1b1b1b; border: 1px solid #333; padding: 6px; }
+.pane h2 { font-size: 13px; margin: 0 0 6px 0; color: #aaa; font-weight: 600; }
+img.view { width: 100%; image-rendering: auto; background: #000; aspect-ratio: 4 / 3; display: block; }
+canvas { width: 100%; background: #050505; display: block; }
+table { border-collapse: collapse; width: 100%; font-size: 12px; }
+td, th { padding: 2px 4px; vertical-align: top; border-bottom: 1px solid #2a2a2a; text-align: left; }
+.ok { color: #6c6; } .bad { color: #e66; } .warn { color: #eb4; }
+#events { height: 260px; overflow-y: auto; font: 12px monospace; white-space: pre-wrap; }
+button { background: #333; color: #eee; border: 1px solid #555; padding: 4px 10px; margin: 2px; cursor: pointer; }
+button:hover { background: #444; }
+input, select { background: #222; color: #eee; border: 1px solid #555; padding: 3px; }
+#said { font: 12px monospace; min-height: 1.2em; }
+</style></head>
+<body>
+<header><b>rmslab instructor station</b>
+<span id="clock">t -- s</span><span id="mode">no telemetry yet</span>
+<span id="flags"></span><span id="collisions"></span><span id="conn"></span></header>
+<main>
+<div class="pane"><h2>The operator's view <span id="opstation"></span></h2>
+<img class="view" id="view0" alt="the operator's view"></div>
+<div class="pane"><h2>Station <select id="station"></select> <span id="viewframe"></span></h2>
+<img class="view" id="view1" alt="a camera station's view"></div>
+<div class="pane"><h2>Controls</h2>
+<button id="freeze">Freeze</button><button id="run">Run</button><button id="step">Step</button><br>
+<input id="cpname" placeholder="checkpoint name" size="16"><button id="checkpoint">Checkpoint</button><br>
+<select id="cplist"></select><button id="restore">Restore</button>
+<div id="said"></div>
+<h2>Events</h2><div id="events"></div></div>
+<div class="pane"><h2>From above: the orbiter, the CAE and the end effector's path (nose up, starboard right)</h2>
+<canvas id="map" width="640" height="480"></canvas></div>
+<div class="pane"><h2>Acquisition and docking</h2><table id="acq"></table></div>
+<div class="pane"><h2>Processes: rates, latency, losses</h2><table id="procs"></table></div>
+</main>
+<script>
+"use strict";
+const token = new URLSearchParams(location.search).get("token") || "";
+const q = (p) => p + (p.includes("?") ? "&" : "?") + "token=" + encodeURIComponent(token);
+const $ = (id) => document.getElementById(id);
+const fmt = (x, n) => (x === null || x === undefined) ? "--" : Number(x).toFixed(n);
+let map = null, path = [], pathNext = 0, eventsNext = 0, lastStatus = null;
+
+async function getJson(p) {
+  const r = await fetch(q(p), {headers: {"X-Rmslab-Token": token}, cache: "no-store"});
+  if (!r.ok) throw new Error(p + ": " + r.status);
+  return r.json();
+}
+
+// Each view: the next image is asked for as soon as the last one arrived.
+function liveView(img, viewOf) {
+  let n = 0;
+  const next = () => { img.src = q("/api/view?v=" + viewOf() + "&n=" + (n++)); };
+  img.onload = () => { img.dataset.loads = String(Number(img.dataset.loads || 0) + 1); setTimeout(next, 30); };
+  img.onerror = () => setTimeout(next, 300);
+  next();
+}
+
+async function control(command, extra) {
+  const body = new URLSearchParams(Object.assign({command}, extra || {}));
+  const r = await fetch(q("/api/control"), {method: "POST", body, headers: {"X-Rmslab-Token": token}});
+  const j = await r.json().catch(() => ({}));
+  $("said").textContent = r.ok ? ("sent " + command + (j.name ? " " + j.name : "")) : ("refused: " + (j.error || r.status));
+  $("said").className = r.ok ? "ok" : "bad";
+  refreshCheckpoints();
+}
+
+async function refreshCheckpoints() {
+  try {
+    const names = await getJson("/api/checkpoints");
+    const sel = $("cplist"), was = sel.value;
+    sel.innerHTML = "";
+    for (const n of names) { const o = document.createElement("option"); o.textContent = n; sel.appendChild(o); }
+    if (names.includes(was)) sel.value = was;
+  } catch (e) {}
+}
+
+function drawMap() {
+  const c = $("map"), g = c.getContext("2d");
+  g.clearRect(0, 0, c.width, c.height);
+  if (!map) return;
+  let xs = [], ys = [];
+  for (const o of map.outlines) for (const p of o.points) { xs.push(p[0]); ys.push(p[1]); }
+  for (const p of path) { xs.push(p[1]); ys.push(p[2]); }
+  const x0 = Math.min(...xs) - 3, x1 = Math.max(...xs) + 3, y0 = Math.min(...ys) - 3, y1 = Math.max(...ys) + 3;
+  const s = Math.min(c.height / (x1 - x0), c.width / (y1 - y0));
+  // Seen from above (R: x aft, y starboard, z up): the nose up the page, starboard right.
+  const P = (x, y) => [c.width / 2 + (y - (y0 + y1) / 2) * s, c.height / 2 + (x - (x0 + x1) / 2) * s];
+  for (const o of map.outlines) {
+    g.beginPath();
+    o.points.forEach((p, i) => { const [u, v] = P(p[0], p[1]); i ? g.lineTo(u, v) : g.moveTo(u, v); });
+    g.closePath();
+    g.strokeStyle = o.group === "cae" ? "#c9a" : "#789";
+    g.stroke();
+  }
+  g.beginPath();
+  path.forEach((p, i) => { const [u, v] = P(p[1], p[2]); i ? g.lineTo(u, v) : g.moveTo(u, v); });
+  g.strokeStyle = "#fc3"; g.stroke();
+  if (path.length) {
+    const p = path[path.length - 1], [u, v] = P(p[1], p[2]);
+    g.fillStyle = "#f63"; g.beginPath(); g.arc(u, v, 4, 0, 7); g.fill();
+  }
+}
+
+function showStatus(s) {
+  lastStatus = s;
+  const d = s.dcp;
+  $("opstation").textContent = s.camera_station ? "(station " + s.camera_station + ")" : "";
+  if (d) {
+    $("clock").textContent = "t " + fmt(d.session_s, 1) + " s  frame " + d.frame;
+    $("mode").textContent = "MODE " + d.mode;
+    $("flags").innerHTML = (d.acquired ? "<span class=ok>ACQUIRED</span> " : "not acquired ") +
+      (d.docked ? "<span class=ok>DOCKED</span> " : "") + (d.held ? "<span class=bad>HELD</span>" : "");
+    $("collisions").innerHTML = d.collisions ? "<span class=bad>collision: " + d.collisions + "</span>" : "no collision";
+    let rows = "<tr><th>condition</th><th>holds</th><th>margin ft</th></tr>";
+    for (const c of d.acquisition_conditions)
+      rows += d.mode === 1
+        ? "<tr><td>" + c.name + "</td><td class=" + (c.holds ? "ok>yes" : "bad>no") + "</td><td>" + fmt(c.margin_ft, 3) + "</td></tr>"
+        : "<tr><td>" + c.name + "</td><td colspan=2>(Mode 1 only: acquired)</td></tr>";
+    rows += "<tr><td>docking distance</td><td></td><td>" + fmt(d.dock_distance_ft, 3) + " (&le; " + fmt(d.dock_distance_limit_ft, 2) + ")</td></tr>";
+    rows += "<tr><td>docking angle, deg</td><td></td><td>" + fmt(d.dock_angle_deg, 2) + " (&le; " + fmt(d.dock_angle_limit_deg, 2) + ")</td></tr>";
+    rows += "<tr><td>clear of the bay, ft</td><td></td><td>" + fmt(d.bay_clearance_ft, 2) + "</td></tr>";
+    $("acq").innerHTML = rows;
+  }
+  let rows = "<tr><th>process</th><th>state</th><th>Hz</th><th>latency p50/p99 ms</th><th>dropped</th></tr>";
+  for (const [name, p] of Object.entries(s.processes)) {
+    const lat = Object.entries(p.latency).map(([k, v]) => k + " " + fmt(v.p50_ms, 1) + "/" + fmt(v.p99_ms, 1)).join("<br>");
+    rows += "<tr><td>" + name + "</td><td class=" + (p.state === "running" ? "ok" : "warn") + ">" + p.state +
+      "</td><td>" + fmt(p.rate_hz, 1) + "</td><td>" + lat + "</td><td>" + p.dropped + "</td></tr>";
+  }
+  $("procs").innerHTML = rows;
+}
+
+async function poll() {
+  try {
+    showStatus(await getJson("/api/status"));
+    const ev = await getJson("/api/events?since=" + eventsNext);
+    for (const e of ev) {
+      const line = document.createElement("div");
+      line.textContent = fmt(e.session_s, 1).padStart(7) + " s  " + e.text;
+      line.dataset.kind = e.kind;
+      $("events").appendChild(line);
+      eventsNext = e.seq + 1;
+    }
+    if (ev.length) $("events").scrollTop = 1e9;
+    const p = await getJson("/api/path?since=" + pathNext);
+    path = path.concat(p.points); pathNext = p.next;
+    drawMap();
+    $("conn").textContent = "";
+  } catch (e) {
+    $("conn").innerHTML = "<span class=bad>" + e.message + "</span>";
+  }
+  setTimeout(poll, 250);
+}
+
+async function start() {
+  map = await getJson("/api/map").catch(() => null);
+  const sel = $("station");
+  (map ? map.stations : ["1", "2", "3", "4", "5", "6", "7", "8"]).forEach((n, i) => {
+    const o = document.createElement("option"); o.value = String(i + 1); o.textContent = (i + 1) + " " + n; sel.appendChild(o);
+  });
+  liveView($("view0"), () => 0);
+  liveView($("view1"), () => sel.value);
+  $("freeze").onclick = () => control("freeze");
+  $("run").onclick = () => control("run");
+  $("step").onclick = () => control("step");
+  $("checkpoint").onclick = () => control("checkpoint", {name: $("cpname").value});
+  $("restore").onclick = () => control("restore", {name: $("cplist").value});
+  refreshCheckpoints();
+  poll();
+}
+start();
+</script></body></html>
+)PAGE";
+
+}  // namespace rms::instructor_station

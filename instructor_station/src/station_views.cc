@@ -1,0 +1,85 @@
+#include "rms/instructor_station/station_views.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "rms/esg_renderer/png_io.h"
+
+namespace rms::instructor_station {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+// A view nobody asked for in this long is no longer drawn.
+constexpr auto kWatchedFor = std::chrono::seconds(2);
+}  // namespace
+
+StationViews::StationViews(const LabConfig& config, int width, int height, double max_rate_hz,
+                           Counters* counters)
+    : config_(config),
+      width_(width),
+      height_(height),
+      min_interval_(std::chrono::nanoseconds(static_cast<std::int64_t>(1e9 / max_rate_hz))),
+      counters_(counters) {
+  gl_ = esg_renderer::CreateGlContext(esg_renderer::GlBackend::kOsMesa, width, height);
+  renderer_ = std::make_unique<esg_renderer::FrameRenderer>(config, gl_.get(),
+                                                            esg_renderer::RenderOptions{});
+  overlay_ = esg_renderer::MakeOverlayModel(config);
+  for (auto& p : programs_) p = std::make_unique<scene_proc::VisualSceneProgram>(config);
+}
+
+void StationViews::Request(int view) {
+  if (view < 0 || view >= kNumViews) throw std::out_of_range("view");
+  std::lock_guard<std::mutex> lock(mu_);
+  watched_[view] = Clock::now();
+}
+
+ViewImage StationViews::Latest(int view) const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return images_.at(static_cast<std::size_t>(view));
+}
+
+void StationViews::Update(const wire::DcpFrameData& dcp) {
+  if (dcp.frame == last_frame_) return;
+  last_frame_ = dcp.frame;
+  const auto now = Clock::now();
+  std::array<bool, kNumViews> watched{}, due{};
+  {
+    std::lock_guard<std::mutex> lock(mu_);
+    for (int v = 0; v < kNumViews; ++v) {
+      watched[v] = now - watched_[v] < kWatchedFor;
+      due[v] = watched[v] && now - drawn_at_[v] >= min_interval_;
+    }
+  }
+  const auto frame_count = static_cast<std::uint32_t>(dcp.frame & 0xFFFFFF);
+  for (int v = 0; v < kNumViews; ++v) {
+    // The operator's view: its camera drive follows the operator's commands
+    // every frame, watched or not, as scene_proc's does.
+    if (v != kOperatorView && !watched[v]) continue;
+    wire::DcpFrameData d = dcp;
+    if (v != kOperatorView) {
+      d.control.camera_station = v;  // the station at its default aim, widest
+      d.camera_pan_deg = d.camera_tilt_deg = d.camera_zoom = 0.0;
+    }
+    const wire::EsgFrameData e = programs_[v]->Step(d, frame_count, nullptr);
+    if (due[v]) Draw(v, e, dcp.frame);
+  }
+}
+
+void StationViews::Draw(int view, const wire::EsgFrameData& e, std::int64_t frame) {
+  // Through the words, as the ESG receives them (the same rounding).
+  const wire::EsgFrameData f = wire::UnpackEsgWords(wire::PackEsgWords(e, nullptr));
+  renderer_->Render(f);
+  const std::uint8_t* px = renderer_->pixels();
+  std::vector<std::uint8_t> rgba(px, px + static_cast<std::size_t>(width_) * height_ * 4);
+  esg_renderer::DrawOverlay(rgba.data(), width_, height_, f, overlay_);
+  ViewImage img;
+  img.frame = frame;
+  img.png = esg_renderer::EncodePng(width_, height_, rgba.data());
+  counters_->Add(Counter::kViewsRendered);
+  std::lock_guard<std::mutex> lock(mu_);
+  images_[view] = std::move(img);
+  drawn_at_[view] = Clock::now();
+}
+
+}  // namespace rms::instructor_station

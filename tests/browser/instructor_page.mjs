@@ -1,0 +1,132 @@
+// The instructor's page in a real browser (docs/instructor.md "Tests"):
+// headless Chromium from Debian, driven by puppeteer-core over its DevTools
+// protocol.
+//
+//   node tests/browser/instructor_page.mjs URL [STATION]
+//
+// URL: the page's URL as the launcher printed it (with its token). Checks,
+// printing one line each and a JSON summary last; exits 1 at the first that
+// fails:
+//   1. the page loads, the operator's view and a chosen station's view load;
+//   2. the chosen station's image changes as the arm moves (two images
+//      several frames apart differ);
+//   3. Freeze freezes the session (the DCP's frame stops, and the event
+//      list shows the command), Run runs it again (the frame moves on);
+//   4. a second viewer joining late sees the events from the session's
+//      start, the freeze included.
+import puppeteer from "puppeteer-core";
+
+const url = process.argv[2];
+const station = process.argv[3] || "1";
+if (!url) {
+  console.error("usage: node instructor_page.mjs URL [STATION]");
+  process.exit(2);
+}
+const result = {};
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+function fail(why) {
+  console.log("FAIL " + why);
+  console.log(JSON.stringify(result));
+  process.exit(1);
+}
+
+async function until(what, fn, seconds) {
+  const end = Date.now() + seconds * 1000;
+  for (;;) {
+    const v = await fn();
+    if (v) return v;
+    if (Date.now() > end) fail(what + " (not within " + seconds + " s)");
+    await sleep(200);
+  }
+}
+
+// The displayed image's pixels, hashed, and the frame it showed.
+async function viewPixels(page, id) {
+  return page.evaluate((id) => {
+    const img = document.getElementById(id);
+    if (!img.complete || !img.naturalWidth) return null;
+    const c = document.createElement("canvas");
+    c.width = img.naturalWidth;
+    c.height = img.naturalHeight;
+    const g = c.getContext("2d");
+    g.drawImage(img, 0, 0);
+    const d = g.getImageData(0, 0, c.width, c.height).data;
+    let h = 2166136261 >>> 0, lit = 0;
+    for (let i = 0; i < d.length; i += 4) {
+      h = Math.imul(h ^ (d[i] + 3 * d[i + 1] + 7 * d[i + 2]), 16777619) >>> 0;
+      if (d[i] + d[i + 1] + d[i + 2] > 60) ++lit;
+    }
+    return {hash: h, lit, width: c.width, loads: Number(img.dataset.loads || 0)};
+  }, id);
+}
+
+async function dcpFrame(page) {
+  return page.evaluate(async () => {
+    const token = new URLSearchParams(location.search).get("token");
+    const r = await fetch("/api/status?token=" + token, {cache: "no-store"});
+    const s = await r.json();
+    return s.dcp ? s.dcp.frame : null;
+  });
+}
+
+const eventsText = (page) => page.evaluate(() => document.getElementById("events").innerText);
+
+const browser = await puppeteer.launch({
+  executablePath: process.env.RMSLAB_CHROMIUM || "/usr/bin/chromium",
+  headless: true,
+  args: ["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage"],
+});
+try {
+  const page = await browser.newPage();
+  const errors = [];
+  page.on("pageerror", (e) => errors.push(String(e)));
+  await page.goto(url, {waitUntil: "load", timeout: 30000});
+  // 1. The views load.
+  await until("the operator's view loads", async () => ((await viewPixels(page, "view0")) || {}).loads >= 2, 30);
+  await page.select("#station", station);
+  await sleep(500);  // the image asked for before the change may still arrive
+  const first = await until("station " + station + "'s view loads", async () => {
+    const v = await viewPixels(page, "view1");
+    return v && v.loads >= 2 ? v : null;
+  }, 30);
+  result.view_width = first.width;
+  result.lit_pixels = first.lit;
+  if (first.lit < 100) fail("station " + station + "'s view is black (" + first.lit + " lit pixels)");
+  console.log("ok the page loads; station " + station + "'s view " + first.width + " px wide, " + first.lit + " lit pixels");
+  // 2. It changes as the arm moves.
+  const f0 = await dcpFrame(page);
+  const moved = await until("station " + station + "'s image changes as the arm moves", async () => {
+    const v = await viewPixels(page, "view1");
+    return v && v.hash !== first.hash ? v : null;
+  }, 20);
+  result.view_changed_after_frames = (await dcpFrame(page)) - f0;
+  console.log("ok station " + station + "'s image changed (" + moved.loads + " images loaded)");
+  // 3. Freeze, then run.
+  await page.click("#freeze");
+  await until("the freeze is in the event list", async () => /freeze \(from instructor_station\)/.test(await eventsText(page)), 10);
+  await sleep(700);  // frames in flight through the pipeline
+  const a = await dcpFrame(page);
+  await sleep(1500);
+  const b = await dcpFrame(page);
+  result.frozen_frames = [a, b];
+  if (a === null || a !== b) fail("frozen, the DCP's frame still moves (" + a + " -> " + b + ")");
+  console.log("ok frozen: the DCP's frame holds at " + a);
+  await page.click("#run");
+  await until("the session runs again", async () => (await dcpFrame(page)) > b, 10);
+  console.log("ok run: the DCP's frame moves on");
+  // 4. A second viewer, late.
+  const late = await browser.newPage();
+  await late.goto(url, {waitUntil: "load", timeout: 30000});
+  const seen = await until("a late viewer sees the earlier events", async () => {
+    const t = await eventsText(late);
+    return /Mode 1/.test(t) && /freeze \(from instructor_station\)/.test(t) ? t : null;
+  }, 15);
+  result.late_viewer_events = seen.split("\n").length;
+  console.log("ok a late viewer sees " + result.late_viewer_events + " events from the start, the freeze among them");
+  if (errors.length) fail("the page's scripts failed: " + errors.join("; "));
+  result.ok = true;
+  console.log(JSON.stringify(result));
+} finally {
+  await browser.close();
+}

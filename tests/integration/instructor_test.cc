@@ -1,0 +1,93 @@
+// The instructor's station as an instructor runs it (docs/instructor.md):
+// `scripts/lab demo --instructor` prints the page's URL; the page, driven in
+// the system's Chromium by puppeteer-core (tests/browser/instructor_page.mjs),
+// shows live views that change as the arm moves, freezes and runs the
+// session, and shows a late viewer the events from the start; the commands
+// are in the session's log (summary.json "control"). Requests without the
+// token, or with bad parameters, are refused and counted.
+#include <httplib.h>
+
+#include <filesystem>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "subprocess.h"
+
+namespace rms {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::ReadFile;
+using testing::SourcePath;
+using testing::Subprocess;
+
+// "http://127.0.0.1:PORT/?token=T" -> port and token.
+void SplitUrl(const std::string& url, int* port, std::string* token) {
+  const auto colon = url.rfind(':');
+  *port = std::stoi(url.substr(colon + 1));
+  *token = url.substr(url.find("token=") + 6);
+  while (!token->empty() && std::isspace(static_cast<unsigned char>(token->back())))
+    token->pop_back();
+}
+
+TEST(InstructorStation, ItsPageShowsLiveViewsFreezesTheSessionAndALateViewerSeesTheEvents) {
+  const std::string tmp = testing::MakeTempDir("instructor");
+  const std::string out = tmp + "/session";
+  Subprocess lab({SourcePath("scripts/lab"), "demo", "--no-build", "--out", out, "--lcm-url",
+                  testing::UniqueLcmUrl(8600), "--instructor", "0", "--no-video", "--png-every",
+                  "0", "--width", "320", "--height", "240"},
+                 tmp + "/lab.log", {std::string("RMSLAB_BUILD=") + RMSLAB_BUILD_DIR});
+  ASSERT_TRUE(testing::WaitForFile(out + "/run/instructor.url", 90)) << ReadFile(tmp + "/lab.log");
+  const std::string url = ReadFile(out + "/run/instructor.url");
+  testing::WaitForFile(out + "/run/operator_station.ready", 30);
+  EXPECT_NE(ReadFile(tmp + "/lab.log").find("instructor's page: http://127.0.0.1:"),
+            std::string::npos);
+
+  // The page in a real browser.
+  Subprocess browser(
+      {"/usr/bin/env", "node", SourcePath("tests/browser/instructor_page.mjs"), url, "1"},
+      tmp + "/browser.log");
+  EXPECT_EQ(browser.Wait(180), 0) << ReadFile(tmp + "/browser.log");
+
+  // Without the token, or with bad parameters: refused, said, nothing sent.
+  int port = 0;
+  std::string token;
+  SplitUrl(url, &port, &token);
+  httplib::Client web("127.0.0.1", port);
+  const auto no_token =
+      web.Post("/api/control", "command=freeze", "application/x-www-form-urlencoded");
+  ASSERT_TRUE(no_token);
+  EXPECT_EQ(no_token->status, 403);
+  const auto wrong = web.Post("/api/control?token=" + std::string(token.size(), 'a'),
+                              "command=freeze", "application/x-www-form-urlencoded");
+  ASSERT_TRUE(wrong);
+  EXPECT_EQ(wrong->status, 403);
+  const auto path = web.Post("/api/control?token=" + token, "command=checkpoint&name=../../x",
+                             "application/x-www-form-urlencoded");
+  ASSERT_TRUE(path);
+  EXPECT_EQ(path->status, 400);
+  EXPECT_NE(path->body.find("not a path"), std::string::npos) << path->body;
+  const auto view = web.Get("/api/view?v=9");
+  ASSERT_TRUE(view);
+  EXPECT_EQ(view->status, 400);
+
+  ASSERT_EQ(lab.Wait(240), 0) << ReadFile(tmp + "/lab.log");
+  // The commands are in the session's log, from the instructor's station.
+  const auto summary = nlohmann::json::parse(ReadFile(out + "/summary.json"));
+  EXPECT_TRUE(summary["docked"].get<bool>());
+  int freezes = 0, runs = 0;
+  for (const auto& c : summary["control"]) {
+    EXPECT_EQ(c["process"], "instructor_station") << c.dump();
+    freezes += c["command"] == "freeze";
+    runs += c["command"] == "run";
+  }
+  EXPECT_EQ(freezes, 1) << summary["control"].dump();
+  EXPECT_EQ(runs, 1) << summary["control"].dump();
+  const auto stats = nlohmann::json::parse(ReadFile(out + "/stats/instructor_station.json"));
+  EXPECT_GT(stats["counters"].value("views.rendered", 0), 10);
+  EXPECT_EQ(stats["counters"].value("http.refused", 0), 4);
+  EXPECT_EQ(stats["counters"].value("control.sent", 0), 2);
+}
+
+}  // namespace
+}  // namespace rms
