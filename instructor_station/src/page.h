@@ -36,7 +36,8 @@ input, select { background: #222; color: #eee; border: 1px solid #555; padding: 
 <div class="pane"><h2>Station <select id="station"></select> <span id="viewframe"></span></h2>
 <img class="view" id="view1" alt="a camera station's view"></div>
 <div class="pane"><h2>Controls</h2>
-<button id="freeze">Freeze</button><button id="run">Run</button><button id="step">Step</button><br>
+<button id="freeze">Freeze</button><button id="run">Run</button><button id="step">Step</button>
+<button id="reset">Reset</button><br>
 <input id="cpname" placeholder="checkpoint name" size="16"><button id="checkpoint">Checkpoint</button><br>
 <select id="cplist"></select><button id="restore">Restore</button>
 <div id="said"></div>
@@ -177,6 +178,7 @@ async function start() {
   $("freeze").onclick = () => control("freeze");
   $("run").onclick = () => control("run");
   $("step").onclick = () => control("step");
+  $("reset").onclick = () => control("reset");
   $("checkpoint").onclick = () => control("checkpoint", {name: $("cpname").value});
   $("restore").onclick = () => control("restore", {name: $("cplist").value});
   refreshCheckpoints();

@@ -32,23 +32,6 @@ const char* ModeText(int mode) {
   }
 }
 
-const char* CommandText(std::int8_t c) {
-  switch (c) {
-    case session_control_t::FREEZE:
-      return "freeze";
-    case session_control_t::RUN:
-      return "run";
-    case session_control_t::STEP:
-      return "step";
-    case session_control_t::CHECKPOINT:
-      return "checkpoint";
-    case session_control_t::RESTORE:
-      return "restore";
-    default:
-      return "unknown command";
-  }
-}
-
 // The collision bits less the essential contact (the finger closing onto
 // the BAR), as the summary counts them (docs/collision.md).
 std::uint32_t Detrimental(const dcp_telemetry_t& t) {
@@ -168,7 +151,7 @@ void SessionWatch::OnControl(const void* data, int size) {
     counters_->Add(Counter::kDroppedControlMalformed);
     return;
   }
-  std::string text = std::string(CommandText(m.command));
+  std::string text = std::string(wire::ControlCommandName(m.command));
   if (!m.name.empty()) text += " " + m.name.substr(0, 64);
   text += std::string(" (from ") + wire::ProcessCodeName(m.sender.process) + ")";
   std::lock_guard<std::mutex> lock(mu_);

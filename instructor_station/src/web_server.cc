@@ -90,7 +90,9 @@ std::int8_t CommandCode(const std::string& c) {
   if (c == "step") return session_control_t::STEP;
   if (c == "checkpoint") return session_control_t::CHECKPOINT;
   if (c == "restore") return session_control_t::RESTORE;
-  throw InputError("command '" + c.substr(0, 32) + "': freeze, run, step, checkpoint or restore");
+  if (c == "reset") return session_control_t::RESET;
+  throw InputError("command '" + c.substr(0, 32) +
+                   "': freeze, run, step, checkpoint, restore or reset");
 }
 
 }  // namespace

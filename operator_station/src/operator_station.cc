@@ -215,6 +215,10 @@ void OperatorStation::OnControl(const void* data, int size, std::int64_t) {
       if (frozen_) ++steps_pending_;
       counters_.Add(Counter::kControlSteps);
       break;
+    case session_control_t::RESET:
+      reset_pending_ = true;
+      counters_.Add(Counter::kControlResets);
+      break;
     case session_control_t::RESTORE:
       if (checkpoint_rate_.Allow(lcm_.NowUs()))
         restored_from_ = m.name;
@@ -405,9 +409,17 @@ bool OperatorStation::StepFrame(transport::StatusReporter* status) {
   f.dt_s = 1.0 / config_.session.frame_rate_hz;
   f.telemetry = telemetry_ ? &*telemetry_ : nullptr;
   f.now_us = lcm_.NowUs();
-  const std::optional<wire::OperatorInputs> in = source_->Next(f);
+  std::optional<wire::OperatorInputs> in = source_->Next(f);
   if (source_->requests().freeze) SendControl(session_control_t::FREEZE);
   if (!in) return false;
+  if (reset_pending_) {
+    // RESET from RMS_CONTROL (an instructor): the button for this frame;
+    // the source carries on from these inputs (the autopilot begins the
+    // task again from the telemetry after the reset).
+    in->reset = true;
+    reset_pending_ = false;
+    source_->Resume(*in, false);
+  }
   last_ = *in;
   if (in->reset) {
     spdlog::info("reset pressed: back to Mode 1");

@@ -12,8 +12,10 @@
 //      several frames apart differ);
 //   3. Freeze freezes the session (the DCP's frame stops, and the event
 //      list shows the command), Run runs it again (the frame moves on);
-//   4. a second viewer joining late sees the events from the session's
-//      start, the freeze included.
+//   4. Reset sends the session back to Mode 1 (the event list shows the
+//      command and the reset), and the autopilot begins again;
+//   5. a second viewer joining late sees the events from the session's
+//      start, the freeze and the reset included.
 import puppeteer from "puppeteer-core";
 
 const url = process.argv[2];
@@ -115,15 +117,26 @@ try {
   await page.click("#run");
   await until("the session runs again", async () => (await dcpFrame(page)) > b, 10);
   console.log("ok run: the DCP's frame moves on");
-  // 4. A second viewer, late.
+  // 4. Reset.
+  const modeNow = () => page.evaluate(async () => {
+    const token = new URLSearchParams(location.search).get("token");
+    const s = await (await fetch("/api/status?token=" + token, {cache: "no-store"})).json();
+    return s.dcp ? s.dcp.mode : null;
+  });
+  await page.click("#reset");
+  await until("the reset is in the event list", async () => /reset \(from instructor_station\)/.test(await eventsText(page)) &&
+      /RESET: back to Mode 1/.test(await eventsText(page)), 10);
+  await until("Mode 1 after the reset", async () => (await modeNow()) === 1, 10);
+  console.log("ok reset: back to Mode 1");
+  // 5. A second viewer, late.
   const late = await browser.newPage();
   await late.goto(url, {waitUntil: "load", timeout: 30000});
   const seen = await until("a late viewer sees the earlier events", async () => {
     const t = await eventsText(late);
-    return /Mode 1/.test(t) && /freeze \(from instructor_station\)/.test(t) ? t : null;
+    return /Mode 1/.test(t) && /freeze \(from instructor_station\)/.test(t) && /RESET/.test(t) ? t : null;
   }, 15);
   result.late_viewer_events = seen.split("\n").length;
-  console.log("ok a late viewer sees " + result.late_viewer_events + " events from the start, the freeze among them");
+  console.log("ok a late viewer sees " + result.late_viewer_events + " events from the start, the freeze and the reset among them");
   if (errors.length) fail("the page's scripts failed: " + errors.join("; "));
   result.ok = true;
   console.log(JSON.stringify(result));

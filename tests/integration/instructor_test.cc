@@ -1,8 +1,8 @@
 // The instructor's station as an instructor runs it (docs/instructor.md):
 // `scripts/lab demo --instructor` prints the page's URL; the page, driven in
 // the system's Chromium by puppeteer-core (tests/browser/instructor_page.mjs),
-// shows live views that change as the arm moves, freezes and runs the
-// session, and shows a late viewer the events from the start; the commands
+// shows live views that change as the arm moves, freezes, runs and resets
+// the session, and shows a late viewer the events from the start; the commands
 // are in the session's log (summary.json "control"). Requests without the
 // token, or with bad parameters, are refused and counted.
 #include <httplib.h>
@@ -30,7 +30,8 @@ void SplitUrl(const std::string& url, int* port, std::string* token) {
     token->pop_back();
 }
 
-TEST(InstructorStation, ItsPageShowsLiveViewsFreezesTheSessionAndALateViewerSeesTheEvents) {
+TEST(InstructorStation,
+     ItsPageShowsLiveViewsFreezesAndResetsTheSessionAndALateViewerSeesTheEvents) {
   const std::string tmp = testing::MakeTempDir("instructor");
   const std::string out = tmp + "/session";
   Subprocess lab({SourcePath("scripts/lab"), "demo", "--no-build", "--out", out, "--lcm-url",
@@ -75,18 +76,30 @@ TEST(InstructorStation, ItsPageShowsLiveViewsFreezesTheSessionAndALateViewerSees
   // The commands are in the session's log, from the instructor's station.
   const auto summary = nlohmann::json::parse(ReadFile(out + "/summary.json"));
   EXPECT_TRUE(summary["docked"].get<bool>());
-  int freezes = 0, runs = 0;
+  int freezes = 0, runs = 0, resets = 0;
   for (const auto& c : summary["control"]) {
     EXPECT_EQ(c["process"], "instructor_station") << c.dump();
     freezes += c["command"] == "freeze";
     runs += c["command"] == "run";
+    resets += c["command"] == "reset";
   }
   EXPECT_EQ(freezes, 1) << summary["control"].dump();
   EXPECT_EQ(runs, 1) << summary["control"].dump();
+  EXPECT_EQ(resets, 1) << summary["control"].dump();
+  // The reset began a second attempt, and the autopilot flew it to the dock.
+  EXPECT_EQ(summary["attempts"].size(), 2u) << summary["attempts"].dump();
   const auto stats = nlohmann::json::parse(ReadFile(out + "/stats/instructor_station.json"));
   EXPECT_GT(stats["counters"].value("views.rendered", 0), 10);
   EXPECT_EQ(stats["counters"].value("http.refused", 0), 4);
-  EXPECT_EQ(stats["counters"].value("control.sent", 0), 2);
+  EXPECT_EQ(stats["counters"].value("control.sent", 0), 3);
+  const auto op = nlohmann::json::parse(ReadFile(out + "/stats/operator_station.json"));
+  EXPECT_EQ(op["counters"].value("control.resets", 0), 1);
+  // What the page did re-simulates word for word.
+  const testing::ScriptRun resim = testing::Script(
+      {SourcePath("scripts/lab"), "resim", out, "--no-build", "--out", tmp + "/resim"},
+      tmp + "/resim.log");
+  EXPECT_EQ(resim.rc, 0) << resim.out;
+  EXPECT_NE(resim.out.find("identical, word for word"), std::string::npos) << resim.out;
 }
 
 }  // namespace

@@ -124,9 +124,8 @@ bool WindowKeys(const void* d, int n, ChannelStats* c) {
 bool Control(const void* d, int n, ChannelStats* c) {
   session_control_t m;
   if (wire::SafeDecode(d, n, &m) != wire::DecodeError::kNone) return false;
-  static const char* kNames[] = {"?", "freeze", "run", "step", "checkpoint", "restore"};
   c->last = Sprintf("#%lld %s %s", static_cast<long long>(m.sequence),
-                    m.command >= 1 && m.command <= 5 ? kNames[m.command] : "?", m.name.c_str());
+                    wire::ControlCommandName(m.command), m.name.c_str());
   return true;
 }
 

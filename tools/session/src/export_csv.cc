@@ -343,9 +343,8 @@ struct ChannelFiles {
       }
     } else if (base == wire::channels::kControl) {
       const auto m = Decoded<session_control_t>(msg);
-      static const char* kNames[] = {"?", "freeze", "run", "step", "checkpoint", "restore"};
-      ctl.Row({t, st_s, I(m.send_time_us), I(m.sequence),
-               m.command >= 1 && m.command <= 5 ? kNames[m.command] : "?", m.name});
+      ctl.Row(
+          {t, st_s, I(m.send_time_us), I(m.sequence), wire::ControlCommandName(m.command), m.name});
     }
   }
 };

@@ -359,8 +359,7 @@ void ScanControl(const LogMessage& ev, LogScan* s) {
     ++s->malformed;
     return;
   }
-  static const char* const kNames[] = {"?", "freeze", "run", "step", "checkpoint", "restore"};
-  const char* what = m.command >= 1 && m.command <= 5 ? kNames[m.command] : "?";
+  const char* what = wire::ControlCommandName(m.command);
   nlohmann::ordered_json e = {{"time_s", (ev.log_us - s->first_us) * 1e-6},
                               {"command", what},
                               {"process", wire::ProcessCodeName(m.sender.process)},

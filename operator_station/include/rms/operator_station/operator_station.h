@@ -136,6 +136,7 @@ class OperatorStation {
   // RMS_CONTROL.
   bool frozen_ = false;
   int steps_pending_ = 0;
+  bool reset_pending_ = false;                // RMS_CONTROL RESET: the next frame's reset button
   std::optional<std::string> restored_from_;  // a checkpoint name (CheckpointFolder)
   wire::CheckpointFolder checkpoints_;
   wire::CheckpointRateLimit checkpoint_rate_;

@@ -78,6 +78,9 @@ bool ReadSenderProcess(const void* data, int size, std::int8_t* process, std::in
 // "0x" and 16 hex digits, as the manifest and the logs write a session id.
 std::string FormatSessionId(std::int64_t session_id);
 // "dynamics_proc", ... for sender_t::PROCESS_*; "unknown" otherwise.
+// "freeze", "run", "step", "checkpoint", "restore", "reset" for
+// session_control_t's commands; "?" otherwise (the one table of their names).
+const char* ControlCommandName(std::int8_t command);
 const char* ProcessCodeName(std::int8_t process);
 // sender_t::PROCESS_* for a process name ("operator_station", ...); PROCESS_TOOL otherwise.
 std::int8_t ProcessCode(std::string_view name);
