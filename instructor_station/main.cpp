@@ -17,7 +17,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--port", o.port, "Port (0: any free one)")->capture_default_str();
   app.add_option("--token", o.token,
-                 "The page's token (16..128 of [A-Za-z0-9_-]; default: a random one, in the URL)");
+                 "The page's token (16..128 of [A-Za-z0-9_-]; default: RMSLAB_INSTRUCTOR_TOKEN, "
+                 "else a random one, in the URL file)");
   app.add_option("--url-file", o.url_file, "Write the page's URL (with its token) to this file");
   app.add_option("--checkpoint-dir", o.checkpoint_dir, "The session's checkpoints folder");
   app.add_option("--view-width", o.view_width, "The views' width, pixels")->capture_default_str();
@@ -28,8 +29,12 @@ int main(int argc, char** argv) {
   return rms::transport::ProcessMain(
       app, argc, argv, "instructor_station", &common,
       [&](const rms::LabConfig& config, rms::transport::LcmInterface& lcm) {
+        rms::instructor_station::TakeTokenFromEnvironment(&o);
         return rms::instructor_station::RunInstructorStation(config, lcm, o, common.stats_path,
                                                              common.ready_path);
       },
-      [&](const rms::LabConfig&) { rms::instructor_station::CheckOptions(o); });
+      [&](const rms::LabConfig&) {
+        rms::instructor_station::TakeTokenFromEnvironment(&o);
+        rms::instructor_station::CheckOptions(o);
+      });
 }

@@ -1,6 +1,9 @@
 #include "rms/instructor_station/instructor_station.h"
 
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <random>
 #include <spdlog/spdlog.h>
 
@@ -26,11 +29,24 @@ std::string NewToken() {
   return t;
 }
 
+void WriteUrlFile(const std::string& path, const std::string& url) {
+  std::filesystem::remove(path);
+  { std::ofstream(path).flush(); }
+  std::filesystem::permissions(
+      path, std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
+  WriteWholeFile(path, url + "\n");
+}
+
 bool Loopback(const std::string& host) {
   return host == "127.0.0.1" || host == "localhost" || host == "::1";
 }
 
 }  // namespace
+
+void TakeTokenFromEnvironment(InstructorOptions* o) {
+  if (!o->token.empty()) return;
+  if (const char* t = std::getenv("RMSLAB_INSTRUCTOR_TOKEN"); t && *t) o->token = t;
+}
 
 void CheckOptions(const InstructorOptions& o) {
   if (o.port < 0 || o.port > 65535)
@@ -51,7 +67,8 @@ void CheckOptions(const InstructorOptions& o) {
   if (!Loopback(o.bind) && o.token.empty()) {
     // Refused rather than made up: whoever opens it beyond this host needs
     // to be given the token (docs/security.md "The instructor's page").
-    throw InputError("--bind " + o.bind + " serves beyond this host: give --token");
+    throw InputError("--bind " + o.bind +
+                     " serves beyond this host: give --token (or RMSLAB_INSTRUCTOR_TOKEN)");
   }
 }
 
@@ -68,11 +85,15 @@ int RunInstructorStation(const LabConfig& config, transport::LcmInterface& lcm,
   ControlQueue controls;
   WebServer server(config, options, &watch, &views, &controls, &counters);
   const int port = server.Start();
-  const std::string host = options.bind == "0.0.0.0" ? "localhost" : options.bind;
-  const std::string url =
-      "http://" + host + ":" + std::to_string(port) + "/?token=" + options.token;
-  spdlog::info("instructor's page: {}", url);
-  if (!options.url_file.empty()) WriteWholeFile(options.url_file, url + "\n");
+  std::string host = options.bind == "0.0.0.0" || options.bind == "::" ? "localhost" : options.bind;
+  if (host.find(':') != std::string::npos) host = "[" + host + "]";  // IPv6
+  const std::string page = "http://" + host + ":" + std::to_string(port) + "/";
+  // The token goes only to the URL file, readable by this user alone (not
+  // to the log, nor the command line: the launcher passes it in the
+  // environment).
+  if (!options.url_file.empty()) WriteUrlFile(options.url_file, page + "?token=" + options.token);
+  spdlog::info("instructor's page: {} (its token: {})", page,
+               options.url_file.empty() ? "given with --token" : "in " + options.url_file);
   if (!ready_path.empty()) transport::WriteReadyFile(ready_path);
   std::int64_t sequence = 0;
   transport::RunNodeLoop(

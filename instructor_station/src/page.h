@@ -53,7 +53,10 @@ const token = new URLSearchParams(location.search).get("token") || "";
 const q = (p) => p + (p.includes("?") ? "&" : "?") + "token=" + encodeURIComponent(token);
 const $ = (id) => document.getElementById(id);
 const fmt = (x, n) => (x === null || x === undefined) ? "--" : Number(x).toFixed(n);
-let map = null, path = [], pathNext = 0, eventsNext = 0, lastStatus = null;
+let map = null, path = [], pathNext = 0, eventsNext = 0, lastStatus = null, instance = null;
+// Text from the session's messages (process, host and counter names) is
+// never markup.
+const esc = (t) => String(t).replace(/[&<>"']/g, (c) => ({"&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;", "'": "&#39;"})[c]);
 
 async function getJson(p) {
   const r = await fetch(q(p), {headers: {"X-Rmslab-Token": token}, cache: "no-store"});
@@ -118,6 +121,12 @@ function drawMap() {
 
 function showStatus(s) {
   lastStatus = s;
+  if (instance !== null && s.instance !== instance) {
+    // The station restarted: its events and path begin again.
+    eventsNext = 0; pathNext = 0; path = [];
+    $("events").textContent = "";
+  }
+  instance = s.instance;
   const d = s.dcp;
   $("opstation").textContent = s.camera_station ? "(station " + s.camera_station + ")" : "";
   if (d) {
@@ -125,12 +134,12 @@ function showStatus(s) {
     $("mode").textContent = "MODE " + d.mode;
     $("flags").innerHTML = (d.acquired ? "<span class=ok>ACQUIRED</span> " : "not acquired ") +
       (d.docked ? "<span class=ok>DOCKED</span> " : "") + (d.held ? "<span class=bad>HELD</span>" : "");
-    $("collisions").innerHTML = d.collisions ? "<span class=bad>collision: " + d.collisions + "</span>" : "no collision";
+    $("collisions").innerHTML = d.collisions ? "<span class=bad>collision: " + esc(d.collisions) + "</span>" : "no collision";
     let rows = "<tr><th>condition</th><th>holds</th><th>margin ft</th></tr>";
     for (const c of d.acquisition_conditions)
       rows += d.mode === 1
-        ? "<tr><td>" + c.name + "</td><td class=" + (c.holds ? "ok>yes" : "bad>no") + "</td><td>" + fmt(c.margin_ft, 3) + "</td></tr>"
-        : "<tr><td>" + c.name + "</td><td colspan=2>(Mode 1 only: acquired)</td></tr>";
+        ? "<tr><td>" + esc(c.name) + "</td><td class=" + (c.holds ? "ok>yes" : "bad>no") + "</td><td>" + fmt(c.margin_ft, 3) + "</td></tr>"
+        : "<tr><td>" + esc(c.name) + "</td><td colspan=2>(Mode 1 only: acquired)</td></tr>";
     rows += "<tr><td>docking distance</td><td></td><td>" + fmt(d.dock_distance_ft, 3) + " (&le; " + fmt(d.dock_distance_limit_ft, 2) + ")</td></tr>";
     rows += "<tr><td>docking angle, deg</td><td></td><td>" + fmt(d.dock_angle_deg, 2) + " (&le; " + fmt(d.dock_angle_limit_deg, 2) + ")</td></tr>";
     rows += "<tr><td>clear of the bay, ft</td><td></td><td>" + fmt(d.bay_clearance_ft, 2) + "</td></tr>";
@@ -138,9 +147,9 @@ function showStatus(s) {
   }
   let rows = "<tr><th>process</th><th>state</th><th>Hz</th><th>latency p50/p99 ms</th><th>dropped</th></tr>";
   for (const [name, p] of Object.entries(s.processes)) {
-    const lat = Object.entries(p.latency).map(([k, v]) => k + " " + fmt(v.p50_ms, 1) + "/" + fmt(v.p99_ms, 1)).join("<br>");
-    rows += "<tr><td>" + name + "</td><td class=" + (p.state === "running" ? "ok" : "warn") + ">" + p.state +
-      "</td><td>" + fmt(p.rate_hz, 1) + "</td><td>" + lat + "</td><td>" + p.dropped + "</td></tr>";
+    const lat = Object.entries(p.latency).map(([k, v]) => esc(k) + " " + fmt(v.p50_ms, 1) + "/" + fmt(v.p99_ms, 1)).join("<br>");
+    rows += "<tr><td>" + esc(name) + "</td><td class=" + (p.state === "running" ? "ok" : "warn") + ">" + esc(p.state) +
+      "</td><td>" + fmt(p.rate_hz, 1) + "</td><td>" + lat + "</td><td>" + fmt(p.dropped, 0) + "</td></tr>";
   }
   $("procs").innerHTML = rows;
 }
@@ -162,7 +171,7 @@ async function poll() {
     drawMap();
     $("conn").textContent = "";
   } catch (e) {
-    $("conn").innerHTML = "<span class=bad>" + e.message + "</span>";
+    $("conn").innerHTML = "<span class=bad>" + esc(e.message) + "</span>";
   }
   setTimeout(poll, 250);
 }

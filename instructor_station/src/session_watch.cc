@@ -1,5 +1,7 @@
 #include "rms/instructor_station/session_watch.h"
 
+#include <unistd.h>
+
 #include <cmath>
 
 #include "rms/process_status_t.hpp"
@@ -51,7 +53,10 @@ bool Finite(const dcp_telemetry_t& t) {
 
 SessionWatch::SessionWatch(const LabConfig& config, transport::LcmInterface* lcm,
                            Counters* counters)
-    : config_(config), lcm_(lcm), counters_(counters) {
+    : config_(config),
+      lcm_(lcm),
+      counters_(counters),
+      instance_(std::to_string(getpid()) + "-" + std::to_string(lcm->NowUs())) {
   lcm_->Subscribe(wire::channels::kDcpFrame,
                   [this](const void* d, int n, std::int64_t t) { OnDcpFrame(d, n, t); });
   lcm_->Subscribe(wire::channels::kDcpTelemetry,
@@ -271,6 +276,9 @@ nlohmann::json SessionWatch::StatusJson() const {
   }
   j["processes"] = procs;
   j["events"] = static_cast<std::int64_t>(events_.size());
+  // This station's run: a page that sees it change (the station restarted)
+  // reads the events and the path again from the start.
+  j["instance"] = instance_;
   return j;
 }
 

@@ -40,15 +40,15 @@ ViewImage StationViews::Latest(int view) const {
 }
 
 void StationViews::Update(const wire::DcpFrameData& dcp) {
-  if (dcp.frame == last_frame_) return;
-  last_frame_ = dcp.frame;
   const auto now = Clock::now();
   std::array<bool, kNumViews> watched{}, due{};
   {
     std::lock_guard<std::mutex> lock(mu_);
     for (int v = 0; v < kNumViews; ++v) {
       watched[v] = now - watched_[v] < kWatchedFor;
-      due[v] = watched[v] && now - drawn_at_[v] >= min_interval_;
+      // Due: watched, not drawn for this frame yet, and not drawn too
+      // recently. A frozen session's frame is drawn once when first asked.
+      due[v] = watched[v] && images_[v].frame != dcp.frame && now - drawn_at_[v] >= min_interval_;
     }
   }
   const auto frame_count = static_cast<std::uint32_t>(dcp.frame & 0xFFFFFF);
@@ -56,13 +56,16 @@ void StationViews::Update(const wire::DcpFrameData& dcp) {
     // The operator's view: its camera drive follows the operator's commands
     // every frame, watched or not, as scene_proc's does.
     if (v != kOperatorView && !watched[v]) continue;
-    wire::DcpFrameData d = dcp;
-    if (v != kOperatorView) {
-      d.control.camera_station = v;  // the station at its default aim, widest
-      d.camera_pan_deg = d.camera_tilt_deg = d.camera_zoom = 0.0;
+    if (stepped_frame_[v] != dcp.frame) {
+      wire::DcpFrameData d = dcp;
+      if (v != kOperatorView) {
+        d.control.camera_station = v;  // the station at its default aim, widest
+        d.camera_pan_deg = d.camera_tilt_deg = d.camera_zoom = 0.0;
+      }
+      content_[v] = programs_[v]->Step(d, frame_count, nullptr);
+      stepped_frame_[v] = dcp.frame;
     }
-    const wire::EsgFrameData e = programs_[v]->Step(d, frame_count, nullptr);
-    if (due[v]) Draw(v, e, dcp.frame);
+    if (due[v]) Draw(v, content_[v], dcp.frame);
   }
 }
 

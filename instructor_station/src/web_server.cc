@@ -59,8 +59,11 @@ nlohmann::json MapJson(const LabConfig& config) {
 
 namespace {
 
-bool Loopback(const std::string& host) {
-  return host == "127.0.0.1" || host == "localhost" || host == "::1";
+// JSON text, whatever bytes the session's messages carried: a stranger's
+// invalid UTF-8 in a process or checkpoint name becomes U+FFFD instead of
+// breaking the answer (and so the page).
+std::string Json(const nlohmann::json& j) {
+  return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 // Equal in time independent of where they differ.
@@ -75,6 +78,10 @@ std::int64_t IntParam(const httplib::Request& req, const char* name, std::int64_
                       std::int64_t lo, std::int64_t hi) {
   if (!req.has_param(name)) return fallback;
   const std::string v = req.get_param_value(name);
+  if (v.empty() || !std::isdigit(static_cast<unsigned char>(v[0]))) {
+    throw InputError(std::string("parameter ") + name + "='" + v.substr(0, 32) + "': a number " +
+                     std::to_string(lo) + ".." + std::to_string(hi));
+  }
   char* end = nullptr;
   const long long n = std::strtoll(v.c_str(), &end, 10);
   if (v.empty() || *end != '\0' || n < lo || n > hi) {
@@ -97,6 +104,9 @@ std::int8_t CommandCode(const std::string& c) {
 
 }  // namespace
 
+// Requests answered at once; more wait in the listen queue.
+constexpr int kWorkers = 32;
+
 struct WebServer::Impl {
   const LabConfig& config;
   InstructorOptions options;
@@ -109,13 +119,11 @@ struct WebServer::Impl {
   std::string map_json;
   std::atomic<std::int64_t> requests{0}, refused{0}, sent{0};
 
-  // Which requests need the token: every one when served beyond loopback;
-  // on loopback the commands (a page elsewhere in the browser cannot send
-  // them: it does not know the token).
+  // Every request needs the token, on loopback too: a page from elsewhere
+  // in the same browser (or one reached through DNS rebinding) can then
+  // neither send commands nor read the session.
   bool Allowed(const httplib::Request& req) const {
     if (options.token.empty()) return true;
-    const bool needs = !Loopback(options.bind) || req.method != "GET";
-    if (!needs) return true;
     std::string t = req.get_header_value("X-Rmslab-Token");
     if (t.empty() && req.has_param("token")) t = req.get_param_value("token");
     return SameToken(t, options.token);
@@ -127,8 +135,24 @@ struct WebServer::Impl {
 };
 
 void WebServer::Impl::Routes() {
+  // Without SO_REUSEPORT (cpp-httplib sets it by default): a second station
+  // on a port in use must fail, not share it and mix two sessions' pages.
+  server.set_socket_options([](socket_t sock) {
+    int yes = 1;
+    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+  });
+  // A slow or idle client cannot hold a worker for long, nor send much.
+  server.set_read_timeout(3, 0);
+  server.set_write_timeout(5, 0);
+  server.set_keep_alive_timeout(2);
+  server.set_payload_max_length(64 * 1024);
+  server.new_task_queue = [] { return new httplib::ThreadPool(kWorkers); };
   server.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
     ++requests;
+    if (req.path == "/favicon.ico") {  // browsers ask, without the page's token: nothing to give
+      res.status = 204;
+      return httplib::Server::HandlerResponse::Handled;
+    }
     if (Allowed(req)) return httplib::Server::HandlerResponse::Unhandled;
     ++refused;
     res.status = 403;
@@ -147,22 +171,22 @@ void WebServer::Impl::Routes() {
         } catch (...) {
         }
         res.status = 400;
-        res.set_content(nlohmann::json{{"error", what}}.dump(), "application/json");
+        res.set_content(Json(nlohmann::json{{"error", what}}), "application/json");
       });
   server.Get("/", [](const httplib::Request&, httplib::Response& res) {
     res.set_content(kPageHtml, "text/html; charset=utf-8");
   });
   server.Get("/api/status", [this](const httplib::Request&, httplib::Response& res) {
-    res.set_content(watch->StatusJson().dump(), "application/json");
+    res.set_content(Json(watch->StatusJson()), "application/json");
   });
   server.Get("/api/events", [this](const httplib::Request& req, httplib::Response& res) {
     const std::int64_t since = IntParam(req, "since", 0, 0, std::int64_t{1} << 40);
-    res.set_content(watch->EventsJson(since, 1000).dump(), "application/json");
+    res.set_content(Json(watch->EventsJson(since, 1000)), "application/json");
   });
   server.Get("/api/path", [this](const httplib::Request& req, httplib::Response& res) {
     const auto since =
         static_cast<std::size_t>(IntParam(req, "since", 0, 0, std::int64_t{1} << 40));
-    res.set_content(watch->PathJson(since).dump(), "application/json");
+    res.set_content(Json(watch->PathJson(since)), "application/json");
   });
   server.Get("/api/map", [this](const httplib::Request&, httplib::Response& res) {
     res.set_content(map_json, "application/json");
@@ -200,7 +224,7 @@ void WebServer::Impl::Control(const httplib::Request& req, httplib::Response& re
       r.command == session_control_t::STEP ? static_cast<int>(IntParam(req, "n", 1, 1, 300)) : 1;
   for (int i = 0; i < steps; ++i) controls->Push(r);
   sent += steps;
-  res.set_content(nlohmann::json{{"sent", command}, {"name", r.name}, {"times", steps}}.dump(),
+  res.set_content(Json(nlohmann::json{{"sent", command}, {"name", r.name}, {"times", steps}}),
                   "application/json");
 }
 
@@ -214,13 +238,13 @@ void WebServer::Impl::Checkpoints(httplib::Response& res) const {
         names.push_back(n);
     }
   }
-  res.set_content(names.dump(), "application/json");
+  res.set_content(Json(names), "application/json");
 }
 
 WebServer::WebServer(const LabConfig& config, const InstructorOptions& options, SessionWatch* watch,
                      StationViews* views, ControlQueue* controls, Counters* counters)
     : impl_(new Impl{config, options, watch, views, controls, counters, {}, {}, {}, {}, {}, {}}) {
-  impl_->map_json = MapJson(config).dump();
+  impl_->map_json = Json(MapJson(config));
   impl_->Routes();
 }
 

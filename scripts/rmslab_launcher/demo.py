@@ -4,6 +4,7 @@ import argparse
 import json
 import os
 import secrets
+import socket
 import shutil
 import signal
 import subprocess
@@ -139,21 +140,32 @@ class Demo:
                   ("scene_proc", [binary("scene_proc/scene_proc")] + common), ("esg_renderer", esg)]
         if a.instructor is not None:
             checks.append(("instructor_station", [binary("instructor_station/instructor_station")] + common +
-                           self.instructor_args()))
+                           self.instructor_args() + ["--token", "x" * 16]))
         session.precheck(checks)
 
     def instructor_args(self):
-        """The instructor station's own options (docs/instructor.md)."""
-        if not hasattr(self, "instructor_token"):
-            # Beyond loopback the page needs a token; on loopback its commands do.
+        """The instructor station's own options (docs/instructor.md). Its
+        token goes in the environment (instructor_env), not on the command
+        line where every user of the host can read it."""
+        if not hasattr(self, "instructor_port"):
             self.instructor_token = secrets.token_hex(16)
-        return ["--bind", self.instructor_bind, "--port", str(self.a.instructor), "--token", self.instructor_token]
+            self.instructor_port = self.a.instructor
+            if self.instructor_port == 0:
+                # Chosen here, once: a restarted station serves where the open pages look.
+                family = socket.AF_INET6 if ":" in self.instructor_bind else socket.AF_INET
+                with socket.socket(family, socket.SOCK_STREAM) as s:
+                    s.bind((self.instructor_bind, 0))
+                    self.instructor_port = s.getsockname()[1]
+        return ["--bind", self.instructor_bind, "--port", str(self.instructor_port)]
+
+    def instructor_env(self):
+        return {"RMSLAB_INSTRUCTOR_TOKEN": self.instructor_token}
 
     def start_instructor(self):
         url_file = os.path.join(self.out, "run", "instructor.url")
         extra = self.instructor_args() + ["--url-file", url_file,
                                           "--checkpoint-dir", os.path.join(self.out, "checkpoints")]
-        self.sup.add(self.spec("instructor_station", extra))
+        self.sup.add(self.spec("instructor_station", extra, env=self.instructor_env()))
         err = self.sup.wait_ready(["instructor_station"])
         if err:
             raise LabError(err, 1)
@@ -336,7 +348,8 @@ class Demo:
         lab_hosts = {str(h) for h in self.hosts.values()} != {"localhost"}
         where = f"the lab's hosts ({os.path.basename(self.a.lab)})" if lab_hosts else "this host"
         suffix = f" (channel suffix {self.a.channel_suffix})" if self.a.channel_suffix else ""
-        say(f"four processes up on {where}, {self.url}{suffix}; session {self.session_id}; flying: {flying}")
+        n = "five" if self.a.instructor is not None else "four"
+        say(f"{n} processes up on {where}, {self.url}{suffix}; session {self.session_id}; flying: {flying}")
         self.sup.add(self.operator_spec())
 
     def watch(self):

@@ -137,6 +137,15 @@ try {
   }, 15);
   result.late_viewer_events = seen.split("\n").length;
   console.log("ok a late viewer sees " + result.late_viewer_events + " events from the start, the freeze and the reset among them");
+  // 6. Text from the session's messages is shown as text, never run.
+  const forged = await page.evaluate(() => ({
+    element: document.getElementById("forged") !== null,
+    title: document.title,
+    shown: document.getElementById("procs").innerText.includes("<img id=forged"),
+  }));
+  result.forged = forged;
+  if (forged.element || forged.title === "pwned") fail("a forged process name became markup");
+  if (forged.shown) console.log("ok a forged process name is shown as text");
   if (errors.length) fail("the page's scripts failed: " + errors.join("; "));
   result.ok = true;
   console.log(JSON.stringify(result));

@@ -4,12 +4,18 @@
 // shows live views that change as the arm moves, freezes, runs and resets
 // the session, and shows a late viewer the events from the start; the commands
 // are in the session's log (summary.json "control"). Requests without the
-// token, or with bad parameters, are refused and counted.
+// token, or with bad parameters, are refused and counted; a second station
+// cannot take the port.
 #include <httplib.h>
 
 #include <filesystem>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+
+#include "rms/process_status_t.hpp"
+#include "rms/sender_t.hpp"
+#include "rms/transport/lcm_interface.h"
+#include "rms/wire/channels.h"
 
 #include "subprocess.h"
 
@@ -17,6 +23,7 @@ namespace rms {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::BuildPath;
 using testing::ReadFile;
 using testing::SourcePath;
 using testing::Subprocess;
@@ -34,21 +41,41 @@ TEST(InstructorStation,
      ItsPageShowsLiveViewsFreezesAndResetsTheSessionAndALateViewerSeesTheEvents) {
   const std::string tmp = testing::MakeTempDir("instructor");
   const std::string out = tmp + "/session";
-  Subprocess lab({SourcePath("scripts/lab"), "demo", "--no-build", "--out", out, "--lcm-url",
-                  testing::UniqueLcmUrl(8600), "--instructor", "0", "--no-video", "--png-every",
-                  "0", "--width", "320", "--height", "240"},
-                 tmp + "/lab.log", {std::string("RMSLAB_BUILD=") + RMSLAB_BUILD_DIR});
+  const std::string lcm_url = testing::UniqueLcmUrl(8600);
+  Subprocess lab(
+      {SourcePath("scripts/lab"), "demo", "--no-build", "--out", out, "--lcm-url", lcm_url,
+       "--instructor", "0", "--no-video", "--png-every", "0", "--width", "320", "--height", "240"},
+      tmp + "/lab.log", {std::string("RMSLAB_BUILD=") + RMSLAB_BUILD_DIR});
   ASSERT_TRUE(testing::WaitForFile(out + "/run/instructor.url", 90)) << ReadFile(tmp + "/lab.log");
   const std::string url = ReadFile(out + "/run/instructor.url");
   testing::WaitForFile(out + "/run/operator_station.ready", 30);
   EXPECT_NE(ReadFile(tmp + "/lab.log").find("instructor's page: http://127.0.0.1:"),
             std::string::npos);
 
+  // A forged status report whose process name is markup, and whose host is
+  // not UTF-8: anyone with the session's id can send one.
+  {
+    const auto manifest = nlohmann::json::parse(ReadFile(out + "/manifest.json"));
+    transport::LcmOptions lo;
+    lo.url = lcm_url;
+    transport::UdpLcm forger(lo);
+    forger.SetSender({transport::ParseSessionId(manifest["session_id"], "session_id"),
+                      sender_t::PROCESS_TOOL, 4242});
+    process_status_t m{};
+    m.process = "<img id=forged src=x onerror=\"document.title='pwned'\">";
+    m.host = "\xff\xfe";
+    m.pid = 4242;
+    transport::PublishMessage(forger, wire::channels::kStatus, m);
+  }
+
   // The page in a real browser.
   Subprocess browser(
       {"/usr/bin/env", "node", SourcePath("tests/browser/instructor_page.mjs"), url, "1"},
       tmp + "/browser.log");
   EXPECT_EQ(browser.Wait(180), 0) << ReadFile(tmp + "/browser.log");
+  EXPECT_NE(ReadFile(tmp + "/browser.log").find("ok a forged process name is shown as text"),
+            std::string::npos)
+      << ReadFile(tmp + "/browser.log");
 
   // Without the token, or with bad parameters: refused, said, nothing sent.
   int port = 0;
@@ -68,9 +95,20 @@ TEST(InstructorStation,
   ASSERT_TRUE(path);
   EXPECT_EQ(path->status, 400);
   EXPECT_NE(path->body.find("not a path"), std::string::npos) << path->body;
-  const auto view = web.Get("/api/view?v=9");
+  const auto view = web.Get("/api/view?v=9&token=" + token);
   ASSERT_TRUE(view);
   EXPECT_EQ(view->status, 400);
+  EXPECT_NE(view->body.find("parameter v='9'"), std::string::npos) << view->body;
+  const auto read = web.Get("/api/status");  // reading needs the token too
+  ASSERT_TRUE(read);
+  EXPECT_EQ(read->status, 403);
+  // A second station on the same port is refused (no SO_REUSEPORT sharing).
+  Subprocess second({BuildPath("instructor_station/instructor_station"), "--lcm-url",
+                     testing::UniqueLcmUrl(8650), "--port", std::to_string(port)},
+                    tmp + "/second.log");
+  EXPECT_EQ(second.Wait(30), 2) << ReadFile(tmp + "/second.log");
+  EXPECT_NE(ReadFile(tmp + "/second.log").find("cannot serve the page"), std::string::npos)
+      << ReadFile(tmp + "/second.log");
 
   ASSERT_EQ(lab.Wait(240), 0) << ReadFile(tmp + "/lab.log");
   // The commands are in the session's log, from the instructor's station.
@@ -90,7 +128,7 @@ TEST(InstructorStation,
   EXPECT_EQ(summary["attempts"].size(), 2u) << summary["attempts"].dump();
   const auto stats = nlohmann::json::parse(ReadFile(out + "/stats/instructor_station.json"));
   EXPECT_GT(stats["counters"].value("views.rendered", 0), 10);
-  EXPECT_EQ(stats["counters"].value("http.refused", 0), 4);
+  EXPECT_EQ(stats["counters"].value("http.refused", 0), 5);
   EXPECT_EQ(stats["counters"].value("control.sent", 0), 3);
   const auto op = nlohmann::json::parse(ReadFile(out + "/stats/operator_station.json"));
   EXPECT_EQ(op["counters"].value("control.resets", 0), 1);

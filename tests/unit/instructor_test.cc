@@ -180,6 +180,11 @@ TEST(InstructorViews, OnlyWatchedViewsAreDrawnEachFromItsOwnStation) {
   EXPECT_TRUE(views.Latest(5).png.empty());
   views.Update(d);  // the same frame: not drawn again
   EXPECT_EQ(counters.Get(Counter::kViewsRendered), 2);
+  // Frozen (no new frame), a view first asked for now is drawn all the same.
+  views.Request(5);
+  views.Update(d);
+  EXPECT_EQ(views.Latest(5).frame, 2);
+  EXPECT_EQ(counters.Get(Counter::kViewsRendered), 3);
   EXPECT_THROW(views.Request(9), std::out_of_range);
 }
 

@@ -42,12 +42,13 @@ Command Summary(CLI::App& app) {
   c->add_flag("--brief", o->brief, "Print a few human-readable lines instead of the JSON");
   return {c, [o] {
             const auto j = session::Summarize(o->dir);
-            rms::WriteWholeFile(o->out.empty() ? o->dir + "/summary.json" : o->out,
-                                j.dump(2) + "\n");
+            rms::WriteWholeFile(
+                o->out.empty() ? o->dir + "/summary.json" : o->out,
+                j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
             if (o->brief)
               session::PrintBrief(j, std::cout);
             else
-              std::cout << j.dump(2) << "\n";
+              std::cout << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
             return 0;
           }};
 }
@@ -77,8 +78,11 @@ Command Manifest(CLI::App& app) {
   c->add_option("--kind", f.kind, "live, replay or re-simulation")->capture_default_str();
   c->add_option("--parent", f.parent, "A replay's recorded session");
   return {c, [o] {
-            rms::WriteWholeFile(o->dir + "/manifest.json",
-                                session::MakeManifest(o->dir, o->f).dump(2) + "\n");
+            rms::WriteWholeFile(
+                o->dir + "/manifest.json",
+                session::MakeManifest(o->dir, o->f)
+                        .dump(2, ' ', false, nlohmann::json::error_handler_t::replace) +
+                    "\n");
             return 0;
           }};
 }
@@ -96,7 +100,7 @@ Command CompareEsg(CLI::App& app) {
       ->check(CLI::ExistingDirectory);
   return {c, [o] {
             const auto r = session::CompareEsgFrames(o->first, o->second);
-            std::cout << r.dump(2) << "\n";
+            std::cout << r.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
             return r["identical"] == r["recorded"] && r["missing"] == 0 ? 0 : 1;
           }};
 }
@@ -155,7 +159,9 @@ Command LabFile(CLI::App& app) {
       app.add_subcommand("labfile", "Check a lab file (docs/sessions.md) and print it as JSON");
   c->add_option("file", *path, "Lab file")->required()->check(CLI::ExistingFile);
   return {c, [path] {
-            std::cout << session::LabFileJson(session::LoadLabFile(*path)).dump(2) << "\n";
+            std::cout << session::LabFileJson(session::LoadLabFile(*path))
+                             .dump(2, ' ', false, nlohmann::json::error_handler_t::replace)
+                      << "\n";
             return 0;
           }};
 }
@@ -171,7 +177,9 @@ Command Probe(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(0.1, 60.0));
   return {c, [o] {
-            std::cout << session::ProbeAddress(o->first, o->second).dump(2) << "\n";
+            std::cout << session::ProbeAddress(o->first, o->second)
+                             .dump(2, ' ', false, nlohmann::json::error_handler_t::replace)
+                      << "\n";
             return 0;
           }};
 }

@@ -14,14 +14,17 @@ namespace rms::instructor_station {
 struct InstructorOptions {
   std::string bind = "127.0.0.1";  // --bind ADDRESS: where the page is served
   int port = 8080;                 // --port N (0: any free port)
-  std::string token;               // --token T: needed beyond loopback (docs/security.md)
-  std::string url_file;            // --url-file FILE: the page's URL written there once serving
-  std::string checkpoint_dir;      // --checkpoint-dir DIR: the session's checkpoints (listed)
-  int view_width = 512;            // --view-width: the views' size, pixels
-  int view_height = 384;           // --view-height
-  double view_rate_hz = 15.0;      // --view-rate: each view drawn at most this often
+  std::string token;     // --token T (or RMSLAB_INSTRUCTOR_TOKEN; default random): every request
+  std::string url_file;  // --url-file FILE: the page's URL written there once serving
+  std::string checkpoint_dir;  // --checkpoint-dir DIR: the session's checkpoints (listed)
+  int view_width = 512;        // --view-width: the views' size, pixels
+  int view_height = 384;       // --view-height
+  double view_rate_hz = 15.0;  // --view-rate: each view drawn at most this often
 };
 
+// --token's default: RMSLAB_INSTRUCTOR_TOKEN (how the launcher passes it,
+// so it is not on the command line for every user of the host to read).
+void TakeTokenFromEnvironment(InstructorOptions* options);
 // Checks the options (throws InputError naming the option and the reason).
 void CheckOptions(const InstructorOptions& options);
 

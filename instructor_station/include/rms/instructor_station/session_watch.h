@@ -66,6 +66,7 @@ class SessionWatch {
   const LabConfig& config_;
   transport::LcmInterface* lcm_;
   Counters* counters_;
+  const std::string instance_;  // pid and start time of this station
   mutable std::mutex mu_;
   wire::SequenceTracker dcp_frames_;
   std::optional<wire::DcpFrameData> dcp_;

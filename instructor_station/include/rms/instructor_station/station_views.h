@@ -5,7 +5,8 @@
 // the ESG's own code (the Visual Scene Program, then FrameRenderer on the
 // frame's words, then the overlay), so the 64-word ESG frame stays the
 // operator's alone. Only the views someone watched in the last two seconds
-// are drawn, each at most `max_rate_hz`, each once per DCP frame.
+// are drawn, each at most `max_rate_hz`, each once per DCP frame (and once
+// when first asked for while the session is frozen).
 #include <array>
 #include <chrono>
 #include <cstdint>
@@ -48,6 +49,11 @@ class StationViews {
   void Update(const wire::DcpFrameData& dcp);
 
  private:
+  static std::array<std::int64_t, kNumViews> MinusOnes() {
+    std::array<std::int64_t, kNumViews> a{};
+    a.fill(-1);
+    return a;
+  }
   void Draw(int view, const wire::EsgFrameData& e, std::int64_t frame);
 
   const LabConfig& config_;
@@ -58,7 +64,9 @@ class StationViews {
   std::unique_ptr<esg_renderer::FrameRenderer> renderer_;
   esg_renderer::OverlayModel overlay_;
   std::array<std::unique_ptr<scene_proc::VisualSceneProgram>, kNumViews> programs_;
-  std::int64_t last_frame_ = -1;
+  // Each view's content for the DCP frame it last stepped on (LCM thread).
+  std::array<wire::EsgFrameData, kNumViews> content_{};
+  std::array<std::int64_t, kNumViews> stepped_frame_ = MinusOnes();
   mutable std::mutex mu_;  // guards the two arrays below
   std::array<std::chrono::steady_clock::time_point, kNumViews> watched_{};
   std::array<ViewImage, kNumViews> images_;
