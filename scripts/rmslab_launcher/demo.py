@@ -411,7 +411,7 @@ class Demo:
         if where is not None and not own:
             say(f"summary: {where}")
         if where is None:
-            say("no summary could be written anywhere (every disk tried is full)")
+            say("no summary could be written (each place tried said why, above)")
         if self.sup.fatal:
             return self.sup.fatal[1]
         if self.interrupted is not None or op_rc == 130:
