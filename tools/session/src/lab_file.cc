@@ -1,5 +1,6 @@
 #include "rms/session/lab_file.h"
 
+#include <array>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -20,6 +21,17 @@ bool ValidName(const std::string& s) {
     if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.' ||
           c == '@'))
       return false;
+  }
+  return true;
+}
+
+// "a.b.c.d", each 0..255, and nothing after: an IPv4 address.
+bool DottedQuad(const std::string& s, std::array<int, 4>* a) {
+  char tail = 0;
+  if (std::sscanf(s.c_str(), "%d.%d.%d.%d%c", &(*a)[0], &(*a)[1], &(*a)[2], &(*a)[3], &tail) != 4)
+    return false;
+  for (int v : *a) {
+    if (v < 0 || v > 255) return false;
   }
   return true;
 }
@@ -61,13 +73,8 @@ LabFile ParseLabFile(std::string_view text, const std::string& path) {
     // docs/security.md: a lab names its own multicast group and port.
     lab.group = l.String("group");
     {
-      int a[4] = {-1, -1, -1, -1};
-      char tail = 0;
-      const bool dotted =
-          std::sscanf(lab.group.c_str(), "%d.%d.%d.%d%c", &a[0], &a[1], &a[2], &a[3], &tail) == 4;
-      bool ok = dotted && a[0] >= 224 && a[0] <= 239;
-      for (int k = 1; k < 4; ++k) ok = ok && a[k] >= 0 && a[k] <= 255;
-      if (!ok)
+      std::array<int, 4> a{};
+      if (!DottedQuad(lab.group, &a) || a[0] < 224 || a[0] > 239)
         l.Fail("group",
                "must be an IPv4 multicast address (224.0.0.0 .. 239.255.255.255; 239.x.x.x for a "
                "lab), got \"" +
@@ -86,12 +93,8 @@ LabFile ParseLabFile(std::string_view text, const std::string& path) {
   if (root.contains("instructor")) {  // optional: docs/instructor.md "Beyond this host"
     TomlReader i = top.Sub("instructor");
     lab.instructor_bind = i.String("bind");
-    int a[4] = {-1, -1, -1, -1};
-    char tail = 0;
-    bool ok = std::sscanf(lab.instructor_bind.c_str(), "%d.%d.%d.%d%c", &a[0], &a[1], &a[2], &a[3],
-                          &tail) == 4;
-    for (int v : a) ok = ok && v >= 0 && v <= 255;
-    if (!ok) {
+    std::array<int, 4> a{};
+    if (!DottedQuad(lab.instructor_bind, &a)) {
       i.Fail("bind", "must be an IPv4 address of this host (\"0.0.0.0\": every one), got \"" +
                          lab.instructor_bind + "\"");
     }
