@@ -32,8 +32,22 @@ bool AllHave(const std::array<LocationWord, 8>& words, int face) {
 
 }  // namespace
 
+namespace {
+
+// The malfunctions' frame rate and each joint's range (config [inputs.*]).
+Malfunctions MakeMalfunctions(const LabConfig& config) {
+  std::array<double, 6> lo{}, hi{};
+  for (int i = 0; i < 6; ++i) {
+    lo[i] = config.inputs[i].min;
+    hi[i] = config.inputs[i].max;
+  }
+  return Malfunctions(config.session.frame_rate_hz, lo, hi);
+}
+
+}  // namespace
+
 DynamicCollisionProgram::DynamicCollisionProgram(const LabConfig& config, const DcpOptions& options)
-    : config_(config), options_(options) {
+    : config_(config), options_(options), malfunctions_(MakeMalfunctions(config)) {
   X_RP_bay_ = arm::MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft);
   bay_ = MakeCargoBay(config.shuttle);
   cae_ = MakeCaeFrontHalf(config.cae);
@@ -617,6 +631,7 @@ wire::DcpFrameData DynamicCollisionProgram::FrameOut(const wire::OperatorInputs&
   out.control.reset = in.reset;
   out.control.overlay = in.overlay;
   out.control.crosshairs = in.crosshairs;
+  out.control.no_video = malfunctions_.CameraLost(in.camera_station);
   out.control.mode = status_.mode;
   // COLLISION: a detrimental collision; RECPT: the essential contact.
   const std::uint32_t essential =
@@ -637,9 +652,19 @@ wire::DcpFrameData DynamicCollisionProgram::FrameOut(const wire::OperatorInputs&
   return out;
 }
 
-wire::DcpFrameData DynamicCollisionProgram::Step(const wire::OperatorInputs& in) {
+void DynamicCollisionProgram::Inject(const wire::Malfunction& m) {
+  const ArmCommand& slave = started_ ? slave_->cmd : initial_;
+  malfunctions_.Inject(m, slave.angles_deg, slave.finger);
+}
+
+wire::DcpFrameData DynamicCollisionProgram::Step(const wire::OperatorInputs& raw) {
+  // docs/sessions.md "Malfunctions": the inputs due, the operator's command
+  // (the master's, as telemetered) and what the failed parts let through.
+  const wire::OperatorInputs& in = malfunctions_.Delay(raw);
   const ArmCommand master = TakeInputs(in);
-  const ArmCommand command = SlaveCommand(master);
+  ArmCommand failed = master;
+  if (started_) malfunctions_.Apply(slave_->cmd.angles_deg, &failed.angles_deg, &failed.finger);
+  const ArmCommand command = SlaveCommand(failed);
   if (started_)
     Respond(command);
   else
@@ -953,6 +978,9 @@ nlohmann::ordered_json DynamicCollisionProgram::SaveState() const {
   for (const CollisionResult& r : slave_->ee_body) body.push_back(PlaneJson(r));
   j["planes_ee_bar"] = bar;
   j["planes_ee_body"] = body;
+  // Only while one is in force: a state without is as it was before
+  // malfunctions existed (older logs' states compare equal).
+  if (malfunctions_.any()) j[wire::kMalfunctionsKey] = malfunctions_.ToJson();
   return j;
 }
 
@@ -967,11 +995,13 @@ struct DynamicCollisionProgram::RestoredState {
   double contact_gap_ft = 0, acquisition_gap_ft = 0;
   ArmCommand master, slave;
   Evaluation hints;  // only its planes
+  Malfunctions malfunctions;
+  explicit RestoredState(const LabConfig& config) : malfunctions(MakeMalfunctions(config)) {}
 };
 
 std::unique_ptr<DynamicCollisionProgram::RestoredState> DynamicCollisionProgram::ReadRestoredState(
     const nlohmann::json& j) const {
-  auto p = std::make_unique<RestoredState>();
+  auto p = std::make_unique<RestoredState>(config_);
   try {
     if (j.at("format").get<std::string>() != kCheckpointFormat) {
       throw InputError("checkpoint: format '" + j.at("format").get<std::string>() +
@@ -989,6 +1019,8 @@ std::unique_ptr<DynamicCollisionProgram::RestoredState> DynamicCollisionProgram:
     p->acquisition_gap_ft = j.at("acquisition_gap_ft").get<double>();
     p->reset_pressed = j.contains("reset_pressed") ? j.at("reset_pressed").get<bool>() : false;
     p->master = CommandFrom(j.at("master"));
+    // Absent before malfunctions: none in force.
+    if (j.contains(wire::kMalfunctionsKey)) p->malfunctions.FromJson(j.at(wire::kMalfunctionsKey));
     p->have_slave = j.at("have_slave").get<bool>();
     if (p->have_slave) {
       p->slave = CommandFrom(j.at("slave"));
@@ -1056,6 +1088,7 @@ void DynamicCollisionProgram::RestoreState(const nlohmann::json& j) {
   contact_gap_ft_ = p->contact_gap_ft;
   acquisition_gap_ft_ = p->acquisition_gap_ft;
   reset_pressed_ = p->reset_pressed;
+  malfunctions_ = p->malfunctions;
   started_ = p->have_slave;
   status_.master = p->master;
   PlacePayload(p->docked ? p->X_RP_docked : p->X_RP_free);

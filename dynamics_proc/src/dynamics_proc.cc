@@ -1,5 +1,6 @@
 #include "rms/dynamics_proc/dynamics_proc.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <spdlog/spdlog.h>
 
@@ -12,6 +13,7 @@
 #include "rms/wire/channels.h"
 #include "rms/wire/checkpoint.h"
 #include "rms/wire/frame_receiver.h"
+#include "rms/wire/malfunction.h"
 #include "rms/wire/message_io.h"
 
 namespace rms::dynamics_proc {
@@ -80,6 +82,10 @@ void DynamicsProc::ApplyState(const dcp_state_t& m, bool with_state) {
       throw InputError(std::string("RMS_DCP_STATE: ") + e.what());
     }
     last_inputs_ = c.inputs;
+  } else if (m.reason == dcp_state_t::MALFUNCTION) {
+    // Another design keeps its own state but fails as the recorded one did.
+    const wire::Checkpoint c = wire::ParseCheckpoint(m.checkpoint, "RMS_DCP_STATE");
+    MatchMalfunctions(wire::MalfunctionTexts(c.dcp));
   }
   next_frame_ = m.next_frame;
   last_input_frame_ = m.input_frame;
@@ -88,6 +94,43 @@ void DynamicsProc::ApplyState(const dcp_state_t& m, bool with_state) {
   else
     resume_.reset();
   frames_since_state_ = 0;
+}
+
+void DynamicsProc::MatchMalfunctions(const std::vector<std::string>& texts) {
+  const std::vector<wire::Malfunction> now = dcp_.malfunctions().active();
+  std::vector<wire::Malfunction> want;
+  try {
+    for (const std::string& t : texts) want.push_back(wire::ParseMalfunction(t));
+  } catch (const InputError& e) {
+    throw InputError(std::string("RMS_DCP_STATE: ") + e.what());
+  }
+  auto in = [](const std::vector<wire::Malfunction>& v, const wire::Malfunction& m) {
+    return std::find(v.begin(), v.end(), m) != v.end();
+  };
+  for (const wire::Malfunction& m : now) {
+    if (in(want, m)) continue;
+    wire::Repair r{wire::RepairWhat::kAll, m.target};
+    switch (m.kind) {
+      case wire::MalfunctionKind::kJointStuck:
+      case wire::MalfunctionKind::kJointDrift:
+      case wire::MalfunctionKind::kJointSlow:
+        r.what = wire::RepairWhat::kJoint;
+        break;
+      case wire::MalfunctionKind::kFingerJammedOpen:
+      case wire::MalfunctionKind::kFingerJammedClosed:
+        r.what = wire::RepairWhat::kFinger;
+        break;
+      case wire::MalfunctionKind::kCameraLost:
+        r.what = wire::RepairWhat::kCamera;
+        break;
+      default:
+        r.what = wire::RepairWhat::kInputs;
+    }
+    dcp_.Repair(r);
+  }
+  for (const wire::Malfunction& m : want) {
+    if (!in(now, m)) dcp_.Inject(m);
+  }
 }
 
 bool DynamicsProc::ResumeFromStateFile() {
@@ -131,6 +174,10 @@ void DynamicsProc::OnControl(const void* data, int size) {
     counters_.Add(Counter::kDroppedControlMalformed);
     return;
   }
+  if (m.command == session_control_t::MALFUNCTION || m.command == session_control_t::REPAIR) {
+    OnMalfunction(m);
+    return;
+  }
   if (m.command != session_control_t::CHECKPOINT && m.command != session_control_t::RESTORE) return;
   // The name is the sender's (docs/security.md "The control channel"): it
   // is looked up in the session's checkpoints folder only, a few times a
@@ -158,6 +205,40 @@ void DynamicsProc::OnControl(const void* data, int size) {
     counters_.Add(Counter::kControlRefused);
     spdlog::error("{}", e.what());
   }
+}
+
+// docs/sessions.md "Malfunctions": taken between frames, at most
+// CheckpointRateLimit's rate (each sends the DCP's state to the log), and
+// logged with the state from which the next frame has it.
+void DynamicsProc::OnMalfunction(const session_control_t& m) {
+  if (!malfunction_rate_.Allow(lcm_->NowUs())) {
+    if (counters_.Get(Counter::kControlRateLimited) == 0) {
+      spdlog::warn("malfunction commands refused: more than {} a second (control.rate_limited)",
+                   wire::CheckpointRateLimit::kPerSecond);
+    }
+    counters_.Add(Counter::kControlRateLimited);
+    return;
+  }
+  const char* from = wire::ProcessCodeName(m.sender.process);
+  try {
+    if (m.command == session_control_t::MALFUNCTION) {
+      const wire::Malfunction f = wire::ParseMalfunction(m.name);
+      dcp_.Inject(f);
+      counters_.Add(Counter::kControlMalfunctions);
+      spdlog::warn("malfunction from {}: {}, from DCP frame {}", from, wire::MalfunctionText(f),
+                   next_frame_);
+    } else {
+      const wire::Repair r = wire::ParseRepair(m.name);
+      dcp_.Repair(r);
+      counters_.Add(Counter::kControlRepairs);
+      spdlog::info("repair from {}: {}, from DCP frame {}", from, wire::RepairText(r), next_frame_);
+    }
+  } catch (const InputError& e) {
+    counters_.Add(Counter::kControlRefused);
+    spdlog::error("{} from {} refused: {}", wire::ControlCommandName(m.command), from, e.what());
+    return;
+  }
+  PublishState(dcp_state_t::MALFUNCTION);
 }
 
 void DynamicsProc::EnableLiveChecks(double frame_rate_hz) {

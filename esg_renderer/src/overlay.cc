@@ -197,10 +197,17 @@ void DrawCrosshairs(std::uint8_t* rgba, int w, int h, const wire::EsgFrameData& 
 
 void DrawOverlay(std::uint8_t* rgba, int w, int h, const wire::EsgFrameData& f,
                  const OverlayModel& model) {
-  if (f.control.crosshairs) DrawCrosshairs(rgba, w, h, f, model);
+  if (f.control.crosshairs && !f.control.no_video) DrawCrosshairs(rgba, w, h, f, model);
   const std::vector<std::string>& names = model.camera_names;
-  if (!f.control.overlay) return;
   const int s = std::max(1, h / 300);
+  if (f.control.no_video) {
+    // A lost station's monitor says so, overlay switch or not.
+    const int big = 3 * s;
+    const std::string_view msg = "NO VIDEO";
+    DrawText(rgba, w, h, (w - static_cast<int>(msg.size()) * 6 * big) / 2, (h - 8 * big) / 2, msg,
+             {230, 230, 230}, big);
+  }
+  if (!f.control.overlay) return;
   const int line = 9 * s, margin = 4 * s;
   const scene_model::Rgb text{230, 230, 120}, dim{90, 90, 90}, black{0, 0, 0};
   char buf[64];

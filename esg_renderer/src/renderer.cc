@@ -236,6 +236,14 @@ void FrameRenderer::Render(const wire::EsgFrameData& f) {
   stats_ = {};
   context_->MakeCurrent();
   const int w = context_->width(), h = context_->height();
+  if (f.control.no_video) {
+    // The station is lost (docs/sessions.md "Malfunctions"): no picture.
+    gl_.Viewport(0, 0, w, h);
+    gl_.ClearColor(0, 0, 0, 1);
+    gl_.Clear(GL_COLOR_BUFFER_BIT);
+    order_.clear();
+    return;
+  }
   const Eigen::Matrix4d P =
       ProjectionMatrix(f.fov_deg, static_cast<double>(w) / h, kNearFt, kFarFt);
   const Eigen::Matrix4d view = ViewMatrix(f);

@@ -1,7 +1,12 @@
 #include "rms/instructor_station/instructor_station.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -29,12 +34,18 @@ std::string NewToken() {
   return t;
 }
 
+// Mode 0600 from its creation, and whole or not there: written to a
+// temporary file and renamed (a reader never sees it empty or half written).
 void WriteUrlFile(const std::string& path, const std::string& url) {
-  std::filesystem::remove(path);
-  { std::ofstream(path).flush(); }
-  std::filesystem::permissions(
-      path, std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
-  WriteWholeFile(path, url + "\n");
+  const std::string tmp = path + ".tmp";
+  std::filesystem::remove(tmp);
+  const int fd = open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0600);
+  if (fd < 0) throw InputError("cannot write " + tmp + ": " + std::strerror(errno));
+  const std::string text = url + "\n";
+  const bool ok = write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size());
+  close(fd);
+  if (!ok) throw InputError("cannot write " + tmp + ": " + std::strerror(errno));
+  std::filesystem::rename(tmp, path);
 }
 
 bool Loopback(const std::string& host) {
@@ -103,7 +114,7 @@ int RunInstructorStation(const LabConfig& config, transport::LcmInterface& lcm,
         return d ? d->frame : std::int64_t{-1};
       },
       [&] {
-        if (auto d = watch.LatestDcpFrame()) views.Update(*d);
+        if (auto d = watch.LatestDcpFrame()) views.Update(*d, watch.LostStations());
         for (const ControlRequest& r : controls.Drain()) {
           session_control_t m;
           m.send_time_us = lcm.NowUs();

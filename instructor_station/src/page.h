@@ -40,6 +40,10 @@ input, select { background: #222; color: #eee; border: 1px solid #555; padding: 
 <button id="reset">Reset</button><br>
 <input id="cpname" placeholder="checkpoint name" size="16"><button id="checkpoint">Checkpoint</button><br>
 <select id="cplist"></select><button id="restore">Restore</button>
+<h2>Malfunctions</h2>
+<select id="mkind"></select><select id="mtarget"></select><input id="mvalue" size="6">
+<span id="munit"></span><button id="inject">Inject</button><br>
+<div id="mlist">none in force</div>
 <div id="said"></div>
 <h2>Events</h2><div id="events"></div></div>
 <div class="pane"><h2>From above: the orbiter, the CAE and the end effector's path (nose up, starboard right)</h2>
@@ -90,6 +94,53 @@ async function refreshCheckpoints() {
     for (const n of names) { const o = document.createElement("option"); o.textContent = n; sel.appendChild(o); }
     if (names.includes(was)) sel.value = was;
   } catch (e) {}
+}
+
+// The malfunction menu, from /api/map's table: the text is the pattern with
+// N the target and V the value ("joint 2 drift 0.5"); the station checks it.
+function malfunctionMenu() {
+  const kind = $("mkind"), target = $("mtarget");
+  for (const k of map.malfunctions) {
+    const o = document.createElement("option"); o.value = k.name; o.textContent = k.name.replace(/_/g, " "); kind.appendChild(o);
+  }
+  const chosen = () => map.malfunctions.find((k) => k.name === kind.value);
+  const update = () => {
+    const k = chosen(), was = target.value;
+    target.innerHTML = "";
+    const names = k.pattern.startsWith("joint") ? map.joints : k.pattern.startsWith("camera") ? map.stations : [];
+    names.forEach((n, i) => { const o = document.createElement("option"); o.value = String(i + 1); o.textContent = (i + 1) + " " + n; target.appendChild(o); });
+    if ([...target.options].some((o) => o.value === was)) target.value = was;
+    target.style.display = names.length ? "" : "none";
+    $("mvalue").style.display = k.value ? "" : "none";
+    $("mvalue").value = k.pattern.includes("delayed") ? "500" : "1";
+    $("munit").textContent = k.value ? k.value + " " : "";
+  };
+  kind.onchange = update;
+  update();
+  $("inject").onclick = () => {
+    const k = chosen();
+    control("malfunction", {name: k.pattern.replace("N", target.value).replace("V", $("mvalue").value)});
+  };
+}
+
+// What a malfunction in force is repaired as: "joint 2 stuck" -> "joint 2".
+const repairOf = (t) => t.startsWith("joint") || t.startsWith("camera") ? t.split(" ").slice(0, 2).join(" ") : t.split(" ")[0];
+
+function showMalfunctions(list) {
+  const div = $("mlist");
+  if (div.dataset.shown === JSON.stringify(list)) return;
+  div.dataset.shown = JSON.stringify(list);
+  div.innerHTML = list.length ? "" : "none in force";
+  for (const t of list) {
+    const row = document.createElement("div"), b = document.createElement("button");
+    b.textContent = "Repair"; b.onclick = () => control("repair", {name: repairOf(t)});
+    row.className = "bad"; row.appendChild(document.createTextNode(t + " ")); row.appendChild(b);
+    div.appendChild(row);
+  }
+  if (list.length > 1) {
+    const b = document.createElement("button"); b.id = "repairall"; b.textContent = "Repair all";
+    b.onclick = () => control("repair", {name: "all"}); div.appendChild(b);
+  }
 }
 
 function drawMap() {
@@ -143,6 +194,13 @@ function showStatus(s) {
     rows += "<tr><td>docking distance</td><td></td><td>" + fmt(d.dock_distance_ft, 3) + " (&le; " + fmt(d.dock_distance_limit_ft, 2) + ")</td></tr>";
     rows += "<tr><td>docking angle, deg</td><td></td><td>" + fmt(d.dock_angle_deg, 2) + " (&le; " + fmt(d.dock_angle_limit_deg, 2) + ")</td></tr>";
     rows += "<tr><td>clear of the bay, ft</td><td></td><td>" + fmt(d.bay_clearance_ft, 2) + "</td></tr>";
+    // Each joint as commanded and as it is: a failed joint shows here.
+    (map ? map.joints : []).forEach((n, i) => {
+      const off = Math.abs(d.master_angles_deg[i] - d.slave_angles_deg[i]) > 0.5;
+      rows += "<tr><td>joint " + (i + 1) + " " + esc(n) + ", deg</td><td></td><td" + (off ? " class=bad" : "") + ">" +
+        fmt(d.slave_angles_deg[i], 1) + " (commanded " + fmt(d.master_angles_deg[i], 1) + ")</td></tr>";
+    });
+    rows += "<tr><td>finger lever</td><td></td><td>" + fmt(d.slave_finger, 2) + " (commanded " + fmt(d.master_finger, 2) + ")</td></tr>";
     $("acq").innerHTML = rows;
   }
   let rows = "<tr><th>process</th><th>state</th><th>Hz</th><th>latency p50/p99 ms</th><th>dropped</th></tr>";
@@ -152,6 +210,7 @@ function showStatus(s) {
       "</td><td>" + fmt(p.rate_hz, 1) + "</td><td>" + lat + "</td><td>" + fmt(p.dropped, 0) + "</td></tr>";
   }
   $("procs").innerHTML = rows;
+  showMalfunctions(s.malfunctions || []);
 }
 
 async function poll() {
@@ -190,6 +249,7 @@ async function start() {
   $("reset").onclick = () => control("reset");
   $("checkpoint").onclick = () => control("checkpoint", {name: $("cpname").value});
   $("restore").onclick = () => control("restore", {name: $("cplist").value});
+  if (map) malfunctionMenu();
   refreshCheckpoints();
   poll();
 }

@@ -2,14 +2,18 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 
+#include "rms/dcp_state_t.hpp"
 #include "rms/process_status_t.hpp"
 #include "rms/session_control_t.hpp"
 #include "rms/wire/acquisition_conditions.h"
 #include "rms/wire/channels.h"
+#include "rms/wire/checkpoint.h"
 #include "rms/wire/collision_bits.h"
 #include "rms/wire/frame_receiver.h"
+#include "rms/wire/malfunction.h"
 #include "rms/wire/message_io.h"
 
 namespace rms::instructor_station {
@@ -65,6 +69,8 @@ SessionWatch::SessionWatch(const LabConfig& config, transport::LcmInterface* lcm
                   [this](const void* d, int n, std::int64_t) { OnStatus(d, n); });
   lcm_->Subscribe(wire::channels::kControl,
                   [this](const void* d, int n, std::int64_t) { OnControl(d, n); });
+  lcm_->Subscribe(wire::channels::kDcpState,
+                  [this](const void* d, int n, std::int64_t) { OnDcpState(d, n); });
 }
 
 void SessionWatch::OnDcpFrame(const void* data, int size, std::int64_t recv_us) {
@@ -141,6 +147,18 @@ void SessionWatch::OnStatus(const void* data, int size) {
     p.rate_hz = static_cast<double>(m.frame - p.frame) * 1e6 / static_cast<double>(now - p.last_us);
   }
   if (m.final && !p.ended) AddEvent("process", m.process + " ended");
+  // The operator station saw a joint or the finger stop following its
+  // command (docs/operator.md "A joint that does not follow").
+  const std::string kNotFollowing(CounterName(Counter::kNotFollowing));
+  std::int64_t before = 0, after = 0;
+  if (auto f = p.figures.find(kNotFollowing); f != p.figures.end()) before = f->second;
+  for (int i = 0; i < m.num_counters; ++i) {
+    if (m.counter_names[i] == kNotFollowing) after = m.counter_values[i];
+  }
+  if (after > before && p.pid == m.pid) {
+    AddEvent("failure", m.process + " reports a joint or the finger NOT FOLLOWING its command (" +
+                            std::to_string(after) + " so far)");
+  }
   p.ended = m.final;
   p.pid = m.pid;
   p.host = m.host;
@@ -161,6 +179,47 @@ void SessionWatch::OnControl(const void* data, int size) {
   text += std::string(" (from ") + wire::ProcessCodeName(m.sender.process) + ")";
   std::lock_guard<std::mutex> lock(mu_);
   AddEvent("control", text);
+}
+
+// The malfunctions in force, from the DCP's state (sent when one is
+// injected or repaired, and every 5 s): each change is an event.
+void SessionWatch::OnDcpState(const void* data, int size) {
+  dcp_state_t m;
+  if (wire::SafeDecode(data, size, &m) != wire::DecodeError::kNone) {
+    counters_->Add(Counter::kDroppedStateMalformed);
+    return;
+  }
+  std::vector<std::string> now;
+  std::uint32_t lost = 0;
+  try {
+    now = wire::MalfunctionTexts(wire::ParseCheckpoint(m.checkpoint, "RMS_DCP_STATE").dcp);
+    for (const std::string& t : now) {
+      const wire::Malfunction f = wire::ParseMalfunction(t);
+      if (f.kind == wire::MalfunctionKind::kCameraLost) lost |= 1u << (f.target - 1);
+    }
+  } catch (const InputError&) {
+    counters_->Add(Counter::kDroppedStateMalformed);
+    return;
+  }
+  std::lock_guard<std::mutex> lock(mu_);
+  auto has = [](const std::vector<std::string>& v, const std::string& x) {
+    return std::find(v.begin(), v.end(), x) != v.end();
+  };
+  const std::string from = " (from DCP frame " + std::to_string(m.next_frame) + ")";
+  for (const std::string& t : now) {
+    if (!has(malfunctions_, t))
+      AddEvent("malfunction", std::string("MALFUNCTION: ").append(t) + from);
+  }
+  for (const std::string& t : malfunctions_) {
+    if (!has(now, t)) AddEvent("malfunction", std::string("repaired: ").append(t) + from);
+  }
+  malfunctions_ = std::move(now);
+  lost_stations_ = lost;
+}
+
+std::uint32_t SessionWatch::LostStations() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return lost_stations_;
 }
 
 void SessionWatch::NoteLocal(const std::string& kind, const std::string& text) {
@@ -236,7 +295,10 @@ nlohmann::json TelemetryJson(const dcp_telemetry_t& t, const LabConfig& config) 
           {"dock_distance_limit_ft", config.dcp.dock_distance_ft},
           {"dock_angle_limit_deg", config.dcp.dock_angle_deg},
           {"p_RoA_R_ft", {t.p_RoA_R_ft[0], t.p_RoA_R_ft[1], t.p_RoA_R_ft[2]}},
-          {"slave_angles_deg", t.slave_angles_deg}};
+          {"slave_angles_deg", t.slave_angles_deg},
+          {"master_angles_deg", t.master_angles_deg},
+          {"master_finger", t.master_finger},
+          {"slave_finger", t.slave_finger}};
 }
 
 }  // namespace
@@ -269,13 +331,15 @@ nlohmann::json SessionWatch::StatusJson() const {
     q["dropped"] = dropped;
     q["latency"] = latency;
     for (const char* k : {"frames.late", "superseded", "input.missing", "dcp.missing",
-                          "esg.missing", "control.freezes", "control.steps"}) {
+                          "esg.missing", "control.freezes", "control.steps", "control.malfunctions",
+                          "control.repairs", "arm.not_following"}) {
       if (auto f = p.figures.find(k); f != p.figures.end()) q["counters"][k] = f->second;
     }
     procs[name] = q;
   }
   j["processes"] = procs;
   j["events"] = static_cast<std::int64_t>(events_.size());
+  j["malfunctions"] = malfunctions_;
   // This station's run: a page that sees it change (the station restarted)
   // reads the events and the path again from the start.
   j["instance"] = instance_;

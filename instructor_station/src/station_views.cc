@@ -39,7 +39,7 @@ ViewImage StationViews::Latest(int view) const {
   return images_.at(static_cast<std::size_t>(view));
 }
 
-void StationViews::Update(const wire::DcpFrameData& dcp) {
+void StationViews::Update(const wire::DcpFrameData& dcp, std::uint32_t lost_stations) {
   const auto now = Clock::now();
   std::array<bool, kNumViews> watched{}, due{};
   {
@@ -61,6 +61,7 @@ void StationViews::Update(const wire::DcpFrameData& dcp) {
       if (v != kOperatorView) {
         d.control.camera_station = v;  // the station at its default aim, widest
         d.camera_pan_deg = d.camera_tilt_deg = d.camera_zoom = 0.0;
+        d.control.no_video = (lost_stations >> (v - 1)) & 1u;  // a lost station: no picture
       }
       content_[v] = programs_[v]->Step(d, frame_count, nullptr);
       stepped_frame_[v] = dcp.frame;

@@ -12,6 +12,7 @@
 #include "rms/session_control_t.hpp"
 #include "rms/transport/lcm_interface.h"
 #include "rms/wire/checkpoint.h"
+#include "rms/wire/malfunction.h"
 
 #include "page.h"
 
@@ -52,9 +53,22 @@ nlohmann::json MapJson(const LabConfig& config) {
   }
   nlohmann::json stations = nlohmann::json::array();
   for (const auto& cam : config.cameras) stations.push_back(cam.name);
+  // The page's malfunction menu, from the one table (rms/wire/malfunction.h).
+  nlohmann::json kinds = nlohmann::json::array();
+  for (const wire::MalfunctionKindInfo& k : wire::kMalfunctionKinds) {
+    kinds.push_back({{"name", k.name},
+                     {"pattern", k.pattern},
+                     {"value", k.value},
+                     {"min", k.min_value},
+                     {"max", k.max_value}});
+  }
+  nlohmann::json joints = nlohmann::json::array();
+  for (int j = 1; j <= wire::kNumJoints; ++j) joints.push_back(wire::JointName(j));
   return {{"outlines", outlines},
           {"payload_ft", {config.payload.p_RoPo_R_ft.x(), config.payload.p_RoPo_R_ft.y()}},
-          {"stations", stations}};
+          {"stations", stations},
+          {"malfunctions", kinds},
+          {"joints", joints}};
 }
 
 namespace {
@@ -98,8 +112,10 @@ std::int8_t CommandCode(const std::string& c) {
   if (c == "checkpoint") return session_control_t::CHECKPOINT;
   if (c == "restore") return session_control_t::RESTORE;
   if (c == "reset") return session_control_t::RESET;
+  if (c == "malfunction") return session_control_t::MALFUNCTION;
+  if (c == "repair") return session_control_t::REPAIR;
   throw InputError("command '" + c.substr(0, 32) +
-                   "': freeze, run, step, checkpoint, restore or reset");
+                   "': freeze, run, step, checkpoint, restore, reset, malfunction or repair");
 }
 
 }  // namespace
@@ -220,6 +236,12 @@ void WebServer::Impl::Control(const httplib::Request& req, httplib::Response& re
     if (r.name.size() < 5 || r.name.compare(r.name.size() - 5, 5, ".json") != 0) r.name += ".json";
     wire::CheckpointFolder::ValidateName(r.name);  // InputError: said to the page
   }
+  // docs/sessions.md "Malfunctions": checked here (InputError: said to the
+  // page), sent in the canonical text.
+  const std::string what = req.has_param("name") ? req.get_param_value("name") : std::string();
+  if (r.command == session_control_t::MALFUNCTION)
+    r.name = wire::MalfunctionText(wire::ParseMalfunction(what));
+  if (r.command == session_control_t::REPAIR) r.name = wire::RepairText(wire::ParseRepair(what));
   const int steps =
       r.command == session_control_t::STEP ? static_cast<int>(IntParam(req, "n", 1, 1, 300)) : 1;
   for (int i = 0; i < steps; ++i) controls->Push(r);

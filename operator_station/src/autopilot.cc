@@ -62,7 +62,8 @@ Autopilot::Autopilot(const LabConfig& config, AutopilotOptions options)
       opt_(options),
       limits_(LimitsFromConfig(config, options.joint_rate_deg_s)),
       model_(scene_model::BuildSceneModel(config)),
-      dt_s_(1.0 / config.session.frame_rate_hz) {
+      dt_s_(1.0 / config.session.frame_rate_hz),
+      follow_(config.session.frame_rate_hz) {
   cmd_ = wire::InitialInputs(config.inputs);
   cmd_.camera_station = 8;
   cmd_.overlay = true;
@@ -377,6 +378,7 @@ void Autopilot::Resync(const wire::OperatorInputs& restored) {
   retries_ = 0;
   relieved_at_frame_ = -1000;
   failure_.clear();
+  follow_.Forget();
   Enter(AutopilotPhase::kResync);
 }
 
@@ -400,6 +402,17 @@ wire::OperatorInputs Autopilot::Step(const dcp_telemetry_t* tm_ptr) {
     Relieve(tm);
     return cmd_;
   }
+  // A part that does not follow: said, and the command held until it does
+  // (a repair; a slowed joint catching up).
+  for (const FollowWatch::Change& c : follow_.Observe(tm)) {
+    if (c.failing) {
+      spdlog::warn("autopilot: {}: holding its command in phase '{}' until it follows", c.text,
+                   AutopilotPhaseName(phase_));
+    } else {
+      spdlog::info("autopilot: {}: carrying on", c.text);
+    }
+  }
+  if (moving_phase && follow_.failing()) return cmd_;
 
   switch (phase_) {
     case AutopilotPhase::kWaitTelemetry:

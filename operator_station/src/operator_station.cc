@@ -106,6 +106,7 @@ OperatorStation::OperatorStation(const OperatorOptions& options, const LabConfig
       rate_hz_(options.rate_hz > 0 ? options.rate_hz : config.session.frame_rate_hz),
       period_ns_(static_cast<std::int64_t>(std::llround(1e9 / rate_hz_))),
       builder_(config.inputs),
+      follow_(config.session.frame_rate_hz),
       checkpoints_(options.checkpoint_dir) {
   telemetry_seq_.SetClock(transport::SessionFrameClock(config.session.frame_rate_hz));
   Subscribe();
@@ -165,6 +166,14 @@ void OperatorStation::OnTelemetry(const void* data, int size, std::int64_t recv_
   telemetry_rate_.Tick(recv_us);
   input_to_dcp_ms_ = (recv_us - m.input_send_time_us) / 1000.0;
   events_.Observe(m);
+  for (const FollowWatch::Change& c : follow_.Observe(m)) {
+    if (c.failing) {
+      counters_.Add(Counter::kNotFollowing);
+      spdlog::warn("{}", c.text);
+    } else {
+      spdlog::info("{}", c.text);
+    }
+  }
 }
 
 void OperatorStation::OnStatus(const void* data, int size, std::int64_t recv_us) {
@@ -262,6 +271,7 @@ void OperatorStation::ForgetTelemetry(std::int64_t fresh_from_input_frame) {
   telemetry_seq_ = wire::SequenceTracker{};
   telemetry_seq_.SetClock(clock);
   events_.Forget();
+  follow_.Forget();
 }
 
 void OperatorStation::ApplyRestore() {
@@ -365,6 +375,7 @@ void OperatorStation::DrawScreen(std::int64_t frame, const wire::OperatorInputs&
   s.keys = source_->key_hints();
   s.publish_hz = publish_rate_.hz();
   s.telemetry_hz = telemetry_rate_.hz();
+  s.not_following = follow_.failing();
   s.input_to_dcp_ms = input_to_dcp_ms_;
   s.render_hz = render_hz_;
   s.input_to_render_p50_ms = render_p50_ms_;

@@ -14,6 +14,7 @@
 #include "rms/base/text.h"
 #include "rms/wire/acquisition_conditions.h"
 #include "rms/wire/collision_bits.h"
+#include "rms/wire/malfunction.h"
 
 namespace rms::operator_station {
 
@@ -171,6 +172,17 @@ void ModeLines(const StatusSnapshot& s, Flow& flow) {
 
 void CollisionLines(const StatusSnapshot& s, Flow& flow) {
   const dcp_telemetry_t& t = *s.telemetry;
+  if (s.not_following) {
+    // docs/operator.md "A joint that does not follow".
+    std::string parts;
+    for (int p = 0; p < 7; ++p) {
+      if (!((s.not_following >> p) & 1u)) continue;
+      parts += (parts.empty() ? "" : ", ") +
+               (p < 6 ? Sprintf("joint %d (%s)", p + 1, wire::JointName(p + 1))
+                      : std::string("the finger"));
+    }
+    flow.Line("FAILURE? NOT FOLLOWING ITS COMMAND: " + parts);
+  }
   flow.Line("collisions: " +
             wire::CollisionNames(static_cast<std::uint32_t>(t.collisions), ", ", "none"));
 }

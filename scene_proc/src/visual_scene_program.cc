@@ -51,6 +51,9 @@ wire::EsgFrameData VisualSceneProgram::Step(const wire::DcpFrameData& dcp,
   e.fov_deg = view.fov_deg;
   e.p_RoPo_R_ft = dcp.p_RoPo_R_ft;
   e.R_RP = dcp.R_RP;
+  // A lost station (NO VIDEO, docs/sessions.md "Malfunctions") shows no
+  // picture: no priority to compute.
+  if (e.control.no_video) return e;
   // Visual priority from the words as the ESG will read them.
   const wire::EsgFrameData sent = wire::UnpackEsgWords(wire::PackEsgWords(e, nullptr));
   const scene_model::ClusterPoses poses =

@@ -4,7 +4,7 @@
                    [--subject NAME] [--note TEXT]
                    [--restore CHECKPOINT] [--lab LABFILE] [--config FILE] [--speed X]
                    [--png-every N] [--width W] [--height H] [--no-video] [--window]
-                   [--gl osmesa|egl] [--visibility priority|depth]
+                   [--instructor [PORT]] [--gl osmesa|egl] [--visibility priority|depth]
                    [--lcm-url URL] [--channel-suffix S] [--share-network] [--no-build]
   scripts/lab replay SESSION [options]       scene and ESG driven from the log: frames, video
   scripts/lab resim SESSION [--config FILE]  the DCP again on the recorded inputs
@@ -13,6 +13,7 @@
   scripts/lab compare SESSION...             scorecards side by side, learning curves
   scripts/lab monitor [--lcm-url URL]        live decoded traffic per channel
   scripts/lab control [--session DIR] freeze|run|step [N]|checkpoint NAME|restore NAME|FILE [--run]
+                      | malfunction WHAT... | repair WHAT...   e.g. malfunction joint 2 stuck
 
 demo: installs what is missing, builds, checks every file the session will
 use (refusing, with the reason, what is wrong), looks for another session on

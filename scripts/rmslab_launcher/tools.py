@@ -165,10 +165,14 @@ def running_sessions():
 
 
 def control(argv):
-    """scripts/lab control [--session DIR] freeze | run | step [N] | checkpoint NAME | restore NAME|FILE [--run]:
+    """scripts/lab control [--session DIR] freeze | run | step [N] | checkpoint NAME | restore NAME|FILE [--run]
+                    | malfunction WHAT... | repair WHAT...:
     commands to a running session (docs/sessions.md "Freeze, run, step,
-    checkpoint"). Without --session (or --lcm-url and --session-id): the one
-    session of this checkout that is running now."""
+    checkpoint" and "Malfunctions"). WHAT is 'joint N stuck', 'joint N drift
+    DEG_S', 'joint N slow DEG_S', 'finger jammed open|closed', 'camera N lost'
+    or 'inputs delayed MS'; a repair names 'joint N', 'finger', 'camera N',
+    'inputs' or 'all'. Without --session (or --lcm-url and --session-id): the
+    one session of this checkout that is running now."""
     if not argv or argv[0] in ("-h", "--help"):
         print(control.__doc__)
         return 0 if argv else 2

@@ -15,7 +15,12 @@
 //   4. Reset sends the session back to Mode 1 (the event list shows the
 //      command and the reset), and the autopilot begins again;
 //   5. a second viewer joining late sees the events from the session's
-//      start, the freeze and the reset included.
+//      start, the freeze and the reset included;
+//   6. a malfunction injected from the page's menu stops that joint in the
+//      DCP's telemetry (the joint the autopilot is moving most, chosen as
+//      it flies), the operator station's autopilot reports it (its report is
+//      in the event list), and the page's Repair puts it right; a lost
+//      camera station's view goes black but for "NO VIDEO".
 import puppeteer from "puppeteer-core";
 
 const url = process.argv[2];
@@ -137,7 +142,67 @@ try {
   }, 15);
   result.late_viewer_events = seen.split("\n").length;
   console.log("ok a late viewer sees " + result.late_viewer_events + " events from the start, the freeze and the reset among them");
-  // 6. Text from the session's messages is shown as text, never run.
+  // 6. Malfunctions from the page (the first viewer's, in front again: a
+  // background tab's scripts are throttled).
+  await late.close();
+  await page.bringToFront();
+  const status = () => page.evaluate(async () => {
+    const token = new URLSearchParams(location.search).get("token");
+    return (await fetch("/api/status?token=" + token, {cache: "no-store"})).json();
+  });
+  const joint = await until("a joint the autopilot moves", async () => {
+    const a = (await status()).dcp;
+    await sleep(400);
+    const b = (await status()).dcp;
+    if (!a || !b || b.mode !== 1) return null;
+    let best = 0, j = 0;
+    for (let i = 0; i < 6; ++i) {
+      const d = Math.abs(b.master_angles_deg[i] - a.master_angles_deg[i]);
+      if (d > best) { best = d; j = i + 1; }
+    }
+    return best > 0.2 ? j : null;
+  }, 30);
+  await page.select("#mkind", "joint_stuck");
+  await page.select("#mtarget", String(joint));
+  await page.click("#inject");
+  await until("the malfunction is in the event list", async () =>
+      new RegExp("MALFUNCTION: joint " + joint + " stuck").test(await eventsText(page)), 10);
+  await until("the autopilot reports the joint not following", async () =>
+      /operator_station reports a joint or the finger NOT FOLLOWING/.test(await eventsText(page)), 20);
+  const s1 = (await status()).dcp;
+  await sleep(1500);
+  const s2 = (await status()).dcp;
+  result.stuck = {joint, slave: [s1.slave_angles_deg[joint - 1], s2.slave_angles_deg[joint - 1]],
+                  master: s2.master_angles_deg[joint - 1]};
+  if (s1.slave_angles_deg[joint - 1] !== s2.slave_angles_deg[joint - 1] ||
+      Math.abs(s2.master_angles_deg[joint - 1] - s2.slave_angles_deg[joint - 1]) < 0.5)
+    fail("joint " + joint + " is not stopped in the telemetry: " + JSON.stringify(result.stuck));
+  console.log("ok joint " + joint + " stuck from the page: stopped at " + s2.slave_angles_deg[joint - 1].toFixed(2) +
+              " deg (commanded " + s2.master_angles_deg[joint - 1].toFixed(2) + "), the autopilot reports it");
+  // A camera station lost: its view goes black.
+  await page.select("#mkind", "camera_lost");
+  await page.select("#mtarget", station);
+  await page.click("#inject");
+  const dark = await until("station " + station + "'s view goes black", async () => {
+    const v = await viewPixels(page, "view1");
+    return v && v.lit < first.lit / 10 && v.lit > 0 ? v : null;
+  }, 20);
+  result.lost_lit_pixels = dark.lit;
+  console.log("ok camera " + station + " lost: its view shows " + dark.lit + " lit pixels (NO VIDEO)");
+  await until("both malfunctions listed with Repair all", async () => (await page.$("#repairall")) !== null, 10);
+  await page.click("#repairall");
+  await until("the repair is in the event list", async () =>
+      new RegExp("repaired: joint " + joint + " stuck").test(await eventsText(page)), 10);
+  await until("the joint follows again", async () => {
+    const d = (await status()).dcp;
+    return d && Math.abs(d.master_angles_deg[joint - 1] - d.slave_angles_deg[joint - 1]) < 0.05;
+  }, 10);
+  await until("station " + station + "'s view comes back", async () => {
+    const v = await viewPixels(page, "view1");
+    return v && v.lit > first.lit / 4 ? v : null;
+  }, 20);
+  console.log("ok repaired from the page: the joint follows and the view is back");
+  // 7. Text from the session's messages is shown as text, never run.
   const forged = await page.evaluate(() => ({
     element: document.getElementById("forged") !== null,
     title: document.title,

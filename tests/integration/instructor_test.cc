@@ -2,8 +2,10 @@
 // `scripts/lab demo --instructor` prints the page's URL; the page, driven in
 // the system's Chromium by puppeteer-core (tests/browser/instructor_page.mjs),
 // shows live views that change as the arm moves, freezes, runs and resets
-// the session, and shows a late viewer the events from the start; the commands
-// are in the session's log (summary.json "control"). Requests without the
+// the session, and shows a late viewer the events from the start; it injects
+// a stuck joint and a lost camera station, which the DCP honours and the
+// autopilot reports, and repairs them; the commands are in the session's log
+// (summary.json "control" and "malfunctions") and re-simulate word for word. Requests without the
 // token, or with bad parameters, are refused and counted; a second station
 // cannot take the port.
 #include <httplib.h>
@@ -95,6 +97,11 @@ TEST(InstructorStation,
   ASSERT_TRUE(path);
   EXPECT_EQ(path->status, 400);
   EXPECT_NE(path->body.find("not a path"), std::string::npos) << path->body;
+  const auto bad = web.Post("/api/control?token=" + token, "command=malfunction&name=joint+9+stuck",
+                            "application/x-www-form-urlencoded");
+  ASSERT_TRUE(bad);
+  EXPECT_EQ(bad->status, 400);
+  EXPECT_NE(bad->body.find("joint '9' is not 1..6"), std::string::npos) << bad->body;
   const auto view = web.Get("/api/view?v=9&token=" + token);
   ASSERT_TRUE(view);
   EXPECT_EQ(view->status, 400);
@@ -114,24 +121,51 @@ TEST(InstructorStation,
   // The commands are in the session's log, from the instructor's station.
   const auto summary = nlohmann::json::parse(ReadFile(out + "/summary.json"));
   EXPECT_TRUE(summary["docked"].get<bool>());
-  int freezes = 0, runs = 0, resets = 0;
+  int freezes = 0, runs = 0, resets = 0, malfunctions = 0, repairs = 0;
   for (const auto& c : summary["control"]) {
     EXPECT_EQ(c["process"], "instructor_station") << c.dump();
     freezes += c["command"] == "freeze";
     runs += c["command"] == "run";
     resets += c["command"] == "reset";
+    malfunctions += c["command"] == "malfunction";
+    repairs += c["command"] == "repair";
   }
   EXPECT_EQ(freezes, 1) << summary["control"].dump();
   EXPECT_EQ(runs, 1) << summary["control"].dump();
   EXPECT_EQ(resets, 1) << summary["control"].dump();
+  EXPECT_EQ(malfunctions, 2) << summary["control"].dump();
+  EXPECT_EQ(repairs, 1) << summary["control"].dump();
+  // The malfunctions as the DCP took them, with their times and frames: the
+  // joint stuck, the camera lost, both repaired at once.
+  const auto& mf = summary["malfunctions"];
+  ASSERT_EQ(mf.size(), 3u) << mf.dump();
+  EXPECT_NE(mf[0]["injected"][0].get<std::string>().find(" stuck"), std::string::npos) << mf.dump();
+  EXPECT_EQ(mf[1]["injected"][0], "camera 1 lost") << mf.dump();
+  EXPECT_EQ(mf[2]["repaired"].size(), 2u) << mf.dump();
+  EXPECT_TRUE(mf[2]["in_force"].empty()) << mf.dump();
+  for (std::size_t i = 1; i < mf.size(); ++i) {
+    EXPECT_GE(mf[i]["time_s"].get<double>(), mf[i - 1]["time_s"].get<double>());
+    EXPECT_GT(mf[i]["dcp_frame"].get<std::int64_t>(), mf[i - 1]["dcp_frame"].get<std::int64_t>());
+  }
+  const auto dcp = nlohmann::json::parse(ReadFile(out + "/stats/dynamics_proc.json"));
+  EXPECT_EQ(dcp["counters"].value("control.malfunctions", 0), 2);
+  EXPECT_EQ(dcp["counters"].value("control.repairs", 0), 1);
   // The reset began a second attempt, and the autopilot flew it to the dock.
   EXPECT_EQ(summary["attempts"].size(), 2u) << summary["attempts"].dump();
   const auto stats = nlohmann::json::parse(ReadFile(out + "/stats/instructor_station.json"));
   EXPECT_GT(stats["counters"].value("views.rendered", 0), 10);
-  EXPECT_EQ(stats["counters"].value("http.refused", 0), 5);
-  EXPECT_EQ(stats["counters"].value("control.sent", 0), 3);
+  EXPECT_EQ(stats["counters"].value("http.refused", 0), 6);
+  EXPECT_EQ(stats["counters"].value("control.sent", 0), 6);
   const auto op = nlohmann::json::parse(ReadFile(out + "/stats/operator_station.json"));
   EXPECT_EQ(op["counters"].value("control.resets", 0), 1);
+  EXPECT_GE(op["counters"].value("arm.not_following", 0), 1);
+  // The report lists them.
+  const testing::ScriptRun report = testing::Script(
+      {SourcePath("scripts/lab"), "report", out, "--no-build"}, tmp + "/report.log");
+  EXPECT_EQ(report.rc, 0) << report.out;
+  const std::string html = ReadFile(out + "/report.html");
+  EXPECT_NE(html.find("<h2>Malfunctions</h2>"), std::string::npos);
+  EXPECT_NE(html.find("camera 1 lost"), std::string::npos);
   // What the page did re-simulates word for word.
   const testing::ScriptRun resim = testing::Script(
       {SourcePath("scripts/lab"), "resim", out, "--no-build", "--out", tmp + "/resim"},

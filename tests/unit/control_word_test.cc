@@ -25,8 +25,8 @@ TEST(ControlWord, ExhaustiveEveryValidWordRoundTripsAndEveryOtherIsRefused) {
     const wire::ControlWord cw = wire::UnpackControlWord(static_cast<std::int32_t>(w));
     ASSERT_EQ(wire::PackControlWord(cw), w);
   }
-  // 2^24 words; reserved bits 6-7 must be 0 (1/4) and mode 1-3 (3/4).
-  EXPECT_EQ(valid, (1 << 24) / 4 * 3 / 4);
+  // 2^24 words; reserved bit 7 must be 0 (1/2) and mode 1-3 (3/4).
+  EXPECT_EQ(valid, (1 << 24) / 2 * 3 / 4);
   EXPECT_GT(refused_checked, 10000);
 }
 
@@ -35,6 +35,9 @@ TEST(ControlWord, FieldsLandInTheDocumentedBits) {
   cw.camera_station = 8;
   cw.mode = 3;
   EXPECT_EQ(wire::PackControlWord(cw), 0x7u | (3u << 8));
+  cw = {};
+  cw.no_video = true;
+  EXPECT_EQ(wire::PackControlWord(cw), (1u << 8) | (1u << 6));
   cw = {};
   cw.docked = true;
   EXPECT_EQ(wire::PackControlWord(cw), (1u << 8) | (1u << 13));

@@ -2,6 +2,7 @@
 // (docs/sessions.md "Freeze, run, step, checkpoint"; docs/security.md "The
 // control channel"):
 //   rms_control --session DIR freeze | run | step [N] | checkpoint NAME | restore NAME|FILE [--run]
+//               | malfunction WHAT... | repair WHAT...
 // Every command carries the session's id (from DIR/manifest.json, or
 // --session-id): the session's processes take no other. A checkpoint is a
 // name in the session's checkpoints folder, never a path; restore of a file
@@ -27,6 +28,7 @@
 #include "rms/transport/lcm_interface.h"
 #include "rms/wire/channels.h"
 #include "rms/wire/checkpoint.h"
+#include "rms/wire/malfunction.h"
 #include "rms/wire/message_io.h"
 
 namespace fs = std::filesystem;
@@ -267,12 +269,49 @@ int Restore(ControlLink& link, const std::string& name, bool then_run,
   return 1;
 }
 
+// MALFUNCTION and REPAIR (docs/sessions.md "Malfunctions"), confirmed by
+// the DCP's counts.
+int Malfunction(ControlLink& link, std::int8_t command, const std::string& text,
+                const rms::transport::LcmOptions& options, std::int64_t id) {
+  if (!link.WaitForCounts()) return NobodyThere(options, id, "dynamics_proc");
+  const rms::Counter taken = command == rms::session_control_t::MALFUNCTION
+                                 ? rms::Counter::kControlMalfunctions
+                                 : rms::Counter::kControlRepairs;
+  auto refusals = [&link] {
+    return link.Count(rms::Counter::kControlRefused) +
+           link.Count(rms::Counter::kControlRateLimited);
+  };
+  const std::int64_t taken0 = link.Count(taken), refused0 = refusals();
+  link.Send(command, text);
+  SayWhereSent(options, id);
+  const int seen = link.reports();
+  link.ListenUntil(3.0, [&] {
+    return link.reports() > seen && link.Count(taken) + refusals() > taken0 + refused0;
+  });
+  if (link.Count(taken) > taken0) {
+    std::printf("%s: %s (dynamics_proc confirms)\n",
+                command == rms::session_control_t::MALFUNCTION ? "malfunction" : "repaired",
+                text.c_str());
+    return 0;
+  }
+  std::fprintf(stderr, "rms_control: dynamics_proc did not take '%s' (%s; see its log)\n",
+               text.c_str(), refusals() > refused0 ? "refused" : "no word from it within 3 s");
+  return 1;
+}
+
+// The words after the subcommand, as one text.
+std::string Joined(const std::vector<std::string>& words) {
+  std::string out;
+  for (const auto& w : words) out += (out.empty() ? "" : " ") + w;
+  return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "rmslab rms_control: freeze, run, step, checkpoint or restore a running session "
-      "(RMS_CONTROL)"};
+      "rmslab rms_control: freeze, run, step, checkpoint, restore, inject a malfunction in or "
+      "repair a running session (RMS_CONTROL)"};
   rms::transport::LcmOptions lcm_options;
   std::string session_dir, session_id;
   app.add_option("--session", session_dir,
@@ -304,6 +343,16 @@ int main(int argc, char** argv) {
       ->add_option("checkpoint", what, "A checkpoint's name in the session, or a checkpoint file")
       ->required();
   restore->add_flag("--run", then_run, "Run again after restoring");
+  std::vector<std::string> words;
+  auto* malfunction = app.add_subcommand(
+      "malfunction",
+      "Inject a malfunction: 'joint N stuck', 'joint N drift DEG_S', 'joint N slow DEG_S', "
+      "'finger jammed open|closed', 'camera N lost', 'inputs delayed MS' (docs/sessions.md "
+      "\"Malfunctions\")");
+  malfunction->add_option("what", words, "The malfunction, e.g. joint 2 stuck")->required();
+  auto* repair = app.add_subcommand(
+      "repair", "Repair a malfunction: 'joint N', 'finger', 'camera N', 'inputs' or 'all'");
+  repair->add_option("what", words, "What to repair, e.g. joint 2")->required();
   if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   try {
     std::string folder;
@@ -329,7 +378,15 @@ int main(int argc, char** argv) {
       }
     }
     if (restore->parsed()) name = RestoreName(what, folder);
+    // A malfunction's text is checked here first: a clear error, nothing sent.
+    if (malfunction->parsed())
+      name = rms::wire::MalfunctionText(rms::wire::ParseMalfunction(Joined(words)));
+    if (repair->parsed()) name = rms::wire::RepairText(rms::wire::ParseRepair(Joined(words)));
     ControlLink link(lcm_options, id);
+    if (malfunction->parsed())
+      return Malfunction(link, rms::session_control_t::MALFUNCTION, name, lcm_options, id);
+    if (repair->parsed())
+      return Malfunction(link, rms::session_control_t::REPAIR, name, lcm_options, id);
     if (checkpoint->parsed()) return Checkpoint(link, name, folder, lcm_options, id);
     if (restore->parsed()) return Restore(link, name, then_run, lcm_options, id);
     if (freeze->parsed()) return Clock(link, rms::session_control_t::FREEZE, 1, lcm_options, id);

@@ -25,13 +25,7 @@ std::string CheckpointText(const Checkpoint& c) {
   j["dcp_frame"] = c.dcp_frame;
   j["input_frame"] = c.input_frame;
   j["config"] = c.config;
-  nlohmann::ordered_json in;
-  for (int i = 0; i < kNumAnalogInputs; ++i)
-    in[std::string(kAnalogInputNames[i])] = c.inputs.value[i];
-  in["camera_station"] = c.inputs.camera_station;
-  in["overlay"] = c.inputs.overlay;
-  in["crosshairs"] = c.inputs.crosshairs;
-  j["operator_inputs"] = in;
+  j["operator_inputs"] = InputsJson(c.inputs);
   j["dcp"] = c.dcp;
   return j.dump(2) + "\n";
 }
@@ -174,12 +168,7 @@ Checkpoint ParseCheckpoint(std::string_view text, const std::string& path) {
     c.dcp_frame = j.at("dcp_frame").get<std::int64_t>();
     c.input_frame = j.at("input_frame").get<std::int64_t>();
     c.config = j.at("config").get<std::string>();
-    const auto& o = j.at("operator_inputs");
-    for (int i = 0; i < kNumAnalogInputs; ++i)
-      c.inputs.value[i] = o.at(std::string(kAnalogInputNames[i])).get<double>();
-    c.inputs.camera_station = o.at("camera_station").get<int>();
-    c.inputs.overlay = o.at("overlay").get<bool>();
-    c.inputs.crosshairs = o.value("crosshairs", false);  // absent before the crosshairs switch
+    c.inputs = InputsFromJson(j.at("operator_inputs"));
     c.dcp = j.at("dcp");
   } catch (const std::exception& e) {
     std::string why =

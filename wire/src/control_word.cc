@@ -15,6 +15,7 @@ wire::Word PackControlWord(const ControlWord& cw) {
   if (cw.reset) w |= kReset;
   if (cw.overlay) w |= kOverlay;
   if (cw.crosshairs) w |= kCrosshairs;
+  if (cw.no_video) w |= kNoVideo;
   w |= static_cast<std::uint32_t>(cw.mode) << kModeShift;
   if (cw.collision) w |= kCollision;
   if (cw.receptacle_collision) w |= kReceptacle;
@@ -31,13 +32,14 @@ ControlWord UnpackControlWord(std::int32_t carried) {
   }
   const auto w = static_cast<std::uint32_t>(carried);
   if (w & kReservedMask) {
-    throw InputError("control word " + wire::FormatWord(carried) + " has reserved bits 6-7 set");
+    throw InputError("control word " + wire::FormatWord(carried) + " has reserved bit 7 set");
   }
   ControlWord cw;
   cw.camera_station = static_cast<int>((w >> kCameraShift) & kCameraMask) + 1;
   cw.reset = w & kReset;
   cw.overlay = w & kOverlay;
   cw.crosshairs = w & kCrosshairs;
+  cw.no_video = w & kNoVideo;
   cw.mode = static_cast<int>((w >> kModeShift) & kModeMask);
   if (cw.mode == 0) {
     throw InputError("control word " + wire::FormatWord(carried) + " has mode 0 (must be 1-3)");

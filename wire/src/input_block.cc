@@ -88,4 +88,38 @@ OperatorInputs DecodeInputs(const std::array<std::int32_t, kInputWords>& words,
   return in;
 }
 
+nlohmann::ordered_json InputsJson(const OperatorInputs& in) {
+  nlohmann::ordered_json j;
+  for (int i = 0; i < kNumAnalogInputs; ++i) j[std::string(kAnalogInputNames[i])] = in.value[i];
+  j["camera_station"] = in.camera_station;
+  j["reset"] = in.reset;
+  j["overlay"] = in.overlay;
+  j["crosshairs"] = in.crosshairs;
+  return j;
+}
+
+OperatorInputs InputsFromJson(const nlohmann::json& j) {
+  OperatorInputs in;
+  try {
+    for (int i = 0; i < kNumAnalogInputs; ++i) {
+      in.value[i] = j.at(std::string(kAnalogInputNames[i])).get<double>();
+      if (!std::isfinite(in.value[i])) {
+        throw InputError("input '" + std::string(kAnalogInputNames[i]) + "' is not finite");
+      }
+    }
+    in.camera_station = j.at("camera_station").get<int>();
+    in.reset = j.value("reset", false);  // absent in checkpoints before the delayed inputs
+    in.overlay = j.value("overlay", true);
+    in.crosshairs = j.value("crosshairs", false);  // absent before the crosshairs switch
+  } catch (const nlohmann::json::exception& e) {
+    std::string why = e.what();
+    if (why.rfind("[json.exception.", 0) == 0 && why.find("] ") != std::string::npos)
+      why = why.substr(why.find("] ") + 2);
+    throw InputError("operator inputs: " + why);
+  }
+  if (in.camera_station < 1 || in.camera_station > 8)
+    throw InputError("operator inputs: camera_station must be 1..8");
+  return in;
+}
+
 }  // namespace rms::wire

@@ -71,10 +71,10 @@ constexpr struct {
 }  // namespace
 
 const char* ControlCommandName(std::int8_t command) {
-  static constexpr const char* kNames[] = {"?",          "freeze",  "run",  "step",
-                                           "checkpoint", "restore", "reset"};
-  static_assert(session_control_t::RESET == 6, "kNames follows session_control_t's commands");
-  return command >= 1 && command <= 6 ? kNames[command] : "?";
+  static constexpr const char* kNames[] = {
+      "?", "freeze", "run", "step", "checkpoint", "restore", "reset", "malfunction", "repair"};
+  static_assert(session_control_t::REPAIR == 8, "kNames follows session_control_t's commands");
+  return command >= 1 && command <= 8 ? kNames[command] : "?";
 }
 
 const char* ProcessCodeName(std::int8_t process) {

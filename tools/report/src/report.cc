@@ -414,6 +414,30 @@ std::string AttemptsSection(const nlohmann::ordered_json& s) {
   return h.str();
 }
 
+// docs/sessions.md "Malfunctions": each change, with its time and frame.
+std::string MalfunctionsSection(const nlohmann::ordered_json& s) {
+  const auto& list = s["malfunctions"];
+  if (!list.is_array() || list.empty()) return "";
+  std::ostringstream h;
+  auto texts = [](const nlohmann::ordered_json& a) {
+    std::string out;
+    for (const auto& t : a) out += (out.empty() ? "" : "; ") + Html(t.get<std::string>());
+    return out.empty() ? std::string("-") : out;
+  };
+  h << "<h2>Malfunctions</h2>\n<p>As the DCP took them (its logged states): each from the DCP "
+       "frame given; a restore or a resumed process may change them too.</p>\n"
+       "<table><tr><th>time, s</th><th>from DCP frame</th><th>by</th><th>injected</th>"
+       "<th>repaired</th><th>in force after</th></tr>";
+  for (const auto& m : list) {
+    h << "<tr><td>" << Cell(m["time_s"], "", 2) << "</td><td>" << m["dcp_frame"] << "</td><td>"
+      << Cell(m["why"]) << "</td><td" << (m["injected"].empty() ? "" : " class=\"bad\"") << ">"
+      << texts(m["injected"]) << "</td><td>" << texts(m["repaired"]) << "</td><td>"
+      << texts(m["in_force"]) << "</td></tr>";
+  }
+  h << "</table>\n";
+  return h.str();
+}
+
 std::string ScorecardSection(const nlohmann::ordered_json& s) {
   const auto& attempts = s["attempts"];
   if (attempts.empty()) return "";
@@ -709,7 +733,7 @@ std::string MakeReport(const std::string& session_dir, const std::string& chart_
        "statistics and its manifest. One self-contained file: the plots are drawn by Chart.js, "
        "embedded.</p>\n";
   h << SessionSection(manifest, s) << TolerancesSection(config) << AttemptsSection(s)
-    << ScorecardSection(s);
+    << MalfunctionsSection(s) << ScorecardSection(s);
   h << "<h2>Plots</h2>\n<div id=\"rms-charts\"></div>\n";
   h << "<script>\nwindow.RMS_REPORT = " << ScriptJson(data) << ";\n</script>\n<script>\n"
     << charts << "\n</script>\n";

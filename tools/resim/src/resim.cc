@@ -35,10 +35,11 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// A logged state: a restore, a resume or a start is taken as the live DCP
-// took it (another design keeps its own state at a resume: only the
-// numbering); a periodic one is checked against the re-simulated state
-// (the same design only: another one is expected to differ).
+// A logged state: a restore, a resume, a malfunction or a start is taken as
+// the live DCP took it (another design keeps its own state at a resume: only
+// the numbering; at a malfunction, the numbering and the malfunctions in
+// force); a periodic one is checked against the re-simulated state (the same
+// design only: another one is expected to differ).
 void TakeState(const dcp_state_t& m, bool first, bool other_design,
                dynamics_proc::DynamicsProc* node, ResimResult* result) {
   if (m.reason == dcp_state_t::PERIODIC && !first) {
@@ -52,7 +53,9 @@ void TakeState(const dcp_state_t& m, bool first, bool other_design,
     }
     return;
   }
-  node->ApplyState(m, first || !(other_design && m.reason == dcp_state_t::RESUME));
+  const bool own_state =
+      other_design && (m.reason == dcp_state_t::RESUME || m.reason == dcp_state_t::MALFUNCTION);
+  node->ApplyState(m, first || !own_state);
   ++result->states_taken;
   // Into the new session's log too, so it can be re-simulated and its
   // summary sees the same restores (its attempts).

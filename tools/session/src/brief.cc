@@ -120,6 +120,24 @@ void SessionLines(const Json& j, std::ostream& os) {
     for (const auto& [what, k] : n) os << " " << what << " " << k;
     os << "\n";
   }
+  if (j.contains("malfunctions") && !j["malfunctions"].empty()) {
+    // docs/sessions.md "Malfunctions": as the DCP took them.
+    os << "malfunctions:";
+    const char* sep = " ";
+    for (const auto& m : j["malfunctions"]) {
+      for (const auto& t : m["injected"]) {
+        os << sep << t.get<std::string>() << " at " << HumanNumber(m["time_s"].get<double>())
+           << " s";
+        sep = "; ";
+      }
+      for (const auto& t : m["repaired"]) {
+        os << sep << t.get<std::string>() << " repaired at "
+           << HumanNumber(m["time_s"].get<double>()) << " s";
+        sep = "; ";
+      }
+    }
+    os << "\n";
+  }
   if (!j["ignored"].value("session_id_checked", true)) {
     os << "this session has no id (made before session ids): every message in its log was read as "
           "its own\n";

@@ -31,8 +31,10 @@
 #include "rms/transport/lcm_interface.h"
 #include "rms/transport/process.h"
 #include "rms/wire/channels.h"
+#include "rms/wire/checkpoint.h"
 #include "rms/wire/collision_bits.h"
 #include "rms/wire/control_word.h"
+#include "rms/wire/malfunction.h"
 #include "rms/wire/message_io.h"
 
 #include "attempts.h"
@@ -318,6 +320,10 @@ struct LogScan {
   nlohmann::ordered_json control = nlohmann::ordered_json::array();
   AttemptLog* attempts = nullptr;
   std::string last_restore_name;
+  // docs/sessions.md "Malfunctions": each change of the malfunctions in
+  // force, as the DCP's logged states show it, and those in force now.
+  nlohmann::ordered_json malfunctions = nlohmann::ordered_json::array();
+  std::vector<std::string> in_force;
 };
 
 void ScanTelemetry(const LogMessage& ev, const std::map<std::int64_t, DcpFrameRecord>& dcp,
@@ -412,6 +418,30 @@ void ScanState(const LogMessage& ev, LogScan* s) {
     return;
   }
   if (m.reason == dcp_state_t::RESTORE) s->attempts->ObserveRestore(s->last_restore_name);
+  std::vector<std::string> now;
+  try {
+    now = wire::MalfunctionTexts(wire::ParseCheckpoint(m.checkpoint, "RMS_DCP_STATE").dcp);
+  } catch (const InputError&) {
+    ++s->malformed;
+    return;
+  }
+  if (now == s->in_force) return;
+  auto minus = [](const std::vector<std::string>& a, const std::vector<std::string>& b) {
+    nlohmann::ordered_json out = nlohmann::ordered_json::array();
+    for (const auto& x : a) {
+      if (std::find(b.begin(), b.end(), x) == b.end()) out.push_back(x);
+    }
+    return out;
+  };
+  static constexpr const char* kReasons[] = {"?",       "start",  "periodic",
+                                             "restore", "resume", "malfunction"};
+  s->malfunctions.push_back({{"time_s", (ev.log_us - s->first_us) * 1e-6},
+                             {"dcp_frame", m.next_frame},
+                             {"why", m.reason >= 1 && m.reason <= 5 ? kReasons[m.reason] : "?"},
+                             {"injected", minus(now, s->in_force)},
+                             {"repaired", minus(s->in_force, now)},
+                             {"in_force", now}});
+  s->in_force = std::move(now);
 }
 
 LogScan ScanLog(SessionLog& log, const std::map<std::int64_t, DcpFrameRecord>& dcp,
@@ -778,6 +808,7 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
   j["totals"] = std::move(a["totals"]);
   j["mode_changes"] = s.telemetry.mode_changes;
   j["control"] = s.control;
+  j["malfunctions"] = s.malfunctions;
   AddResult(&j);
   j["by_hand"] = s.hand.Json();
   if (j["by_hand"].is_object()) {

@@ -31,6 +31,7 @@
 #include "rms/base/config.h"
 #include "rms/dynamics_proc/collision.h"
 #include "rms/dynamics_proc/dcp_models.h"
+#include "rms/dynamics_proc/malfunctions.h"
 #include "rms/wire/acquisition_conditions.h"
 #include "rms/wire/collision_bits.h"
 #include "rms/wire/input_block.h"
@@ -195,6 +196,13 @@ class DynamicCollisionProgram {
   nlohmann::ordered_json SaveState() const;
   void RestoreState(const nlohmann::json& state);
 
+  // Malfunctions (docs/sessions.md "Malfunctions"), between frames: from
+  // the next frame on, anchored where the slave arm is now. Kept by a reset
+  // (the arm is still broken), saved in the checkpoint.
+  void Inject(const wire::Malfunction& m);
+  void Repair(const wire::Repair& r) { malfunctions_.Repair(r); }
+  const Malfunctions& malfunctions() const { return malfunctions_; }
+
   int mode() const { return status_.mode; }
   bool released() const { return released_; }
   const DcpStatus& status() const { return status_; }
@@ -339,6 +347,7 @@ class DynamicCollisionProgram {
   // pose until the finger opens past the acquisition gap (released).
   bool released_ = false;
   Eigen::Isometry3d X_RP_docked_ = Eigen::Isometry3d::Identity();  // payload at the dock
+  Malfunctions malfunctions_;
   DcpStatus status_;
 };
 

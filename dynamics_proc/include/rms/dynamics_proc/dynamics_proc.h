@@ -4,11 +4,13 @@
 // dynamics_proc's LCM side: RMS_OPERATOR_INPUT in, RMS_DCP_FRAME out, one
 // output frame per input block, counters and latency.
 #include <string>
+#include <vector>
 
 #include "rms/base/counters.h"
 #include "rms/dcp_state_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/dynamics_proc/dynamic_collision_program.h"
+#include "rms/session_control_t.hpp"
 #include "rms/transport/lcm_interface.h"
 #include "rms/transport/process.h"
 #include "rms/wire/checkpoint.h"
@@ -40,9 +42,9 @@ class DynamicsProc {
   // (CheckpointFolder; docs/security.md "The control channel").
   void set_checkpoint_folder(wire::CheckpointFolder folder) { checkpoints_ = std::move(folder); }
   const wire::CheckpointFolder& checkpoint_folder() const { return checkpoints_; }
-  // An RMS_CONTROL message: CHECKPOINT and RESTORE act (between frames),
-  // at most CheckpointRateLimit's rate; a bad or refused one is counted and
-  // logged, never fatal.
+  // An RMS_CONTROL message: CHECKPOINT, RESTORE, MALFUNCTION and REPAIR
+  // act (between frames), each kind at most CheckpointRateLimit's rate; a
+  // bad or refused one is counted and logged, never fatal.
   void OnControl(const void* data, int size);
 
   // Process faults (docs/sessions.md "Faults"): with a state file, the node
@@ -64,8 +66,12 @@ class DynamicsProc {
   // Re-simulation (docs/sessions.md "Re-simulation"): takes a logged
   // RMS_DCP_STATE as the live DCP had it, the state and its numbering; with
   // with_state false, the numbering only (another design's DCP keeps its
-  // own state). Throws InputError for a checkpoint it cannot read.
+  // own state), and from a MALFUNCTION state the malfunctions in force
+  // (MatchMalfunctions). Throws InputError for a checkpoint it cannot read.
   void ApplyState(const dcp_state_t& m, bool with_state);
+  // The malfunctions in force become these (their text): those not among
+  // them repaired, those new injected where this DCP's arm is now.
+  void MatchMalfunctions(const std::vector<std::string>& texts);
   // Whether the node has made a frame since it started.
   bool made_a_frame() const { return made_a_frame_; }
   // The first DCP frame number to publish (FirstFrameNumber).
@@ -78,6 +84,7 @@ class DynamicsProc {
 
  private:
   void Report(const DcpStatus& status, std::int64_t frame);
+  void OnMalfunction(const session_control_t& m);
   const LabConfig& config_;
   transport::LcmInterface* lcm_;
   DynamicCollisionProgram dcp_;
@@ -93,6 +100,7 @@ class DynamicsProc {
   std::string state_file_;
   wire::CheckpointFolder checkpoints_;
   wire::CheckpointRateLimit checkpoint_rate_;
+  wire::CheckpointRateLimit malfunction_rate_;
   std::optional<std::pair<std::int64_t, std::int64_t>>
       resume_;  // (DCP frame, input frame) of the state resumed
   std::int64_t state_written_us_ = 0;

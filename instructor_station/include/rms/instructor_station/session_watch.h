@@ -4,7 +4,9 @@
 // telemetry, each process's status reports, the end effector's path, and the
 // events since the session began -- mode changes, acquisition, docking,
 // collisions, holds, resets, control commands (freeze, run, step,
-// checkpoint, restore), processes that started, restarted or ended. Fed by
+// checkpoint, restore, malfunction, repair), malfunctions the DCP took, a
+// part the operator station saw not following its command, processes that
+// started, restarted or ended. Fed by
 // the LCM thread; read by the web server's threads (every method locks).
 #include <cstdint>
 #include <deque>
@@ -35,8 +37,8 @@ struct Event {
 
 class SessionWatch {
  public:
-  // Subscribes on `lcm` to RMS_DCP_FRAME, RMS_DCP_TELEMETRY, RMS_STATUS and
-  // RMS_CONTROL. Malformed messages are counted in `counters` and dropped.
+  // Subscribes on `lcm` to RMS_DCP_FRAME, RMS_DCP_TELEMETRY, RMS_DCP_STATE,
+  // RMS_STATUS and RMS_CONTROL. Malformed messages are counted in `counters` and dropped.
   SessionWatch(const LabConfig& config, transport::LcmInterface* lcm, Counters* counters);
 
   // The latest DCP frame (what the views are drawn from), if any yet.
@@ -50,6 +52,9 @@ class SessionWatch {
   // The end effector's path (point A, R, ft), a point every few frames.
   nlohmann::json PathJson(std::size_t since) const;
   std::int64_t events_seen() const;
+  // The camera stations lost (docs/sessions.md "Malfunctions"), bit k-1 for
+  // station k, as the DCP's last state says.
+  std::uint32_t LostStations() const;
 
   // Called by the web server for commands it sends (also heard back on
   // RMS_CONTROL; this says who asked).
@@ -60,6 +65,7 @@ class SessionWatch {
   void OnTelemetry(const void* data, int size);
   void OnStatus(const void* data, int size);
   void OnControl(const void* data, int size);
+  void OnDcpState(const void* data, int size);
   void AddEvent(const std::string& kind, const std::string& text);  // mu_ held
   void TelemetryEvents(const dcp_telemetry_t& t);                   // mu_ held
 
@@ -85,6 +91,8 @@ class SessionWatch {
   std::vector<Event> events_;
   std::vector<std::array<double, 4>> path_;  // session_s, x, y, z of point A in R, ft
   std::int64_t last_path_frame_ = -1000;
+  std::vector<std::string> malfunctions_;  // in force, as the DCP's last state says
+  std::uint32_t lost_stations_ = 0;
 };
 
 }  // namespace rms::instructor_station

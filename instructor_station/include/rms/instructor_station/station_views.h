@@ -46,7 +46,9 @@ class StationViews {
   ViewImage Latest(int view) const;
   // On the LCM thread, after each wait: steps every camera drive on a new DCP
   // frame, draws the views watched that are due.
-  void Update(const wire::DcpFrameData& dcp);
+  // lost_stations: bit k-1, station k is lost (SessionWatch::LostStations):
+  // its view shows no picture, as the ESG would.
+  void Update(const wire::DcpFrameData& dcp, std::uint32_t lost_stations = 0);
 
  private:
   static std::array<std::int64_t, kNumViews> MinusOnes() {

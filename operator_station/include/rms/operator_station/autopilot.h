@@ -25,6 +25,7 @@
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/mission/mission_geometry.h"
 #include "rms/operator_station/arm_motion.h"
+#include "rms/operator_station/follow_watch.h"
 #include "rms/scene_model/scene_model.h"
 #include "rms/wire/input_block.h"
 
@@ -147,6 +148,9 @@ class Autopilot {
   JointLimits limits_;
   scene_model::SceneModel model_;
   double dt_s_;
+  // A joint or the finger not following (a failure, docs/operator.md "The
+  // autopilot"): the autopilot says so and holds its command until it follows.
+  FollowWatch follow_;
   double t_s_ = 0.0, phase_t0_s_ = 0.0;
   AutopilotPhase phase_ = AutopilotPhase::kWaitTelemetry;
   std::string failure_;

@@ -16,6 +16,7 @@
 #include "rms/base/counters.h"
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/operator_input_t.hpp"
+#include "rms/operator_station/follow_watch.h"
 #include "rms/operator_station/guidance.h"
 #include "rms/operator_station/input_sources.h"
 #include "rms/operator_station/session_events.h"
@@ -114,6 +115,7 @@ class OperatorStation {
   InputBlockBuilder builder_;
   std::unique_ptr<StatusScreen> screen_;
   TelemetryEvents events_;
+  FollowWatch follow_;
 
   // What the DCP and the other processes say.
   std::optional<dcp_telemetry_t> telemetry_;

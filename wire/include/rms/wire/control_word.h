@@ -6,7 +6,8 @@
 //  bit  3     RESET     reset pushbutton seen this frame          (DCP, from the inputs)
 //  bit  4     OVERLAY   draw frame counter and indicators         (DCP, from the inputs)
 //  bit  5     CROSSHAIRS draw the wrist and port cameras' crosshairs (DCP, from the inputs)
-//  bits 6-7   reserved, zero
+//  bit  6     NO VIDEO  the selected camera station is lost: no picture (DCP, a malfunction)
+//  bit  7     reserved, zero
 //  bits 8-9   MODE      1 acquisition, 2 extraction, 3 manoeuvring (DCP-generated)
 //  bit  10    COLLISION a detrimental collision this frame         (DCP-generated)
 //  bit  11    RECPT     end effector in collision with the receptacle (DCP-generated)
@@ -25,7 +26,8 @@ struct ControlWord {
   bool reset = false;
   bool overlay = false;
   bool crosshairs = false;
-  int mode = 1;  // 1..3
+  bool no_video = false;  // docs/sessions.md "Malfunctions": camera station lost
+  int mode = 1;           // 1..3
   bool collision = false;
   bool receptacle_collision = false;
   bool acquired = false;
@@ -41,7 +43,8 @@ inline constexpr std::uint32_t kCameraShift = 0, kCameraMask = 0x7;
 inline constexpr std::uint32_t kReset = 1u << 3;
 inline constexpr std::uint32_t kOverlay = 1u << 4;
 inline constexpr std::uint32_t kCrosshairs = 1u << 5;
-inline constexpr std::uint32_t kReservedMask = 0x3u << 6;
+inline constexpr std::uint32_t kNoVideo = 1u << 6;
+inline constexpr std::uint32_t kReservedMask = 0x1u << 7;
 inline constexpr std::uint32_t kModeShift = 8, kModeMask = 0x3;
 inline constexpr std::uint32_t kCollision = 1u << 10;
 inline constexpr std::uint32_t kReceptacle = 1u << 11;

@@ -8,6 +8,7 @@
 // Word 11 holds the discrete inputs.
 #include <array>
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
 
@@ -53,5 +54,12 @@ std::array<std::int32_t, kInputWords> EncodeInputs(const OperatorInputs& in,
 // outside [min, max] are clamped ("clamped.NAME").
 OperatorInputs DecodeInputs(const std::array<std::int32_t, kInputWords>& words,
                             const InputCalibrations& cal, Counters* counters);
+
+// The inputs as JSON (checkpoints, the DCP's delayed inputs): each channel
+// by its name, the camera station, the reset, overlay and crosshairs
+// switches; doubles exact. InputsFromJson throws rms::InputError naming a
+// missing or bad key (an absent switch reads as off; the overlay as on).
+nlohmann::ordered_json InputsJson(const OperatorInputs& in);
+OperatorInputs InputsFromJson(const nlohmann::json& j);
 
 }  // namespace rms::wire

@@ -1,0 +1,199 @@
+#include "rms/dynamics_proc/malfunctions.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "rms/base/check.h"
+
+namespace rms::dynamics_proc {
+
+using wire::MalfunctionKind;
+
+Malfunctions::Malfunctions(double frame_rate_hz, const std::array<double, 6>& joint_min_deg,
+                           const std::array<double, 6>& joint_max_deg)
+    : frame_rate_hz_(frame_rate_hz), joint_min_deg_(joint_min_deg), joint_max_deg_(joint_max_deg) {
+  RMS_CHECK(frame_rate_hz > 0.0);
+}
+
+void Malfunctions::Inject(const wire::Malfunction& m, const std::array<double, 6>& slave_angles_deg,
+                          double slave_finger) {
+  switch (m.kind) {
+    case MalfunctionKind::kJointStuck:
+    case MalfunctionKind::kJointDrift:
+    case MalfunctionKind::kJointSlow:
+      RMS_CHECK(m.target >= 1 && m.target <= 6);
+      joints_[m.target - 1] = JointFault{m.kind, m.value, slave_angles_deg[m.target - 1]};
+      break;
+    case MalfunctionKind::kFingerJammedOpen:
+    case MalfunctionKind::kFingerJammedClosed:
+      finger_ = FingerFault{m.kind == MalfunctionKind::kFingerJammedOpen, slave_finger};
+      break;
+    case MalfunctionKind::kCameraLost:
+      RMS_CHECK(m.target >= 1 && m.target <= 8);
+      cameras_lost_ |= 1u << (m.target - 1);
+      break;
+    case MalfunctionKind::kInputsDelayed: {
+      delay_ms_ = m.value;
+      delay_frames_ = std::max(1, static_cast<int>(std::lround(m.value * frame_rate_hz_ / 1000.0)));
+      // A longer delay holds the oldest block due for the extra frames; a
+      // shorter one drops the oldest (the arm jumps ahead to them).
+      const wire::OperatorInputs hold = line_.empty() ? last_ : line_.front();
+      if (have_last_ || !line_.empty()) {
+        while (static_cast<int>(line_.size()) < delay_frames_) line_.push_front(hold);
+      }
+      while (static_cast<int>(line_.size()) > delay_frames_) line_.pop_front();
+      break;
+    }
+    case MalfunctionKind::kCount:
+      RMS_CHECK(false);
+  }
+}
+
+void Malfunctions::Repair(const wire::Repair& r) {
+  for (const wire::Malfunction& m : active()) {
+    if (!wire::Clears(r, m)) continue;
+    switch (m.kind) {
+      case MalfunctionKind::kJointStuck:
+      case MalfunctionKind::kJointDrift:
+      case MalfunctionKind::kJointSlow:
+        joints_[m.target - 1].reset();
+        break;
+      case MalfunctionKind::kFingerJammedOpen:
+      case MalfunctionKind::kFingerJammedClosed:
+        finger_.reset();
+        break;
+      case MalfunctionKind::kCameraLost:
+        cameras_lost_ &= ~(1u << (m.target - 1));
+        break;
+      case MalfunctionKind::kInputsDelayed:
+        delay_ms_ = 0.0;
+        delay_frames_ = 0;
+        line_.clear();  // the next frame answers its own block
+        break;
+      case MalfunctionKind::kCount:
+        break;
+    }
+  }
+}
+
+const wire::OperatorInputs& Malfunctions::Delay(const wire::OperatorInputs& in) {
+  if (delay_frames_ == 0) {
+    last_ = in;
+    have_last_ = true;
+    return last_;
+  }
+  line_.push_back(in);
+  // Injected before any frame: nothing to hold, the line fills from the
+  // first blocks (the first delay_frames_ frames answer the first block).
+  while (static_cast<int>(line_.size()) <= delay_frames_) line_.push_front(line_.front());
+  last_ = line_.front();
+  line_.pop_front();
+  have_last_ = true;
+  return last_;
+}
+
+void Malfunctions::Apply(const std::array<double, 6>& slave_angles_deg,
+                         std::array<double, 6>* angles_deg, double* finger) {
+  const double dt_s = 1.0 / frame_rate_hz_;
+  for (int i = 0; i < 6; ++i) {
+    if (!joints_[i]) continue;
+    JointFault& f = *joints_[i];
+    double& q = (*angles_deg)[i];
+    switch (f.kind) {
+      case MalfunctionKind::kJointStuck:
+        q = f.anchor_deg;
+        break;
+      case MalfunctionKind::kJointDrift:
+        // From where the slave is (a held arm does not wind the drift up).
+        q = std::clamp(slave_angles_deg[i] + f.value * dt_s, joint_min_deg_[i], joint_max_deg_[i]);
+        break;
+      case MalfunctionKind::kJointSlow: {
+        const double step = f.value * dt_s;
+        q = slave_angles_deg[i] + std::clamp(q - slave_angles_deg[i], -step, step);
+        break;
+      }
+      default:
+        break;
+    }
+  }
+  if (finger_) {
+    *finger = finger_->open ? std::min(*finger, finger_->anchor_lever)
+                            : std::max(*finger, finger_->anchor_lever);
+  }
+}
+
+std::vector<wire::Malfunction> Malfunctions::active() const {
+  std::vector<wire::Malfunction> out;
+  for (int i = 0; i < 6; ++i) {
+    if (joints_[i]) out.push_back({joints_[i]->kind, i + 1, joints_[i]->value});
+  }
+  if (finger_) {
+    out.push_back(
+        {finger_->open ? MalfunctionKind::kFingerJammedOpen : MalfunctionKind::kFingerJammedClosed,
+         0, 0.0});
+  }
+  for (int k = 1; k <= 8; ++k) {
+    if (CameraLost(k)) out.push_back({MalfunctionKind::kCameraLost, k, 0.0});
+  }
+  if (delay_frames_ > 0) out.push_back({MalfunctionKind::kInputsDelayed, 0, delay_ms_});
+  std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) {
+    return static_cast<int>(a.kind) < static_cast<int>(b.kind);
+  });
+  return out;
+}
+
+nlohmann::ordered_json Malfunctions::ToJson() const {
+  nlohmann::ordered_json j;
+  nlohmann::ordered_json list = nlohmann::ordered_json::array();
+  for (const wire::Malfunction& m : active()) {
+    nlohmann::ordered_json a;
+    a["text"] = wire::MalfunctionText(m);
+    if (m.kind == MalfunctionKind::kJointStuck || m.kind == MalfunctionKind::kJointDrift ||
+        m.kind == MalfunctionKind::kJointSlow) {
+      a["anchor"] = joints_[m.target - 1]->anchor_deg;
+    } else if (m.kind == MalfunctionKind::kFingerJammedOpen ||
+               m.kind == MalfunctionKind::kFingerJammedClosed) {
+      a["anchor"] = finger_->anchor_lever;
+    }
+    list.push_back(a);
+  }
+  j["active"] = list;
+  nlohmann::ordered_json line = nlohmann::ordered_json::array();
+  for (const wire::OperatorInputs& in : line_) line.push_back(wire::InputsJson(in));
+  j["delay_line"] = line;
+  j["last_inputs"] = have_last_ ? nlohmann::ordered_json(wire::InputsJson(last_))
+                                : nlohmann::ordered_json(nullptr);
+  return j;
+}
+
+void Malfunctions::FromJson(const nlohmann::json& j) {
+  Malfunctions next(frame_rate_hz_, joint_min_deg_, joint_max_deg_);
+  try {
+    if (!j.is_object()) throw InputError("must be an object");
+    if (j.contains("last_inputs") && !j.at("last_inputs").is_null()) {
+      next.last_ = wire::InputsFromJson(j.at("last_inputs"));
+      next.have_last_ = true;
+    }
+    for (const auto& a : j.at("active")) {
+      const wire::Malfunction m = wire::ParseMalfunction(a.at("text").get<std::string>());
+      const bool anchored =
+          m.kind != MalfunctionKind::kCameraLost && m.kind != MalfunctionKind::kInputsDelayed;
+      const double anchor = anchored ? a.at("anchor").get<double>() : 0.0;
+      if (!std::isfinite(anchor)) throw InputError("an anchor is not finite");
+      std::array<double, 6> q{};
+      q.fill(anchor);
+      next.Inject(m, q, anchor);
+    }
+    next.line_.clear();
+    for (const auto& in : j.at("delay_line")) next.line_.push_back(wire::InputsFromJson(in));
+    if (static_cast<int>(next.line_.size()) > next.delay_frames_)
+      throw InputError("the delay line is longer than the delay");
+  } catch (const InputError& e) {
+    throw InputError(std::string("checkpoint: '") + wire::kMalfunctionsKey + "': " + e.what());
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(std::string("checkpoint: '") + wire::kMalfunctionsKey + "': " + e.what());
+  }
+  *this = std::move(next);
+}
+
+}  // namespace rms::dynamics_proc
