@@ -34,12 +34,13 @@ bool AllHave(const std::array<LocationWord, 8>& words, int face) {
 
 namespace {
 
-// The malfunctions' frame rate and each joint's range (config [inputs.*]).
+// The malfunctions' frame rate and each joint's travel: the arm's joint
+// limits within the input's range (config [arm], [inputs.*]).
 Malfunctions MakeMalfunctions(const LabConfig& config) {
   std::array<double, 6> lo{}, hi{};
   for (int i = 0; i < 6; ++i) {
-    lo[i] = config.inputs[i].min;
-    hi[i] = config.inputs[i].max;
+    lo[i] = std::max(config.arm.joint_min_deg[i], config.inputs[i].min);
+    hi[i] = std::min(config.arm.joint_max_deg[i], config.inputs[i].max);
   }
   return Malfunctions(config.session.frame_rate_hz, lo, hi);
 }

@@ -108,25 +108,7 @@ void DynamicsProc::MatchMalfunctions(const std::vector<std::string>& texts) {
     return std::find(v.begin(), v.end(), m) != v.end();
   };
   for (const wire::Malfunction& m : now) {
-    if (in(want, m)) continue;
-    wire::Repair r{wire::RepairWhat::kAll, m.target};
-    switch (m.kind) {
-      case wire::MalfunctionKind::kJointStuck:
-      case wire::MalfunctionKind::kJointDrift:
-      case wire::MalfunctionKind::kJointSlow:
-        r.what = wire::RepairWhat::kJoint;
-        break;
-      case wire::MalfunctionKind::kFingerJammedOpen:
-      case wire::MalfunctionKind::kFingerJammedClosed:
-        r.what = wire::RepairWhat::kFinger;
-        break;
-      case wire::MalfunctionKind::kCameraLost:
-        r.what = wire::RepairWhat::kCamera;
-        break;
-      default:
-        r.what = wire::RepairWhat::kInputs;
-    }
-    dcp_.Repair(r);
+    if (!in(want, m)) dcp_.Repair(wire::RepairFor(m));
   }
   for (const wire::Malfunction& m : want) {
     if (!in(now, m)) dcp_.Inject(m);
@@ -207,11 +189,14 @@ void DynamicsProc::OnControl(const void* data, int size) {
   }
 }
 
-// docs/sessions.md "Malfunctions": taken between frames, at most
-// CheckpointRateLimit's rate (each sends the DCP's state to the log), and
-// logged with the state from which the next frame has it.
+// docs/sessions.md "Malfunctions": taken between frames, and logged with
+// the state from which the next frame has it (and written to the state file
+// at once, so a restarted DCP keeps it). Injections at most
+// CheckpointRateLimit's rate (each sends the DCP's state to the log);
+// repairs always (one sends a state only when it clears something, and
+// nothing is in force that was not injected).
 void DynamicsProc::OnMalfunction(const session_control_t& m) {
-  if (!malfunction_rate_.Allow(lcm_->NowUs())) {
+  if (m.command == session_control_t::MALFUNCTION && !malfunction_rate_.Allow(lcm_->NowUs())) {
     if (counters_.Get(Counter::kControlRateLimited) == 0) {
       spdlog::warn("malfunction commands refused: more than {} a second (control.rate_limited)",
                    wire::CheckpointRateLimit::kPerSecond);
@@ -229,7 +214,12 @@ void DynamicsProc::OnMalfunction(const session_control_t& m) {
                    next_frame_);
     } else {
       const wire::Repair r = wire::ParseRepair(m.name);
+      const std::size_t before = dcp_.malfunctions().active().size();
       dcp_.Repair(r);
+      if (dcp_.malfunctions().active().size() == before) {
+        throw InputError("nothing to repair: no malfunction of '" + wire::RepairText(r) +
+                         "' is in force");
+      }
       counters_.Add(Counter::kControlRepairs);
       spdlog::info("repair from {}: {}, from DCP frame {}", from, wire::RepairText(r), next_frame_);
     }
@@ -239,6 +229,7 @@ void DynamicsProc::OnMalfunction(const session_control_t& m) {
     return;
   }
   PublishState(dcp_state_t::MALFUNCTION);
+  WriteStateFile();
 }
 
 void DynamicsProc::EnableLiveChecks(double frame_rate_hz) {

@@ -382,6 +382,15 @@ void Autopilot::Resync(const wire::OperatorInputs& restored) {
   Enter(AutopilotPhase::kResync);
 }
 
+bool Autopilot::CommandedWhereItIs(const dcp_telemetry_t& tm) const {
+  for (int i = 0; i < 6; ++i) {
+    if (std::abs(tm.master_angles_deg[i] - tm.slave_angles_deg[i]) >
+        FollowWatch::kRecoverToleranceDeg)
+      return false;
+  }
+  return std::abs(tm.master_shoulder_height_ft - tm.slave_shoulder_height_ft) <= 1e-6;
+}
+
 wire::OperatorInputs Autopilot::Step(const dcp_telemetry_t* tm_ptr) {
   t_s_ += dt_s_;
   cmd_.reset = false;
@@ -398,21 +407,35 @@ wire::OperatorInputs Autopilot::Step(const dcp_telemetry_t* tm_ptr) {
   const bool moving_phase = phase_ != AutopilotPhase::kWaitTelemetry &&
                             phase_ != AutopilotPhase::kReset && phase_ != AutopilotPhase::kDocked &&
                             phase_ != AutopilotPhase::kResync;
-  if (moving_phase && tm.held && tm.frame > relieved_at_frame_ + 3) {
-    Relieve(tm);
-    return cmd_;
-  }
   // A part that does not follow: said, and the command held until it does
-  // (a repair; a slowed joint catching up).
+  // (a repair; a slowed joint catching up); said again every 30 s.
   for (const FollowWatch::Change& c : follow_.Observe(tm)) {
     if (c.failing) {
       spdlog::warn("autopilot: {}: holding its command in phase '{}' until it follows", c.text,
                    AutopilotPhaseName(phase_));
+      holding_since_s_ = t_s_;
     } else {
       spdlog::info("autopilot: {}: carrying on", c.text);
     }
   }
-  if (moving_phase && follow_.failing()) return cmd_;
+  if (moving_phase && follow_.failing()) {
+    if (t_s_ - holding_since_s_ >= 30.0) {
+      holding_since_s_ = t_s_;
+      spdlog::warn(
+          "autopilot: still holding: a part does not follow its command (repair it: "
+          "scripts/lab control repair all; the autopilot gives up {:.0f} s into the "
+          "session)",
+          opt_.timeout_s);
+    }
+    return cmd_;
+  }
+  if (moving_phase && tm.held && tm.frame > relieved_at_frame_ + 3) {
+    // Held though commanded where the arm is: no relief can help (a
+    // drifting joint pushes it); the watch says so. Hold, do not count it.
+    if (CommandedWhereItIs(tm)) return cmd_;
+    Relieve(tm);
+    return cmd_;
+  }
 
   switch (phase_) {
     case AutopilotPhase::kWaitTelemetry:

@@ -16,14 +16,48 @@ void FollowWatch::Forget() {
   failing_ = 0;
 }
 
+namespace {
+
+std::string FailingText(int part, const dcp_telemetry_t& t) {
+  if (part == FollowWatch::kArm) {
+    return "the arm is HELD by a collision though commanded where it is: something moves it on "
+           "its own";
+  }
+  if (part == FollowWatch::kFinger) {
+    return fmt::format("the finger is NOT FOLLOWING its command: commanded {:.2f}, at {:.2f}",
+                       t.master_finger, t.slave_finger);
+  }
+  return fmt::format(
+      "joint {} ({}) is NOT FOLLOWING its command: commanded {:.1f} deg, at {:.1f} deg", part + 1,
+      wire::JointName(part + 1), t.master_angles_deg[part], t.slave_angles_deg[part]);
+}
+
+std::string RecoveredText(int part) {
+  if (part == FollowWatch::kArm) return "the arm is no longer held";
+  if (part == FollowWatch::kFinger) return "the finger follows its command again";
+  return fmt::format("joint {} ({}) follows its command again", part + 1,
+                     wire::JointName(part + 1));
+}
+
+}  // namespace
+
 std::vector<FollowWatch::Change> FollowWatch::Observe(const dcp_telemetry_t& t) {
   std::vector<Change> changes;
   // Held by a collision, or captured at the dock: the arm is meant to stay.
-  const bool arm_judged = !t.held && !(t.docked && !t.released);
-  for (int p = 0; p <= kFinger; ++p) {
+  const bool captured = t.docked && !t.released;
+  const bool arm_judged = !t.held && !captured;
+  bool at_command = true;  // every joint where it is commanded
+  for (int i = 0; i < 6; ++i) {
+    at_command = at_command &&
+                 std::abs(t.master_angles_deg[i] - t.slave_angles_deg[i]) <= kRecoverToleranceDeg;
+  }
+  for (int p = 0; p <= kArm; ++p) {
     const bool was = (failing_ >> p) & 1u;
     bool off = false, back = false;
-    if (p < kFinger) {
+    if (p == kArm) {
+      off = t.held && at_command && !captured;
+      back = !t.held;
+    } else if (p < kFinger) {
       const double d = std::abs(t.master_angles_deg[p] - t.slave_angles_deg[p]);
       off = arm_judged && d > kJointToleranceDeg;
       back = arm_judged && d <= kRecoverToleranceDeg;
@@ -36,24 +70,10 @@ std::vector<FollowWatch::Change> FollowWatch::Observe(const dcp_telemetry_t& t) 
     off_frames_[p] = off ? off_frames_[p] + 1 : 0;
     if (!was && off_frames_[p] >= fail_frames_) {
       failing_ |= 1u << p;
-      Change c{p, true, ""};
-      c.text = p < kFinger ? fmt::format(
-                                 "joint {} ({}) is NOT FOLLOWING its command: commanded {:.1f} "
-                                 "deg, at {:.1f} deg",
-                                 p + 1, wire::JointName(p + 1), t.master_angles_deg[p],
-                                 t.slave_angles_deg[p])
-                           : fmt::format(
-                                 "the finger is NOT FOLLOWING its command: commanded {:.2f}, at "
-                                 "{:.2f}",
-                                 t.master_finger, t.slave_finger);
-      changes.push_back(c);
+      changes.push_back({p, true, FailingText(p, t)});
     } else if (was && back) {
       failing_ &= ~(1u << p);
-      Change c{p, false, ""};
-      c.text = p < kFinger ? fmt::format("joint {} ({}) follows its command again", p + 1,
-                                         wire::JointName(p + 1))
-                           : std::string("the finger follows its command again");
-      changes.push_back(c);
+      changes.push_back({p, false, RecoveredText(p)});
     }
   }
   return changes;

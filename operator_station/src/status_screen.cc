@@ -12,6 +12,7 @@
 #include <sys/ioctl.h>
 
 #include "rms/base/text.h"
+#include "rms/operator_station/follow_watch.h"
 #include "rms/wire/acquisition_conditions.h"
 #include "rms/wire/collision_bits.h"
 #include "rms/wire/malfunction.h"
@@ -175,11 +176,13 @@ void CollisionLines(const StatusSnapshot& s, Flow& flow) {
   if (s.not_following) {
     // docs/operator.md "A joint that does not follow".
     std::string parts;
-    for (int p = 0; p < 7; ++p) {
+    for (int p = 0; p <= FollowWatch::kArm; ++p) {
       if (!((s.not_following >> p) & 1u)) continue;
       parts += (parts.empty() ? "" : ", ") +
-               (p < 6 ? Sprintf("joint %d (%s)", p + 1, wire::JointName(p + 1))
-                      : std::string("the finger"));
+               (p < FollowWatch::kFinger ? Sprintf("joint %d (%s)", p + 1, wire::JointName(p + 1))
+                : p == FollowWatch::kFinger
+                    ? std::string("the finger")
+                    : std::string("the arm (held, though commanded where it is)"));
     }
     flow.Line("FAILURE? NOT FOLLOWING ITS COMMAND: " + parts);
   }

@@ -63,6 +63,7 @@ TEST(MalfunctionText, BadTextIsRefusedNamingWhatIsWrong) {
            {"joint 2 drift 50", "outside"},
            {"joint 2 slow 0", "outside"},
            {"joint 2 drift nan", "not a number"},
+           {"joint 2 drift -0", "a drift of 0 is no drift"},
            {"joint 2 drift 1e400", "not a number"},
            {"joint 2 stuck now", "expected 3 words"},
            {"finger jammed", "expected 3 words"},
@@ -84,6 +85,26 @@ TEST(MalfunctionText, BadTextIsRefusedNamingWhatIsWrong) {
   }
   for (const char* r : {"", "joint", "joint 9", "camera 0", "finger 1", "everything"})
     EXPECT_THROW(wire::ParseRepair(r), InputError) << r;
+  // Said as a repair; a quoted text is cut at a character, controls shown.
+  try {
+    wire::ParseRepair("joint 9");
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("repair 'joint 9'", 0), 0u) << e.what();
+  }
+  try {
+    wire::ParseMalfunction(std::string("joint\x01") + std::string(39, 'x') + "\xc3\xa9\xc3\xa9");
+  } catch (const InputError& e) {
+    const std::string w = e.what();
+    EXPECT_EQ(w.find('\x01'), std::string::npos) << w;
+    EXPECT_NE(w.find("joint?"), std::string::npos) << w;
+  }
+  try {
+    wire::ParseMalfunction(std::string(79, 'x') +
+                           "\xc3\xa9");  // the cut falls inside the last character
+  } catch (const InputError& e) {
+    const std::string w = e.what();
+    EXPECT_NE(w.find(std::string(79, 'x') + "'"), std::string::npos) << "cut before it, whole";
+  }
 }
 
 TEST(MalfunctionText, ARepairClearsOnlyItsOwn) {
@@ -95,6 +116,13 @@ TEST(MalfunctionText, ARepairClearsOnlyItsOwn) {
   EXPECT_TRUE(wire::Clears(wire::ParseRepair("camera 2"), cam2));
   EXPECT_TRUE(wire::Clears(wire::ParseRepair("all"), cam2));
   EXPECT_FALSE(wire::Clears(wire::ParseRepair("inputs"), cam2));
+  // Each malfunction's own part.
+  for (const char* t :
+       {"joint 4 drift 1", "finger jammed closed", "camera 3 lost", "inputs delayed 10"}) {
+    const wire::Malfunction m = wire::ParseMalfunction(t);
+    EXPECT_TRUE(wire::Clears(wire::RepairFor(m), m)) << t;
+  }
+  EXPECT_EQ(wire::RepairText(wire::RepairFor(wire::ParseMalfunction("joint 4 slow 1"))), "joint 4");
 }
 
 // The Malfunctions object alone, at 10 Hz: every number exact.
@@ -351,6 +379,28 @@ TEST(FollowWatch, AJointOffItsCommandForHalfASecondIsReportedOnceAndItsRecovery)
   ASSERT_EQ(c.size(), 1u);
   EXPECT_FALSE(c[0].failing);
   EXPECT_EQ(w.failing(), 0u);
+}
+
+TEST(FollowWatch, HeldThoughCommandedWhereItIsIsAFailureOfTheArm) {
+  // A drifting joint pushing the arm into a collision: the DCP holds it
+  // where the command is; nothing the operator does explains it.
+  FollowWatch w(30.0);
+  dcp_telemetry_t t = Following();
+  t.held = true;
+  bool seen = false;
+  for (int k = 0; k < 20; ++k) {
+    for (const auto& c : w.Observe(t)) seen = seen || (c.part == FollowWatch::kArm && c.failing);
+  }
+  EXPECT_TRUE(seen);
+  t.held = false;
+  const auto c = w.Observe(t);
+  ASSERT_EQ(c.size(), 1u);
+  EXPECT_FALSE(c[0].failing);
+  // Held while the command is elsewhere is an ordinary collision: no failure.
+  t = Following();
+  t.held = true;
+  t.master_angles_deg[0] += 3.0;
+  for (int k = 0; k < 60; ++k) EXPECT_TRUE(w.Observe(t).empty());
 }
 
 TEST(FollowWatch, CollisionHoldsTheDockAndTheFingerOnTheBarAreNoFailure) {

@@ -169,6 +169,7 @@ Checkpoint ParseCheckpoint(std::string_view text, const std::string& path) {
     c.input_frame = j.at("input_frame").get<std::int64_t>();
     c.config = j.at("config").get<std::string>();
     c.inputs = InputsFromJson(j.at("operator_inputs"));
+    c.inputs.reset = false;  // the inputs to carry on from: never a press of the reset button
     c.dcp = j.at("dcp");
   } catch (const std::exception& e) {
     std::string why =

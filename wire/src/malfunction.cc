@@ -1,5 +1,6 @@
 #include "rms/wire/malfunction.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <sstream>
@@ -27,9 +28,26 @@ std::vector<std::string> Words(std::string_view text) {
   return words;
 }
 
+// Control characters shown as '?' (an error message is printed and sent).
+std::string Printable(std::string s) {
+  for (char& c : s) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7F) c = '?';
+  }
+  return s;
+}
+
+// The text as quoted in an error: at most 80 bytes, cut at a character's
+// start, control characters shown as '?'.
+std::string Quoted(std::string_view text) {
+  std::size_t n = std::min<std::size_t>(text.size(), 80);
+  while (n > 0 && n < text.size() && (static_cast<unsigned char>(text[n]) & 0xC0) == 0x80) --n;
+  return Printable(std::string(text.substr(0, n)));
+}
+
 [[noreturn]] void Refuse(std::string_view text, const std::string& why, const char* grammar) {
-  throw InputError("malfunction '" + std::string(text.substr(0, 80)) + "': " + why + "; expected " +
-                   grammar);
+  const char* what = grammar == kRepairGrammar ? "repair" : "malfunction";
+  throw InputError(std::string(what) + " '" + Quoted(text) + "': " + Printable(why) +
+                   "; expected " + grammar);
 }
 
 int Target(std::string_view text, const std::string& word, int max, const char* what,
@@ -55,6 +73,8 @@ double Value(std::string_view text, std::string word, const MalfunctionKindInfo&
     Refuse(text, std::string(info.value) + " " + word + " is outside " + range.str(),
            kMalfunctionGrammar);
   }
+  if (v == 0.0 && info.kind == MalfunctionKind::kJointDrift)
+    Refuse(text, "a drift of 0 is no drift (a joint that stays is 'stuck')", kMalfunctionGrammar);
   if (v == 0.0) v = 0.0;  // no -0: the text reads back the same
   return v;
 }
@@ -202,6 +222,24 @@ bool Clears(const Repair& r, const Malfunction& m) {
       return m.kind == MalfunctionKind::kInputsDelayed;
   }
   return false;
+}
+
+Repair RepairFor(const Malfunction& m) {
+  switch (m.kind) {
+    case MalfunctionKind::kJointStuck:
+    case MalfunctionKind::kJointDrift:
+    case MalfunctionKind::kJointSlow:
+      return {RepairWhat::kJoint, m.target};
+    case MalfunctionKind::kFingerJammedOpen:
+    case MalfunctionKind::kFingerJammedClosed:
+      return {RepairWhat::kFinger, 0};
+    case MalfunctionKind::kCameraLost:
+      return {RepairWhat::kCamera, m.target};
+    case MalfunctionKind::kInputsDelayed:
+    case MalfunctionKind::kCount:
+      break;
+  }
+  return {RepairWhat::kInputs, 0};
 }
 
 std::vector<std::string> MalfunctionTexts(const nlohmann::json& dcp_state) {

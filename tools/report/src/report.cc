@@ -425,13 +425,14 @@ std::string MalfunctionsSection(const nlohmann::ordered_json& s) {
     return out.empty() ? std::string("-") : out;
   };
   h << "<h2>Malfunctions</h2>\n<p>As the DCP took them (its logged states): each from the DCP "
-       "frame given; a restore or a resumed process may change them too.</p>\n"
+       "frame given, at session time; a restore or a resumed process may change them too.</p>\n"
        "<table><tr><th>time, s</th><th>from DCP frame</th><th>by</th><th>injected</th>"
        "<th>repaired</th><th>in force after</th></tr>";
   for (const auto& m : list) {
     h << "<tr><td>" << Cell(m["time_s"], "", 2) << "</td><td>" << m["dcp_frame"] << "</td><td>"
       << Cell(m["why"]) << "</td><td" << (m["injected"].empty() ? "" : " class=\"bad\"") << ">"
-      << texts(m["injected"]) << "</td><td>" << texts(m["repaired"]) << "</td><td>"
+      << texts(m["injected"]) << "</td><td>" << texts(m["repaired"])
+      << (m["replaced"].empty() ? "" : " (replaced: " + texts(m["replaced"]) + ")") << "</td><td>"
       << texts(m["in_force"]) << "</td></tr>";
   }
   h << "</table>\n";

@@ -121,18 +121,24 @@ void SessionLines(const Json& j, std::ostream& os) {
     os << "\n";
   }
   if (j.contains("malfunctions") && !j["malfunctions"].empty()) {
-    // docs/sessions.md "Malfunctions": as the DCP took them.
+    // docs/sessions.md "Malfunctions": as the DCP took them, at session time.
     os << "malfunctions:";
     const char* sep = " ";
     for (const auto& m : j["malfunctions"]) {
+      const std::string at = " at " + HumanNumber(m["time_s"].get<double>()) + " s";
+      const std::string why = m["why"].get<std::string>();
+      const std::string ended = why == "malfunction" ? " repaired" : " cleared by a " + why;
       for (const auto& t : m["injected"]) {
-        os << sep << t.get<std::string>() << " at " << HumanNumber(m["time_s"].get<double>())
-           << " s";
+        os << sep << t.get<std::string>() << (why == "malfunction" ? "" : " (by a " + why + ")")
+           << at;
+        sep = "; ";
+      }
+      for (const auto& t : m["replaced"]) {
+        os << sep << t.get<std::string>() << " replaced" << at;
         sep = "; ";
       }
       for (const auto& t : m["repaired"]) {
-        os << sep << t.get<std::string>() << " repaired at "
-           << HumanNumber(m["time_s"].get<double>()) << " s";
+        os << sep << t.get<std::string>() << ended << at;
         sep = "; ";
       }
     }

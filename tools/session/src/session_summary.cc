@@ -421,25 +421,45 @@ void ScanState(const LogMessage& ev, LogScan* s) {
   std::vector<std::string> now;
   try {
     now = wire::MalfunctionTexts(wire::ParseCheckpoint(m.checkpoint, "RMS_DCP_STATE").dcp);
+    for (const auto& x : now) (void)wire::ParseMalfunction(x);  // each one readable
   } catch (const InputError&) {
     ++s->malformed;
     return;
   }
   if (now == s->in_force) return;
-  auto minus = [](const std::vector<std::string>& a, const std::vector<std::string>& b) {
-    nlohmann::ordered_json out = nlohmann::ordered_json::array();
-    for (const auto& x : a) {
-      if (std::find(b.begin(), b.end(), x) == b.end()) out.push_back(x);
-    }
-    return out;
+  // Each part's malfunction (its repair's name: "joint 2", "finger" ...):
+  // one taken away while another of the same part came is replaced.
+  auto part = [](const std::string& text) {
+    return wire::RepairText(wire::RepairFor(wire::ParseMalfunction(text)));
   };
+  auto has = [](const std::vector<std::string>& v, const std::string& x) {
+    return std::find(v.begin(), v.end(), x) != v.end();
+  };
+  nlohmann::ordered_json injected = nlohmann::ordered_json::array(),
+                         repaired = nlohmann::ordered_json::array(),
+                         replaced = nlohmann::ordered_json::array();
+  std::vector<std::string> new_parts;
+  for (const auto& x : now) {
+    if (!has(s->in_force, x)) {
+      injected.push_back(x);
+      new_parts.push_back(part(x));
+    }
+  }
+  for (const auto& x : s->in_force) {
+    if (has(now, x)) continue;
+    (has(new_parts, part(x)) ? replaced : repaired).push_back(x);
+  }
   static constexpr const char* kReasons[] = {"?",       "start",  "periodic",
                                              "restore", "resume", "malfunction"};
-  s->malfunctions.push_back({{"time_s", (ev.log_us - s->first_us) * 1e-6},
+  // Session time as mode_changes has it: the operator frames answered over
+  // the frame rate (it stands still in a freeze).
+  s->malfunctions.push_back({{"time_s", (m.input_frame + 1) / s->rate_hz},
+                             {"log_time_s", (ev.log_us - s->first_us) * 1e-6},
                              {"dcp_frame", m.next_frame},
                              {"why", m.reason >= 1 && m.reason <= 5 ? kReasons[m.reason] : "?"},
-                             {"injected", minus(now, s->in_force)},
-                             {"repaired", minus(s->in_force, now)},
+                             {"injected", injected},
+                             {"repaired", repaired},
+                             {"replaced", replaced},
                              {"in_force", now}});
   s->in_force = std::move(now);
 }

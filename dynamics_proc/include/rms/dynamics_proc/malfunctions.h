@@ -32,8 +32,9 @@ namespace rms::dynamics_proc {
 
 class Malfunctions {
  public:
-  // frame_rate_hz: the session's; joint_min/max_deg: each joint's input
-  // range (config [inputs.*]), which a drifting joint stays within.
+  // frame_rate_hz: the session's; joint_min/max_deg: each joint's travel
+  // (config [arm] joint limits within [inputs.*]), which a drifting joint
+  // stays within.
   Malfunctions(double frame_rate_hz, const std::array<double, 6>& joint_min_deg,
                const std::array<double, 6>& joint_max_deg);
 

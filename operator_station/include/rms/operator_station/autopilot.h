@@ -151,6 +151,10 @@ class Autopilot {
   // A joint or the finger not following (a failure, docs/operator.md "The
   // autopilot"): the autopilot says so and holds its command until it follows.
   FollowWatch follow_;
+  double holding_since_s_ = 0.0;  // when it last said it holds for a failure
+  // The telemetry's master command is where the slave arm is (every joint
+  // within FollowWatch's recovery tolerance, the same shoulder height).
+  bool CommandedWhereItIs(const dcp_telemetry_t& tm) const;
   double t_s_ = 0.0, phase_t0_s_ = 0.0;
   AutopilotPhase phase_ = AutopilotPhase::kWaitTelemetry;
   std::string failure_;

@@ -11,7 +11,9 @@
 // neither held by a collision nor captured at the dock; it follows again once
 // within kRecoverToleranceDeg. The finger: the slave's lever more closed than
 // commanded (it does not open), or in Mode 1, free of the bar, less closed (it
-// does not close), by kFingerTolerance.
+// does not close), by kFingerTolerance. The arm: held by a collision for
+// kFailSeconds though every joint is commanded where it is (a drifting joint
+// pushing into a collision); it follows again once no longer held.
 #include <array>
 #include <cstdint>
 #include <string>
@@ -28,13 +30,16 @@ class FollowWatch {
   static constexpr double kFingerTolerance = 0.02;
   static constexpr double kFailSeconds = 0.5;
   static constexpr int kFinger = 6;  // part index of the finger; joints 0..5
+  // Part index of "the arm": held by a collision though commanded where it
+  // is -- something moves it that the command does not (a drifting joint).
+  static constexpr int kArm = 7;
 
   explicit FollowWatch(double frame_rate_hz);
 
   // What changed with this telemetry: each part that stopped or began
   // following again, as a sentence for the operator's events.
   struct Change {
-    int part = 0;  // 0..5 joint (shoulder yaw .. wrist roll), kFinger
+    int part = 0;  // 0..5 joint (shoulder yaw .. wrist roll), kFinger, kArm
     bool failing = false;
     std::string text;
   };
@@ -46,7 +51,7 @@ class FollowWatch {
 
  private:
   int fail_frames_;
-  std::array<int, 7> off_frames_{};  // consecutive frames off its command
+  std::array<int, 8> off_frames_{};  // consecutive frames off its command
   std::uint32_t failing_ = 0;
 };
 

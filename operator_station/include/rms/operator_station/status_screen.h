@@ -40,8 +40,9 @@ struct StatusSnapshot {
   double input_to_dcp_ms = -1.0;  // this block's round trip through the DCP (-1: none yet)
   double render_hz = -1.0;        // esg_renderer's frames a second (from RMS_STATUS; -1: not heard)
   double input_to_render_p50_ms = -1.0, input_to_render_p99_ms = -1.0;  // esg_renderer's end to end
-  std::uint32_t not_following = 0;   // FollowWatch::failing(): bit p, joint p (6: the finger)
-  long clamped_inputs = 0;           // inputs clamped to their range so far
+  std::uint32_t not_following =
+      0;                    // FollowWatch::failing(): bit p, joint p (6: the finger, 7: the arm)
+  long clamped_inputs = 0;  // inputs clamped to their range so far
   std::vector<std::string> devices;  // what is connected
   std::vector<std::string> log;      // the session's events and log lines, oldest first
   std::string help;                  // the key map, one line (wrapped to the width)

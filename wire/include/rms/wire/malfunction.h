@@ -48,7 +48,7 @@ inline constexpr std::array<MalfunctionKindInfo, static_cast<int>(MalfunctionKin
     kMalfunctionKinds = {{
         {MalfunctionKind::kJointStuck, "joint_stuck", "joint N stuck", "", 0, 0},
         {MalfunctionKind::kJointDrift, "joint_drift", "joint N drift V",
-         "drift rate, deg/s (signed)", -20.0, 20.0},
+         "drift rate, deg/s (signed, not 0)", -20.0, 20.0},
         {MalfunctionKind::kJointSlow, "joint_slow", "joint N slow V",
          "the joint's rate at most, deg/s", 0.01, 100.0},
         {MalfunctionKind::kFingerJammedOpen, "finger_jammed_open", "finger jammed open", "", 0, 0},
@@ -89,6 +89,9 @@ std::string MalfunctionText(const Malfunction& m);
 std::string RepairText(const Repair& r);
 // Whether a repair clears this malfunction.
 bool Clears(const Repair& r, const Malfunction& m);
+// The repair that clears exactly this malfunction's part (its joint, the
+// finger, its camera station, the inputs): the part's name as RepairText.
+Repair RepairFor(const Malfunction& m);
 // The joint's name, 1 "shoulder yaw" .. 6 "wrist roll".
 const char* JointName(int joint);
 // The longest malfunction or repair text a command may carry, bytes.
