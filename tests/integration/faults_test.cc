@@ -91,9 +91,17 @@ TEST(Faults, EachProcessKilledIsRestartedTheDcpResumesAndTheAutopilotDocks) {
       "%ld\n",
       d["operator_to_dcp"].get<long>(), d["dcp_to_scene"].get<long>(),
       d["scene_to_esg"].get<long>(), s["log"]["esg_frames_missing"].get<long>());
+  // Each restart may lose the frames of its downtime (restart_s, longer on a
+  // loaded machine) and a few more while the restarted process rejoins (the
+  // operator station resumes from the first telemetry it hears): at most 8
+  // a restart beyond the downtime.
+  double down_s = 0.0;
+  for (const auto& r : s["restarts"]) down_s += r["restart_s"].get<double>();
+  const double allowed = 30.0 * down_s + 8.0 * static_cast<double>(s["restarts"].size());
   EXPECT_LT(d["operator_to_dcp"].get<long>() + d["dcp_to_scene"].get<long>() +
                 d["scene_to_esg"].get<long>(),
-            30);
+            allowed)
+      << "restarts down " << down_s << " s in all";
   // The log kept everything that was sent: every operator frame the
   // stations counted is in it (the status reports lag a second behind a
   // killed run's last frames, hence the margin).
