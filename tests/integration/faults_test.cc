@@ -106,7 +106,9 @@ TEST(Faults, EachProcessKilledIsRestartedTheDcpResumesAndTheAutopilotDocks) {
   // stations counted is in it (the status reports lag a second behind a
   // killed run's last frames, hence the margin).
   EXPECT_GE(s["log"]["operator_frames"].get<long>(),
-            s["frames"]["operator_published"].get<long>() * 95 / 100);
+            s["frames"]["operator_published"].get<long>() * 95 / 100)
+      << "log " << s["log"].dump() << "\nrecord " << s["record"].dump() << "\nignored "
+      << s["ignored"].dump();
   fs::remove_all(tmp);
 }
 
