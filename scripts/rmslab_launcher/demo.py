@@ -247,7 +247,8 @@ class Demo:
         h = self.hosts[name]
         log = os.path.join(self.out, "logs", f"{name}.log")
         if h.remote:
-            ready_fn = lambda c: "] ready: " in open(log, errors="replace").read()  # noqa: E731
+            # Ready once this run has said so: the log keeps the earlier runs' lines.
+            ready_fn = lambda c: open(log, errors="replace").read().count("] ready: ") > c.n  # noqa: E731
         else:
             ready_fn = lambda c: os.path.exists(ready)  # noqa: E731
             if os.path.exists(ready):

@@ -152,6 +152,15 @@ class Supervisor:
             env["RMSLAB_LIFELINE"] = "stdin"
         argv = s.next_argv(c.n) if (s.next_argv and c.n > 0) else s.argv
         cmd = s.host.wrap(argv, env, s.remote_run, s.name)
+        # A restart must not be taken as ready from the killed run's ready
+        # file (nor its pid read from it: the summary would then refuse every
+        # message of the new run as not the session's process).
+        try:
+            os.remove(os.path.join(self.run_dir, f"{s.name}.ready"))
+        except FileNotFoundError:
+            pass
+        except OSError as e:
+            say(f"could not remove {s.name}'s old ready file ({e.strerror})")
         full_env = dict(os.environ)
         full_env.update(env)
         stdin = None

@@ -102,6 +102,10 @@ TEST(Faults, EachProcessKilledIsRestartedTheDcpResumesAndTheAutopilotDocks) {
                 d["scene_to_esg"].get<long>(),
             allowed)
       << "restarts down " << down_s << " s in all";
+  // Every restarted run's messages are the session's own: the launcher
+  // records each run's pid (a restart is never taken as ready from the
+  // killed run's ready file, whose pid it would record again).
+  EXPECT_EQ(s["ignored"]["total"].get<long>(), 0) << s["ignored"].dump();
   // The log kept everything that was sent: every operator frame the
   // stations counted is in it (the status reports lag a second behind a
   // killed run's last frames, hence the margin).
