@@ -4,8 +4,9 @@
 //
 //   rms_collision_bench [--md FILE] [--agreement N] [Google Benchmark flags]
 //
-// Timing: 4096 random box pairs (and 4096 random general hexahedra), each
-// method given the pairs in its own form, prepared before timing, cycled
+// Timing: 4096 random box pairs (and 4096 random general hexahedra), and
+// 4096 dense pairs of each (bounding spheres overlapping, half colliding),
+// each method given the pairs in its own form, prepared before timing, cycled
 // through in the same order. Agreement: N pairs of each family of the test
 // generator (random, touching to 1e-6..1e-12, parallel edges, nested, rods
 // through slabs, near contact), against the exact reference (CGAL, exact
@@ -47,7 +48,50 @@ struct Sets {
   std::vector<std::pair<rms::bench::BoxShape, rms::bench::BoxShape>> boxes;
   std::vector<std::pair<Hull, Hull>> hulls_boxes, hulls_general;
   std::vector<std::unique_ptr<rms::bench::FclPair>> fcl_boxes, fcl_general;
+  // Dense: pairs whose bounding spheres overlap (what Mode 1 sees with the
+  // end effector at the receptacle), half of them colliding.
+  std::vector<std::pair<rms::dynamics_proc::Hexahedron, rms::dynamics_proc::Hexahedron>>
+      hex_dense_boxes, hex_dense_general;
+  std::vector<std::pair<rms::bench::BoxShape, rms::bench::BoxShape>> dense_boxes;
+  std::vector<std::unique_ptr<rms::bench::FclPair>> fcl_dense_boxes, fcl_dense_general;
+  int dense_boxes_colliding = 0, dense_general_colliding = 0;  // of the 4096
 };
+
+// The solids' bounding spheres (about their vertices' mean) overlap.
+bool SpheresOverlap(const Hull& a, const Hull& b) {
+  auto sphere = [](const Hull& h) {
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (const auto& v : h) c += v / 8.0;
+    double r = 0.0;
+    for (const auto& v : h) r = std::max(r, (v - c).norm());
+    return std::pair{c, r};
+  };
+  const auto [ca, ra] = sphere(a);
+  const auto [cb, rb] = sphere(b);
+  return (ca - cb).norm() < ra + rb;
+}
+
+// 4096 pairs of the generator's (boxes only, or general hexahedra only)
+// whose spheres overlap, 2048 colliding and 2048 not by the exact reference
+// -- or, if one kind is still short after 400,000 draws, the rest of either
+// kind. Returns how many collide.
+template <typename Take>
+int MakeDenseSet(rms::reference::PairGenerator& gen, bool boxes, Take take) {
+  int colliding = 0, apart = 0;
+  long draws = 0;
+  while (colliding + apart < 4096) {
+    const Pair p = gen.Next(1.0, boxes);
+    ++draws;
+    const bool right_kind = boxes ? (p.a.is_box && p.b.is_box) : !(p.a.is_box || p.b.is_box);
+    if (!right_kind || !SpheresOverlap(p.a.v, p.b.v)) continue;
+    const bool hit = rms::reference::ExactHullsIntersect(p.a.v, p.b.v);
+    int& n = hit ? colliding : apart;
+    if (n >= 2048 && draws < 400000) continue;
+    ++n;
+    take(p);
+  }
+  return colliding;
+}
 
 Sets MakeSets() {
   Sets s;
@@ -67,6 +111,16 @@ Sets MakeSets() {
     s.hulls_general.emplace_back(p.a.v, p.b.v);
     s.fcl_general.push_back(rms::bench::FclPair::Hulls(p.a.v, p.b.v));
   }
+  rms::reference::PairGenerator dense(271828);
+  s.dense_boxes_colliding = MakeDenseSet(dense, true, [&s](const Pair& p) {
+    s.hex_dense_boxes.emplace_back(p.a.hex, p.b.hex);
+    s.dense_boxes.emplace_back(Shape(p.a), Shape(p.b));
+    s.fcl_dense_boxes.push_back(rms::bench::FclPair::Boxes(Shape(p.a), Shape(p.b)));
+  });
+  s.dense_general_colliding = MakeDenseSet(dense, false, [&s](const Pair& p) {
+    s.hex_dense_general.emplace_back(p.a.hex, p.b.hex);
+    s.fcl_dense_general.push_back(rms::bench::FclPair::Hulls(p.a.v, p.b.v));
+  });
   return s;
 }
 
@@ -205,6 +259,27 @@ void RegisterTimings(const Sets& sets) {
                                                  sets.hulls_boxes[i].second);
     });
   });
+  // Dense pairs: bounding spheres overlapping, half colliding.
+  dcp("dense boxes/DCP, verdict", sets.hex_dense_boxes, verdict_only);
+  dcp("dense boxes/DCP, verdict and separating plane", sets.hex_dense_boxes, {});
+  benchmark::RegisterBenchmark("dense boxes/separating axes, 15 (double)",
+                               [&sets, cycle](benchmark::State& st) {
+                                 cycle(st, [&](std::size_t i) {
+                                   return rms::bench::SatBoxesIntersect(sets.dense_boxes[i].first,
+                                                                        sets.dense_boxes[i].second);
+                                 });
+                               });
+  benchmark::RegisterBenchmark(
+      "dense boxes/FCL collide() on boxes (computes a contact)",
+      [&sets, cycle](benchmark::State& st) {
+        cycle(st, [&](std::size_t i) { return sets.fcl_dense_boxes[i]->Collide(); });
+      });
+  dcp("dense general/DCP, verdict", sets.hex_dense_general, verdict_only);
+  dcp("dense general/DCP, verdict and separating plane", sets.hex_dense_general, {});
+  benchmark::RegisterBenchmark(
+      "dense general/FCL collide() on convex (GJK/EPA)", [&sets, cycle](benchmark::State& st) {
+        cycle(st, [&](std::size_t i) { return sets.fcl_dense_general[i]->Collide(); });
+      });
   // General hexahedra.
   dcp("general/DCP, verdict", sets.hex_general, verdict_only);
   dcp("general/DCP, verdict and separating plane", sets.hex_general, {});
@@ -225,15 +300,88 @@ void RegisterTimings(const Sets& sets) {
   });
 }
 
-// The timing tables and their targets (docs/performance.md).
-void TimingTables(Collector& collector, std::ostringstream& md) {
-  auto figure = [&](const std::string& name) {
-    const auto it = collector.ns.find(name);
-    return it == collector.ns.end() ? 0.0 : it->second;
+// A set's rows (names under `prefix`), each against the set's DCP verdict
+// and, when given (> 0), its separating-axis test.
+void SetRows(const Collector& collector, const std::string& prefix, double dcp, double sat,
+             std::ostringstream& md) {
+  char line[600];
+  for (const auto& [name, ns] : collector.ns) {
+    if (name.rfind(prefix, 0) != 0) continue;
+    if (sat > 0)
+      std::snprintf(line, sizeof line, "| %s | %.1f | %.2f | %.2f |\n",
+                    name.substr(prefix.size()).c_str(), ns, ns / dcp, ns / sat);
+    else
+      std::snprintf(line, sizeof line, "| %s | %.1f | %.2f |\n", name.substr(prefix.size()).c_str(),
+                    ns, ns / dcp);
+    md << line;
+  }
+}
+
+double Figure(const Collector& collector, const std::string& name) {
+  const auto it = collector.ns.find(name);
+  return it == collector.ns.end() ? 0.0 : it->second;
+}
+
+// "**Target** what: figure (met | MISSED by ...)", or "not measured".
+std::string TargetLine(const std::string& what, double value, double limit, bool at_most,
+                       const char* unit) {
+  if (!(value > 0)) return "- **Target** " + what + ": not measured.\n";
+  const bool met = at_most ? value <= limit : value >= limit;
+  char verdict[48] = "met";
+  if (!met)
+    std::snprintf(verdict, sizeof verdict, "MISSED by %.2fx",
+                  at_most ? value / limit : limit / value);
+  char b[300];
+  std::snprintf(b, sizeof b, "- **Target** %s: %.2f%s (%s).\n", what.c_str(), value, unit, verdict);
+  return b;
+}
+
+// Issue 18's sets: pairs whose bounding spheres overlap, half colliding, and
+// its targets (docs/performance.md "Collision against its peers").
+void DenseTables(const Collector& collector, const Sets& sets_made, std::ostringstream& md) {
+  const double dcp = Figure(collector, "dense boxes/DCP, verdict");
+  const double plane = Figure(collector, "dense boxes/DCP, verdict and separating plane");
+  const double sat = Figure(collector, "dense boxes/separating axes, 15 (double)");
+  const double dcp_g = Figure(collector, "dense general/DCP, verdict");
+  md << "\n| Method (4096 dense box pairs: bounding spheres overlap, "
+     << sets_made.dense_boxes_colliding
+     << " colliding) | ns / pair | vs the DCP | vs separating axes |\n|---|---|---|---|\n";
+  if (dcp > 0 && sat > 0) SetRows(collector, "dense boxes/", dcp, sat, md);
+  md << "\n| Method (4096 dense general hexahedra: spheres overlap, "
+     << sets_made.dense_general_colliding
+     << " colliding) | ns / pair | vs the DCP |\n|---|---|---|\n";
+  if (dcp_g > 0) SetRows(collector, "dense general/", dcp_g, 0.0, md);
+  md << "\n"
+     << TargetLine("on dense box pairs the verdict at most 2x separating axes",
+                   sat > 0 ? dcp / sat : 0.0, 2.0, true, "x")
+     << TargetLine("on dense box pairs the verdict with its plane at most 3x separating axes",
+                   sat > 0 ? plane / sat : 0.0, 3.0, true, "x");
+  // At least 10x faster than FCL on every set.
+  const struct {
+    const char* set;
+    const char* dcp;
+    const char* fcl;
+  } sets[] = {
+      {"random boxes", "boxes/DCP, verdict", "boxes/FCL collide() on boxes (computes a contact)"},
+      {"random general hexahedra", "general/DCP, verdict",
+       "general/FCL collide() on convex (GJK/EPA)"},
+      {"dense boxes", "dense boxes/DCP, verdict",
+       "dense boxes/FCL collide() on boxes (computes a contact)"},
+      {"dense general hexahedra", "dense general/DCP, verdict",
+       "dense general/FCL collide() on convex (GJK/EPA)"},
   };
-  const double dcp = figure("boxes/DCP, verdict");
-  const double sat = figure("boxes/separating axes, 15 (double)");
-  const double fcl = figure("boxes/FCL collide() on boxes (computes a contact)");
+  for (const auto& x : sets) {
+    const double d = Figure(collector, x.dcp), f = Figure(collector, x.fcl);
+    md << TargetLine(std::string("at least 10x faster than FCL on ") + x.set,
+                     d > 0 && f > 0 ? f / d : 0.0, 10.0, false, "x");
+  }
+}
+
+// The timing tables and their targets (docs/performance.md).
+void TimingTables(Collector& collector, const Sets& sets_made, std::ostringstream& md) {
+  const double dcp = Figure(collector, "boxes/DCP, verdict");
+  const double sat = Figure(collector, "boxes/separating axes, 15 (double)");
+  const double fcl = Figure(collector, "boxes/FCL collide() on boxes (computes a contact)");
   char line[600];
   // The FCL ratio repetition by repetition (the same pairs, run after run).
   double ratio_lo = 1e30, ratio_hi = 0;
@@ -265,7 +413,7 @@ void TimingTables(Collector& collector, std::ostringstream& md) {
                   ns / dcp, ns / sat);
     md << line;
   }
-  const double dcp_g = figure("general/DCP, verdict");
+  const double dcp_g = Figure(collector, "general/DCP, verdict");
   md << "\n| Method (4096 random general hexahedra: frusta, skewed) | ns / pair | vs the DCP "
         "|\n|---|---|---|\n";
   for (const auto& [name, ns] : collector.ns) {
@@ -294,6 +442,7 @@ void TimingTables(Collector& collector, std::ostringstream& md) {
   } else {
     md << "- **Target** collision at least 8x faster than FCL on the same pairs: not measured.\n";
   }
+  DenseTables(collector, sets_made, md);
 }
 
 // Disagreements with the exact reference, by family of pairs, every method.
@@ -351,7 +500,7 @@ int main(int argc, char** argv) {
   const auto [box_agree, gen_agree] = MeasureAgreement(agreement_pairs, seed);
 
   std::ostringstream md;
-  TimingTables(collector, md);
+  TimingTables(collector, sets, md);
   md << "\nVerdicts that disagree with the exact reference (CGAL, exact arithmetic; touching "
         "counts as intersecting), "
         "by family of pairs (seed 19721122):\n";
