@@ -9,8 +9,8 @@
 int main(int argc, char** argv) {
   CLI::App app{
       "rmslab instructor_station: a web page to watch any camera station live, see the "
-      "session's status and events, and freeze, run, step, checkpoint or restore it "
-      "(docs/instructor.md)."};
+      "session's status and events, freeze, run, step, checkpoint, restore or reset it, and "
+      "inject and repair malfunctions (docs/instructor.md)."};
   rms::transport::CommonOptions common;
   rms::instructor_station::InstructorOptions o;
   app.add_option("--bind", o.bind, "Address to serve the page on (beyond loopback: --token)")

@@ -122,6 +122,11 @@ void Malfunctions::Apply(const std::array<double, 6>& slave_angles_deg,
   }
 }
 
+bool Malfunctions::any() const {
+  return finger_ || cameras_lost_ != 0 || delay_frames_ > 0 ||
+         std::any_of(joints_.begin(), joints_.end(), [](const auto& j) { return j.has_value(); });
+}
+
 std::vector<wire::Malfunction> Malfunctions::active() const {
   std::vector<wire::Malfunction> out;
   for (int i = 0; i < 6; ++i) {

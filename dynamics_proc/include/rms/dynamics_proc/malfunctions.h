@@ -54,7 +54,8 @@ class Malfunctions {
              double* finger);
   bool CameraLost(int station) const { return (cameras_lost_ >> (station - 1)) & 1u; }
 
-  bool any() const { return !active().empty(); }
+  // Whether any is in force (what active() lists), without building the list.
+  bool any() const;
   // What is in force, in the order of kMalfunctionKinds and targets.
   std::vector<wire::Malfunction> active() const;
   int delay_frames() const { return delay_frames_; }
