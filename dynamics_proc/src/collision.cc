@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "simd.h"
+
 namespace rms::dynamics_proc {
 
 namespace {
@@ -60,6 +62,71 @@ double SegmentDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& u, const
   return (r + s * u - t * v).norm();
 }
 
+// sqrt(dir_sq), computed once (the same bits as Eigen's norm()).
+double DirLen(double dir_sq, double* dir_len) {
+  if (*dir_len < 0) *dir_len = std::sqrt(dir_sq);
+  return *dir_len;
+}
+
+// The four triple products of Section IV.A.1's edge test for face f of Q,
+// T_j = h (b_j - v) x (b_j+1 - b_j) . V for j = 0..3 (h: Q's handedness),
+// each computed as Eigen computes h * (q0 - apex).cross(e).dot(dir) -- the
+// same operations in the same order, so the same bits -- four at a time in
+// AVX where the processor has it.
+#if defined(RMS_DCP_X86)
+// Coordinate c of face f's four vertices from its s-th on (a helper, not a
+// lambda: a lambda would not inherit the target).
+__attribute__((target("avx"))) inline __m256d FaceLanes(const std::array<double, 8>& c, int f,
+                                                        int s) {
+  const auto& b = kFaceVertices[f];
+  return _mm256_setr_pd(c[b[s]], c[b[(s + 1) % 4]], c[b[(s + 2) % 4]], c[b[(s + 3) % 4]]);
+}
+
+__attribute__((target("avx"))) void FaceProductsAvx(const Hexahedron& Q, int f,
+                                                    const Eigen::Vector3d& v,
+                                                    const Eigen::Vector3d& V, double t[4]) {
+  const __m256d q0x = FaceLanes(Q.x, f, 0), q0y = FaceLanes(Q.y, f, 0), q0z = FaceLanes(Q.z, f, 0);
+  const __m256d ex = _mm256_sub_pd(FaceLanes(Q.x, f, 1), q0x),
+                ey = _mm256_sub_pd(FaceLanes(Q.y, f, 1), q0y),
+                ez = _mm256_sub_pd(FaceLanes(Q.z, f, 1), q0z);
+  const __m256d wx = _mm256_sub_pd(q0x, _mm256_set1_pd(v.x())),
+                wy = _mm256_sub_pd(q0y, _mm256_set1_pd(v.y())),
+                wz = _mm256_sub_pd(q0z, _mm256_set1_pd(v.z()));
+  const __m256d cx = _mm256_sub_pd(_mm256_mul_pd(wy, ez), _mm256_mul_pd(wz, ey));
+  const __m256d cy = _mm256_sub_pd(_mm256_mul_pd(wz, ex), _mm256_mul_pd(wx, ez));
+  const __m256d cz = _mm256_sub_pd(_mm256_mul_pd(wx, ey), _mm256_mul_pd(wy, ex));
+  const __m256d dot = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(cx, _mm256_set1_pd(V.x())),
+                                                  _mm256_mul_pd(cy, _mm256_set1_pd(V.y()))),
+                                    _mm256_mul_pd(cz, _mm256_set1_pd(V.z())));
+  _mm256_storeu_pd(t, _mm256_mul_pd(_mm256_set1_pd(Q.handedness), dot));
+}
+#endif
+
+void FaceProducts(const Hexahedron& Q, int f, const Eigen::Vector3d& v, const Eigen::Vector3d& V,
+                  double t[4]) {
+#if defined(RMS_DCP_X86)
+  if (avx_enabled) return FaceProductsAvx(Q, f, v, V, t);
+#endif
+  for (int j = 0; j < 4; ++j) {
+    const Eigen::Vector3d q0 = Q.vertex(kFaceVertices[f][j]);
+    const Eigen::Vector3d e = Q.vertex(kFaceVertices[f][(j + 1) % 4]) - q0;
+    t[j] = Q.handedness * (q0 - v).cross(e).dot(V);
+  }
+}
+
+// A positive T_j at most `clear`: does the edge pass clear of face f's
+// bounding edge j, by more than tau? T_j / (|e| |V|) is at most the distance between
+// the two lines, so above tau x |e| x |V| it is clear; below, near-parallel
+// edges can be far apart with a small T_j, and the segments' distance
+// decides (docs/collision.md "Tolerance rule").
+bool ClearOfBoundingEdge(const Hexahedron& Q, int f, int j, const Eigen::Vector3d& apex,
+                         const Eigen::Vector3d& dir, double t, double dir_sq, double tau,
+                         double* dir_len) {
+  const Eigen::Vector3d q0 = Q.vertex(kFaceVertices[f][j]);
+  const Eigen::Vector3d e = Q.vertex(kFaceVertices[f][(j + 1) % 4]) - q0;
+  return t > tau * e.norm() * DirLen(dir_sq, dir_len) || SegmentDistance(apex, dir, q0, e) > tau;
+}
+
 // Section IV.A.1's edge test for the edge (i, k) of P against the faces of Q,
 // given the two vertices' location words against Q. Returns the face of Q the
 // edge pierces, or -1.
@@ -73,37 +140,52 @@ double SegmentDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& u, const
 //   T_j = (b_j - v) x (b_j+1 - b_j) . V <= 0   for j = 0..3
 // (the report's V_B x V_A . V_i with V_B = b_j - v, V_A = b_j+1 - v). A T_j
 // above the tolerance ends the sequence for that face.
+//
+// `clear` is (tau x Q.scale) x P.scale: no larger than the bound
+// tau |e| |V| of any of Q's edges e and P's V as computed (an edge is no
+// longer than its solid's bounding-box diagonal, and rounding is monotonic),
+// so a T_j above it is clear without the two square roots; the same
+// decisions, bit for bit, as always computing them.
 int EdgePiercesFace(const Hexahedron& P, int i, int k, LocationWord wi, LocationWord wk,
-                    const Hexahedron& Q, double tau, PlaneCandidate* cand, int* products) {
-  const LocationWord x = wi ^ wk;
-  if (std::popcount(static_cast<unsigned>(x)) < 2) return -1;
+                    const Hexahedron& Q, double tau, double clear, PlaneCandidate* cand,
+                    int* products) {
+  // The faces whose planes the edge crosses: two or more, or it cannot pierce.
+  const FaceList& faces = kFacesOfMask[wi ^ wk];
+  if (faces.count < 2) return -1;
   const Eigen::Vector3d vi = P.vertex(i), vk = P.vertex(k);
-  const FaceList& faces = kFacesOfMask[x];
+  // The edge's length (|V| is the same either way round), when needed.
+  const double dir_sq = (vk - vi).squaredNorm();
+  if (!(dir_sq > 0)) return -1;
+  double dir_len = -1.0;
   for (int n = 0; n < faces.count; ++n) {
     const int f = faces.faces[n];
     const bool apex_is_i = (wi & FaceBit(f)) != 0;
     const Eigen::Vector3d& apex = apex_is_i ? vi : vk;
     const Eigen::Vector3d dir = apex_is_i ? Eigen::Vector3d(vk - vi) : Eigen::Vector3d(vi - vk);
-    const double dir_len = dir.norm();
-    if (!(dir_len > 0)) continue;
-    bool inside = true;
+    double t4[4];
+    FaceProducts(Q, f, apex, dir, t4);
+    // T_j > 0: the edge passes outside the bounding edge. It still touches
+    // when it comes within tau of it (docs/collision.md "Tolerance rule").
+    // In the report's sequence, the first T_j that clears ends it.
+    unsigned positive = 0, cleared = 0;
     for (int j = 0; j < 4; ++j) {
-      const int b0 = kFaceVertices[f][j], b1 = kFaceVertices[f][(j + 1) % 4];
-      const Eigen::Vector3d q0 = Q.vertex(b0);
-      const Eigen::Vector3d e = Q.vertex(b1) - q0;
-      const double t = Q.handedness * (q0 - apex).cross(e).dot(dir);
-      ++*products;
-      // T_j > 0: the edge passes outside the bounding edge. It still touches
-      // when it comes within tau of it (docs/collision.md "Tolerance rule").
-      // T_j / (|e| |V|) is at most the distance between the two lines, so
-      // above tau the edge is clear; below, near-parallel edges can be far
-      // apart with a small T_j, and the segments' distance decides.
-      if (t > 0 && (t > tau * e.norm() * dir_len || SegmentDistance(apex, dir, q0, e) > tau)) {
-        inside = false;
-        if (!cand->have) *cand = {true, apex, q0, Q.vertex(b1)};
+      positive |= static_cast<unsigned>(t4[j] > 0) << j;
+      cleared |= static_cast<unsigned>(t4[j] > clear) << j;
+    }
+    int outside = -1;
+    for (unsigned m = positive; m != 0; m &= m - 1) {
+      const int j = std::countr_zero(m);
+      if ((cleared >> j & 1u) ||
+          ClearOfBoundingEdge(Q, f, j, apex, dir, t4[j], dir_sq, tau, &dir_len)) {
+        outside = j;
         break;
       }
     }
+    const bool inside = outside < 0;
+    *products += inside ? 4 : outside + 1;
+    if (!inside && !cand->have)
+      *cand = {true, apex, Q.vertex(kFaceVertices[f][outside]),
+               Q.vertex(kFaceVertices[f][(outside + 1) % 4])};
     if (inside) return f;
   }
   return -1;
@@ -140,15 +222,24 @@ void FindEdgePlane(const Hexahedron& a, const Hexahedron& b, const PlaneCandidat
       if (PlaneSeparates(a, b, -n, -d, tau)) return SetPlane(r, -n, -d);
     }
   }
+  // The edge directions and their lengths, once (the same bits as forming
+  // them pair by pair).
+  std::array<Eigen::Vector3d, kNumEdges> da, db;
+  std::array<double, kNumEdges> la, lb;
+  for (int e = 0; e < kNumEdges; ++e) {
+    da[e] = a.vertex(kEdges[e][1]) - a.vertex(kEdges[e][0]);
+    db[e] = b.vertex(kEdges[e][1]) - b.vertex(kEdges[e][0]);
+    la[e] = da[e].norm();
+    lb[e] = db[e].norm();
+  }
   double best_gap = -std::numeric_limits<double>::infinity();
   Eigen::Vector3d best_n = Eigen::Vector3d::UnitZ();
   double best_d = 0;
-  for (const auto& ea : kEdges) {
-    const Eigen::Vector3d da = a.vertex(ea[1]) - a.vertex(ea[0]);
-    for (const auto& eb : kEdges) {
-      Eigen::Vector3d n = da.cross(b.vertex(eb[1]) - b.vertex(eb[0]));
+  for (int ea = 0; ea < kNumEdges; ++ea) {
+    for (int eb = 0; eb < kNumEdges; ++eb) {
+      Eigen::Vector3d n = da[ea].cross(db[eb]);
       const double len = n.norm();
-      if (!(len > 1e-12 * da.norm() * (b.vertex(eb[1]) - b.vertex(eb[0])).norm())) continue;
+      if (!(len > 1e-12 * la[ea] * lb[eb])) continue;
       n /= len;
       double alo, ahi, blo, bhi;
       ProjectionRange(a, n, &alo, &ahi);
@@ -281,10 +372,11 @@ bool VertexPhase(const Hexahedron& faces, const Hexahedron& verts, bool a_in_b, 
 bool EdgePhase(const Hexahedron& edges, const std::array<LocationWord, 8>& words,
                const Hexahedron& faces, double tau, Decider decider, PlaneCandidate* cand,
                CollisionResult* r) {
+  const double clear = tau * faces.scale * edges.scale;
   for (int e = 0; e < kNumEdges; ++e) {
     const int i = kEdges[e][0], k = kEdges[e][1];
-    const int f =
-        EdgePiercesFace(edges, i, k, words[i], words[k], faces, tau, cand, &r->triple_products);
+    const int f = EdgePiercesFace(edges, i, k, words[i], words[k], faces, tau, clear, cand,
+                                  &r->triple_products);
     if (f >= 0) {
       r->verdict = Verdict::kCollide;
       r->decider = decider;

@@ -3,9 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#if defined(__x86_64__) || defined(__i386__)
-#include <immintrin.h>
-#endif
+#include "simd.h"
 
 namespace rms::dynamics_proc {
 
@@ -65,7 +63,7 @@ std::array<LocationWord, 8> Hexahedron::Words(const Hexahedron& o, double tau) c
 // session re-simulates identically anywhere).
 namespace {
 
-#if defined(__x86_64__) || defined(__i386__)
+#if defined(RMS_DCP_X86)
 // (Helpers, not lambdas: a lambda would not inherit the target.)
 __attribute__((target("avx"))) inline __m256d ProjectAvx(const Hexahedron& h, int f, __m256d X,
                                                          __m256d Y, __m256d Z) {
@@ -104,16 +102,24 @@ __attribute__((target("avx"))) void MasksAvx(const Hexahedron& h, const Hexahedr
     }
   }
 }
-
-const bool kHaveAvx = __builtin_cpu_supports("avx");
 #endif
 
 }  // namespace
 
+bool UseAvx(bool on) {
+#if defined(RMS_DCP_X86)
+  avx_enabled = on && __builtin_cpu_supports("avx");
+  return avx_enabled;
+#else
+  (void)on;
+  return false;
+#endif
+}
+
 int Hexahedron::FaceMasks(const Hexahedron& o, double tau,
                           std::array<std::uint8_t, 6>* masks) const {
-#if defined(__x86_64__) || defined(__i386__)
-  if (kHaveAvx) {
+#if defined(RMS_DCP_X86)
+  if (avx_enabled) {
     MasksAvx(*this, o, tau, masks);
     for (int f = 0; f < kNumFaces; ++f) {
       if ((*masks)[f] == 0xFF) return f;
@@ -169,12 +175,24 @@ int Hexahedron::FaceMasks(const Hexahedron& o, double tau,
   return -1;
 }
 
+namespace {
+// Bit i of m spread to bit 8 i: a face's mask as one bit in each vertex's byte.
+constexpr std::array<std::uint64_t, 256> MakeSpread() {
+  std::array<std::uint64_t, 256> t{};
+  for (unsigned m = 0; m < 256; ++m)
+    for (int i = 0; i < 8; ++i)
+      if (m & (1u << i)) t[m] |= std::uint64_t{1} << (8 * i);
+  return t;
+}
+constexpr std::array<std::uint64_t, 256> kSpread = MakeSpread();
+}  // namespace
+
 std::array<LocationWord, 8> WordsFromMasks(const std::array<std::uint8_t, 6>& masks) {
+  // The transpose, eight words at once: byte i of `all` is vertex i's word.
+  std::uint64_t all = 0;
+  for (int f = 0; f < kNumFaces; ++f) all |= kSpread[masks[f]] << f;
   std::array<LocationWord, 8> w{};
-  for (int f = 0; f < kNumFaces; ++f) {
-    for (int i = 0; i < kNumVertices; ++i)
-      w[i] |= static_cast<LocationWord>(((masks[f] >> i) & 1u) << f);
-  }
+  for (int i = 0; i < kNumVertices; ++i) w[i] = static_cast<LocationWord>(all >> (8 * i));
   return w;
 }
 

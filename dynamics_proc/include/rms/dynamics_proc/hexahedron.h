@@ -146,6 +146,13 @@ struct Hexahedron {
   int FaceMasks(const Hexahedron& other, double tau, std::array<std::uint8_t, 6>* masks) const;
 };
 
+// The AVX paths (FaceMasks, the edge test's triple products) run where the
+// processor has them and give the same bits as the portable scalar code.
+// UseAvx(false) forces the scalar code, for a test that checks the two
+// agree; UseAvx(true) restores AVX if the processor has it. Returns whether
+// AVX is now used. Not to be called while another thread tests pairs.
+bool UseAvx(bool on);
+
 // The report's way (Section IV.A.2): from point A at the centre of face a and
 // the Reference coordinates of three unit vectors U (a to d), V (b to e) and
 // W (c to f) -- for EFF HEX 1 these are UX2, UY2, UZ2 -- scaled by the length
