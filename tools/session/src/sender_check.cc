@@ -16,7 +16,7 @@ namespace rms::session {
 namespace {
 
 // Who publishes each channel (docs/protocol.md "Channels").
-bool Publishes(const std::string& base, std::int8_t process) {
+bool Publishes(std::string_view base, std::int8_t process) {
   using S = sender_t;
   if (base == wire::channels::kOperatorInput || base == wire::channels::kOperatorState)
     return process == S::PROCESS_OPERATOR_STATION;
@@ -48,7 +48,7 @@ SenderCheck::SenderCheck(const std::string& dir) {
   while (f >> name >> pid) pids_[wire::ProcessCode(name)].insert(static_cast<std::int32_t>(pid));
 }
 
-const char* SenderCheck::Ignore(const std::string& base, const void* data, int size) {
+const char* SenderCheck::Ignore(std::string_view base, const void* data, int size) {
   if (session_id_ == 0) return nullptr;  // recorded before session ids: nothing to tell them by
   const char* why = nullptr;
   std::int64_t id = 0;

@@ -3,12 +3,13 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <lcm/lcm-cpp.hpp>
 
 #include "rms/base/check.h"
 #include "rms/base/config.h"
 #include "rms/session/session_summary.h"
 #include "rms/wire/channels.h"
+
+#include "mapped_log.h"
 
 namespace fs = std::filesystem;
 
@@ -46,18 +47,16 @@ SessionLog::SessionLog(const std::string& session_dir)
 
 void SessionLog::Read(std::initializer_list<std::string_view> channels,
                       const std::function<void(const LogMessage&)>& visit) {
-  lcm::LogFile log(log_path_, "r");
-  if (!log.good()) throw InputError("cannot read the session's LCM log '" + log_path_ + "'");
+  MappedLog log(log_path_);
   events_ = 0;
   first_us_ = last_us_ = -1;
   std::int64_t input_frame = -1;
-  long good_end = 0;  // where the last whole event ends
-  while (const lcm::LogEvent* ev = log.readNextEvent()) {
-    good_end = std::ftell(log.getFilePtr());
+  MappedEvent ev;
+  while (log.Next(&ev)) {
     ++events_;
-    if (first_us_ < 0) first_us_ = ev->timestamp;
-    last_us_ = ev->timestamp;
-    std::string_view channel = ev->channel;
+    if (first_us_ < 0) first_us_ = ev.timestamp_us;
+    last_us_ = ev.timestamp_us;
+    std::string_view channel = ev.channel;
     if (!suffix_.empty()) {
       if (channel.size() <= suffix_.size() ||
           channel.substr(channel.size() - suffix_.size()) != suffix_)
@@ -65,32 +64,26 @@ void SessionLog::Read(std::initializer_list<std::string_view> channels,
       channel.remove_suffix(suffix_.size());
     }
     // Only the channels asked for are looked at (and the operator's, for the
-    // session time): the rest are skipped before any decoding.
+    // session time): the rest are skipped by their length, unread.
     const bool wanted = channels.size() == 0 ||
                         std::find(channels.begin(), channels.end(), channel) != channels.end();
     const bool input = channel == wire::channels::kOperatorInput;
     if (!wanted && !input) continue;
-    const std::string base(channel);
-    if (check_.Ignore(base, ev->data, ev->datalen)) continue;
+    if (check_.Ignore(channel, ev.data, ev.size)) continue;
     std::int64_t f = 0;
-    if (input && InputFrame(ev->data, ev->datalen, &f) && f >= 0) input_frame = f;
+    if (input && InputFrame(ev.data, ev.size, &f) && f >= 0) input_frame = f;
     if (!wanted) continue;
     LogMessage m;
-    m.base = base;
-    m.channel = ev->channel;
-    m.log_us = ev->timestamp;
-    m.log_time_s = (ev->timestamp - first_us_) * 1e-6;
+    m.base = channel;
+    m.channel = ev.channel;
+    m.log_us = ev.timestamp_us;
+    m.log_time_s = (ev.timestamp_us - first_us_) * 1e-6;
     m.session_time_s = input_frame < 0 ? 0.0 : input_frame / rate_hz_;
-    m.data = ev->data;
-    m.size = ev->datalen;
+    m.data = ev.data;
+    m.size = ev.size;
     visit(m);
   }
-  const long at = good_end;
-  std::error_code ec;
-  const auto size = fs::file_size(log_path_, ec);
-  unread_bytes_ = (at >= 0 && !ec && static_cast<std::int64_t>(size) > at)
-                      ? static_cast<std::int64_t>(size) - at
-                      : 0;
+  unread_bytes_ = static_cast<std::int64_t>(log.size() - log.good_end());
 }
 
 }  // namespace rms::session

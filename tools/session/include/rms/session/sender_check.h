@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 #include <string>
+#include <string_view>
 
 namespace rms::session {
 
@@ -30,7 +31,7 @@ class SenderCheck {
   // that channel), "not_the_sessions_process" (a pid none of the session's
   // processes had), "no_sender" (too short to carry one). base_channel: the
   // channel without the session's suffix. Counts what it leaves out.
-  const char* Ignore(const std::string& base_channel, const void* data, int size);
+  const char* Ignore(std::string_view base_channel, const void* data, int size);
   // A message left out for a reason of the caller's own (e.g. telemetry no
   // DCP frame confirms): counted with the rest.
   void Count(const std::string& reason, std::int64_t n = 1) {
