@@ -5,7 +5,7 @@
 // fused multiply-adds, and compute each number with the same operations in
 // the same order as the scalar code: the same bits on every machine, so a
 // session re-simulates identically anywhere (docs/performance.md).
-#if defined(RMS_DCP_X86)
+#if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
 #define RMS_DCP_X86 1
 #endif

@@ -315,6 +315,9 @@ TEST(Collide, TheAvxPathsGiveTheScalarCodesResultsBitForBit) {
   std::printf("seed %llu\n", static_cast<unsigned long long>(seed));
   const bool avx = UseAvx(true);
   std::printf("AVX on this processor: %s\n", avx ? "yes" : "no (scalar against scalar)");
+#if defined(__x86_64__) || defined(__i386__)
+  ASSERT_EQ(avx, __builtin_cpu_supports("avx") != 0) << "the AVX paths are not built in";
+#endif
   CollideOptions opts[3];
   opts[1].want_plane = false;
   opts[2].sphere_reject = opts[2].aabb_reject = false;

@@ -59,6 +59,7 @@ std::vector<Event> ReadWithLiblcm(const std::string& path, long* good_end) {
 enum class Damage {
   kNone,
   kGarbageFirst,
+  kTwoBytesAfter,
   kGarbageBetween,
   kCutShort,
   kBadChannelLength,
@@ -97,6 +98,7 @@ TEST_P(SessionLogRead, GivesLiblcmsEventsAndUnreadBytes) {
     }
   }
   if (GetParam() == Damage::kCutShort) bytes.resize(bytes.size() - 1234);
+  if (GetParam() == Damage::kTwoBytesAfter) bytes += "\xED\xA1";  // less than a sync word
   const std::string path = (dir / "lcmlog").string();
   std::ofstream(path, std::ios::binary) << bytes;
 
@@ -112,8 +114,10 @@ TEST_P(SessionLogRead, GivesLiblcmsEventsAndUnreadBytes) {
   EXPECT_TRUE(got == expected);
   EXPECT_EQ(log.events(), static_cast<std::int64_t>(expected.size()));
   EXPECT_EQ(log.unread_bytes(), static_cast<std::int64_t>(bytes.size()) - good_end);
-  if (GetParam() == Damage::kNone || GetParam() == Damage::kGarbageFirst) {
+  if (GetParam() == Damage::kNone || GetParam() == Damage::kGarbageFirst ||
+      GetParam() == Damage::kTwoBytesAfter) {
     EXPECT_EQ(got.size(), 300u);
+    EXPECT_EQ(log.unread_bytes(), 0);  // liblcm reads past up to three bytes after the last event
   } else {
     EXPECT_LT(got.size(), 300u);
     EXPECT_GT(log.unread_bytes(), 0);
@@ -132,8 +136,9 @@ TEST_P(SessionLogRead, GivesLiblcmsEventsAndUnreadBytes) {
 
 INSTANTIATE_TEST_SUITE_P(Damages, SessionLogRead,
                          ::testing::Values(Damage::kNone, Damage::kGarbageFirst,
-                                           Damage::kGarbageBetween, Damage::kCutShort,
-                                           Damage::kBadChannelLength, Damage::kNegativeDataLength));
+                                           Damage::kTwoBytesAfter, Damage::kGarbageBetween,
+                                           Damage::kCutShort, Damage::kBadChannelLength,
+                                           Damage::kNegativeDataLength));
 
 TEST(SessionLogRead, AnEmptyLogHasNoEventsAndAMissingOneIsRefusedByName) {
   const fs::path dir =

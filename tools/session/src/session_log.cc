@@ -9,7 +9,7 @@
 #include "rms/session/session_summary.h"
 #include "rms/wire/channels.h"
 
-#include "mapped_log.h"
+#include "raw_log.h"
 
 namespace fs = std::filesystem;
 
@@ -47,11 +47,11 @@ SessionLog::SessionLog(const std::string& session_dir)
 
 void SessionLog::Read(std::initializer_list<std::string_view> channels,
                       const std::function<void(const LogMessage&)>& visit) {
-  MappedLog log(log_path_);
+  RawLogReader log(log_path_);
   events_ = 0;
   first_us_ = last_us_ = -1;
   std::int64_t input_frame = -1;
-  MappedEvent ev;
+  RawLogEvent ev;
   while (log.Next(&ev)) {
     ++events_;
     if (first_us_ < 0) first_us_ = ev.timestamp_us;

@@ -1,12 +1,8 @@
-#include "mapped_log.h"
-
-#include <fcntl.h>
-#include <unistd.h>
+#include "raw_log.h"
 
 #include <cerrno>
 #include <cstring>
-#include <sys/mman.h>
-#include <sys/stat.h>
+#include <fstream>
 
 #include "rms/base/check.h"
 
@@ -25,33 +21,23 @@ std::uint64_t BigEndian(const std::uint8_t* p, int bytes) {
 
 }  // namespace
 
-MappedLog::MappedLog(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) throw InputError("cannot read the LCM log '" + path + "': " + std::strerror(errno));
-  struct stat st {};
-  if (::fstat(fd, &st) != 0) {
-    const int err = errno;
-    ::close(fd);
-    throw InputError("cannot read the LCM log '" + path + "': " + std::strerror(err));
-  }
-  size_ = static_cast<std::size_t>(st.st_size);
-  if (size_ > 0) {
-    void* m = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
-    if (m == MAP_FAILED) {
-      const int err = errno;
-      ::close(fd);
-      throw InputError("cannot map the LCM log '" + path + "': " + std::strerror(err));
-    }
-    base_ = static_cast<const std::uint8_t*>(m);
-  }
-  ::close(fd);
+RawLogReader::RawLogReader(const std::string& path) {
+  // Read whole, once: a mapping would die of SIGBUS if the file were cut
+  // short while it is read (a log overwritten or emptied meanwhile).
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw InputError("cannot read the LCM log '" + path + "': " + std::strerror(errno));
+  f.seekg(0, std::ios::end);
+  const std::streamoff size = f.tellg();
+  f.seekg(0, std::ios::beg);
+  bytes_.resize(size > 0 ? static_cast<std::size_t>(size) : 0);
+  f.read(bytes_.data(), static_cast<std::streamsize>(bytes_.size()));
+  bytes_.resize(static_cast<std::size_t>(f.gcount()));  // less, if it was cut short meanwhile
+  if (f.bad()) throw InputError("cannot read the LCM log '" + path + "': a read error");
+  base_ = reinterpret_cast<const std::uint8_t*>(bytes_.data());
+  size_ = bytes_.size();
 }
 
-MappedLog::~MappedLog() {
-  if (base_) ::munmap(const_cast<std::uint8_t*>(base_), size_);
-}
-
-bool MappedLog::Next(MappedEvent* ev) {
+bool RawLogReader::Next(RawLogEvent* ev) {
   // The sync word: the first place at or after the last event's end where
   // its four bytes stand (liblcm reads byte by byte until they do).
   const void* found = size_ - at_ >= 4 ? ::memmem(base_ + at_, size_ - at_, kSync, 4) : nullptr;
@@ -72,7 +58,10 @@ bool MappedLog::Next(MappedEvent* ev) {
   ev->channel = std::string_view(reinterpret_cast<const char*>(base_ + p), c);
   ev->data = base_ + p + c;
   ev->size = data_len;
-  at_ = good_end_ = end;
+  // liblcm's look for the next sync word takes up to three bytes after the
+  // last event with it: its reader ends past them.
+  at_ = end;
+  good_end_ = size_ - end < 4 ? size_ : end;
   return true;
 }
 
