@@ -43,31 +43,46 @@ int MakeBarPosts(const PayloadConfig& p, const Eigen::Isometry3d& X_RP,
   return b.count;
 }
 
-PayloadModel MakePayload(const PayloadConfig& p, const Eigen::Isometry3d& X_RP) {
+PayloadShape MakePayloadShape(const PayloadConfig& p) {
+  PayloadShape s;
+  s.half_len = 0.5 * p.length_ft;
+  s.probe_length = p.probe_length_ft;
+  s.probe_radius = 0.5 * p.probe_diameter_ft;
+  const double r = 0.5 * p.diameter_ft;
+  // The 16-gon's vertex levels from the top: level j at angle (2j + 1) pi/16
+  // from +z_P, z = r cos, half-width r sin (scene_model.cc draws the same).
+  for (int j = 0; j < 8; ++j) {
+    const double a = (2 * j + 1) * M_PI / kBodySides;
+    s.level_z[j] = r * std::cos(a);
+    s.level_hx[j] = r * std::sin(a);
+  }
+  // The rings: vertex k at angle (2k + 1) pi/16 round y_P from +z_P toward +x_P.
+  for (int k = 0; k < kBodySides; ++k) {
+    const double a = (2 * k + 1) * M_PI / kBodySides;
+    s.ring_x[k] = r * std::sin(a);
+    s.ring_z[k] = r * std::cos(a);
+  }
+  for (int j = 0; j < 6; ++j) {
+    const double a = j * M_PI / 3.0;
+    s.tip_cos[j] = std::cos(a);
+    s.tip_sin[j] = std::sin(a);
+  }
+  return s;
+}
+
+PayloadModel MakePayload(const PayloadShape& s, const Eigen::Isometry3d& X_RP) {
   const Eigen::Matrix3d& R = X_RP.linear();
   const Eigen::Vector3d xP = R.col(0), yP = R.col(1), zP = R.col(2);
   const Eigen::Vector3d centre = X_RP.translation();
-  const double half_len = 0.5 * p.length_ft, r = 0.5 * p.diameter_ft,
-               pr = 0.5 * p.probe_diameter_ft;
+  const double half_len = s.half_len, pr = s.probe_radius;
   PayloadModel m;
-  // The 16-gon's vertex levels from the top: level j at angle (2j + 1) pi/16
-  // from +z_P, z = r cos, half-width r sin (scene_model.cc draws the same).
-  std::array<double, 9> z{}, hx{};
-  for (int j = 0; j < 8; ++j) {
-    const double a = (2 * j + 1) * M_PI / kBodySides;
-    z[j] = r * std::cos(a);
-    hx[j] = r * std::sin(a);
-  }
   auto at = [&](double x, double y, double zz) {
     return Eigen::Vector3d(centre + x * xP + y * yP + zz * zP);
   };
-  // The rings: vertex k of a ring at angle (2k + 1) pi/16 round y_P from +z_P toward +x_P.
   for (int end = 0; end < 2; ++end) {
     const double y = end ? half_len : -half_len;
-    for (int k = 0; k < kBodySides; ++k) {
-      const double a = (2 * k + 1) * M_PI / kBodySides;
-      m.v[end * kBodySides + k] = at(r * std::sin(a), y, r * std::cos(a));
-    }
+    for (int k = 0; k < kBodySides; ++k)
+      m.v[end * kBodySides + k] = at(s.ring_x[k], y, s.ring_z[k]);
   }
   // The strips, each from its eight vertices in the standard numbering
   // (generators' signs: u from a to d, v from b to e, w from c to f).
@@ -77,22 +92,23 @@ PayloadModel MakePayload(const PayloadConfig& p, const Eigen::Isometry3d& X_RP) 
     std::array<Eigen::Vector3d, 8> v;
     for (int i = 0; i < 8; ++i) {
       const int level = kSigns[i][2] < 0 ? j : j + 1;  // w = -z_P: the c side is the top
-      v[i] = at(kSigns[i][1] * hx[level], kSigns[i][0] * half_len, z[level]);
+      v[i] = at(kSigns[i][1] * s.level_hx[level], kSigns[i][0] * half_len, s.level_z[level]);
     }
     m.body[j] = FromVertices(v);
   }
   const Eigen::Vector3d root = centre + half_len * yP;
-  const Eigen::Vector3d tip = root + p.probe_length_ft * yP;
+  const Eigen::Vector3d tip = root + s.probe_length * yP;
   int k = kProbeFirst;
   for (double sx : {-1.0, 1.0})
     for (double sz : {-1.0, 1.0}) m.v[k++] = root + pr * (sx * xP + sz * zP);
-  for (int j = 0; j < 6; ++j) {
-    const double a = j * M_PI / 3.0;
-    m.v[k++] = tip + pr * (std::cos(a) * xP + std::sin(a) * zP);
-  }
+  for (int j = 0; j < 6; ++j) m.v[k++] = tip + pr * (s.tip_cos[j] * xP + s.tip_sin[j] * zP);
   m.probe_tip_centre = tip;
   m.probe_axis = yP;
   return m;
+}
+
+PayloadModel MakePayload(const PayloadConfig& p, const Eigen::Isometry3d& X_RP) {
+  return MakePayload(MakePayloadShape(p), X_RP);
 }
 
 std::string PayloadVertexName(int i) {

@@ -85,7 +85,7 @@ DynamicCollisionProgram::DynamicCollisionProgram(const LabConfig& config, const 
 void DynamicCollisionProgram::PlacePayload(const Eigen::Isometry3d& X_RP) {
   X_RP_free_ = X_RP;
   bar_ = MakeBar(config_.payload, X_RP);
-  payload_ = MakePayload(config_.payload, X_RP);
+  payload_ = MakePayload(payload_shape_, X_RP);
   post_count_ = MakeBarPosts(config_.payload, X_RP, &posts_);
 }
 
@@ -258,7 +258,7 @@ void DynamicCollisionProgram::EvaluateMode1(const Evaluation* prev, Evaluation* 
 // bottom: a vertex below face c that is beyond a wall collides with it.
 void DynamicCollisionProgram::EvaluateMode2(Evaluation* e) const {
   e->X_RP = e->pose.X_RS2 * X_S2P_;
-  e->payload = MakePayload(config_.payload, e->X_RP);
+  e->payload = MakePayload(payload_shape_, e->X_RP);
   e->clearance_ft = std::numeric_limits<double>::infinity();
   e->collisions |= BayCollisions(e->payload, &e->clearance_ft);
 }
@@ -280,7 +280,7 @@ void DynamicCollisionProgram::EvaluateMode3(const Evaluation* prev, Evaluation* 
     return;
   }
   e->X_RP = e->pose.X_RS2 * X_S2P_;
-  e->payload = MakePayload(config_.payload, e->X_RP);
+  e->payload = MakePayload(payload_shape_, e->X_RP);
   const double tau = ToleranceFt(cae_, cae_, tau_rel_);
   e->clearance_ft = std::numeric_limits<double>::infinity();
   for (const Eigen::Vector3d& v : e->payload.v) {
@@ -1134,7 +1134,7 @@ void DynamicCollisionProgram::CheckRestored(int mode, bool acquired, bool docked
 
 double DynamicCollisionProgram::PayloadReachFt(const Eigen::Isometry3d& X_S2P) const {
   // The payload in System Two: its vertices' distances from point A.
-  const PayloadModel m = MakePayload(config_.payload, X_S2P);
+  const PayloadModel m = MakePayload(payload_shape_, X_S2P);
   double reach = 0.0;
   for (const Eigen::Vector3d& v : m.v) reach = std::max(reach, v.norm());
   return reach;

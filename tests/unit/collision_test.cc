@@ -342,6 +342,15 @@ TEST(Collide, TheAvxPathsGiveTheScalarCodesResultsBitForBit) {
       UseAvx(false);
       const CollisionResult plain = Collide(p.a.hex, p.b.hex, o);
       edge_phase += plain.words_valid;
+      // The DCP's clearance: the gap along each plane (the same value; an
+      // exactly zero gap may differ in sign, which the DCP's max(0, gap) hides).
+      if (plain.plane_valid) {
+        UseAvx(true);
+        const double gap_fast = GapAlong(p.a.hex, p.b.hex, plain.plane.n_R);
+        UseAvx(false);
+        const double gap_plain = GapAlong(p.a.hex, p.b.hex, plain.plane.n_R);
+        if (!(gap_fast == gap_plain) && ++differ < 5) ADD_FAILURE() << p.kind << " gap " << i;
+      }
       if (!same(fast, plain) && ++differ < 5) ADD_FAILURE() << p.kind << " pair " << i;
     }
   }

@@ -53,6 +53,18 @@ struct PayloadModel {
   Eigen::Vector3d probe_tip_centre;  // centre of V31-V36
   Eigen::Vector3d probe_axis;        // y_P, the probe's y-axis
 };
+// What of the payload's model depends on its configuration alone (its
+// coordinates in its own frame P, ft; the angles' sines and cosines), made
+// once: a frame then only places it.
+struct PayloadShape {
+  double half_len = 0, probe_length = 0, probe_radius = 0;
+  std::array<double, 9> level_z{}, level_hx{};        // the 16-gon's levels from the top
+  std::array<double, kBodySides> ring_x{}, ring_z{};  // each ring's vertices about y_P
+  std::array<double, 6> tip_cos{}, tip_sin{};         // V31..V36 round the probe's tip
+};
+PayloadShape MakePayloadShape(const PayloadConfig& p);
+// The payload placed at X_RP (the same numbers whichever form is called).
+PayloadModel MakePayload(const PayloadShape& s, const Eigen::Isometry3d& X_RP);
 PayloadModel MakePayload(const PayloadConfig& p, const Eigen::Isometry3d& X_RP);
 // The payload vertex names: "B1" .. "B32" (the body), "V21" .. "V36".
 std::string PayloadVertexName(int i);

@@ -324,6 +324,7 @@ class DynamicCollisionProgram {
   // the finger let it go. Its BAR, body and the BAR's posts.
   Eigen::Isometry3d X_RP_free_;
   Hexahedron bar_;
+  PayloadShape payload_shape_ = MakePayloadShape(config_.payload);  // made once
   PayloadModel payload_;
   std::array<Hexahedron, 2> posts_{};
   int post_count_ = 0;
