@@ -70,7 +70,7 @@ PayloadShape MakePayloadShape(const PayloadConfig& p) {
   return s;
 }
 
-PayloadModel MakePayload(const PayloadShape& s, const Eigen::Isometry3d& X_RP) {
+PayloadModel MakePayload(const PayloadShape& s, const Eigen::Isometry3d& X_RP, bool with_body) {
   const Eigen::Matrix3d& R = X_RP.linear();
   const Eigen::Vector3d xP = R.col(0), yP = R.col(1), zP = R.col(2);
   const Eigen::Vector3d centre = X_RP.translation();
@@ -88,7 +88,8 @@ PayloadModel MakePayload(const PayloadShape& s, const Eigen::Isometry3d& X_RP) {
   // (generators' signs: u from a to d, v from b to e, w from c to f).
   static constexpr int kSigns[8][3] = {{-1, -1, -1}, {-1, -1, 1}, {1, -1, -1}, {-1, 1, 1},
                                        {-1, 1, -1},  {1, -1, 1},  {1, 1, 1},   {1, 1, -1}};
-  for (int j = 0; j < kBodyStrips; ++j) {
+  m.has_body = with_body;
+  for (int j = 0; j < kBodyStrips && with_body; ++j) {
     std::array<Eigen::Vector3d, 8> v;
     for (int i = 0; i < 8; ++i) {
       const int level = kSigns[i][2] < 0 ? j : j + 1;  // w = -z_P: the c side is the top

@@ -145,8 +145,14 @@ bool Finite(const ArmCommand& c) {
 }
 
 bool Finite(const PayloadModel& p) {
-  double zero = 0.0;
-  for (const Eigen::Vector3d& v : p.v) zero += (v.x() + v.y() + v.z()) * 0.0;
+  double zero = 0.0, largest = 0.0;
+  for (const Eigen::Vector3d& v : p.v) {
+    zero += (v.x() + v.y() + v.z()) * 0.0;
+    largest = std::max(largest, v.cwiseAbs().maxCoeff());
+  }
+  // Without its strips, what would refuse them (a coordinate too large for
+  // their products) refuses the vertices.
+  if (!p.has_body) return zero == 0.0 && largest <= kMaxCoordinateFt;
   for (const Hexahedron& h : p.body) zero += h.valid ? 0.0 : NAN;
   return zero == 0.0;
 }
@@ -258,7 +264,8 @@ void DynamicCollisionProgram::EvaluateMode1(const Evaluation* prev, Evaluation* 
 // bottom: a vertex below face c that is beyond a wall collides with it.
 void DynamicCollisionProgram::EvaluateMode2(Evaluation* e) const {
   e->X_RP = e->pose.X_RS2 * X_S2P_;
-  e->payload = MakePayload(payload_shape_, e->X_RP);
+  // The vertices only, unless every pair is tested (EvaluateExtraPairs).
+  e->payload = MakePayload(payload_shape_, e->X_RP, !options_.mode_pairs_only);
   e->clearance_ft = std::numeric_limits<double>::infinity();
   e->collisions |= BayCollisions(e->payload, &e->clearance_ft);
 }
@@ -280,7 +287,7 @@ void DynamicCollisionProgram::EvaluateMode3(const Evaluation* prev, Evaluation* 
     return;
   }
   e->X_RP = e->pose.X_RS2 * X_S2P_;
-  e->payload = MakePayload(payload_shape_, e->X_RP);
+  e->payload = MakePayload(payload_shape_, e->X_RP, !options_.mode_pairs_only);
   const double tau = ToleranceFt(cae_, cae_, tau_rel_);
   e->clearance_ft = std::numeric_limits<double>::infinity();
   for (const Eigen::Vector3d& v : e->payload.v) {

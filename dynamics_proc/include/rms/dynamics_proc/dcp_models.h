@@ -48,6 +48,9 @@ struct PayloadModel {
   // Strip j between the 16-gon's vertex levels j and j + 1 from the top:
   // u = y_P (face d at the probe end), v = x_P, w = -z_P (c the strip's top).
   std::array<Hexahedron, kBodyStrips> body;
+  // The strips are made (MakePayload with_body): Modes 2 and 3 test only
+  // the vertices, and skip them.
+  bool has_body = true;
   std::array<Eigen::Vector3d, kPayloadVertices>
       v;                             // body (aft ring, then fore ring), V21..V24, V31..V36
   Eigen::Vector3d probe_tip_centre;  // centre of V31-V36
@@ -63,8 +66,10 @@ struct PayloadShape {
   std::array<double, 6> tip_cos{}, tip_sin{};         // V31..V36 round the probe's tip
 };
 PayloadShape MakePayloadShape(const PayloadConfig& p);
-// The payload placed at X_RP (the same numbers whichever form is called).
-PayloadModel MakePayload(const PayloadShape& s, const Eigen::Isometry3d& X_RP);
+// The payload placed at X_RP (the same numbers whichever form is called);
+// without its strips when !with_body.
+PayloadModel MakePayload(const PayloadShape& s, const Eigen::Isometry3d& X_RP,
+                         bool with_body = true);
 PayloadModel MakePayload(const PayloadConfig& p, const Eigen::Isometry3d& X_RP);
 // The payload vertex names: "B1" .. "B32" (the body), "V21" .. "V36".
 std::string PayloadVertexName(int i);
