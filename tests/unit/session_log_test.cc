@@ -84,6 +84,7 @@ TEST_P(SessionLogRead, GivesLiblcmsEventsAndUnreadBytes) {
   for (int n = 0; n < 300; ++n) {
     Event e{1'700'000'000'000'000 + n * 33'333, channels[pick(rng)], ""};
     for (int k = size(rng); k > 0; --k) e.data.push_back(static_cast<char>(byte(rng)));
+    if (n == 150) e.data.append(100'000, 'x');  // larger than the reader's buffer
     const auto c = static_cast<std::int32_t>(e.channel.size());
     const auto d = static_cast<std::int32_t>(e.data.size());
     if (GetParam() == Damage::kGarbageBetween && n % 7 == 3) {

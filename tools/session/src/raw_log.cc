@@ -1,8 +1,12 @@
 #include "raw_log.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
-#include <fstream>
+#include <sys/stat.h>
 
 #include "rms/base/check.h"
 
@@ -12,6 +16,7 @@ namespace {
 
 constexpr std::uint8_t kSync[4] = {0xED, 0xA1, 0xDA, 0x01};
 constexpr std::size_t kHeaderBytes = 8 + 8 + 4 + 4;  // event number, time, two lengths
+constexpr std::size_t kBlockBytes = 1 << 16;         // read in blocks of 64 KiB
 
 std::uint64_t BigEndian(const std::uint8_t* p, int bytes) {
   std::uint64_t v = 0;
@@ -21,47 +26,87 @@ std::uint64_t BigEndian(const std::uint8_t* p, int bytes) {
 
 }  // namespace
 
-RawLogReader::RawLogReader(const std::string& path) {
-  // Read whole, once: a mapping would die of SIGBUS if the file were cut
-  // short while it is read (a log overwritten or emptied meanwhile).
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw InputError("cannot read the LCM log '" + path + "': " + std::strerror(errno));
-  f.seekg(0, std::ios::end);
-  const std::streamoff size = f.tellg();
-  f.seekg(0, std::ios::beg);
-  bytes_.resize(size > 0 ? static_cast<std::size_t>(size) : 0);
-  f.read(bytes_.data(), static_cast<std::streamsize>(bytes_.size()));
-  bytes_.resize(static_cast<std::size_t>(f.gcount()));  // less, if it was cut short meanwhile
-  if (f.bad()) throw InputError("cannot read the LCM log '" + path + "': a read error");
-  base_ = reinterpret_cast<const std::uint8_t*>(bytes_.data());
-  size_ = bytes_.size();
+RawLogReader::RawLogReader(const std::string& path) : path_(path) {
+  fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd_ < 0) throw InputError("cannot read the LCM log '" + path + "': " + std::strerror(errno));
+  struct stat st {};
+  if (::fstat(fd_, &st) == 0 && st.st_size > 0) file_size_ = static_cast<std::size_t>(st.st_size);
+  capacity_ = std::min<std::size_t>(std::max<std::size_t>(file_size_, 4), kBlockBytes);
+  buf_ = std::make_unique_for_overwrite<std::uint8_t[]>(capacity_);
+}
+
+RawLogReader::~RawLogReader() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+bool RawLogReader::Have(std::size_t n) {
+  if (end_ - begin_ >= n) return true;
+  if (offset_ + begin_ + n > file_size_) return false;  // past the end of the file as opened
+  // The unread bytes to the front; a larger buffer for an event larger than it.
+  if (n > capacity_) {
+    const std::size_t grown = std::max(n, 2 * capacity_);
+    auto bigger = std::make_unique_for_overwrite<std::uint8_t[]>(grown);
+    std::memcpy(bigger.get(), buf_.get() + begin_, end_ - begin_);
+    buf_ = std::move(bigger);
+    capacity_ = grown;
+  } else if (begin_ > 0) {
+    std::memmove(buf_.get(), buf_.get() + begin_, end_ - begin_);
+  }
+  offset_ += begin_;
+  end_ -= begin_;
+  begin_ = 0;
+  while (end_ < n) {
+    const std::size_t want = std::min(capacity_ - end_, file_size_ - offset_ - end_);
+    const ssize_t got = ::read(fd_, buf_.get() + end_, want);
+    if (got < 0 && errno == EINTR) continue;
+    if (got < 0)
+      throw InputError("cannot read the LCM log '" + path_ + "': " + std::strerror(errno));
+    if (got == 0) {  // cut short since it was opened
+      file_size_ = offset_ + end_;
+      return false;
+    }
+    end_ += static_cast<std::size_t>(got);
+  }
+  return true;
 }
 
 bool RawLogReader::Next(RawLogEvent* ev) {
   // The sync word: the first place at or after the last event's end where
   // its four bytes stand (liblcm reads byte by byte until they do).
-  const void* found = size_ - at_ >= 4 ? ::memmem(base_ + at_, size_ - at_, kSync, 4) : nullptr;
-  if (!found) return false;
-  std::size_t p = static_cast<std::size_t>(static_cast<const std::uint8_t*>(found) - base_) + 4;
-  if (size_ - p < kHeaderBytes) return false;
-  ev->timestamp_us = static_cast<std::int64_t>(BigEndian(base_ + p + 8, 8));
-  const auto channel_len = static_cast<std::int32_t>(BigEndian(base_ + p + 16, 4));
-  const auto data_len = static_cast<std::int32_t>(BigEndian(base_ + p + 20, 4));
-  p += kHeaderBytes;
+  for (;;) {
+    if (!Have(4)) return false;
+    const void* found = ::memmem(buf_.get() + begin_, end_ - begin_, kSync, 4);
+    if (found) {
+      begin_ = static_cast<std::size_t>(static_cast<const std::uint8_t*>(found) - buf_.get());
+      break;
+    }
+    begin_ = end_ - 3;  // a sync word may begin in the last three bytes
+    if (!Have(4)) return false;
+  }
+  if (!Have(4 + kHeaderBytes)) return false;
+  const std::uint8_t* h = buf_.get() + begin_ + 4;
+  const auto timestamp_us = static_cast<std::int64_t>(BigEndian(h + 8, 8));
+  const auto channel_len = static_cast<std::int32_t>(BigEndian(h + 16, 4));
+  const auto data_len = static_cast<std::int32_t>(BigEndian(h + 20, 4));
   if (channel_len <= 0 || channel_len >= 1000 || data_len < 0) return false;
-  const auto c = static_cast<std::size_t>(channel_len), d = static_cast<std::size_t>(data_len);
-  if (size_ - p < c || size_ - p - c < d) return false;
-  // liblcm takes an event only when the next one's sync word (or the end,
-  // or fewer than four bytes) follows it.
-  const std::size_t end = p + c + d;
-  if (size_ - end >= 4 && std::memcmp(base_ + end, kSync, 4) != 0) return false;
-  ev->channel = std::string_view(reinterpret_cast<const char*>(base_ + p), c);
-  ev->data = base_ + p + c;
+  const std::size_t total =
+      4 + kHeaderBytes + static_cast<std::size_t>(channel_len) + static_cast<std::size_t>(data_len);
+  if (!Have(total)) return false;
+  // liblcm takes an event only when the next one's sync word follows it, or
+  // fewer than four bytes do (which its look for the sync word takes up).
+  std::size_t end = offset_ + begin_ + total;
+  if (Have(total + 4)) {
+    if (std::memcmp(buf_.get() + begin_ + total, kSync, 4) != 0) return false;
+  } else {
+    end = file_size_;
+  }
+  const std::uint8_t* p = buf_.get() + begin_ + 4 + kHeaderBytes;
+  ev->timestamp_us = timestamp_us;
+  ev->channel = std::string_view(reinterpret_cast<const char*>(p), channel_len);
+  ev->data = p + channel_len;
   ev->size = data_len;
-  // liblcm's look for the next sync word takes up to three bytes after the
-  // last event with it: its reader ends past them.
-  at_ = end;
-  good_end_ = size_ - end < 4 ? size_ : end;
+  begin_ += total;
+  good_end_ = end;
   return true;
 }
 
