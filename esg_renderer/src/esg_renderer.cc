@@ -134,15 +134,14 @@ bool EsgRenderer::RenderPending() {
   // Skip what the scene doesn't need: the same words but for the frame
   // counter (word 0) draw the same scene; only the overlay changes.
   const bool unchanged =
-      options_.skip_unchanged && !scene_.empty() && msg.words.size() == last_words_.size() &&
+      options_.skip_unchanged && scene_ && msg.words.size() == last_words_.size() &&
       std::equal(msg.words.begin() + 1, msg.words.end(), last_words_.begin() + 1);
   const std::int64_t t0 = MonotonicUs();
   if (unchanged) {
     counters_.Add(Counter::kSkippedUnchanged);
   } else {
     renderer_->Render(frame);
-    const std::uint8_t* px = renderer_->pixels();
-    scene_.assign(px, px + bytes);
+    scene_ = renderer_->pixels();
     last_words_ = msg.words;
     const RenderStats& s = renderer_->stats();
     counters_.Add(Counter::kRenderedScenes);
@@ -152,7 +151,7 @@ bool EsgRenderer::RenderPending() {
     if (s.cycles_broken) counters_.Add(Counter::kPriorityCyclesBroken, s.cycles_broken);
     latencies_["render"].Add(MonotonicUs() - t0);
   }
-  output_ = scene_;
+  output_.assign(scene_, scene_ + bytes);
   if (!options_.id_colors) DrawOverlay(output_.data(), w, h, frame, overlay_);
   const std::int64_t done = lcm_->NowUs();
   counters_.Add(Counter::kRendered);

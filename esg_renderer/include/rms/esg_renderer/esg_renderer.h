@@ -79,10 +79,12 @@ class EsgRenderer {
   // The first frame number accepted: the video starts there even when that
   // frame was superseded before it could be drawn.
   std::int64_t first_frame_ = -1;
-  std::vector<std::int32_t> last_words_;  // the words of the image in scene_
-  std::vector<std::uint8_t> scene_;       // the last rendered scene, before the overlay
-  std::vector<std::uint8_t> output_;      // the last output image, overlay included
-  std::vector<std::uint8_t> shown_;       // the window's: the output and the operator's guidance
+  std::vector<std::int32_t> last_words_;  // the words of the image at scene_
+  // The last rendered scene, before the overlay: the renderer's own buffer,
+  // which nothing else draws into (not copied: a frame is 3 MB at 1024x768).
+  const std::uint8_t* scene_ = nullptr;
+  std::vector<std::uint8_t> output_;  // the last output image, overlay included
+  std::vector<std::uint8_t> shown_;   // the window's: the output and the operator's guidance
   std::optional<operator_state_t>
       operator_state_;  // the newest RMS_OPERATOR_STATE (the window's guidance)
   std::int64_t keys_sequence_ = 0, keys_sent_us_ = 0;
