@@ -53,6 +53,9 @@ struct FrameVariant {
   DcpOptions options;
   std::vector<double> ns;                      // every frame of every repetition
   std::array<std::vector<double>, 4> ns_mode;  // by the mode the frame started in
+  // By flight, and by whether the master's command moved from the frame
+  // before (the motion test between the frames runs) or stood still.
+  std::vector<std::array<std::vector<double>, 2>> ns_flight_moving;
   long mismatches = 0;  // frames whose decisions differ from the first variant's
 };
 
@@ -72,18 +75,25 @@ void RunFrames(const rms::LabConfig& config, const std::vector<Flight>& flights,
   std::vector<std::vector<Decision>> reference;
   for (std::size_t vi = 0; vi < variants->size(); ++vi) {
     FrameVariant& v = (*variants)[vi];
+    v.ns_flight_moving.resize(flights.size());
     for (std::size_t fi = 0; fi < flights.size(); ++fi) {
       for (int r = 0; r < reps; ++r) {
         DynamicCollisionProgram dcp(config, v.options);
         std::vector<Decision> decisions;
         for (const rms::wire::OperatorInputs& in : flights[fi].inputs) {
           const int mode = dcp.mode();
+          const auto before = dcp.status().master;
           const auto t0 = Clock::now();
           rms::wire::DcpFrameData out = dcp.Step(in);
           benchmark::DoNotOptimize(out);
           const double ns = std::chrono::duration<double, std::nano>(Clock::now() - t0).count();
           v.ns.push_back(ns);
           v.ns_mode[mode].push_back(ns);
+          const auto& after = dcp.status().master;
+          const bool moved = before.angles_deg != after.angles_deg ||
+                             before.shoulder_height_ft != after.shoulder_height_ft ||
+                             before.finger != after.finger;
+          v.ns_flight_moving[fi][moved].push_back(ns);
           if (r == 0) {
             decisions.push_back({rms::wire::PackControlWord(out.control), dcp.status().collisions,
                                  dcp.mode(), dcp.status().X_RS2.translation()});
@@ -303,6 +313,34 @@ void MakeFlights(Bench* b, std::uint64_t seed) {
                r1.held_frames);
 }
 
+// The default's frames by flight, with the arm still and moving; the
+// targets on them.
+void MovingTable(const Bench& b, const FrameVariant& v, std::ostringstream& md) {
+  md << "\nThe default's frames by flight, the master's command still (the same as the frame "
+        "before) or moving (the motion test between the frames runs):\n\n"
+     << "| flight | frames still | still median ns | frames moving | moving median ns | moving "
+        "p99 ns |\n|---|---:|---:|---:|---:|---:|\n";
+  std::array<std::vector<double>, 2> all;
+  for (std::size_t fi = 0; fi < b.flights.size(); ++fi) {
+    const auto& m = v.ns_flight_moving[fi];
+    for (int k = 0; k < 2; ++k) all[k].insert(all[k].end(), m[k].begin(), m[k].end());
+    md << Sprintf("| %s | %zu | %.0f | %zu | %.0f | %.0f |\n", b.flights[fi].name.c_str(),
+                  m[0].size(), m[0].empty() ? 0.0 : Percentile(m[0], 0.5), m[1].size(),
+                  m[1].empty() ? 0.0 : Percentile(m[1], 0.5),
+                  m[1].empty() ? 0.0 : Percentile(m[1], 0.99));
+  }
+  const double still = all[0].empty() ? -1 : Percentile(all[0], 0.5);
+  const double moving = all[1].empty() ? -1 : Percentile(all[1], 0.5);
+  auto target = [](const char* what, double ns, double limit) {
+    if (ns < 0) return Sprintf("- **Target** %s: not measured.\n", what);
+    return Sprintf("- **Target** %s: %.0f ns (%s).\n", what, ns,
+                   ns <= limit ? "met" : Sprintf("MISSED by %.2fx", ns / limit).c_str());
+  };
+  md << "\n"
+     << target("DCP whole frame median, arm still, <= 1000 ns", still, 1000)
+     << target("DCP whole frame median, arm moving, <= 5000 ns", moving, 5000) << "\n";
+}
+
 // 1. The whole frame under each saving; 1 when a variant decided a frame
 // differently from the default.
 int FrameTable(const Bench& b, int reps, std::ostringstream& md) {
@@ -368,8 +406,7 @@ int FrameTable(const Bench& b, int reps, std::ostringstream& md) {
       status = 1;
     }
   }
-  md << Sprintf("\n- **Target** DCP whole frame median <= 1000 ns: %.0f ns, %s.\n\n", base,
-                base <= 1000 ? "met" : "MISSED");
+  MovingTable(b, fv[0], md);
   return status;
 }
 
