@@ -4,8 +4,9 @@
 //
 //   rms_collision_bench [--md FILE] [--agreement N] [Google Benchmark flags]
 //
-// Timing: 4096 random box pairs (and 4096 random general hexahedra), and
-// 4096 dense pairs of each (bounding spheres overlapping, half colliding),
+// Timing: 4096 random box pairs (and 4096 random general hexahedra), 4096
+// dense pairs of each (bounding spheres overlapping, half colliding), and
+// 4096 of each kind the DCP tests in an autopilot mission's Mode 1 frames,
 // each method given the pairs in its own form, prepared before timing, cycled
 // through in the same order. Agreement: N pairs of each family of the test
 // generator (random, touching to 1e-6..1e-12, parallel edges, nested, rods
@@ -21,9 +22,13 @@
 #include <string>
 #include <vector>
 
+#include "rms/base/config.h"
 #include "rms/dynamics_proc/collision.h"
+#include "rms/dynamics_proc/dcp_models.h"
+#include "rms/dynamics_proc/dynamic_collision_program.h"
 #include "rms/reference/exact_hull.h"
 #include "rms/reference/generators.h"
+#include "rms/sim/closed_loop.h"
 
 #include "peers.h"
 
@@ -55,6 +60,14 @@ struct Sets {
   std::vector<std::pair<rms::bench::BoxShape, rms::bench::BoxShape>> dense_boxes;
   std::vector<std::unique_ptr<rms::bench::FclPair>> fcl_dense_boxes, fcl_dense_general;
   int dense_boxes_colliding = 0, dense_general_colliding = 0;  // of the 4096
+  // The pairs the DCP tests in the Mode 1 frames of an autopilot mission
+  // (EFF HEX 1-3 against the BAR and its posts: boxes; against the payload's
+  // strips: general hexahedra), 4096 of each taken evenly in flight order.
+  std::vector<std::pair<rms::dynamics_proc::Hexahedron, rms::dynamics_proc::Hexahedron>>
+      hex_mission_boxes, hex_mission_general;
+  std::vector<std::pair<rms::bench::BoxShape, rms::bench::BoxShape>> mission_boxes;
+  std::vector<std::unique_ptr<rms::bench::FclPair>> fcl_mission_boxes, fcl_mission_general;
+  int mission_frames = 0, mission_boxes_colliding = 0, mission_general_colliding = 0;
 };
 
 // The solids' bounding spheres (about their vertices' mean) overlap.
@@ -93,6 +106,69 @@ int MakeDenseSet(rms::reference::PairGenerator& gen, bool boxes, Take take) {
   return colliding;
 }
 
+Hull HullOf(const rms::dynamics_proc::Hexahedron& h) {
+  Hull v;
+  for (int i = 0; i < 8; ++i) v[i] = h.vertex(i);
+  return v;
+}
+
+// A box hexahedron (MakeBox's numbering) as centre, axes and half extents.
+rms::bench::BoxShape BoxOf(const rms::dynamics_proc::Hexahedron& h) {
+  rms::bench::BoxShape b;
+  b.centre = Eigen::Vector3d::Zero();
+  for (int i = 0; i < 8; ++i) b.centre += h.vertex(i) / 8.0;
+  const Eigen::Vector3d edges[3] = {h.vertex(2) - h.vertex(0), h.vertex(4) - h.vertex(0),
+                                    h.vertex(1) - h.vertex(0)};  // U: v3-v1, V: v5-v1, W: v2-v1
+  for (int k = 0; k < 3; ++k) {
+    b.R.col(k) = edges[k].normalized();
+    b.half[k] = 0.5 * edges[k].norm();
+  }
+  return b;
+}
+
+// The mission's Mode 1 pairs: the planned autopilot's flight replayed
+// through the DCP, each Mode 1 frame's models rebuilt from its status.
+void MakeMissionSets(Sets* s) {
+  using namespace rms::dynamics_proc;
+  const rms::LabConfig config = rms::LoadConfig(rms::DefaultConfigPath());
+  std::vector<rms::wire::OperatorInputs> inputs;
+  rms::sim::FlyAutopilot(config, {}, 20000, 1, &inputs);
+  DynamicCollisionProgram dcp(config);
+  std::vector<std::pair<Hexahedron, Hexahedron>> boxes, general;
+  for (const auto& in : inputs) {
+    const bool mode1 = dcp.mode() == 1;
+    dcp.Step(in);
+    if (!mode1 || dcp.mode() != 1) continue;
+    ++s->mission_frames;
+    const DcpStatus& st = dcp.status();
+    const EndEffectorModel ee = MakeEndEffector(config.end_effector, st.X_RS2, st.finger_gap_ft);
+    const Hexahedron bar = MakeBar(config.payload, st.X_RP);
+    std::array<Hexahedron, 2> posts;
+    const int n_posts = MakeBarPosts(config.payload, st.X_RP, &posts);
+    const PayloadModel payload = MakePayload(config.payload, st.X_RP);
+    for (const Hexahedron& h : ee.hex) {
+      boxes.emplace_back(h, bar);
+      for (int j = 0; j < n_posts; ++j) boxes.emplace_back(h, posts[j]);
+      for (const Hexahedron& strip : payload.body) general.emplace_back(h, strip);
+    }
+  }
+  auto take = [](const auto& all, auto* out) {
+    for (std::size_t i = 0; i < 4096 && !all.empty(); ++i)
+      out->push_back(all[i * all.size() / 4096]);
+  };
+  take(boxes, &s->hex_mission_boxes);
+  take(general, &s->hex_mission_general);
+  for (const auto& [a, b] : s->hex_mission_boxes) {
+    s->mission_boxes.emplace_back(BoxOf(a), BoxOf(b));
+    s->fcl_mission_boxes.push_back(rms::bench::FclPair::Boxes(BoxOf(a), BoxOf(b)));
+    s->mission_boxes_colliding += rms::reference::ExactHullsIntersect(HullOf(a), HullOf(b));
+  }
+  for (const auto& [a, b] : s->hex_mission_general) {
+    s->fcl_mission_general.push_back(rms::bench::FclPair::Hulls(HullOf(a), HullOf(b)));
+    s->mission_general_colliding += rms::reference::ExactHullsIntersect(HullOf(a), HullOf(b));
+  }
+}
+
 Sets MakeSets() {
   Sets s;
   rms::reference::PairGenerator gen(12345);
@@ -121,6 +197,7 @@ Sets MakeSets() {
     s.hex_dense_general.emplace_back(p.a.hex, p.b.hex);
     s.fcl_dense_general.push_back(rms::bench::FclPair::Hulls(p.a.v, p.b.v));
   });
+  MakeMissionSets(&s);
   return s;
 }
 
@@ -280,6 +357,29 @@ void RegisterTimings(const Sets& sets) {
       "dense general/FCL collide() on convex (GJK/EPA)", [&sets, cycle](benchmark::State& st) {
         cycle(st, [&](std::size_t i) { return sets.fcl_dense_general[i]->Collide(); });
       });
+  // The mission's Mode 1 pairs.
+  if (sets.hex_mission_boxes.size() == 4096 && sets.hex_mission_general.size() == 4096) {
+    dcp("mission boxes/DCP, verdict", sets.hex_mission_boxes, verdict_only);
+    dcp("mission boxes/DCP, verdict and separating plane", sets.hex_mission_boxes, {});
+    benchmark::RegisterBenchmark("mission boxes/separating axes, 15 (double)",
+                                 [&sets, cycle](benchmark::State& st) {
+                                   cycle(st, [&](std::size_t i) {
+                                     return rms::bench::SatBoxesIntersect(
+                                         sets.mission_boxes[i].first, sets.mission_boxes[i].second);
+                                   });
+                                 });
+    benchmark::RegisterBenchmark(
+        "mission boxes/FCL collide() on boxes (computes a contact)",
+        [&sets, cycle](benchmark::State& st) {
+          cycle(st, [&](std::size_t i) { return sets.fcl_mission_boxes[i]->Collide(); });
+        });
+    dcp("mission general/DCP, verdict", sets.hex_mission_general, verdict_only);
+    dcp("mission general/DCP, verdict and separating plane", sets.hex_mission_general, {});
+    benchmark::RegisterBenchmark(
+        "mission general/FCL collide() on convex (GJK/EPA)", [&sets, cycle](benchmark::State& st) {
+          cycle(st, [&](std::size_t i) { return sets.fcl_mission_general[i]->Collide(); });
+        });
+  }
   // General hexahedra.
   dcp("general/DCP, verdict", sets.hex_general, verdict_only);
   dcp("general/DCP, verdict and separating plane", sets.hex_general, {});
@@ -351,6 +451,19 @@ void DenseTables(const Collector& collector, const Sets& sets_made, std::ostring
      << sets_made.dense_general_colliding
      << " colliding) | ns / pair | vs the DCP |\n|---|---|---|\n";
   if (dcp_g > 0) SetRows(collector, "dense general/", dcp_g, 0.0, md);
+  const double dcp_mb = Figure(collector, "mission boxes/DCP, verdict");
+  const double sat_mb = Figure(collector, "mission boxes/separating axes, 15 (double)");
+  const double dcp_mg = Figure(collector, "mission general/DCP, verdict");
+  md << "\n| Method (4096 box pairs of an autopilot mission's " << sets_made.mission_frames
+     << " Mode 1 frames: EFF HEX 1-3 against the BAR and its posts; "
+     << sets_made.mission_boxes_colliding
+     << " colliding) | ns / pair | vs the DCP | vs separating axes |\n|---|---|---|---|\n";
+  if (dcp_mb > 0 && sat_mb > 0) SetRows(collector, "mission boxes/", dcp_mb, sat_mb, md);
+  md << "\n| Method (4096 general pairs of the same frames: EFF HEX 1-3 against the payload's "
+        "strips; "
+     << sets_made.mission_general_colliding
+     << " colliding) | ns / pair | vs the DCP |\n|---|---|---|\n";
+  if (dcp_mg > 0) SetRows(collector, "mission general/", dcp_mg, 0.0, md);
   md << "\n"
      << TargetLine("on dense box pairs the verdict at most 2x separating axes",
                    sat > 0 ? dcp / sat : 0.0, 2.0, true, "x")
@@ -369,6 +482,10 @@ void DenseTables(const Collector& collector, const Sets& sets_made, std::ostring
        "dense boxes/FCL collide() on boxes (computes a contact)"},
       {"dense general hexahedra", "dense general/DCP, verdict",
        "dense general/FCL collide() on convex (GJK/EPA)"},
+      {"the mission's box pairs", "mission boxes/DCP, verdict",
+       "mission boxes/FCL collide() on boxes (computes a contact)"},
+      {"the mission's general pairs", "mission general/DCP, verdict",
+       "mission general/FCL collide() on convex (GJK/EPA)"},
   };
   for (const auto& x : sets) {
     const double d = Figure(collector, x.dcp), f = Figure(collector, x.fcl);
