@@ -201,18 +201,23 @@ LogLcm::LogLcm(const std::string& input_path, const std::string& output_path,
 LogLcm::~LogLcm() = default;
 
 bool LogLcm::Publish(std::string_view channel, const void* data, int size) {
-  const std::string full = FullChannel(channel);
+  if (pending_count_ == pending_.size()) pending_.emplace_back();
+  Pending& p = pending_[pending_count_++];
+  p.channel.assign(channel);
+  p.channel.append(channel_suffix());
+  const auto* bytes = static_cast<const std::uint8_t*>(data);
+  p.data.assign(bytes, bytes + size);
   if (out_) {
     lcm::LogEvent ev{};
     ev.timestamp = now_us_;
-    ev.channel = full;
+    ev.channel = p.channel;
     ev.datalen = size;
     ev.data = const_cast<void*>(data);
-    if (out_->writeEvent(&ev) != 0) return false;
+    if (out_->writeEvent(&ev) != 0) {
+      --pending_count_;  // not sent
+      return false;
+    }
   }
-  Pending p{full, std::vector<std::uint8_t>(static_cast<const std::uint8_t*>(data),
-                                            static_cast<const std::uint8_t*>(data) + size)};
-  pending_.push_back(std::move(p));
   return true;
 }
 
@@ -231,10 +236,13 @@ int LogLcm::HandleSubscriptions(int /*timeout_ms*/) {
   // Messages published locally go first (they were "sent" before the next
   // logged event is read), then one logged event.
   int handled = 0;
-  while (!pending_.empty()) {
-    std::vector<Pending> batch;
-    batch.swap(pending_);
-    for (const Pending& p : batch) {
+  while (pending_count_ > 0) {
+    // Handlers may publish: into the other list.
+    std::swap(pending_, dispatching_);
+    const std::size_t n = pending_count_;
+    pending_count_ = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const Pending& p = dispatching_[i];
       Dispatch(p.channel, p.data.data(), static_cast<int>(p.data.size()));
       ++handled;
     }

@@ -1,5 +1,7 @@
 #include "comparison.h"
 
+#include <array>
+#include <cstring>
 #include <map>
 #include <sstream>
 #include <toml++/toml.h>
@@ -35,13 +37,21 @@ bool SameFrame(const dcp_frame_t& a, const dcp_frame_t& b, std::string* what) {
 bool SameTelemetry(dcp_telemetry_t a, dcp_telemetry_t b, std::string* what) {
   // Everything but the wall-clock send time and the sender (a re-simulation
   // is another process), field for field: the message's encoding with those
-  // equalised compares every bit of every other field.
+  // equalised compares every bit of every other field. (A fixed size: no
+  // allocation.)
   a.send_time_us = b.send_time_us = 0;
   a.sender = b.sender = sender_t{};
-  std::vector<std::uint8_t> ea(a.getEncodedSize()), eb(b.getEncodedSize());
-  a.encode(ea.data(), 0, static_cast<int>(ea.size()));
-  b.encode(eb.data(), 0, static_cast<int>(eb.size()));
-  if (ea == eb) return true;
+  constexpr int kMax = 4096;
+  static_assert(sizeof(dcp_telemetry_t) < kMax, "dcp_telemetry_t grew: enlarge kMax");
+  std::array<std::uint8_t, kMax> ea, eb;
+  const int na = a.getEncodedSize(), nb = b.getEncodedSize();
+  if (na != nb || na > kMax) {
+    *what = "telemetry";
+    return false;
+  }
+  a.encode(ea.data(), 0, na);
+  b.encode(eb.data(), 0, nb);
+  if (std::memcmp(ea.data(), eb.data(), static_cast<std::size_t>(na)) == 0) return true;
   *what = "telemetry";
   return false;
 }

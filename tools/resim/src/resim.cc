@@ -1,5 +1,6 @@
 #include "rms/resim/resim.h"
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -62,11 +63,43 @@ void TakeState(const dcp_state_t& m, bool first, bool other_design,
   node->PublishState(m.reason == dcp_state_t::PERIODIC ? dcp_state_t::START : m.reason);
 }
 
-// What the re-simulated DCP sent: its frames and telemetry by DCP frame.
+// What the re-simulated DCP sent, in DCP frame order, one message a frame
+// (the last sent, were there two); Find looks one up.
 struct Outputs {
-  std::map<std::int64_t, dcp_frame_t> frames;
-  std::map<std::int64_t, dcp_telemetry_t> telemetry;
+  std::vector<dcp_frame_t> frames;
+  std::vector<dcp_telemetry_t> telemetry;
 };
+
+template <class Msg>
+void SortByFrame(std::vector<Msg>* v) {
+  // As the DCP sends them: increasing, nothing to do.
+  if (std::adjacent_find(v->begin(), v->end(),
+                         [](const Msg& a, const Msg& b) { return a.frame >= b.frame; }) == v->end())
+    return;
+  std::stable_sort(v->begin(), v->end(),
+                   [](const Msg& a, const Msg& b) { return a.frame < b.frame; });
+  // Of equal frames the last sent stays.
+  std::vector<Msg> kept;
+  kept.reserve(v->size());
+  for (std::size_t i = 0; i < v->size(); ++i) {
+    if (i + 1 < v->size() && (*v)[i + 1].frame == (*v)[i].frame) continue;
+    kept.push_back(std::move((*v)[i]));
+  }
+  v->swap(kept);
+}
+
+std::map<std::int64_t, dcp_telemetry_t> ByFrame(const std::vector<dcp_telemetry_t>& v) {
+  std::map<std::int64_t, dcp_telemetry_t> m;
+  for (const auto& t : v) m.emplace_hint(m.end(), t.frame, t);
+  return m;
+}
+
+template <class Msg>
+const Msg* Find(const std::vector<Msg>& v, std::int64_t frame) {
+  const auto it = std::lower_bound(v.begin(), v.end(), frame,
+                                   [](const Msg& m, std::int64_t f) { return m.frame < f; });
+  return it != v.end() && it->frame == frame ? &*it : nullptr;
+}
 
 // The DCP's own node over a log-backed transport, step by step through the
 // plan (out_log: the new session's log, "" for none).
@@ -117,9 +150,9 @@ Outputs RunDcp(const LabConfig& config, const Recording& rec, const Plan& plan,
                std::to_string(k) + " of " + std::to_string(n) + " steps");
   }
   result->run_seconds = std::chrono::duration<double>(Clock::now() - t_run).count();
-  Outputs out;
-  for (const auto& f : frames_run) out.frames[f.frame] = f;
-  for (const auto& t : telemetry_run) out.telemetry[t.frame] = t;
+  Outputs out{std::move(frames_run), std::move(telemetry_run)};
+  SortByFrame(&out.frames);
+  SortByFrame(&out.telemetry);
   result->frames = static_cast<long>(out.frames.size());
   if (other_design) {
     transport::WriteStatsJson((fs::path(result->out_dir) / "stats" / "dynamics_proc.json").string(),
@@ -134,15 +167,14 @@ void CompareWithRecording(const Recording& rec, std::size_t first, const Outputs
   for (std::size_t i = first; i < rec.dcp_frames.size(); ++i) {
     const dcp_frame_t& r = rec.dcp_frames[i];
     ++result->compared;
-    const auto it = out.frames.find(r.frame);
+    const dcp_frame_t* made = Find(out.frames, r.frame);
     std::string what;
-    bool same = it != out.frames.end() && SameFrame(it->second, r, &what);
+    bool same = made && SameFrame(*made, r, &what);
     if (same) {
       const auto rt = rec.telemetry.find(r.frame);
-      const auto nt = out.telemetry.find(r.frame);
-      if (rt != rec.telemetry.end() && nt != out.telemetry.end())
-        same = SameTelemetry(nt->second, rt->second, &what);
-    } else if (it == out.frames.end()) {
+      const dcp_telemetry_t* nt = Find(out.telemetry, r.frame);
+      if (rt != rec.telemetry.end() && nt) same = SameTelemetry(*nt, rt->second, &what);
+    } else if (!made) {
       what = "missing";
     }
     if (same)
@@ -211,7 +243,7 @@ void WriteNewSession(const fs::path& session, const std::string& config_path,
                  session::MakeManifest(dir.string(), mf).dump(2) + "\n");
   WriteWholeFile((dir / "summary.json").string(), session::Summarize(dir.string()).dump(2) + "\n");
   result->comparison =
-      DesignComparison(rec.telemetry, out.telemetry, config, config.session.frame_rate_hz);
+      DesignComparison(rec.telemetry, ByFrame(out.telemetry), config, config.session.frame_rate_hz);
   result->comparison["config_changes"] =
       ConfigChanges((session / "config.toml").string(), config_path);
   result->comparison["frames_identical"] = result->identical;

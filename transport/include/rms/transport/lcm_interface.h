@@ -157,7 +157,7 @@ class LogLcm final : public LcmInterface {
   std::int64_t NowUs() const override { return now_us_; }
   // Sets the time used for publishing when there is no input log.
   void SetNowUs(std::int64_t t) { now_us_ = t; }
-  bool at_end() const { return input_done_ && pending_.empty(); }
+  bool at_end() const { return input_done_ && pending_count_ == 0; }
 
  private:
   struct Pending {
@@ -170,7 +170,11 @@ class LogLcm final : public LcmInterface {
   bool input_done_ = true;
   std::int64_t now_us_ = 0;
   std::vector<std::pair<std::string, Handler>> handlers_;
-  std::vector<Pending> pending_;
+  // Published and not yet dispatched: the first pending_count_ of pending_.
+  // The two lists take turns (the one being dispatched, the one filling) and
+  // keep their storage, so a frame's messages allocate nothing.
+  std::vector<Pending> pending_, dispatching_;
+  std::size_t pending_count_ = 0;
 };
 
 // Wall clock, microseconds since 1970 (CLOCK_REALTIME): the send_time_us of
