@@ -18,19 +18,23 @@ Recording ReadRecording(session::SessionLog& log) {
                operator_input_t m;
                if (!log.Decode(ev, &m)) return;
                const auto* p = static_cast<const std::uint8_t*>(ev.data);
-               r.inputs[m.frame] = {ev.log_us, std::vector<std::uint8_t>(p, p + ev.size)};
+               r.inputs.push_back(
+                   {m.frame, ev.log_us, r.input_bytes.size(), static_cast<std::size_t>(ev.size)});
+               r.input_bytes.insert(r.input_bytes.end(), p, p + ev.size);
              } else if (ev.base == wire::channels::kDcpFrame) {
                dcp_frame_t m;
                if (log.Decode(ev, &m)) r.dcp_frames.push_back(m);
              } else if (ev.base == wire::channels::kDcpTelemetry) {
-               dcp_telemetry_t m;
-               if (log.Decode(ev, &m)) r.telemetry[m.frame] = m;
+               r.telemetry.emplace_back();
+               if (!log.Decode(ev, &r.telemetry.back())) r.telemetry.pop_back();
              } else {
                LoggedState st;
                st.before = r.dcp_frames.size();
                if (log.Decode(ev, &st.m)) r.states.push_back(std::move(st));
              }
            });
+  SortByFrame(&r.inputs);
+  SortByFrame(&r.telemetry);
   if (r.dcp_frames.empty()) {
     throw InputError(log.log_path() + ": no RMS_DCP_FRAME recorded: nothing to re-simulate");
   }
@@ -50,6 +54,12 @@ Recording ReadRecording(session::SessionLog& log) {
     r.dcp_frames = std::move(kept);
   }
   return r;
+}
+
+std::map<std::int64_t, dcp_telemetry_t> TelemetryByFrame(const std::vector<dcp_telemetry_t>& v) {
+  std::map<std::int64_t, dcp_telemetry_t> m;
+  for (const auto& t : v) m.emplace_hint(m.end(), t.frame, t);
+  return m;
 }
 
 namespace {
@@ -127,10 +137,10 @@ Plan MakePlan(const Recording& r) {
       // that the log does not show: unambiguous only if exactly that many
       // were logged.
       std::vector<std::int64_t> between;
-      for (auto it = r.inputs.upper_bound(prev_input);
-           it != r.inputs.end() && it->first < f.input_frame; ++it) {
-        between.push_back(it->first);
-      }
+      auto it =
+          std::upper_bound(r.inputs.begin(), r.inputs.end(), prev_input,
+                           [](std::int64_t f, const RecordedInput& in) { return f < in.frame; });
+      for (; it != r.inputs.end() && it->frame < f.input_frame; ++it) between.push_back(it->frame);
       if (static_cast<std::int64_t>(between.size()) != lost) {
         throw InputError("the log lost " + Frames(prev_frame + 1, f.frame - 1) +
                          " and which operator frames they answered cannot be told (" +

@@ -3,6 +3,7 @@
 // "Re-simulation"): the operator frames, the DCP's frames and telemetry it
 // made from them, the states it logged; and the plan that replays them in
 // order, from the state the log allows the re-simulation to start from.
+#include <algorithm>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -15,9 +16,12 @@
 
 namespace rms::resim {
 
+// An operator frame as logged: its bytes are Recording::input_bytes[offset,
+// offset + size).
 struct RecordedInput {
+  std::int64_t frame = 0;
   std::int64_t timestamp_us = 0;
-  std::vector<std::uint8_t> bytes;
+  std::size_t offset = 0, size = 0;
 };
 
 // An RMS_DCP_STATE as logged, with the number of the DCP's (believed)
@@ -29,11 +33,41 @@ struct LoggedState {
 
 struct Recording {
   std::string suffix;
-  std::map<std::int64_t, RecordedInput> inputs;       // by operator frame
-  std::vector<dcp_frame_t> dcp_frames;                // in log order
-  std::map<std::int64_t, dcp_telemetry_t> telemetry;  // by DCP frame
-  std::vector<LoggedState> states;                    // in log order
+  std::vector<RecordedInput> inputs;       // by operator frame (the last logged of a frame)
+  std::vector<std::uint8_t> input_bytes;   // the inputs' bytes, one after another
+  std::vector<dcp_frame_t> dcp_frames;     // in log order
+  std::vector<dcp_telemetry_t> telemetry;  // by DCP frame (the last logged of a frame)
+  std::vector<LoggedState> states;         // in log order
 };
+
+// Messages with a frame number, in increasing order of it, one a frame:
+// the last of equal frames kept (left as they are when already so).
+template <class Msg>
+void SortByFrame(std::vector<Msg>* v) {
+  if (std::adjacent_find(v->begin(), v->end(),
+                         [](const Msg& a, const Msg& b) { return a.frame >= b.frame; }) == v->end())
+    return;
+  std::stable_sort(v->begin(), v->end(),
+                   [](const Msg& a, const Msg& b) { return a.frame < b.frame; });
+  std::vector<Msg> kept;
+  kept.reserve(v->size());
+  for (std::size_t i = 0; i < v->size(); ++i) {
+    if (i + 1 < v->size() && (*v)[i + 1].frame == (*v)[i].frame) continue;
+    kept.push_back(std::move((*v)[i]));
+  }
+  v->swap(kept);
+}
+
+// The message of a frame in a vector SortByFrame made, or null.
+template <class Msg>
+const Msg* FindFrame(const std::vector<Msg>& v, std::int64_t frame) {
+  const auto it = std::lower_bound(v.begin(), v.end(), frame,
+                                   [](const Msg& m, std::int64_t f) { return m.frame < f; });
+  return it != v.end() && it->frame == frame ? &*it : nullptr;
+}
+
+// The same as a map by frame (what the design comparison reads).
+std::map<std::int64_t, dcp_telemetry_t> TelemetryByFrame(const std::vector<dcp_telemetry_t>& v);
 
 // The channels re-simulation needs, read from the log (the DCP's increasing
 // run of frames only, as the summary believes them); throws InputError when

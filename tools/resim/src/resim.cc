@@ -70,37 +70,6 @@ struct Outputs {
   std::vector<dcp_telemetry_t> telemetry;
 };
 
-template <class Msg>
-void SortByFrame(std::vector<Msg>* v) {
-  // As the DCP sends them: increasing, nothing to do.
-  if (std::adjacent_find(v->begin(), v->end(),
-                         [](const Msg& a, const Msg& b) { return a.frame >= b.frame; }) == v->end())
-    return;
-  std::stable_sort(v->begin(), v->end(),
-                   [](const Msg& a, const Msg& b) { return a.frame < b.frame; });
-  // Of equal frames the last sent stays.
-  std::vector<Msg> kept;
-  kept.reserve(v->size());
-  for (std::size_t i = 0; i < v->size(); ++i) {
-    if (i + 1 < v->size() && (*v)[i + 1].frame == (*v)[i].frame) continue;
-    kept.push_back(std::move((*v)[i]));
-  }
-  v->swap(kept);
-}
-
-std::map<std::int64_t, dcp_telemetry_t> ByFrame(const std::vector<dcp_telemetry_t>& v) {
-  std::map<std::int64_t, dcp_telemetry_t> m;
-  for (const auto& t : v) m.emplace_hint(m.end(), t.frame, t);
-  return m;
-}
-
-template <class Msg>
-const Msg* Find(const std::vector<Msg>& v, std::int64_t frame) {
-  const auto it = std::lower_bound(v.begin(), v.end(), frame,
-                                   [](const Msg& m, std::int64_t f) { return m.frame < f; });
-  return it != v.end() && it->frame == frame ? &*it : nullptr;
-}
-
 // The DCP's own node over a log-backed transport, step by step through the
 // plan (out_log: the new session's log, "" for none).
 Outputs RunDcp(const LabConfig& config, const Recording& rec, const Plan& plan,
@@ -134,15 +103,15 @@ Outputs RunDcp(const LabConfig& config, const Recording& rec, const Plan& plan,
       TakeState(*step.state, step.first, other_design, &node, result);
       continue;
     }
-    const auto it = rec.inputs.find(step.input_frame);
-    if (it == rec.inputs.end()) {
+    const RecordedInput* input = FindFrame(rec.inputs, step.input_frame);
+    if (!input) {
       throw InputError(
           "operator frame " + std::to_string(step.input_frame) +
           ", which the DCP answered, is not in the log: the re-simulation cannot be exact");
     }
-    lcm.SetNowUs(it->second.timestamp_us);
-    lcm.Publish(wire::channels::kOperatorInput, it->second.bytes.data(),
-                static_cast<int>(it->second.bytes.size()));
+    lcm.SetNowUs(input->timestamp_us);
+    lcm.Publish(wire::channels::kOperatorInput, rec.input_bytes.data() + input->offset,
+                static_cast<int>(input->size));
     lcm.HandleSubscriptions(0);  // the input to the DCP
     lcm.HandleSubscriptions(0);  // its outputs to the comparison
     if (n >= 20 && k % (n / 20) == 0)
@@ -167,13 +136,13 @@ void CompareWithRecording(const Recording& rec, std::size_t first, const Outputs
   for (std::size_t i = first; i < rec.dcp_frames.size(); ++i) {
     const dcp_frame_t& r = rec.dcp_frames[i];
     ++result->compared;
-    const dcp_frame_t* made = Find(out.frames, r.frame);
+    const dcp_frame_t* made = FindFrame(out.frames, r.frame);
     std::string what;
     bool same = made && SameFrame(*made, r, &what);
     if (same) {
-      const auto rt = rec.telemetry.find(r.frame);
-      const dcp_telemetry_t* nt = Find(out.telemetry, r.frame);
-      if (rt != rec.telemetry.end() && nt) same = SameTelemetry(*nt, rt->second, &what);
+      const dcp_telemetry_t* rt = FindFrame(rec.telemetry, r.frame);
+      const dcp_telemetry_t* nt = FindFrame(out.telemetry, r.frame);
+      if (rt && nt) same = SameTelemetry(*nt, *rt, &what);
     } else if (!made) {
       what = "missing";
     }
@@ -243,7 +212,8 @@ void WriteNewSession(const fs::path& session, const std::string& config_path,
                  session::MakeManifest(dir.string(), mf).dump(2) + "\n");
   WriteWholeFile((dir / "summary.json").string(), session::Summarize(dir.string()).dump(2) + "\n");
   result->comparison =
-      DesignComparison(rec.telemetry, ByFrame(out.telemetry), config, config.session.frame_rate_hz);
+      DesignComparison(TelemetryByFrame(rec.telemetry), TelemetryByFrame(out.telemetry), config,
+                       config.session.frame_rate_hz);
   result->comparison["config_changes"] =
       ConfigChanges((session / "config.toml").string(), config_path);
   result->comparison["frames_identical"] = result->identical;
@@ -268,7 +238,10 @@ ResimResult Resimulate(const ResimOptions& opt) {
     if (opt.progress) opt.progress(f, line);
   };
   progress(0.0, "reading " + (session / "lcmlog").string());
-  session::SessionLog log(opt.session);
+  // The session's own config is read once (another design's is not its).
+  session::SessionLog log = other_design
+                                ? session::SessionLog(opt.session)
+                                : session::SessionLog(opt.session, config.session.frame_rate_hz);
   const Recording rec = ReadRecording(log);
   const Plan plan = MakePlan(rec);
   const auto t_read = Clock::now();
@@ -289,7 +262,7 @@ ResimResult Resimulate(const ResimOptions& opt) {
   result.read_seconds = std::chrono::duration<double>(t_read - t0).count();
   if (!rec.inputs.empty()) {
     result.recorded_seconds =
-        (rec.inputs.rbegin()->second.timestamp_us - rec.inputs.begin()->second.timestamp_us) / 1e6;
+        (rec.inputs.back().timestamp_us - rec.inputs.front().timestamp_us) / 1e6;
   }
   if (other_design) WriteNewSession(session, config_path, config, rec, out, &result);
   return result;

@@ -29,21 +29,31 @@ bool InputFrame(const void* data, int size, std::int64_t* frame) {
   return true;
 }
 
+// The session's frame rate from its config.toml; a session without its
+// config: the report's rate (docs/config.md).
+double SessionFrameRate(const std::string& session_dir) {
+  try {
+    return LoadConfig((fs::path(session_dir) / "config.toml").string()).session.frame_rate_hz;
+  } catch (const std::exception&) {
+    return 30.0;
+  }
+}
+
 }  // namespace
 
-SessionLog::SessionLog(const std::string& session_dir)
-    : dir_(session_dir), log_path_((fs::path(session_dir) / "lcmlog").string()) {
+SessionLog::SessionLog(const std::string& session_dir, double frame_rate_hz)
+    : dir_(session_dir),
+      log_path_((fs::path(session_dir) / "lcmlog").string()),
+      rate_hz_(frame_rate_hz) {
   if (!fs::exists(log_path_)) throw InputError(session_dir + ": not a session folder (no lcmlog)");
   if (fs::exists(fs::path(session_dir) / "manifest.json")) {
     suffix_ = ReadSessionInfo(session_dir).channel_suffix;
     check_ = SenderCheck(session_dir);
   }
-  try {
-    rate_hz_ = LoadConfig((fs::path(session_dir) / "config.toml").string()).session.frame_rate_hz;
-  } catch (const std::exception&) {
-    rate_hz_ = 30.0;  // a session without its config: the report's rate (docs/config.md)
-  }
 }
+
+SessionLog::SessionLog(const std::string& session_dir)
+    : SessionLog(session_dir, SessionFrameRate(session_dir)) {}
 
 void SessionLog::Read(std::initializer_list<std::string_view> channels,
                       const std::function<void(const LogMessage&)>& visit) {

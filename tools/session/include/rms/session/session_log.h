@@ -38,6 +38,9 @@ class SessionLog {
   // the frame rate of SESSION/config.toml. Throws rms::InputError naming what
   // is missing or unreadable.
   explicit SessionLog(const std::string& session_dir);
+  // The same with the session's frame rate already known (its config.toml
+  // read by the caller): not read again.
+  SessionLog(const std::string& session_dir, double frame_rate_hz);
 
   // Every message of the session's own on `channels` (base names; empty:
   // every channel), in log order. Messages of other sessions and other
