@@ -53,7 +53,7 @@ struct FrameVariant {
   DcpOptions options;
   std::vector<double> ns;                      // every frame of every repetition
   std::array<std::vector<double>, 4> ns_mode;  // by the mode the frame started in
-  // By flight, and by whether the master's command moved from the frame
+  // By flight, and by whether the arm (the slave) moved from the frame
   // before (the motion test between the frames runs) or stood still.
   std::vector<std::array<std::vector<double>, 2>> ns_flight_moving;
   long mismatches = 0;  // frames whose decisions differ from the first variant's
@@ -82,14 +82,14 @@ void RunFrames(const rms::LabConfig& config, const std::vector<Flight>& flights,
         std::vector<Decision> decisions;
         for (const rms::wire::OperatorInputs& in : flights[fi].inputs) {
           const int mode = dcp.mode();
-          const auto before = dcp.status().master;
+          const auto before = dcp.status().slave;
           const auto t0 = Clock::now();
           rms::wire::DcpFrameData out = dcp.Step(in);
           benchmark::DoNotOptimize(out);
           const double ns = std::chrono::duration<double, std::nano>(Clock::now() - t0).count();
           v.ns.push_back(ns);
           v.ns_mode[mode].push_back(ns);
-          const auto& after = dcp.status().master;
+          const auto& after = dcp.status().slave;
           const bool moved = before.angles_deg != after.angles_deg ||
                              before.shoulder_height_ft != after.shoulder_height_ft ||
                              before.finger != after.finger;
@@ -316,7 +316,7 @@ void MakeFlights(Bench* b, std::uint64_t seed) {
 // The default's frames by flight, with the arm still and moving; the
 // targets on them.
 void MovingTable(const Bench& b, const FrameVariant& v, std::ostringstream& md) {
-  md << "\nThe default's frames by flight, the master's command still (the same as the frame "
+  md << "\nThe default's frames by flight, the arm (the slave) still (where it was the frame "
         "before) or moving (the motion test between the frames runs):\n\n"
      << "| flight | frames still | still median ns | frames moving | moving median ns | moving "
         "p99 ns |\n|---|---:|---:|---:|---:|---:|\n";

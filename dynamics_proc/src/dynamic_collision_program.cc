@@ -145,15 +145,10 @@ bool Finite(const ArmCommand& c) {
 }
 
 bool Finite(const PayloadModel& p) {
-  double zero = 0.0, largest = 0.0;
-  for (const Eigen::Vector3d& v : p.v) {
-    zero += (v.x() + v.y() + v.z()) * 0.0;
-    largest = std::max(largest, v.cwiseAbs().maxCoeff());
-  }
-  // Without its strips, what would refuse them (a coordinate too large for
-  // their products) refuses the vertices.
-  if (!p.has_body) return zero == 0.0 && largest <= kMaxCoordinateFt;
-  for (const Hexahedron& h : p.body) zero += h.valid ? 0.0 : NAN;
+  double zero = 0.0;
+  for (const Eigen::Vector3d& v : p.v) zero += (v.x() + v.y() + v.z()) * 0.0;
+  // Without its strips (HeldPayload: only near enough that they are valid).
+  for (const Hexahedron& h : p.body) zero += !p.has_body || h.valid ? 0.0 : NAN;
   return zero == 0.0;
 }
 
@@ -260,12 +255,27 @@ void DynamicCollisionProgram::EvaluateMode1(const Evaluation* prev, Evaluation* 
   }
 }
 
+// The held payload at X_RP for Modes 2 and 3, which test only its vertices:
+// without its seven strips -- unless every pair is tested
+// (EvaluateExtraPairs), or it is so far out (beyond kStripsCheckedBeyondFt)
+// that the strips' own checks (flatness and face areas against the rounding
+// at such coordinates) could refuse it: then with them, so Finite() decides
+// exactly as when the strips were always made.
+PayloadModel DynamicCollisionProgram::HeldPayload(const Eigen::Isometry3d& X_RP) const {
+  if (!options_.mode_pairs_only) return MakePayload(payload_shape_, X_RP, true);
+  PayloadModel m = MakePayload(payload_shape_, X_RP, false);
+  double largest = 0.0;
+  for (const Eigen::Vector3d& v : m.v) largest = std::max(largest, v.cwiseAbs().maxCoeff());
+  if (!(largest <= kStripsCheckedBeyondFt) || !payload_strips_valid_)
+    m = MakePayload(payload_shape_, X_RP, true);
+  return m;
+}
+
 // Mode 2: the payload's and probe's vertices against the bay's walls and
 // bottom: a vertex below face c that is beyond a wall collides with it.
 void DynamicCollisionProgram::EvaluateMode2(Evaluation* e) const {
   e->X_RP = e->pose.X_RS2 * X_S2P_;
-  // The vertices only, unless every pair is tested (EvaluateExtraPairs).
-  e->payload = MakePayload(payload_shape_, e->X_RP, !options_.mode_pairs_only);
+  e->payload = HeldPayload(e->X_RP);
   e->clearance_ft = std::numeric_limits<double>::infinity();
   e->collisions |= BayCollisions(e->payload, &e->clearance_ft);
 }
@@ -287,7 +297,7 @@ void DynamicCollisionProgram::EvaluateMode3(const Evaluation* prev, Evaluation* 
     return;
   }
   e->X_RP = e->pose.X_RS2 * X_S2P_;
-  e->payload = MakePayload(payload_shape_, e->X_RP, !options_.mode_pairs_only);
+  e->payload = HeldPayload(e->X_RP);
   const double tau = ToleranceFt(cae_, cae_, tau_rel_);
   e->clearance_ft = std::numeric_limits<double>::infinity();
   for (const Eigen::Vector3d& v : e->payload.v) {
@@ -1141,7 +1151,7 @@ void DynamicCollisionProgram::CheckRestored(int mode, bool acquired, bool docked
 
 double DynamicCollisionProgram::PayloadReachFt(const Eigen::Isometry3d& X_S2P) const {
   // The payload in System Two: its vertices' distances from point A.
-  const PayloadModel m = MakePayload(payload_shape_, X_S2P);
+  const PayloadModel m = MakePayload(payload_shape_, X_S2P, /*with_body=*/false);
   double reach = 0.0;
   for (const Eigen::Vector3d& v : m.v) reach = std::max(reach, v.norm());
   return reach;

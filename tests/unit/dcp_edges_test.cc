@@ -297,19 +297,26 @@ TEST_F(DcpEdges, ACheckpointMissingItsLastKeyLeavesTheStateUnchanged) {
   EXPECT_EQ(other.SaveState().dump(), before);
   // States the program could not reach: refused, nothing changed.
   const nlohmann::json good = nlohmann::json::parse(saved.SaveState().dump());
-  std::vector<nlohmann::json> bad(5, good);
+  std::vector<nlohmann::json> bad(6, good);
   bad[0]["acquired"] = false;      // Mode 2 without acquisition
   bad[1]["contact_gap_ft"] = 2.0;  // above the gap at acquisition
   bad[2]["X_S2P"][0] = 2.0;        // not a rigid pose
   bad[3]["slave"]["angles_deg"][1] =
       good["slave"]["angles_deg"][1].get<double>() - 30.0;  // the palm in the bay
   bad[4]["released"] = true;                                // released, not docked
+  // The payload held 1e15 ft away: its strips are flat at such coordinates
+  // (Modes 2 and 3 leave the strips out only near the origin).
+  bad[5]["X_S2P"][3] = 1e15;
   for (std::size_t i = 0; i < bad.size(); ++i) {
     try {
       other.RestoreState(bad[i]);
       ADD_FAILURE() << "case " << i << " restored";
     } catch (const InputError& e) {
       std::printf("case %zu refused: %s\n", i, e.what());
+      // Refused as not finite, as when the strips were always made.
+      if (i == 5) {
+        EXPECT_NE(std::string(e.what()).find("non-finite"), std::string::npos);
+      }
     }
     EXPECT_EQ(other.SaveState().dump(), before) << "case " << i;
   }

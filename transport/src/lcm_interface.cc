@@ -236,6 +236,14 @@ int LogLcm::HandleSubscriptions(int /*timeout_ms*/) {
   // Messages published locally go first (they were "sent" before the next
   // logged event is read), then one logged event.
   int handled = 0;
+  // A handler may publish (into the other list) but not dispatch again: the
+  // list being dispatched would be swapped under it.
+  RMS_CHECK(!dispatching_now_);
+  dispatching_now_ = true;
+  struct Done {
+    bool* flag;
+    ~Done() { *flag = false; }  // also when a handler throws
+  } done{&dispatching_now_};
   while (pending_count_ > 0) {
     // Handlers may publish: into the other list.
     std::swap(pending_, dispatching_);

@@ -77,8 +77,7 @@ Outputs RunDcp(const LabConfig& config, const Recording& rec, const Plan& plan,
                const std::function<void(double, const std::string&)>& progress,
                ResimResult* result) {
   // During the run the outputs are appended to vectors reserved up front (no
-  // allocation a frame); the maps the comparison looks them up in are built
-  // after it.
+  // allocation a frame), in frame order; the comparison finds them there.
   std::vector<dcp_frame_t> frames_run;
   std::vector<dcp_telemetry_t> telemetry_run;
   frames_run.reserve(plan.steps.size());

@@ -44,7 +44,7 @@ bool RawLogReader::Have(std::size_t n) {
   if (offset_ + begin_ + n > file_size_) return false;  // past the end of the file as opened
   // The unread bytes to the front; a larger buffer for an event larger than it.
   if (n > capacity_) {
-    const std::size_t grown = std::max(n, 2 * capacity_);
+    const std::size_t grown = std::max(n + 4, 2 * capacity_);  // + the next sync word
     auto bigger = std::make_unique_for_overwrite<std::uint8_t[]>(grown);
     std::memcpy(bigger.get(), buf_.get() + begin_, end_ - begin_);
     buf_ = std::move(bigger);
@@ -81,7 +81,6 @@ bool RawLogReader::Next(RawLogEvent* ev) {
       break;
     }
     begin_ = end_ - 3;  // a sync word may begin in the last three bytes
-    if (!Have(4)) return false;
   }
   if (!Have(4 + kHeaderBytes)) return false;
   const std::uint8_t* h = buf_.get() + begin_ + 4;

@@ -48,8 +48,8 @@ struct PayloadModel {
   // Strip j between the 16-gon's vertex levels j and j + 1 from the top:
   // u = y_P (face d at the probe end), v = x_P, w = -z_P (c the strip's top).
   std::array<Hexahedron, kBodyStrips> body;
-  // The strips are made (MakePayload with_body): Modes 2 and 3 test only
-  // the vertices, and skip them.
+  // The strips were made (MakePayload with_body). Modes 2 and 3 test only
+  // the vertices and usually leave them out (HeldPayload).
   bool has_body = true;
   std::array<Eigen::Vector3d, kPayloadVertices>
       v;                             // body (aft ring, then fore ring), V21..V24, V31..V36

@@ -22,6 +22,7 @@
 // interpenetration. The finger closing on the bar is the essential contact:
 // the finger stops on it and the acquisition conditions are met.
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -237,6 +238,7 @@ class DynamicCollisionProgram {
   void Evaluate(const ArmCommand& cmd, const Evaluation* prev, Evaluation* e) const;
   // The mode's tests of Evaluate, and every other pair when asked.
   void EvaluateMode1(const Evaluation* prev, Evaluation* e) const;
+  PayloadModel HeldPayload(const Eigen::Isometry3d& X_RP) const;
   void EvaluateMode2(Evaluation* e) const;
   void EvaluateMode3(const Evaluation* prev, Evaluation* e) const;
   void EvaluateExtraPairs(Evaluation* e) const;
@@ -325,6 +327,17 @@ class DynamicCollisionProgram {
   Eigen::Isometry3d X_RP_free_;
   Hexahedron bar_;
   PayloadShape payload_shape_ = MakePayloadShape(config_.payload);  // made once
+  // Its strips are valid where the payload rests at the origin (a payload
+  // whose configuration makes them flat or degenerate: HeldPayload always
+  // makes them, and the DCP refuses it as before).
+  bool payload_strips_valid_ = [this] {
+    const PayloadModel m = MakePayload(payload_shape_, Eigen::Isometry3d::Identity());
+    return std::all_of(m.body.begin(), m.body.end(), [](const Hexahedron& h) { return h.valid; });
+  }();
+  // Within this many ft of the origin the held payload's strips, valid at
+  // the origin, are valid too: their rounding tolerance there (about 1e-11
+  // ft) is far below any strip's thickness.
+  static constexpr double kStripsCheckedBeyondFt = 1e4;
   PayloadModel payload_;
   std::array<Hexahedron, 2> posts_{};
   int post_count_ = 0;

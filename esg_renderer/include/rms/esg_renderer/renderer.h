@@ -50,6 +50,8 @@ class FrameRenderer {
   FrameRenderer(const LabConfig& config, GlContext* context, RenderOptions options);
   void Render(const wire::EsgFrameData& frame);
   // The frame just drawn: RGBA, rows top down; valid until the next Render.
+  // The last Render's pixels: the context's own buffer, valid until the
+  // next Render on it (the ESG keeps it as its scene between frames).
   const std::uint8_t* pixels() {
     context_->MakeCurrent();
     return context_->FinishAndGetPixels();

@@ -175,6 +175,7 @@ class LogLcm final : public LcmInterface {
   // keep their storage, so a frame's messages allocate nothing.
   std::vector<Pending> pending_, dispatching_;
   std::size_t pending_count_ = 0;
+  bool dispatching_now_ = false;
 };
 
 // Wall clock, microseconds since 1970 (CLOCK_REALTIME): the send_time_us of
