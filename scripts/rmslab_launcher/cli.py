@@ -2,12 +2,14 @@
 
   scripts/lab demo [--out DIR] [--timeline FILE | --by-hand [--bindings FILE]] [--autopilot-straight]
                    [--subject NAME] [--note TEXT]
-                   [--restore CHECKPOINT] [--lab LABFILE] [--config FILE] [--speed X]
+                   [--restore CHECKPOINT | --from SESSION@TIME] [--lab LABFILE] [--config FILE] [--speed X]
                    [--png-every N] [--width W] [--height H] [--no-video] [--window]
                    [--instructor [PORT]] [--gl osmesa|egl] [--visibility priority|depth]
                    [--lcm-url URL] [--channel-suffix S] [--share-network] [--no-build]
   scripts/lab replay SESSION [options]       scene and ESG driven from the log: frames, video
-  scripts/lab resim SESSION [--config FILE]  the DCP again on the recorded inputs
+  scripts/lab resim SESSION [--config FILE] [--set KEY=VALUE]  the DCP again on the recorded inputs
+  scripts/lab sweep SESSION... --vary KEY=V1,V2,... [--hosts LABFILE | --slurm]
+                                             every session under every design: one table
   scripts/lab export SESSION [--mcap]        every channel to CSV, or the log as MCAP
   scripts/lab report SESSION                 one self-contained HTML report
   scripts/lab compare SESSION...             scorecards side by side, learning curves
@@ -32,7 +34,7 @@ command explains itself with --help.
 import os
 import sys
 
-from . import demo, replay, tools
+from . import demo, replay, sweep, tools
 from .common import LabError, say
 
 
@@ -44,6 +46,8 @@ def main(argv):
             return demo.run(rest, "scripts/lab demo " + " ".join(rest))
         if cmd == "replay":
             return replay.run(rest)
+        if cmd == "sweep":
+            return sweep.run(rest)
         if cmd in ("resim", "export", "report", "compare", "monitor", "control"):
             return getattr(tools, cmd)(rest)
         if cmd in ("help", "-h", "--help"):

@@ -12,6 +12,7 @@ import sys
 import time
 
 from . import disk, session
+from .branch import Branch
 from .common import (BUILD, DEFAULT_URL, ROOT, LabError, binary, check_speed, check_suffix, ensure_multicast_route,
                      frame_rate_hz, check_lcm_url, install_and_build, require_built, say, timeline_length_s)
 from .hosts import Host, check_hosts
@@ -32,8 +33,12 @@ def add_arguments(p):
     p.add_argument("--subject", default="", help="who flies it, for the manifest and scripts/lab compare")
     p.add_argument("--note", default="", help="the experimenter's note, for the manifest")
     p.add_argument("--restore", help="start from this checkpoint")
+    p.add_argument("--from", dest="from_", metavar="SESSION@TIME",
+                   help="branch from a recorded session: its inputs re-simulated up to TIME (s of session "
+                        "time; or @fFRAME, a DCP frame), word for word, then flown live from there")
     p.add_argument("--lab", help="a lab file: which process runs on which host (docs/sessions.md)")
-    p.add_argument("--config", default=os.path.join(ROOT, "config", "rmslab.toml"))
+    p.add_argument("--config", help="the configuration (default config/rmslab.toml; with --from, the "
+                                    "recorded session's)")
     p.add_argument("--speed", default="1", help="the same frames, that many times faster (0.01 .. 100)")
     p.add_argument("--png-every", type=int, default=30, help="a PNG frame every N frames (0: none)")
     p.add_argument("--width", type=int, default=1024)
@@ -63,6 +68,13 @@ class Demo:
     # ---- before anything starts ----
     def validate(self):
         a = self.a
+        self.branch = None
+        if a.from_:
+            if a.restore:
+                raise LabError("--from and --restore: give one (a branch starts from its own checkpoint)")
+            self.branch = Branch(a.from_)
+            a.config = a.config or os.path.join(self.branch.parent, "config.toml")
+        a.config = a.config or os.path.join(ROOT, "config", "rmslab.toml")
         for f in [a.config, a.timeline, a.restore, a.lab, a.bindings]:
             if f and not os.path.exists(f):
                 raise LabError(f"no such file: {f}")
@@ -221,6 +233,8 @@ class Demo:
             fields.append(("--timeline", a.timeline))
         if a.restore:
             fields.append(("--restore", a.restore))
+        if self.branch:
+            fields += self.branch.manifest_fields()
         if a.subject:
             fields.append(("--subject", a.subject))
         if a.note:
@@ -440,6 +454,9 @@ def run(argv, command_line):
     require_built("operator_station/operator_station", "dynamics_proc/dynamics_proc", "scene_proc/scene_proc",
                   "esg_renderer/esg_renderer", "tools/rms_session",
                   *(["instructor_station/instructor_station"] if a.instructor is not None else []))
+    if d.branch:
+        require_built("tools/rms_resim")
+        a.restore = d.branch.make_checkpoint()
     d.layout()
     check_lcm_url(d.url)
     ensure_multicast_route()

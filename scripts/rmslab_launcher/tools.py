@@ -18,13 +18,16 @@ def ensure(rel, no_build=False):
 
 
 def resim(argv):
-    """scripts/lab resim SESSION [--config FILE] [--out DIR] [--video]: the DCP
-    again on the recorded inputs. Without --config, exit 0 only if every
-    output is identical; with it, a new session (default SESSION-resim) with
-    comparison.md; --video replays it to make its video."""
+    """scripts/lab resim SESSION [--config FILE] [--set KEY=VALUE]... [--out DIR] [--video]:
+    the DCP again on the recorded inputs. Without --config or --set, exit 0
+    only if every output is identical; with them (another design), a new
+    session (default SESSION-resim) with comparison.md; --video replays it
+    to make its video."""
     p = argparse.ArgumentParser(prog="scripts/lab resim", description=resim.__doc__)
     p.add_argument("session")
     p.add_argument("--config")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help="a configuration key set over the session's (or --config's), e.g. dcp.tpob_ft=0.4")
     p.add_argument("--out")
     p.add_argument("--video", action="store_true")
     p.add_argument("--no-build", action="store_true")
@@ -34,13 +37,15 @@ def resim(argv):
     cmd = [binary("tools/rms_resim"), a.session]
     if a.config:
         cmd += ["--config", a.config]
+    for kv in a.set:
+        cmd += ["--set", kv]
     if a.out:
         cmd += ["--out", a.out]
     rc = subprocess.run(cmd).returncode
     if rc == 0 and a.video:
         out = a.out or a.session.rstrip("/") + "-resim"
         if not os.path.isdir(out):
-            raise LabError("resim --video needs the new session (--config)")
+            raise LabError("resim --video needs the new session (--config or --set)")
         replay.run([out, "--out", os.path.join(out, "replay"), "--no-build", "--speed", "4"])
         video = os.path.join(out, "replay", "session.mp4")
         if os.path.exists(video):

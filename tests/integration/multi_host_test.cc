@@ -9,36 +9,17 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "netns_lab.h"
 #include "subprocess.h"
 
 namespace rms {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::NetnsLab;
 using testing::ReadFile;
 using testing::SourcePath;
 using testing::Subprocess;
-
-class NetnsLab {
- public:
-  NetnsLab(std::string prefix, std::string dir) : prefix_(std::move(prefix)), dir_(std::move(dir)) {
-    Subprocess up({SourcePath("scripts/netns-lab"), "up", prefix_, "4"}, dir_ + "/netns.log");
-    ok_ = up.Wait(60) == 0;
-  }
-  ~NetnsLab() { Down(); }
-  void Down() {
-    if (down_) return;
-    down_ = true;
-    Subprocess down({SourcePath("scripts/netns-lab"), "down", prefix_}, "/dev/null");
-    down.Wait(60);
-  }
-  bool ok() const { return ok_; }
-  std::string host(int i) const { return "netns:" + prefix_ + "-" + std::to_string(i); }
-
- private:
-  std::string prefix_, dir_;
-  bool ok_ = false, down_ = false;
-};
 
 // A lab file with one process a host (the recorder beside the operator
 // station), on a group and port of its own, TTL 1.

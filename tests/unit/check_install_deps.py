@@ -26,7 +26,7 @@ TOOLS = [
     "tmux",  # the terminal tests
     "chromium",  # the report's browser test
     "ssh", "nsenter", "ping", "ip", "tc", "nft", "mount", "umount",  # hosts, namespaces, disks
-    "ps", "pkill", "timeout", "jq", "python3", "flock",
+    "ps", "pkill", "timeout", "jq", "python3", "flock", "parallel",  # parallel: scripts/lab sweep
     "clang-format", "clang-tidy", "run-clang-tidy",  # scripts/lint
 ]
 
@@ -55,7 +55,12 @@ def launcher_tools():
 
 def owner(path):
     r = subprocess.run(["dpkg", "-S", path], capture_output=True, text=True)
-    return r.stdout.split(":", 1)[0].split(",")[0].strip() if r.returncode == 0 else None
+    if r.returncode != 0:
+        return None
+    # A diverted file (GNU parallel diverts moreutils' parallel) is listed
+    # first as "diversion by ...": its owner is on the line after.
+    lines = [ln for ln in r.stdout.splitlines() if not ln.startswith("diversion by")]
+    return lines[0].split(":", 1)[0].split(",")[0].strip() if lines else None
 
 
 def package_of(name):

@@ -2,13 +2,20 @@
 // recorded operator inputs (docs/sessions.md "Re-simulation").
 //   rms_resim SESSION                      exit 0 only if identical, word for word
 //   rms_resim SESSION --config FILE [--out DIR]   the same inputs, another design
+//   rms_resim SESSION --set KEY=VALUE... [--discard] [--result-json]   a sweep's cell
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <nlohmann/json.hpp>
+#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include "rms/base/check.h"
 #include "rms/base/command_line.h"
+#include "rms/base/config.h"
+#include "rms/base/text.h"
+#include "rms/base/version.h"
 #include "rms/resim/resim.h"
 
 int main(int argc, char** argv) {
@@ -19,7 +26,9 @@ int main(int argc, char** argv) {
       "word; "
       "with --config, writes a new session with the outcome and a comparison."};
   rms::resim::ResimOptions opt;
-  bool quiet = false;
+  bool quiet = false, result_json = false, check_only = false;
+  std::vector<std::string> sets;
+  app.set_version_flag("--version", rms::VersionString());
   app.add_option("session", opt.session, "Session folder")
       ->required()
       ->check(CLI::ExistingDirectory);
@@ -27,6 +36,28 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   app.add_option("--out", opt.out_dir,
                  "With --config: the new session folder (default SESSION-resim)");
+  app.add_option("--set", sets,
+                 "KEY=VALUE: a configuration key set over the session's config (or --config's), "
+                 "e.g. dcp.tpob_ft=0.4; repeatable (another design)")
+      ->type_name("KEY=VALUE");
+  app.add_flag("--discard", opt.discard,
+               "Another design: its new session in a temporary folder, removed at the end "
+               "(what remains is the output)");
+  app.add_flag("--result-json", result_json,
+               "Another design: print only its result, one JSON line on stdout (a sweep's cell: "
+               "outcome, recorded outcome, scorecard changes, first divergence)");
+  app.add_flag("--check", check_only,
+               "Only check the design (the configuration with its --set keys) and exit: 0 if "
+               "it is valid");
+  std::string checkpoint_out;
+  app.add_option(
+         "--until", opt.until_frame,
+         "Only up to this DCP frame, word for word (the session's own design); with "
+         "--checkpoint-out, the DCP's state there: a branch point (scripts/lab demo --from)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--checkpoint-out", checkpoint_out,
+                 "With --until: write the DCP's state after that frame here, as a checkpoint "
+                 "(only when the frames up to it are identical)");
   app.add_flag("--quiet", quiet, "No progress lines (they go only to a terminal anyway)");
   bool verbose = false;
   app.add_flag("--verbose", verbose,
@@ -34,13 +65,37 @@ int main(int argc, char** argv) {
   if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   // The re-flown DCP's log lines only when asked for: the result is the output.
   spdlog::set_level(verbose ? spdlog::level::info : spdlog::level::warn);
+  // With --result-json stdout is the result alone: log lines go to stderr.
+  if (result_json) spdlog::set_default_logger(spdlog::stderr_color_mt("rms_resim"));
   if (!quiet && isatty(STDERR_FILENO)) {  // progress only to a person at a terminal
     opt.progress = [](double f, const std::string& line) {
       std::fprintf(stderr, "resim: %3.0f%% %s\n", 100 * f, line.c_str());
     };
   }
   try {
+    for (const std::string& s : sets) opt.settings.push_back(rms::ParseConfigSetting(s));
+    if (check_only) {
+      rms::ParseConfig(rms::resim::EffectiveConfigText(opt), rms::resim::ConfigSource(opt));
+      return 0;
+    }
+    if (result_json && !rms::resim::OtherDesign(opt))
+      throw rms::InputError("--result-json needs another design (--config or --set)");
+    if (!checkpoint_out.empty() && opt.until_frame < 0)
+      throw rms::InputError("--checkpoint-out needs --until FRAME");
     const rms::resim::ResimResult r = rms::resim::Resimulate(opt);
+    if (!checkpoint_out.empty()) {
+      if (!r.first_difference.empty()) {
+        throw rms::InputError(
+            "the session does not re-simulate word for word up to DCP frame " +
+            std::to_string(opt.until_frame) + " (" + r.first_difference +
+            "): a branch from there could not reproduce it; no checkpoint written");
+      }
+      rms::WriteWholeFile(checkpoint_out, r.checkpoint_text);
+    }
+    if (result_json) {
+      std::printf("%s\n", r.cell.dump().c_str());
+      return 0;
+    }
     std::printf(
         "re-simulated %ld DCP frames in %.2f s (%.0f frames/s); %ld of %ld recorded frames "
         "identical%s\n",
@@ -58,6 +113,7 @@ int main(int argc, char** argv) {
                   r.states_checked);
     }
     if (!r.note.empty()) std::printf("note: %s\n", r.note.c_str());
+    if (!r.branch_note.empty()) std::printf("%s\n", r.branch_note.c_str());
     if (!r.log_note.empty()) std::printf("note: %s\n", r.log_note.c_str());
     if (!r.first_difference.empty())
       std::printf("first difference: %s\n", r.first_difference.c_str());
@@ -70,6 +126,8 @@ int main(int argc, char** argv) {
     return r.first_difference.empty() ? 0 : 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rms_resim: %s\n", e.what());
+    // A sweep's cell says why it has no result, on its one line.
+    if (result_json) std::printf("%s\n", nlohmann::json{{"error", e.what()}}.dump().c_str());
     return 2;
   }
 }

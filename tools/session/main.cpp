@@ -77,6 +77,12 @@ Command Manifest(CLI::App& app) {
   c->add_option("--note", f.note, "The experimenter's note");
   c->add_option("--kind", f.kind, "live, replay or re-simulation")->capture_default_str();
   c->add_option("--parent", f.parent, "A replay's recorded session");
+  c->add_option("--branch-of", f.branch_of,
+                "A branch's recorded session (scripts/lab demo --from)");
+  c->add_option("--branch-frame", f.branch_frame, "... the last DCP frame of its prefix");
+  c->add_option("--branch-time", f.branch_time_s, "... that frame's session time, s");
+  c->add_option("--branch-parent-log-sha256", f.branch_parent_log_sha256,
+                "... SHA-256 of the recorded session's lcmlog");
   return {c, [o] {
             rms::WriteWholeFile(
                 o->dir + "/manifest.json",

@@ -85,12 +85,12 @@ void Flatten(const toml::node& n, const std::string& prefix,
 
 }  // namespace
 
-nlohmann::ordered_json ConfigChanges(const std::string& a_path, const std::string& b_path) {
+nlohmann::ordered_json ConfigChanges(const std::string& a_text, const std::string& b_text) {
   nlohmann::ordered_json changes = nlohmann::ordered_json::array();
   std::map<std::string, std::string> a, b;
   try {
-    Flatten(toml::parse_file(a_path), "", &a);
-    Flatten(toml::parse_file(b_path), "", &b);
+    Flatten(toml::parse(std::string_view(a_text)), "", &a);
+    Flatten(toml::parse(std::string_view(b_text)), "", &b);
   } catch (const std::exception&) {
     return changes;
   }

@@ -15,8 +15,8 @@ namespace rms::resim {
 bool SameFrame(const dcp_frame_t& a, const dcp_frame_t& b, std::string* what);
 // True when every field but the wall-clock send time and the sender agrees.
 bool SameTelemetry(dcp_telemetry_t a, dcp_telemetry_t b, std::string* what);
-// Every key whose value differs between two configuration files:
-// [{"key", "recorded", "now"}]; empty when either cannot be read.
-nlohmann::ordered_json ConfigChanges(const std::string& recorded_path, const std::string& now_path);
+// Every key whose value differs between two configurations (TOML texts):
+// [{"key", "recorded", "now"}]; empty when either cannot be parsed.
+nlohmann::ordered_json ConfigChanges(const std::string& recorded_toml, const std::string& now_toml);
 
 }  // namespace rms::resim

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -11,6 +12,7 @@
 #include "rms/base/check.h"
 #include "rms/base/config.h"
 #include "rms/base/text.h"
+#include "rms/base/toml_reader.h"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_state_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
@@ -26,6 +28,7 @@
 
 #include "comparison.h"
 #include "narrative.h"
+#include "outcome.h"
 #include "recording.h"
 
 namespace fs = std::filesystem;
@@ -73,7 +76,7 @@ struct Outputs {
 // The DCP's own node over a log-backed transport, step by step through the
 // plan (out_log: the new session's log, "" for none).
 Outputs RunDcp(const LabConfig& config, const Recording& rec, const Plan& plan,
-               const std::string& out_log, bool other_design,
+               const std::string& out_log, bool other_design, long until_frame,
                const std::function<void(double, const std::string&)>& progress,
                ResimResult* result) {
   // During the run the outputs are appended to vectors reserved up front (no
@@ -113,11 +116,13 @@ Outputs RunDcp(const LabConfig& config, const Recording& rec, const Plan& plan,
                 static_cast<int>(input->size));
     lcm.HandleSubscriptions(0);  // the input to the DCP
     lcm.HandleSubscriptions(0);  // its outputs to the comparison
+    if (until_frame >= 0 && !frames_run.empty() && frames_run.back().frame >= until_frame) break;
     if (n >= 20 && k % (n / 20) == 0)
       progress(static_cast<double>(k) / n,
                std::to_string(k) + " of " + std::to_string(n) + " steps");
   }
   result->run_seconds = std::chrono::duration<double>(Clock::now() - t_run).count();
+  if (until_frame >= 0) result->checkpoint_text = wire::CheckpointText(node.MakeCheckpoint());
   Outputs out{std::move(frames_run), std::move(telemetry_run)};
   SortByFrame(&out.frames);
   SortByFrame(&out.telemetry);
@@ -130,14 +135,19 @@ Outputs RunDcp(const LabConfig& config, const Recording& rec, const Plan& plan,
 }
 
 // Word for word against the recording, from the plan's first frame.
-void CompareWithRecording(const Recording& rec, std::size_t first, const Outputs& out,
-                          ResimResult* result) {
+void CompareWithRecording(const Recording& rec, std::size_t first, long until_frame,
+                          const Outputs& out, ResimResult* result) {
   for (std::size_t i = first; i < rec.dcp_frames.size(); ++i) {
     const dcp_frame_t& r = rec.dcp_frames[i];
+    if (until_frame >= 0 && r.frame > until_frame) break;
     ++result->compared;
     const dcp_frame_t* made = FindFrame(out.frames, r.frame);
     std::string what;
     bool same = made && SameFrame(*made, r, &what);
+    if (!same && result->first_decision_frame < 0) {  // the DCP's words: its decisions
+      result->first_decision_frame = static_cast<long>(r.frame);
+      result->first_decision = made ? what : "missing";
+    }
     if (same) {
       const dcp_telemetry_t* rt = FindFrame(rec.telemetry, r.frame);
       const dcp_telemetry_t* nt = FindFrame(out.telemetry, r.frame);
@@ -145,25 +155,93 @@ void CompareWithRecording(const Recording& rec, std::size_t first, const Outputs
     } else if (!made) {
       what = "missing";
     }
-    if (same)
+    if (same) {
       ++result->identical;
-    else if (result->first_difference.empty())
+    } else if (result->first_difference.empty()) {
       result->first_difference = "DCP frame " + std::to_string(r.frame) + ": " + what;
+      result->first_difference_frame = static_cast<long>(r.frame);
+    }
   }
   if (result->first_difference.empty() && !result->state_difference.empty()) {
     result->first_difference = result->state_difference;
   }
 }
 
+// A branch (scripts/lab demo --from; docs/sessions.md "Branching"): its
+// recorded session re-simulated up to the instant, word for word, and the
+// DCP's state there against the branch's first logged state. Nothing when
+// the session is no branch.
+void CheckBranchPrefix(const fs::path& session, const Recording& rec, ResimResult* result) {
+  nlohmann::json m;
+  try {
+    m = nlohmann::json::parse(ReadTextFile((session / "manifest.json").string(), "the manifest"));
+  } catch (const std::exception&) {
+    return;  // no manifest, or none readable: no branch to check
+  }
+  if (!m.contains("branch") || !m["branch"].is_object()) return;
+  const auto& b = m["branch"];
+  ResimOptions popt;
+  popt.session = b.value("parent", "");
+  popt.until_frame = b.value("frame", -1L);
+  const std::string prefix =
+      "DCP frames up to " + std::to_string(popt.until_frame) + " of " + popt.session;
+  ResimResult p;
+  try {
+    p = Resimulate(popt);
+  } catch (const InputError& e) {
+    throw InputError("the branch's prefix (" + prefix + ") cannot be re-simulated: " + e.what());
+  }
+  result->prefix_frames = p.compared;
+  result->prefix_identical = p.identical;
+  std::string why;
+  if (!p.first_difference.empty()) {
+    why = "the prefix differs from its recording: " + p.first_difference;
+  } else if (rec.states.empty()) {
+    why = "the branch's log holds no RMS_DCP_STATE to check its start against";
+  } else if (wire::ParseCheckpoint(rec.states.front().m.checkpoint, "RMS_DCP_STATE").dcp !=
+             wire::ParseCheckpoint(p.checkpoint_text, "the prefix").dcp) {
+    why = "the branch's first state is not the DCP's state at the end of the prefix";
+  }
+  if (!why.empty()) {
+    result->first_difference = "the branch's prefix (" + prefix + "): " + why;
+    result->branch_note = result->first_difference;
+    return;
+  }
+  result->branch_note = "the branch's prefix, " + prefix +
+                        ", re-simulated: " + std::to_string(p.identical) + " of " +
+                        std::to_string(p.compared) +
+                        " frames identical, word for word; the DCP's state at its end is the "
+                        "branch's first state";
+}
+
+// --until: a frame the re-simulation reaches, with its own design.
+void CheckUntil(const Recording& rec, const Plan& plan, const ResimOptions& opt,
+                bool other_design) {
+  if (other_design)
+    throw InputError("--until is for the session's own design (no --config, --set)");
+  const std::int64_t first = rec.dcp_frames[plan.first].frame, last = rec.dcp_frames.back().frame;
+  if (opt.until_frame < first || opt.until_frame > last) {
+    throw InputError(opt.session + " re-simulates DCP frames " + std::to_string(first) + ".." +
+                     std::to_string(last) + ": DCP frame " + std::to_string(opt.until_frame) +
+                     " is not among them");
+  }
+}
+
 // Another design: a new session folder with its configuration, ready for the run's log.
-std::string OpenNewSession(const ResimOptions& opt, const std::string& config_path,
+std::string OpenNewSession(const ResimOptions& opt, const std::string& config_text,
                            ResimResult* result) {
-  result->out_dir = opt.out_dir.empty()
-                        ? (fs::path(opt.session).lexically_normal().string() + "-resim")
-                        : opt.out_dir;
+  if (opt.discard) {
+    std::string pattern = (fs::temp_directory_path() / "rmslab-resim-XXXXXX").string();
+    if (!mkdtemp(pattern.data()))
+      throw InputError("cannot make a temporary folder in " + fs::temp_directory_path().string());
+    result->out_dir = pattern + "/session";
+  } else {
+    result->out_dir = opt.out_dir.empty()
+                          ? (fs::path(opt.session).lexically_normal().string() + "-resim")
+                          : opt.out_dir;
+  }
   session::CreateSessionFolder(result->out_dir);
-  fs::copy_file(config_path, fs::path(result->out_dir) / "config.toml",
-                fs::copy_options::overwrite_existing);
+  WriteWholeFile((fs::path(result->out_dir) / "config.toml").string(), config_text);
   WriteWholeFile((fs::path(result->out_dir) / "run" / "pilot").string(), "resim\n");
   return (fs::path(result->out_dir) / "lcmlog").string();
 }
@@ -171,6 +249,7 @@ std::string OpenNewSession(const ResimOptions& opt, const std::string& config_pa
 // comparison.md: what changed, and what it did.
 std::string ComparisonMarkdown(const fs::path& session, const std::string& config_path,
                                const ResimResult& result) {
+  // config_path: where the design came from, with its settings
   std::ostringstream md;
   md << "# Re-simulation of " << fs::absolute(session).lexically_normal().string() << "\n\n";
   md << "The recorded operator inputs, flown again with `" << config_path
@@ -187,17 +266,48 @@ std::string ComparisonMarkdown(const fs::path& session, const std::string& confi
   return md.str();
 }
 
+// The sweep's cell (docs/sessions.md "Sweeps"): the outcome against the
+// recorded session's (its summary.json, or made now when it has none).
+nlohmann::ordered_json CellJson(const fs::path& session, const LabConfig& config,
+                                const nlohmann::json& summary, const ResimResult& result) {
+  nlohmann::json recorded;
+  try {
+    recorded = nlohmann::json::parse(
+        ReadTextFile((session / "summary.json").string(), "the session's summary"));
+  } catch (const std::exception&) {
+    recorded = session::Summarize(session.string());
+  }
+  nlohmann::ordered_json cell;
+  cell["outcome"] = Outcome(summary);
+  cell["recorded_outcome"] = Outcome(recorded);
+  cell["changes"] = ScorecardChanges(recorded, summary);
+  auto at = [&](long frame, const std::string& what) {
+    return frame < 0 ? nlohmann::ordered_json(nullptr)
+                     : nlohmann::ordered_json{{"frame", frame},
+                                              {"time_s", frame / config.session.frame_rate_hz},
+                                              {"what", what}};
+  };
+  // The DCP frame's words (pose, control word, planes, state): its decisions.
+  cell["first_divergence"] = at(result.first_decision_frame, result.first_decision);
+  // Any output, its telemetry too (the margins to a changed tolerance differ from the first frame).
+  cell["first_difference"] = at(result.first_difference_frame, result.first_difference);
+  cell["frames_identical"] = result.identical;
+  cell["frames_compared"] = result.compared;
+  cell["explanation"] = result.comparison["explanation"];
+  return cell;
+}
+
 // Another design's session: its manifest (the parent's subject and note go
 // with the inputs), summary, comparison.json and comparison.md.
 void WriteNewSession(const fs::path& session, const std::string& config_path,
-                     const LabConfig& config, const Recording& rec, const Outputs& out,
-                     ResimResult* result) {
+                     const std::string& config_text, const LabConfig& config, const Recording& rec,
+                     const Outputs& out, ResimResult* result) {
   const fs::path dir(result->out_dir);
   session::ManifestFields mf;
   mf.pilot = "resim";
   mf.kind = "re-simulation";
   mf.parent = fs::absolute(session).lexically_normal().string();
-  mf.config_source = fs::absolute(config_path).string();
+  mf.config_source = config_path;
   if (fs::exists(session / "manifest.json")) {
     try {
       const auto parent =
@@ -209,30 +319,50 @@ void WriteNewSession(const fs::path& session, const std::string& config_path,
   }
   WriteWholeFile((dir / "manifest.json").string(),
                  session::MakeManifest(dir.string(), mf).dump(2) + "\n");
-  WriteWholeFile((dir / "summary.json").string(), session::Summarize(dir.string()).dump(2) + "\n");
+  const nlohmann::ordered_json summary = session::Summarize(dir.string());
+  WriteWholeFile((dir / "summary.json").string(), summary.dump(2) + "\n");
   result->comparison =
       DesignComparison(TelemetryByFrame(rec.telemetry), TelemetryByFrame(out.telemetry), config,
                        config.session.frame_rate_hz);
-  result->comparison["config_changes"] =
-      ConfigChanges((session / "config.toml").string(), config_path);
+  result->comparison["config_changes"] = ConfigChanges(
+      ReadTextFile((session / "config.toml").string(), "the session's configuration"), config_text);
   result->comparison["frames_identical"] = result->identical;
   result->comparison["frames_compared"] = result->compared;
   WriteWholeFile((dir / "comparison.json").string(), result->comparison.dump(2) + "\n");
   WriteWholeFile((dir / "comparison.md").string(),
                  ComparisonMarkdown(session, config_path, *result));
+  result->cell = CellJson(session, config, summary, *result);
 }
 
 }  // namespace
+
+std::string ConfigSource(const ResimOptions& opt) {
+  std::string s = opt.config_path.empty() ? (fs::path(opt.session) / "config.toml").string()
+                                          : fs::absolute(opt.config_path).string();
+  for (const ConfigSetting& c : opt.settings) s += " --set " + c.key + "=" + c.value;
+  return s;
+}
+
+bool OtherDesign(const ResimOptions& opt) {
+  return !opt.config_path.empty() || !opt.settings.empty();
+}
+
+std::string EffectiveConfigText(const ResimOptions& opt) {
+  const std::string base =
+      opt.config_path.empty() ? (fs::path(opt.session) / "config.toml").string() : opt.config_path;
+  const std::string text = ReadTextFile(base, "the configuration file");
+  return opt.settings.empty() ? text : ApplyConfigSettings(text, base, opt.settings);
+}
 
 ResimResult Resimulate(const ResimOptions& opt) {
   const auto t0 = Clock::now();
   const fs::path session(opt.session);
   if (!fs::exists(session / "lcmlog"))
     throw InputError(opt.session + ": not a session folder (no lcmlog)");
-  const bool other_design = !opt.config_path.empty();
-  const std::string config_path =
-      other_design ? opt.config_path : (session / "config.toml").string();
-  const LabConfig config = LoadConfig(config_path);
+  const bool other_design = OtherDesign(opt);
+  const std::string config_text = EffectiveConfigText(opt);
+  const std::string config_path = ConfigSource(opt);
+  const LabConfig config = ParseConfig(config_text, config_path);
   auto progress = [&](double f, const std::string& line) {
     if (opt.progress) opt.progress(f, line);
   };
@@ -253,17 +383,33 @@ ResimResult Resimulate(const ResimOptions& opt) {
   }
   result.note = plan.note;
   result.skipped = static_cast<long>(plan.first);
-  const std::string out_log = other_design ? OpenNewSession(opt, config_path, &result) : "";
-  const Outputs out = RunDcp(config, rec, plan, out_log, other_design, progress, &result);
+  const std::string out_log = other_design ? OpenNewSession(opt, config_text, &result) : "";
+  // A discarded session's folder goes however the run ends.
+  struct Discard {
+    std::string folder;  // the temporary folder the new session is in ("": none)
+    ~Discard() {
+      std::error_code ec;
+      if (!folder.empty()) fs::remove_all(folder, ec);
+    }
+  } discard{opt.discard && other_design ? fs::path(result.out_dir).parent_path().string() : ""};
+  if (opt.until_frame >= 0) CheckUntil(rec, plan, opt, other_design);
+  const Outputs out =
+      RunDcp(config, rec, plan, out_log, other_design, opt.until_frame, progress, &result);
   progress(1.0, "done");
-  CompareWithRecording(rec, plan.first, out, &result);
+  CompareWithRecording(rec, plan.first, opt.until_frame, out, &result);
+  if (!other_design && opt.until_frame < 0) {
+    const std::string own = result.first_difference;
+    CheckBranchPrefix(session, rec, &result);
+    if (!own.empty()) result.first_difference = own;  // the branch's own difference first
+  }
   result.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   result.read_seconds = std::chrono::duration<double>(t_read - t0).count();
   if (!rec.inputs.empty()) {
     result.recorded_seconds =
         (rec.inputs.back().timestamp_us - rec.inputs.front().timestamp_us) / 1e6;
   }
-  if (other_design) WriteNewSession(session, config_path, config, rec, out, &result);
+  if (other_design) WriteNewSession(session, config_path, config_text, config, rec, out, &result);
+  if (!discard.folder.empty()) result.out_dir.clear();
   return result;
 }
 

@@ -79,6 +79,9 @@ void LossLines(const Json& j, std::ostream& os) {
 void OutcomeLines(const Json& j, std::ostream& os) {
   if (j["log"].value("dcp_frames", 0) == 0)
     os << "modes: none (no DCP frame in the log)";
+  else if (j.contains("attempts") && !j["attempts"].empty() &&
+           j["attempts"][0].contains("started_in_mode"))
+    os << "modes " << j["attempts"][0]["started_in_mode"];  // a restore may start past Mode 1
   else
     os << "modes 1";
   std::size_t shown = 0;

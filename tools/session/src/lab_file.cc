@@ -45,6 +45,32 @@ bool LabFile::all_local() const {
   return true;
 }
 
+namespace {
+
+bool ValidHost(const std::string& v) {
+  return v == "localhost" || (v.rfind("netns:", 0) == 0 && ValidName(v.substr(6))) ||
+         (v.rfind("ssh:", 0) == 0 && ValidName(v.substr(4)));
+}
+
+// [sweep] (optional; docs/sessions.md "Sweeps"): where scripts/lab sweep runs its cells.
+void ReadSweepHosts(TomlReader s, LabFile* lab) {
+  const toml::node* n = s.table().get("hosts");
+  s.Use("hosts");
+  const toml::array* a = n ? n->as_array() : nullptr;
+  if (!a || a->empty()) s.Fail("hosts", "must be an array of one or more hosts");
+  for (const toml::node& h : *a) {
+    const std::optional<std::string> v = h.value<std::string>();
+    if (!h.is_string() || !ValidHost(*v)) {
+      s.Fail("hosts", "each must be \"localhost\", \"netns:NAME\" or \"ssh:[USER@]HOST\"");
+    }
+    lab->sweep_hosts.push_back(*v);
+  }
+  lab->sweep_jobs_per_host = static_cast<int>(s.Number("jobs_per_host", 1, 256));
+  s.Finish();
+}
+
+}  // namespace
+
 LabFile LoadLabFile(const std::string& path) {
   return ParseLabFile(ReadTextFile(path, "the lab file"), path);
 }
@@ -59,9 +85,7 @@ LabFile ParseLabFile(std::string_view text, const std::string& path) {
     TomlReader h = top.Sub("hosts");
     for (const char* p : kProcesses) {
       const std::string v = h.String(p);
-      const bool ok = v == "localhost" || (v.rfind("netns:", 0) == 0 && ValidName(v.substr(6))) ||
-                      (v.rfind("ssh:", 0) == 0 && ValidName(v.substr(4)));
-      if (!ok)
+      if (!ValidHost(v))
         h.Fail(p,
                "must be \"localhost\", \"netns:NAME\" or \"ssh:[USER@]HOST\", got \"" + v + "\"");
       lab.hosts[p] = v;
@@ -100,6 +124,7 @@ LabFile ParseLabFile(std::string_view text, const std::string& path) {
     }
     i.Finish();
   }
+  if (root.contains("sweep")) ReadSweepHosts(top.Sub("sweep"), &lab);
   top.Finish();
   return lab;
 }
@@ -114,6 +139,8 @@ nlohmann::ordered_json LabFileJson(const LabFile& lab) {
   j["remote_root"] = lab.remote_root;
   j["remote_build"] = lab.remote_build;
   j["instructor_bind"] = lab.instructor_bind;
+  j["sweep_hosts"] = lab.sweep_hosts;
+  j["sweep_jobs_per_host"] = lab.sweep_jobs_per_host;
   return j;
 }
 

@@ -876,6 +876,12 @@ nlohmann::ordered_json MakeManifest(const std::string& dir, const ManifestFields
   if (!f.note.empty()) j["note"] = f.note;
   if (!timeline.empty()) j["timeline"] = {{"file", "timeline.tl"}, {"source", timeline}};
   if (!restore.empty()) j["restored_from"] = restore;
+  if (!f.branch_of.empty()) {
+    j["branch"] = {{"parent", f.branch_of},
+                   {"frame", f.branch_frame},
+                   {"time_s", f.branch_time_s},
+                   {"parent_log_sha256", f.branch_parent_log_sha256}};
+  }
   j["config"] = {{"file", "config.toml"}, {"sha256", config_sha256}};
   if (!f.config_source.empty()) j["config"]["source"] = f.config_source;
   j["software"] = {{"version", VersionString()},         {"project", Version().project},

@@ -9,6 +9,9 @@
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
+
+#include "rms/base/config_settings.h"
 
 namespace rms::resim {
 
@@ -16,6 +19,15 @@ struct ResimOptions {
   std::string session;      // the recorded session folder
   std::string config_path;  // another configuration ("" = the session's own config.toml)
   std::string out_dir;      // where the new session goes (with a config; default SESSION-resim)
+  // Keys set over the configuration (the session's own, or config_path's):
+  // another design (docs/sessions.md "Sweeps").
+  std::vector<ConfigSetting> settings;
+  bool discard =
+      false;  // another design: its new session in a temporary folder, removed at the end
+  // The session's own design, only up to this DCP frame (-1: all): the
+  // branch point of scripts/lab demo --from (docs/sessions.md "Branching");
+  // ResimResult::checkpoint_text is the DCP's state after it.
+  long until_frame = -1;
   // Progress (0..1) with a line to show; called every few percent.
   std::function<void(double, const std::string&)> progress;
 };
@@ -24,7 +36,10 @@ struct ResimResult {
   long frames = 0;     // DCP frames re-simulated
   long compared = 0;   // recorded DCP frames compared
   long identical = 0;  // ... identical word for word (and their telemetry field for field)
-  std::string first_difference;  // where they first differ ("" if nowhere)
+  std::string first_difference;      // where they first differ ("" if nowhere)
+  long first_difference_frame = -1;  // ... its DCP frame (-1 if nowhere, or a state differs)
+  long first_decision_frame = -1;    // the first DCP frame whose words differ (-1 if none)
+  std::string first_decision;        // ... which word ("control_word", "arm_words[3]", "missing")
   long skipped = 0;  // recorded DCP frames not re-simulated (the log lacks the state before them)
   std::string note;  // ... said in words ("" if none)
   std::string log_note;     // the log's end is no whole event ("" if it is)
@@ -37,7 +52,24 @@ struct ResimResult {
   double recorded_seconds = 0.0;      // the session's own duration (first to last input frame)
   std::string out_dir;                // the new session (with another configuration)
   nlohmann::ordered_json comparison;  // with another configuration: comparison.json
+  // Another design: the sweep's cell (docs/sessions.md "Sweeps"): outcome,
+  // recorded outcome, scorecard changes, first divergence.
+  nlohmann::ordered_json cell;
+  std::string checkpoint_text;  // with until_frame: the DCP's state after it (a checkpoint)
+  // A branch (its manifest's "branch"): its recorded session's prefix
+  // re-simulated first, and the state there against the branch's first state.
+  long prefix_frames = 0, prefix_identical = 0;
+  std::string branch_note;  // said in words ("" when not a branch)
 };
+
+// The effective configuration's TOML text: the session's own config.toml or
+// options.config_path, with options.settings applied. Throws rms::InputError
+// for a file that cannot be read or a setting that does not fit it.
+std::string EffectiveConfigText(const ResimOptions& options);
+// Where it came from, as a person reads it: "FILE --set KEY=VALUE ...".
+std::string ConfigSource(const ResimOptions& options);
+// True with another configuration or any setting.
+bool OtherDesign(const ResimOptions& options);
 
 // Throws rms::InputError for a folder that is no session, a log that cannot
 // be re-simulated (DCP frames missing from it with their inputs ambiguous,

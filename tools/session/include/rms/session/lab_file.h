@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace rms::session {
 
@@ -24,6 +25,11 @@ struct LabFile {
   // [instructor] bind: where the instructor's page is served ("" = 127.0.0.1
   // only; docs/instructor.md "Beyond this host"); optional.
   std::string instructor_bind;
+  // [sweep] (optional; docs/sessions.md "Sweeps"): the hosts scripts/lab
+  // sweep runs its cells on (none: every distinct host of [hosts]) and how
+  // many at once on each (0: each host's cores).
+  std::vector<std::string> sweep_hosts;
+  int sweep_jobs_per_host = 0;
   bool all_local() const;
 };
 
@@ -31,7 +37,8 @@ LabFile LoadLabFile(const std::string& path);
 // The same from the file's text (path names it in errors).
 LabFile ParseLabFile(std::string_view text, const std::string& path);
 // {"hosts": {process: host}, "ttl", "group", "port", "all_local",
-// "remote_root", "remote_build", "instructor_bind"}: for the launcher (scripts/lab).
+// "remote_root", "remote_build", "instructor_bind", "sweep_hosts",
+// "sweep_jobs_per_host"}: for the launcher (scripts/lab).
 nlohmann::ordered_json LabFileJson(const LabFile& lab);
 
 }  // namespace rms::session

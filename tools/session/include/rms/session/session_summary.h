@@ -37,6 +37,13 @@ struct ManifestFields {
   std::string kind = "live";  // "live", "replay" or "re-simulation"
   std::string parent;         // a replay's or re-simulation's recorded session (absolute path)
   std::string config_source;  // where config.toml came from
+  // A session branched from a recorded one (scripts/lab demo --from
+  // SESSION@TIME; docs/sessions.md "Branching"): the recorded session, the
+  // instant (its DCP frame, after which the branch took over) and its log's hash.
+  std::string branch_of;           // the recorded session (absolute path); "" when not a branch
+  std::int64_t branch_frame = -1;  // the last DCP frame of the recorded session's prefix
+  double branch_time_s = 0;        // ... its session time (frame / frame rate)
+  std::string branch_parent_log_sha256;  // SHA-256 of the recorded session's lcmlog
 };
 nlohmann::ordered_json MakeManifest(const std::string& session_dir, const ManifestFields& f);
 

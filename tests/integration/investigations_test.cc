@@ -1,0 +1,408 @@
+// Investigations at scale (docs/sessions.md "Sweeps" and "Branching"), the
+// way an experimenter runs them: two recorded sessions swept over a 3 x 2
+// grid of designs, whose cells agree with single `rms_resim --config` runs;
+// the same sweep across the suite's namespace hosts through GNU parallel; a
+// rerun and a resumed sweep that redo nothing finished; a failed cell tried
+// again and reported; a Slurm array job whose tasks fill the cache; the
+// table drawn by a real browser; and a session branched from a recorded
+// instant whose prefix re-simulates word for word. One ctest
+// (integration.investigations): the two sessions are recorded once.
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <gtest/gtest.h>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include "netns_lab.h"
+#include "subprocess.h"
+
+namespace rms {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::ReadFile;
+using testing::Script;
+using testing::ScriptRun;
+using testing::SourcePath;
+
+// A CSV file as rows of named fields (the sweep's table: no quoted commas
+// in the columns read here but "what changed", which is read as the rest).
+std::vector<std::map<std::string, std::string>> ReadCsv(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::vector<std::string> names;
+  std::vector<std::map<std::string, std::string>> rows;
+  auto split = [](const std::string& l) {
+    std::vector<std::string> f;
+    std::string cur;
+    bool quoted = false;
+    for (char c : l) {
+      if (c == '"') {
+        quoted = !quoted;
+      } else if (c == ',' && !quoted) {
+        f.push_back(cur);
+        cur.clear();
+      } else {
+        cur += c;
+      }
+    }
+    f.push_back(cur);
+    return f;
+  };
+  if (std::getline(in, line)) names = split(line);
+  while (std::getline(in, line)) {
+    const auto f = split(line);
+    std::map<std::string, std::string> row;
+    for (std::size_t i = 0; i < names.size() && i < f.size(); ++i) row[names[i]] = f[i];
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+std::string Lines(const std::string& text, const std::string& needle) {
+  std::istringstream in(text);
+  std::string line, out;
+  while (std::getline(in, line))
+    if (line.find(needle) != std::string::npos) out += line + "\n";
+  return out;
+}
+
+std::vector<std::string> Joblogs(const std::string& dir) {
+  std::vector<std::string> v;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().filename().string().rfind("joblog-", 0) == 0) v.push_back(e.path().string());
+  std::sort(v.begin(), v.end());
+  return v;
+}
+
+class Investigations : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    tmp_ = new std::string(testing::MakeTempDir("investigations"));
+    a_ = new std::string(*tmp_ + "/autopilot");
+    b_ = new std::string(*tmp_ + "/mission");
+    // The autopilot and a timeline, each at 4x, small frames, no video.
+    for (const auto& [dir, extra] :
+         {std::pair{*a_, std::vector<std::string>{}},
+          std::pair{*b_, std::vector<std::string>{"--timeline",
+                                                  SourcePath("scripts/timelines/mission.tl")}}}) {
+      std::vector<std::string> argv = {SourcePath("scripts/lab"),
+                                       "demo",
+                                       "--no-build",
+                                       "--out",
+                                       dir,
+                                       "--speed",
+                                       "4",
+                                       "--lcm-url",
+                                       testing::UniqueLcmUrl(9300),
+                                       "--png-every",
+                                       "0",
+                                       "--no-video",
+                                       "--width",
+                                       "160",
+                                       "--height",
+                                       "120"};
+      argv.insert(argv.end(), extra.begin(), extra.end());
+      const ScriptRun r = Script(argv, dir + ".log");
+      ASSERT_EQ(r.rc, 0) << r.out;
+    }
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*tmp_);
+    delete tmp_;
+    delete a_;
+    delete b_;
+  }
+  // scripts/lab sweep over both sessions on the 3 x 2 grid.
+  static ScriptRun Sweep(const std::string& out, const std::string& cache,
+                         std::vector<std::string> extra = {}) {
+    std::vector<std::string> argv = {SourcePath("scripts/lab"),
+                                     "sweep",
+                                     *a_,
+                                     *b_,
+                                     "--vary",
+                                     "dcp.tpob_ft=0.2,0.3,0.4",
+                                     "--vary",
+                                     "arm.upper_boom_ft=20.9,21.5",
+                                     "--out",
+                                     out,
+                                     "--cache",
+                                     cache,
+                                     "--no-build"};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    return Script(argv, out + ".log");
+  }
+  static std::string* tmp_;
+  static std::string* a_;
+  static std::string* b_;
+};
+std::string* Investigations::tmp_ = nullptr;
+std::string* Investigations::a_ = nullptr;
+std::string* Investigations::b_ = nullptr;
+
+// The session's configuration with the two keys set, by editing its text.
+std::string WriteDesign(const std::string& session, const std::string& tpob,
+                        const std::string& boom, const std::string& path) {
+  std::string text = ReadFile(session + "/config.toml");
+  text = std::regex_replace(text, std::regex(R"((\ntpob_ft\s*=\s*)[^\s#]+)"), "$01" + tpob);
+  text = std::regex_replace(text, std::regex(R"((\nupper_boom_ft\s*=\s*)[^\s#]+)"), "$01" + boom);
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST_F(Investigations, TwoSessionsOnAThreeByTwoGridAgreeWithSingleResims) {
+  const std::string out = *tmp_ + "/sweep-local";
+  const ScriptRun r = Sweep(out, *tmp_ + "/cache-local", {"--jobs", "2"});
+  ASSERT_EQ(r.rc, 0) << r.out;
+  EXPECT_NE(r.out.find("12 cells (2 sessions x 6 designs)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("sweep [####"), std::string::npos) << "no progress bar: " << r.out;
+  const auto rows = ReadCsv(out + "/sweep.csv");
+  ASSERT_EQ(rows.size(), 12u);
+  int k = 0;
+  for (const auto& row : rows) {
+    SCOPED_TRACE("cell " + row.at("cell"));
+    ASSERT_EQ(row.at("status"), "ok") << row.at("error");
+    const std::string design = *tmp_ + "/design-" + std::to_string(++k) + ".toml";
+    WriteDesign(row.at("session"), row.at("dcp.tpob_ft"), row.at("arm.upper_boom_ft"), design);
+    const std::string single = *tmp_ + "/single-" + std::to_string(k);
+    const ScriptRun one = Script({testing::BuildPath("tools/rms_resim"), row.at("session"),
+                                  "--config", design, "--out", single, "--quiet"},
+                                 single + ".log");
+    ASSERT_EQ(one.rc, 0) << one.out;
+    const auto summary = nlohmann::json::parse(ReadFile(single + "/summary.json"));
+    const auto comparison = nlohmann::json::parse(ReadFile(single + "/comparison.json"));
+    EXPECT_EQ(row.at("acquired"), summary["acquired"].get<bool>() ? "1" : "0");
+    EXPECT_EQ(row.at("docked"), summary["docked"].get<bool>() ? "1" : "0");
+    EXPECT_EQ(row.at("held_frames"), std::to_string(summary["held_frames"].get<long>()));
+    EXPECT_EQ(row.at("collisions"), std::to_string(summary["totals"]["collisions"].get<long>()));
+    EXPECT_EQ(row.at("frames_identical"),
+              std::to_string(comparison["frames_identical"].get<long>()));
+    EXPECT_EQ(row.at("frames_compared"), std::to_string(comparison["frames_compared"].get<long>()));
+    if (summary["docked"].get<bool>()) {
+      EXPECT_EQ(std::stod(row.at("docked_at [s]")),
+                summary["attempts"][summary["result_attempt"].get<int>() - 1]["reached_s"]["docked"]
+                    .get<double>());
+    }
+    // The recorded design is the recording, word for word; the longer boom
+    // departs from it, and the table says where.
+    const bool recorded = row.at("dcp.tpob_ft") == "0.3" && row.at("arm.upper_boom_ft") == "20.9";
+    if (recorded) {
+      EXPECT_EQ(row.at("frames_identical"), row.at("frames_compared"));
+      EXPECT_EQ(row.at("first_divergence_frame"), "");
+      EXPECT_EQ(row.at("changes"), "0");
+    }
+    if (row.at("arm.upper_boom_ft") == "21.5") {
+      EXPECT_NE(row.at("first_divergence_frame"), "");
+    }
+  }
+  // The page: a browser draws one plot per varied key.
+  const std::string html = ReadFile(out + "/sweep.html");
+  EXPECT_EQ(html.find("<script src="), std::string::npos) << "not self-contained";
+  testing::Subprocess chrome(
+      {"/usr/bin/chromium", "--headless=new", "--no-sandbox", "--disable-gpu",
+       "--virtual-time-budget=5000", "--dump-dom", "file://" + out + "/sweep.html"},
+      *tmp_ + "/sweep-dom.html");
+  ASSERT_EQ(chrome.Wait(120), 0);
+  const std::string dom = ReadFile(*tmp_ + "/sweep-dom.html");
+  std::size_t drawn = 0;
+  for (std::size_t at = dom.find("data-drawn=\"1\""); at != std::string::npos;
+       at = dom.find("data-drawn=\"1\"", at + 1))
+    ++drawn;
+  EXPECT_EQ(drawn, 2u) << "plots not drawn";
+}
+
+TEST_F(Investigations, TheSameSweepAcrossTheNamespaceHostsThroughGnuParallel) {
+  const std::string dir = *tmp_ + "/hosts";
+  fs::create_directories(dir);
+  testing::NetnsLab net("sw" + std::to_string(getpid() % 100000), dir, 2);
+  ASSERT_TRUE(net.ok()) << ReadFile(dir + "/netns.log");
+  const std::string lab = dir + "/lab.toml";
+  std::ofstream(lab) << "[hosts]\noperator_station = \"" << net.host(1) << "\"\ndynamics_proc = \""
+                     << net.host(2) << "\"\nscene_proc = \"" << net.host(1)
+                     << "\"\nesg_renderer = \"" << net.host(2)
+                     << "\"\nrecorder = \"localhost\"\n[lcm]\ngroup = \"239.255.76.69\"\nport = "
+                        "7670\nttl = 1\n[remote]\nroot = \"\"\nbuild = \"\"\n[sweep]\nhosts = [\""
+                     << net.host(1) << "\", \"" << net.host(2) << "\"]\njobs_per_host = 1\n";
+  const ScriptRun local = Sweep(dir + "/local", dir + "/cache-local");
+  ASSERT_EQ(local.rc, 0) << local.out;
+  const ScriptRun across = Sweep(dir + "/across", dir + "/cache-across", {"--hosts", lab});
+  ASSERT_EQ(across.rc, 0) << across.out;
+  // Every cell ran on one of the lab's hosts (the joblog's Host), and both
+  // hosts took cells; the table is the local one, cell for cell.
+  const auto logs = Joblogs(dir + "/across");
+  ASSERT_EQ(logs.size(), 1u);
+  std::set<std::string> hosts;
+  std::istringstream jl(ReadFile(logs[0]));
+  std::string line;
+  std::getline(jl, line);  // the header
+  int jobs = 0;
+  while (std::getline(jl, line)) {
+    ++jobs;
+    std::istringstream fields(line);
+    std::string seq, host;
+    std::getline(fields, seq, '\t');
+    std::getline(fields, host, '\t');  // Seq, Host, Starttime, ...
+    hosts.insert(host);
+    EXPECT_NE(host.find("netns-login"), std::string::npos) << line;
+  }
+  EXPECT_EQ(jobs, 12);
+  EXPECT_EQ(hosts.size(), 2u) << ReadFile(logs[0]);
+  EXPECT_EQ(ReadFile(dir + "/across/sweep.csv"), ReadFile(dir + "/local/sweep.csv"));
+}
+
+TEST_F(Investigations, ARerunOrAResumedSweepRedoesNothingFinished) {
+  const std::string out = *tmp_ + "/resume", cache = *tmp_ + "/cache-resume";
+  ScriptRun r = Sweep(out, cache);
+  ASSERT_EQ(r.rc, 0) << r.out;
+  EXPECT_NE(r.out.find("12 cells run"), std::string::npos) << r.out;
+  const std::string table = ReadFile(out + "/sweep.csv");
+  // Again: all from the cache, nothing run, the same table.
+  r = Sweep(out, cache);
+  ASSERT_EQ(r.rc, 0) << r.out;
+  EXPECT_NE(r.out.find("0 cells run"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("12 from the cache"), std::string::npos) << r.out;
+  EXPECT_EQ(ReadFile(out + "/sweep.csv"), table);
+  // A sweep stopped part way (three results lost): only those three run.
+  int removed = 0;
+  for (const auto& e : fs::directory_iterator(cache))
+    if (removed < 3 && fs::remove(e.path())) ++removed;
+  r = Sweep(out, cache);
+  ASSERT_EQ(r.rc, 0) << r.out;
+  EXPECT_NE(r.out.find("3 cells run"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("9 from the cache"), std::string::npos) << r.out;
+  EXPECT_EQ(ReadFile(out + "/sweep.csv"), table);
+  // A wider grid runs only its new cells.
+  const ScriptRun wider =
+      Script({SourcePath("scripts/lab"), "sweep", *a_, *b_, "--vary", "dcp.tpob_ft=0.2,0.3,0.4,0.5",
+              "--vary", "arm.upper_boom_ft=20.9,21.5", "--out", out + "-wider", "--cache", cache,
+              "--no-build"},
+             out + "-wider.log");
+  ASSERT_EQ(wider.rc, 0) << wider.out;
+  EXPECT_NE(wider.out.find("4 cells run"), std::string::npos) << wider.out;
+  EXPECT_NE(wider.out.find("12 from the cache"), std::string::npos) << wider.out;
+}
+
+TEST_F(Investigations, AFailedCellIsTriedAgainAndReportedNeverDropped) {
+  const std::string dir = *tmp_ + "/failing";
+  fs::create_directories(dir);
+  const std::string lab = dir + "/lab.toml";
+  std::ofstream(lab)
+      << "[hosts]\noperator_station = \"localhost\"\ndynamics_proc = "
+         "\"localhost\"\nscene_proc = \"localhost\"\nesg_renderer = "
+         "\"localhost\"\nrecorder = \"localhost\"\n[lcm]\ngroup = "
+         "\"239.255.76.69\"\nport = 7670\nttl = 0\n[remote]\nroot = \"\"\nbuild = "
+         "\"\"\n[sweep]\nhosts = [\"netns:rmslab-no-such-host\"]\njobs_per_host = 2\n";
+  const ScriptRun r = Sweep(dir + "/out", dir + "/cache", {"--hosts", lab, "--retries", "1"});
+  EXPECT_EQ(r.rc, 1) << r.out;
+  EXPECT_FALSE(Lines(r.out, "FAILED").empty()) << r.out;
+  EXPECT_NE(r.out.find("trying 12 failed cells again (try 2 of 2)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("rmslab-no-such-host"), std::string::npos) << "the reason is not shown";
+  EXPECT_EQ(Joblogs(dir + "/out").size(), 2u);
+  const auto rows = ReadCsv(dir + "/out/sweep.csv");
+  ASSERT_EQ(rows.size(), 12u) << "a failed cell was dropped from the table";
+  for (const auto& row : rows) {
+    EXPECT_EQ(row.at("status"), "failed");
+    EXPECT_NE(row.at("error"), "");
+  }
+  EXPECT_TRUE(fs::is_empty(dir + "/cache")) << "a failure was cached";
+}
+
+TEST_F(Investigations, ASlurmArrayJobsTasksFillTheCacheAndTheTableFollows) {
+  const std::string out = *tmp_ + "/slurm", cache = *tmp_ + "/cache-slurm";
+  ScriptRun r = Sweep(out, cache, {"--slurm"});
+  ASSERT_EQ(r.rc, 0) << r.out;
+  const std::string job = ReadFile(out + "/sweep.sbatch");
+  EXPECT_NE(job.find("#SBATCH --array=1-12"), std::string::npos) << job;
+  EXPECT_FALSE(fs::exists(out + "/sweep.csv")) << "--slurm ran the cells itself";
+  // Slurm would run each task with its SLURM_ARRAY_TASK_ID: so does the test.
+  for (int task = 12; task >= 1; --task) {
+    const std::string log = out + "/task-" + std::to_string(task) + ".log";
+    testing::Subprocess t({"/bin/sh", out + "/sweep.sbatch"}, log,
+                          {"SLURM_ARRAY_TASK_ID=" + std::to_string(task)});
+    ASSERT_EQ(t.Wait(60), 0) << ReadFile(log);
+    EXPECT_EQ(ReadFile(log).rfind(std::to_string(task) + "\t{\"outcome\"", 0), 0u) << ReadFile(log);
+  }
+  r = Sweep(out, cache);
+  ASSERT_EQ(r.rc, 0) << r.out;
+  EXPECT_NE(r.out.find("12 from the cache"), std::string::npos) << r.out;
+  EXPECT_EQ(ReadCsv(out + "/sweep.csv").size(), 12u);
+}
+
+TEST_F(Investigations, ABadKeyOrValueIsRefusedBeforeAnythingRuns) {
+  struct Case {
+    const char* vary;
+    const char* says;
+  } cases[] = {{"dcp.no_such_key=1,2", "no key 'no_such_key'"},
+               {"dcp.tpob_ft=0.2,-1", "must be > 0"},
+               {"dcp.tpob_ft=0.2,abc", "no TOML value"},
+               {"dcp.tpob_ft", "must be KEY=V1,V2"},
+               {"dcp.tpob_ft=0.2,0.2", "a value given twice"}};
+  for (const Case& c : cases) {
+    const std::string out = *tmp_ + "/bad-" + std::to_string(&c - cases);
+    const ScriptRun r = Script({SourcePath("scripts/lab"), "sweep", *a_, "--vary", c.vary, "--out",
+                                out, "--cache", out + "-cache", "--no-build"},
+                               out + ".log");
+    EXPECT_EQ(r.rc, 2) << c.vary << ": " << r.out;
+    EXPECT_NE(r.out.find(c.says), std::string::npos) << c.vary << ": " << r.out;
+    EXPECT_FALSE(fs::exists(out)) << c.vary << ": a refused sweep left a folder";
+  }
+}
+
+TEST_F(Investigations, ABranchedSessionReproducesItsParentsPrefixWordForWord) {
+  const std::string child = *tmp_ + "/branch";
+  // From 20 s of the autopilot's session (after it acquired), the autopilot flies on.
+  const ScriptRun r =
+      Script({SourcePath("scripts/lab"), "demo", "--no-build", "--from", *a_ + "@20", "--out",
+              child, "--speed", "4", "--lcm-url", testing::UniqueLcmUrl(9400), "--png-every", "0",
+              "--no-video", "--width", "160", "--height", "120"},
+             child + ".log");
+  ASSERT_EQ(r.rc, 0) << r.out;
+  const auto m = nlohmann::json::parse(ReadFile(child + "/manifest.json"));
+  ASSERT_TRUE(m.contains("branch")) << m.dump(2);
+  EXPECT_EQ(m["branch"]["parent"], fs::absolute(*a_).lexically_normal().string());
+  const double rate = 30.0;
+  EXPECT_EQ(m["branch"]["frame"].get<long>(), 600);
+  EXPECT_DOUBLE_EQ(m["branch"]["time_s"].get<double>(), 600 / rate);
+  EXPECT_EQ(m["branch"]["parent_log_sha256"].get<std::string>().size(), 64u);
+  // The branch began where its parent was: past Mode 1, the payload held.
+  const auto s = nlohmann::json::parse(ReadFile(child + "/summary.json"));
+  EXPECT_EQ(s["attempts"][0]["started_in_mode"], 2) << s["attempts"].dump();
+  EXPECT_TRUE(s["docked"].get<bool>());
+  // Re-simulating the child: the parent's prefix word for word, then its own.
+  const ScriptRun resim =
+      Script({testing::BuildPath("tools/rms_resim"), child}, child + "-resim.log");
+  EXPECT_EQ(resim.rc, 0) << resim.out;
+  EXPECT_NE(resim.out.find("601 of 601 frames identical, word for word; the DCP's state at its "
+                           "end is the branch's first state"),
+            std::string::npos)
+      << resim.out;
+  EXPECT_NE(resim.out.find("recorded frames identical, word for word"), std::string::npos)
+      << resim.out;
+  // A branch whose first state is not its parent's state there is caught:
+  // the manifest pointed at another instant.
+  auto moved = m;
+  moved["branch"]["frame"] = 450;
+  std::ofstream(child + "/manifest.json") << moved.dump(2);
+  const ScriptRun wrong =
+      Script({testing::BuildPath("tools/rms_resim"), child}, child + "-wrong.log");
+  EXPECT_EQ(wrong.rc, 1) << wrong.out;
+  EXPECT_NE(wrong.out.find("the branch's first state is not the DCP's state at the end of the "
+                           "prefix"),
+            std::string::npos)
+      << wrong.out;
+  // An instant the parent never reached is refused before anything starts.
+  const ScriptRun late = Script({SourcePath("scripts/lab"), "demo", "--no-build", "--from",
+                                 *a_ + "@f999999", "--out", child + "-late"},
+                                child + "-late.log");
+  EXPECT_EQ(late.rc, 2) << late.out;
+  EXPECT_NE(late.out.find("is not among them"), std::string::npos) << late.out;
+  EXPECT_FALSE(fs::exists(child + "-late"));
+}
+
+}  // namespace
+}  // namespace rms

@@ -1,0 +1,73 @@
+// Configuration keys set on a command line (rms/base/config_settings.h):
+// each setting changes its key alone, exactly; a key the file lacks, a value
+// that is no TOML or of another kind, and a table are refused with the key.
+#include "rms/base/config_settings.h"
+
+#include <gtest/gtest.h>
+
+#include "rms/base/check.h"
+#include "rms/base/config.h"
+#include "rms/base/toml_reader.h"
+
+namespace rms {
+namespace {
+
+std::string DefaultText() { return ReadTextFile(DefaultConfigPath(), "the default configuration"); }
+
+std::string Refusal(const std::vector<ConfigSetting>& s) {
+  try {
+    ApplyConfigSettings(DefaultText(), "rmslab.toml", s);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ConfigSettings, EachSettingChangesItsKeyAloneAndExactly) {
+  const LabConfig before = ParseConfig(DefaultText(), "default");
+  const std::string text =
+      ApplyConfigSettings(DefaultText(), "rmslab.toml",
+                          {{"dcp.tpob_ft", "0.30000000000000004"},
+                           {"arm.upper_boom_ft", "21"},  // an integer for a float key: 21.0
+                           {"arm.base_position_ft", "[1.5, -8.0, 0.25]"},
+                           {"cameras[2].tilt_deg", "[-30, 40.0]"},
+                           {"dcp.tpob_ft", "0.45"}});  // the last of two wins
+  const LabConfig after = ParseConfig(text, "set");
+  EXPECT_EQ(after.dcp.tpob_ft, 0.45);
+  EXPECT_EQ(after.arm.upper_boom_ft, 21.0);
+  EXPECT_EQ(after.arm.p_RoB_R_ft.y(), -8.0);
+  EXPECT_EQ(after.arm.p_RoB_R_ft.z(), 0.25);
+  EXPECT_EQ(after.cameras[2].tilt_min_deg, -30.0);
+  EXPECT_EQ(after.cameras[2].tilt_max_deg, 40.0);
+  // Everything else as it was, to the bit.
+  EXPECT_EQ(after.arm.lower_boom_ft, before.arm.lower_boom_ft);
+  EXPECT_EQ(after.dcp.dock_angle_deg, before.dcp.dock_angle_deg);
+  EXPECT_EQ(after.cameras[1].tilt_min_deg, before.cameras[1].tilt_min_deg);
+  EXPECT_EQ(after.session.frame_rate_hz, before.session.frame_rate_hz);
+  // No settings: the same configuration.
+  EXPECT_EQ(ParseConfig(ApplyConfigSettings(DefaultText(), "x", {}), "x").dcp.dock_angle_deg,
+            before.dcp.dock_angle_deg);
+}
+
+TEST(ConfigSettings, ABadSettingIsRefusedNamingTheKeyAndWhy) {
+  EXPECT_NE(Refusal({{"dcp.no_such", "1"}})
+                .find("--set dcp.no_such: the configuration has no key "
+                      "'no_such'"),
+            std::string::npos);
+  EXPECT_NE(Refusal({{"dcp.tpob_ft", "abc"}}).find("'abc' is no TOML value"), std::string::npos);
+  EXPECT_NE(Refusal({{"dcp.tpob_ft", "\"0.3\""}}).find("the key is a number, the value a string"),
+            std::string::npos);
+  EXPECT_NE(Refusal({{"dcp", "1"}}).find("is a table"), std::string::npos);
+  EXPECT_NE(Refusal({{"cameras[99].tilt_deg", "1"}}).find("'cameras' has no element 99"),
+            std::string::npos);
+  EXPECT_NE(Refusal({{"cameras[x].tilt_deg", "1"}}).find("no index a number"), std::string::npos);
+  EXPECT_THROW(ParseConfigSetting("no_equals"), InputError);
+  EXPECT_THROW(ParseConfigSetting("=1"), InputError);
+  EXPECT_THROW(ParseConfigSetting("a="), InputError);
+  const ConfigSetting s = ParseConfigSetting("dcp.tpob_ft=0.4=x");
+  EXPECT_EQ(s.key, "dcp.tpob_ft");
+  EXPECT_EQ(s.value, "0.4=x");
+}
+
+}  // namespace
+}  // namespace rms
