@@ -349,14 +349,18 @@ void MovingTable(const Bench& b, const FrameVariant& v, std::ostringstream& md) 
 // differently from the default.
 int FrameTable(const Bench& b, int reps, std::ostringstream& md) {
   std::vector<FrameVariant> fv;
-  auto add = [&](std::string name, bool mode_only, bool spheres, bool coherence) {
+  auto add = [&](std::string name, bool mode_only, bool spheres, bool coherence,
+                 bool reuse = true) {
     FrameVariant v;
     v.name = std::move(name);
-    v.options = {
-        .mode_pairs_only = mode_only, .bounding_reject = spheres, .frame_coherence = coherence};
+    v.options = {.mode_pairs_only = mode_only,
+                 .bounding_reject = spheres,
+                 .frame_coherence = coherence,
+                 .reuse_still = reuse};
     fv.push_back(std::move(v));
   };
-  add("the default: mode pairs, bounding spheres and boxes", true, true, false);
+  add("the default: mode pairs, bounding spheres and boxes, still frames kept", true, true, false);
+  add("the default, every still frame evaluated again", true, true, false, false);
   add("the default + frame coherence", true, true, true);
   add("without bounding-volume rejection", true, false, false);
   add("every pair every frame (not only the mode's)", false, true, false);

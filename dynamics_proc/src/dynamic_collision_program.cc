@@ -1,7 +1,9 @@
 #include "rms/dynamics_proc/dynamic_collision_program.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <spdlog/spdlog.h>
@@ -334,6 +336,7 @@ void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* 
                                        Evaluation* out) const {
   RMS_DASSERT(out != prev);
   Evaluation& e = *out;
+  e.scene = Scene();
   e.collisions = 0;
   e.extra_collisions = 0;
   e.ee_bar = {};
@@ -512,8 +515,58 @@ std::uint32_t DynamicCollisionProgram::MoveFinger(double finger) {
   return bits;
 }
 
+namespace {
+// Bit for bit (-0 and 0 differ; a NaN equals the same NaN).
+bool SameBits(double a, double b) {
+  return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
+}
+template <typename Range>
+bool SameBits(const Range& a, const Range& b) {
+  return std::equal(std::begin(a), std::end(a), std::begin(b),
+                    [](double x, double y) { return SameBits(x, y); });
+}
+bool SameBits(const Eigen::Matrix4d& a, const Eigen::Matrix4d& b) {
+  return std::equal(a.data(), a.data() + 16, b.data(),
+                    [](double x, double y) { return SameBits(x, y); });
+}
+bool SameBits(const ArmCommand& a, const ArmCommand& b) {
+  return SameBits(a.angles_deg, b.angles_deg) &&
+         SameBits(a.shoulder_height_ft, b.shoulder_height_ft) && SameBits(a.finger, b.finger);
+}
+}  // namespace
+
+bool DynamicCollisionProgram::SceneKey::operator==(const SceneKey& o) const {
+  return mode == o.mode && docked == o.docked && released == o.released &&
+         SameBits(contact_gap_ft, o.contact_gap_ft) &&
+         SameBits(acquisition_gap_ft, o.acquisition_gap_ft) && SameBits(X_RP_free, o.X_RP_free) &&
+         SameBits(X_S2P, o.X_S2P) && SameBits(X_RP_docked, o.X_RP_docked);
+}
+
+DynamicCollisionProgram::SceneKey DynamicCollisionProgram::Scene() const {
+  SceneKey k;
+  k.mode = status_.mode;
+  k.docked = status_.docked;
+  k.released = released_;
+  k.contact_gap_ft = contact_gap_ft_;
+  k.acquisition_gap_ft = acquisition_gap_ft_;
+  k.X_RP_free = X_RP_free_.matrix();  // the payload, BAR and posts (PlacePayload)
+  k.X_S2P = X_S2P_.matrix();
+  k.X_RP_docked = X_RP_docked_.matrix();
+  return k;
+}
+
 void DynamicCollisionProgram::Respond(const ArmCommand& command) {
   namespace cb = wire::collision_bits;
+  // A still frame: evaluating the slave's own free pose again, in the same
+  // scene, gives what it has (the evaluation is a function of the command
+  // and the scene; with frame coherence, its hints are its own planes,
+  // which decide as they did). The motion test's one evaluation, kept.
+  if (options_.reuse_still && slave_->collisions == 0 && SameBits(command, slave_->cmd) &&
+      slave_->scene == Scene()) {
+    status_.substeps = 1;
+    status_.collisions = 0;
+    return;
+  }
   const std::uint32_t hit = TestMotion(slave_->cmd, command, spare_);
   status_.collisions = hit & ~kTooFast;
   if (!hit) return AcceptSpare();

@@ -10,16 +10,19 @@
 #include <gtest/gtest.h>
 #include <random>
 #include <sstream>
+#include <tuple>
 
 #include "rms/base/check.h"
 #include "rms/base/config.h"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dynamics_proc/dcp_models.h"
 #include "rms/dynamics_proc/dynamic_collision_program.h"
+#include "rms/dynamics_proc/dynamics_proc.h"
 #include "rms/mission/arm_ik.h"
 #include "rms/mission/mission_plan.h"
 #include "rms/operator_station/timeline.h"
 #include "rms/scene_model/scene_model.h"
+#include "rms/sim/random_operator.h"
 #include "rms/wire/checkpoint.h"
 #include "rms/wire/word_blocks.h"
 
@@ -177,6 +180,67 @@ TEST_F(Dcp, TheMissionTimelineAcquiresExtractsAndDocks) {
   EXPECT_TRUE(dcp.status().docked);
   EXPECT_LE(dcp.status().dock_distance_ft, config.dcp.dock_distance_ft);
   EXPECT_LE(dcp.status().dock_angle_deg, config.dcp.dock_angle_deg);
+}
+
+// The encoded DCP frame and telemetry of a frame: every word and field.
+std::vector<std::uint8_t> FrameBytes(const DynamicCollisionProgram& dcp,
+                                     const wire::DcpFrameData& out) {
+  Counters counters;
+  dcp_frame_t f{};
+  wire::PackDcpFrame(out, &f, &counters);
+  dcp_telemetry_t t = MakeTelemetry(dcp.status(), out);
+  std::vector<std::uint8_t> bytes(
+      static_cast<std::size_t>(f.getEncodedSize() + t.getEncodedSize()));
+  f.encode(bytes.data(), 0, f.getEncodedSize());
+  t.encode(bytes.data() + f.getEncodedSize(), 0, t.getEncodedSize());
+  return bytes;
+}
+
+TEST_F(Dcp, AStillFrameKeptGivesTheWordsAndStateOfOneEvaluatedAgain) {
+  // The mission and a random operator, each input held for 1 to 4 frames
+  // (still frames), with resets: with still frames kept and without, with
+  // and without frame coherence, every frame's words and telemetry and the
+  // state every 25 frames are the same, bit for bit.
+  constexpr unsigned kSeed = 20261202;
+  std::printf("seed %u\n", kSeed);
+  std::mt19937 rng(kSeed);
+  std::vector<wire::OperatorInputs> inputs;
+  const operator_station::Timeline tl = operator_station::Timeline::Parse(
+      mission::FormatTimeline(mission::PlanMission(config), ""), "mission", config.inputs);
+  for (double t = 0; t <= tl.end_time(); t += 1.0 / 30.0) {
+    for (int k = std::uniform_int_distribution<int>(1, 4)(rng); k > 0; --k)
+      inputs.push_back(tl.Sample(t));
+  }
+  sim::RandomOperator op(config.inputs, kSeed);
+  for (int f = 0; f < 3000; ++f) {
+    wire::OperatorInputs in = op.Next();
+    in.reset = f % 700 == 350;
+    for (int k = std::uniform_int_distribution<int>(1, 4)(rng); k > 0; --k) inputs.push_back(in);
+  }
+  for (const bool coherence : {false, true}) {
+    DynamicCollisionProgram kept(config, {.frame_coherence = coherence, .reuse_still = true});
+    DynamicCollisionProgram again(config, {.frame_coherence = coherence, .reuse_still = false});
+    long still = 0;
+    for (std::size_t i = 0; i < inputs.size(); ++i) {
+      const ArmCommand before = kept.status().slave;
+      const wire::DcpFrameData a = kept.Step(inputs[i]), b = again.Step(inputs[i]);
+      still += before.angles_deg == kept.status().slave.angles_deg &&
+               before.finger == kept.status().slave.finger && !kept.status().held;
+      ASSERT_EQ(FrameBytes(kept, a), FrameBytes(again, b))
+          << "frame " << i << ", frame coherence " << coherence;
+      const DcpStatus &x = kept.status(), &y = again.status();
+      ASSERT_EQ(std::tie(x.collisions, x.slave_collisions, x.held, x.finger_held, x.substeps,
+                         x.motion_collision, x.too_fast, x.essential_contact),
+                std::tie(y.collisions, y.slave_collisions, y.held, y.finger_held, y.substeps,
+                         y.motion_collision, y.too_fast, y.essential_contact))
+          << "frame " << i << ", frame coherence " << coherence;
+      if (i % 25 == 0) {
+        ASSERT_EQ(kept.SaveState().dump(), again.SaveState().dump())
+            << "frame " << i << ", frame coherence " << coherence;
+      }
+    }
+    EXPECT_GT(still, static_cast<long>(inputs.size() / 3)) << "too few still frames to test";
+  }
 }
 
 TEST_F(Dcp, ACollisionHoldsTheSlaveAtContactAndReleasesIt) {

@@ -1,5 +1,7 @@
 #include "rms/resim/resim.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
@@ -231,7 +233,11 @@ void CheckUntil(const Recording& rec, const Plan& plan, const ResimOptions& opt,
 std::string OpenNewSession(const ResimOptions& opt, const std::string& config_text,
                            ResimResult* result) {
   if (opt.discard) {
-    std::string pattern = (fs::temp_directory_path() / "rmslab-resim-XXXXXX").string();
+    // In memory where the machine has it (/dev/shm): a sweep's cells write
+    // and read their short-lived sessions there (docs/performance.md "Sweeps").
+    const bool shm = std::getenv("TMPDIR") == nullptr && access("/dev/shm", W_OK | X_OK) == 0;
+    std::string pattern =
+        ((shm ? fs::path("/dev/shm") : fs::temp_directory_path()) / "rmslab-resim-XXXXXX").string();
     if (!mkdtemp(pattern.data()))
       throw InputError("cannot make a temporary folder in " + fs::temp_directory_path().string());
     result->out_dir = pattern + "/session";

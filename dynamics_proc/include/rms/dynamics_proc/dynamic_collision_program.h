@@ -165,6 +165,12 @@ struct DcpOptions {
   // tried first (it is part of the checkpoint). Off by default: measured, it
   // costs about as much as it saves (docs/collision.md "Real-time savings").
   bool frame_coherence = false;
+  // A still frame -- the slave's command bit for bit what its accepted pose
+  // was evaluated at, in the same scene (SceneKey), free -- keeps that
+  // evaluation instead of making it again: the same verdicts, planes and
+  // clearance (docs/collision.md "Real-time savings"). False: every frame
+  // evaluates, for comparison.
+  bool reuse_still = true;
 };
 
 class DynamicCollisionProgram {
@@ -212,7 +218,19 @@ class DynamicCollisionProgram {
   double FingerGapFt(double lever) const;
 
  private:
+  // What an evaluation depends on besides its command: the mode, docking,
+  // the finger's clamps in Modes 2 and 3, and where the payload is (free,
+  // held, docked). Compared bit for bit.
+  struct SceneKey {
+    int mode = 0;
+    bool docked = false, released = false;
+    double contact_gap_ft = 0.0, acquisition_gap_ft = 0.0;
+    Eigen::Matrix4d X_RP_free{}, X_S2P{}, X_RP_docked{};
+    bool operator==(const SceneKey& o) const;
+  };
+  SceneKey Scene() const;
   struct Evaluation {
+    SceneKey scene;  // what it was evaluated in
     ArmCommand cmd;
     arm::ArmSinCos words{};
     arm::ArmPose pose{};
