@@ -41,11 +41,10 @@ Slot Find(toml::table* root, const std::string& key, std::string* why) {
     long index = -1;
     if (const auto lb = part.find('['); lb != std::string::npos && part.back() == ']') {
       name = part.substr(0, lb);
-      try {
-        index = std::stol(part.substr(lb + 1, part.size() - lb - 2));
-      } catch (const std::exception&) {
-        index = -2;
-      }
+      const std::string digits = part.substr(lb + 1, part.size() - lb - 2);
+      const bool number = !digits.empty() && digits.size() <= 6 &&
+                          digits.find_first_not_of("0123456789") == std::string::npos;
+      index = number ? std::stol(digits) : -2;
       if (index < 0) {
         *why = "'" + part + "' has no index a number";
         return {};

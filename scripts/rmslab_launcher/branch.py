@@ -3,8 +3,10 @@ one (docs/sessions.md "Branching"). The recorded inputs are re-simulated up
 to the instant, word for word (rms_resim --until), the DCP's state there
 becomes the new session's checkpoint (--restore), and the controls go to
 the pilot of the new session: the autopilot, a timeline or a person."""
+import atexit
 import os
 import re
+import shutil
 import subprocess
 import tempfile
 
@@ -40,11 +42,13 @@ class Branch:
         """The recorded inputs re-simulated up to the instant; the DCP's
         state there, a checkpoint file. Refused (with rms_resim's reason)
         when the recording does not re-simulate word for word up to it."""
-        folder = tempfile.mkdtemp(prefix="rmslab-branch-")
-        self.checkpoint = os.path.join(folder, "branch.json")
+        self.folder = tempfile.mkdtemp(prefix="rmslab-branch-")
+        atexit.register(shutil.rmtree, self.folder, True)  # however the launcher ends
+        self.checkpoint = os.path.join(self.folder, "branch.json")
         r = subprocess.run([binary("tools/rms_resim"), self.parent, "--until", str(self.frame),
                             "--checkpoint-out", self.checkpoint, "--quiet"], capture_output=True, text=True)
         if r.returncode != 0:
+            shutil.rmtree(self.folder, True)
             why = (r.stderr.strip() or r.stdout.strip()).replace("rms_resim: ", "")
             raise LabError(f"--from {self.parent}@f{self.frame}: {why}", 2 if r.returncode == 2 else 1)
         first = r.stdout.splitlines()[0] if r.stdout else ""

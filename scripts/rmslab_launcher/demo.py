@@ -231,9 +231,10 @@ class Demo:
             fields.append(("--channel-suffix", a.channel_suffix))
         if a.timeline:
             fields.append(("--timeline", a.timeline))
-        if a.restore:
+        if a.restore and not self.branch:
             fields.append(("--restore", a.restore))
-        if self.branch:
+        if self.branch:  # its checkpoint is the session's own run/restore.json
+            fields.append(("--restore", os.path.join(self.out, "run", "restore.json")))
             fields += self.branch.manifest_fields()
         if a.subject:
             fields.append(("--subject", a.subject))

@@ -16,13 +16,14 @@ import json
 import os
 import shlex
 import shutil
+import signal
 import subprocess
 import sys
 import threading
 import time
 import tomllib
 
-from . import sweep_table
+from . import sweep_cache, sweep_table
 from .common import BUILD, ROOT, LabError, binary, install_and_build, read_toml, say
 
 CELL = os.path.join(ROOT, "scripts", "sweep-cell")
@@ -33,9 +34,13 @@ SSH_OPTIONS = "ssh -o BatchMode=yes -o ConnectTimeout=5"
 def split_values(text):
     """'0.3,0.4,[1, 2]' -> ['0.3', '0.4', '[1, 2]']: commas inside brackets,
     braces and quotes do not split."""
-    out, depth, quote, cur = [], 0, None, ""
+    out, depth, quote, cur, escaped = [], 0, None, "", False
     for c in text:
-        if quote:
+        if escaped:  # a backslash escape inside a basic string
+            escaped = False
+        elif quote == '"' and c == "\\":
+            escaped = True
+        elif quote:
             quote = None if c == quote else quote
         elif c in "\"'":
             quote = c
@@ -81,24 +86,26 @@ def toml_value(key, text):
 
 
 def set_key(cfg, key, value):
-    """cfg with key ("a.b[2].c") set to value, as rms_resim's --set does
-    (a float key given an integer keeps a float)."""
-    node = cfg
-    parts = key.split(".")
+    """cfg with key ("a.b", "a[2].b", "a.b[1]") set to value, as rms_resim's
+    --set does (base/src/config_settings.cc): an index is decimal digits; a
+    float key (or element) given an integer keeps a float. rms_resim --check
+    has checked the key before this runs."""
+    node, parts = cfg, key.split(".")
     for i, part in enumerate(parts):
         name, index = part, None
         if part.endswith("]") and "[" in part:
             name, _, idx = part[:-1].partition("[")
-            index = int(idx) if idx.isdigit() else None
-        last = i == len(parts) - 1
-        if last and index is None:
-            if isinstance(node.get(name), float) and isinstance(value, int) and not isinstance(value, bool):
+            if not (idx.isascii() and idx.isdigit()):
+                raise LabError(f"--vary {key}: '{part}' has no index a number")
+            index = int(idx)
+        container, slot = (node, name) if index is None else (node[name], index)
+        if i == len(parts) - 1:
+            old = container[slot]
+            if isinstance(old, float) and isinstance(value, int) and not isinstance(value, bool):
                 value = float(value)
-            node[name] = value
+            container[slot] = value
             return
-        node = node[name] if index is None else node[name][index]
-        if last:
-            raise LabError(f"--vary {key}: an element of an array of tables cannot be set whole")
+        node = container[slot]
 
 
 def file_sha256(path):
@@ -110,25 +117,35 @@ def file_sha256(path):
 
 
 def software_version():
+    """rms_resim's --version and the SHA-256 of the binary itself: a tree
+    rebuilt with uncommitted changes has the same --version, not the same binary."""
     r = subprocess.run([binary("tools/rms_resim"), "--version"], capture_output=True, text=True)
     if r.returncode != 0 or not r.stdout.strip():
         raise LabError(f"{binary('tools/rms_resim')} --version failed: build first (drop --no-build)", 1)
-    return r.stdout.strip()
+    return f"{r.stdout.strip()} {file_sha256(binary('tools/rms_resim'))}"
 
 
 class Session:
     def __init__(self, path):
         self.path = os.path.abspath(path)
+        if any(c in self.path for c in "\t\n\r"):
+            raise LabError(f"{path!r}: tabs and line breaks are not allowed in a session's path")
         for f in ("lcmlog", "config.toml"):
             if not os.path.isfile(os.path.join(self.path, f)):
                 raise LabError(f"{path}: not a session folder (no {f})")
+        if os.path.getsize(os.path.join(self.path, "lcmlog")) == 0:
+            raise LabError(f"{path}: its lcmlog is empty: nothing to re-simulate")
+        self.real = os.path.realpath(self.path)
         self.config = read_toml(os.path.join(self.path, "config.toml"), "the session's configuration")
         self.log_sha = file_sha256(os.path.join(self.path, "lcmlog"))
+        self.subject = ""
         try:
             with open(os.path.join(self.path, "manifest.json")) as f:
-                self.subject = json.load(f).get("subject", "")
+                m = json.load(f)
+            if isinstance(m, dict) and isinstance(m.get("subject"), str):
+                self.subject = m["subject"]
         except (OSError, ValueError):
-            self.subject = ""
+            pass
 
 
 def make_cells(sessions, grid, version):
@@ -143,7 +160,7 @@ def make_cells(sessions, grid, version):
                 set_key(cfg, k, toml_value(k, v))
             cfg_sha = hashlib.sha256(json.dumps(cfg, sort_keys=True, separators=(",", ":"),
                                                 default=str).encode()).hexdigest()
-            key = hashlib.sha256(f"{s.log_sha}\n{cfg_sha}\n{version}".encode()).hexdigest()[:32]
+            key = hashlib.sha256(f"{s.log_sha}\n{cfg_sha}\n{version}".encode()).hexdigest()
             cells.append({"index": len(cells) + 1, "session": s.path, "subject": s.subject,
                           "sets": sets, "key": key})
     return cells
@@ -234,69 +251,80 @@ class Progress:
             say(line)
 
 
-def run_parallel(todo, sweep_dir, args, progress, round_no):
-    """The cells through GNU parallel; {index: result} as their lines arrive."""
-    if not shutil.which("parallel"):
-        raise LabError("GNU parallel is not installed: run scripts/install-deps", 1)
+def parallel_command(todo_file, sweep_dir, args, round_no, ncols):
     cell, env_build = CELL, {}
-    cmd = ["parallel", "--will-cite", "--colsep", "\t", "--joblog",
-           os.path.join(sweep_dir, f"joblog-{time.strftime('%Y%m%dT%H%M%S')}-try{round_no}"),
-           "--halt", "never"]
+    cmd = ["parallel", "--will-cite", "--colsep", "\t", "--halt", "never", "--joblog",
+           os.path.join(sweep_dir, f"joblog-{time.strftime('%Y%m%dT%H%M%S')}-try{round_no}")]
     if args.workers:
         logins, cell, remote_build = args.workers
         for login in logins:
             cmd += ["--sshlogin", login]
         cmd += ["--ssh", SSH_OPTIONS]
+        if len(logins) > 1:
+            # A host that does not answer is left out; a cell that fails on
+            # one host is tried on another within the try.
+            cmd += ["--filter-hosts", "--retries", str(len(logins))]
         if remote_build:
             env_build = {"RMSLAB_BUILD": remote_build}
     else:
         cmd += ["--jobs", str(args.jobs or os.cpu_count() or 1)]
     prefix = " ".join(f"{k}={shlex.quote(v)}" for k, v in env_build.items())
-    ncols = 3 + len(todo[0]["sets"])
     template = (f"{prefix} {shlex.quote(cell)} --cell " +
                 " ".join("{%d}" % i for i in range(1, ncols + 1))).strip()
-    cmd.append(template)
+    return cmd + [template, "::::", todo_file]
+
+
+def run_parallel(todo, sweep_dir, args, progress, round_no, on_result):
+    """The cells through GNU parallel; on_result(cell, result) as each line
+    arrives (so a sweep stopped part way keeps what it finished). Returns
+    the lines GNU parallel wrote to its standard error."""
+    if not shutil.which("parallel"):
+        raise LabError("GNU parallel is not installed: run scripts/install-deps", 1)
     todo_file = os.path.join(sweep_dir, "todo.tsv")
     write_manifest(todo_file, todo)
-    cmd += ["::::", todo_file]
-    results = {}
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    by_index = {c["index"]: c for c in todo}
+    cmd = parallel_command(todo_file, sweep_dir, args, round_no, 3 + len(todo[0]["sets"]))
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
     errors = []
-
-    def drain_stderr():
-        for line in proc.stderr:
-            errors.append(line.rstrip())
-    t = threading.Thread(target=drain_stderr, daemon=True)
+    t = threading.Thread(target=lambda: errors.extend(line.rstrip() for line in proc.stderr), daemon=True)
     t.start()
-    for line in proc.stdout:
-        idx, _, payload = line.rstrip("\n").partition("\t")
+    try:
+        for line in proc.stdout:
+            idx, _, payload = line.rstrip("\n").partition("\t")
+            try:
+                res, cell = json.loads(payload), by_index[int(idx)]
+            except (ValueError, KeyError):
+                errors.append(line.rstrip())
+                continue
+            ok = on_result(cell, res)
+            progress.step(ok)
+        proc.wait()
+    except BaseException:
         try:
-            res = json.loads(payload)
-            idx = int(idx)
-        except ValueError:
-            errors.append(line.rstrip())
-            continue
-        ok = "error" not in res
-        results[idx] = res
-        progress.step(ok)
-    proc.wait()
+            os.killpg(proc.pid, signal.SIGTERM)  # parallel and the cells it runs
+        except ProcessLookupError:
+            pass
+        proc.wait()
+        raise
     t.join(timeout=5)
-    return results, errors
+    return errors
 
 
-def write_slurm(sweep_dir, cells, cache_dir, args):
+def write_slurm(sweep_dir, cells, cache_dir, rerun):
     """A Slurm array job: task N runs cell N of cells.tsv and stores its
-    result in the cache; `scripts/lab sweep` run again afterwards makes the
-    table from the cache."""
+    result in the cache; `scripts/lab sweep ... --cached-only` afterwards
+    makes the table from the cache."""
+    if any(c.isspace() for c in sweep_dir + cache_dir + ROOT + BUILD):
+        raise LabError("--slurm: the sweep's folder, the cache and the tree must have no spaces in their "
+                       "paths (#SBATCH lines cannot quote them)")
     script = os.path.join(sweep_dir, "sweep.sbatch")
     manifest = os.path.join(sweep_dir, "cells.tsv")
-    rerun = " ".join(shlex.quote(a) for a in [os.path.join(ROOT, "scripts", "lab"), "sweep"] + args.raw_argv
-                     if a != "--slurm")
     with open(script, "w") as f:
         f.write(f"""#!/bin/sh
 # A Slurm array job of {len(cells)} cells (docs/sessions.md "Sweeps"), written by scripts/lab sweep --slurm.
 #   sbatch {shlex.quote(script)}
-# then, when it has run, the table (every cell from the cache):
+# then, when it has run, the table (every cell from the cache, nothing run here):
 #   {rerun}
 #SBATCH --job-name=rmslab-sweep
 #SBATCH --array=1-{len(cells)}
@@ -306,14 +334,30 @@ export RMSLAB_BUILD={shlex.quote(BUILD)}
 exec {shlex.quote(CELL)} {shlex.quote(manifest)} "$SLURM_ARRAY_TASK_ID" --store {shlex.quote(cache_dir)}
 """)
     os.chmod(script, 0o755)
-    return script, rerun
+    return script
 
 
-def run(argv):
-    """scripts/lab sweep SESSION... --vary KEY=V1,V2,... [--vary ...] [--out DIR]
-    [--hosts LABFILE] [--jobs N] [--slurm] [--cache DIR] [--retries N]: every
-    session re-simulated under every combination of the varied keys; one
-    table (DIR/sweep.csv, DIR/sweep.html) of what each design did."""
+def rerun_command(a, sessions, sweep_dir, cache_dir):
+    """The command that makes the table from the cache: absolute paths, every option spelled out."""
+    argv = [os.path.join(ROOT, "scripts", "lab"), "sweep"] + [s.path for s in sessions]
+    for k, vals in a.grid:
+        argv += ["--vary", f"{k}={','.join(vals)}"]
+    argv += ["--out", sweep_dir, "--cache", cache_dir, "--cached-only", "--no-build"]
+    return " ".join(shlex.quote(x) for x in argv)
+
+
+def check_out(out):
+    """The sweep's folder: an existing writable folder, or one that can be made."""
+    if os.path.exists(out):
+        if not os.path.isdir(out) or not os.access(out, os.W_OK | os.X_OK):
+            raise LabError(f"--out {out}: not a folder this user can write")
+        return
+    parent = os.path.dirname(out) or "."
+    if not os.path.isdir(parent) or not os.access(parent, os.W_OK | os.X_OK):
+        raise LabError(f"--out {out}: its folder {parent} does not exist or cannot be written")
+
+
+def parse_args(argv):
     p = argparse.ArgumentParser(prog="scripts/lab sweep", description=run.__doc__)
     p.add_argument("sessions", nargs="+", metavar="SESSION")
     p.add_argument("--vary", action="append", default=[], metavar="KEY=V1,V2,...",
@@ -322,92 +366,128 @@ def run(argv):
     p.add_argument("--hosts", metavar="LABFILE", help="run the cells on the lab's hosts (GNU parallel over ssh)")
     p.add_argument("--jobs", type=int, default=0, help="cells at once (a host): default its cores")
     p.add_argument("--slurm", action="store_true", help="write a Slurm array job instead of running")
+    p.add_argument("--cached-only", action="store_true",
+                   help="run nothing: the table from the cache (after a Slurm job); a missing cell is a failed row")
     p.add_argument("--cache", help="the results' cache (default sessions/sweep-cache)")
     p.add_argument("--retries", type=int, default=2,
                    help="a failed cell is tried again up to N times (default 2), through GNU parallel again")
-    p.add_argument("--no-build", action="store_true")
+    p.add_argument("--no-build", action="store_true", help="do not install or build first")
     a = p.parse_args(argv)
-    a.raw_argv = argv
     if not a.vary:
         raise LabError("scripts/lab sweep: give at least one --vary KEY=V1,V2,...")
     if a.slurm and a.hosts:
         raise LabError("--slurm and --hosts: give one (a Slurm cluster places the cells itself)")
+    if a.cached_only and (a.slurm or a.hosts):
+        raise LabError("--cached-only runs nothing: not with --slurm or --hosts")
     if a.jobs < 0 or a.retries < 0:
         raise LabError("--jobs and --retries: must not be negative")
-    grid = parse_vary(a.vary)
-    if not a.no_build:
-        install_and_build()
-    if not os.access(binary("tools/rms_resim"), os.X_OK):
-        raise LabError(f"{binary('tools/rms_resim')} is not built (drop --no-build)", 1)
-    sessions = [Session(s) for s in a.sessions]
-    if len({s.path for s in sessions}) != len(sessions):
-        raise LabError("a session is given twice")
-    check_designs(sessions, grid)
-    a.workers = lab_workers(a.hosts, a.jobs) if a.hosts else None
-    version = software_version()
-    cells = make_cells(sessions, grid, version)
-    sweep_dir = os.path.abspath(a.out or os.path.join(
-        ROOT, "sessions", "sweep-" + time.strftime("%Y%m%dT%H%M%SZ", time.gmtime())))
-    cache_dir = os.path.abspath(a.cache or os.path.join(ROOT, "sessions", "sweep-cache"))
-    os.makedirs(sweep_dir, exist_ok=True)
-    os.makedirs(cache_dir, exist_ok=True)
-    write_manifest(os.path.join(sweep_dir, "cells.tsv"), cells)
-    with open(os.path.join(sweep_dir, "sweep.json"), "w") as f:
-        json.dump({"sessions": [s.path for s in sessions], "vary": [{"key": k, "values": v} for k, v in grid],
-                   "software": version, "cache": cache_dir, "cells": len(cells)}, f, indent=2)
-    cached = {c["index"]: c for c in cells if os.path.isfile(os.path.join(cache_dir, c["key"] + ".json"))}
-    todo = [c for c in cells if c["index"] not in cached]
-    say(f"sweep: {len(cells)} cells ({len(sessions)} sessions x "
-        f"{len(cells) // len(sessions)} designs), {len(cached)} already in the cache {cache_dir}")
-    if a.slurm:
-        script, rerun = write_slurm(sweep_dir, cells, cache_dir, a)
-        say(f"Slurm array job written: sbatch {script}")
-        say(f"then, for the table: {rerun}")
-        return 0
-    t0 = time.monotonic()
-    errors, retried = [], 0
-    pending = todo
+    a.grid = parse_vary(a.vary)
+    return a
+
+
+def run_cells(a, cells, todo, sweep_dir, cache):
+    """The missing cells through GNU parallel, tried again up to --retries
+    times; each result cached as it arrives. Returns (tries again, errors)."""
+    errors, retried, pending = [], 0, todo
+
+    def on_result(cell, res):
+        why = sweep_cache.valid_result(res)
+        if why is None:
+            cache.store(cell["key"], res)
+            cell.pop("error", None)
+            return True
+        cell["error"] = res.get("error", why) if isinstance(res, dict) else why
+        return False
+
     for round_no in range(1, a.retries + 2):
         if not pending:
             break
         if round_no > 1:
             retried += len(pending)
             say(f"sweep: trying {len(pending)} failed cells again (try {round_no} of {a.retries + 1})")
-        progress = Progress(len(cells), len(cells) - len(pending))
-        results, errs = run_parallel(pending, sweep_dir, a, progress, round_no)
-        errors += errs
-        progress.show(end=True)
-        still = []
         for c in pending:
-            res = results.get(c["index"])
-            if res is not None and "error" not in res:
-                c.pop("error", None)
-                tmp = os.path.join(cache_dir, c["key"] + ".json.tmp")
-                with open(tmp, "w") as f:
-                    json.dump(res, f)
-                os.replace(tmp, os.path.join(cache_dir, c["key"] + ".json"))
-            else:
-                c["error"] = (res or {}).get("error") or "no result: its job failed before rms_resim ran " \
-                    "(the host? see the joblog and the lines of GNU parallel below)"
-                still.append(c)
-        pending = still
+            c["error"] = ("no result: its job failed before rms_resim ran (a host that did not answer? "
+                          "see the joblog and GNU parallel's lines below)")
+        progress = Progress(len(cells), len(cells) - len(pending))
+        errors += run_parallel(pending, sweep_dir, a, progress, round_no, on_result)
+        progress.show(end=True)
+        pending = [c for c in pending if "error" in c]
+    return retried, errors
+
+
+def run(argv):
+    """scripts/lab sweep SESSION... --vary KEY=V1,V2,... [--vary ...] [--out DIR]
+    [--hosts LABFILE] [--jobs N] [--slurm | --cached-only] [--cache DIR] [--retries N]:
+    every session re-simulated under every combination of the varied keys;
+    one table (DIR/sweep.csv, DIR/sweep.html) of what each design did."""
+    a = parse_args(argv)
+    if not a.no_build:
+        install_and_build()
+    if not os.access(binary("tools/rms_resim"), os.X_OK):
+        raise LabError(f"{binary('tools/rms_resim')} is not built (drop --no-build)", 1)
+    sessions = [Session(s) for s in a.sessions]
+    if len({s.real for s in sessions}) != len(sessions):
+        raise LabError("a session is given twice (the same folder, by another path or a link)")
+    check_designs(sessions, a.grid)
+    a.workers = lab_workers(a.hosts, a.jobs) if a.hosts else None
+    sweep_dir = os.path.abspath(a.out or os.path.join(
+        ROOT, "sessions", "sweep-" + time.strftime("%Y%m%dT%H%M%SZ", time.gmtime())))
+    check_out(sweep_dir)
+    cache = sweep_cache.Cache(a.cache or os.path.join(ROOT, "sessions", "sweep-cache"))
+    version = software_version()
+    cells = make_cells(sessions, a.grid, version)
+    if a.slurm and len(cells) > 1001:
+        say(f"note: {len(cells)} cells: Slurm's default MaxArraySize is 1001 (ask the cluster's admin, "
+            "or sweep a part of the grid at a time)")
+    os.makedirs(sweep_dir, exist_ok=True)
+    if not a.cached_only:
+        write_manifest(os.path.join(sweep_dir, "cells.tsv"), cells)
+        with open(os.path.join(sweep_dir, "sweep.json"), "w") as f:
+            json.dump({"sessions": [s.path for s in sessions],
+                       "vary": [{"key": k, "values": v} for k, v in a.grid],
+                       "software": version, "cache": cache.folder, "cells": len(cells)}, f, indent=2)
+    results = {c["index"]: cache.load(c["key"]) for c in cells}
+    for path, why in cache.unreadable:
+        say(f"cache entry {path}: {why}: its cell is run again")
+    todo = [c for c in cells if results[c["index"]] is None]
+    cached = len(cells) - len(todo)
+    say(f"sweep: {len(cells)} cells ({len(sessions)} sessions x {len(cells) // len(sessions)} designs), "
+        f"{cached} already in the cache {cache.folder}")
+    if a.slurm:
+        rerun = rerun_command(a, sessions, sweep_dir, cache.folder)
+        script = write_slurm(sweep_dir, cells, cache.folder, rerun)
+        say(f"Slurm array job written: sbatch {script}")
+        say(f"then, for the table: {rerun}")
+        return 0
+    t0, retried, errors = time.monotonic(), 0, []
+    if a.cached_only:
+        for c in todo:
+            c["error"] = "not in the cache (has the Slurm job run every task? see DIR/slurm-*.out)"
+    elif todo:
+        try:
+            retried, errors = run_cells(a, cells, todo, sweep_dir, cache)
+        except KeyboardInterrupt:
+            done = sum(1 for c in todo if "error" not in c)
+            say(f"sweep interrupted: the {done} cells finished in this run are in the cache; "
+                "the same command again runs only what is missing")
+            return 130
+        for c in todo:
+            results[c["index"]] = None if "error" in c else cache.load(c["key"])
     elapsed = time.monotonic() - t0
-    rows = []
-    for c in cells:
-        res = None
-        if "error" not in c:
-            try:
-                with open(os.path.join(cache_dir, c["key"] + ".json")) as f:
-                    res = json.load(f)
-            except (OSError, ValueError) as e:
-                c["error"] = f"its cached result cannot be read ({e})"
-        rows.append((c, res))
-    failed = [c for c in cells if "error" in c]
-    csv_path, html_path = sweep_table.write(sweep_dir, grid, rows)
-    ran = len(todo) - len(failed)
+    return finish(a, cells, results, todo, sweep_dir, cached, retried, errors, elapsed)
+
+
+def finish(a, cells, results, todo, sweep_dir, cached, retried, errors, elapsed):
+    """The table, and what ran, what failed and why."""
+    rows = [(c, results[c["index"]]) for c in cells]
+    failed = [c for c, res in rows if res is None]
+    for c in failed:
+        c.setdefault("error", "no result")
+    csv_path, html_path = sweep_table.write(sweep_dir, a.grid, rows)
+    ran = len(todo) - len(failed) if not a.cached_only else 0
     say(f"sweep: {ran} cells run in {elapsed:.2f} s"
-        + (f" ({ran / elapsed:.1f} cells/s)" if ran and elapsed > 0 else "")
-        + f", {len(cached)} from the cache, {retried} tries again, {len(failed)} failed")
+        + (f" ({ran / elapsed:.1f} cells/s)" if ran > 0 and elapsed > 0 else "")
+        + f", {cached} from the cache, {retried} tries again, {len(failed)} failed")
     for c in failed:
         say(f"  cell {c['index']} FAILED ({os.path.basename(c['session'])} "
             f"{' '.join(f'{k}={v}' for k, v in c['sets'])}): {c['error']}")

@@ -46,8 +46,11 @@ def cell_text(v):
 
 
 def changes_text(res):
-    return "; ".join(f"{c['field']}: {cell_text(c['recorded']) or '-'} -> {cell_text(c['now']) or '-'}"
-                     for c in res["changes"])
+    try:
+        return "; ".join(f"{c['field']}: {cell_text(c['recorded']) or '-'} -> {cell_text(c['now']) or '-'}"
+                         for c in res["changes"])
+    except (KeyError, TypeError):
+        return "(not readable)"
 
 
 def header(grid):
@@ -86,11 +89,12 @@ def plots(grid, rows):
         for v in values:
             done = [res for c, res in rows if res is not None and dict(c["sets"])[key] == v]
             n = len(done)
-            docked_at = [r["outcome"]["reached_s"]["docked"] for r in done if r["outcome"]["docked"]]
+            docked_at = [r["outcome"]["reached_s"].get("docked") for r in done if r["outcome"]["docked"]]
+            docked_at = [t for t in docked_at if isinstance(t, (int, float)) and not isinstance(t, bool)]
             per.append({"value": v, "cells": n,
                         "acquired": sum(r["outcome"]["acquired"] for r in done) / n if n else None,
                         "docked": sum(r["outcome"]["docked"] for r in done) / n if n else None,
-                        "docked_at": sum(docked_at) / len(docked_at) if docked_at else None})
+                        "docked_at": round(sum(docked_at) / len(docked_at), 3) if docked_at else None})
         out.append({"key": key, "numeric": all(numeric(v) is not None for v in values), "points": per})
     return out
 
@@ -160,7 +164,7 @@ if (typeof Chart !== 'undefined') plots.forEach((p, i) => {
     data: {labels, datasets: [
       {label: 'acquired (share)', data: p.points.map(q => q.acquired), yAxisID: 'share'},
       {label: 'docked (share)', data: p.points.map(q => q.docked), yAxisID: 'share'},
-      {label: 'docked at (s, mean)', data: p.points.map(q => q.docked_at), yAxisID: 'time',
+      {label: 'docked at (s; mean of the cells that docked)', data: p.points.map(q => q.docked_at), yAxisID: 'time',
        borderDash: [4, 4]}]},
     options: {animation: false, plugins: {title: {display: true, text: p.key}},
       scales: {share: {type: 'linear', min: 0, max: 1, position: 'left', title: {display: true, text: 'share of cells'}},

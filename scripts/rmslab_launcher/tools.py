@@ -42,6 +42,8 @@ def resim(argv):
     if a.out:
         cmd += ["--out", a.out]
     rc = subprocess.run(cmd).returncode
+    if rc == 0 and not a.config and not a.set and not branch_parent_unchanged(a.session):
+        rc = 1
     if rc == 0 and a.video:
         out = a.out or a.session.rstrip("/") + "-resim"
         if not os.path.isdir(out):
@@ -52,6 +54,28 @@ def resim(argv):
             os.replace(video, os.path.join(out, "session.mp4"))
             say(f"video: {os.path.join(out, 'session.mp4')}")
     return rc
+
+
+def branch_parent_unchanged(session):
+    """A branch (docs/sessions.md "Branching"): its parent's log is the one
+    the branch was made from (the manifest's SHA-256). False, said, if not."""
+    from .sweep import file_sha256
+    try:
+        with open(os.path.join(session, "manifest.json")) as f:
+            b = json.load(f).get("branch")
+        want, parent = b["parent_log_sha256"], b["parent"]
+    except (OSError, ValueError, AttributeError, KeyError, TypeError):
+        return True  # no branch (rms_resim has checked what a branch's manifest says)
+    try:
+        now = file_sha256(os.path.join(parent, "lcmlog"))
+    except OSError as e:
+        say(f"the branch's parent log {parent}/lcmlog cannot be read ({e.strerror})")
+        return False
+    if now != want:
+        say(f"the branch's parent {parent} is not the session it was made from: its lcmlog's SHA-256 is "
+            f"{now[:16]}..., the branch's manifest says {str(want)[:16]}...")
+        return False
+    return True
 
 
 def export(argv):

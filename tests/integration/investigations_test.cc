@@ -7,6 +7,7 @@
 // table drawn by a real browser; and a session branched from a recorded
 // instant whose prefix re-simulates word for word. One ctest
 // (integration.investigations): the two sessions are recorded once.
+#include <signal.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -17,6 +18,7 @@
 #include <regex>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include "netns_lab.h"
 #include "subprocess.h"
@@ -221,13 +223,19 @@ TEST_F(Investigations, TheSameSweepAcrossTheNamespaceHostsThroughGnuParallel) {
   fs::create_directories(dir);
   testing::NetnsLab net("sw" + std::to_string(getpid() % 100000), dir, 2);
   ASSERT_TRUE(net.ok()) << ReadFile(dir + "/netns.log");
-  const std::string lab = dir + "/lab.toml";
-  std::ofstream(lab) << "[hosts]\noperator_station = \"" << net.host(1) << "\"\ndynamics_proc = \""
-                     << net.host(2) << "\"\nscene_proc = \"" << net.host(1)
-                     << "\"\nesg_renderer = \"" << net.host(2)
-                     << "\"\nrecorder = \"localhost\"\n[lcm]\ngroup = \"239.255.76.69\"\nport = "
-                        "7670\nttl = 1\n[remote]\nroot = \"\"\nbuild = \"\"\n[sweep]\nhosts = [\""
-                     << net.host(1) << "\", \"" << net.host(2) << "\"]\njobs_per_host = 1\n";
+  // A lab file whose [sweep] runs one cell at a time on each of `hosts`.
+  auto write_lab = [&](const std::string& path, const std::string& hosts) {
+    std::ofstream(path) << "[hosts]\noperator_station = \"" << net.host(1)
+                        << "\"\ndynamics_proc = \"" << net.host(2) << "\"\nscene_proc = \""
+                        << net.host(1) << "\"\nesg_renderer = \"" << net.host(2)
+                        << "\"\nrecorder = \"localhost\"\n[lcm]\ngroup = \"239.255.76.69\"\n"
+                           "port = 7670\nttl = 1\n[remote]\nroot = \"\"\nbuild = \"\"\n"
+                           "[sweep]\nhosts = ["
+                        << hosts << "]\njobs_per_host = 1\n";
+    return path;
+  };
+  const std::string lab =
+      write_lab(dir + "/lab.toml", "\"" + net.host(1) + "\", \"" + net.host(2) + "\"");
   const ScriptRun local = Sweep(dir + "/local", dir + "/cache-local");
   ASSERT_EQ(local.rc, 0) << local.out;
   const ScriptRun across = Sweep(dir + "/across", dir + "/cache-across", {"--hosts", lab});
@@ -253,6 +261,12 @@ TEST_F(Investigations, TheSameSweepAcrossTheNamespaceHostsThroughGnuParallel) {
   EXPECT_EQ(jobs, 12);
   EXPECT_EQ(hosts.size(), 2u) << ReadFile(logs[0]);
   EXPECT_EQ(ReadFile(dir + "/across/sweep.csv"), ReadFile(dir + "/local/sweep.csv"));
+  // A host that does not answer, beside one that does: left out, every cell done.
+  const std::string half =
+      write_lab(dir + "/half.toml", "\"netns:rmslab-no-such-host\", \"" + net.host(1) + "\"");
+  const ScriptRun partly = Sweep(dir + "/partly", dir + "/cache-partly", {"--hosts", half});
+  ASSERT_EQ(partly.rc, 0) << partly.out;
+  EXPECT_EQ(ReadFile(dir + "/partly/sweep.csv"), ReadFile(dir + "/local/sweep.csv"));
 }
 
 TEST_F(Investigations, ARerunOrAResumedSweepRedoesNothingFinished) {
@@ -276,6 +290,16 @@ TEST_F(Investigations, ARerunOrAResumedSweepRedoesNothingFinished) {
   EXPECT_NE(r.out.find("3 cells run"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("9 from the cache"), std::string::npos) << r.out;
   EXPECT_EQ(ReadFile(out + "/sweep.csv"), table);
+  // Two entries spoiled (not JSON; JSON but no result): said, run again.
+  int spoiled = 0;
+  for (const auto& e : fs::directory_iterator(cache)) {
+    if (spoiled < 2) std::ofstream(e.path()) << (spoiled++ == 0 ? "garbage" : "[]");
+  }
+  r = Sweep(out, cache);
+  ASSERT_EQ(r.rc, 0) << r.out;
+  EXPECT_NE(r.out.find("2 cells run"), std::string::npos) << r.out;
+  EXPECT_FALSE(Lines(r.out, "its cell is run again").empty()) << r.out;
+  EXPECT_EQ(ReadFile(out + "/sweep.csv"), table);
   // A wider grid runs only its new cells.
   const ScriptRun wider =
       Script({SourcePath("scripts/lab"), "sweep", *a_, *b_, "--vary", "dcp.tpob_ft=0.2,0.3,0.4,0.5",
@@ -285,6 +309,45 @@ TEST_F(Investigations, ARerunOrAResumedSweepRedoesNothingFinished) {
   ASSERT_EQ(wider.rc, 0) << wider.out;
   EXPECT_NE(wider.out.find("4 cells run"), std::string::npos) << wider.out;
   EXPECT_NE(wider.out.find("12 from the cache"), std::string::npos) << wider.out;
+}
+
+TEST_F(Investigations, ASweepInterruptedKeepsWhatItFinishedAndTheRerunDoesTheRest) {
+  const std::string out = *tmp_ + "/interrupted", cache = *tmp_ + "/cache-interrupted";
+  const std::vector<std::string> argv = {SourcePath("scripts/lab"),
+                                         "sweep",
+                                         *a_,
+                                         *b_,
+                                         "--vary",
+                                         "dcp.tpob_ft=0.2,0.25,0.3,0.35,0.4",
+                                         "--vary",
+                                         "arm.upper_boom_ft=20.5,20.9,21.2,21.5,21.8",
+                                         "--out",
+                                         out,
+                                         "--cache",
+                                         cache,
+                                         "--no-build",
+                                         "--jobs",
+                                         "1"};
+  testing::Subprocess sweep(argv, out + ".log");
+  auto cached = [&] {
+    std::size_t n = 0;
+    if (fs::is_directory(cache))
+      for (const auto& e : fs::directory_iterator(cache)) n += e.path().extension() == ".json";
+    return n;
+  };
+  for (int i = 0; i < 600 && cached() < 3 && sweep.Running(); ++i) usleep(50000);
+  sweep.Signal(SIGINT);
+  EXPECT_EQ(sweep.Wait(60), 130) << ReadFile(out + ".log");
+  const std::string said = ReadFile(out + ".log");
+  EXPECT_NE(said.find("sweep interrupted: the "), std::string::npos) << said;
+  const std::size_t kept = cached();
+  ASSERT_GE(kept, 3u) << said;
+  ASSERT_LT(kept, 50u) << "it ran to the end before the interruption: " << said;
+  const ScriptRun rest = Script(argv, out + "-rest.log");
+  ASSERT_EQ(rest.rc, 0) << rest.out;
+  EXPECT_NE(rest.out.find(std::to_string(50 - kept) + " cells run"), std::string::npos)
+      << kept << " were kept: " << rest.out;
+  EXPECT_NE(rest.out.find(std::to_string(kept) + " from the cache"), std::string::npos) << rest.out;
 }
 
 TEST_F(Investigations, AFailedCellIsTriedAgainAndReportedNeverDropped) {
@@ -319,6 +382,12 @@ TEST_F(Investigations, ASlurmArrayJobsTasksFillTheCacheAndTheTableFollows) {
   const std::string job = ReadFile(out + "/sweep.sbatch");
   EXPECT_NE(job.find("#SBATCH --array=1-12"), std::string::npos) << job;
   EXPECT_FALSE(fs::exists(out + "/sweep.csv")) << "--slurm ran the cells itself";
+  EXPECT_NE(r.out.find("--cached-only"), std::string::npos) << r.out;
+  // Before the job has run, the table says every cell is missing and runs none.
+  r = Sweep(out, cache, {"--cached-only"});
+  EXPECT_EQ(r.rc, 1) << r.out;
+  EXPECT_NE(r.out.find("not in the cache"), std::string::npos) << r.out;
+  EXPECT_TRUE(Joblogs(out).empty()) << "--cached-only ran cells";
   // Slurm would run each task with its SLURM_ARRAY_TASK_ID: so does the test.
   for (int task = 12; task >= 1; --task) {
     const std::string log = out + "/task-" + std::to_string(task) + ".log";
@@ -327,10 +396,11 @@ TEST_F(Investigations, ASlurmArrayJobsTasksFillTheCacheAndTheTableFollows) {
     ASSERT_EQ(t.Wait(60), 0) << ReadFile(log);
     EXPECT_EQ(ReadFile(log).rfind(std::to_string(task) + "\t{\"outcome\"", 0), 0u) << ReadFile(log);
   }
-  r = Sweep(out, cache);
+  r = Sweep(out, cache, {"--cached-only"});
   ASSERT_EQ(r.rc, 0) << r.out;
   EXPECT_NE(r.out.find("12 from the cache"), std::string::npos) << r.out;
   EXPECT_EQ(ReadCsv(out + "/sweep.csv").size(), 12u);
+  EXPECT_TRUE(Joblogs(out).empty());
 }
 
 TEST_F(Investigations, ABadKeyOrValueIsRefusedBeforeAnythingRuns) {
@@ -387,6 +457,7 @@ TEST_F(Investigations, ABranchedSessionReproducesItsParentsPrefixWordForWord) {
   // the manifest pointed at another instant.
   auto moved = m;
   moved["branch"]["frame"] = 450;
+  moved["branch"]["time_s"] = 450 / rate;
   std::ofstream(child + "/manifest.json") << moved.dump(2);
   const ScriptRun wrong =
       Script({testing::BuildPath("tools/rms_resim"), child}, child + "-wrong.log");
@@ -395,6 +466,29 @@ TEST_F(Investigations, ABranchedSessionReproducesItsParentsPrefixWordForWord) {
                            "prefix"),
             std::string::npos)
       << wrong.out;
+  for (const auto& [field, value, says] :
+       {std::tuple{"frame", nlohmann::json("abc"), "'branch.frame' is not a DCP frame"},
+        std::tuple{"frame", nlohmann::json(-1), "'branch.frame' is not a DCP frame"},
+        std::tuple{"time_s", nlohmann::json(3.0),
+                   "'branch.time_s' is not its frame's session time"},
+        std::tuple{"parent", nlohmann::json(*tmp_ + "/nowhere"), "cannot be re-simulated"}}) {
+    auto bad = m;
+    bad["branch"][field] = value;
+    std::ofstream(child + "/manifest.json") << bad.dump(2);
+    const ScriptRun t = Script({testing::BuildPath("tools/rms_resim"), child}, child + "-bad.log");
+    EXPECT_EQ(t.rc, 1) << field << ": " << t.out;
+    EXPECT_NE(t.out.find(says), std::string::npos) << field << ": " << t.out;
+  }
+  // The parent's log changed since: scripts/lab resim says so.
+  std::ofstream(child + "/manifest.json") << m.dump(2);
+  {
+    std::ofstream(*a_ + "/lcmlog", std::ios::app) << "x";
+    const ScriptRun t =
+        Script({SourcePath("scripts/lab"), "resim", child, "--no-build"}, child + "-changed.log");
+    EXPECT_EQ(t.rc, 1) << t.out;
+    EXPECT_NE(t.out.find("is not the session it was made from"), std::string::npos) << t.out;
+    fs::resize_file(*a_ + "/lcmlog", fs::file_size(*a_ + "/lcmlog") - 1);
+  }
   // An instant the parent never reached is refused before anything starts.
   const ScriptRun late = Script({SourcePath("scripts/lab"), "demo", "--no-build", "--from",
                                  *a_ + "@f999999", "--out", child + "-late"},

@@ -60,7 +60,13 @@ TEST(ConfigSettings, ABadSettingIsRefusedNamingTheKeyAndWhy) {
   EXPECT_NE(Refusal({{"dcp", "1"}}).find("is a table"), std::string::npos);
   EXPECT_NE(Refusal({{"cameras[99].tilt_deg", "1"}}).find("'cameras' has no element 99"),
             std::string::npos);
-  EXPECT_NE(Refusal({{"cameras[x].tilt_deg", "1"}}).find("no index a number"), std::string::npos);
+  for (const char* k : {"cameras[x].tilt_deg", "cameras[+0].tilt_deg", "cameras[0x0].tilt_deg",
+                        "cameras[ 0].tilt_deg", "cameras[].tilt_deg", "cameras[-1].tilt_deg"})
+    EXPECT_NE(Refusal({{k, "[-30, 40]"}}).find("no index a number"), std::string::npos) << k;
+  // An element of an array of numbers is a number.
+  const LabConfig c = ParseConfig(
+      ApplyConfigSettings(DefaultText(), "x", {{"arm.base_position_ft[1]", "-8"}}), "x");
+  EXPECT_EQ(c.arm.p_RoB_R_ft.y(), -8.0);
   EXPECT_THROW(ParseConfigSetting("no_equals"), InputError);
   EXPECT_THROW(ParseConfigSetting("=1"), InputError);
   EXPECT_THROW(ParseConfigSetting("a="), InputError);

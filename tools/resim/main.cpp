@@ -101,6 +101,7 @@ int main(int argc, char** argv) {
         "identical%s\n",
         r.frames, r.seconds, r.frames / std::max(r.seconds, 1e-9), r.identical, r.compared,
         r.first_difference.empty() ? ", word for word" : "");
+    if (!r.branch_note.empty()) std::printf("%s\n", r.branch_note.c_str());
     std::printf(
         "timing: %.4f s in all (%.4f s reading the log, %.4f s running the DCP); the session "
         "lasted %.1f s of wall time: "
@@ -113,7 +114,6 @@ int main(int argc, char** argv) {
                   r.states_checked);
     }
     if (!r.note.empty()) std::printf("note: %s\n", r.note.c_str());
-    if (!r.branch_note.empty()) std::printf("%s\n", r.branch_note.c_str());
     if (!r.log_note.empty()) std::printf("note: %s\n", r.log_note.c_str());
     if (!r.first_difference.empty())
       std::printf("first difference: %s\n", r.first_difference.c_str());

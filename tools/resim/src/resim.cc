@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -173,6 +174,43 @@ void CompareWithRecording(const Recording& rec, std::size_t first, long until_fr
 // recorded session re-simulated up to the instant, word for word, and the
 // DCP's state there against the branch's first logged state. Nothing when
 // the session is no branch.
+// The manifest's "branch", checked: its parent (a path) and frame (a DCP
+// frame, an integer >= 0); "" or why it is not usable.
+std::string ReadBranch(const nlohmann::json& b, ResimOptions* parent) {
+  if (!b.is_object()) return "the manifest's 'branch' is not an object";
+  if (!b.contains("parent") || !b["parent"].is_string() || b["parent"].get<std::string>().empty())
+    return "the manifest's 'branch.parent' is not a session's path";
+  if (!b.contains("frame") || !b["frame"].is_number_integer() || b["frame"].get<long>() < 0)
+    return "the manifest's 'branch.frame' is not a DCP frame (an integer >= 0)";
+  parent->session = b["parent"].get<std::string>();
+  parent->until_frame = b["frame"].get<long>();
+  if (b.contains("time_s")) {
+    double rate = 0;
+    try {
+      rate = LoadConfig((fs::path(parent->session) / "config.toml").string()).session.frame_rate_hz;
+    } catch (const std::exception&) {
+      return "";  // the prefix's own run says what is wrong with the parent
+    }
+    if (!b["time_s"].is_number() ||
+        std::abs(b["time_s"].get<double>() - parent->until_frame / rate) > 1e-6)
+      return "the manifest's 'branch.time_s' is not its frame's session time";
+  }
+  return "";
+}
+
+// "" when the prefix re-simulated word for word and its end state is the
+// branch's first logged state; else why not.
+std::string PrefixAgrees(const Recording& rec, const ResimResult& p) {
+  if (!p.first_difference.empty())
+    return "the prefix differs from its recording: " + p.first_difference;
+  if (rec.states.empty())
+    return "the branch's log holds no RMS_DCP_STATE to check its start against";
+  if (wire::ParseCheckpoint(rec.states.front().m.checkpoint, "RMS_DCP_STATE").dcp !=
+      wire::ParseCheckpoint(p.checkpoint_text, "the prefix").dcp)
+    return "the branch's first state is not the DCP's state at the end of the prefix";
+  return "";
+}
+
 void CheckBranchPrefix(const fs::path& session, const Recording& rec, ResimResult* result) {
   nlohmann::json m;
   try {
@@ -180,32 +218,26 @@ void CheckBranchPrefix(const fs::path& session, const Recording& rec, ResimResul
   } catch (const std::exception&) {
     return;  // no manifest, or none readable: no branch to check
   }
-  if (!m.contains("branch") || !m["branch"].is_object()) return;
-  const auto& b = m["branch"];
+  if (!m.is_object() || !m.contains("branch")) return;
   ResimOptions popt;
-  popt.session = b.value("parent", "");
-  popt.until_frame = b.value("frame", -1L);
+  std::string why = ReadBranch(m["branch"], &popt);
   const std::string prefix =
-      "DCP frames up to " + std::to_string(popt.until_frame) + " of " + popt.session;
+      why.empty() ? "DCP frames up to " + std::to_string(popt.until_frame) + " of " + popt.session
+                  : "";
   ResimResult p;
-  try {
-    p = Resimulate(popt);
-  } catch (const InputError& e) {
-    throw InputError("the branch's prefix (" + prefix + ") cannot be re-simulated: " + e.what());
+  if (why.empty()) {
+    try {
+      p = Resimulate(popt);
+    } catch (const std::exception& e) {
+      why = std::string("it cannot be re-simulated: ") + e.what();
+    }
   }
+  if (why.empty()) why = PrefixAgrees(rec, p);
   result->prefix_frames = p.compared;
   result->prefix_identical = p.identical;
-  std::string why;
-  if (!p.first_difference.empty()) {
-    why = "the prefix differs from its recording: " + p.first_difference;
-  } else if (rec.states.empty()) {
-    why = "the branch's log holds no RMS_DCP_STATE to check its start against";
-  } else if (wire::ParseCheckpoint(rec.states.front().m.checkpoint, "RMS_DCP_STATE").dcp !=
-             wire::ParseCheckpoint(p.checkpoint_text, "the prefix").dcp) {
-    why = "the branch's first state is not the DCP's state at the end of the prefix";
-  }
   if (!why.empty()) {
-    result->first_difference = "the branch's prefix (" + prefix + "): " + why;
+    result->first_difference =
+        "the branch's prefix" + (prefix.empty() ? std::string() : " (" + prefix + ")") + ": " + why;
     result->branch_note = result->first_difference;
     return;
   }
