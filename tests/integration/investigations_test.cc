@@ -224,7 +224,10 @@ TEST_F(Investigations, TheSameSweepAcrossTheNamespaceHostsThroughGnuParallel) {
   testing::NetnsLab net("sw" + std::to_string(getpid() % 100000), dir, 2);
   ASSERT_TRUE(net.ok()) << ReadFile(dir + "/netns.log");
   // A lab file whose [sweep] runs one cell at a time on each of `hosts`.
-  auto write_lab = [&](const std::string& path, const std::string& hosts) {
+  auto write_lab = [&](const std::string& path, const std::vector<std::string>& list) {
+    std::string hosts;
+    for (const std::string& h : list)
+      hosts.append(hosts.empty() ? "" : ", ").append(nlohmann::json(h).dump());
     std::ofstream(path) << "[hosts]\noperator_station = \"" << net.host(1)
                         << "\"\ndynamics_proc = \"" << net.host(2) << "\"\nscene_proc = \""
                         << net.host(1) << "\"\nesg_renderer = \"" << net.host(2)
@@ -234,8 +237,7 @@ TEST_F(Investigations, TheSameSweepAcrossTheNamespaceHostsThroughGnuParallel) {
                         << hosts << "]\njobs_per_host = 1\n";
     return path;
   };
-  const std::string lab =
-      write_lab(dir + "/lab.toml", "\"" + net.host(1) + "\", \"" + net.host(2) + "\"");
+  const std::string lab = write_lab(dir + "/lab.toml", {net.host(1), net.host(2)});
   const ScriptRun local = Sweep(dir + "/local", dir + "/cache-local");
   ASSERT_EQ(local.rc, 0) << local.out;
   const ScriptRun across = Sweep(dir + "/across", dir + "/cache-across", {"--hosts", lab});
@@ -263,7 +265,7 @@ TEST_F(Investigations, TheSameSweepAcrossTheNamespaceHostsThroughGnuParallel) {
   EXPECT_EQ(ReadFile(dir + "/across/sweep.csv"), ReadFile(dir + "/local/sweep.csv"));
   // A host that does not answer, beside one that does: left out, every cell done.
   const std::string half =
-      write_lab(dir + "/half.toml", "\"netns:rmslab-no-such-host\", \"" + net.host(1) + "\"");
+      write_lab(dir + "/half.toml", {"netns:rmslab-no-such-host", net.host(1)});
   const ScriptRun partly = Sweep(dir + "/partly", dir + "/cache-partly", {"--hosts", half});
   ASSERT_EQ(partly.rc, 0) << partly.out;
   EXPECT_EQ(ReadFile(dir + "/partly/sweep.csv"), ReadFile(dir + "/local/sweep.csv"));
