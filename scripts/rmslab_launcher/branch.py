@@ -26,6 +26,7 @@ class Branch:
         if not m:
             raise LabError(f"--from '{text}': must be SESSION@TIME (seconds, e.g. sessions/X@20.5) "
                            f"or SESSION@fFRAME (a DCP frame, e.g. sessions/X@f600)")
+        self.text = text
         self.parent = os.path.abspath(m.group("session"))
         for f in ("lcmlog", "config.toml", "manifest.json"):
             if not os.path.isfile(os.path.join(self.parent, f)):
@@ -50,10 +51,15 @@ class Branch:
         if r.returncode != 0:
             shutil.rmtree(self.folder, True)
             why = (r.stderr.strip() or r.stdout.strip()).replace("rms_resim: ", "")
-            raise LabError(f"--from {self.parent}@f{self.frame}: {why}", 2 if r.returncode == 2 else 1)
+            raise LabError(f"--from {self.text} (DCP frame {self.frame}): {why}", 2 if r.returncode == 2 else 1)
         first = r.stdout.splitlines()[0] if r.stdout else ""
         say(f"branch: {self.parent} re-simulated up to DCP frame {self.frame} ({self.time_s:.2f} s): {first}")
         return self.checkpoint
+
+    def cleanup(self):
+        """The temporary checkpoint, once the session has its own copy (run/restore.json)."""
+        if self.checkpoint:
+            shutil.rmtree(os.path.dirname(self.checkpoint), True)
 
     def manifest_fields(self):
         return [("--branch-of", self.parent), ("--branch-frame", str(self.frame)),

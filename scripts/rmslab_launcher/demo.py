@@ -465,6 +465,8 @@ def run(argv, command_line):
     session.claim_address(d.url, a.channel_suffix, a.share_network, str(d.hosts["recorder"]))
     session.probe_network(d.hosts["recorder"], d.url, a.channel_suffix, a.share_network)
     d.make_session()
+    if d.branch:
+        d.branch.cleanup()
 
     def fly():
         d.start()

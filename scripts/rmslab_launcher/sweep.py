@@ -10,6 +10,7 @@ scripts/sweep-cell: rms_resim SESSION --set KEY=VALUE... --discard
 hash and the software's version, so a rerun does only what is missing.
 """
 import argparse
+import contextlib
 import hashlib
 import itertools
 import json
@@ -222,7 +223,7 @@ def lab_workers(labfile, jobs):
         else:  # ssh:[USER@]HOST (the reader allows nothing else)
             logins.append(f"{n}{h[4:]}")
     remote_root = lab["remote_root"] or ROOT
-    return logins, os.path.join(remote_root, "scripts", "sweep-cell"), lab["remote_build"]
+    return logins, os.path.join(remote_root, "scripts", "sweep-cell"), lab["remote_build"], per_host
 
 
 class Progress:
@@ -254,12 +255,14 @@ class Progress:
 def parallel_command(todo_file, sweep_dir, args, round_no, ncols):
     cell, env_build = CELL, {}
     cmd = ["parallel", "--will-cite", "--colsep", "\t", "--halt", "never", "--joblog",
-           os.path.join(sweep_dir, f"joblog-{time.strftime('%Y%m%dT%H%M%S')}-try{round_no}")]
+           os.path.join(sweep_dir, f"joblog-{time.strftime('%Y%m%dT%H%M%S')}-{os.getpid()}-try{round_no}")]
     if args.workers:
-        logins, cell, remote_build = args.workers
+        logins, cell, remote_build, per_host = args.workers
         for login in logins:
             cmd += ["--sshlogin", login]
         cmd += ["--ssh", SSH_OPTIONS]
+        if per_host > 0:  # --filter-hosts would replace the logins' N/ with each host's cores
+            cmd += ["--jobs", str(per_host)]
         if len(logins) > 1:
             # A host that does not answer is left out; a cell that fails on
             # one host is tried on another within the try.
@@ -280,7 +283,7 @@ def run_parallel(todo, sweep_dir, args, progress, round_no, on_result):
     the lines GNU parallel wrote to its standard error."""
     if not shutil.which("parallel"):
         raise LabError("GNU parallel is not installed: run scripts/install-deps", 1)
-    todo_file = os.path.join(sweep_dir, "todo.tsv")
+    todo_file = os.path.join(sweep_dir, f"todo-{os.getpid()}.tsv")
     write_manifest(todo_file, todo)
     by_index = {c["index"]: c for c in todo}
     cmd = parallel_command(todo_file, sweep_dir, args, round_no, 3 + len(todo[0]["sets"]))
@@ -301,14 +304,28 @@ def run_parallel(todo, sweep_dir, args, progress, round_no, on_result):
             progress.step(ok)
         proc.wait()
     except BaseException:
-        try:
-            os.killpg(proc.pid, signal.SIGTERM)  # parallel and the cells it runs
-        except ProcessLookupError:
-            pass
-        proc.wait()
+        stop_parallel(proc)
         raise
+    finally:
+        with contextlib.suppress(OSError):
+            os.remove(todo_file)
     t.join(timeout=5)
     return errors
+
+
+def stop_parallel(proc):
+    """GNU parallel stopped with the cells it runs: its SIGINT (it sends its
+    --termseq to each job's process group; a job on another host ends when
+    its login does), then SIGKILL to what is left of its group."""
+    with contextlib.suppress(ProcessLookupError):
+        proc.send_signal(signal.SIGINT)
+    try:
+        proc.wait(timeout=10)
+    except subprocess.TimeoutExpired:
+        pass
+    with contextlib.suppress(ProcessLookupError, PermissionError):
+        os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait()
 
 
 def write_slurm(sweep_dir, cells, cache_dir, rerun):
@@ -347,14 +364,17 @@ def rerun_command(a, sessions, sweep_dir, cache_dir):
 
 
 def check_out(out):
-    """The sweep's folder: an existing writable folder, or one that can be made."""
+    """The sweep's folder: an existing writable folder, or one that can be
+    made (its nearest existing folder writable)."""
     if os.path.exists(out):
         if not os.path.isdir(out) or not os.access(out, os.W_OK | os.X_OK):
             raise LabError(f"--out {out}: not a folder this user can write")
         return
-    parent = os.path.dirname(out) or "."
+    parent = os.path.dirname(out)
+    while parent and not os.path.exists(parent):
+        parent = os.path.dirname(parent)
     if not os.path.isdir(parent) or not os.access(parent, os.W_OK | os.X_OK):
-        raise LabError(f"--out {out}: its folder {parent} does not exist or cannot be written")
+        raise LabError(f"--out {out}: cannot be made ({parent} is not a folder this user can write)")
 
 
 def parse_args(argv):
@@ -415,11 +435,38 @@ def run_cells(a, cells, todo, sweep_dir, cache):
     return retried, errors
 
 
+class Interrupted(Exception):
+    def __init__(self, signum):
+        super().__init__(signal.Signals(signum).name)
+        self.signum, self.name = signum, signal.Signals(signum).name
+
+
+@contextlib.contextmanager
+def stopped_by_signals():
+    """Ctrl-C, SIGTERM and SIGHUP end the cells' run the same way (Interrupted)."""
+    def stop(signum, _frame):
+        raise Interrupted(signum)
+    old = {sig: signal.signal(sig, stop) for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
+    try:
+        yield
+    finally:
+        for sig, h in old.items():
+            signal.signal(sig, h)
+
+
 def run(argv):
     """scripts/lab sweep SESSION... --vary KEY=V1,V2,... [--vary ...] [--out DIR]
     [--hosts LABFILE] [--jobs N] [--slurm | --cached-only] [--cache DIR] [--retries N]:
     every session re-simulated under every combination of the varied keys;
     one table (DIR/sweep.csv, DIR/sweep.html) of what each design did."""
+    try:
+        return run_sweep(argv)
+    except KeyboardInterrupt:
+        say("sweep interrupted before any cell ran")
+        return 130
+
+
+def run_sweep(argv):
     a = parse_args(argv)
     if not a.no_build:
         install_and_build()
@@ -433,7 +480,8 @@ def run(argv):
     sweep_dir = os.path.abspath(a.out or os.path.join(
         ROOT, "sessions", "sweep-" + time.strftime("%Y%m%dT%H%M%SZ", time.gmtime())))
     check_out(sweep_dir)
-    cache = sweep_cache.Cache(a.cache or os.path.join(ROOT, "sessions", "sweep-cache"))
+    cache = sweep_cache.Cache(a.cache or os.path.join(ROOT, "sessions", "sweep-cache"),
+                              must_exist=a.cached_only)
     version = software_version()
     cells = make_cells(sessions, a.grid, version)
     if a.slurm and len(cells) > 1001:
@@ -447,11 +495,14 @@ def run(argv):
                        "vary": [{"key": k, "values": v} for k, v in a.grid],
                        "software": version, "cache": cache.folder, "cells": len(cells)}, f, indent=2)
     results = {c["index"]: cache.load(c["key"]) for c in cells}
+    spoiled = {p: why for p, why in cache.unreadable}
     for path, why in cache.unreadable:
-        say(f"cache entry {path}: {why}: its cell is run again")
+        say(f"cache entry {path}: {why}: " +
+            ("not used" if a.cached_only else "its cell is run again"))
     todo = [c for c in cells if results[c["index"]] is None]
     cached = len(cells) - len(todo)
-    say(f"sweep: {len(cells)} cells ({len(sessions)} sessions x {len(cells) // len(sessions)} designs), "
+    n_s, n_d = len(sessions), len(cells) // len(sessions)
+    say(f"sweep: {len(cells)} cells ({n_s} session{'s' * (n_s != 1)} x {n_d} design{'s' * (n_d != 1)}), "
         f"{cached} already in the cache {cache.folder}")
     if a.slurm:
         rerun = rerun_command(a, sessions, sweep_dir, cache.folder)
@@ -462,15 +513,18 @@ def run(argv):
     t0, retried, errors = time.monotonic(), 0, []
     if a.cached_only:
         for c in todo:
-            c["error"] = "not in the cache (has the Slurm job run every task? see DIR/slurm-*.out)"
+            why = spoiled.get(cache.path(c["key"]))
+            c["error"] = (f"its cache entry is not usable ({why}): run its Slurm task again" if why else
+                          "not in the cache (has the Slurm job run every task? see DIR/slurm-*.out)")
     elif todo:
         try:
-            retried, errors = run_cells(a, cells, todo, sweep_dir, cache)
-        except KeyboardInterrupt:
+            with stopped_by_signals():
+                retried, errors = run_cells(a, cells, todo, sweep_dir, cache)
+        except Interrupted as e:
             done = sum(1 for c in todo if "error" not in c)
-            say(f"sweep interrupted: the {done} cells finished in this run are in the cache; "
+            say(f"sweep interrupted ({e.name}): the {done} cells finished in this run are in the cache; "
                 "the same command again runs only what is missing")
-            return 130
+            return 128 + e.signum
         for c in todo:
             results[c["index"]] = None if "error" in c else cache.load(c["key"])
     elapsed = time.monotonic() - t0

@@ -10,33 +10,61 @@ import tempfile
 
 from .common import LabError
 
-# What a cell's result (rms_resim --result-json) holds, with the kinds the table reads.
-REQUIRED = {"outcome": dict, "recorded_outcome": dict, "changes": list, "frames_identical": int,
-            "frames_compared": int}
-OUTCOME = {"acquired": bool, "docked": bool, "reached_s": dict}
+def _number(x):
+    return (isinstance(x, (int, float)) and not isinstance(x, bool)) or x is None
+
+
+def _integer(x):
+    return type(x) is int or x is None  # noqa: E721 (a bool is no integer here)
+
+
+def _outcome_why(o, name):
+    if not isinstance(o, dict):
+        return f"'{name}' is not an object"
+    checks = [("acquired", lambda x: type(x) is bool), ("docked", lambda x: type(x) is bool),  # noqa: E721
+              ("final_mode", _integer), ("collisions", _integer), ("held_frames", _integer),
+              ("reached_s", lambda x: isinstance(x, dict) and all(_number(v) for v in x.values())),
+              ("phase_durations_s",
+               lambda x: x is None or (isinstance(x, dict) and all(_number(v) for v in x.values()))),
+              ("docking", lambda x: x is None or (isinstance(x, dict) and all(_number(v) for v in x.values())))]
+    for key, ok in checks:
+        if key not in o or not ok(o[key]):
+            return f"'{name}.{key}' is missing or of the wrong kind"
+    return None
 
 
 def valid_result(res):
-    """None when res is a cell's result, else why not."""
+    """None when res is a cell's result (rms_resim --result-json; every
+    field the table reads, of its kind), else why not."""
     if not isinstance(res, dict):
         return "not a JSON object"
     if "error" in res:
         return f"a failure ({res['error']})"
-    for key, kind in REQUIRED.items():
-        if not isinstance(res.get(key), kind):
-            return f"no '{key}'"
-    for part in ("outcome", "recorded_outcome"):
-        for key, kind in OUTCOME.items():
-            if not isinstance(res[part].get(key), kind):
-                return f"no '{part}.{key}'"
+    for name in ("outcome", "recorded_outcome"):
+        why = _outcome_why(res.get(name), name)
+        if why:
+            return why
+    for name in ("frames_identical", "frames_compared"):
+        if type(res.get(name)) is not int:  # noqa: E721
+            return f"'{name}' is missing or not an integer"
+    changes = res.get("changes")
+    if not isinstance(changes, list) or not all(isinstance(c, dict) and isinstance(c.get("field"), str)
+                                                for c in changes):
+        return "'changes' is missing or not a list of changes"
+    for name in ("first_divergence", "first_difference"):
+        d = res.get(name)
+        if d is not None and not (isinstance(d, dict) and _integer(d.get("frame")) and _number(d.get("time_s"))):
+            return f"'{name}' is of the wrong kind"
     if "first_divergence" not in res:
-        return "no 'first_divergence'"
+        return "'first_divergence' is missing"
     return None
 
 
 class Cache:
-    def __init__(self, folder):
+    def __init__(self, folder, must_exist=False):
         self.folder = os.path.abspath(folder)
+        if must_exist and not os.path.isdir(self.folder):
+            raise LabError(f"--cache {folder}: no such folder (--cached-only reads an existing cache)")
         try:
             os.makedirs(self.folder, exist_ok=True)
             fd, probe = tempfile.mkstemp(dir=self.folder, prefix=".probe-")
@@ -57,8 +85,8 @@ class Cache:
                 res = json.load(f)
         except FileNotFoundError:
             return None
-        except (OSError, ValueError) as e:
-            self.unreadable.append((p, f"cannot be read ({e})"))
+        except (OSError, ValueError, RecursionError) as e:
+            self.unreadable.append((p, f"cannot be read ({type(e).__name__}: {str(e)[:80]})"))
             return None
         why = valid_result(res)
         if why:

@@ -2,10 +2,12 @@
 a cell, and sweep.html, the same table with a plot per varied key (the
 share of cells that acquired and docked, and the docking time, against the
 key's value), self-contained: Chart.js (Debian's libjs-chart.js) embedded."""
+import contextlib
 import csv
 import html
 import json
 import os
+import tempfile
 
 CHART_JS = "/usr/share/javascript/chart.js/chart.min.js"
 
@@ -104,16 +106,29 @@ def write(sweep_dir, grid, rows):
     cols = header(grid)
     table = [row_values(c, res, grid) for c, res in rows]
     csv_path = os.path.join(sweep_dir, "sweep.csv")
-    with open(csv_path + ".tmp", "w", newline="") as f:
+    with _replacing(csv_path, newline="") as f:
         w = csv.writer(f, lineterminator="\n")
         w.writerow(cols)
         w.writerows(table)
-    os.replace(csv_path + ".tmp", csv_path)
     html_path = os.path.join(sweep_dir, "sweep.html")
-    with open(html_path + ".tmp", "w") as f:
+    with _replacing(html_path) as f:
         f.write(page(grid, cols, table, plots(grid, rows), rows))
-    os.replace(html_path + ".tmp", html_path)
     return csv_path, html_path
+
+
+@contextlib.contextmanager
+def _replacing(path, **kw):
+    """A file written under a unique temporary name, then renamed over path
+    (two sweeps writing the same table do not trip each other)."""
+    fd, tmp = tempfile.mkstemp(dir=os.path.dirname(path), prefix="." + os.path.basename(path) + ".")
+    try:
+        with os.fdopen(fd, "w", **kw) as f:
+            yield f
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.remove(tmp)
+        raise
 
 
 def page(grid, cols, table, plot_data, rows):

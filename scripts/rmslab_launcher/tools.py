@@ -63,9 +63,18 @@ def branch_parent_unchanged(session):
     try:
         with open(os.path.join(session, "manifest.json")) as f:
             b = json.load(f).get("branch")
+    except (OSError, ValueError, AttributeError, RecursionError):
+        return True  # no manifest to speak of: no branch
+    if b is None:
+        return True
+    try:
         want, parent = b["parent_log_sha256"], b["parent"]
-    except (OSError, ValueError, AttributeError, KeyError, TypeError):
-        return True  # no branch (rms_resim has checked what a branch's manifest says)
+        if not isinstance(want, str) or not isinstance(parent, str):
+            raise TypeError
+    except (KeyError, TypeError):
+        say("the branch's manifest names no parent's log hash ('branch.parent_log_sha256'): "
+            "its parent cannot be checked")
+        return False
     try:
         now = file_sha256(os.path.join(parent, "lcmlog"))
     except OSError as e:

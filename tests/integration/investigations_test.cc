@@ -341,7 +341,17 @@ TEST_F(Investigations, ASweepInterruptedKeepsWhatItFinishedAndTheRerunDoesTheRes
   sweep.Signal(SIGINT);
   EXPECT_EQ(sweep.Wait(60), 130) << ReadFile(out + ".log");
   const std::string said = ReadFile(out + ".log");
-  EXPECT_NE(said.find("sweep interrupted: the "), std::string::npos) << said;
+  EXPECT_NE(said.find("sweep interrupted (SIGINT): the "), std::string::npos) << said;
+  // No cell left running (each names its session, in this test's folder).
+  std::string left;
+  for (int i = 0; i < 50; ++i) {
+    const ScriptRun p =
+        Script({"/usr/bin/pgrep", "-af", "sweep-cell --cell .*" + *tmp_}, out + "-pgrep.log");
+    left = p.rc == 0 ? p.out : "";
+    if (left.empty()) break;
+    usleep(100000);
+  }
+  EXPECT_EQ(left, "") << "cells still running after the sweep was interrupted";
   const std::size_t kept = cached();
   ASSERT_GE(kept, 3u) << said;
   ASSERT_LT(kept, 50u) << "it ran to the end before the interruption: " << said;

@@ -184,7 +184,8 @@ std::string ReadBranch(const nlohmann::json& b, ResimOptions* parent) {
     return "the manifest's 'branch.frame' is not a DCP frame (an integer >= 0)";
   parent->session = b["parent"].get<std::string>();
   parent->until_frame = b["frame"].get<long>();
-  if (b.contains("time_s")) {
+  if (!b.contains("time_s")) return "the manifest's 'branch.time_s' is missing";
+  {
     double rate = 0;
     try {
       rate = LoadConfig((fs::path(parent->session) / "config.toml").string()).session.frame_rate_hz;
@@ -238,7 +239,6 @@ void CheckBranchPrefix(const fs::path& session, const Recording& rec, ResimResul
   if (!why.empty()) {
     result->first_difference =
         "the branch's prefix" + (prefix.empty() ? std::string() : " (" + prefix + ")") + ": " + why;
-    result->branch_note = result->first_difference;
     return;
   }
   result->branch_note = "the branch's prefix, " + prefix +
