@@ -59,7 +59,8 @@ struct ResimResult {
   // A branch (its manifest's "branch"): its recorded session's prefix
   // re-simulated first, and the state there against the branch's first state.
   long prefix_frames = 0, prefix_identical = 0;
-  std::string branch_note;  // said in words when it agrees ("" when not a branch, or first_difference says why not)
+  std::string branch_note;  // said in words when it agrees ("" when not a branch, or
+                            // first_difference says why not)
 };
 
 // The effective configuration's TOML text: the session's own config.toml or
