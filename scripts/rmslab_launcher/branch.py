@@ -10,8 +10,7 @@ import shutil
 import subprocess
 import tempfile
 
-from .common import LabError, binary, frame_rate_hz, say
-from .sweep import file_sha256
+from .common import LabError, binary, file_sha256, frame_rate_hz, say
 
 INSTANT = re.compile(r"^(?P<session>.+)@(?:(?P<time>\d+(?:\.\d*)?|\.\d+)s?|f(?:rame)?(?P<frame>\d+))$")
 

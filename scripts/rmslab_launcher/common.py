@@ -4,6 +4,7 @@ multicast route, reading configuration (TOML, with Python's tomllib).
 docs/sessions.md "The launcher" describes what scripts/lab does; this
 package is that launcher.
 """
+import hashlib
 import os
 import shutil
 import subprocess
@@ -50,6 +51,15 @@ def write_run_file(path, text, append=True):
             _unwritable.add(path)
             say(f"could not write {path} ({e.strerror})")
         return False
+
+
+def file_sha256(path):
+    """The SHA-256 of a file, hex (as sha256sum prints it)."""
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
 
 
 def binary(rel):

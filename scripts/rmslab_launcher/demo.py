@@ -14,7 +14,8 @@ import time
 from . import disk, session
 from .branch import Branch
 from .common import (BUILD, DEFAULT_URL, ROOT, LabError, binary, check_speed, check_suffix, ensure_multicast_route,
-                     frame_rate_hz, check_lcm_url, install_and_build, require_built, say, timeline_length_s)
+                     file_sha256, frame_rate_hz, check_lcm_url, install_and_build, require_built, say,
+                     timeline_length_s)
 from .hosts import Host, check_hosts
 from .supervisor import Spec, Supervisor
 
@@ -222,8 +223,7 @@ class Demo:
         session.note_address_holder(self.session_id)
         fields = [("--pilot", self.pilot), ("--lcm-url", self.url), ("--session-id", self.session_id),
                   ("--command", self.command_line),
-                  ("--config-sha256", subprocess.run(["sha256sum", os.path.join(self.out, "config.toml")],
-                                                     capture_output=True, text=True).stdout.split()[0])]
+                  ("--config-sha256", file_sha256(os.path.join(self.out, "config.toml")))]
         for p in PROCESSES:
             fields.append(("--host", f"{p}={self.hosts[p]}"))
         fields.append(("--host", f"lcm-logger={self.hosts['recorder']}"))

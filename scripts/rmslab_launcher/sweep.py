@@ -25,7 +25,7 @@ import time
 import tomllib
 
 from . import sweep_cache, sweep_table
-from .common import BUILD, ROOT, LabError, binary, install_and_build, read_toml, say
+from .common import BUILD, ROOT, LabError, binary, file_sha256, install_and_build, read_toml, say
 
 CELL = os.path.join(ROOT, "scripts", "sweep-cell")
 NETNS_LOGIN = os.path.join(ROOT, "scripts", "rmslab_launcher", "netns-login")
@@ -107,14 +107,6 @@ def set_key(cfg, key, value):
             container[slot] = value
             return
         node = container[slot]
-
-
-def file_sha256(path):
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
 
 
 def software_version():

@@ -7,7 +7,7 @@ import subprocess
 import time
 
 from . import replay
-from .common import DEFAULT_URL, ROOT, LabError, binary, install_and_build, say
+from .common import DEFAULT_URL, ROOT, LabError, binary, file_sha256, install_and_build, say
 
 
 def ensure(rel, no_build=False):
@@ -59,7 +59,6 @@ def resim(argv):
 def branch_parent_unchanged(session):
     """A branch (docs/sessions.md "Branching"): its parent's log is the one
     the branch was made from (the manifest's SHA-256). False, said, if not."""
-    from .sweep import file_sha256
     try:
         with open(os.path.join(session, "manifest.json")) as f:
             b = json.load(f).get("branch")

@@ -20,6 +20,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "live_session.h"
 #include "netns_lab.h"
 #include "subprocess.h"
 
@@ -86,32 +87,19 @@ class Investigations : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     tmp_ = new std::string(testing::MakeTempDir("investigations"));
-    a_ = new std::string(*tmp_ + "/autopilot");
-    b_ = new std::string(*tmp_ + "/mission");
+    a_ = new std::string();
+    b_ = new std::string();
     // The autopilot and a timeline, each at 4x, small frames, no video.
-    for (const auto& [dir, extra] :
-         {std::pair{*a_, std::vector<std::string>{}},
-          std::pair{*b_, std::vector<std::string>{"--timeline",
-                                                  SourcePath("scripts/timelines/mission.tl")}}}) {
-      std::vector<std::string> argv = {SourcePath("scripts/lab"),
-                                       "demo",
-                                       "--no-build",
-                                       "--out",
-                                       dir,
-                                       "--speed",
-                                       "4",
-                                       "--lcm-url",
-                                       testing::UniqueLcmUrl(9300),
-                                       "--png-every",
-                                       "0",
-                                       "--no-video",
-                                       "--width",
-                                       "160",
-                                       "--height",
-                                       "120"};
-      argv.insert(argv.end(), extra.begin(), extra.end());
-      const ScriptRun r = Script(argv, dir + ".log");
-      ASSERT_EQ(r.rc, 0) << r.out;
+    const std::string url = testing::UniqueLcmUrl(9300);
+    for (const auto& [name, extra] :
+         {std::pair{"autopilot", std::vector<std::string>{"--speed", "4"}},
+          std::pair{"mission",
+                    std::vector<std::string>{"--speed", "4", "--timeline",
+                                             SourcePath("scripts/timelines/mission.tl")}}}) {
+      fs::create_directories(*tmp_ + "/" + name);
+      testing::LiveSession s(*tmp_ + "/" + name, url, extra);
+      ASSERT_EQ(s.Wait(300), 0) << ReadFile(s.log());
+      *(std::string(name) == "autopilot" ? a_ : b_) = s.out();
     }
   }
   static void TearDownTestSuite() {
@@ -273,35 +261,32 @@ TEST_F(Investigations, TheSameSweepAcrossTheNamespaceHostsThroughGnuParallel) {
 
 TEST_F(Investigations, ARerunOrAResumedSweepRedoesNothingFinished) {
   const std::string out = *tmp_ + "/resume", cache = *tmp_ + "/cache-resume";
-  ScriptRun r = Sweep(out, cache);
-  ASSERT_EQ(r.rc, 0) << r.out;
-  EXPECT_NE(r.out.find("12 cells run"), std::string::npos) << r.out;
-  const std::string table = ReadFile(out + "/sweep.csv");
-  // Again: all from the cache, nothing run, the same table.
-  r = Sweep(out, cache);
-  ASSERT_EQ(r.rc, 0) << r.out;
-  EXPECT_NE(r.out.find("0 cells run"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("12 from the cache"), std::string::npos) << r.out;
-  EXPECT_EQ(ReadFile(out + "/sweep.csv"), table);
+  std::string table;
+  // The sweep again: `run` cells run, `cached` from the cache, the same table.
+  auto again = [&](int run, int cached) {
+    const ScriptRun r = Sweep(out, cache);
+    EXPECT_EQ(r.rc, 0) << r.out;
+    EXPECT_NE(r.out.find("sweep: " + std::to_string(run) + " cells run"), std::string::npos)
+        << r.out;
+    EXPECT_NE(r.out.find(", " + std::to_string(cached) + " from the cache"), std::string::npos)
+        << r.out;
+    if (table.empty()) table = ReadFile(out + "/sweep.csv");
+    EXPECT_EQ(ReadFile(out + "/sweep.csv"), table);
+    return r.out;
+  };
+  again(12, 0);
+  again(0, 12);  // all from the cache, nothing run
   // A sweep stopped part way (three results lost): only those three run.
   int removed = 0;
   for (const auto& e : fs::directory_iterator(cache))
     if (removed < 3 && fs::remove(e.path())) ++removed;
-  r = Sweep(out, cache);
-  ASSERT_EQ(r.rc, 0) << r.out;
-  EXPECT_NE(r.out.find("3 cells run"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("9 from the cache"), std::string::npos) << r.out;
-  EXPECT_EQ(ReadFile(out + "/sweep.csv"), table);
+  again(3, 9);
   // Two entries spoiled (not JSON; JSON but no result): said, run again.
   int spoiled = 0;
   for (const auto& e : fs::directory_iterator(cache)) {
     if (spoiled < 2) std::ofstream(e.path()) << (spoiled++ == 0 ? "garbage" : "[]");
   }
-  r = Sweep(out, cache);
-  ASSERT_EQ(r.rc, 0) << r.out;
-  EXPECT_NE(r.out.find("2 cells run"), std::string::npos) << r.out;
-  EXPECT_FALSE(Lines(r.out, "its cell is run again").empty()) << r.out;
-  EXPECT_EQ(ReadFile(out + "/sweep.csv"), table);
+  EXPECT_FALSE(Lines(again(2, 10), "its cell is run again").empty());
   // A wider grid runs only its new cells.
   const ScriptRun wider =
       Script({SourcePath("scripts/lab"), "sweep", *a_, *b_, "--vary", "dcp.tpob_ft=0.2,0.3,0.4,0.5",

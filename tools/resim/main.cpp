@@ -18,6 +18,43 @@
 #include "rms/base/version.h"
 #include "rms/resim/resim.h"
 
+namespace {
+
+// What the re-simulation found, as lines for a person; the exit code: 0
+// identical (or another design, expected to differ), 1 a difference.
+int Report(const rms::resim::ResimResult& r) {
+  std::printf(
+      "re-simulated %ld DCP frames in %.2f s (%.0f frames/s); %ld of %ld recorded frames "
+      "identical%s\n",
+      r.frames, r.seconds, r.frames / std::max(r.seconds, 1e-9), r.identical, r.compared,
+      r.first_difference.empty() ? ", word for word" : "");
+  if (!r.branch_note.empty()) std::printf("%s\n", r.branch_note.c_str());
+  std::printf(
+      "timing: %.4f s in all (%.4f s reading the log, %.4f s running the DCP); the session "
+      "lasted %.1f s of wall time: "
+      "%.0fx real time in all, %.0fx for the DCP's run\n",
+      r.seconds, r.read_seconds, r.run_seconds, r.recorded_seconds,
+      r.recorded_seconds / std::max(r.seconds, 1e-9),
+      r.recorded_seconds / std::max(r.run_seconds, 1e-9));
+  if (r.states_checked > 0 && r.state_difference.empty()) {
+    std::printf("the DCP's whole state agreed with the %ld states it logged along the way\n",
+                r.states_checked);
+  }
+  if (!r.note.empty()) std::printf("note: %s\n", r.note.c_str());
+  if (!r.log_note.empty()) std::printf("note: %s\n", r.log_note.c_str());
+  if (!r.first_difference.empty())
+    std::printf("first difference: %s\n", r.first_difference.c_str());
+  if (!r.out_dir.empty()) {
+    std::printf("new session: %s (summary.json, comparison.md)\n", r.out_dir.c_str());
+    for (const auto& s : r.comparison["explanation"])
+      std::printf("  %s\n", s.get<std::string>().c_str());
+    return 0;  // another design is expected to differ
+  }
+  return r.first_difference.empty() ? 0 : 1;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   CLI::App app{
       "rmslab rms_resim: run the DCP again on a session's recorded operator inputs, as fast as it "
@@ -96,34 +133,7 @@ int main(int argc, char** argv) {
       std::printf("%s\n", r.cell.dump().c_str());
       return 0;
     }
-    std::printf(
-        "re-simulated %ld DCP frames in %.2f s (%.0f frames/s); %ld of %ld recorded frames "
-        "identical%s\n",
-        r.frames, r.seconds, r.frames / std::max(r.seconds, 1e-9), r.identical, r.compared,
-        r.first_difference.empty() ? ", word for word" : "");
-    if (!r.branch_note.empty()) std::printf("%s\n", r.branch_note.c_str());
-    std::printf(
-        "timing: %.4f s in all (%.4f s reading the log, %.4f s running the DCP); the session "
-        "lasted %.1f s of wall time: "
-        "%.0fx real time in all, %.0fx for the DCP's run\n",
-        r.seconds, r.read_seconds, r.run_seconds, r.recorded_seconds,
-        r.recorded_seconds / std::max(r.seconds, 1e-9),
-        r.recorded_seconds / std::max(r.run_seconds, 1e-9));
-    if (r.states_checked > 0 && r.state_difference.empty()) {
-      std::printf("the DCP's whole state agreed with the %ld states it logged along the way\n",
-                  r.states_checked);
-    }
-    if (!r.note.empty()) std::printf("note: %s\n", r.note.c_str());
-    if (!r.log_note.empty()) std::printf("note: %s\n", r.log_note.c_str());
-    if (!r.first_difference.empty())
-      std::printf("first difference: %s\n", r.first_difference.c_str());
-    if (!r.out_dir.empty()) {
-      std::printf("new session: %s (summary.json, comparison.md)\n", r.out_dir.c_str());
-      for (const auto& s : r.comparison["explanation"])
-        std::printf("  %s\n", s.get<std::string>().c_str());
-      return 0;  // another design is expected to differ
-    }
-    return r.first_difference.empty() ? 0 : 1;
+    return Report(r);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rms_resim: %s\n", e.what());
     // A sweep's cell says why it has no result, on its one line.
