@@ -22,7 +22,7 @@ namespace {
 
 // What the re-simulation found, as lines for a person; the exit code: 0
 // identical (or another design, expected to differ), 1 a difference.
-int Report(const rms::resim::ResimResult& r) {
+int Report(const rms::resim::ResimResult& r, bool other_design) {
   std::printf(
       "re-simulated %ld DCP frames in %.2f s (%.0f frames/s); %ld of %ld recorded frames "
       "identical%s\n",
@@ -44,8 +44,9 @@ int Report(const rms::resim::ResimResult& r) {
   if (!r.log_note.empty()) std::printf("note: %s\n", r.log_note.c_str());
   if (!r.first_difference.empty())
     std::printf("first difference: %s\n", r.first_difference.c_str());
-  if (!r.out_dir.empty()) {
+  if (!r.out_dir.empty())
     std::printf("new session: %s (summary.json, comparison.md)\n", r.out_dir.c_str());
+  if (other_design) {
     for (const auto& s : r.comparison["explanation"])
       std::printf("  %s\n", s.get<std::string>().c_str());
     return 0;  // another design is expected to differ
@@ -133,7 +134,7 @@ int main(int argc, char** argv) {
       std::printf("%s\n", r.cell.dump().c_str());
       return 0;
     }
-    return Report(r);
+    return Report(r, rms::resim::OtherDesign(opt));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rms_resim: %s\n", e.what());
     // A sweep's cell says why it has no result, on its one line.
