@@ -10,6 +10,7 @@ scripts/sweep-cell: rms_resim SESSION --set KEY=VALUE... --discard
 hash and the software's version, so a rerun does only what is missing.
 """
 import argparse
+import concurrent.futures
 import contextlib
 import hashlib
 import itertools
@@ -30,6 +31,7 @@ from .common import BUILD, ROOT, LabError, binary, file_sha256, install_and_buil
 CELL = os.path.join(ROOT, "scripts", "sweep-cell")
 NETNS_LOGIN = os.path.join(ROOT, "scripts", "rmslab_launcher", "netns-login")
 SSH_OPTIONS = "ssh -o BatchMode=yes -o ConnectTimeout=5"
+PROBE_TIMEOUT_S = 10  # a login that runs `true`, as GNU parallel allows its own probes
 
 
 def split_values(text):
@@ -197,8 +199,8 @@ def write_manifest(path, cells):
 def lab_workers(labfile, jobs):
     """GNU parallel's ssh logins for a lab file's hosts ([sweep] hosts, or
     every distinct host of [hosts]; the file read strictly by rms_session
-    labfile, as scripts/lab demo reads it), the remote tree's sweep-cell and
-    its build."""
+    labfile, as scripts/lab demo reads it), each with the command that
+    checks it answers; the remote tree's sweep-cell and its build."""
     r = subprocess.run([binary("tools/rms_session"), "labfile", labfile], capture_output=True, text=True)
     if r.returncode:
         raise LabError(r.stderr.strip() or f"{labfile}: cannot be read as a lab file")
@@ -209,13 +211,57 @@ def lab_workers(labfile, jobs):
     for h in hosts:
         n = f"{per_host}/" if per_host > 0 else ""
         if h == "localhost":
-            logins.append(f"{n}:")
+            logins.append(Login(h, f"{n}:", None))
         elif h.startswith("netns:"):
-            logins.append(f"{n}{NETNS_LOGIN} {h[6:]}")
+            logins.append(Login(h, f"{n}{NETNS_LOGIN} {h[6:]}", [NETNS_LOGIN, h[6:], "--", "true"]))
         else:  # ssh:[USER@]HOST (the reader allows nothing else)
-            logins.append(f"{n}{h[4:]}")
+            logins.append(Login(h, f"{n}{h[4:]}", shlex.split(SSH_OPTIONS) + [h[4:], "true"]))
     remote_root = lab["remote_root"] or ROOT
     return logins, os.path.join(remote_root, "scripts", "sweep-cell"), lab["remote_build"], per_host
+
+
+class Login:
+    """A lab host as GNU parallel's --sshlogin, and the command (None: this
+    machine) that logs in and runs `true` there."""
+
+    def __init__(self, host, sshlogin, probe):
+        self.host, self.sshlogin, self.probe = host, sshlogin, probe
+
+    def why_not_answering(self, tries=2, timeout_s=PROBE_TIMEOUT_S):
+        """None if the host answers within one of `tries` logins, else why
+        not (its exit code or the timeout, and what the login printed)."""
+        if self.probe is None:
+            return None
+        why = ""
+        for _ in range(tries):
+            try:
+                r = subprocess.run(self.probe, stdin=subprocess.DEVNULL, capture_output=True, text=True,
+                                   timeout=timeout_s)
+            except subprocess.TimeoutExpired:
+                why = f"no answer within {timeout_s:g} s"
+                continue
+            except OSError as e:
+                return str(e)
+            if r.returncode == 0:
+                return None
+            last = (r.stderr.strip().splitlines() or [""])[-1]
+            why = f"the login exited {r.returncode}" + (f": {last}" if last else "")
+        return why
+
+
+def answering(logins):
+    """The logins of the hosts that answer, all checked at once. A host
+    that does not is named, with why, and left out of this try (GNU
+    parallel's own --filter-hosts is not used: on the CI machine its probe
+    of a host's cores came back short, and it then stopped the whole run
+    with an internal error, "ncores missing", instead of leaving the host
+    out)."""
+    with concurrent.futures.ThreadPoolExecutor(max_workers=len(logins)) as pool:
+        whys = list(pool.map(lambda login: login.why_not_answering(), logins))
+    for login, why in zip(logins, whys):
+        if why is not None:
+            say(f"sweep: host {login.host} does not answer ({why}): left out of this try")
+    return [login for login, why in zip(logins, whys) if why is None]
 
 
 class Progress:
@@ -250,15 +296,17 @@ def parallel_command(todo_file, sweep_dir, args, round_no, ncols):
            os.path.join(sweep_dir, f"joblog-{time.strftime('%Y%m%dT%H%M%S')}-{os.getpid()}-try{round_no}")]
     if args.workers:
         logins, cell, remote_build, per_host = args.workers
-        for login in logins:
-            cmd += ["--sshlogin", login]
+        live = answering(logins) if len(logins) > 1 else logins
+        if not live:
+            return None
+        for login in live:
+            cmd += ["--sshlogin", login.sshlogin]
         cmd += ["--ssh", SSH_OPTIONS]
-        if per_host > 0:  # --filter-hosts would replace the logins' N/ with each host's cores
+        if per_host > 0:
             cmd += ["--jobs", str(per_host)]
-        if len(logins) > 1:
-            # A host that does not answer is left out; a cell that fails on
-            # one host is tried on another within the try.
-            cmd += ["--filter-hosts", "--retries", str(len(logins))]
+        if len(live) > 1:
+            # A cell that fails on one host is tried on another within the try.
+            cmd += ["--retries", str(len(live))]
         if remote_build:
             env_build = {"RMSLAB_BUILD": remote_build}
     else:
@@ -276,9 +324,13 @@ def run_parallel(todo, sweep_dir, args, progress, round_no, on_result):
     if not shutil.which("parallel"):
         raise LabError("GNU parallel is not installed: run scripts/install-deps", 1)
     todo_file = os.path.join(sweep_dir, f"todo-{os.getpid()}.tsv")
+    cmd = parallel_command(todo_file, sweep_dir, args, round_no, 3 + len(todo[0]["sets"]))
+    if cmd is None:
+        for c in todo:
+            c["error"] = f"no host of {args.hosts} answered"
+        return []
     write_manifest(todo_file, todo)
     by_index = {c["index"]: c for c in todo}
-    cmd = parallel_command(todo_file, sweep_dir, args, round_no, 3 + len(todo[0]["sets"]))
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             start_new_session=True)
     errors = []

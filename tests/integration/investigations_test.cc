@@ -256,6 +256,8 @@ TEST_F(Investigations, TheSameSweepAcrossTheNamespaceHostsThroughGnuParallel) {
       write_lab(dir + "/half.toml", {"netns:rmslab-no-such-host", net.host(1)});
   const ScriptRun partly = Sweep(dir + "/partly", dir + "/cache-partly", {"--hosts", half});
   ASSERT_EQ(partly.rc, 0) << partly.out;
+  EXPECT_NE(partly.out.find("host netns:rmslab-no-such-host does not answer"), std::string::npos)
+      << partly.out;
   EXPECT_EQ(ReadFile(dir + "/partly/sweep.csv"), ReadFile(dir + "/local/sweep.csv"));
 }
 
