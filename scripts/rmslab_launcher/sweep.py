@@ -272,6 +272,12 @@ class Progress:
         self.cached, self.tty, self.last_tenth = cached, sys.stderr.isatty(), -1
         self.show()
 
+    def recovered(self, ok):
+        """A cell that had failed, tried again."""
+        if ok:
+            self.failed -= 1
+            self.show()
+
     def step(self, ok):
         self.done += 1
         self.failed += not ok
@@ -290,9 +296,18 @@ class Progress:
             say(line)
 
 
-def parallel_command(todo_file, sweep_dir, args, round_no, ncols):
-    cell, env_build = CELL, {}
-    cmd = ["parallel", "--will-cite", "--colsep", "\t", "--halt", "never", "--joblog",
+def batch_size(cells, slots):
+    """Cells a job: one rms_resim process re-simulates a batch (each
+    session's log read once, no process started a cell), about four
+    batches a job slot so the slots finish together; at most 32."""
+    return max(1, min(32, -(-cells // (4 * max(slots, 1)))))
+
+
+def parallel_command(sweep_dir, args, round_no, cells):
+    """GNU parallel's command line: the cells' lines (cells.tsv's form) on
+    its standard input, --pipe hands each job a batch of them."""
+    cell, env_build, slots = CELL, {}, args.jobs or os.cpu_count() or 1
+    cmd = ["parallel", "--will-cite", "--pipe", "--line-buffer", "--halt", "never", "--joblog",
            os.path.join(sweep_dir, f"joblog-{time.strftime('%Y%m%dT%H%M%S')}-{os.getpid()}-try{round_no}")]
     if args.workers:
         logins, cell, remote_build, per_host = args.workers
@@ -305,16 +320,16 @@ def parallel_command(todo_file, sweep_dir, args, round_no, ncols):
         if per_host > 0:
             cmd += ["--jobs", str(per_host)]
         if len(live) > 1:
-            # A cell that fails on one host is tried on another within the try.
+            # A batch that fails on one host is tried on another within the try.
             cmd += ["--retries", str(len(live))]
         if remote_build:
             env_build = {"RMSLAB_BUILD": remote_build}
+        slots = len(live) * (per_host if per_host > 0 else 2)
     else:
-        cmd += ["--jobs", str(args.jobs or os.cpu_count() or 1)]
+        cmd += ["--jobs", str(slots)]
     prefix = " ".join(f"{k}={shlex.quote(v)}" for k, v in env_build.items())
-    template = (f"{prefix} {shlex.quote(cell)} --cell " +
-                " ".join("{%d}" % i for i in range(1, ncols + 1))).strip()
-    return cmd + [template, "::::", todo_file]
+    template = f"{prefix} {shlex.quote(cell)} --cells {shlex.quote(sweep_dir)}".strip()
+    return cmd + ["-N", str(batch_size(cells, slots)), template]
 
 
 def run_parallel(todo, sweep_dir, args, progress, round_no, on_result):
@@ -324,36 +339,46 @@ def run_parallel(todo, sweep_dir, args, progress, round_no, on_result):
     if not shutil.which("parallel"):
         raise LabError("GNU parallel is not installed: run scripts/install-deps", 1)
     todo_file = os.path.join(sweep_dir, f"todo-{os.getpid()}.tsv")
-    cmd = parallel_command(todo_file, sweep_dir, args, round_no, 3 + len(todo[0]["sets"]))
+    cmd = parallel_command(sweep_dir, args, round_no, len(todo))
     if cmd is None:
         for c in todo:
             c["error"] = f"no host of {args.hosts} answered"
         return []
     write_manifest(todo_file, todo)
     by_index = {c["index"]: c for c in todo}
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)
+    seen, done = set(), set()  # a batch tried again on another host says its cells again
     errors = []
-    t = threading.Thread(target=lambda: errors.extend(line.rstrip() for line in proc.stderr), daemon=True)
-    t.start()
     try:
-        for line in proc.stdout:
-            idx, _, payload = line.rstrip("\n").partition("\t")
-            try:
-                res, cell = json.loads(payload), by_index[int(idx)]
-            except (ValueError, KeyError):
-                errors.append(line.rstrip())
-                continue
-            ok = on_result(cell, res)
-            progress.step(ok)
-        proc.wait()
-    except BaseException:
-        stop_parallel(proc)
-        raise
+        with open(todo_file) as cells_in:
+            proc = subprocess.Popen(cmd, stdin=cells_in, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                    text=True, start_new_session=True)
+        t = threading.Thread(target=lambda: errors.extend(line.rstrip() for line in proc.stderr),
+                             daemon=True)
+        t.start()
+        try:
+            for line in proc.stdout:
+                idx, _, payload = line.rstrip("\n").partition("\t")
+                try:
+                    res, cell = json.loads(payload), by_index[int(idx)]
+                except (ValueError, KeyError):
+                    errors.append(line.rstrip())
+                    continue
+                if cell["index"] in done:
+                    continue
+                first = cell["index"] not in seen
+                seen.add(cell["index"])
+                ok = on_result(cell, res)
+                if ok:
+                    done.add(cell["index"])
+                progress.step(ok) if first else progress.recovered(ok)
+            proc.wait()
+        except BaseException:
+            stop_parallel(proc)
+            raise
+        t.join(timeout=5)
     finally:
         with contextlib.suppress(OSError):
             os.remove(todo_file)
-    t.join(timeout=5)
     return errors
 
 

@@ -3,10 +3,15 @@
 //   rms_resim SESSION                      exit 0 only if identical, word for word
 //   rms_resim SESSION --config FILE [--out DIR]   the same inputs, another design
 //   rms_resim SESSION --set KEY=VALUE... [--discard] [--result-json]   a sweep's cell
+//   rms_resim --cells FILE|-               a sweep's batch of cells, a result line each
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
@@ -54,6 +59,64 @@ int Report(const rms::resim::ResimResult& r, bool other_design) {
   return r.first_difference.empty() ? 0 : 1;
 }
 
+// A usage error, as rms::ParseCommandLine reports one (exit 2).
+int Usage(const char* what) {
+  std::fprintf(stderr, "%s\nRun with --help for more information.\n", what);
+  return rms::kUsageExitCode;
+}
+
+// The fields of a tab-separated line.
+std::vector<std::string> Fields(const std::string& line) {
+  std::vector<std::string> f;
+  std::size_t at = 0;
+  for (std::size_t tab; (tab = line.find('\t', at)) != std::string::npos; at = tab + 1)
+    f.push_back(line.substr(at, tab - at));
+  f.push_back(line.substr(at));
+  return f;
+}
+
+// A sweep's batch of cells (docs/sessions.md "Sweeps"): each line of `in`,
+// "INDEX<TAB>KEY<TAB>SESSION<TAB>KEY=VALUE..." (a line of the sweep's
+// cells.tsv; KEY, the cache's, is not used here), re-simulated in a
+// temporary folder as --discard does; its result "INDEX<TAB>JSON" on stdout
+// as soon as it is made ({"error": ...} when it has none). Each session's
+// log is read once for all its designs. Exit 0 when every line had its
+// result line, 2 when a line was no cell.
+int RunCells(std::istream& in) {
+  std::map<std::string, std::shared_ptr<const rms::resim::RecordedSession>> sessions;
+  int rc = 0;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty()) continue;
+    const std::vector<std::string> f = Fields(line);
+    if (f.size() < 3 || f[0].empty() || f[0].find_first_not_of("0123456789") != std::string::npos) {
+      std::fprintf(stderr, "rms_resim: --cells: not a cell (INDEX<TAB>KEY<TAB>SESSION...): %s\n",
+                   line.c_str());
+      rc = 2;
+      continue;
+    }
+    std::string out;
+    try {
+      rms::resim::ResimOptions opt;
+      opt.session = f[2];
+      opt.discard = true;
+      for (std::size_t i = 3; i < f.size(); ++i)
+        opt.settings.push_back(rms::ParseConfigSetting(f[i]));
+      if (!rms::resim::OtherDesign(opt))
+        throw rms::InputError("a cell needs at least one KEY=VALUE (another design)");
+      auto& recorded = sessions[opt.session];
+      if (!recorded) recorded = rms::resim::ReadRecordedSession(opt.session);
+      opt.recorded = recorded;
+      out = rms::resim::Resimulate(opt).cell.dump();
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "rms_resim: cell %s: %s\n", f[0].c_str(), e.what());
+      out = nlohmann::json{{"error", e.what()}}.dump();
+    }
+    std::printf("%s\t%s\n", f[0].c_str(), out.c_str());
+    std::fflush(stdout);
+  }
+  return rc;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -67,9 +130,14 @@ int main(int argc, char** argv) {
   bool quiet = false, result_json = false, check_only = false;
   std::vector<std::string> sets;
   app.set_version_flag("--version", rms::VersionString());
-  app.add_option("session", opt.session, "Session folder")
-      ->required()
+  std::string cells;
+  app.add_option("session", opt.session, "Session folder (required but with --cells)")
       ->check(CLI::ExistingDirectory);
+  app.add_option("--cells", cells,
+                 "A sweep's batch: each line of FILE ('-': standard input) "
+                 "INDEX<TAB>KEY<TAB>SESSION<TAB>KEY=VALUE..., re-simulated as --set ... "
+                 "--discard --result-json would; a line 'INDEX<TAB>JSON' each on stdout")
+      ->type_name("FILE");
   app.add_option("--config", opt.config_path, "Another configuration (a different design)")
       ->check(CLI::ExistingFile);
   app.add_option("--out", opt.out_dir,
@@ -110,6 +178,21 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "resim: %3.0f%% %s\n", 100 * f, line.c_str());
     };
   }
+  if (!cells.empty()) {
+    if (!opt.session.empty() || !sets.empty() || !opt.config_path.empty() || check_only)
+      return Usage(
+          "--cells: the sessions and keys are in its lines (no SESSION, --set, --config or --check "
+          "beside it)");
+    spdlog::set_default_logger(spdlog::stderr_color_mt("rms_resim"));
+    if (cells == "-") return RunCells(std::cin);
+    std::ifstream in(cells);
+    if (!in) {
+      std::fprintf(stderr, "rms_resim: --cells %s: cannot be read\n", cells.c_str());
+      return 2;
+    }
+    return RunCells(in);
+  }
+  if (opt.session.empty()) return Usage("session is required (or --cells)");
   try {
     for (const std::string& s : sets) opt.settings.push_back(rms::ParseConfigSetting(s));
     if (check_only) {

@@ -38,6 +38,36 @@ namespace fs = std::filesystem;
 
 namespace rms::resim {
 
+class RecordedSession {
+ public:
+  RecordedSession(const std::string& dir, session::SessionLog log)
+      : dir_(dir), rec_(ReadRecording(log)), plan_(MakePlan(rec_)), unread_(log.unread_bytes()) {}
+  const std::string& dir() const { return dir_; }
+  const Recording& recording() const { return rec_; }
+  const Plan& plan() const { return plan_; }
+  std::int64_t unread_bytes() const { return unread_; }
+  // The recorded session's summary.json (made now when it has none), read at the first call.
+  const nlohmann::json& summary() const {
+    if (summary_.is_null()) {
+      const fs::path session(dir_);
+      try {
+        summary_ = nlohmann::json::parse(
+            ReadTextFile((session / "summary.json").string(), "the session's summary"));
+      } catch (const std::exception&) {
+        summary_ = session::Summarize(dir_);
+      }
+    }
+    return summary_;
+  }
+
+ private:
+  std::string dir_;
+  Recording rec_;
+  Plan plan_;
+  std::int64_t unread_ = 0;
+  mutable nlohmann::json summary_;
+};
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -306,15 +336,8 @@ std::string ComparisonMarkdown(const fs::path& session, const std::string& confi
 
 // The sweep's cell (docs/sessions.md "Sweeps"): the outcome against the
 // recorded session's (its summary.json, or made now when it has none).
-nlohmann::ordered_json CellJson(const fs::path& session, const LabConfig& config,
+nlohmann::ordered_json CellJson(const nlohmann::json& recorded, const LabConfig& config,
                                 const nlohmann::json& summary, const ResimResult& result) {
-  nlohmann::json recorded;
-  try {
-    recorded = nlohmann::json::parse(
-        ReadTextFile((session / "summary.json").string(), "the session's summary"));
-  } catch (const std::exception&) {
-    recorded = session::Summarize(session.string());
-  }
   nlohmann::ordered_json cell;
   cell["outcome"] = Outcome(summary);
   cell["recorded_outcome"] = Outcome(recorded);
@@ -337,10 +360,11 @@ nlohmann::ordered_json CellJson(const fs::path& session, const LabConfig& config
 
 // Another design's session: its manifest (the parent's subject and note go
 // with the inputs), summary, comparison.json and comparison.md.
-void WriteNewSession(const fs::path& session, const std::string& config_path,
-                     const std::string& config_text, const LabConfig& config, const Recording& rec,
-                     const Outputs& out, ResimResult* result) {
-  const fs::path dir(result->out_dir);
+void WriteNewSession(const RecordedSession& recorded, const std::string& config_path,
+                     const std::string& config_text, const LabConfig& config, const Outputs& out,
+                     ResimResult* result) {
+  const fs::path dir(result->out_dir), session(recorded.dir());
+  const Recording& rec = recorded.recording();
   session::ManifestFields mf;
   mf.pilot = "resim";
   mf.kind = "re-simulation";
@@ -369,7 +393,7 @@ void WriteNewSession(const fs::path& session, const std::string& config_path,
   WriteWholeFile((dir / "comparison.json").string(), result->comparison.dump(2) + "\n");
   WriteWholeFile((dir / "comparison.md").string(),
                  ComparisonMarkdown(session, config_path, *result));
-  result->cell = CellJson(session, config, summary, *result);
+  result->cell = CellJson(recorded.summary(), config, summary, *result);
 }
 
 }  // namespace
@@ -392,6 +416,12 @@ std::string EffectiveConfigText(const ResimOptions& opt) {
   return opt.settings.empty() ? text : ApplyConfigSettings(text, base, opt.settings);
 }
 
+std::shared_ptr<const RecordedSession> ReadRecordedSession(const std::string& dir) {
+  if (!fs::exists(fs::path(dir) / "lcmlog"))
+    throw InputError(dir + ": not a session folder (no lcmlog)");
+  return std::make_shared<const RecordedSession>(dir, session::SessionLog(dir));
+}
+
 ResimResult Resimulate(const ResimOptions& opt) {
   const auto t0 = Clock::now();
   const fs::path session(opt.session);
@@ -406,16 +436,21 @@ ResimResult Resimulate(const ResimOptions& opt) {
   };
   progress(0.0, "reading " + (session / "lcmlog").string());
   // The session's own config is read once (another design's is not its).
-  session::SessionLog log = other_design
-                                ? session::SessionLog(opt.session)
-                                : session::SessionLog(opt.session, config.session.frame_rate_hz);
-  const Recording rec = ReadRecording(log);
-  const Plan plan = MakePlan(rec);
+  std::shared_ptr<const RecordedSession> recorded = opt.recorded;
+  if (!other_design) {
+    recorded = std::make_shared<const RecordedSession>(
+        opt.session, session::SessionLog(opt.session, config.session.frame_rate_hz));
+  } else if (!recorded) {
+    recorded = ReadRecordedSession(opt.session);
+  }
+  RMS_CHECK(recorded->dir() == opt.session);
+  const Recording& rec = recorded->recording();
+  const Plan& plan = recorded->plan();
   const auto t_read = Clock::now();
 
   ResimResult result;
-  if (log.unread_bytes() > 0) {
-    result.log_note = "the log ends in " + std::to_string(log.unread_bytes()) +
+  if (recorded->unread_bytes() > 0) {
+    result.log_note = "the log ends in " + std::to_string(recorded->unread_bytes()) +
                       " bytes that are no whole event (it was cut short or damaged there): "
                       "re-simulated up to them";
   }
@@ -446,7 +481,7 @@ ResimResult Resimulate(const ResimOptions& opt) {
     result.recorded_seconds =
         (rec.inputs.back().timestamp_us - rec.inputs.front().timestamp_us) / 1e6;
   }
-  if (other_design) WriteNewSession(session, config_path, config_text, config, rec, out, &result);
+  if (other_design) WriteNewSession(*recorded, config_path, config_text, config, out, &result);
   if (!discard.folder.empty()) result.out_dir.clear();
   return result;
 }

@@ -7,6 +7,7 @@
 // session folder showing how the same inputs fare with that design, and a
 // comparison of the two.
 #include <functional>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -14,6 +15,14 @@
 #include "rms/base/config_settings.h"
 
 namespace rms::resim {
+
+// A recorded session's log, plan and summary, read once: several designs
+// re-simulated on it in one process (rms_resim --cells, a sweep's batch of
+// cells; docs/sessions.md "Sweeps") share it instead of each reading the log.
+class RecordedSession;
+// Throws rms::InputError for a folder that is no session or a log that
+// cannot be re-simulated.
+std::shared_ptr<const RecordedSession> ReadRecordedSession(const std::string& session);
 
 struct ResimOptions {
   std::string session;      // the recorded session folder
@@ -28,6 +37,9 @@ struct ResimOptions {
   // branch point of scripts/lab demo --from (docs/sessions.md "Branching");
   // ResimResult::checkpoint_text is the DCP's state after it.
   long until_frame = -1;
+  // Another design only: the session as read before (ReadRecordedSession
+  // of the same folder), or null to read it now.
+  std::shared_ptr<const RecordedSession> recorded;
   // Progress (0..1) with a line to show; called every few percent.
   std::function<void(double, const std::string&)> progress;
 };
