@@ -85,19 +85,26 @@ void Flatten(const toml::node& n, const std::string& prefix,
 
 }  // namespace
 
-nlohmann::ordered_json ConfigChanges(const std::string& a_text, const std::string& b_text) {
-  nlohmann::ordered_json changes = nlohmann::ordered_json::array();
-  std::map<std::string, std::string> a, b;
+std::optional<ConfigKeys> FlattenConfig(const std::string& toml_text) {
+  ConfigKeys keys;
   try {
-    Flatten(toml::parse(std::string_view(a_text)), "", &a);
-    Flatten(toml::parse(std::string_view(b_text)), "", &b);
+    Flatten(toml::parse(std::string_view(toml_text)), "", &keys);
   } catch (const std::exception&) {
-    return changes;
+    return std::nullopt;
   }
-  for (const auto& [k, v] : b) {
-    const auto it = a.find(k);
-    if (it == a.end() || it->second != v)
-      changes.push_back({{"key", k}, {"recorded", it == a.end() ? "" : it->second}, {"now", v}});
+  return keys;
+}
+
+nlohmann::ordered_json ConfigChanges(const std::optional<ConfigKeys>& recorded,
+                                     const std::string& now_toml) {
+  nlohmann::ordered_json changes = nlohmann::ordered_json::array();
+  const std::optional<ConfigKeys> now = FlattenConfig(now_toml);
+  if (!recorded || !now) return changes;
+  for (const auto& [k, v] : *now) {
+    const auto it = recorded->find(k);
+    if (it == recorded->end() || it->second != v)
+      changes.push_back(
+          {{"key", k}, {"recorded", it == recorded->end() ? "" : it->second}, {"now", v}});
   }
   return changes;
 }

@@ -2,7 +2,9 @@
 // Re-simulation's comparisons (docs/sessions.md "Re-simulation"): a DCP
 // frame and its telemetry word for word against the recorded ones, and two
 // configuration files key by key.
+#include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
 #include "rms/dcp_frame_t.hpp"
@@ -15,8 +17,13 @@ namespace rms::resim {
 bool SameFrame(const dcp_frame_t& a, const dcp_frame_t& b, std::string* what);
 // True when every field but the wall-clock send time and the sender agrees.
 bool SameTelemetry(dcp_telemetry_t a, dcp_telemetry_t b, std::string* what);
-// Every key whose value differs between two configurations (TOML texts):
+// Every key of a configuration (TOML text) as "a.b.c" -> its value's text;
+// nullopt when it cannot be parsed.
+using ConfigKeys = std::map<std::string, std::string>;
+std::optional<ConfigKeys> FlattenConfig(const std::string& toml_text);
+// Every key whose value differs between two configurations:
 // [{"key", "recorded", "now"}]; empty when either cannot be parsed.
-nlohmann::ordered_json ConfigChanges(const std::string& recorded_toml, const std::string& now_toml);
+nlohmann::ordered_json ConfigChanges(const std::optional<ConfigKeys>& recorded,
+                                     const std::string& now_toml);
 
 }  // namespace rms::resim

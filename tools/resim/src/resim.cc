@@ -59,13 +59,29 @@ class RecordedSession {
     }
     return summary_;
   }
+  // Its telemetry by DCP frame, made at the first call.
+  const std::map<std::int64_t, dcp_telemetry_t>& telemetry() const {
+    if (!telemetry_) telemetry_ = TelemetryByFrame(rec_.telemetry);
+    return *telemetry_;
+  }
+  // Its config.toml's keys, read at the first call.
+  const std::optional<ConfigKeys>& config_keys() const {
+    if (!config_keys_) {
+      config_keys_ = FlattenConfig(
+          ReadTextFile((fs::path(dir_) / "config.toml").string(), "the session's configuration"));
+    }
+    return *config_keys_;
+  }
 
  private:
   std::string dir_;
   Recording rec_;
   Plan plan_;
   std::int64_t unread_ = 0;
+  // Made once, at the first call (a batch's designs share them).
   mutable nlohmann::json summary_;
+  mutable std::optional<std::map<std::int64_t, dcp_telemetry_t>> telemetry_;
+  mutable std::optional<std::optional<ConfigKeys>> config_keys_;
 };
 
 namespace {
@@ -364,7 +380,6 @@ void WriteNewSession(const RecordedSession& recorded, const std::string& config_
                      const std::string& config_text, const LabConfig& config, const Outputs& out,
                      ResimResult* result) {
   const fs::path dir(result->out_dir), session(recorded.dir());
-  const Recording& rec = recorded.recording();
   session::ManifestFields mf;
   mf.pilot = "resim";
   mf.kind = "re-simulation";
@@ -383,11 +398,9 @@ void WriteNewSession(const RecordedSession& recorded, const std::string& config_
                  session::MakeManifest(dir.string(), mf).dump(2) + "\n");
   const nlohmann::ordered_json summary = session::Summarize(dir.string());
   WriteWholeFile((dir / "summary.json").string(), summary.dump(2) + "\n");
-  result->comparison =
-      DesignComparison(TelemetryByFrame(rec.telemetry), TelemetryByFrame(out.telemetry), config,
-                       config.session.frame_rate_hz);
-  result->comparison["config_changes"] = ConfigChanges(
-      ReadTextFile((session / "config.toml").string(), "the session's configuration"), config_text);
+  result->comparison = DesignComparison(recorded.telemetry(), TelemetryByFrame(out.telemetry),
+                                        config, config.session.frame_rate_hz);
+  result->comparison["config_changes"] = ConfigChanges(recorded.config_keys(), config_text);
   result->comparison["frames_identical"] = result->identical;
   result->comparison["frames_compared"] = result->compared;
   WriteWholeFile((dir / "comparison.json").string(), result->comparison.dump(2) + "\n");
