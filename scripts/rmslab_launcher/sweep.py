@@ -10,7 +10,6 @@ scripts/sweep-cell: rms_resim SESSION --set KEY=VALUE... --discard
 hash and the software's version, so a rerun does only what is missing.
 """
 import argparse
-import concurrent.futures
 import contextlib
 import hashlib
 import itertools
@@ -125,6 +124,10 @@ class Session:
         self.path = os.path.abspath(path)
         if any(c in self.path for c in "\t\n\r"):
             raise LabError(f"{path!r}: tabs and line breaks are not allowed in a session's path")
+        try:
+            self.path.encode("utf-8")
+        except UnicodeEncodeError:
+            raise LabError(f"{path!r}: a session's path must be UTF-8 text (it goes into the table)")
         for f in ("lcmlog", "config.toml"):
             if not os.path.isfile(os.path.join(self.path, f)):
                 raise LabError(f"{path}: not a session folder (no {f})")
@@ -227,49 +230,65 @@ class Login:
     def __init__(self, host, sshlogin, probe):
         self.host, self.sshlogin, self.probe = host, sshlogin, probe
 
-    def why_not_answering(self, tries=2, timeout_s=PROBE_TIMEOUT_S):
-        """None if the host answers within one of `tries` logins, else why
-        not (its exit code or the timeout, and what the login printed)."""
-        if self.probe is None:
-            return None
-        why = ""
-        for _ in range(tries):
+
+def probe_once(logins, timeout_s):
+    """Each login's command started at once; {login: why} for those that
+    did not answer within timeout_s (its exit code or the timeout, and
+    the last line it printed). Every probe is killed however this ends."""
+    procs, whys = {}, {}
+    try:
+        for login in logins:
             try:
-                r = subprocess.run(self.probe, stdin=subprocess.DEVNULL, capture_output=True, text=True,
-                                   timeout=timeout_s)
-            except subprocess.TimeoutExpired:
-                why = f"no answer within {timeout_s:g} s"
-                continue
+                procs[login] = subprocess.Popen(login.probe, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                                                stderr=subprocess.PIPE, text=True, start_new_session=True)
             except OSError as e:
-                return str(e)
-            if r.returncode == 0:
-                return None
-            last = (r.stderr.strip().splitlines() or [""])[-1]
-            why = f"the login exited {r.returncode}" + (f": {last}" if last else "")
-        return why
+                whys[login] = str(e)
+        deadline = time.monotonic() + timeout_s
+        for login, p in procs.items():
+            try:
+                _, err = p.communicate(timeout=max(0.0, deadline - time.monotonic()))
+            except subprocess.TimeoutExpired:
+                whys[login] = f"no answer within {timeout_s:g} s"
+                continue
+            if p.returncode != 0:
+                last = (err.strip().splitlines() or [""])[-1]
+                whys[login] = f"the login exited {p.returncode}" + (f": {last}" if last else "")
+    finally:
+        for p in procs.values():
+            if p.poll() is None:
+                with contextlib.suppress(ProcessLookupError, PermissionError):
+                    os.killpg(p.pid, signal.SIGKILL)
+                p.wait()
+    return whys
 
 
-def answering(logins):
-    """The logins of the hosts that answer, all checked at once. A host
-    that does not is named, with why, and left out of this try (GNU
-    parallel's own --filter-hosts is not used: on the CI machine its probe
-    of a host's cores came back short, and it then stopped the whole run
-    with an internal error, "ncores missing", instead of leaving the host
-    out)."""
-    with concurrent.futures.ThreadPoolExecutor(max_workers=len(logins)) as pool:
-        whys = list(pool.map(lambda login: login.why_not_answering(), logins))
-    for login, why in zip(logins, whys):
-        if why is not None:
-            say(f"sweep: host {login.host} does not answer ({why}): left out of this try")
-    return [login for login, why in zip(logins, whys) if why is None]
+def answering(logins, tries=2, timeout_s=PROBE_TIMEOUT_S):
+    """The logins of the hosts that answer: each logged in to at once, a
+    host that does not tried once more. One that still does not is named,
+    with why, and left out of this try (GNU parallel's own --filter-hosts is
+    not used: on the CI machine its probe of a host's cores came back short,
+    and it then stopped the whole run with an internal error, "ncores
+    missing", instead of leaving the host out)."""
+    whys = {}
+    pending = [login for login in logins if login.probe is not None]
+    for _ in range(tries):
+        whys = probe_once(pending, timeout_s)
+        pending = [login for login in pending if login in whys]
+        if not pending:
+            break
+    for login in pending:
+        say(f"sweep: host {login.host} does not answer ({whys[login]}): left out of this try")
+    return [login for login in logins if login not in pending]
 
 
 class Progress:
     """A progress bar on a terminal; a line every tenth otherwise."""
 
-    def __init__(self, total, cached):
-        self.total, self.done, self.failed, self.t0 = total, cached, 0, time.monotonic()
-        self.cached, self.tty, self.last_tenth = cached, sys.stderr.isatty(), -1
+    def __init__(self, total, done, cached):
+        """done: cells with their result before this try (cached: of them,
+        those that came from the cache)."""
+        self.total, self.done, self.failed, self.t0 = total, done, 0, time.monotonic()
+        self.start, self.cached, self.tty, self.last_tenth = done, cached, sys.stderr.isatty(), -1
         self.show()
 
     def recovered(self, ok):
@@ -285,7 +304,7 @@ class Progress:
 
     def show(self, end=False):
         frac = self.done / self.total if self.total else 1.0
-        rate = (self.done - self.cached) / max(time.monotonic() - self.t0, 1e-9)
+        rate = (self.done - self.start) / max(time.monotonic() - self.t0, 1e-9)
         bar = "#" * int(30 * frac) + "." * (30 - int(30 * frac))
         line = (f"sweep [{bar}] {self.done}/{self.total} cells ({self.cached} cached, "
                 f"{self.failed} failed) {rate:.1f} cells/s")
@@ -303,33 +322,79 @@ def batch_size(cells, slots):
     return max(1, min(32, -(-cells // (4 * max(slots, 1)))))
 
 
-def parallel_command(sweep_dir, args, round_no, cells):
-    """GNU parallel's command line: the cells' lines (cells.tsv's form) on
-    its standard input, --pipe hands each job a batch of them."""
+def parallel_command(args, joblog, cells):
+    """GNU parallel's command line and the cells a job: the cells' lines
+    (cells.tsv's form) on its standard input, --pipe hands each job a batch
+    of them. None when no host of the lab answers."""
     cell, env_build, slots = CELL, {}, args.jobs or os.cpu_count() or 1
-    cmd = ["parallel", "--will-cite", "--pipe", "--line-buffer", "--halt", "never", "--joblog",
-           os.path.join(sweep_dir, f"joblog-{time.strftime('%Y%m%dT%H%M%S')}-{os.getpid()}-try{round_no}")]
+    cmd = ["parallel", "--will-cite", "--pipe", "--line-buffer", "--halt", "never", "--joblog", joblog]
     if args.workers:
         logins, cell, remote_build, per_host = args.workers
         live = answering(logins) if len(logins) > 1 else logins
         if not live:
-            return None
+            return None, 0
         for login in live:
             cmd += ["--sshlogin", login.sshlogin]
         cmd += ["--ssh", SSH_OPTIONS]
         if per_host > 0:
             cmd += ["--jobs", str(per_host)]
         if len(live) > 1:
-            # A batch that fails on one host is tried on another within the try.
+            # A batch that fails on one host (an error line, or no line) is
+            # tried on another within the try.
             cmd += ["--retries", str(len(live))]
         if remote_build:
             env_build = {"RMSLAB_BUILD": remote_build}
         slots = len(live) * (per_host if per_host > 0 else 2)
     else:
         cmd += ["--jobs", str(slots)]
+    # Nothing of the user's in the command: GNU parallel reads {...} in it
+    # as its replacement strings (check_parallel_paths refused braces in these).
     prefix = " ".join(f"{k}={shlex.quote(v)}" for k, v in env_build.items())
-    template = f"{prefix} {shlex.quote(cell)} --cells {shlex.quote(sweep_dir)}".strip()
-    return cmd + ["-N", str(batch_size(cells, slots)), template]
+    template = f"{prefix} {shlex.quote(cell)} --cells".strip()
+    k = batch_size(cells, slots)
+    return cmd + ["-N", str(k), template], k
+
+
+def check_parallel_paths(workers):
+    """GNU parallel reads braces in its command as replacement strings (even
+    perl code, {=...=}): the paths that go into it must have none."""
+    paths = [CELL] + ([workers[1], workers[2]] if workers else [])
+    for p in paths:
+        if p and ("{" in p or "}" in p):
+            raise LabError(f"{p}: a path with braces cannot go into GNU parallel's command "
+                           "(it reads them as its replacement strings)")
+
+
+def failed_jobs(joblog):
+    """{job number: (host, exit code, signal)} of the jobs the joblog says
+    failed (its last try of each)."""
+    failed = {}
+    with contextlib.suppress(OSError):
+        with open(joblog) as f:
+            next(f, None)  # the header
+            for line in f:
+                col = line.rstrip("\n").split("\t")
+                if len(col) >= 8 and col[0].isdigit() and (col[6] != "0" or col[7] != "0"):
+                    failed[int(col[0])] = (col[1], col[6], col[7])
+    return failed
+
+
+def why_no_line(todo, joblog, per_job):
+    """The reason of each cell of todo that had no line: its batch's end as
+    the joblog tells it (job N got todo's lines (N-1)K+1..NK, in order)."""
+    failed = failed_jobs(joblog)
+    for i, c in enumerate(todo):
+        if "line" in c:
+            continue
+        job = i // per_job + 1
+        if job in failed:
+            host, code, sig = failed[job]
+            where = "this machine" if host == ":" else host
+            c["error"] = (f"no result: its batch (GNU parallel's job {job}, on {where}) ended with exit code "
+                          f"{code}" + (f", signal {sig}" if sig != "0" else "") + " before this cell's line")
+        else:
+            c["error"] = ("no result: its batch gave no line for it (a host that did not answer? see the "
+                          "joblog and GNU parallel's lines below)")
 
 
 def run_parallel(todo, sweep_dir, args, progress, round_no, on_result):
@@ -339,19 +404,25 @@ def run_parallel(todo, sweep_dir, args, progress, round_no, on_result):
     if not shutil.which("parallel"):
         raise LabError("GNU parallel is not installed: run scripts/install-deps", 1)
     todo_file = os.path.join(sweep_dir, f"todo-{os.getpid()}.tsv")
-    cmd = parallel_command(sweep_dir, args, round_no, len(todo))
+    joblog = os.path.join(sweep_dir, f"joblog-{time.strftime('%Y%m%dT%H%M%S')}-{os.getpid()}-try{round_no}")
+    cmd, per_job = parallel_command(args, joblog, len(todo))
     if cmd is None:
         for c in todo:
             c["error"] = f"no host of {args.hosts} answered"
+            progress.step(False)
         return []
     write_manifest(todo_file, todo)
     by_index = {c["index"]: c for c in todo}
-    seen, done = set(), set()  # a batch tried again on another host says its cells again
+    for c in todo:
+        c.pop("line", None)
+    done = set()  # a batch tried again on another host says its cells again
     errors = []
     try:
         with open(todo_file) as cells_in:
+            # RMSLAB_SWEEP names the sweep in a batch's environment (on this machine).
             proc = subprocess.Popen(cmd, stdin=cells_in, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                    text=True, start_new_session=True)
+                                    text=True, start_new_session=True,
+                                    env=dict(os.environ, RMSLAB_SWEEP=sweep_dir))
         t = threading.Thread(target=lambda: errors.extend(line.rstrip() for line in proc.stderr),
                              daemon=True)
         t.start()
@@ -365,8 +436,8 @@ def run_parallel(todo, sweep_dir, args, progress, round_no, on_result):
                     continue
                 if cell["index"] in done:
                     continue
-                first = cell["index"] not in seen
-                seen.add(cell["index"])
+                first = "line" not in cell
+                cell["line"] = True
                 ok = on_result(cell, res)
                 if ok:
                     done.add(cell["index"])
@@ -379,6 +450,10 @@ def run_parallel(todo, sweep_dir, args, progress, round_no, on_result):
     finally:
         with contextlib.suppress(OSError):
             os.remove(todo_file)
+    why_no_line(todo, joblog, per_job)
+    for c in todo:
+        if "line" not in c:
+            progress.step(False)
     return errors
 
 
@@ -474,7 +549,7 @@ def parse_args(argv):
     return a
 
 
-def run_cells(a, cells, todo, sweep_dir, cache):
+def run_cells(a, cells, todo, sweep_dir, cache, cached):
     """The missing cells through GNU parallel, tried again up to --retries
     times; each result cached as it arrives. Returns (tries again, errors)."""
     errors, retried, pending = [], 0, todo
@@ -495,9 +570,8 @@ def run_cells(a, cells, todo, sweep_dir, cache):
             retried += len(pending)
             say(f"sweep: trying {len(pending)} failed cells again (try {round_no} of {a.retries + 1})")
         for c in pending:
-            c["error"] = ("no result: its job failed before rms_resim ran (a host that did not answer? "
-                          "see the joblog and GNU parallel's lines below)")
-        progress = Progress(len(cells), len(cells) - len(pending))
+            c["error"] = "no result"  # until its line says otherwise
+        progress = Progress(len(cells), len(cells) - len(pending), cached)
         errors += run_parallel(pending, sweep_dir, a, progress, round_no, on_result)
         progress.show(end=True)
         pending = [c for c in pending if "error" in c]
@@ -546,6 +620,7 @@ def run_sweep(argv):
         raise LabError("a session is given twice (the same folder, by another path or a link)")
     check_designs(sessions, a.grid)
     a.workers = lab_workers(a.hosts, a.jobs) if a.hosts else None
+    check_parallel_paths(a.workers)
     sweep_dir = os.path.abspath(a.out or os.path.join(
         ROOT, "sessions", "sweep-" + time.strftime("%Y%m%dT%H%M%SZ", time.gmtime())))
     check_out(sweep_dir)
@@ -588,7 +663,10 @@ def run_sweep(argv):
     elif todo:
         try:
             with stopped_by_signals():
-                retried, errors = run_cells(a, cells, todo, sweep_dir, cache)
+                try:
+                    retried, errors = run_cells(a, cells, todo, sweep_dir, cache, cached)
+                finally:
+                    drop_if_log_changed(sessions, todo, cache)
         except Interrupted as e:
             done = sum(1 for c in todo if "error" not in c)
             say(f"sweep interrupted ({e.name}): the {done} cells finished in this run are in the cache; "
@@ -598,6 +676,27 @@ def run_sweep(argv):
             results[c["index"]] = None if "error" in c else cache.load(c["key"])
     elapsed = time.monotonic() - t0
     return finish(a, cells, results, todo, sweep_dir, cached, retried, errors, elapsed)
+
+
+def drop_if_log_changed(sessions, todo, cache):
+    """A session whose log is not the one the cache keys were made from
+    (changed, cut short or gone during the sweep): its cells' results of
+    this run are taken out of the cache and the cells failed, as their
+    results may be the changed log's."""
+    for s in sessions:
+        try:
+            same = file_sha256(os.path.join(s.path, "lcmlog")) == s.log_sha
+        except OSError:
+            same = False
+        if same:
+            continue
+        for c in todo:
+            if c["session"] != s.path or "error" in c:
+                continue
+            with contextlib.suppress(OSError):
+                os.remove(cache.path(c["key"]))
+            c["error"] = ("its session's log changed during the sweep (its SHA-256 is no longer the one "
+                          "its cache key was made from): result not kept; run the sweep again")
 
 
 def finish(a, cells, results, todo, sweep_dir, cached, retried, errors, elapsed):
@@ -614,7 +713,7 @@ def finish(a, cells, results, todo, sweep_dir, cached, retried, errors, elapsed)
     for c in failed:
         say(f"  cell {c['index']} FAILED ({os.path.basename(c['session'])} "
             f"{' '.join(f'{k}={v}' for k, v in c['sets'])}): {c['error']}")
-    for e in errors[-5:]:
+    for e in errors[-5:] if failed else []:  # their last lines, when a cell failed
         say(f"  parallel: {e}")
     say(f"table: {csv_path}")
     say(f"page:  {html_path}")

@@ -10,6 +10,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <gtest/gtest.h>
@@ -348,6 +349,27 @@ TEST_F(Investigations, ARerunOrAResumedSweepRedoesNothingFinished) {
   EXPECT_NE(wider.out.find("12 from the cache"), std::string::npos) << wider.out;
 }
 
+// The processes on this machine whose environment says they run a batch
+// of the sweep in `dir` (RMSLAB_SWEEP=dir), "PID COMMAND" a line.
+std::string ProcessesOfSweep(const std::string& dir) {
+  const std::string mark = "RMSLAB_SWEEP=" + dir;
+  std::string found;
+  for (const auto& e : fs::directory_iterator("/proc")) {
+    const std::string pid = e.path().filename().string();
+    if (pid.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::ifstream env(e.path() / "environ");
+    std::string var;
+    bool ours = false;
+    while (std::getline(env, var, '\0')) ours = ours || var == mark;
+    if (!ours) continue;
+    std::string cmd;
+    std::getline(std::ifstream(e.path() / "cmdline"), cmd);
+    std::replace(cmd.begin(), cmd.end(), '\0', ' ');
+    found += pid + " " + cmd + "\n";
+  }
+  return found;
+}
+
 TEST_F(Investigations, ASweepInterruptedKeepsWhatItFinishedAndTheRerunDoesTheRest) {
   const std::string out = *tmp_ + "/interrupted", cache = *tmp_ + "/cache-interrupted";
   const std::vector<std::string> argv = {SourcePath("scripts/lab"),
@@ -377,12 +399,10 @@ TEST_F(Investigations, ASweepInterruptedKeepsWhatItFinishedAndTheRerunDoesTheRes
   EXPECT_EQ(sweep.Wait(60), 130) << ReadFile(out + ".log");
   const std::string said = ReadFile(out + ".log");
   EXPECT_NE(said.find("sweep interrupted (SIGINT): the "), std::string::npos) << said;
-  // No cell left running (each batch names its sweep's folder).
+  // No batch left running (each carries RMSLAB_SWEEP=its folder).
   std::string left;
   for (int i = 0; i < 50; ++i) {
-    const ScriptRun p =
-        Script({"/usr/bin/pgrep", "-af", "sweep-cell --cells " + out}, out + "-pgrep.log");
-    left = p.rc == 0 ? p.out : "";
+    left = ProcessesOfSweep(out);
     if (left.empty()) break;
     usleep(100000);
   }
@@ -395,6 +415,80 @@ TEST_F(Investigations, ASweepInterruptedKeepsWhatItFinishedAndTheRerunDoesTheRes
   EXPECT_NE(rest.out.find(std::to_string(50 - kept) + " cells run"), std::string::npos)
       << kept << " were kept: " << rest.out;
   EXPECT_NE(rest.out.find(std::to_string(kept) + " from the cache"), std::string::npos) << rest.out;
+}
+
+TEST_F(Investigations, ABatchThatDiesOrALogThatChangesLeavesItsCellsFailedWithWhy) {
+  const std::string dir = *tmp_ + "/dying";
+  fs::create_directories(dir + "/build/tools");
+  // A build whose rms_resim dies (SIGKILL) when it is handed a batch; the
+  // real one otherwise (the sweep's checks).
+  for (const auto& e : fs::directory_iterator(testing::BuildPath("tools")))
+    fs::create_symlink(e.path(), fs::path(dir + "/build/tools") / e.path().filename());
+  fs::remove(dir + "/build/tools/rms_resim");
+  std::ofstream(dir + "/build/tools/rms_resim")
+      << "#!/bin/sh\ncase \"$1\" in --cells) kill -9 $$ ;; esac\nexec '"
+      << testing::BuildPath("tools/rms_resim") << "' \"$@\"\n";
+  fs::permissions(dir + "/build/tools/rms_resim", fs::perms::owner_all);
+  const ScriptRun r =
+      Script({"/usr/bin/env", "RMSLAB_BUILD=" + dir + "/build", SourcePath("scripts/lab"), "sweep",
+              *a_, "--vary", "dcp.tpob_ft=0.2,0.3", "--out", dir + "/out", "--cache",
+              dir + "/cache", "--no-build", "--retries", "0", "--jobs", "1"},
+             dir + "/out.log");
+  EXPECT_EQ(r.rc, 1) << r.out;
+  auto rows = ReadCsv(dir + "/out/sweep.csv");
+  ASSERT_EQ(rows.size(), 2u) << r.out;
+  for (const auto& row : rows) {
+    EXPECT_EQ(row.at("status"), "failed");
+    // A batch of one cell each here (two cells, one job slot: ceil(2 / 4)).
+    EXPECT_NE(row.at("error").find("its batch (GNU parallel's job " + row.at("cell") +
+                                   ", on this machine) ended with exit code 137"),
+              std::string::npos)
+        << row.at("error");
+  }
+  EXPECT_NE(r.out.find("sweep [##############################] 2/2 cells (0 cached, 2 failed)"),
+            std::string::npos)
+      << "the progress line does not count the cells lost: " << r.out;
+
+  // A log that changes during the sweep: what was run on it is not kept.
+  const std::string copy = dir + "/session";
+  fs::copy(*a_, copy, fs::copy_options::recursive);
+  const std::vector<std::string> argv = {
+      SourcePath("scripts/lab"),
+      "sweep",
+      copy,
+      "--vary",
+      "dcp.tpob_ft=0.2,0.22,0.25,0.27,0.3,0.32,0.35,0.37,0.4,0.42",
+      "--vary",
+      "arm.upper_boom_ft=20.5,20.7,20.9,21.2,21.5",
+      "--out",
+      dir + "/changing",
+      "--cache",
+      dir + "/cache2",
+      "--no-build",
+      "--retries",
+      "0",
+      "--jobs",
+      "1"};
+  testing::Subprocess sweep(argv, dir + "/changing.log");
+  auto cached = [&] {
+    std::size_t n = 0;
+    if (fs::is_directory(dir + "/cache2"))
+      for (const auto& e : fs::directory_iterator(dir + "/cache2"))
+        n += e.path().extension() == ".json";
+    return n;
+  };
+  for (int i = 0; i < 3000 && cached() < 1 && sweep.Running(); ++i) usleep(10000);
+  if (!sweep.Running()) GTEST_SKIP() << "the sweep ended before its log could be changed";
+  std::ofstream(copy + "/lcmlog", std::ios::app) << "not an event";
+  ASSERT_EQ(sweep.Wait(300), 1) << ReadFile(dir + "/changing.log");
+  EXPECT_EQ(cached(), 0u) << "a result of the changed log was kept";
+  rows = ReadCsv(dir + "/changing/sweep.csv");
+  ASSERT_EQ(rows.size(), 50u);
+  for (const auto& row : rows) {
+    EXPECT_EQ(row.at("status"), "failed");
+    EXPECT_NE(row.at("error").find("its session's log changed during the sweep"), std::string::npos)
+        << row.at("error");
+  }
 }
 
 TEST_F(Investigations, AFailedCellIsTriedAgainAndReportedNeverDropped) {

@@ -7,10 +7,11 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <spdlog/sinks/stdout_color_sinks.h>
@@ -75,20 +76,32 @@ std::vector<std::string> Fields(const std::string& line) {
   return f;
 }
 
+// JSON as text; a string that is no UTF-8 (a path's bytes) has U+FFFD in
+// its place instead of throwing.
+template <class Json>
+std::string Dump(const Json& j) {
+  return j.dump(-1, ' ', false, Json::error_handler_t::replace);
+}
+
 // A sweep's batch of cells (docs/sessions.md "Sweeps"): each line of `in`,
 // "INDEX<TAB>KEY<TAB>SESSION<TAB>KEY=VALUE..." (a line of the sweep's
-// cells.tsv; KEY, the cache's, is not used here), re-simulated in a
+// cells.tsv; KEY, the cache key, is not used here), re-simulated in a
 // temporary folder as --discard does; its result "INDEX<TAB>JSON" on stdout
-// as soon as it is made ({"error": ...} when it has none). Each session's
-// log is read once for all its designs. Exit 0 when every line had its
-// result line, 2 when a line was no cell.
+// as soon as it is made ({"error": ...} when it has none). A session's log
+// is read once for its designs that follow one another (a sweep's lines
+// are session by session); only one session is held at a time. Exit 0
+// when every cell had its result, 1 when a cell had an error line (so GNU
+// parallel --retries tries the batch on another host), 2 when a line was
+// no cell.
 int RunCells(std::istream& in) {
-  std::map<std::string, std::shared_ptr<const rms::resim::RecordedSession>> sessions;
+  std::shared_ptr<const rms::resim::RecordedSession> recorded;
+  std::string recorded_dir;  // the session `recorded` is
   int rc = 0;
   for (std::string line; std::getline(in, line);) {
     if (line.empty()) continue;
     const std::vector<std::string> f = Fields(line);
-    if (f.size() < 3 || f[0].empty() || f[0].find_first_not_of("0123456789") != std::string::npos) {
+    if (f.size() < 3 || f[0].empty() || f[0].size() > 18 ||
+        f[0].find_first_not_of("0123456789") != std::string::npos) {
       std::fprintf(stderr, "rms_resim: --cells: not a cell (INDEX<TAB>KEY<TAB>SESSION...): %s\n",
                    line.c_str());
       rc = 2;
@@ -103,13 +116,17 @@ int RunCells(std::istream& in) {
         opt.settings.push_back(rms::ParseConfigSetting(f[i]));
       if (!rms::resim::OtherDesign(opt))
         throw rms::InputError("a cell needs at least one KEY=VALUE (another design)");
-      auto& recorded = sessions[opt.session];
-      if (!recorded) recorded = rms::resim::ReadRecordedSession(opt.session);
+      if (!recorded || recorded_dir != opt.session) {
+        recorded.reset();  // the last session's memory freed before the next is read
+        recorded = rms::resim::ReadRecordedSession(opt.session);
+        recorded_dir = opt.session;
+      }
       opt.recorded = recorded;
-      out = rms::resim::Resimulate(opt).cell.dump();
+      out = Dump(rms::resim::Resimulate(opt).cell);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "rms_resim: cell %s: %s\n", f[0].c_str(), e.what());
-      out = nlohmann::json{{"error", e.what()}}.dump();
+      out = Dump(nlohmann::json{{"error", e.what()}});
+      rc = std::max(rc, 1);
     }
     std::printf("%s\t%s\n", f[0].c_str(), out.c_str());
     std::fflush(stdout);
@@ -178,15 +195,19 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "resim: %3.0f%% %s\n", 100 * f, line.c_str());
     };
   }
-  if (!cells.empty()) {
-    if (!opt.session.empty() || !sets.empty() || !opt.config_path.empty() || check_only)
+  if (app.count("--cells") > 0) {
+    if (!opt.session.empty() || !sets.empty() || !opt.config_path.empty() || check_only ||
+        !opt.out_dir.empty() || opt.discard || result_json || opt.until_frame >= 0 ||
+        !checkpoint_out.empty())
       return Usage(
-          "--cells: the sessions and keys are in its lines (no SESSION, --set, --config or --check "
-          "beside it)");
+          "--cells: the sessions and keys are in its lines, each cell's result is its line "
+          "(no SESSION, --set, --config, --out, --discard, --result-json, --check, --until or "
+          "--checkpoint-out beside it)");
+    if (cells.empty()) return Usage("--cells: a FILE, or - for standard input");
     spdlog::set_default_logger(spdlog::stderr_color_mt("rms_resim"));
     if (cells == "-") return RunCells(std::cin);
     std::ifstream in(cells);
-    if (!in) {
+    if (!in || std::filesystem::is_directory(cells)) {
       std::fprintf(stderr, "rms_resim: --cells %s: cannot be read\n", cells.c_str());
       return 2;
     }
@@ -214,14 +235,14 @@ int main(int argc, char** argv) {
       rms::WriteWholeFile(checkpoint_out, r.checkpoint_text);
     }
     if (result_json) {
-      std::printf("%s\n", r.cell.dump().c_str());
+      std::printf("%s\n", Dump(r.cell).c_str());
       return 0;
     }
     return Report(r, rms::resim::OtherDesign(opt));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rms_resim: %s\n", e.what());
     // A sweep's cell says why it has no result, on its one line.
-    if (result_json) std::printf("%s\n", nlohmann::json{{"error", e.what()}}.dump().c_str());
+    if (result_json) std::printf("%s\n", Dump(nlohmann::json{{"error", e.what()}}).c_str());
     return 2;
   }
 }
