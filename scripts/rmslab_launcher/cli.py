@@ -31,7 +31,6 @@ summary.json, and stops everything at the end, on Ctrl-C, when the terminal
 closes -- and, through its reaper, when it is itself killed. Each other
 command explains itself with --help.
 """
-import os
 import sys
 
 from . import demo, replay, sweep, tools

@@ -365,7 +365,7 @@ std::string ProcessesOfSweep(const std::string& dir) {
     std::string cmd;
     std::getline(std::ifstream(e.path() / "cmdline"), cmd);
     std::replace(cmd.begin(), cmd.end(), '\0', ' ');
-    found += pid + " " + cmd + "\n";
+    found.append(pid).append(" ").append(cmd).append("\n");
   }
   return found;
 }
