@@ -4,10 +4,11 @@ of configuration values (docs/sessions.md "Sweeps").
 The cells run through GNU parallel (Debian's `parallel`): on this machine's
 cores, or on a lab's hosts (--hosts LABFILE: parallel's ssh logins; a
 "netns:NAME" host through scripts/rmslab_launcher/netns-login), or, with
---slurm, as a Slurm array job written for a cluster. Each cell is
-scripts/sweep-cell: rms_resim SESSION --set KEY=VALUE... --discard
---result-json. Results are cached by the log's hash, the configuration's
-hash and the software's version, so a rerun does only what is missing.
+--slurm, as a Slurm array job written for a cluster. The cells go in
+batches (scripts/sweep-cell --cells: one rms_resim --cells a batch), each
+cell what rms_resim SESSION --set KEY=VALUE... --discard --result-json
+gives. Results are cached by the log's hash, the configuration's hash and
+the software's version, so a rerun does only what is missing.
 """
 import argparse
 import contextlib

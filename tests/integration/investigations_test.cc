@@ -214,7 +214,7 @@ ScriptRun Stdout(const std::string& command, const std::string& log) {
 
 std::string Quoted(const std::string& s) { return "'" + s + "'"; }
 
-TEST_F(Investigations, ABatchOfCellsGivesEachCellsResultAsASingleRunDoes) {
+TEST_F(Investigations, ABatchOfCellsGivesEachCellsResultAsASingleRunAndAWrittenSessionDo) {
   // Both sessions' designs interleaved (each log read once for its designs),
   // a key the configuration lacks, and a line that is no cell.
   const std::string dir = *tmp_ + "/batch";
@@ -224,6 +224,7 @@ TEST_F(Investigations, ABatchOfCellsGivesEachCellsResultAsASingleRunDoes) {
   };
   const std::vector<Cell> cells = {{"7", *a_, "dcp.tpob_ft=0.4"},
                                    {"3", *b_, "arm.upper_boom_ft=21.5"},
+                                   {"4", *b_, "arm.upper_boom_ft=19"},  // collisions, holds
                                    {"12", *a_, "arm.upper_boom_ft=21.5\tdcp.tpob_ft=0.2"},
                                    {"5", *b_, "dcp.no_such_key=1"},
                                    {"9", *b_, "dcp.tpob_ft=0.3"}};
@@ -248,6 +249,12 @@ TEST_F(Investigations, ABatchOfCellsGivesEachCellsResultAsASingleRunDoes) {
         Stdout(Quoted(resim) + " " + Quoted(c.session) + sets + " --discard --result-json --quiet",
                dir + "/single-" + c.index + ".log");
     EXPECT_EQ(line.substr(line.find('\t') + 1) + "\n", single.out);
+    // Made in memory (SummarizeDcpRun), as from the session written and summarised.
+    const ScriptRun written =
+        Stdout(Quoted(resim) + " " + Quoted(c.session) + sets + " --out " +
+                   Quoted(dir + "/written-" + c.index) + " --result-json --quiet",
+               dir + "/written-" + c.index + ".log");
+    EXPECT_EQ(single.out, written.out);
     if (c.index == "5") {
       EXPECT_NE(line.find("\"error\""), std::string::npos) << line;
     }

@@ -85,8 +85,8 @@ std::string Dump(const Json& j) {
 
 // A sweep's batch of cells (docs/sessions.md "Sweeps"): each line of `in`,
 // "INDEX<TAB>KEY<TAB>SESSION<TAB>KEY=VALUE..." (a line of the sweep's
-// cells.tsv; KEY, the cache key, is not used here), re-simulated in a
-// temporary folder as --discard does; its result "INDEX<TAB>JSON" on stdout
+// cells.tsv; KEY, the cache key, is not used here), re-simulated in
+// memory as --discard does; its result "INDEX<TAB>JSON" on stdout
 // as soon as it is made ({"error": ...} when it has none). A session's log
 // is read once for its designs that follow one another (a sweep's lines
 // are session by session); only one session is held at a time. Exit 0
@@ -164,8 +164,8 @@ int main(int argc, char** argv) {
                  "e.g. dcp.tpob_ft=0.4; repeatable (another design)")
       ->type_name("KEY=VALUE");
   app.add_flag("--discard", opt.discard,
-               "Another design: its new session in a temporary folder, removed at the end "
-               "(what remains is the output)");
+               "Another design: no session written, its result made in memory (what remains is "
+               "the output; no --out)");
   app.add_flag("--result-json", result_json,
                "Another design: print only its result, one JSON line on stdout (a sweep's cell: "
                "outcome, recorded outcome, scorecard changes, first divergence)");
@@ -222,6 +222,8 @@ int main(int argc, char** argv) {
     }
     if (result_json && !rms::resim::OtherDesign(opt))
       throw rms::InputError("--result-json needs another design (--config or --set)");
+    if (opt.discard && !opt.out_dir.empty())
+      throw rms::InputError("--discard writes no session: --out has no place beside it");
     if (!checkpoint_out.empty() && opt.until_frame < 0)
       throw rms::InputError("--checkpoint-out needs --until FRAME");
     const rms::resim::ResimResult r = rms::resim::Resimulate(opt);

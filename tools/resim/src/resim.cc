@@ -116,11 +116,9 @@ void TakeState(const dcp_state_t& m, bool first, bool other_design,
 }
 
 // What the re-simulated DCP sent, in DCP frame order, one message a frame
-// (the last sent, were there two); Find looks one up.
-struct Outputs {
-  std::vector<dcp_frame_t> frames;
-  std::vector<dcp_telemetry_t> telemetry;
-};
+// (the last sent, were there two); Find looks one up. With where it sent a
+// restore among them: what its new session's summary is made from.
+using Outputs = session::DcpRun;
 
 // The DCP's own node over a log-backed transport, step by step through the
 // plan (out_log: the new session's log, "" for none).
@@ -145,6 +143,12 @@ Outputs RunDcp(const LabConfig& config, const Recording& rec, const Plan& plan,
     telemetry_run.emplace_back();
     if (wire::SafeDecode(d, n, &telemetry_run.back()) != wire::DecodeError::kNone)
       telemetry_run.pop_back();
+  });
+  std::vector<std::size_t> restores_before;  // where a restore's RMS_DCP_STATE went among them
+  lcm.Subscribe(wire::channels::kDcpState, [&](const void* d, int n, std::int64_t) {
+    dcp_state_t m;
+    if (wire::SafeDecode(d, n, &m) == wire::DecodeError::kNone && m.reason == dcp_state_t::RESTORE)
+      restores_before.push_back(telemetry_run.size());
   });
   const auto t_run = Clock::now();
   const std::size_t n = plan.steps.size();
@@ -172,11 +176,11 @@ Outputs RunDcp(const LabConfig& config, const Recording& rec, const Plan& plan,
   }
   result->run_seconds = std::chrono::duration<double>(Clock::now() - t_run).count();
   if (until_frame >= 0) result->checkpoint_text = wire::CheckpointText(node.MakeCheckpoint());
-  Outputs out{std::move(frames_run), std::move(telemetry_run)};
+  Outputs out{std::move(frames_run), std::move(telemetry_run), std::move(restores_before)};
   SortByFrame(&out.frames);
   SortByFrame(&out.telemetry);
   result->frames = static_cast<long>(out.frames.size());
-  if (other_design) {
+  if (!result->out_dir.empty()) {
     transport::WriteStatsJson((fs::path(result->out_dir) / "stats" / "dynamics_proc.json").string(),
                               "dynamics_proc", node.counters(), node.latencies());
   }
@@ -310,20 +314,9 @@ void CheckUntil(const Recording& rec, const Plan& plan, const ResimOptions& opt,
 // Another design: a new session folder with its configuration, ready for the run's log.
 std::string OpenNewSession(const ResimOptions& opt, const std::string& config_text,
                            ResimResult* result) {
-  if (opt.discard) {
-    // In memory where the machine has it (/dev/shm): a sweep's cells write
-    // and read their short-lived sessions there (docs/performance.md "Sweeps").
-    const bool shm = std::getenv("TMPDIR") == nullptr && access("/dev/shm", W_OK | X_OK) == 0;
-    std::string pattern =
-        ((shm ? fs::path("/dev/shm") : fs::temp_directory_path()) / "rmslab-resim-XXXXXX").string();
-    if (!mkdtemp(pattern.data()))
-      throw InputError("cannot make a temporary folder in " + fs::temp_directory_path().string());
-    result->out_dir = pattern + "/session";
-  } else {
-    result->out_dir = opt.out_dir.empty()
-                          ? (fs::path(opt.session).lexically_normal().string() + "-resim")
-                          : opt.out_dir;
-  }
+  result->out_dir = opt.out_dir.empty()
+                        ? (fs::path(opt.session).lexically_normal().string() + "-resim")
+                        : opt.out_dir;
   session::CreateSessionFolder(result->out_dir);
   WriteWholeFile((fs::path(result->out_dir) / "config.toml").string(), config_text);
   WriteWholeFile((fs::path(result->out_dir) / "run" / "pilot").string(), "resim\n");
@@ -469,15 +462,9 @@ ResimResult Resimulate(const ResimOptions& opt) {
   }
   result.note = plan.note;
   result.skipped = static_cast<long>(plan.first);
-  const std::string out_log = other_design ? OpenNewSession(opt, config_text, &result) : "";
-  // A discarded session's folder goes however the run ends.
-  struct Discard {
-    std::string folder;  // the temporary folder the new session is in ("": none)
-    ~Discard() {
-      std::error_code ec;
-      if (!folder.empty()) fs::remove_all(folder, ec);
-    }
-  } discard{opt.discard && other_design ? fs::path(result.out_dir).parent_path().string() : ""};
+  // Another design discarded (a sweep's cell) is made in memory: no session written.
+  const bool written = other_design && !opt.discard;
+  const std::string out_log = written ? OpenNewSession(opt, config_text, &result) : "";
   if (opt.until_frame >= 0) CheckUntil(rec, plan, opt, other_design);
   const Outputs out =
       RunDcp(config, rec, plan, out_log, other_design, opt.until_frame, progress, &result);
@@ -494,8 +481,14 @@ ResimResult Resimulate(const ResimOptions& opt) {
     result.recorded_seconds =
         (rec.inputs.back().timestamp_us - rec.inputs.front().timestamp_us) / 1e6;
   }
-  if (other_design) WriteNewSession(*recorded, config_path, config_text, config, out, &result);
-  if (!discard.folder.empty()) result.out_dir.clear();
+  if (written) {
+    WriteNewSession(*recorded, config_path, config_text, config, out, &result);
+  } else if (other_design) {
+    result.comparison = DesignComparison(recorded->telemetry(), TelemetryByFrame(out.telemetry),
+                                         config, config.session.frame_rate_hz);
+    result.cell =
+        CellJson(recorded->summary(), config, session::SummarizeDcpRun(config, out), result);
+  }
   return result;
 }
 

@@ -852,6 +852,57 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
   return j;
 }
 
+nlohmann::ordered_json SummarizeDcpRun(const LabConfig& config, const DcpRun& run) {
+  // The frames believed, as ReadDcpFrames finds them in a log of this run.
+  std::vector<std::int64_t> numbers;
+  std::map<std::int64_t, DcpFrameRecord> first;
+  std::vector<wire::ControlWord> words;
+  for (const dcp_frame_t& m : run.frames) {
+    try {
+      const DcpFrameRecord r{m.input_frame, wire::UnpackControlWord(m.control_word)};
+      if (!first.emplace(m.frame, r).second) continue;  // a run publishes a frame once
+      numbers.push_back(m.frame);
+      words.push_back(r.word);
+    } catch (const InputError&) {
+    }
+  }
+  std::map<std::int64_t, DcpFrameRecord> believed;
+  int final_mode = 0;
+  std::set<int> modes;
+  for (const std::size_t i : LongestIncreasingRun(numbers)) {
+    believed.emplace(numbers[i], first.at(numbers[i]));
+    final_mode = words[i].mode;  // ScanFrameNumbers: the last believed frame's mode
+    modes.insert(final_mode);
+  }
+  // The telemetry they confirm, and the restores in their places, as ScanLog reads them.
+  const double rate_hz = config.session.frame_rate_hz;
+  TelemetryLog telemetry(rate_hz);
+  AttemptLog attempts(config);
+  std::set<std::int64_t> seen;
+  std::size_t restore = 0;
+  for (std::size_t i = 0; i < run.telemetry.size(); ++i) {
+    for (; restore < run.restores_before.size() && run.restores_before[restore] <= i; ++restore)
+      attempts.ObserveRestore("");  // no RMS_CONTROL in such a log: no checkpoint's name
+    const dcp_telemetry_t& m = run.telemetry[i];
+    const auto it = believed.find(m.frame);
+    if (it == believed.end() || !Agrees(m, it->second) || !seen.insert(m.frame).second) continue;
+    telemetry.Observe(m, 0, 0);
+    attempts.ObserveFrame(m, it->second.word.reset, m.input_frame / rate_hz);
+  }
+  nlohmann::ordered_json j;
+  j["final_mode"] = final_mode;
+  j["modes_seen"] = std::vector<int>(modes.begin(), modes.end());
+  j["acquired"] = telemetry.acquired;
+  j["docked"] = telemetry.docked;
+  nlohmann::ordered_json a = attempts.Json();
+  j["attempts"] = std::move(a["attempts"]);
+  j["totals"] = std::move(a["totals"]);
+  AddResult(&j);
+  j["held_frames"] = telemetry.held_frames;
+  ForPeople(&j);
+  return j;
+}
+
 nlohmann::ordered_json MakeManifest(const std::string& dir, const ManifestFields& f) {
   const std::string &pilot = f.pilot, &url = f.url, &suffix = f.suffix,
                     &config_sha256 = f.config_sha256, &timeline = f.timeline, &restore = f.restore,

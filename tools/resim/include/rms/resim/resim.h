@@ -31,8 +31,9 @@ struct ResimOptions {
   // Keys set over the configuration (the session's own, or config_path's):
   // another design (docs/sessions.md "Sweeps").
   std::vector<ConfigSetting> settings;
-  bool discard =
-      false;  // another design: its new session in a temporary folder, removed at the end
+  // Another design: no session written; its cell made in memory
+  // (session::SummarizeDcpRun: docs/sessions.md "Re-simulation").
+  bool discard = false;
   // The session's own design, only up to this DCP frame (-1: all): the
   // branch point of scripts/lab demo --from (docs/sessions.md "Branching");
   // ResimResult::checkpoint_text is the DCP's state after it.

@@ -8,11 +8,31 @@
 #include <string>
 #include <vector>
 
+#include "rms/base/config.h"
+#include "rms/dcp_frame_t.hpp"
+#include "rms/dcp_telemetry_t.hpp"
+
 namespace rms::session {
 
 // Reads SESSION/lcmlog and SESSION/stats/*.json. Throws rms::InputError when
 // the log cannot be read.
 nlohmann::ordered_json Summarize(const std::string& session_dir);
+
+// A DCP's run held in memory (a re-simulated design: docs/sessions.md
+// "Sweeps"): its frames and telemetry in the order it published them, and
+// where it published an RMS_DCP_STATE RESTORE among them.
+struct DcpRun {
+  std::vector<dcp_frame_t> frames;
+  std::vector<dcp_telemetry_t> telemetry;
+  std::vector<std::size_t> restores_before;  // telemetry messages published before each restore
+};
+// The mission's part of summary.json -- final_mode, modes_seen, acquired,
+// docked, attempts, totals, result_attempt, phase_durations_s, docking,
+// held_frames -- as Summarize makes it from a log holding this run and
+// nothing else (a re-simulation's log, whose session has no restarts), by
+// the same code (the DCP frames believed, the telemetry they confirm, the
+// attempt log), without writing and reading a log. `config`: the run's.
+nlohmann::ordered_json SummarizeDcpRun(const LabConfig& config, const DcpRun& run);
 
 // The indices of the longest run of strictly increasing values in v, in
 // order (patience sorting, O(n log n)): the DCP's frames a reader of a log
