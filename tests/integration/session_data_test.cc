@@ -176,6 +176,32 @@ TEST_F(HandFlownSession, ReSimulatesWordForWord) {
   EXPECT_NE(r.out.find("the DCP's whole state agreed"), std::string::npos) << r.out;
 }
 
+// A design's cell made in memory (--discard: session::SummarizeDcpRun) is
+// the cell made from its session written and summarised, over a session
+// with a reset, a restore and a restarted DCP.
+TEST_F(HandFlownSession, AnotherDesignsCellMadeInMemoryIsTheWrittenSessionsCell) {
+  const std::string resim = testing::BuildPath("tools/rms_resim");
+  for (const std::string design : {"dcp.tpob_ft=0.4", "arm.upper_boom_ft=19"}) {
+    SCOPED_TRACE(design);
+    const std::string dir = *tmp_ + "/design-" + design;
+    const ScriptRun memory = Script({"/bin/sh", "-c",
+                                     "'" + resim + "' '" + *out_ + "' --set " + design +
+                                         " --discard --result-json --quiet 2>/dev/null"},
+                                    dir + "-memory.log");
+    const ScriptRun written = Script({"/bin/sh", "-c",
+                                      "'" + resim + "' '" + *out_ + "' --set " + design +
+                                          " --out '" + dir + "' --result-json --quiet 2>/dev/null"},
+                                     dir + "-written.log");
+    ASSERT_EQ(written.rc, 0) << written.out;
+    EXPECT_EQ(memory.rc, 0);
+    EXPECT_EQ(memory.out, written.out);
+    const auto summary = nlohmann::json::parse(ReadFile(dir + "/summary.json"));
+    std::set<std::string> starts;
+    for (const auto& a : summary["attempts"]) starts.insert(a["started_by"].get<std::string>());
+    EXPECT_EQ(starts, (std::set<std::string>{"start", "reset", "restore"})) << summary["attempts"];
+  }
+}
+
 TEST_F(HandFlownSession, TheSummaryListsEveryAttempt) {
   const auto s = nlohmann::json::parse(ReadFile(*out_ + "/summary.json"));
   ASSERT_TRUE(s.contains("attempts")) << s.dump(2).substr(0, 2000);
