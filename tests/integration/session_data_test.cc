@@ -184,14 +184,15 @@ TEST_F(HandFlownSession, AnotherDesignsCellMadeInMemoryIsTheWrittenSessionsCell)
   for (const std::string design : {"dcp.tpob_ft=0.4", "arm.upper_boom_ft=19"}) {
     SCOPED_TRACE(design);
     const std::string dir = *tmp_ + "/design-" + design;
-    const ScriptRun memory = Script({"/bin/sh", "-c",
-                                     "'" + resim + "' '" + *out_ + "' --set " + design +
-                                         " --discard --result-json --quiet 2>/dev/null"},
-                                    dir + "-memory.log");
-    const ScriptRun written = Script({"/bin/sh", "-c",
-                                      "'" + resim + "' '" + *out_ + "' --set " + design +
-                                          " --out '" + dir + "' --result-json --quiet 2>/dev/null"},
-                                     dir + "-written.log");
+    // rms_resim SESSION --set DESIGN ... with its stdout alone.
+    auto run = [&](const std::string& rest, const std::string& log) {
+      std::string cmd = "'";
+      cmd.append(resim).append("' '").append(*out_).append("' --set ").append(design);
+      cmd.append(" ").append(rest).append(" --result-json --quiet 2>/dev/null");
+      return Script({"/bin/sh", "-c", cmd}, log);
+    };
+    const ScriptRun memory = run("--discard", dir + "-memory.log");
+    const ScriptRun written = run("--out '" + dir + "'", dir + "-written.log");
     ASSERT_EQ(written.rc, 0) << written.out;
     EXPECT_EQ(memory.rc, 0);
     EXPECT_EQ(memory.out, written.out);
