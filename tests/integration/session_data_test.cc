@@ -17,6 +17,8 @@
 #include <sstream>
 #include <thread>
 
+#include "rms/dcp_state_t.hpp"
+
 #include "lab_processes.h"
 #include "subprocess.h"
 #include "tmux.h"
@@ -200,6 +202,71 @@ TEST_F(HandFlownSession, AnotherDesignsCellMadeInMemoryIsTheWrittenSessionsCell)
     std::set<std::string> starts;
     for (const auto& a : summary["attempts"]) starts.insert(a["started_by"].get<std::string>());
     EXPECT_EQ(starts, (std::set<std::string>{"start", "reset", "restore"})) << summary["attempts"];
+  }
+}
+
+// The same over a forged log: the DCP's RESTORE state logged again just
+// before its last frame, so the re-simulated DCP makes frames it made
+// already (the summary's own rules for repeated frames and restores apply).
+TEST_F(HandFlownSession, ARestoreLoggedAgainGivesTheSameCellInMemoryAsWritten) {
+  struct Event {
+    std::int64_t timestamp;
+    std::string channel;
+    std::vector<std::uint8_t> data;
+  };
+  std::vector<Event> events;
+  {
+    lcm::LogFile in(*out_ + "/lcmlog", "r");
+    while (const lcm::LogEvent* ev = in.readNextEvent()) {
+      const auto* d = static_cast<const std::uint8_t*>(ev->data);
+      events.push_back({ev->timestamp, ev->channel, {d, d + ev->datalen}});
+    }
+  }
+  std::size_t restore = events.size(), last_frame = events.size();
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    const Event& e = events[i];
+    if (e.channel.rfind("RMS_DCP_FRAME", 0) == 0) last_frame = i;
+    rms::dcp_state_t m;
+    if (restore == events.size() && e.channel.rfind("RMS_DCP_STATE", 0) == 0 &&
+        m.decode(e.data.data(), 0, static_cast<int>(e.data.size())) > 0 &&
+        m.reason == rms::dcp_state_t::RESTORE)
+      restore = i;
+  }
+  ASSERT_LT(restore, events.size()) << "the session has no restore";
+  ASSERT_LT(restore, last_frame);
+  Event again = events[restore];
+  again.timestamp = events[last_frame - 1].timestamp;
+  events.insert(events.begin() + static_cast<std::ptrdiff_t>(last_frame), again);
+  const std::string forged = *tmp_ + "/forged";
+  fs::copy(*out_, forged, fs::copy_options::recursive);
+  {
+    lcm::LogFile out(forged + "/lcmlog", "w");
+    for (Event& e : events) {
+      lcm::LogEvent ev{};
+      ev.timestamp = e.timestamp;
+      ev.channel = e.channel;
+      ev.datalen = static_cast<std::int32_t>(e.data.size());
+      ev.data = e.data.data();
+      out.writeEvent(&ev);
+    }
+  }
+  const std::string resim = testing::BuildPath("tools/rms_resim");
+  for (const std::string design : {"dcp.dock_distance_ft=0.01", "arm.upper_boom_ft=21.5"}) {
+    SCOPED_TRACE(design);
+    const std::string dir = *tmp_ + "/forged-" + design;
+    auto run = [&](const std::string& rest, const std::string& log) {
+      std::string cmd = "'";
+      cmd.append(resim).append("' '").append(forged).append("' --set ").append(design);
+      cmd.append(" ").append(rest).append(" --result-json --quiet 2>/dev/null");
+      return Script({"/bin/sh", "-c", cmd}, log);
+    };
+    const ScriptRun memory = run("--discard", dir + "-memory.log");
+    const ScriptRun written = run("--out '" + dir + "'", dir + "-written.log");
+    ASSERT_EQ(written.rc, 0) << written.out;
+    EXPECT_EQ(memory.out, written.out);
+    // The restore was taken: frames the DCP had made are in its new log again.
+    const auto summary = nlohmann::json::parse(ReadFile(dir + "/summary.json"));
+    EXPECT_GT(summary["ignored"]["total"].get<int>(), 0) << summary["ignored"];
   }
 }
 

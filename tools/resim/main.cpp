@@ -222,6 +222,8 @@ int main(int argc, char** argv) {
     }
     if (result_json && !rms::resim::OtherDesign(opt))
       throw rms::InputError("--result-json needs another design (--config or --set)");
+    if (opt.discard && !rms::resim::OtherDesign(opt))
+      throw rms::InputError("--discard needs another design (--config or --set)");
     if (opt.discard && !opt.out_dir.empty())
       throw rms::InputError("--discard writes no session: --out has no place beside it");
     if (!checkpoint_out.empty() && opt.until_frame < 0)

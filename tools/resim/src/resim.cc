@@ -116,9 +116,14 @@ void TakeState(const dcp_state_t& m, bool first, bool other_design,
 }
 
 // What the re-simulated DCP sent, in DCP frame order, one message a frame
-// (the last sent, were there two); Find looks one up. With where it sent a
-// restore among them: what its new session's summary is made from.
-using Outputs = session::DcpRun;
+// (the last sent, were there two); Find looks one up. For a design made in
+// memory, also all of it in the order sent, with its restores: what its
+// summary is made from, as from a log of it.
+struct Outputs {
+  std::vector<dcp_frame_t> frames;
+  std::vector<dcp_telemetry_t> telemetry;
+  session::DcpRun published;
+};
 
 // The DCP's own node over a log-backed transport, step by step through the
 // plan (out_log: the new session's log, "" for none).
@@ -176,7 +181,11 @@ Outputs RunDcp(const LabConfig& config, const Recording& rec, const Plan& plan,
   }
   result->run_seconds = std::chrono::duration<double>(Clock::now() - t_run).count();
   if (until_frame >= 0) result->checkpoint_text = wire::CheckpointText(node.MakeCheckpoint());
-  Outputs out{std::move(frames_run), std::move(telemetry_run), std::move(restores_before)};
+  Outputs out;
+  if (other_design && out_log.empty())
+    out.published = session::DcpRun{frames_run, telemetry_run, std::move(restores_before)};
+  out.frames = std::move(frames_run);
+  out.telemetry = std::move(telemetry_run);
   SortByFrame(&out.frames);
   SortByFrame(&out.telemetry);
   result->frames = static_cast<long>(out.frames.size());
@@ -486,8 +495,8 @@ ResimResult Resimulate(const ResimOptions& opt) {
   } else if (other_design) {
     result.comparison = DesignComparison(recorded->telemetry(), TelemetryByFrame(out.telemetry),
                                          config, config.session.frame_rate_hz);
-    result.cell =
-        CellJson(recorded->summary(), config, session::SummarizeDcpRun(config, out), result);
+    result.cell = CellJson(recorded->summary(), config,
+                           session::SummarizeDcpRun(config, out.published), result);
   }
   return result;
 }

@@ -853,26 +853,36 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
 }
 
 nlohmann::ordered_json SummarizeDcpRun(const LabConfig& config, const DcpRun& run) {
-  // The frames believed, as ReadDcpFrames finds them in a log of this run.
+  // The frames believed, as ReadDcpFrames finds them in a log of this run
+  // (every copy of a number in the run, the first one's record; two that
+  // differ dispute their number).
   std::vector<std::int64_t> numbers;
   std::map<std::int64_t, DcpFrameRecord> first;
-  std::vector<wire::ControlWord> words;
+  std::set<std::int64_t> disputed;
   for (const dcp_frame_t& m : run.frames) {
     try {
       const DcpFrameRecord r{m.input_frame, wire::UnpackControlWord(m.control_word)};
-      if (!first.emplace(m.frame, r).second) continue;  // a run publishes a frame once
+      const auto [it, fresh] = first.emplace(m.frame, r);
+      if (!fresh && (it->second.input_frame != r.input_frame || it->second.word != r.word))
+        disputed.insert(m.frame);
       numbers.push_back(m.frame);
-      words.push_back(r.word);
     } catch (const InputError&) {
     }
   }
   std::map<std::int64_t, DcpFrameRecord> believed;
+  for (const std::size_t i : LongestIncreasingRun(numbers)) {
+    DcpFrameRecord r = first.at(numbers[i]);
+    r.disputed = disputed.count(numbers[i]) > 0;
+    believed.emplace(numbers[i], r);
+  }
+  // ScanFrameNumbers: each frame of a believed number, in order, sets the mode.
   int final_mode = 0;
   std::set<int> modes;
-  for (const std::size_t i : LongestIncreasingRun(numbers)) {
-    believed.emplace(numbers[i], first.at(numbers[i]));
-    final_mode = words[i].mode;  // ScanFrameNumbers: the last believed frame's mode
-    modes.insert(final_mode);
+  for (const std::int64_t n : numbers) {
+    if (const auto it = believed.find(n); it != believed.end()) {
+      final_mode = it->second.word.mode;
+      modes.insert(final_mode);
+    }
   }
   // The telemetry they confirm, and the restores in their places, as ScanLog reads them.
   const double rate_hz = config.session.frame_rate_hz;
@@ -885,7 +895,9 @@ nlohmann::ordered_json SummarizeDcpRun(const LabConfig& config, const DcpRun& ru
       attempts.ObserveRestore("");  // no RMS_CONTROL in such a log: no checkpoint's name
     const dcp_telemetry_t& m = run.telemetry[i];
     const auto it = believed.find(m.frame);
-    if (it == believed.end() || !Agrees(m, it->second) || !seen.insert(m.frame).second) continue;
+    if (it == believed.end() || it->second.disputed || !Agrees(m, it->second) ||
+        !seen.insert(m.frame).second)
+      continue;
     telemetry.Observe(m, 0, 0);
     attempts.ObserveFrame(m, it->second.word.reset, m.input_frame / rate_hz);
   }

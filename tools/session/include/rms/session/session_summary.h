@@ -19,8 +19,9 @@ namespace rms::session {
 nlohmann::ordered_json Summarize(const std::string& session_dir);
 
 // A DCP's run held in memory (a re-simulated design: docs/sessions.md
-// "Sweeps"): its frames and telemetry in the order it published them, and
-// where it published an RMS_DCP_STATE RESTORE among them.
+// "Sweeps"): its frames and telemetry in the order it published them (as a
+// log of it would hold them: repeats and all), and where it published an
+// RMS_DCP_STATE RESTORE among them.
 struct DcpRun {
   std::vector<dcp_frame_t> frames;
   std::vector<dcp_telemetry_t> telemetry;
