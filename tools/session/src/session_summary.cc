@@ -161,8 +161,9 @@ struct DcpFrameRecord {
   bool disputed = false;
 };
 
-// First pass: the session's own DCP frames, by frame number. The DCP
-// numbers its frames upward, across restarts and restores, so the frames
+// First pass: the session's own DCP frames (as logged, in the log's order),
+// by frame number. The DCP numbers its frames upward, across restarts and
+// restores, so the frames
 // believed are the longest run of increasing numbers in the log's order; a
 // frame off it -- a forgery far ahead or behind, with the DCP's own id and
 // pid -- is left out (out_of_sequence), and its telemetry with it. Two
@@ -172,24 +173,20 @@ struct DcpFrames {
   std::int64_t out_of_sequence = 0;
 };
 
-DcpFrames ReadDcpFrames(SessionLog& log) {
+DcpFrames BelieveDcpFrames(const std::vector<dcp_frame_t>& frames) {
   std::vector<std::int64_t> numbers;
-  std::vector<DcpFrameRecord> records;
   std::map<std::int64_t, DcpFrameRecord> first;
   std::set<std::int64_t> disputed;
-  log.Read({wire::channels::kDcpFrame}, [&](const LogMessage& ev) {
-    dcp_frame_t m;
-    if (!log.Decode(ev, &m)) return;
+  for (const dcp_frame_t& m : frames) {
     try {
       const DcpFrameRecord r{m.input_frame, wire::UnpackControlWord(m.control_word)};
       const auto [it, fresh] = first.emplace(m.frame, r);
       if (!fresh && (it->second.input_frame != r.input_frame || it->second.word != r.word))
         disputed.insert(m.frame);
       numbers.push_back(m.frame);
-      records.push_back(r);
     } catch (const InputError&) {
     }
-  });
+  }
   DcpFrames out;
   for (const std::size_t i : LongestIncreasingRun(numbers)) {
     DcpFrameRecord r = first.at(numbers[i]);
@@ -200,6 +197,15 @@ DcpFrames ReadDcpFrames(SessionLog& log) {
     if (!out.by_frame.count(n)) ++out.out_of_sequence;
   }
   return out;
+}
+
+DcpFrames ReadDcpFrames(SessionLog& log) {
+  std::vector<dcp_frame_t> frames;
+  log.Read({wire::channels::kDcpFrame}, [&](const LogMessage& ev) {
+    frames.emplace_back();
+    if (!log.Decode(ev, &frames.back())) frames.pop_back();
+  });
+  return BelieveDcpFrames(frames);
 }
 
 // The telemetry agrees with the DCP frame of its number: the same input
@@ -853,33 +859,13 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
 }
 
 nlohmann::ordered_json SummarizeDcpRun(const LabConfig& config, const DcpRun& run) {
-  // The frames believed, as ReadDcpFrames finds them in a log of this run
-  // (every copy of a number in the run, the first one's record; two that
-  // differ dispute their number).
-  std::vector<std::int64_t> numbers;
-  std::map<std::int64_t, DcpFrameRecord> first;
-  std::set<std::int64_t> disputed;
-  for (const dcp_frame_t& m : run.frames) {
-    try {
-      const DcpFrameRecord r{m.input_frame, wire::UnpackControlWord(m.control_word)};
-      const auto [it, fresh] = first.emplace(m.frame, r);
-      if (!fresh && (it->second.input_frame != r.input_frame || it->second.word != r.word))
-        disputed.insert(m.frame);
-      numbers.push_back(m.frame);
-    } catch (const InputError&) {
-    }
-  }
-  std::map<std::int64_t, DcpFrameRecord> believed;
-  for (const std::size_t i : LongestIncreasingRun(numbers)) {
-    DcpFrameRecord r = first.at(numbers[i]);
-    r.disputed = disputed.count(numbers[i]) > 0;
-    believed.emplace(numbers[i], r);
-  }
+  // The frames believed, as ReadDcpFrames finds them in a log of this run.
+  const std::map<std::int64_t, DcpFrameRecord> believed = BelieveDcpFrames(run.frames).by_frame;
   // ScanFrameNumbers: each frame of a believed number, in order, sets the mode.
   int final_mode = 0;
   std::set<int> modes;
-  for (const std::int64_t n : numbers) {
-    if (const auto it = believed.find(n); it != believed.end()) {
+  for (const dcp_frame_t& m : run.frames) {
+    if (const auto it = believed.find(m.frame); it != believed.end()) {
       final_mode = it->second.word.mode;
       modes.insert(final_mode);
     }
