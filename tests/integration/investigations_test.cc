@@ -356,6 +356,14 @@ TEST_F(Investigations, ARerunOrAResumedSweepRedoesNothingFinished) {
   EXPECT_NE(wider.out.find("12 from the cache"), std::string::npos) << wider.out;
 }
 
+// The results a sweep's cache holds (its .json entries).
+std::size_t CachedResults(const std::string& cache) {
+  std::size_t n = 0;
+  if (fs::is_directory(cache))
+    for (const auto& e : fs::directory_iterator(cache)) n += e.path().extension() == ".json";
+  return n;
+}
+
 // The processes on this machine whose environment says they run a batch
 // of the sweep in `dir` (RMSLAB_SWEEP=dir), "PID COMMAND" a line.
 std::string ProcessesOfSweep(const std::string& dir) {
@@ -395,12 +403,7 @@ TEST_F(Investigations, ASweepInterruptedKeepsWhatItFinishedAndTheRerunDoesTheRes
                                          "--jobs",
                                          "1"};
   testing::Subprocess sweep(argv, out + ".log");
-  auto cached = [&] {
-    std::size_t n = 0;
-    if (fs::is_directory(cache))
-      for (const auto& e : fs::directory_iterator(cache)) n += e.path().extension() == ".json";
-    return n;
-  };
+  auto cached = [&] { return CachedResults(cache); };
   for (int i = 0; i < 600 && cached() < 3 && sweep.Running(); ++i) usleep(50000);
   sweep.Signal(SIGINT);
   EXPECT_EQ(sweep.Wait(60), 130) << ReadFile(out + ".log");
@@ -477,13 +480,7 @@ TEST_F(Investigations, ABatchThatDiesOrALogThatChangesLeavesItsCellsFailedWithWh
       "--jobs",
       "1"};
   testing::Subprocess sweep(argv, dir + "/changing.log");
-  auto cached = [&] {
-    std::size_t n = 0;
-    if (fs::is_directory(dir + "/cache2"))
-      for (const auto& e : fs::directory_iterator(dir + "/cache2"))
-        n += e.path().extension() == ".json";
-    return n;
-  };
+  auto cached = [&] { return CachedResults(dir + "/cache2"); };
   for (int i = 0; i < 3000 && cached() < 1 && sweep.Running(); ++i) usleep(10000);
   if (!sweep.Running()) GTEST_SKIP() << "the sweep ended before its log could be changed";
   std::ofstream(copy + "/lcmlog", std::ios::app) << "not an event";

@@ -100,6 +100,17 @@ void CopyWithLog(const std::string& from, const std::string& to,
   }
 }
 
+// A design's cell: rms_resim SESSION --set DESIGN REST --result-json, its
+// stdout alone (REST: --discard, or --out DIR).
+ScriptRun CellOf(const std::string& session, const std::string& design, const std::string& rest,
+                 const std::string& log) {
+  std::string cmd = "'";
+  cmd.append(testing::BuildPath("tools/rms_resim")).append("' '").append(session);
+  cmd.append("' --set ").append(design).append(" ").append(rest);
+  cmd.append(" --result-json --quiet 2>/dev/null");
+  return Script({"/bin/sh", "-c", cmd}, log);
+}
+
 class HandFlownSession : public ::testing::Test {
  protected:
   // Flown once, by hand in tmux, under CPU load; shared by the tests that read it.
@@ -182,16 +193,11 @@ TEST_F(HandFlownSession, ReSimulatesWordForWord) {
 // the cell made from its session written and summarised, over a session
 // with a reset, a restore and a restarted DCP.
 TEST_F(HandFlownSession, AnotherDesignsCellMadeInMemoryIsTheWrittenSessionsCell) {
-  const std::string resim = testing::BuildPath("tools/rms_resim");
   for (const std::string design : {"dcp.tpob_ft=0.4", "arm.upper_boom_ft=19"}) {
     SCOPED_TRACE(design);
     const std::string dir = *tmp_ + "/design-" + design;
-    // rms_resim SESSION --set DESIGN ... with its stdout alone.
     auto run = [&](const std::string& rest, const std::string& log) {
-      std::string cmd = "'";
-      cmd.append(resim).append("' '").append(*out_).append("' --set ").append(design);
-      cmd.append(" ").append(rest).append(" --result-json --quiet 2>/dev/null");
-      return Script({"/bin/sh", "-c", cmd}, log);
+      return CellOf(*out_, design, rest, log);
     };
     const ScriptRun memory = run("--discard", dir + "-memory.log");
     const ScriptRun written = run("--out '" + dir + "'", dir + "-written.log");
@@ -250,15 +256,11 @@ TEST_F(HandFlownSession, ARestoreLoggedAgainGivesTheSameCellInMemoryAsWritten) {
       out.writeEvent(&ev);
     }
   }
-  const std::string resim = testing::BuildPath("tools/rms_resim");
   for (const std::string design : {"dcp.dock_distance_ft=0.01", "arm.upper_boom_ft=21.5"}) {
     SCOPED_TRACE(design);
     const std::string dir = *tmp_ + "/forged-" + design;
     auto run = [&](const std::string& rest, const std::string& log) {
-      std::string cmd = "'";
-      cmd.append(resim).append("' '").append(forged).append("' --set ").append(design);
-      cmd.append(" ").append(rest).append(" --result-json --quiet 2>/dev/null");
-      return Script({"/bin/sh", "-c", cmd}, log);
+      return CellOf(forged, design, rest, log);
     };
     const ScriptRun memory = run("--discard", dir + "-memory.log");
     const ScriptRun written = run("--out '" + dir + "'", dir + "-written.log");
