@@ -685,15 +685,16 @@ def drop_if_log_changed(sessions, todo, cache):
     this run are taken out of the cache and the cells failed, as their
     results may be the changed log's."""
     for s in sessions:
+        kept = [c for c in todo if c["session"] == s.path and "error" not in c]
+        if not kept:
+            continue  # nothing of this run to keep or drop: its log is not read again
         try:
             same = file_sha256(os.path.join(s.path, "lcmlog")) == s.log_sha
         except OSError:
             same = False
         if same:
             continue
-        for c in todo:
-            if c["session"] != s.path or "error" in c:
-                continue
+        for c in kept:
             with contextlib.suppress(OSError):
                 os.remove(cache.path(c["key"]))
             c["error"] = ("its session's log changed during the sweep (its SHA-256 is no longer the one "

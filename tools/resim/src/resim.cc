@@ -1,11 +1,8 @@
 #include "rms/resim/resim.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -377,10 +374,10 @@ nlohmann::ordered_json CellJson(const nlohmann::json& recorded, const LabConfig&
 }
 
 // Another design's session: its manifest (the parent's subject and note go
-// with the inputs), summary, comparison.json and comparison.md.
+// with the inputs), summary, comparison.json (result->comparison, with the
+// configuration's changes added) and comparison.md.
 void WriteNewSession(const RecordedSession& recorded, const std::string& config_path,
-                     const std::string& config_text, const LabConfig& config, const Outputs& out,
-                     ResimResult* result) {
+                     const std::string& config_text, const LabConfig& config, ResimResult* result) {
   const fs::path dir(result->out_dir), session(recorded.dir());
   session::ManifestFields mf;
   mf.pilot = "resim";
@@ -400,8 +397,6 @@ void WriteNewSession(const RecordedSession& recorded, const std::string& config_
                  session::MakeManifest(dir.string(), mf).dump(2) + "\n");
   const nlohmann::ordered_json summary = session::Summarize(dir.string());
   WriteWholeFile((dir / "summary.json").string(), summary.dump(2) + "\n");
-  result->comparison = DesignComparison(recorded.telemetry(), TelemetryByFrame(out.telemetry),
-                                        config, config.session.frame_rate_hz);
   result->comparison["config_changes"] = ConfigChanges(recorded.config_keys(), config_text);
   result->comparison["frames_identical"] = result->identical;
   result->comparison["frames_compared"] = result->compared;
@@ -490,11 +485,13 @@ ResimResult Resimulate(const ResimOptions& opt) {
     result.recorded_seconds =
         (rec.inputs.back().timestamp_us - rec.inputs.front().timestamp_us) / 1e6;
   }
-  if (written) {
-    WriteNewSession(*recorded, config_path, config_text, config, out, &result);
-  } else if (other_design) {
+  if (other_design) {
     result.comparison = DesignComparison(recorded->telemetry(), TelemetryByFrame(out.telemetry),
                                          config, config.session.frame_rate_hz);
+  }
+  if (written) {
+    WriteNewSession(*recorded, config_path, config_text, config, &result);
+  } else if (other_design) {
     result.cell = CellJson(recorded->summary(), config,
                            session::SummarizeDcpRun(config, out.published), result);
   }

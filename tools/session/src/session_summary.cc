@@ -163,8 +163,7 @@ struct DcpFrameRecord {
 
 // First pass: the session's own DCP frames (as logged, in the log's order),
 // by frame number. The DCP numbers its frames upward, across restarts and
-// restores, so the frames
-// believed are the longest run of increasing numbers in the log's order; a
+// restores, so the frames believed are the longest run of increasing numbers in the log's order; a
 // frame off it -- a forgery far ahead or behind, with the DCP's own id and
 // pid -- is left out (out_of_sequence), and its telemetry with it. Two
 // different frames of one number mark that number disputed.
@@ -332,6 +331,20 @@ struct LogScan {
   std::vector<std::string> in_force;
 };
 
+// Why a telemetry message is not believed, as SenderCheck counts it, or
+// nullptr when it is: it is believed only where the DCP frame of its number
+// (believed, not disputed) says the same, and once a frame (`believed`: the
+// frames whose telemetry was; docs/security.md "What the summary trusts").
+const char* Disbelief(const dcp_telemetry_t& m, const std::map<std::int64_t, DcpFrameRecord>& dcp,
+                      std::set<std::int64_t>* believed) {
+  const auto it = dcp.find(m.frame);
+  if (it == dcp.end()) return "telemetry_without_its_dcp_frame";
+  if (it->second.disputed) return "disputed_dcp_frame";
+  if (!Agrees(m, it->second)) return "telemetry_contradicts_its_dcp_frame";
+  if (!believed->insert(m.frame).second) return "repeated_frame";
+  return nullptr;
+}
+
 void ScanTelemetry(const LogMessage& ev, const std::map<std::int64_t, DcpFrameRecord>& dcp,
                    SenderCheck* check, LogScan* s) {
   dcp_telemetry_t m{};
@@ -339,16 +352,10 @@ void ScanTelemetry(const LogMessage& ev, const std::map<std::int64_t, DcpFrameRe
     ++s->malformed;
     return;
   }
-  // The telemetry is believed only where the DCP frame of its number says
-  // the same (docs/security.md "What the summary trusts").
-  const auto it = dcp.find(m.frame);
-  if (it == dcp.end()) return check->Count("telemetry_without_its_dcp_frame");
-  s->telemetry_logged.insert(m.frame);  // in the record, believed or not
-  if (it->second.disputed) return check->Count("disputed_dcp_frame");
-  if (!Agrees(m, it->second)) return check->Count("telemetry_contradicts_its_dcp_frame");
-  if (!s->telemetry_frames.insert(m.frame).second) return check->Count("repeated_frame");
+  if (dcp.count(m.frame)) s->telemetry_logged.insert(m.frame);  // in the record, believed or not
+  if (const char* why = Disbelief(m, dcp, &s->telemetry_frames)) return check->Count(why);
   s->telemetry.Observe(m, ev.log_us, s->first_us);
-  s->attempts->ObserveFrame(m, it->second.word.reset, m.input_frame / s->rate_hz);
+  s->attempts->ObserveFrame(m, dcp.at(m.frame).word.reset, m.input_frame / s->rate_hz);
 }
 
 void ScanStatus(const LogMessage& ev, LogScan* s) {
@@ -571,12 +578,13 @@ nlohmann::ordered_json Restarts(const fs::path& root) {
   return restarts;
 }
 
-void AddMission(const LogScan& s, nlohmann::ordered_json* out) {
+void AddMission(int final_mode, const std::set<int>& modes, const TelemetryLog& telemetry,
+                nlohmann::ordered_json* out) {
   nlohmann::ordered_json& j = *out;
-  j["final_mode"] = s.final_mode;
-  j["modes_seen"] = std::vector<int>(s.modes.begin(), s.modes.end());
-  j["acquired"] = s.telemetry.acquired;
-  j["docked"] = s.telemetry.docked;
+  j["final_mode"] = final_mode;
+  j["modes_seen"] = std::vector<int>(modes.begin(), modes.end());
+  j["acquired"] = telemetry.acquired;
+  j["docked"] = telemetry.docked;
 }
 
 // Messages a receiver refused for a reason of its own, not malformed
@@ -754,7 +762,7 @@ void AddSessionFields(const fs::path& root, const LogScan& s, double duration_s,
     (*j)["session"] = fs::absolute(root).parent_path().filename().string();
   if (session_id != 0) (*j)["session_id"] = wire::FormatSessionId(session_id);
   (*j)["duration_s"] = duration_s;
-  AddMission(s, j);
+  AddMission(s.final_mode, s.modes, s.telemetry, j);
   std::ifstream pilot((root / "run" / "pilot").string());
   std::string who;
   if (pilot >> who) (*j)["pilot"] = who;
@@ -880,18 +888,12 @@ nlohmann::ordered_json SummarizeDcpRun(const LabConfig& config, const DcpRun& ru
     for (; restore < run.restores_before.size() && run.restores_before[restore] <= i; ++restore)
       attempts.ObserveRestore("");  // no RMS_CONTROL in such a log: no checkpoint's name
     const dcp_telemetry_t& m = run.telemetry[i];
-    const auto it = believed.find(m.frame);
-    if (it == believed.end() || it->second.disputed || !Agrees(m, it->second) ||
-        !seen.insert(m.frame).second)
-      continue;
+    if (Disbelief(m, believed, &seen)) continue;
     telemetry.Observe(m, 0, 0);
-    attempts.ObserveFrame(m, it->second.word.reset, m.input_frame / rate_hz);
+    attempts.ObserveFrame(m, believed.at(m.frame).word.reset, m.input_frame / rate_hz);
   }
   nlohmann::ordered_json j;
-  j["final_mode"] = final_mode;
-  j["modes_seen"] = std::vector<int>(modes.begin(), modes.end());
-  j["acquired"] = telemetry.acquired;
-  j["docked"] = telemetry.docked;
+  AddMission(final_mode, modes, telemetry, &j);
   nlohmann::ordered_json a = attempts.Json();
   j["attempts"] = std::move(a["attempts"]);
   j["totals"] = std::move(a["totals"]);
