@@ -215,21 +215,23 @@ def lab_workers(labfile, jobs):
     for h in hosts:
         n = f"{per_host}/" if per_host > 0 else ""
         if h == "localhost":
-            logins.append(Login(h, f"{n}:", None))
+            logins.append(Login(h, n, ":", None))
         elif h.startswith("netns:"):
-            logins.append(Login(h, f"{n}{NETNS_LOGIN} {h[6:]}", [NETNS_LOGIN, h[6:], "--", "true"]))
+            logins.append(Login(h, n, f"{NETNS_LOGIN} {h[6:]}", [NETNS_LOGIN, h[6:], "--", "true"]))
         else:  # ssh:[USER@]HOST (the reader allows nothing else)
-            logins.append(Login(h, f"{n}{h[4:]}", shlex.split(SSH_OPTIONS) + [h[4:], "true"]))
+            logins.append(Login(h, n, h[4:], shlex.split(SSH_OPTIONS) + [h[4:], "true"]))
     remote_root = lab["remote_root"] or ROOT
     return logins, os.path.join(remote_root, "scripts", "sweep-cell"), lab["remote_build"], per_host
 
 
 class Login:
-    """A lab host as GNU parallel's --sshlogin, and the command (None: this
-    machine) that logs in and runs `true` there."""
+    """A lab host as GNU parallel's --sshlogin (jobs "N/" before the login,
+    as the joblog's Host column does not show them), and the command (None:
+    this machine) that logs in and runs `true` there."""
 
-    def __init__(self, host, sshlogin, probe):
-        self.host, self.sshlogin, self.probe = host, sshlogin, probe
+    def __init__(self, host, jobs, login, probe):
+        self.host, self.login, self.probe = host, login, probe
+        self.sshlogin = jobs + login
 
 
 def probe_once(logins, timeout_s):
@@ -267,9 +269,9 @@ def answering(logins, tries=2, timeout_s=PROBE_TIMEOUT_S):
     """The logins of the hosts that answer: each logged in to at once, a
     host that does not tried once more. One that still does not is named,
     with why, and left out of this try (GNU parallel's own --filter-hosts is
-    not used: on the CI machine its probe of a host's cores came back short,
-    and it then stopped the whole run with an internal error, "ncores
-    missing", instead of leaving the host out)."""
+    not used: when a host's answer to its probe comes back short, it stops
+    the whole run with an internal error, "ncores missing", instead of
+    leaving that host out)."""
     whys = {}
     pending = [login for login in logins if login.probe is not None]
     for _ in range(tries):
@@ -366,36 +368,42 @@ def check_parallel_paths(workers):
                            "(it reads them as its replacement strings)")
 
 
-def failed_jobs(joblog):
-    """{job number: (host, exit code, signal)} of the jobs the joblog says
-    failed (its last try of each)."""
-    failed = {}
+def job_ends(joblog):
+    """{job number: (host, exit code, signal)} of each job of the joblog
+    (its last try)."""
+    ends = {}
     with contextlib.suppress(OSError):
         with open(joblog) as f:
             next(f, None)  # the header
             for line in f:
                 col = line.rstrip("\n").split("\t")
-                if len(col) >= 8 and col[0].isdigit() and (col[6] != "0" or col[7] != "0"):
-                    failed[int(col[0])] = (col[1], col[6], col[7])
-    return failed
+                if len(col) >= 8 and col[0].isdigit():
+                    ends[int(col[0])] = (col[1], col[6], col[7])
+    return ends
 
 
-def why_no_line(todo, joblog, per_job):
+def why_no_line(todo, joblog, per_job, workers):
     """The reason of each cell of todo that had no line: its batch's end as
     the joblog tells it (job N got todo's lines (N-1)K+1..NK, in order)."""
-    failed = failed_jobs(joblog)
+    ends = job_ends(joblog)
+    names = {login.login: login.host for login in workers[0]} if workers else {":": "this machine"}
     for i, c in enumerate(todo):
         if "line" in c:
             continue
         job = i // per_job + 1
-        if job in failed:
-            host, code, sig = failed[job]
-            where = "this machine" if host == ":" else host
+        if job not in ends:
+            c["error"] = ("no result: its batch never ended (GNU parallel's joblog has no line for its job "
+                          f"{job}: a host that did not answer? see GNU parallel's lines below, if any)")
+            continue
+        host, code, sig = ends[job]
+        where = names.get(host, host)
+        if code == "0" and sig == "0":
+            c["error"] = (f"no result: its batch (GNU parallel's job {job}, on {where}) ended with exit code 0 "
+                          "but gave no line for it (the job did not run the cells: see GNU parallel's lines "
+                          "below, if any)")
+        else:
             c["error"] = (f"no result: its batch (GNU parallel's job {job}, on {where}) ended with exit code "
                           f"{code}" + (f", signal {sig}" if sig != "0" else "") + " before this cell's line")
-        else:
-            c["error"] = ("no result: its batch gave no line for it (a host that did not answer? see the "
-                          "joblog and GNU parallel's lines below)")
 
 
 def run_parallel(todo, sweep_dir, args, progress, round_no, on_result):
@@ -451,7 +459,7 @@ def run_parallel(todo, sweep_dir, args, progress, round_no, on_result):
     finally:
         with contextlib.suppress(OSError):
             os.remove(todo_file)
-    why_no_line(todo, joblog, per_job)
+    why_no_line(todo, joblog, per_job, args.workers)
     for c in todo:
         if "line" not in c:
             progress.step(False)

@@ -11,11 +11,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <gtest/gtest.h>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -284,7 +286,14 @@ TEST_F(Investigations, TheSameSweepAcrossTheNamespaceHostsThroughGnuParallel) {
   const std::string lab = write_lab(dir + "/lab.toml", {net.host(1), net.host(2)});
   const ScriptRun local = Sweep(dir + "/local", dir + "/cache-local");
   ASSERT_EQ(local.rc, 0) << local.out;
+  // Started with no SHELL, as a CI job or cron starts it: a namespace
+  // host's login gives the command the user's shell as ssh does (GNU
+  // parallel's remote worker runs each batch with $SHELL).
+  const std::optional<std::string> shell =
+      std::getenv("SHELL") ? std::optional<std::string>(std::getenv("SHELL")) : std::nullopt;
+  unsetenv("SHELL");
   const ScriptRun across = Sweep(dir + "/across", dir + "/cache-across", {"--hosts", lab});
+  if (shell) setenv("SHELL", shell->c_str(), 1);
   ASSERT_EQ(across.rc, 0) << across.out;
   // Every cell ran on one of the lab's hosts (the joblog's Host), and both
   // hosts took cells; the table is the local one, cell for cell.
