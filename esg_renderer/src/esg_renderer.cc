@@ -120,8 +120,8 @@ void EsgRenderer::OnFrame(const void* data, int size, std::int64_t recv_time_us)
 void EsgRenderer::FinishVideo() {
   RenderPending();
   if (video_ && last_rendered_ >= 0 && frames_.last() > last_rendered_) {
-    video_->Add(output_.data(), static_cast<int>(std::clamp<std::int64_t>(
-                                    frames_.last() - last_rendered_, 1, 300)));
+    video_->Add(image_, static_cast<int>(
+                            std::clamp<std::int64_t>(frames_.last() - last_rendered_, 1, 300)));
   }
 }
 
@@ -132,16 +132,18 @@ bool EsgRenderer::RenderPending() {
   const int w = renderer_->width(), h = renderer_->height();
   const std::size_t bytes = static_cast<std::size_t>(w) * h * 4;
   // Skip what the scene doesn't need: the same words but for the frame
-  // counter (word 0) draw the same scene; only the overlay changes.
+  // counter (word 0) draw the same scene and the same overlay but for the
+  // counter, which is drawn again over what lay under it.
   const bool unchanged =
-      options_.skip_unchanged && scene_ && msg.words.size() == last_words_.size() &&
+      options_.skip_unchanged && image_ && msg.words.size() == last_words_.size() &&
       std::equal(msg.words.begin() + 1, msg.words.end(), last_words_.begin() + 1);
   const std::int64_t t0 = MonotonicUs();
   if (unchanged) {
     counters_.Add(Counter::kSkippedUnchanged);
+    RestoreCounterBackdrop(image_, w, h, backdrop_);
   } else {
     renderer_->Render(frame);
-    scene_ = renderer_->pixels();
+    image_ = renderer_->pixels();
     last_words_ = msg.words;
     const RenderStats& s = renderer_->stats();
     counters_.Add(Counter::kRenderedScenes);
@@ -151,8 +153,9 @@ bool EsgRenderer::RenderPending() {
     if (s.cycles_broken) counters_.Add(Counter::kPriorityCyclesBroken, s.cycles_broken);
     latencies_["render"].Add(MonotonicUs() - t0);
   }
-  output_.assign(scene_, scene_ + bytes);
-  if (!options_.id_colors) DrawOverlay(output_.data(), w, h, frame, overlay_);
+  // The overlay over the renderer's own buffer: no copy of the image in the
+  // frame's path (3 MB at 1024x768).
+  if (!options_.id_colors) DrawOverlay(image_, w, h, frame, overlay_, &backdrop_);
   const std::int64_t done = lcm_->NowUs();
   counters_.Add(Counter::kRendered);
   latencies_["esg_to_render"].Add(done - msg.send_time_us);
@@ -164,11 +167,11 @@ bool EsgRenderer::RenderPending() {
     // video keeps the session's time.
     const std::int64_t since = last_rendered_ < 0 ? first_frame_ - 1 : last_rendered_;
     const std::int64_t gap = std::clamp<std::int64_t>(msg.frame - since, 1, 300);
-    video_->Add(output_.data(), static_cast<int>(gap));
+    video_->Add(image_, static_cast<int>(gap));
   }
   if (window_ && window_->open()) {
     // The window alone shows the operator's guidance over the ESG's image.
-    shown_ = output_;
+    shown_.assign(image_, image_ + bytes);
     if (operator_state_) DrawGuidance(shown_.data(), w, h, *operator_state_);
     if (window_->Show(shown_.data())) counters_.Add(Counter::kWindowFrames);
   }
@@ -177,7 +180,7 @@ bool EsgRenderer::RenderPending() {
     char name[64];
     std::snprintf(name, sizeof name, "frame_%06lld.png", static_cast<long long>(msg.frame));
     try {
-      WritePng((std::filesystem::path(options_.png_dir) / name).string(), w, h, output_.data());
+      WritePng((std::filesystem::path(options_.png_dir) / name).string(), w, h, image_);
       counters_.Add(Counter::kPngWritten);
     } catch (const std::exception& e) {
       counters_.Add(Counter::kPngFailed);

@@ -84,7 +84,7 @@ class OsMesaContext final : public GlContext {
     make_current_(ctx_, buffer_.data(), GL_UNSIGNED_BYTE, w_, h_);
     pixel_store_(OSMESA_Y_UP, 0);
   }
-  const std::uint8_t* FinishAndGetPixels() override {
+  std::uint8_t* FinishAndGetPixels() override {
     gl_.Finish();
     return buffer_.data();
   }
@@ -171,7 +171,7 @@ class EglContext final : public GlContext {
     make_current_(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx_);
     gl_.BindFramebuffer(GL_FRAMEBUFFER, fbo_);
   }
-  const std::uint8_t* FinishAndGetPixels() override {
+  std::uint8_t* FinishAndGetPixels() override {
     gl_.Finish();
     gl_.PixelStorei(GL_PACK_ALIGNMENT, 1);
     gl_.ReadPixels(0, 0, w_, h_, GL_RGBA, GL_UNSIGNED_BYTE, raw_.data());

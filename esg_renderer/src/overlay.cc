@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "rms/arm/kinematics.h"
+#include "rms/base/check.h"
 #include "rms/mission/mission_geometry.h"
 #include "rms/scene_model/scene_model.h"
 
@@ -195,8 +196,38 @@ void DrawCrosshairs(std::uint8_t* rgba, int w, int h, const wire::EsgFrameData& 
   }
 }
 
+namespace {
+
+// The rectangle's pixels (clipped to the image) into b.
+void SaveCounterBackdrop(const std::uint8_t* rgba, int w, int h, int x0, int y0, int x1, int y1,
+                         CounterBackdrop* b) {
+  b->x0 = std::clamp(x0, 0, w);
+  b->x1 = std::clamp(x1, b->x0, w);
+  b->y0 = std::clamp(y0, 0, h);
+  b->y1 = std::clamp(y1, b->y0, h);
+  const std::size_t row = static_cast<std::size_t>(b->x1 - b->x0) * 4;
+  b->rgba.resize(row * static_cast<std::size_t>(b->y1 - b->y0));
+  for (int y = b->y0; y < b->y1; ++y) {
+    std::copy_n(rgba + (static_cast<std::size_t>(y) * w + b->x0) * 4, row,
+                b->rgba.data() + row * static_cast<std::size_t>(y - b->y0));
+  }
+}
+
+}  // namespace
+
+void RestoreCounterBackdrop(std::uint8_t* rgba, int w, int h, const CounterBackdrop& b) {
+  RMS_CHECK(b.x0 >= 0 && b.x1 <= w && b.y0 >= 0 && b.y1 <= h && b.x0 <= b.x1 && b.y0 <= b.y1);
+  const std::size_t row = static_cast<std::size_t>(b.x1 - b.x0) * 4;
+  RMS_CHECK(b.rgba.size() == row * static_cast<std::size_t>(b.y1 - b.y0));
+  for (int y = b.y0; y < b.y1; ++y) {
+    std::copy_n(b.rgba.data() + row * static_cast<std::size_t>(y - b.y0), row,
+                rgba + (static_cast<std::size_t>(y) * w + b.x0) * 4);
+  }
+}
+
 void DrawOverlay(std::uint8_t* rgba, int w, int h, const wire::EsgFrameData& f,
-                 const OverlayModel& model) {
+                 const OverlayModel& model, CounterBackdrop* backdrop) {
+  if (backdrop) *backdrop = CounterBackdrop{};
   if (f.control.crosshairs && !f.control.no_video) DrawCrosshairs(rgba, w, h, f, model);
   const std::vector<std::string>& names = model.camera_names;
   const int s = std::max(1, h / 300);
@@ -212,6 +243,11 @@ void DrawOverlay(std::uint8_t* rgba, int w, int h, const wire::EsgFrameData& f,
   const scene_model::Rgb text{230, 230, 120}, dim{90, 90, 90}, black{0, 0, 0};
   char buf[64];
   std::snprintf(buf, sizeof buf, "FRAME %06u", f.frame_count);
+  if (backdrop) {  // wide enough for any counter: "FRAME " and ten digits
+    constexpr int kWidestCounter = 16;
+    SaveCounterBackdrop(rgba, w, h, margin, margin, margin + kWidestCounter * 6 * s, margin + 7 * s,
+                        backdrop);
+  }
   DrawText(rgba, w, h, margin, margin, buf, text, s);
   const int st = f.control.camera_station;
   std::string name = st >= 1 && st <= static_cast<int>(names.size()) ? names[st - 1] : "";

@@ -5,11 +5,14 @@
 #include "rms/esg_renderer/renderer.h"
 
 #include <cmath>
+#include <cstdio>
 #include <gtest/gtest.h>
+#include <random>
 
 #include "rms/base/config.h"
 #include "rms/esg_renderer/draw_order.h"
 #include "rms/esg_renderer/gl_context.h"
+#include "rms/esg_renderer/overlay.h"
 #include "rms/scene_model/scene_model.h"
 #include "rms/scene_proc/camera_stations.h"
 #include "rms/scene_proc/visual_scene_program.h"
@@ -154,6 +157,53 @@ TEST_F(Renderer, PriorityModeDrawsWhatTheDepthBufferDraws) {
     }
   }
   EXPECT_EQ(frames, 16);
+}
+
+// esg_renderer's unchanged frames: the last output image with what lay under
+// its frame counter put back and the overlay drawn again is, pixel for pixel,
+// the image a full redraw gives (the scene and the new frame's overlay), for
+// every station's overlay (crosshairs on the wrist and CAE cameras, lamps,
+// NO VIDEO), counters that gain digits, and images so small that the lamps
+// and the crosshairs run over the counter.
+TEST_F(Renderer, AnUnchangedFramesOverlayDrawnAgainOverTheLastImageIsAFullRedraw) {
+  constexpr unsigned kSeed = 19721122;
+  std::printf("seed %u\n", kSeed);
+  std::mt19937 rng(kSeed);
+  const OverlayModel model = MakeOverlayModel(config);
+  const std::pair<std::uint32_t, std::uint32_t> counters[] = {
+      {41, 42}, {999999, 1000000}, {7, 4294967295u}, {4294967295u, 0}};
+  int checked = 0;
+  for (const auto& [w, h] : {std::pair{1024, 768}, std::pair{320, 240}, std::pair{100, 75}}) {
+    std::vector<std::uint8_t> scene(static_cast<std::size_t>(w) * h * 4);
+    for (auto& b : scene) b = static_cast<std::uint8_t>(rng());
+    for (int station = 1; station <= static_cast<int>(config.cameras.size()); ++station) {
+      wire::EsgFrameData f = Frame({10, 30, -60, 20, 0, 0}, station);
+      f.control.overlay = true;
+      f.control.crosshairs = true;
+      f.control.no_video = station == 2;
+      f.control.collision = f.control.docked = (station % 2) == 0;
+      f.control.acquired = f.control.receptacle_collision = (station % 2) == 1;
+      for (const auto& [before, after] : counters) {
+        f.frame_count = before;
+        std::vector<std::uint8_t> last = scene;
+        CounterBackdrop backdrop;
+        DrawOverlay(last.data(), w, h, f, model, &backdrop);
+        f.frame_count = after;
+        std::vector<std::uint8_t> full = scene;
+        DrawOverlay(full.data(), w, h, f, model);
+        // (On the smallest image the lamps, drawn after it, may hide it.)
+        if (w >= 320) {
+          ASSERT_NE(last, full) << "the counter changed no pixel at " << w << "x" << h;
+        }
+        RestoreCounterBackdrop(last.data(), w, h, backdrop);
+        DrawOverlay(last.data(), w, h, f, model, &backdrop);
+        ASSERT_EQ(last, full) << w << "x" << h << ", station " << station << ", counter " << before
+                              << " -> " << after;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_EQ(checked, 3 * 4 * static_cast<int>(config.cameras.size()));
 }
 
 }  // namespace

@@ -60,7 +60,6 @@ class EsgRenderer {
   std::int64_t last_rendered() const { return last_rendered_; }
   // A live session's receive checks (as DynamicsProc::EnableLiveChecks).
   void EnableLiveChecks(double frame_rate_hz);
-  const std::vector<std::uint8_t>& output() const { return output_; }
 
  private:
   const LabConfig& config_;
@@ -79,12 +78,13 @@ class EsgRenderer {
   // The first frame number accepted: the video starts there even when that
   // frame was superseded before it could be drawn.
   std::int64_t first_frame_ = -1;
-  std::vector<std::int32_t> last_words_;  // the words of the image at scene_
-  // The last rendered scene, before the overlay: the renderer's own buffer,
-  // which nothing else draws into (not copied: a frame is 3 MB at 1024x768).
-  const std::uint8_t* scene_ = nullptr;
-  std::vector<std::uint8_t> output_;  // the last output image, overlay included
-  std::vector<std::uint8_t> shown_;   // the window's: the output and the operator's guidance
+  std::vector<std::int32_t> last_words_;  // the words of the scene at image_
+  // The last output image, overlay included: the renderer's own buffer, which
+  // nothing else draws into (not copied: a frame is 3 MB at 1024x768), null
+  // before the first frame drawn.
+  std::uint8_t* image_ = nullptr;
+  CounterBackdrop backdrop_;         // what lies under its frame counter
+  std::vector<std::uint8_t> shown_;  // the window's: the output and the operator's guidance
   std::optional<operator_state_t>
       operator_state_;  // the newest RMS_OPERATOR_STATE (the window's guidance)
   std::int64_t keys_sequence_ = 0, keys_sent_us_ = 0;

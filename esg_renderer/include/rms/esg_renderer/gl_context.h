@@ -29,7 +29,7 @@ class GlContext {
   virtual void MakeCurrent() = 0;
   // Finishes rendering and returns the frame: RGBA, rows top to bottom,
   // valid until the next frame is drawn.
-  virtual const std::uint8_t* FinishAndGetPixels() = 0;
+  virtual std::uint8_t* FinishAndGetPixels() = 0;
   virtual std::string description() const = 0;
 };
 

@@ -47,8 +47,22 @@ OverlayModel MakeOverlayModel(const LabConfig& config);
 bool ProjectToImage(const wire::EsgFrameData& frame, int width, int height,
                     const Eigen::Vector3d& p_R, double* x, double* y);
 
+// The pixels under the frame counter as they were just before it was drawn
+// (docs/esg.md "Skipping what the scene does not need"): a frame whose words
+// but the counter equal the last one's has the same overlay but for the
+// counter, and all of it is drawn opaque, so the last output image with
+// these put back and the overlay drawn again is the image a full redraw
+// gives, without copying the scene.
+struct CounterBackdrop {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // the rectangle, pixels (x1, y1 past its end)
+  std::vector<std::uint8_t> rgba;      // its pixels, rows top down
+};
+void RestoreCounterBackdrop(std::uint8_t* rgba, int width, int height, const CounterBackdrop& b);
+
+// The overlay over the frame's image; `backdrop`, if given, takes the pixels
+// under the frame counter first (an empty rectangle when none is drawn).
 void DrawOverlay(std::uint8_t* rgba, int width, int height, const wire::EsgFrameData& frame,
-                 const OverlayModel& model);
+                 const OverlayModel& model, CounterBackdrop* backdrop = nullptr);
 
 // The crosshairs (control word CROSSHAIRS, docs/esg.md "Crosshairs"): on a
 // wrist camera, a cross where the grapple target's cross appears when the

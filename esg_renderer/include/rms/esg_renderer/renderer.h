@@ -49,10 +49,10 @@ class FrameRenderer {
  public:
   FrameRenderer(const LabConfig& config, GlContext* context, RenderOptions options);
   void Render(const wire::EsgFrameData& frame);
-  // The frame just drawn: RGBA, rows top down; valid until the next Render.
-  // The last Render's pixels: the context's own buffer, valid until the
-  // next Render on it (the ESG keeps it as its scene between frames).
-  const std::uint8_t* pixels() {
+  // The last Render's pixels, RGBA, rows top down: the context's own
+  // buffer, valid until the next Render on it. The caller may draw over them
+  // (the ESG draws its overlay there, and keeps the image between frames).
+  std::uint8_t* pixels() {
     context_->MakeCurrent();
     return context_->FinishAndGetPixels();
   }
