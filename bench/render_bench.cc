@@ -16,6 +16,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <thread>
 
 #include "rms/base/check.h"
 #include "rms/base/command_line.h"
@@ -48,6 +49,9 @@ struct Options {
   std::string config_path = rms::DefaultConfigPath();
   std::string timeline = std::string(RMSLAB_SOURCE_DIR) + "/scripts/timelines/mission.tl";
   int every = 1, width = 1024, height = 768;
+  // Idle this long before each variant's frame, as the ESG is between a
+  // session's frames (0: back to back, caches and cores warm).
+  double pace_ms = 0.0;
   std::string json_out, gl_name = "osmesa", dump_dir, md_path;
   std::vector<std::string> sizes;
 };
@@ -88,6 +92,8 @@ void DrawVariants(const rms::wire::EsgFrameData& f, const Options& o, std::vecto
   const std::size_t n = static_cast<std::size_t>(o.width) * o.height;
   for (std::size_t k = 0; k < v->size(); ++k) {
     Variant& x = (*v)[k];
+    if (o.pace_ms > 0)
+      std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(o.pace_ms));
     const auto t0 = Clock::now();
     x.renderer->Render(f);
     const std::uint8_t* px = x.renderer->pixels();
@@ -163,8 +169,10 @@ void PrintFigures(const Options& o, const std::vector<Variant>& v, const Mission
   j["gl"] = v[0].gl->description();
   j["frames"] = m.frames;
   j["frames_measured"] = measured;
-  std::printf("%s, %dx%d, %s: %ld frames, %ld measured\n\n", o.timeline.c_str(), o.width, o.height,
-              v[0].gl->description().c_str(), m.frames, measured);
+  j["pace_ms"] = o.pace_ms;
+  std::printf("%s, %dx%d, %s: %ld frames, %ld measured, idle %.1f ms before each\n\n",
+              o.timeline.c_str(), o.width, o.height, v[0].gl->description().c_str(), m.frames,
+              measured, o.pace_ms);
   std::printf("%-40s %9s %9s %9s %9s %10s %12s %8s\n", "variant (selected station)", "mean ms",
               "p50 ms", "p99 ms", "clusters", "triangles", "px differ", "frames");
   for (const Variant& x : v) {
@@ -300,6 +308,12 @@ int main(int argc, char** argv) {
   app.add_option("--json", o.json_out, "Also write the figures as JSON to this file");
   app.add_option("--dump", o.dump_dir,
                  "Write each variant's worst frame, and the reference's, as PNG here");
+  app.add_option(
+         "--pace-ms", o.pace_ms,
+         "Idle this long before each variant's frame, as the ESG between a session's frames "
+         "(33 at 30 Hz; 0: back to back)")
+      ->check(CLI::Range(0.0, 1000.0))
+      ->capture_default_str();
   app.add_option("--md", o.md_path, "Write the tables as markdown to this file");
   app.add_option("--sizes", o.sizes,
                  "Also time the ESG's default renderer and the depth buffer at these sizes (WxH)");

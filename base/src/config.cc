@@ -10,6 +10,8 @@
 #include "rms/base/text.h"
 #include "rms/base/toml_reader.h"
 
+#include "config_table.h"
+
 #ifndef RMSLAB_DEFAULT_CONFIG
 #error "RMSLAB_DEFAULT_CONFIG must be defined by the build"
 #endif
@@ -236,11 +238,12 @@ void ReadCameras(TableReader& top, LabConfig* config) {
 
 }  // namespace
 
-LabConfig ParseConfig(std::string_view text, const std::string& source) {
-  toml::table root = ParseToml(text, source);
+namespace internal {
+
+LabConfig ConfigFromTable(toml::table* root, const std::string& source) {
   LabConfig c;
   c.source = source;
-  TableReader top(&root, "", &c.source);
+  TableReader top(root, "", &c.source);
   // In the file's order; [dcp] is checked against [end_effector] and [payload].
   for (auto read : {ReadSession, ReadShuttle, ReadArm, ReadEndEffector, ReadPayload, ReadCae,
                     ReadDcp, ReadInputs, ReadCameras}) {
@@ -248,6 +251,13 @@ LabConfig ParseConfig(std::string_view text, const std::string& source) {
   }
   top.Finish();
   return c;
+}
+
+}  // namespace internal
+
+LabConfig ParseConfig(std::string_view text, const std::string& source) {
+  toml::table root = ParseToml(text, source);
+  return internal::ConfigFromTable(&root, source);
 }
 
 LabConfig LoadConfig(const std::string& path) {

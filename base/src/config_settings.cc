@@ -6,6 +6,8 @@
 #include "rms/base/check.h"
 #include "rms/base/toml_reader.h"
 
+#include "config_table.h"
+
 namespace rms {
 
 namespace {
@@ -92,9 +94,11 @@ ConfigSetting ParseConfigSetting(const std::string& text) {
   return {text.substr(0, eq), text.substr(eq + 1)};
 }
 
-std::string ApplyConfigSettings(std::string_view toml_text, const std::string& source,
-                                const std::vector<ConfigSetting>& settings) {
-  toml::table root = ParseToml(toml_text, source);
+namespace {
+
+// Each setting put into root in order (ApplyConfigSettings's rules).
+void SetKeys(toml::table& root, const std::string& source,
+             const std::vector<ConfigSetting>& settings) {
   for (const ConfigSetting& s : settings) {
     std::string why;
     const Slot slot = Find(&root, s.key, &why);
@@ -126,9 +130,34 @@ std::string ApplyConfigSettings(std::string_view toml_text, const std::string& s
       value.visit([&](auto&& v) { Put(slot, v); });
     }
   }
+}
+
+}  // namespace
+
+std::string ApplyConfigSettings(std::string_view toml_text, const std::string& source,
+                                const std::vector<ConfigSetting>& settings) {
+  toml::table root = ParseToml(toml_text, source);
+  SetKeys(root, source, settings);
   std::ostringstream os;
   os << root << "\n";
   return os.str();
+}
+
+struct ConfigDesigns::Parsed {
+  toml::table root;
+  std::string source;
+};
+
+ConfigDesigns::ConfigDesigns(std::string_view toml_text, std::string source)
+    : parsed_(std::make_unique<const Parsed>(Parsed{ParseToml(toml_text, source), source})) {}
+
+ConfigDesigns::~ConfigDesigns() = default;
+
+LabConfig ConfigDesigns::With(const std::vector<ConfigSetting>& settings,
+                              const std::string& name) const {
+  toml::table root = parsed_->root;
+  SetKeys(root, parsed_->source, settings);
+  return internal::ConfigFromTable(&root, name);
 }
 
 }  // namespace rms

@@ -75,5 +75,51 @@ TEST(ConfigSettings, ABadSettingIsRefusedNamingTheKeyAndWhy) {
   EXPECT_EQ(s.value, "0.4=x");
 }
 
+// A batch's designs (ConfigDesigns, the text parsed once) give what the text
+// with the keys set and parsed again gives: the same values, bit for bit,
+// and the same refusals, word for word.
+TEST(ConfigSettings, DesignsFromTheTextParsedOnceAreTheTextSetAndParsedAgain) {
+  const ConfigDesigns designs(DefaultText(), "rmslab.toml");
+  const std::vector<std::vector<ConfigSetting>> cases = {
+      {{"dcp.tpob_ft", "0.30000000000000004"}, {"arm.upper_boom_ft", "21"}},
+      {{"arm.base_position_ft", "[1.5, -8.0, 0.25]"}, {"cameras[2].tilt_deg", "[-30, 40.0]"}},
+      {{"session.frame_rate_hz", "60"}, {"dcp.tpob_ft", "0.1"}, {"dcp.tpob_ft", "0.45"}},
+  };
+  for (const auto& settings : cases) {
+    const LabConfig a = designs.With(settings, "cell");
+    const LabConfig b =
+        ParseConfig(ApplyConfigSettings(DefaultText(), "rmslab.toml", settings), "cell");
+    EXPECT_EQ(a.source, b.source);
+    EXPECT_EQ(a.dcp.tpob_ft, b.dcp.tpob_ft);
+    EXPECT_EQ(a.arm.upper_boom_ft, b.arm.upper_boom_ft);
+    EXPECT_EQ(a.arm.p_RoB_R_ft, b.arm.p_RoB_R_ft);
+    EXPECT_EQ(a.session.frame_rate_hz, b.session.frame_rate_hz);
+    ASSERT_EQ(a.cameras.size(), b.cameras.size());
+    for (std::size_t i = 0; i < a.cameras.size(); ++i) {
+      EXPECT_EQ(a.cameras[i].tilt_min_deg, b.cameras[i].tilt_min_deg) << i;
+      EXPECT_EQ(a.cameras[i].tilt_max_deg, b.cameras[i].tilt_max_deg) << i;
+      EXPECT_EQ(a.cameras[i].name, b.cameras[i].name) << i;
+    }
+  }
+  // The text parsed once is not changed by a design.
+  EXPECT_EQ(designs.With({}, "none").dcp.tpob_ft, ParseConfig(DefaultText(), "none").dcp.tpob_ft);
+  auto refusal = [](auto&& make) -> std::string {
+    try {
+      make();
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  for (const auto& bad : std::vector<std::vector<ConfigSetting>>{
+           {{"dcp.no_such_key", "1"}}, {{"dcp.tpob_ft", "\"wide\""}}, {{"dcp.tpob_ft", "-1"}}}) {
+    const std::string a = refusal([&] { designs.With(bad, "cell"); });
+    const std::string b = refusal(
+        [&] { ParseConfig(ApplyConfigSettings(DefaultText(), "rmslab.toml", bad), "cell"); });
+    EXPECT_FALSE(a.empty()) << bad[0].key << "=" << bad[0].value;
+    EXPECT_EQ(a, b);
+  }
+}
+
 }  // namespace
 }  // namespace rms

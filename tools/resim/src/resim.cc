@@ -61,6 +61,16 @@ class RecordedSession {
     if (!telemetry_) telemetry_ = TelemetryByFrame(rec_.telemetry);
     return *telemetry_;
   }
+  // Its config.toml parsed once for the designs of a batch's cells, at the
+  // first call.
+  const ConfigDesigns& config_designs() const {
+    if (!designs_) {
+      const std::string path = (fs::path(dir_) / "config.toml").string();
+      designs_ =
+          std::make_unique<const ConfigDesigns>(ReadTextFile(path, "the configuration file"), path);
+    }
+    return *designs_;
+  }
   // Its config.toml's keys, read at the first call.
   const std::optional<ConfigKeys>& config_keys() const {
     if (!config_keys_) {
@@ -79,6 +89,7 @@ class RecordedSession {
   mutable nlohmann::json summary_;
   mutable std::optional<std::map<std::int64_t, dcp_telemetry_t>> telemetry_;
   mutable std::optional<std::optional<ConfigKeys>> config_keys_;
+  mutable std::unique_ptr<const ConfigDesigns> designs_;
 };
 
 namespace {
@@ -438,9 +449,15 @@ ResimResult Resimulate(const ResimOptions& opt) {
   if (!fs::exists(session / "lcmlog"))
     throw InputError(opt.session + ": not a session folder (no lcmlog)");
   const bool other_design = OtherDesign(opt);
-  const std::string config_text = EffectiveConfigText(opt);
+  // A batch's cell (the session read before, its own config with keys set,
+  // nothing written) takes the config the session's read parsed once; the
+  // text is needed only for a session written.
+  const bool batch_cell = opt.recorded && opt.discard && opt.config_path.empty() && other_design;
+  const std::string config_text = batch_cell ? "" : EffectiveConfigText(opt);
   const std::string config_path = ConfigSource(opt);
-  const LabConfig config = ParseConfig(config_text, config_path);
+  const LabConfig config = batch_cell
+                               ? opt.recorded->config_designs().With(opt.settings, config_path)
+                               : ParseConfig(config_text, config_path);
   auto progress = [&](double f, const std::string& line) {
     if (opt.progress) opt.progress(f, line);
   };

@@ -5,9 +5,12 @@
 // file has (a dotted path through its tables; `cameras[2].fov_deg` into an
 // array of tables) and gives a TOML value of the key's kind (a number for a
 // number, an array for an array, a string for a string).
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "rms/base/config.h"
 
 namespace rms {
 
@@ -27,5 +30,24 @@ ConfigSetting ParseConfigSetting(const std::string& text);
 // result is not validated: ParseConfig does that.
 std::string ApplyConfigSettings(std::string_view toml_text, const std::string& source,
                                 const std::vector<ConfigSetting>& settings);
+
+// A configuration's text parsed once, for many designs (a sweep's batch of
+// cells): With(settings, name) is ParseConfig(ApplyConfigSettings(text,
+// source, settings), name) -- the same LabConfig, as TOML prints every
+// number so that it reads back exact, and the same errors -- without parsing
+// and printing the text again for each.
+class ConfigDesigns {
+ public:
+  // Throws rms::InputError for text that is no TOML (naming source).
+  ConfigDesigns(std::string_view toml_text, std::string source);
+  ~ConfigDesigns();
+  ConfigDesigns(const ConfigDesigns&) = delete;
+  ConfigDesigns& operator=(const ConfigDesigns&) = delete;
+  LabConfig With(const std::vector<ConfigSetting>& settings, const std::string& name) const;
+
+ private:
+  struct Parsed;
+  std::unique_ptr<const Parsed> parsed_;
+};
 
 }  // namespace rms
