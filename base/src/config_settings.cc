@@ -2,6 +2,7 @@
 
 #include <sstream>
 #include <toml++/toml.h>
+#include <utility>
 
 #include "rms/base/check.h"
 #include "rms/base/toml_reader.h"
@@ -149,7 +150,11 @@ struct ConfigDesigns::Parsed {
 };
 
 ConfigDesigns::ConfigDesigns(std::string_view toml_text, std::string source)
-    : parsed_(std::make_unique<const Parsed>(Parsed{ParseToml(toml_text, source), source})) {}
+    // (A braced list is evaluated in order: the text is parsed before the
+    // source moves.)
+    : parsed_(
+          std::make_unique<const Parsed>(Parsed{ParseToml(toml_text, source), std::move(source)})) {
+}
 
 ConfigDesigns::~ConfigDesigns() = default;
 
