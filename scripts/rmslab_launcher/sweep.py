@@ -30,7 +30,10 @@ from .common import BUILD, ROOT, LabError, binary, file_sha256, install_and_buil
 
 CELL = os.path.join(ROOT, "scripts", "sweep-cell")
 NETNS_LOGIN = os.path.join(ROOT, "scripts", "rmslab_launcher", "netns-login")
-SSH_OPTIONS = "ssh -o BatchMode=yes -o ConnectTimeout=5"
+# A login that stops answering part way (a host down, a link dropped) ends
+# within a minute (ServerAlive), as one that never answers does (ConnectTimeout).
+SSH_OPTIONS = "ssh -o BatchMode=yes -o ConnectTimeout=5 -o ServerAliveInterval=15 -o ServerAliveCountMax=4"
+FAILED_SHOWN = 20  # failed cells named on the terminal (the table has them all)
 PROBE_TIMEOUT_S = 10  # a login that runs `true`, as GNU parallel allows its own probes
 
 
@@ -71,8 +74,11 @@ def parse_vary(texts):
         vals = split_values(values)
         if any(v == "" for v in vals):
             raise LabError(f"--vary {key}: an empty value in '{values}'")
-        if len(set(vals)) != len(vals):
-            raise LabError(f"--vary {key}: a value given twice in '{values}'")
+        parsed = [toml_value(key, v) for v in vals]
+        for i, v in enumerate(parsed):
+            twin = next((vals[j] for j in range(i) if parsed[j] == v and type(parsed[j]) is type(v)), None)
+            if twin is not None:
+                raise LabError(f"--vary {key}: '{twin}' and '{vals[i]}' are the same value")
         if any("\t" in v or "\n" in v for v in vals) or "\t" in key:
             raise LabError(f"--vary {key}: tabs and line breaks are not allowed in keys or values")
         if any(k == key for k, _ in grid):
@@ -325,17 +331,46 @@ def batch_size(cells, slots):
     return max(1, min(32, -(-cells // (4 * max(slots, 1)))))
 
 
-def parallel_command(args, joblog, cells):
-    """GNU parallel's command line and the cells a job: the cells' lines
-    (cells.tsv's form) on its standard input, --pipe hands each job a batch
-    of them. None when no host of the lab answers."""
+# A batch's time limit (docs/sessions.md "Sweeps"): each of its cells
+# CELL_S_BASE + CELL_S_A_MIB for each MiB of the largest log of the sweep
+# (a cell re-simulates a 3.4 MiB, 63 s session in about 0.01 s here: this is
+# hundreds of times that), and BATCH_S_BASE for the login and the process's
+# start. RMSLAB_SWEEP_BATCH_TIMEOUT_S sets it in seconds instead.
+CELL_S_BASE, CELL_S_A_MIB, BATCH_S_BASE = 2.0, 0.5, 30.0
+
+
+def batch_timeout_s(todo, per_job):
+    """The seconds after which GNU parallel stops a batch (--timeout) and
+    tries it again (on another host, if there is one): a host that stalls
+    part way does not hold the sweep for ever."""
+    env = os.environ.get("RMSLAB_SWEEP_BATCH_TIMEOUT_S")
+    if env:
+        try:
+            value = float(env)
+        except ValueError:
+            value = 0.0
+        if not 0 < value < 1e7:
+            raise LabError(f"RMSLAB_SWEEP_BATCH_TIMEOUT_S={env!r}: must be a number of seconds > 0")
+        return value
+    mib = 0.0
+    for s in {c["session"] for c in todo}:
+        with contextlib.suppress(OSError):
+            mib = max(mib, os.path.getsize(os.path.join(s, "lcmlog")) / 2**20)
+    return round(BATCH_S_BASE + per_job * (CELL_S_BASE + CELL_S_A_MIB * mib))
+
+
+def parallel_command(args, joblog, todo):
+    """GNU parallel's command line, the cells a job and its time limit: the
+    cells' lines (cells.tsv's form) on its standard input, --pipe hands each
+    job a batch of them. None when no host of the lab answers."""
+    cells = len(todo)
     cell, env_build, slots = CELL, {}, args.jobs or os.cpu_count() or 1
     cmd = ["parallel", "--will-cite", "--pipe", "--line-buffer", "--halt", "never", "--joblog", joblog]
     if args.workers:
         logins, cell, remote_build, per_host = args.workers
         live = answering(logins) if len(logins) > 1 else logins
         if not live:
-            return None, 0
+            return None, 0, 0
         for login in live:
             cmd += ["--sshlogin", login.sshlogin]
         cmd += ["--ssh", SSH_OPTIONS]
@@ -355,7 +390,8 @@ def parallel_command(args, joblog, cells):
     prefix = " ".join(f"{k}={shlex.quote(v)}" for k, v in env_build.items())
     template = f"{prefix} {shlex.quote(cell)} --cells".strip()
     k = batch_size(cells, slots)
-    return cmd + ["-N", str(k), template], k
+    timeout = batch_timeout_s(todo, k)
+    return cmd + ["--timeout", f"{timeout:g}", "-N", str(k), template], k, timeout
 
 
 def check_parallel_paths(workers):
@@ -369,8 +405,8 @@ def check_parallel_paths(workers):
 
 
 def job_ends(joblog):
-    """{job number: (host, exit code, signal)} of each job of the joblog
-    (its last try)."""
+    """{job number: (host, exit code, signal, run time s)} of each job of
+    the joblog (its last try)."""
     ends = {}
     with contextlib.suppress(OSError):
         with open(joblog) as f:
@@ -378,11 +414,15 @@ def job_ends(joblog):
             for line in f:
                 col = line.rstrip("\n").split("\t")
                 if len(col) >= 8 and col[0].isdigit():
-                    ends[int(col[0])] = (col[1], col[6], col[7])
+                    try:
+                        runtime = float(col[3])
+                    except ValueError:
+                        runtime = 0.0
+                    ends[int(col[0])] = (col[1], col[6], col[7], runtime)
     return ends
 
 
-def why_no_line(todo, joblog, per_job, workers):
+def why_no_line(todo, joblog, per_job, workers, timeout_s):
     """The reason of each cell of todo that had no line: its batch's end as
     the joblog tells it (job N got todo's lines (N-1)K+1..NK, in order)."""
     ends = job_ends(joblog)
@@ -395,9 +435,12 @@ def why_no_line(todo, joblog, per_job, workers):
             c["error"] = ("no result: its batch never ended (GNU parallel's joblog has no line for its job "
                           f"{job}: a host that did not answer? see GNU parallel's lines below, if any)")
             continue
-        host, code, sig = ends[job]
+        host, code, sig, runtime = ends[job]
         where = names.get(host, host)
-        if code == "0" and sig == "0":
+        if sig != "0" and runtime >= timeout_s:
+            c["error"] = (f"no result: its batch (GNU parallel's job {job}, on {where}) ran past its time limit "
+                          f"({timeout_s:g} s) and was stopped (a host that stalled?)")
+        elif code == "0" and sig == "0":
             c["error"] = (f"no result: its batch (GNU parallel's job {job}, on {where}) ended with exit code 0 "
                           "but gave no line for it (the job did not run the cells: see GNU parallel's lines "
                           "below, if any)")
@@ -414,7 +457,7 @@ def run_parallel(todo, sweep_dir, args, progress, round_no, on_result):
         raise LabError("GNU parallel is not installed: run scripts/install-deps", 1)
     todo_file = os.path.join(sweep_dir, f"todo-{os.getpid()}.tsv")
     joblog = os.path.join(sweep_dir, f"joblog-{time.strftime('%Y%m%dT%H%M%S')}-{os.getpid()}-try{round_no}")
-    cmd, per_job = parallel_command(args, joblog, len(todo))
+    cmd, per_job, timeout = parallel_command(args, joblog, todo)
     if cmd is None:
         for c in todo:
             c["error"] = f"no host of {args.hosts} answered"
@@ -459,7 +502,7 @@ def run_parallel(todo, sweep_dir, args, progress, round_no, on_result):
     finally:
         with contextlib.suppress(OSError):
             os.remove(todo_file)
-    why_no_line(todo, joblog, per_job, args.workers)
+    why_no_line(todo, joblog, per_job, args.workers, timeout)
     for c in todo:
         if "line" not in c:
             progress.step(False)
@@ -577,7 +620,8 @@ def run_cells(a, cells, todo, sweep_dir, cache, cached):
             break
         if round_no > 1:
             retried += len(pending)
-            say(f"sweep: trying {len(pending)} failed cells again (try {round_no} of {a.retries + 1})")
+            cells_word = "cell" if len(pending) == 1 else "cells"
+            say(f"sweep: trying {len(pending)} failed {cells_word} again (try {round_no} of {a.retries + 1})")
         for c in pending:
             c["error"] = "no result"  # until its line says otherwise
         progress = Progress(len(cells), len(cells) - len(pending), cached)
@@ -675,7 +719,7 @@ def run_sweep(argv):
                 try:
                     retried, errors = run_cells(a, cells, todo, sweep_dir, cache, cached)
                 finally:
-                    drop_if_log_changed(sessions, todo, cache)
+                    drop_if_changed(sessions, todo, cache, version)
         except Interrupted as e:
             done = sum(1 for c in todo if "error" not in c)
             say(f"sweep interrupted ({e.name}): the {done} cells finished in this run are in the cache; "
@@ -687,11 +731,24 @@ def run_sweep(argv):
     return finish(a, cells, results, todo, sweep_dir, cached, retried, errors, elapsed)
 
 
-def drop_if_log_changed(sessions, todo, cache):
+def drop_if_changed(sessions, todo, cache, version):
     """A session whose log is not the one the cache keys were made from
-    (changed, cut short or gone during the sweep): its cells' results of
-    this run are taken out of the cache and the cells failed, as their
-    results may be the changed log's."""
+    (changed, cut short or gone during the sweep), or an rms_resim that is
+    not the one they were made with (rebuilt during the sweep): the cells'
+    results of this run it touches are taken out of the cache and the cells
+    failed, as their results may be the changed log's or binary's."""
+    try:
+        rebuilt = software_version() != version
+    except LabError:
+        rebuilt = True
+    if rebuilt:
+        for c in todo:
+            if "error" not in c:
+                with contextlib.suppress(OSError):
+                    os.remove(cache.path(c["key"]))
+                c["error"] = (f"{binary('tools/rms_resim')} changed during the sweep (rebuilt?): its cache key "
+                              "was made from the one before; result not kept; run the sweep again")
+        return
     for s in sessions:
         kept = [c for c in todo if c["session"] == s.path and "error" not in c]
         if not kept:
@@ -720,9 +777,11 @@ def finish(a, cells, results, todo, sweep_dir, cached, retried, errors, elapsed)
     say(f"sweep: {ran} cells run in {elapsed:.2f} s"
         + (f" ({ran / elapsed:.1f} cells/s)" if ran > 0 and elapsed > 0 else "")
         + f", {cached} from the cache, {retried} tries again, {len(failed)} failed")
-    for c in failed:
+    for c in failed[:FAILED_SHOWN]:
         say(f"  cell {c['index']} FAILED ({os.path.basename(c['session'])} "
             f"{' '.join(f'{k}={v}' for k, v in c['sets'])}): {c['error']}")
+    if len(failed) > FAILED_SHOWN:
+        say(f"  ... and {len(failed) - FAILED_SHOWN} more failed cells: each with why in {csv_path}")
     for e in errors[-5:] if failed else []:  # their last lines, when a cell failed
         say(f"  parallel: {e}")
     say(f"table: {csv_path}")

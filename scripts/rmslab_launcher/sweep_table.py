@@ -166,7 +166,11 @@ def page(grid, cols, table, plot_data, rows):
         h.append(f"<tr{cls}>" + "".join(cells) + "</tr>")
     h.append("</table>")
     h.append(f"<script>{chart_js}</script>" if chart_js else "")
-    h.append("<script>const plots = " + json.dumps(plot_data).replace("</", "<\\/") + ";\n" + PLOT_JS + "</script>")
+    # Inside <script>, the JSON's < > & written as \u escapes (the same
+    # strings to JavaScript): no value, e.g. "<!--<script>", can end the
+    # script or change how the HTML parser reads it.
+    data = json.dumps(plot_data).replace("<", "\\u003c").replace(">", "\\u003e").replace("&", "\\u0026")
+    h.append("<script>const plots = " + data + ";\n" + PLOT_JS + "</script>")
     h.append("</body></html>\n")
     return "\n".join(h)
 

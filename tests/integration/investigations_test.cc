@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -84,6 +85,21 @@ std::vector<std::string> Joblogs(const std::string& dir) {
     if (e.path().filename().string().rfind("joblog-", 0) == 0) v.push_back(e.path().string());
   std::sort(v.begin(), v.end());
   return v;
+}
+
+// How many of a sweep page's plots a browser (headless Chromium) draws.
+int PlotsDrawn(const std::string& page) {
+  testing::Subprocess chrome(
+      {"/usr/bin/chromium", "--headless=new", "--no-sandbox", "--disable-gpu",
+       "--virtual-time-budget=5000", "--dump-dom", "file://" + page},
+      page + ".dom");
+  if (chrome.Wait(120) != 0) return -1;
+  const std::string dom = ReadFile(page + ".dom");
+  int drawn = 0;
+  for (std::size_t at = dom.find("data-drawn=\"1\""); at != std::string::npos;
+       at = dom.find("data-drawn=\"1\"", at + 1))
+    ++drawn;
+  return drawn;
 }
 
 class Investigations : public ::testing::Test {
@@ -196,17 +212,22 @@ TEST_F(Investigations, TwoSessionsOnAThreeByTwoGridAgreeWithSingleResims) {
   // The page: a browser draws one plot per varied key.
   const std::string html = ReadFile(out + "/sweep.html");
   EXPECT_EQ(html.find("<script src="), std::string::npos) << "not self-contained";
-  testing::Subprocess chrome(
-      {"/usr/bin/chromium", "--headless=new", "--no-sandbox", "--disable-gpu",
-       "--virtual-time-budget=5000", "--dump-dom", "file://" + out + "/sweep.html"},
-      *tmp_ + "/sweep-dom.html");
-  ASSERT_EQ(chrome.Wait(120), 0);
-  const std::string dom = ReadFile(*tmp_ + "/sweep-dom.html");
-  std::size_t drawn = 0;
-  for (std::size_t at = dom.find("data-drawn=\"1\""); at != std::string::npos;
-       at = dom.find("data-drawn=\"1\"", at + 1))
-    ++drawn;
-  EXPECT_EQ(drawn, 2u) << "plots not drawn";
+  EXPECT_EQ(PlotsDrawn(out + "/sweep.html"), 2) << "plots not drawn";
+}
+
+// Values that are markup are the page's text, not its code: the table shows
+// them and the plot is still drawn.
+TEST_F(Investigations, AValueThatIsMarkupIsShownAsTextAndThePlotIsStillDrawn) {
+  const std::string out = *tmp_ + "/markup";
+  const ScriptRun r = Script({SourcePath("scripts/lab"), "sweep", *a_, "--vary",
+                              "cameras[0].name=\"<!--<script>\",\"A</script><b>x&amp;\"", "--out",
+                              out, "--cache", *tmp_ + "/cache-markup", "--no-build"},
+                             out + ".log");
+  ASSERT_EQ(r.rc, 0) << r.out;
+  const std::string html = ReadFile(out + "/sweep.html");
+  EXPECT_EQ(html.find("<!--<script>"), std::string::npos);
+  EXPECT_EQ(html.find("<b>x"), std::string::npos);
+  EXPECT_EQ(PlotsDrawn(out + "/sweep.html"), 1) << "the plot not drawn";
 }
 
 // stdout alone of a tool run through sh (its stderr left out).
@@ -436,6 +457,81 @@ TEST_F(Investigations, ASweepInterruptedKeepsWhatItFinishedAndTheRerunDoesTheRes
   EXPECT_NE(rest.out.find(std::to_string(kept) + " from the cache"), std::string::npos) << rest.out;
 }
 
+// A batch that stalls (a host hung, a file system stuck) is stopped at its
+// time limit and tried again; one that stalls every time fails with why.
+TEST_F(Investigations, AStalledBatchIsStoppedAtItsTimeLimitAndTriedAgain) {
+  const std::string dir = *tmp_ + "/stalling";
+  fs::create_directories(dir + "/build/tools");
+  // A build whose rms_resim, handed a batch, stalls while the file `stall`
+  // is there (`once`: and takes it away, so only the first batch stalls).
+  for (const auto& e : fs::directory_iterator(testing::BuildPath("tools")))
+    fs::create_symlink(e.path(), fs::path(dir + "/build/tools") / e.path().filename());
+  fs::remove(dir + "/build/tools/rms_resim");
+  std::ofstream(dir + "/build/tools/rms_resim")
+      << "#!/bin/sh\nif [ \"$1\" = --cells ] && [ -e '" << dir << "/stall' ]; then\n"
+      << "  grep -q once '" << dir << "/stall' && rm -f '" << dir << "/stall'\n"
+      << "  sleep 120\nfi\nexec '" << testing::BuildPath("tools/rms_resim") << "' \"$@\"\n";
+  fs::permissions(dir + "/build/tools/rms_resim", fs::perms::owner_all);
+  auto sweep = [&](const std::string& name, const std::string& retries, const std::string& vary) {
+    return Script(
+        {"/usr/bin/env", "RMSLAB_BUILD=" + dir + "/build", "RMSLAB_SWEEP_BATCH_TIMEOUT_S=3",
+         SourcePath("scripts/lab"), "sweep", *a_, "--vary", vary, "--out", dir + "/" + name,
+         "--cache", dir + "/cache-" + name, "--no-build", "--retries", retries, "--jobs", "1"},
+        dir + "/" + name + ".log", 100);
+  };
+  const auto t0 = std::chrono::steady_clock::now();
+  std::ofstream(dir + "/stall") << "once\n";
+  const ScriptRun once = sweep("once", "2", "dcp.tpob_ft=0.2,0.3,0.4,0.5");
+  // Done well before the stalled batch's sleep (120 s) would have ended.
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(100));
+  ASSERT_EQ(once.rc, 0) << once.out;
+  EXPECT_NE(once.out.find("trying 1 failed cell again"), std::string::npos) << once.out;
+  for (const auto& row : ReadCsv(dir + "/once/sweep.csv")) EXPECT_EQ(row.at("status"), "ok");
+  std::ofstream(dir + "/stall") << "always\n";
+  const ScriptRun always = sweep("always", "0", "dcp.tpob_ft=0.2,0.3");
+  EXPECT_EQ(always.rc, 1) << always.out;
+  const auto rows = ReadCsv(dir + "/always/sweep.csv");
+  ASSERT_EQ(rows.size(), 2u) << always.out;
+  for (const auto& row : rows) {
+    EXPECT_EQ(row.at("status"), "failed");
+    EXPECT_NE(row.at("error").find("ran past its time limit (3 s) and was stopped"),
+              std::string::npos)
+        << row.at("error");
+  }
+}
+
+// An rms_resim rebuilt while the sweep runs: the results may be either
+// binary's, so none of this run's is kept (the cache keys name the first).
+TEST_F(Investigations, AnRmsResimRebuiltDuringTheSweepKeepsNoResultOfIt) {
+  const std::string dir = *tmp_ + "/rebuilt";
+  fs::create_directories(dir + "/build/tools");
+  for (const auto& e : fs::directory_iterator(testing::BuildPath("tools")))
+    fs::create_symlink(e.path(), fs::path(dir + "/build/tools") / e.path().filename());
+  fs::remove(dir + "/build/tools/rms_resim");
+  // Handed a batch, it changes itself (as a rebuild changes the binary).
+  const std::string self = dir + "/build/tools/rms_resim";
+  std::ofstream(self) << "#!/bin/sh\n[ \"$1\" = --cells ] && echo '# rebuilt' >> '" << self
+                      << "'\nexec '" << testing::BuildPath("tools/rms_resim") << "' \"$@\"\n";
+  fs::permissions(self, fs::perms::owner_all);
+  const ScriptRun r =
+      Script({"/usr/bin/env", "RMSLAB_BUILD=" + dir + "/build", SourcePath("scripts/lab"), "sweep",
+              *a_, "--vary", "dcp.tpob_ft=0.2,0.3", "--out", dir + "/out", "--cache",
+              dir + "/cache", "--no-build", "--retries", "0"},
+             dir + "/out.log");
+  EXPECT_EQ(r.rc, 1) << r.out;
+  const auto rows = ReadCsv(dir + "/out/sweep.csv");
+  ASSERT_EQ(rows.size(), 2u) << r.out;
+  for (const auto& row : rows) {
+    EXPECT_EQ(row.at("status"), "failed");
+    EXPECT_NE(row.at("error").find("changed during the sweep (rebuilt?)"), std::string::npos)
+        << row.at("error");
+  }
+  std::size_t kept = 0;
+  for (const auto& e : fs::recursive_directory_iterator(dir + "/cache"))
+    kept += e.is_regular_file() && e.path().extension() == ".json";
+  EXPECT_EQ(kept, 0u) << "results of the rebuilt binary's run left in the cache";
+}
+
 TEST_F(Investigations, ABatchThatDiesOrALogThatChangesLeavesItsCellsFailedWithWhy) {
   const std::string dir = *tmp_ + "/dying";
   fs::create_directories(dir + "/build/tools");
@@ -565,7 +661,8 @@ TEST_F(Investigations, ABadKeyOrValueIsRefusedBeforeAnythingRuns) {
                {"dcp.tpob_ft=0.2,-1", "must be > 0"},
                {"dcp.tpob_ft=0.2,abc", "no TOML value"},
                {"dcp.tpob_ft", "must be KEY=V1,V2"},
-               {"dcp.tpob_ft=0.2,0.2", "a value given twice"}};
+               {"dcp.tpob_ft=0.2,0.2", "'0.2' and '0.2' are the same value"},
+               {"dcp.tpob_ft=0.2,0.20", "'0.2' and '0.20' are the same value"}};
   for (const Case& c : cases) {
     const std::string out = *tmp_ + "/bad-" + std::to_string(&c - cases);
     const ScriptRun r = Script({SourcePath("scripts/lab"), "sweep", *a_, "--vary", c.vary, "--out",
