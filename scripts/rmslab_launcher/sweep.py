@@ -287,7 +287,7 @@ def answering(logins, tries=2, timeout_s=PROBE_TIMEOUT_S):
             break
     for login in pending:
         say(f"sweep: host {login.host} does not answer ({whys[login]}): left out of this try")
-    return [login for login in logins if login not in pending]
+    return [login for login in logins if login not in pending], {login.host: whys[login] for login in pending}
 
 
 class Progress:
@@ -362,15 +362,16 @@ def batch_timeout_s(todo, per_job):
 def parallel_command(args, joblog, todo):
     """GNU parallel's command line, the cells a job and its time limit: the
     cells' lines (cells.tsv's form) on its standard input, --pipe hands each
-    job a batch of them. None when no host of the lab answers."""
+    job a batch of them. When no host of the lab answers, instead of the
+    command line, why each did not (a string)."""
     cells = len(todo)
     cell, env_build, slots = CELL, {}, args.jobs or os.cpu_count() or 1
     cmd = ["parallel", "--will-cite", "--pipe", "--line-buffer", "--halt", "never", "--joblog", joblog]
     if args.workers:
         logins, cell, remote_build, per_host = args.workers
-        live = answering(logins) if len(logins) > 1 else logins
+        live, whys = answering(logins)
         if not live:
-            return None, 0, 0
+            return "; ".join(f"{host}: {why}" for host, why in whys.items()), 0, 0
         for login in live:
             cmd += ["--sshlogin", login.sshlogin]
         cmd += ["--ssh", SSH_OPTIONS]
@@ -458,9 +459,9 @@ def run_parallel(todo, sweep_dir, args, progress, round_no, on_result):
     todo_file = os.path.join(sweep_dir, f"todo-{os.getpid()}.tsv")
     joblog = os.path.join(sweep_dir, f"joblog-{time.strftime('%Y%m%dT%H%M%S')}-{os.getpid()}-try{round_no}")
     cmd, per_job, timeout = parallel_command(args, joblog, todo)
-    if cmd is None:
+    if isinstance(cmd, str):
         for c in todo:
-            c["error"] = f"no host of {args.hosts} answered"
+            c["error"] = f"no host of {args.hosts} answered ({cmd})"
             progress.step(False)
         return []
     write_manifest(todo_file, todo)
