@@ -554,7 +554,7 @@ TEST_F(Investigations, ABatchThatDiesOrALogThatChangesLeavesItsCellsFailedWithWh
   ASSERT_EQ(rows.size(), 2u) << r.out;
   for (const auto& row : rows) {
     EXPECT_EQ(row.at("status"), "failed");
-    // A batch of one cell each here (two cells, one job slot: ceil(2 / 4)).
+    // A batch of one cell each here (two cells, one job slot: ceil(2 / 2)).
     EXPECT_NE(row.at("error").find("its batch (GNU parallel's job " + row.at("cell") +
                                    ", on this machine) ended with exit code 137"),
               std::string::npos)
