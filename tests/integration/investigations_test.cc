@@ -87,6 +87,20 @@ std::vector<std::string> Joblogs(const std::string& dir) {
   return v;
 }
 
+// DIR/build: this build's tools, but for an rms_resim that is a shell
+// script running `before` and then the real one (RMSLAB_BUILD=DIR/build).
+void WrappedBuild(const std::string& dir, const std::string& before) {
+  fs::create_directories(dir + "/build/tools");
+  for (const auto& e : fs::directory_iterator(testing::BuildPath("tools")))
+    fs::create_symlink(e.path(), fs::path(dir + "/build/tools") / e.path().filename());
+  const std::string resim = dir + "/build/tools/rms_resim";
+  fs::remove(resim);
+  std::ofstream(resim) << "#!/bin/sh\n"
+                       << before << "exec '" << testing::BuildPath("tools/rms_resim")
+                       << "' \"$@\"\n";
+  fs::permissions(resim, fs::perms::owner_all);
+}
+
 // How many of a sweep page's plots a browser (headless Chromium) draws.
 int PlotsDrawn(const std::string& page) {
   testing::Subprocess chrome(
@@ -461,17 +475,11 @@ TEST_F(Investigations, ASweepInterruptedKeepsWhatItFinishedAndTheRerunDoesTheRes
 // time limit and tried again; one that stalls every time fails with why.
 TEST_F(Investigations, AStalledBatchIsStoppedAtItsTimeLimitAndTriedAgain) {
   const std::string dir = *tmp_ + "/stalling";
-  fs::create_directories(dir + "/build/tools");
   // A build whose rms_resim, handed a batch, stalls while the file `stall`
   // is there (`once`: and takes it away, so only the first batch stalls).
-  for (const auto& e : fs::directory_iterator(testing::BuildPath("tools")))
-    fs::create_symlink(e.path(), fs::path(dir + "/build/tools") / e.path().filename());
-  fs::remove(dir + "/build/tools/rms_resim");
-  std::ofstream(dir + "/build/tools/rms_resim")
-      << "#!/bin/sh\nif [ \"$1\" = --cells ] && [ -e '" << dir << "/stall' ]; then\n"
-      << "  grep -q once '" << dir << "/stall' && rm -f '" << dir << "/stall'\n"
-      << "  sleep 120\nfi\nexec '" << testing::BuildPath("tools/rms_resim") << "' \"$@\"\n";
-  fs::permissions(dir + "/build/tools/rms_resim", fs::perms::owner_all);
+  WrappedBuild(dir, "if [ \"$1\" = --cells ] && [ -e '" + dir +
+                        "/stall' ]; then\n  grep -q once '" + dir + "/stall' && rm -f '" + dir +
+                        "/stall'\n  sleep 120\nfi\n");
   auto sweep = [&](const std::string& name, const std::string& retries, const std::string& vary) {
     return Script(
         {"/usr/bin/env", "RMSLAB_BUILD=" + dir + "/build", "RMSLAB_SWEEP_BATCH_TIMEOUT_S=3",
@@ -505,15 +513,8 @@ TEST_F(Investigations, AStalledBatchIsStoppedAtItsTimeLimitAndTriedAgain) {
 // binary's, so none of this run's is kept (the cache keys name the first).
 TEST_F(Investigations, AnRmsResimRebuiltDuringTheSweepKeepsNoResultOfIt) {
   const std::string dir = *tmp_ + "/rebuilt";
-  fs::create_directories(dir + "/build/tools");
-  for (const auto& e : fs::directory_iterator(testing::BuildPath("tools")))
-    fs::create_symlink(e.path(), fs::path(dir + "/build/tools") / e.path().filename());
-  fs::remove(dir + "/build/tools/rms_resim");
   // Handed a batch, it changes itself (as a rebuild changes the binary).
-  const std::string self = dir + "/build/tools/rms_resim";
-  std::ofstream(self) << "#!/bin/sh\n[ \"$1\" = --cells ] && echo '# rebuilt' >> '" << self
-                      << "'\nexec '" << testing::BuildPath("tools/rms_resim") << "' \"$@\"\n";
-  fs::permissions(self, fs::perms::owner_all);
+  WrappedBuild(dir, "[ \"$1\" = --cells ] && echo '# rebuilt' >> \"$0\"\n");
   const ScriptRun r =
       Script({"/usr/bin/env", "RMSLAB_BUILD=" + dir + "/build", SourcePath("scripts/lab"), "sweep",
               *a_, "--vary", "dcp.tpob_ft=0.2,0.3", "--out", dir + "/out", "--cache",
@@ -535,16 +536,9 @@ TEST_F(Investigations, AnRmsResimRebuiltDuringTheSweepKeepsNoResultOfIt) {
 
 TEST_F(Investigations, ABatchThatDiesOrALogThatChangesLeavesItsCellsFailedWithWhy) {
   const std::string dir = *tmp_ + "/dying";
-  fs::create_directories(dir + "/build/tools");
   // A build whose rms_resim dies (SIGKILL) when it is handed a batch; the
   // real one otherwise (the sweep's checks).
-  for (const auto& e : fs::directory_iterator(testing::BuildPath("tools")))
-    fs::create_symlink(e.path(), fs::path(dir + "/build/tools") / e.path().filename());
-  fs::remove(dir + "/build/tools/rms_resim");
-  std::ofstream(dir + "/build/tools/rms_resim")
-      << "#!/bin/sh\ncase \"$1\" in --cells) kill -9 $$ ;; esac\nexec '"
-      << testing::BuildPath("tools/rms_resim") << "' \"$@\"\n";
-  fs::permissions(dir + "/build/tools/rms_resim", fs::perms::owner_all);
+  WrappedBuild(dir, "case \"$1\" in --cells) kill -9 $$ ;; esac\n");
   const ScriptRun r =
       Script({"/usr/bin/env", "RMSLAB_BUILD=" + dir + "/build", SourcePath("scripts/lab"), "sweep",
               *a_, "--vary", "dcp.tpob_ft=0.2,0.3", "--out", dir + "/out", "--cache",
