@@ -63,6 +63,22 @@ def split_values(text):
     return out
 
 
+def same_value(a, b):
+    """Two TOML values that make the same design: numbers by value (a float
+    key given an integer keeps a float, as set_key does: 1 is 1.0), arrays
+    and tables element by element, anything else of the same kind and equal
+    (true is not 1)."""
+    def number(x):
+        return isinstance(x, (int, float)) and not isinstance(x, bool)
+    if number(a) and number(b):
+        return a == b
+    if isinstance(a, list) and isinstance(b, list):
+        return len(a) == len(b) and all(same_value(x, y) for x, y in zip(a, b))
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(same_value(a[k], b[k]) for k in a)
+    return type(a) is type(b) and a == b
+
+
 def parse_vary(texts):
     """--vary KEY=V1,V2,... (repeatable) -> [(key, [values])]."""
     grid = []
@@ -76,7 +92,7 @@ def parse_vary(texts):
             raise LabError(f"--vary {key}: an empty value in '{values}'")
         parsed = [toml_value(key, v) for v in vals]
         for i, v in enumerate(parsed):
-            twin = next((vals[j] for j in range(i) if parsed[j] == v and type(parsed[j]) is type(v)), None)
+            twin = next((vals[j] for j in range(i) if same_value(parsed[j], v)), None)
             if twin is not None:
                 raise LabError(f"--vary {key}: '{twin}' and '{vals[i]}' are the same value")
         if any("\t" in v or "\n" in v for v in vals) or "\t" in key:
@@ -342,18 +358,29 @@ def batch_size(cells, slots):
 CELL_S_BASE, CELL_S_A_MIB, BATCH_S_BASE = 2.0, 0.5, 30.0
 
 
+def timeout_override():
+    """RMSLAB_SWEEP_BATCH_TIMEOUT_S in seconds, None when unset or empty;
+    checked before anything is made (GNU parallel checks its --timeout about
+    once a second: less than 1 s is refused, as it would not be kept)."""
+    env = os.environ.get("RMSLAB_SWEEP_BATCH_TIMEOUT_S", "").strip()
+    if not env:
+        return None
+    try:
+        value = float(env)
+    except ValueError:
+        value = float("nan")
+    if not 1 <= value <= 1e6:
+        raise LabError(f"RMSLAB_SWEEP_BATCH_TIMEOUT_S={env!r}: must be a number of seconds from 1 to 1000000 "
+                       "(GNU parallel checks its --timeout about once a second)", 2)
+    return value
+
+
 def batch_timeout_s(todo, per_job):
     """The seconds after which GNU parallel stops a batch (--timeout) and
     tries it again (on another host, if there is one): a host that stalls
     part way does not hold the sweep for ever."""
-    env = os.environ.get("RMSLAB_SWEEP_BATCH_TIMEOUT_S")
-    if env:
-        try:
-            value = float(env)
-        except ValueError:
-            value = 0.0
-        if not 0 < value < 1e7:
-            raise LabError(f"RMSLAB_SWEEP_BATCH_TIMEOUT_S={env!r}: must be a number of seconds > 0")
+    value = timeout_override()
+    if value is not None:
         return value
     mib = 0.0
     for s in {c["session"] for c in todo}:
@@ -681,6 +708,7 @@ def run_sweep(argv):
     sweep_dir = os.path.abspath(a.out or os.path.join(
         ROOT, "sessions", "sweep-" + time.strftime("%Y%m%dT%H%M%SZ", time.gmtime())))
     check_out(sweep_dir)
+    timeout_override()
     cache = sweep_cache.Cache(a.cache or os.path.join(ROOT, "sessions", "sweep-cache"),
                               must_exist=a.cached_only)
     version = software_version()

@@ -655,20 +655,28 @@ TEST_F(Investigations, ABadKeyOrValueIsRefusedBeforeAnythingRuns) {
   struct Case {
     const char* vary;
     const char* says;
+    const char* timeout = "";  // RMSLAB_SWEEP_BATCH_TIMEOUT_S
   } cases[] = {{"dcp.no_such_key=1,2", "no key 'no_such_key'"},
                {"dcp.tpob_ft=0.2,-1", "must be > 0"},
                {"dcp.tpob_ft=0.2,abc", "no TOML value"},
                {"dcp.tpob_ft", "must be KEY=V1,V2"},
                {"dcp.tpob_ft=0.2,0.2", "'0.2' and '0.2' are the same value"},
-               {"dcp.tpob_ft=0.2,0.20", "'0.2' and '0.20' are the same value"}};
+               {"dcp.tpob_ft=0.2,0.20", "'0.2' and '0.20' are the same value"},
+               {"dcp.tpob_ft=1,1.0", "'1' and '1.0' are the same value"},
+               {"arm.base_position_ft[1]=-8,-8.0", "'-8' and '-8.0' are the same value"},
+               {"dcp.tpob_ft=0.2,0.3", "RMSLAB_SWEEP_BATCH_TIMEOUT_S='abc': must be", "abc"},
+               {"dcp.tpob_ft=0.2,0.3", "RMSLAB_SWEEP_BATCH_TIMEOUT_S='0.5': must be", "0.5"}};
   for (const Case& c : cases) {
     const std::string out = *tmp_ + "/bad-" + std::to_string(&c - cases);
-    const ScriptRun r = Script({SourcePath("scripts/lab"), "sweep", *a_, "--vary", c.vary, "--out",
-                                out, "--cache", out + "-cache", "--no-build"},
-                               out + ".log");
+    const ScriptRun r =
+        Script({"/usr/bin/env", std::string("RMSLAB_SWEEP_BATCH_TIMEOUT_S=") + c.timeout,
+                SourcePath("scripts/lab"), "sweep", *a_, "--vary", c.vary, "--out", out, "--cache",
+                out + "-cache", "--no-build"},
+               out + ".log");
     EXPECT_EQ(r.rc, 2) << c.vary << ": " << r.out;
     EXPECT_NE(r.out.find(c.says), std::string::npos) << c.vary << ": " << r.out;
     EXPECT_FALSE(fs::exists(out)) << c.vary << ": a refused sweep left a folder";
+    EXPECT_FALSE(fs::exists(out + "-cache")) << c.vary << ": a refused sweep left its cache";
   }
 }
 
