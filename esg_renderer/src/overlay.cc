@@ -227,7 +227,10 @@ void RestoreCounterBackdrop(std::uint8_t* rgba, int w, int h, const CounterBackd
 
 void DrawOverlay(std::uint8_t* rgba, int w, int h, const wire::EsgFrameData& f,
                  const OverlayModel& model, CounterBackdrop* backdrop) {
-  if (backdrop) *backdrop = CounterBackdrop{};
+  if (backdrop) {  // none until the counter is drawn (its buffer kept: no allocation a frame)
+    backdrop->x0 = backdrop->x1 = backdrop->y0 = backdrop->y1 = 0;
+    backdrop->rgba.clear();
+  }
   if (f.control.crosshairs && !f.control.no_video) DrawCrosshairs(rgba, w, h, f, model);
   const std::vector<std::string>& names = model.camera_names;
   const int s = std::max(1, h / 300);

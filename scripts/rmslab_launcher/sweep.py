@@ -389,11 +389,14 @@ def batch_timeout_s(todo, per_job):
     return round(BATCH_S_BASE + per_job * (CELL_S_BASE + CELL_S_A_MIB * mib))
 
 
+class NoHostAnswers(Exception):
+    """No host of the lab answered its login: why each did not."""
+
+
 def parallel_command(args, joblog, todo):
     """GNU parallel's command line, the cells a job and its time limit: the
     cells' lines (cells.tsv's form) on its standard input, --pipe hands each
-    job a batch of them. When no host of the lab answers, instead of the
-    command line, why each did not (a string)."""
+    job a batch of them. Raises NoHostAnswers when no host of the lab answers."""
     cells = len(todo)
     cell, env_build, slots = CELL, {}, args.jobs or os.cpu_count() or 1
     cmd = ["parallel", "--will-cite", "--pipe", "--line-buffer", "--halt", "never", "--joblog", joblog]
@@ -401,7 +404,7 @@ def parallel_command(args, joblog, todo):
         logins, cell, remote_build, per_host = args.workers
         live, whys = answering(logins)
         if not live:
-            return "; ".join(f"{host}: {why}" for host, why in whys.items()), 0, 0
+            raise NoHostAnswers("; ".join(f"{host}: {why}" for host, why in whys.items()))
         for login in live:
             cmd += ["--sshlogin", login.sshlogin]
         cmd += ["--ssh", SSH_OPTIONS]
@@ -488,10 +491,11 @@ def run_parallel(todo, sweep_dir, args, progress, round_no, on_result):
         raise LabError("GNU parallel is not installed: run scripts/install-deps", 1)
     todo_file = os.path.join(sweep_dir, f"todo-{os.getpid()}.tsv")
     joblog = os.path.join(sweep_dir, f"joblog-{time.strftime('%Y%m%dT%H%M%S')}-{os.getpid()}-try{round_no}")
-    cmd, per_job, timeout = parallel_command(args, joblog, todo)
-    if isinstance(cmd, str):
+    try:
+        cmd, per_job, timeout = parallel_command(args, joblog, todo)
+    except NoHostAnswers as why:
         for c in todo:
-            c["error"] = f"no host of {args.hosts} answered ({cmd})"
+            c["error"] = f"no host of {args.hosts} answered ({why})"
             progress.step(False)
         return []
     write_manifest(todo_file, todo)
