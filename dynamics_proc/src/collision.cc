@@ -5,9 +5,12 @@
 #include <cmath>
 #include <limits>
 
+#include "projection.h"
 #include "simd.h"
 
 namespace rms::dynamics_proc {
+
+using internal::ProjectionRange;
 
 namespace {
 
@@ -196,16 +199,6 @@ void SetPlane(CollisionResult* r, const Eigen::Vector3d& n, double d) {
   r->plane = {n, d};
 }
 
-void ProjectionRange(const Hexahedron& h, const Eigen::Vector3d& n, double* lo, double* hi) {
-  *lo = std::numeric_limits<double>::infinity();
-  *hi = -*lo;
-  for (int i = 0; i < kNumVertices; ++i) {
-    const double p = n.x() * h.x[i] + n.y() * h.y[i] + n.z() * h.z[i];
-    *lo = std::min(*lo, p);
-    *hi = std::max(*hi, p);
-  }
-}
-
 // A separating plane when no face of either solid is one: the report's
 // candidate if it separates the whole solids, else the widest gap along the
 // cross products of A's and B's edge directions (for convex solids whose
@@ -222,41 +215,8 @@ void FindEdgePlane(const Hexahedron& a, const Hexahedron& b, const PlaneCandidat
       if (PlaneSeparates(a, b, -n, -d, tau)) return SetPlane(r, -n, -d);
     }
   }
-  // The edge directions and their lengths, once (the same bits as forming
-  // them pair by pair).
-  std::array<Eigen::Vector3d, kNumEdges> da, db;
-  std::array<double, kNumEdges> la, lb;
-  for (int e = 0; e < kNumEdges; ++e) {
-    da[e] = a.vertex(kEdges[e][1]) - a.vertex(kEdges[e][0]);
-    db[e] = b.vertex(kEdges[e][1]) - b.vertex(kEdges[e][0]);
-    la[e] = da[e].norm();
-    lb[e] = db[e].norm();
-  }
-  double best_gap = -std::numeric_limits<double>::infinity();
-  Eigen::Vector3d best_n = Eigen::Vector3d::UnitZ();
-  double best_d = 0;
-  for (int ea = 0; ea < kNumEdges; ++ea) {
-    for (int eb = 0; eb < kNumEdges; ++eb) {
-      Eigen::Vector3d n = da[ea].cross(db[eb]);
-      const double len = n.norm();
-      if (!(len > 1e-12 * la[ea] * lb[eb])) continue;
-      n /= len;
-      double alo, ahi, blo, bhi;
-      ProjectionRange(a, n, &alo, &ahi);
-      ProjectionRange(b, n, &blo, &bhi);
-      if (blo - ahi > best_gap) {
-        best_gap = blo - ahi;
-        best_n = n;
-        best_d = 0.5 * (ahi + blo);
-      }
-      if (alo - bhi > best_gap) {
-        best_gap = alo - bhi;
-        best_n = -n;
-        best_d = -0.5 * (bhi + alo);
-      }
-    }
-  }
-  if (best_gap >= -tau) SetPlane(r, best_n, best_d);
+  const internal::EdgeAxisPlane widest = internal::WidestEdgeAxis(a, b);
+  if (widest.gap_ft >= -tau) SetPlane(r, widest.n_R, widest.d_ft);
 }
 
 }  // namespace

@@ -30,6 +30,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <limits>
 
 #include "rms/dynamics_proc/hexahedron.h"
 #include "rms/scene_model/separating_plane.h"
@@ -121,5 +122,28 @@ struct FaceList {
   std::array<std::uint8_t, 6> faces;
 };
 extern const std::array<FaceList, 64> kFacesOfMask;
+
+namespace internal {
+
+// Step 4's last resort for a plane (docs/collision.md "The widest edge
+// axis"): among the unit cross products n of an edge direction of A and
+// one of B (12 x 12; a pair with |da x db| <= 1e-12 |da| |db|, near
+// parallel, skipped), the widest gap from A to B along n or -n. Of equal
+// gaps the first wins, in the order A's edge, B's edge, then B above A
+// before A above B. gap_ft is -infinity when no axis was tried.
+struct EdgeAxisPlane {
+  Eigen::Vector3d n_R = Eigen::Vector3d::UnitZ();  // from A toward B, Reference frame
+  double d_ft = 0.0;                               // the plane n . p = d, midway in the gap, ft
+  double gap_ft = -std::numeric_limits<double>::infinity();  // the gap, ft (negative: overlap)
+  int axes_computed = 0;  // of the 144, how many were computed (work done, for benchmarks)
+};
+// Skips each pair of edge directions whose axes are all bounded below an
+// axis already computed; the same answer, bit for bit, as
+// WidestEdgeAxisExhaustive (docs/collision.md "The widest edge axis").
+EdgeAxisPlane WidestEdgeAxis(const Hexahedron& a, const Hexahedron& b);
+// Every one of the 144 axes: the reference, for tests and the benchmark.
+EdgeAxisPlane WidestEdgeAxisExhaustive(const Hexahedron& a, const Hexahedron& b);
+
+}  // namespace internal
 
 }  // namespace rms::dynamics_proc
