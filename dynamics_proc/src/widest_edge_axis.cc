@@ -19,6 +19,9 @@ namespace {
 constexpr int kNumAxes = kNumEdges * kNumEdges;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kEps = std::numeric_limits<double>::epsilon();  // 2^-52: twice the unit roundoff
+// The range of |da x db| (ft^2) and of the reach (ft) in which a pair of
+// directions may be skipped: its squares normal numbers, far from overflow.
+constexpr double kLeastCross = 0x1p-500, kGreatestCross = 0x1p500;
 
 // The edges along each of the solid's three directions, U (a to d), V (b to
 // e) and W (c to f): edge "x-y" joins faces x and y and runs along the third
@@ -210,10 +213,18 @@ double ClassSlack(const EdgeDirections& da, int p, const EdgeDirections& db, int
                   const AxisExtents& rep, double reach) {
   if (!rep.usable) return kInf;
   const double c_len = rep.cross_len;
+  // Only in the normal range, well inside: below, |c|^2 is subnormal and
+  // the "unit" axis is off by tens of percent; above, it overflows. The
+  // members' |c| is at least 3/4 of the representative's (below), so their
+  // squares stay normal too.
+  if (!(c_len >= kLeastCross && c_len <= kGreatestCross) || !(reach <= kGreatestCross)) return kInf;
   const double change = da.spread[p] * db.longest[q] + da.longest[p] * db.spread[q];
   const double kappa = da.longest[p] * db.longest[q] / c_len;
   if (!(change <= 0.25 * c_len) || !(kappa * kEps <= 1e-4)) return kInf;
-  return 2.0 * (2.0 * reach * (4.0 * change / c_len + 64.0 * kEps * kappa) + 64.0 * kEps * reach);
+  // kLeastCross: the absolute rounding of a subnormal product or projection
+  // (2^-1074 each), far below it.
+  return 2.0 * (2.0 * reach * (4.0 * change / c_len + 64.0 * kEps * kappa) + 64.0 * kEps * reach) +
+         kLeastCross;
 }
 
 double Reach(const Hexahedron& h) {

@@ -367,7 +367,7 @@ bool SameBits(const internal::EdgeAxisPlane& x, const internal::EdgeAxisPlane& y
 }
 
 TEST(WidestEdgeAxis, SkippingAxesGivesTheExhaustiveSearchsAnswerBitForBit) {
-  // Every family of the generator, boxes and general hexahedra, at three
+  // Every family of the generator, boxes and general hexahedra, at five
   // scales, near the origin and 10^5 of their sizes from it; then mirror-
   // image pairs, whose pairs of edge directions tie. The search step 4
   // falls back on (docs/collision.md "The widest edge axis").
@@ -393,11 +393,14 @@ TEST(WidestEdgeAxis, SkippingAxesGivesTheExhaustiveSearchsAnswerBitForBit) {
     UseAvx(true);
     return axes;
   };
+  // Five scales: the three of the lab and two near the ends of the valid
+  // range (products near underflow and far from overflow).
+  const double scales[] = {1e-3, 1.0, 1e4, 1e-72, 1e60};
   for (int i = 0; i < 30000; ++i) {
-    const double scale = i % 3 == 0 ? 1e-3 : (i % 3 == 1 ? 1.0 : 1e4);
+    const double scale = scales[i % 5];
     const bool boxes_only = i % 2 == 0;
     reference::Pair p = gen.Next(scale, boxes_only);
-    if (i % 5 == 0) p = reference::Translated(p, Vector3d(1e5, -2e5, 3e5) * scale);
+    if (i % 11 == 0) p = reference::Translated(p, Vector3d(1e5, -2e5, 3e5) * scale);
     const int axes = check(p.a.hex, p.b.hex, p.kind.c_str(), i);
     if (boxes_only && p.kind == "random boxes") ++boxes, box_axes += axes;
   }
@@ -412,6 +415,32 @@ TEST(WidestEdgeAxis, SkippingAxesGivesTheExhaustiveSearchsAnswerBitForBit) {
     for (int k = 0; k < 8; ++k) mirrored[k] = Vector3d(s.v[k].y(), s.v[k].x(), s.v[k].z()) + shift;
     check(s.hex, FromVertices(mirrored), "mirror image", i);
   }
+  // Solids of about 1e-73 ft whose cross products' squares are subnormal
+  // (so a "unit" axis is off by tens of percent): found by a review, where
+  // an unguarded bound skipped the widest axis.
+  const std::array<Vector3d, 8> tiny_a = {{
+      {-0x1p-247, -0x1p-242, 0x1p-242},
+      {-0x1p-247, -0x1.ffffff62b601ep-243, 0x1.0000004ea4ff1p-242},
+      {0x1p-247, -0x1p-242, 0x1p-242},
+      {-0x1p-247, -0x1.efffff61ac390p-243, 0x1.f000009c3e710p-243},
+      {-0x1p-247, -0x1.fp-243, 0x1.fp-243},
+      {0x1p-247, -0x1.ffffff62b601ep-243, 0x1.0000004ea4ff1p-242},
+      {0x1p-247, -0x1.efffff61ac390p-243, 0x1.f000009c3e710p-243},
+      {0x1p-247, -0x1.fp-243, 0x1.fp-243},
+  }};
+  const std::array<Vector3d, 8> tiny_b = {{
+      {-0x1p-247, 0x1p-242, -0x1p-242},
+      {-0x1.fffff8p-248, 0x1p-242, -0x1p-242},
+      {-0x1p-247, 0x1.08p-242, -0x1.fp-243},
+      {-0x1.fffff8p-248, 0x1.fp-243, -0x1.fp-243},
+      {-0x1p-247, 0x1.fp-243, -0x1.fp-243},
+      {-0x1.fffff8p-248, 0x1.08p-242, -0x1.fp-243},
+      {-0x1.fffff8p-248, 0x1p-242, -0x1.ep-243},
+      {-0x1p-247, 0x1p-242, -0x1.ep-243},
+  }};
+  const Hexahedron ta = FromVertices(tiny_a), tb = FromVertices(tiny_b);
+  ASSERT_TRUE(ta.valid && tb.valid) << HexProblemName(ta.problem) << HexProblemName(tb.problem);
+  check(ta, tb, "subnormal cross products", 0);
   EXPECT_EQ(differ, 0);
   // Random box pairs need far fewer than the 144 axes.
   ASSERT_GT(boxes, 100);
