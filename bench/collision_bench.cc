@@ -365,17 +365,14 @@ void RegisterTimings(const Sets& sets) {
     benchmark::RegisterBenchmark(
         all ? "widest edge axis/all 144 axes" : "widest edge axis/skipping axes",
         [&sets, all](benchmark::State& st) {
+          const auto search = all ? rms::dynamics_proc::internal::WidestEdgeAxisExhaustive
+                                  : rms::dynamics_proc::internal::WidestEdgeAxis;
           const auto& pairs = sets.hex_dense_boxes_no_edge_pierces;
           std::size_t i = 0;
-          double axes = 0;
           for (auto _ : st) {
             const auto& [a, b] = pairs[i++ % pairs.size()];
-            const auto w = all ? rms::dynamics_proc::internal::WidestEdgeAxisExhaustive(a, b)
-                               : rms::dynamics_proc::internal::WidestEdgeAxis(a, b);
-            benchmark::DoNotOptimize(w.gap_ft);
-            axes += w.axes_computed;
+            benchmark::DoNotOptimize(search(a, b).gap_ft);
           }
-          st.counters["axes"] = benchmark::Counter(axes, benchmark::Counter::kAvgIterations);
         });
   }
   dcp("dense general/DCP, verdict", sets.hex_dense_general, verdict_only);
@@ -463,10 +460,10 @@ std::string TargetLine(const std::string& what, double value, double limit, bool
   return b;
 }
 
-// Issue 18's sets: pairs whose bounding spheres overlap, half colliding, and
-// its targets (docs/performance.md "Collision against its peers").
 // Step 4's last resort (docs/collision.md "The widest edge axis") on the
-// dense box pairs that reach it: skipping axes against all 144.
+// dense box pairs that reach it: skipping axes against all 144, and how
+// many axes the skipping search computes on them (counted here, outside the
+// timed loop).
 void WidestEdgeAxisTable(const Collector& collector, const Sets& sets, std::ostringstream& md) {
   const double skip = Figure(collector, "widest edge axis/skipping axes");
   const double all = Figure(collector, "widest edge axis/all 144 axes");
@@ -489,6 +486,8 @@ void WidestEdgeAxisTable(const Collector& collector, const Sets& sets, std::ostr
   md << line;
 }
 
+// Issue 18's sets: pairs whose bounding spheres overlap, half colliding, and
+// its targets (docs/performance.md "Collision against its peers").
 void DenseTables(const Collector& collector, const Sets& sets_made, std::ostringstream& md) {
   const double dcp = Figure(collector, "dense boxes/DCP, verdict");
   const double plane = Figure(collector, "dense boxes/DCP, verdict and separating plane");
