@@ -70,7 +70,10 @@ TEST(UdpLcm, MessagesAreStampedWithTheirSenderAndOtherSessionsAreDropped) {
     ASSERT_TRUE(transport::PublishMessage(a, wire::channels::kOperatorInput, m));
     ASSERT_TRUE(transport::PublishMessage(b, wire::channels::kOperatorInput, m));
   }
-  for (int k = 0; k < 50 && (got_mine.size() < 10 || got_none.size() < 20); ++k) {
+  // Until every message has reached both (B's to `mine` are only counted).
+  for (int k = 0; k < 50 && (got_mine.size() < 10 || got_none.size() < 20 ||
+                             mine.other_session_dropped() < 10);
+       ++k) {
     mine.HandleSubscriptions(20);
     none.HandleSubscriptions(0);
   }
