@@ -532,6 +532,17 @@ def max_size(s, types):
     return total
 
 
+def fixed_size(s, types):
+    """True when every encoding of s has the same size: no string and no
+    variable-length array in it or in a type it holds."""
+    for m in s.members:
+        if m.type_name == "string" or any(kind != "fixed" for kind, _ in m.dims):
+            return False
+        if m.type_name in types and not fixed_size(types[m.type_name], types):
+            return False
+    return True
+
+
 def within_code(s, types, var):
     """C++ conditions: every count and string of `var` (a T) within its bound."""
     conds, counted = [], set()
@@ -580,7 +591,8 @@ def limits_header(types):
         "// encoding of a message, fingerprint included, and whether a decoded",
         "// message keeps within them. rms::wire::SafeDecode refuses a larger",
         "// message before decoding it and one out of bounds after (docs/protocol.md",
-        "// \"Malformed messages\").",
+        "// \"Malformed messages\"). kFixedSize: every encoding of the type has",
+        "// kMaxEncodedSize bytes (no string, no variable-length array).",
         "#pragma once",
         "",
         "#include <algorithm>",
@@ -595,6 +607,7 @@ def limits_header(types):
         body = " &&\n           ".join(conds) if conds else "true"
         out += ["", "template <>", f"struct Bounds<{cpp_type(n)}> {{",
                 f"  static constexpr int kMaxEncodedSize = {8 + max_size(s, types)};",
+                f"  static constexpr bool kFixedSize = {'true' if fixed_size(s, types) else 'false'};",
                 f"  static bool Within([[maybe_unused]] const {cpp_type(n)}& m) {{",
                 f"    return {body};", "  }", "};"]
     out += ["", "// The largest encoding of a T, bytes, fingerprint included.", "template <class T>",

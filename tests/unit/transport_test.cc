@@ -7,10 +7,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <gtest/gtest.h>
+#include <iostream>
 #include <lcm/lcm-cpp.hpp>
+#include <random>
 #include <thread>
 
 #include "rms/base/check.h"
+#include "rms/dcp_frame_t.hpp"
+#include "rms/dcp_telemetry_t.hpp"
 #include "rms/esg_frame_t.hpp"
 #include "rms/operator_input_t.hpp"
 #include "rms/process_status_t.hpp"
@@ -156,6 +160,75 @@ TEST(SafeDecode, ClassifiesHostileBytesWithoutThrowing) {
   process_status_t so;
   const wire::DecodeError e = wire::SafeDecode(sb.data(), static_cast<int>(sb.size()), &so);
   EXPECT_NE(e, wire::DecodeError::kNone);
+}
+
+// The frame number and the send time sit where wire::kFrameAt and
+// wire::kSendTimeAt say, in each type that has them there.
+template <class Msg>
+void ExpectFrameAndSendTimeAt() {
+  Msg m{};
+  m.frame = 0x0102030405060708;
+  m.send_time_us = 0x1112131415161718;
+  const std::vector<std::uint8_t> b = wire::EncodeMessage(m);
+  std::int64_t frame = 0;
+  ASSERT_TRUE(wire::ReadFrameNumber(b.data(), static_cast<int>(b.size()), &frame));
+  EXPECT_EQ(frame, m.frame);
+  std::int64_t t = 0;
+  ASSERT_TRUE(wire::ReadInt64At(b.data(), static_cast<int>(b.size()), wire::kSendTimeAt, &t));
+  EXPECT_EQ(t, m.send_time_us);
+  EXPECT_FALSE(wire::ReadFrameNumber(b.data(), wire::kFrameAt + 7, &frame));
+}
+
+TEST(ReadFrameNumber, TheFrameAndSendTimeFollowTheSender) {
+  ExpectFrameAndSendTimeAt<operator_input_t>();
+  ExpectFrameAndSendTimeAt<dcp_frame_t>();
+  ExpectFrameAndSendTimeAt<dcp_telemetry_t>();
+  dcp_frame_t m{};
+  m.input_frame = -0x0102030405060708;
+  const std::vector<std::uint8_t> b = wire::EncodeMessage(m);
+  std::int64_t input_frame = 0;
+  ASSERT_TRUE(wire::ReadInt64At(b.data(), static_cast<int>(b.size()), wire::kDcpFrameInputFrameAt,
+                                &input_frame));
+  EXPECT_EQ(input_frame, m.input_frame);
+  EXPECT_FALSE(wire::ReadInt64At(b.data(), wire::kDcpFrameInputFrameAt + 7,
+                                 wire::kDcpFrameInputFrameAt, &input_frame));
+}
+
+// CheckEncoded says of a fixed-size type's raw bytes what SafeDecode says,
+// on random sizes around the type's, its fingerprint or another, random
+// contents.
+template <class Msg>
+void ExpectCheckEncodedIsSafeDecode(std::mt19937* rng) {
+  constexpr int kSize = lcm_limits::kMaxEncodedSize<Msg>;
+  std::uniform_int_distribution<int> size(0, kSize + 16), byte(0, 255), coin(0, 3);
+  int valid = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const int n = coin(*rng) == 0 ? kSize : size(*rng);
+    std::vector<std::uint8_t> b(static_cast<std::size_t>(n) + 1);
+    for (auto& x : b) x = static_cast<std::uint8_t>(byte(*rng));
+    if (coin(*rng) != 0) {
+      const auto h = static_cast<std::uint64_t>(Msg::getHash());
+      for (int k = 0; k < 8 && k < n; ++k)
+        b[static_cast<std::size_t>(k)] = (h >> (56 - 8 * k)) & 0xFF;
+    }
+    Msg m;
+    const wire::DecodeError want = wire::SafeDecode(b.data(), n, &m);
+    ASSERT_EQ(wire::CheckEncoded<Msg>(b.data(), n), want) << "size " << n << ", try " << i;
+    valid += want == wire::DecodeError::kNone;
+  }
+  EXPECT_GT(valid, 1000);
+}
+
+TEST(CheckEncoded, SaysOfFixedSizeMessagesWhatSafeDecodeSays) {
+  static_assert(lcm_limits::Bounds<dcp_frame_t>::kFixedSize);
+  static_assert(lcm_limits::Bounds<dcp_telemetry_t>::kFixedSize);
+  static_assert(!lcm_limits::Bounds<esg_frame_t>::kFixedSize);       // a count of words
+  static_assert(!lcm_limits::Bounds<process_status_t>::kFixedSize);  // strings
+  constexpr unsigned kSeed = 19721122;
+  std::cout << "seed " << kSeed << "\n";
+  std::mt19937 rng(kSeed);
+  ExpectCheckEncodedIsSafeDecode<dcp_frame_t>(&rng);
+  ExpectCheckEncodedIsSafeDecode<dcp_telemetry_t>(&rng);
 }
 
 }  // namespace

@@ -2,10 +2,12 @@
 // property tests (fixed, printed seeds) elsewhere.
 #include "rms/wire/word_codec.h"
 
+#include <algorithm>
 #include <cmath>
 #include <gtest/gtest.h>
 #include <limits>
 #include <random>
+#include <vector>
 
 #include "rms/base/check.h"
 
@@ -161,6 +163,35 @@ TEST(WordCodec, TiesRoundAwayFromZero) {
   EXPECT_EQ(
       wire::RawUnchecked(wire::kFT12, wire::Encode(wire::kFT12, 0.4999 * wire::kFT12.lsb()).word),
       0);
+}
+
+// Encode rounds as std::llround does, to the bit: random values over each
+// format's range and past its ends, every tie k + 1/2 LSB near zero, the
+// range's ends and the doubles either side of each.
+TEST(WordCodec, RoundsAsLlroundToTheBit) {
+  const std::uint64_t seed = 1972;
+  std::printf("seed %llu\n", static_cast<unsigned long long>(seed));
+  std::mt19937_64 rng(seed);
+  for (const wire::FixedFormat* f : {&wire::kSC22, &wire::kFT12, &wire::kADC16, &wire::kU24}) {
+    auto expect_llround = [&](double v) {
+      const double scaled = v * static_cast<double>(std::int64_t{1} << f->frac_bits);
+      const std::int64_t want =
+          std::clamp<std::int64_t>(std::llround(scaled), f->raw_min, f->raw_max);
+      ASSERT_EQ(wire::RawUnchecked(*f, wire::Encode(*f, v).word), want) << f->name << " " << v;
+    };
+    std::vector<double> values;
+    std::uniform_real_distribution<double> in(f->min_value() - 3 * f->lsb(),
+                                              f->max_value() + 3 * f->lsb());
+    for (int i = 0; i < 200000; ++i) values.push_back(in(rng));
+    for (std::int64_t k = -2000; k <= 2000; ++k) values.push_back((k + 0.5) * f->lsb());
+    for (const double end : {f->min_value(), f->max_value()})
+      for (const double d : {-0.5, 0.0, 0.5}) values.push_back(end + d * f->lsb());
+    for (const double v : values) {
+      expect_llround(v);
+      expect_llround(std::nextafter(v, -1e300));
+      expect_llround(std::nextafter(v, 1e300));
+    }
+  }
 }
 
 TEST(WordCodec, BamWrapsAnyAngle) {

@@ -41,6 +41,12 @@ bool ReadSessionId(const void* data, int size, std::int64_t* session_id) {
   return true;
 }
 
+bool ReadInt64At(const void* data, int size, int at, std::int64_t* value) {
+  if (at < 0 || size < at + 8) return false;
+  *value = static_cast<std::int64_t>(ReadBigEndian(static_cast<const std::uint8_t*>(data) + at, 8));
+  return true;
+}
+
 bool ReadSenderProcess(const void* data, int size, std::int8_t* process, std::int32_t* pid) {
   if (size < 8 + kSenderBytes) return false;
   const auto* b = static_cast<const std::uint8_t*>(data);

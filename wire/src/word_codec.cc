@@ -49,7 +49,11 @@ Encoded Encode(const FixedFormat& f, double value) {
   // Compare in double before rounding so huge values cannot overflow.
   if (scaled < static_cast<double>(f.raw_min) - 0.5) return {RawToWord(f, f.raw_min), true};
   if (scaled >= static_cast<double>(f.raw_max) + 0.5) return {RawToWord(f, f.raw_max), true};
-  std::int64_t raw = std::llround(scaled);  // ties away from zero
+  // std::llround's rounding (ties away from zero), without the library call:
+  // |scaled| < 2^25 here, so the truncation and the fraction are exact.
+  const auto truncated = static_cast<std::int64_t>(scaled);
+  const double fraction = scaled - static_cast<double>(truncated);
+  std::int64_t raw = truncated + (fraction >= 0.5) - (fraction <= -0.5);
   bool saturated = false;
   if (raw < f.raw_min) {
     raw = f.raw_min;

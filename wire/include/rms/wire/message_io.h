@@ -68,6 +68,20 @@ inline bool ReadFingerprint(const void* data, int size, std::int64_t* out) {
 // sender_t on the wire: right after the fingerprint (every rmslab message
 // has it first), session_id (8 bytes), process (1), pid (4), big-endian.
 inline constexpr int kSenderBytes = 13;
+// RMS_OPERATOR_INPUT, RMS_DCP_FRAME and RMS_DCP_TELEMETRY go on with their
+// frame number, then their send time (int64 each, big-endian): where they
+// start in the raw message (docs/protocol.md "Senders").
+inline constexpr int kFrameAt = 8 + kSenderBytes;
+inline constexpr int kSendTimeAt = kFrameAt + 8;
+// RMS_DCP_FRAME's input_frame, after its send time.
+inline constexpr int kDcpFrameInputFrameAt = kSendTimeAt + 8;
+// The big-endian int64 at byte `at` of a raw message; false when it is too
+// short to hold it.
+bool ReadInt64At(const void* data, int size, int at, std::int64_t* value);
+// Such a raw message's frame number (at kFrameAt).
+inline bool ReadFrameNumber(const void* data, int size, std::int64_t* frame) {
+  return ReadInt64At(data, size, kFrameAt, frame);
+}
 
 // True for the fingerprint of one of rmslab's own message types.
 bool IsRmslabFingerprint(std::int64_t fingerprint);
@@ -104,6 +118,21 @@ DecodeError SafeDecode(const void* data, int size, Msg* msg) {
   if (n < 0) return DecodeError::kTruncated;
   if (n != size) return DecodeError::kTrailingBytes;
   if (!lcm_limits::Bounds<Msg>::Within(*msg)) return DecodeError::kBadCount;
+  return DecodeError::kNone;
+}
+
+// What SafeDecode says of a raw message of a fixed-size type
+// (lcm_limits::Bounds<Msg>::kFixedSize: no string, no variable-length array,
+// so no count to bound), told from its size and fingerprint alone: a reader
+// that keeps or compares the bytes need not decode them.
+template <class Msg>
+DecodeError CheckEncoded(const void* data, int size) {
+  static_assert(lcm_limits::Bounds<Msg>::kFixedSize, "a type with counts must be decoded");
+  if (size > lcm_limits::kMaxEncodedSize<Msg>) return DecodeError::kTooLarge;
+  std::int64_t fp = 0;
+  if (!ReadFingerprint(data, size, &fp)) return DecodeError::kTruncated;
+  if (fp != Msg::getHash()) return DecodeError::kWrongType;
+  if (size < lcm_limits::kMaxEncodedSize<Msg>) return DecodeError::kTruncated;
   return DecodeError::kNone;
 }
 
