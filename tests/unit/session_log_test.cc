@@ -6,6 +6,7 @@
 // the oracle.
 #include "rms/session/session_log.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -66,6 +67,56 @@ enum class Damage {
   kNegativeDataLength
 };
 
+constexpr int kEvents = 800;  // about 1.3 MB: past ReadInTwo's 1 MiB
+
+// ReadInTwo, cut at shares of the log, at events' starts and just before
+// sync words inside events' data, on another core that always takes its
+// part: part 0 and then, when it stands, part 1 are liblcm's events, and
+// the events and unread bytes counted are liblcm's. A cut at an event's
+// start of an undamaged log stands; one before a false sync word never.
+void ExpectReadInTwoReadsAsLiblcm(const std::string& dir, std::size_t size,
+                                  const std::vector<Event>& expected, long good_end,
+                                  const std::vector<std::size_t>& event_starts,
+                                  const std::vector<std::size_t>& false_syncs, bool undamaged) {
+  struct Cut {
+    double share;
+    int stands;  // 1 must, 0 must not, -1 either
+  };
+  std::vector<Cut> cuts = {{0.5, -1}, {0.3, -1}, {0.77, -1}};
+  auto share_cutting_at = [&](std::size_t at) {  // the middle lands at `at`
+    return 1.0 - (static_cast<double>(at) + 0.5) / static_cast<double>(size);
+  };
+  for (const double f : {0.35, 0.5, 0.65}) {
+    const auto near = static_cast<std::size_t>(f * static_cast<double>(size));
+    const auto e = std::lower_bound(event_starts.begin(), event_starts.end(), near);
+    if (e != event_starts.end()) cuts.push_back({share_cutting_at(*e), undamaged ? 1 : -1});
+    const auto s = std::lower_bound(false_syncs.begin(), false_syncs.end(), near);
+    if (s != false_syncs.end()) cuts.push_back({share_cutting_at(*s - 2), 0});
+  }
+  ASSERT_GE(cuts.size(), 8u);
+  OtherCore other(true);
+  for (const Cut& cut : cuts) {
+    SCOPED_TRACE("second share " + std::to_string(cut.share));
+    SessionLog log(dir);
+    std::vector<Event> parts[2];
+    const bool stands = log.ReadInTwo(
+        {},
+        [&](int part, const LogMessage& m) {
+          parts[part].push_back({m.log_us, std::string(m.channel),
+                                 std::string(static_cast<const char*>(m.data), m.size)});
+        },
+        {&other, {}, cut.share});
+    std::vector<Event> got = parts[0];
+    if (stands) got.insert(got.end(), parts[1].begin(), parts[1].end());
+    EXPECT_TRUE(got == expected) << got.size() << " events against " << expected.size();
+    EXPECT_EQ(log.events(), static_cast<std::int64_t>(expected.size()));
+    EXPECT_EQ(log.unread_bytes(), static_cast<std::int64_t>(size) - good_end);
+    if (cut.stands >= 0) {
+      EXPECT_EQ(stands, cut.stands == 1);
+    }
+  }
+}
+
 class SessionLogRead : public ::testing::TestWithParam<Damage> {};
 
 TEST_P(SessionLogRead, GivesLiblcmsEventsAndUnreadBytes) {
@@ -81,15 +132,29 @@ TEST_P(SessionLogRead, GivesLiblcmsEventsAndUnreadBytes) {
   std::uniform_int_distribution<int> size(0, 3000), pick(0, 3), byte(0, 255);
   if (GetParam() == Damage::kGarbageFirst)
     bytes = "\x12\xED\xA1\xDA garbage before the first event";
-  for (int n = 0; n < 300; ++n) {
+  // Where events start, and where a sync word stands inside an event's data
+  // (every fifth event has one): places to cut the log for ReadInTwo.
+  std::vector<std::size_t> event_starts, false_syncs;
+  for (int n = 0; n < kEvents; ++n) {
     Event e{1'700'000'000'000'000 + n * 33'333, channels[pick(rng)], ""};
     for (int k = size(rng); k > 0; --k) e.data.push_back(static_cast<char>(byte(rng)));
     if (n == 150) e.data.append(100'000, 'x');  // larger than the reader's buffer
+    // A whole event, followed by a sync word, inside the data: what a reader
+    // that begins there takes for events.
+    std::size_t sync_at = std::string::npos;
+    const std::string fake = EventBytes(9, {7, "F", "ab"}, 1, 2) + "\xED\xA1\xDA\x01";
+    if (n % 5 == 0 && e.data.size() >= fake.size()) {
+      sync_at = static_cast<std::size_t>(size(rng)) % (e.data.size() - fake.size() + 1);
+      e.data.replace(sync_at, fake.size(), fake);
+    }
     const auto c = static_cast<std::int32_t>(e.channel.size());
     const auto d = static_cast<std::int32_t>(e.data.size());
     if (GetParam() == Damage::kGarbageBetween && n % 7 == 3) {
       for (int k = size(rng) % 50; k > 0; --k) bytes.push_back(static_cast<char>(byte(rng)));
     }
+    event_starts.push_back(bytes.size());
+    if (sync_at != std::string::npos)
+      false_syncs.push_back(bytes.size() + 28 + e.channel.size() + sync_at);
     if (GetParam() == Damage::kBadChannelLength && n == 200) {
       bytes += EventBytes(n, e, 1000, d);
     } else if (GetParam() == Damage::kNegativeDataLength && n == 200) {
@@ -117,10 +182,10 @@ TEST_P(SessionLogRead, GivesLiblcmsEventsAndUnreadBytes) {
   EXPECT_EQ(log.unread_bytes(), static_cast<std::int64_t>(bytes.size()) - good_end);
   if (GetParam() == Damage::kNone || GetParam() == Damage::kGarbageFirst ||
       GetParam() == Damage::kTwoBytesAfter) {
-    EXPECT_EQ(got.size(), 300u);
+    EXPECT_EQ(got.size(), static_cast<std::size_t>(kEvents));
     EXPECT_EQ(log.unread_bytes(), 0);  // liblcm reads past up to three bytes after the last event
   } else {
-    EXPECT_LT(got.size(), 300u);
+    EXPECT_LT(got.size(), static_cast<std::size_t>(kEvents));
     EXPECT_GT(log.unread_bytes(), 0);
   }
   // Only the channels asked for (and, whatever is asked, nothing else).
@@ -132,6 +197,8 @@ TEST_P(SessionLogRead, GivesLiblcmsEventsAndUnreadBytes) {
   int expected_frames = 0;
   for (const Event& e : expected) expected_frames += e.channel == "RMS_DCP_FRAME";
   EXPECT_EQ(frames, expected_frames);
+  ExpectReadInTwoReadsAsLiblcm(dir.string(), bytes.size(), expected, good_end, event_starts,
+                               false_syncs, GetParam() == Damage::kNone);
   fs::remove_all(dir);
 }
 

@@ -35,6 +35,13 @@ RawLogReader::RawLogReader(const std::string& path) : path_(path) {
   buf_ = std::make_unique_for_overwrite<std::uint8_t[]>(capacity_);
 }
 
+RawLogReader::RawLogReader(const std::string& path, std::size_t from) : RawLogReader(path) {
+  from = std::min(from, file_size_);
+  if (::lseek(fd_, static_cast<off_t>(from), SEEK_SET) < 0)
+    throw InputError("cannot read the LCM log '" + path + "': " + std::strerror(errno));
+  offset_ = good_end_ = from;
+}
+
 RawLogReader::~RawLogReader() {
   if (fd_ >= 0) ::close(fd_);
 }
@@ -75,12 +82,20 @@ bool RawLogReader::Next(RawLogEvent* ev) {
   // its four bytes stand (liblcm reads byte by byte until they do).
   for (;;) {
     if (!Have(4)) return false;
+    // Where the last event ended, as a whole log has it (memmem's set-up
+    // costs more than the event's own reading).
+    if (std::memcmp(buf_.get() + begin_, kSync, 4) == 0) break;
     const void* found = ::memmem(buf_.get() + begin_, end_ - begin_, kSync, 4);
     if (found) {
       begin_ = static_cast<std::size_t>(static_cast<const std::uint8_t*>(found) - buf_.get());
       break;
     }
     begin_ = end_ - 3;  // a sync word may begin in the last three bytes
+  }
+  if (offset_ + begin_ >= stop_at_) {
+    stopped_ = true;
+    stopped_at_ = offset_ + begin_;
+    return false;
   }
   if (!Have(4 + kHeaderBytes)) return false;
   const std::uint8_t* h = buf_.get() + begin_ + 4;
@@ -104,6 +119,7 @@ bool RawLogReader::Next(RawLogEvent* ev) {
   ev->channel = std::string_view(reinterpret_cast<const char*>(p), channel_len);
   ev->data = p + channel_len;
   ev->size = data_len;
+  if (first_event_start_ == kNoStop) first_event_start_ = offset_ + begin_;
   begin_ += total;
   good_end_ = end;
   return true;

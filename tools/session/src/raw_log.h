@@ -28,6 +28,11 @@ class RawLogReader {
  public:
   // Throws rms::InputError naming the file when it cannot be opened.
   explicit RawLogReader(const std::string& path);
+  // The same from byte `from` on: the first event is the first whose sync
+  // word stands at or after it (where liblcm, reading on from there, would
+  // find one). Whether that is where an event of the whole log starts, only
+  // a reader from the start can tell (StopAt).
+  RawLogReader(const std::string& path, std::size_t from);
   ~RawLogReader();
   RawLogReader(const RawLogReader&) = delete;
   RawLogReader& operator=(const RawLogReader&) = delete;
@@ -41,6 +46,18 @@ class RawLogReader {
   // bytes after good_end() are no whole event.
   std::size_t good_end() const { return good_end_; }
   std::size_t size() const { return file_size_; }
+  // Stops before an event whose sync word stands at or past `offset`: Next
+  // returns false and stopped() is true, stopped_at() that event's start
+  // (byte from the file's start), not taken; Resume() reads on from it.
+  void StopAt(std::size_t offset) { stop_at_ = offset; }
+  bool stopped() const { return stopped_; }
+  std::size_t stopped_at() const { return stopped_at_; }
+  void Resume() {
+    stop_at_ = kNoStop;
+    stopped_ = false;
+  }
+  // The start (byte from the file's start) of the first event taken.
+  std::size_t first_event_start() const { return first_event_start_; }
 
  private:
   // At least n bytes from begin_ in the buffer: reads on, moving the unread
@@ -56,6 +73,9 @@ class RawLogReader {
   std::size_t begin_ = 0, end_ = 0;  // the unread bytes in buf_
   std::size_t offset_ = 0;           // the file offset of buf_[0]
   std::size_t good_end_ = 0;
+  static constexpr std::size_t kNoStop = ~std::size_t{0};
+  std::size_t stop_at_ = kNoStop, stopped_at_ = 0, first_event_start_ = kNoStop;
+  bool stopped_ = false;
 };
 
 }  // namespace rms::session

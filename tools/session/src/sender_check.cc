@@ -72,6 +72,11 @@ const char* SenderCheck::Ignore(std::string_view base, const void* data, int siz
   return why;
 }
 
+void SenderCheck::Add(const SenderCheck& other) {
+  for (const auto& [reason, n] : other.ignored_) ignored_[reason] += n;
+  other_sessions_.insert(other.other_sessions_.begin(), other.other_sessions_.end());
+}
+
 std::int64_t SenderCheck::ignored_total() const {
   std::int64_t n = 0;
   for (const auto& [k, v] : ignored_) n += v;

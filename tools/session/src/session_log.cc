@@ -6,6 +6,7 @@
 
 #include "rms/base/check.h"
 #include "rms/base/config.h"
+#include "rms/base/other_core.h"
 #include "rms/session/session_summary.h"
 #include "rms/wire/channels.h"
 
@@ -16,18 +17,6 @@ namespace fs = std::filesystem;
 namespace rms::session {
 
 namespace {
-
-// RMS_OPERATOR_INPUT's frame without decoding the rest: it follows the
-// fingerprint and the sender (docs/protocol.md "RMS_OPERATOR_INPUT").
-bool InputFrame(const void* data, int size, std::int64_t* frame) {
-  constexpr int kAt = 8 + wire::kSenderBytes;
-  if (size < kAt + 8) return false;
-  const auto* p = static_cast<const std::uint8_t*>(data) + kAt;
-  std::uint64_t v = 0;
-  for (int i = 0; i < 8; ++i) v = (v << 8) | p[i];
-  *frame = static_cast<std::int64_t>(v);
-  return true;
-}
 
 // The session's frame rate from its config.toml; a session without its
 // config: the report's rate (docs/config.md).
@@ -58,14 +47,21 @@ SessionLog::SessionLog(const std::string& session_dir)
 void SessionLog::Read(std::initializer_list<std::string_view> channels,
                       const std::function<void(const LogMessage&)>& visit) {
   RawLogReader log(log_path_);
-  events_ = 0;
-  first_us_ = last_us_ = -1;
-  std::int64_t input_frame = -1;
+  Pass pass{&check_};
+  ReadEvents(log, channels, &pass, visit);
+  events_ = pass.events;
+  first_us_ = pass.first_us;
+  last_us_ = pass.last_us;
+  unread_bytes_ = static_cast<std::int64_t>(log.size() - log.good_end());
+}
+
+void SessionLog::ReadEvents(RawLogReader& log, std::initializer_list<std::string_view> channels,
+                            Pass* pass, const std::function<void(const LogMessage&)>& visit) {
   RawLogEvent ev;
   while (log.Next(&ev)) {
-    ++events_;
-    if (first_us_ < 0) first_us_ = ev.timestamp_us;
-    last_us_ = ev.timestamp_us;
+    ++pass->events;
+    if (pass->first_us < 0) pass->first_us = ev.timestamp_us;
+    pass->last_us = ev.timestamp_us;
     std::string_view channel = ev.channel;
     if (!suffix_.empty()) {
       if (channel.size() <= suffix_.size() ||
@@ -79,21 +75,80 @@ void SessionLog::Read(std::initializer_list<std::string_view> channels,
                         std::find(channels.begin(), channels.end(), channel) != channels.end();
     const bool input = channel == wire::channels::kOperatorInput;
     if (!wanted && !input) continue;
-    if (check_.Ignore(channel, ev.data, ev.size)) continue;
+    if (pass->check->Ignore(channel, ev.data, ev.size)) continue;
     std::int64_t f = 0;
-    if (input && InputFrame(ev.data, ev.size, &f) && f >= 0) input_frame = f;
+    if (input && wire::ReadFrameNumber(ev.data, ev.size, &f) && f >= 0) pass->input_frame = f;
     if (!wanted) continue;
     LogMessage m;
     m.base = channel;
     m.channel = ev.channel;
     m.log_us = ev.timestamp_us;
-    m.log_time_s = (ev.timestamp_us - first_us_) * 1e-6;
-    m.session_time_s = input_frame < 0 ? 0.0 : input_frame / rate_hz_;
+    m.log_time_s = (ev.timestamp_us - pass->first_us) * 1e-6;
+    m.session_time_s = pass->input_frame < 0 ? 0.0 : pass->input_frame / rate_hz_;
     m.data = ev.data;
     m.size = ev.size;
     visit(m);
   }
+}
+
+// A log smaller than this is read on one thread (a thread's start costs more).
+constexpr std::uintmax_t kTwoPartsFromBytes = 1 << 20;
+
+bool SessionLog::ReadInTwo(std::initializer_list<std::string_view> channels,
+                           const std::function<void(int part, const LogMessage&)>& visit,
+                           const TwoParts& parts) {
+  std::error_code ec;
+  const std::uintmax_t size = fs::file_size(log_path_, ec);
+  if (ec || size < kTwoPartsFromBytes || !parts.other) {
+    if (parts.meanwhile) parts.meanwhile();
+    Read(channels, [&](const LogMessage& m) { visit(0, m); });
+    return false;
+  }
+  OtherCore* other = parts.other;
+  const double share = std::clamp(parts.second_share, 0.0, 1.0);
+  const auto middle = static_cast<std::size_t>(static_cast<double>(size) * (1.0 - share));
+  SenderCheck second_check = check_;
+  Pass second{&second_check};
+  std::size_t second_start = 0, second_unread = 0;
+  other->Start([&] {
+    RawLogEvent ev;
+    RawLogReader start(log_path_);  // the log's first time, for log_time_s
+    if (start.Next(&ev)) second.first_us = ev.timestamp_us;
+    RawLogReader log(log_path_, middle);
+    ReadEvents(log, channels, &second, [&](const LogMessage& m) { visit(1, m); });
+    second_start = log.first_event_start();
+    second_unread = log.size() - log.good_end();
+  });
+  RawLogReader log(log_path_);
+  log.StopAt(middle);
+  Pass first{&check_};
+  try {
+    if (parts.meanwhile) parts.meanwhile();
+    ReadEvents(log, channels, &first, [&](const LogMessage& m) { visit(0, m); });
+  } catch (...) {
+    other->Finish();  // the other part's reading refers to this frame's variables
+    throw;
+  }
+  // An event of the whole log starts where this thread stopped; the other
+  // began at the first sync word at or after the middle: the same event
+  // exactly when both name one place.
+  const bool stands = other->Finish() && !other->error() && log.stopped() && second.events > 0 &&
+                      log.stopped_at() == second_start;
+  if (stands) {
+    check_.Add(second_check);
+    events_ = first.events + second.events;
+    first_us_ = first.first_us;
+    last_us_ = second.last_us;
+    unread_bytes_ = static_cast<std::int64_t>(second_unread);
+    return true;
+  }
+  log.Resume();  // this thread reads on through the second part
+  ReadEvents(log, channels, &first, [&](const LogMessage& m) { visit(0, m); });
+  events_ = first.events;
+  first_us_ = first.first_us;
+  last_us_ = first.last_us;
   unread_bytes_ = static_cast<std::int64_t>(log.size() - log.good_end());
+  return false;
 }
 
 }  // namespace rms::session

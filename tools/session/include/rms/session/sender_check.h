@@ -38,6 +38,9 @@ class SenderCheck {
     if (n > 0) ignored_[reason] += n;
   }
 
+  // Another check's counts (of another part of the same log) added to these.
+  void Add(const SenderCheck& other);
+
   std::int64_t session_id() const { return session_id_; }
   bool checks_pids() const { return !pids_.empty(); }
   std::int64_t ignored_total() const;
