@@ -280,7 +280,10 @@ void DynamicsProc::OnInput(const void* data, int size, std::int64_t recv_time_us
   made_a_frame_ = true;
   if (++frames_since_state_ >=
       static_cast<std::int64_t>(kStateEverySeconds * config_.session.frame_rate_hz)) {
-    PublishState(dcp_state_t::PERIODIC);
+    if (periodic_states_)
+      PublishState(dcp_state_t::PERIODIC);
+    else
+      frames_since_state_ = 0;
   }
   if (!state_file_.empty()) {
     const DcpStatus& st = dcp_.status();

@@ -15,9 +15,11 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <regex>
+#include <sstream>
 
 #include "rms/base/config.h"
 #include "rms/dcp_frame_t.hpp"
+#include "rms/dcp_state_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/esg_frame_t.hpp"
 #include "rms/transport/lcm_interface.h"
@@ -90,6 +92,156 @@ TEST_F(RecordedSession, ItReSimulatesBitForBit) {
   EXPECT_NE(r.out.find(want), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("resim: "), std::string::npos)
       << "progress lines with no terminal to show them";
+}
+
+// rms_resim SESSION with --threads N: its output but the timing line, the
+// timing line apart.
+struct ResimRun {
+  int rc = -1;
+  std::string result, timing;
+};
+ResimRun ResimWithThreads(const std::string& session, const std::string& threads,
+                          const std::string& log) {
+  const ScriptRun r = Script(
+      {testing::BuildPath("tools/rms_resim"), session, "--quiet", "--threads", threads}, log);
+  ResimRun out{r.rc, "", ""};
+  std::istringstream lines(r.out);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("timing:", 0) == 0)
+      out.timing = line;
+    else if (line.rfind("re-simulated ", 0) == 0)  // its first line has the wall time
+      out.result += line.substr(line.find(';')) + "\n";
+    else
+      out.result += line + "\n";
+  }
+  return out;
+}
+
+// The session copied to `to`, each event of its log passed through `edit`
+// (its index among the log's events, the event, whose bytes it may change).
+void CopyEditingLog(const std::string& from, const std::string& to,
+                    const std::function<void(std::size_t, lcm::LogEvent*)>& edit) {
+  fs::copy(from, to, fs::copy_options::recursive);
+  lcm::LogFile in(from + "/lcmlog", "r"), out(to + "/lcmlog", "w");
+  std::vector<std::uint8_t> data;
+  std::size_t i = 0;
+  while (const lcm::LogEvent* ev = in.readNextEvent()) {
+    lcm::LogEvent copy = *ev;
+    const auto* d = static_cast<const std::uint8_t*>(ev->data);
+    data.assign(d, d + ev->datalen);
+    copy.data = data.data();
+    edit(i++, &copy);
+    out.writeEvent(&copy);
+  }
+}
+
+// The indices of the log's events on a channel (its base name) that `take`
+// takes.
+std::vector<std::size_t> EventsOn(
+    const std::string& session, const std::string& channel,
+    const std::function<bool(const lcm::LogEvent&)>& take = [](const lcm::LogEvent&) {
+      return true;
+    }) {
+  std::vector<std::size_t> at;
+  lcm::LogFile in(session + "/lcmlog", "r");
+  std::size_t i = 0;
+  for (const lcm::LogEvent* ev; (ev = in.readNextEvent()); ++i)
+    if (ev->channel.rfind(channel, 0) == 0 && take(*ev)) at.push_back(i);
+  return at;
+}
+
+// Re-simulated on two cores (the log read in two parts, the DCP run in two
+// halves at once: docs/sessions.md "Re-simulation") it says what it says on
+// one, to the word.
+TEST_F(RecordedSession, ReSimulatesTheSameOnTwoCoresAsOnOne) {
+  const ResimRun one = ResimWithThreads(*dir_, "1", *tmp_ + "/resim1.log");
+  const ResimRun two = ResimWithThreads(*dir_, "2", *tmp_ + "/resim2.log");
+  EXPECT_EQ(one.rc, 0) << one.result;
+  EXPECT_EQ(two.rc, 0) << two.result;
+  EXPECT_EQ(two.result, one.result);
+  EXPECT_NE(one.result.find("identical, word for word"), std::string::npos) << one.result;
+  EXPECT_NE(two.timing.find("reading the log in two parts at once"), std::string::npos)
+      << two.timing;
+  EXPECT_NE(two.timing.find("running the DCP in two halves at once"), std::string::npos)
+      << two.timing;
+  EXPECT_EQ(one.timing.find("at once"), std::string::npos) << one.timing;
+}
+
+// A recorded output changed in either half, or a logged state changed, is
+// found where one thread finds it; a send time changed everywhere is no
+// difference (compared byte for byte but the sender and the send time).
+TEST_F(RecordedSession, ADifferenceInEitherHalfIsFoundWhereOneThreadFindsIt) {
+  const std::vector<std::size_t> frames = EventsOn(*dir_, "RMS_DCP_FRAME");
+  const std::vector<std::size_t> telemetry = EventsOn(*dir_, "RMS_DCP_TELEMETRY");
+  const std::vector<std::size_t> states =
+      EventsOn(*dir_, "RMS_DCP_STATE", [](const lcm::LogEvent& ev) {
+        dcp_state_t m;
+        return m.decode(ev.data, 0, ev.datalen) > 0 && m.reason == dcp_state_t::PERIODIC;
+      });
+  ASSERT_GT(frames.size(), 1000u);
+  ASSERT_GT(states.size(), 4u);  // periodic ones, every 5 s of the mission's minute
+  const std::size_t early_frame = frames[frames.size() / 4];
+  const std::size_t late_telemetry = telemetry[telemetry.size() * 3 / 4];
+  const std::size_t middle_state = states[states.size() / 2];
+  struct Case {
+    std::string name;
+    std::function<void(std::size_t, lcm::LogEvent*)> edit;
+    std::string says;  // "" for identical
+  };
+  auto byte_at = [](lcm::LogEvent* ev, int at) -> std::uint8_t& {
+    return static_cast<std::uint8_t*>(ev->data)[at];
+  };
+  const std::vector<Case> cases = {
+      {"an arm word early",
+       [&](std::size_t i, lcm::LogEvent* ev) {
+         if (i == early_frame) byte_at(ev, wire::kDcpFrameInputFrameAt + 16 + 3) ^= 1;
+       },
+       ": arm_words[0]"},
+      {"telemetry late",
+       [&](std::size_t i, lcm::LogEvent* ev) {
+         if (i == late_telemetry) byte_at(ev, ev->datalen - 1) ^= 1;
+       },
+       ": telemetry"},
+      {"the middle state",
+       [&](std::size_t i, lcm::LogEvent* ev) {
+         if (i != middle_state) return;
+         dcp_state_t m;
+         ASSERT_GT(m.decode(ev->data, 0, ev->datalen), 0);
+         const std::size_t dcp = m.checkpoint.find("\"dcp\"");
+         const std::size_t digit = m.checkpoint.find_first_of("123456789", dcp);
+         ASSERT_NE(digit, std::string::npos);
+         m.checkpoint[digit] = m.checkpoint[digit] == '9' ? '1' : m.checkpoint[digit] + 1;
+         static std::vector<std::uint8_t> encoded;
+         encoded = wire::EncodeMessage(m);
+         ev->data = encoded.data();
+         ev->datalen = static_cast<std::int32_t>(encoded.size());
+       },
+       "differs from the state it logged there"},
+      {"every send time",
+       [&](std::size_t, lcm::LogEvent* ev) {
+         if (ev->channel.rfind("RMS_DCP_FRAME", 0) == 0 ||
+             ev->channel.rfind("RMS_DCP_TELEMETRY", 0) == 0)
+           byte_at(ev, wire::kSendTimeAt + 7) ^= 0x55;
+       },
+       ""},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::string copy = *tmp_ + "/edited-" + std::to_string(&c - cases.data());
+    CopyEditingLog(*dir_, copy, c.edit);
+    const ResimRun one = ResimWithThreads(copy, "1", copy + "-1.log");
+    const ResimRun two = ResimWithThreads(copy, "2", copy + "-2.log");
+    EXPECT_EQ(two.result, one.result);
+    EXPECT_EQ(two.rc, one.rc);
+    if (c.says.empty()) {
+      EXPECT_EQ(one.rc, 0) << one.result;
+      EXPECT_NE(one.result.find("identical, word for word"), std::string::npos) << one.result;
+    } else {
+      EXPECT_EQ(one.rc, 1) << one.result;
+      EXPECT_NE(one.result.find("first difference: "), std::string::npos) << one.result;
+      EXPECT_NE(one.result.find(c.says), std::string::npos) << one.result;
+    }
+  }
 }
 
 TEST_F(RecordedSession, ALongerArmFaresOtherwiseAndTheComparisonSaysWhy) {

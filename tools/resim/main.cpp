@@ -36,10 +36,11 @@ int Report(const rms::resim::ResimResult& r, bool other_design) {
       r.first_difference.empty() ? ", word for word" : "");
   if (!r.branch_note.empty()) std::printf("%s\n", r.branch_note.c_str());
   std::printf(
-      "timing: %.4f s in all (%.4f s reading the log, %.4f s running the DCP); the session "
+      "timing: %.4f s in all (%.4f s reading the log%s, %.4f s running the DCP%s); the session "
       "lasted %.1f s of wall time: "
       "%.0fx real time in all, %.0fx for the DCP's run\n",
-      r.seconds, r.read_seconds, r.run_seconds, r.recorded_seconds,
+      r.seconds, r.read_seconds, r.read_in_two ? " in two parts at once" : "", r.run_seconds,
+      r.in_halves ? " in two halves at once" : "", r.recorded_seconds,
       r.recorded_seconds / std::max(r.seconds, 1e-9),
       r.recorded_seconds / std::max(r.run_seconds, 1e-9));
   if (r.states_checked > 0 && r.state_difference.empty()) {
@@ -181,11 +182,19 @@ int main(int argc, char** argv) {
   app.add_option("--checkpoint-out", checkpoint_out,
                  "With --until: write the DCP's state after that frame here, as a checkpoint "
                  "(only when the frames up to it are identical)");
+  std::string threads = "auto";
+  app.add_option("--threads", threads,
+                 "The session's own design: its log read and its DCP run in two shares at once, "
+                 "one on another core: auto (when that core comes in time), 1 (one thread) or 2 "
+                 "(always two); the same result each way (docs/sessions.md \"Re-simulation\")")
+      ->check(CLI::IsMember({"auto", "1", "2"}))
+      ->capture_default_str();
   app.add_flag("--quiet", quiet, "No progress lines (they go only to a terminal anyway)");
   bool verbose = false;
   app.add_flag("--verbose", verbose,
                "Also the DCP's own log lines (mode changes, collisions) as it re-flies");
   if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
+  opt.threads = threads == "auto" ? 0 : std::stoi(threads);
   // The re-flown DCP's log lines only when asked for: the result is the output.
   spdlog::set_level(verbose ? spdlog::level::info : spdlog::level::warn);
   // With --result-json stdout is the result alone: log lines go to stderr.

@@ -30,6 +30,16 @@ std::string CheckpointText(const Checkpoint& c) {
   return j.dump(2) + "\n";
 }
 
+bool TextHoldsDcp(std::string_view text, const nlohmann::json& dcp) {
+  // CheckpointText's last lines: ',\n  "dcp": ...\n}\n', as {"dcp": dcp}
+  // dumps them after its "{".
+  nlohmann::ordered_json last;
+  last["dcp"] = dcp;
+  const std::string tail = last.dump(2).substr(1) + "\n";
+  return text.size() > tail.size() && text.substr(text.size() - tail.size()) == tail &&
+         text[text.size() - tail.size() - 1] == ',';
+}
+
 namespace {
 
 // Reads an open file: a regular one of at most kMaxCheckpointBytes, or refused.

@@ -1,6 +1,5 @@
 #include "comparison.h"
 
-#include <array>
 #include <cstring>
 #include <map>
 #include <sstream>
@@ -32,28 +31,6 @@ bool SameFrame(const dcp_frame_t& a, const dcp_frame_t& b, std::string* what) {
     if (a.state_words[i] != b.state_words[i]) return diff("state_words", i);
   }
   return true;
-}
-
-bool SameTelemetry(dcp_telemetry_t a, dcp_telemetry_t b, std::string* what) {
-  // Everything but the wall-clock send time and the sender (a re-simulation
-  // is another process), field for field: the message's encoding with those
-  // equalised compares every bit of every other field. (A fixed size: no
-  // allocation.)
-  a.send_time_us = b.send_time_us = 0;
-  a.sender = b.sender = sender_t{};
-  constexpr int kMax = 4096;
-  static_assert(sizeof(dcp_telemetry_t) < kMax, "dcp_telemetry_t grew: enlarge kMax");
-  std::array<std::uint8_t, kMax> ea, eb;
-  const int na = a.getEncodedSize(), nb = b.getEncodedSize();
-  if (na != nb || na > kMax) {
-    *what = "telemetry";
-    return false;
-  }
-  a.encode(ea.data(), 0, na);
-  b.encode(eb.data(), 0, nb);
-  if (std::memcmp(ea.data(), eb.data(), static_cast<std::size_t>(na)) == 0) return true;
-  *what = "telemetry";
-  return false;
 }
 
 namespace {

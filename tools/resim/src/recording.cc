@@ -1,38 +1,86 @@
 #include "recording.h"
 
 #include <algorithm>
+#include <filesystem>
 
 #include "rms/base/check.h"
 #include "rms/session/session_summary.h"
 #include "rms/wire/channels.h"
+#include "rms/wire/message_io.h"
 
 namespace rms::resim {
 
-Recording ReadRecording(session::SessionLog& log) {
-  Recording r;
+namespace {
+
+// What one part of the log holds of the recording, as read.
+void Keep(session::SessionLog& log, const session::LogMessage& ev, std::uint8_t part,
+          Recording* r) {
+  // A message kept as logged.
+  auto keep = [&](std::int64_t frame) {
+    std::vector<std::uint8_t>& bytes = r->bytes[part];
+    const auto* p = static_cast<const std::uint8_t*>(ev.data);
+    const RecordedMessage m{frame, ev.log_us, bytes.size(), static_cast<std::size_t>(ev.size),
+                            part};
+    bytes.insert(bytes.end(), p, p + ev.size);
+    return m;
+  };
+  if (ev.base == wire::channels::kOperatorInput) {
+    operator_input_t m;
+    if (log.Decode(ev, &m)) r->inputs.push_back(keep(m.frame));
+  } else if (ev.base == wire::channels::kDcpFrame) {
+    std::int64_t frame = 0, input_frame = 0;
+    if (log.Check<dcp_frame_t>(ev) && wire::ReadFrameNumber(ev.data, ev.size, &frame) &&
+        wire::ReadInt64At(ev.data, ev.size, wire::kDcpFrameInputFrameAt, &input_frame))
+      r->dcp_frames.push_back({keep(frame), input_frame});
+  } else if (ev.base == wire::channels::kDcpTelemetry) {
+    std::int64_t frame = 0;
+    if (log.Check<dcp_telemetry_t>(ev) && wire::ReadFrameNumber(ev.data, ev.size, &frame))
+      r->telemetry.push_back(keep(frame));
+  } else {
+    LoggedState st;
+    st.before = r->dcp_frames.size();
+    if (log.Decode(ev, &st.m)) r->states.push_back(std::move(st));
+  }
+}
+
+// The second part's after the first's (its bytes stay where they are).
+void Append(Recording&& second, Recording* r) {
+  for (LoggedState& st : second.states) st.before += r->dcp_frames.size();
+  auto append = [](auto& from, auto* to) {
+    to->insert(to->end(), std::make_move_iterator(from.begin()),
+               std::make_move_iterator(from.end()));
+  };
+  append(second.inputs, &r->inputs);
+  append(second.dcp_frames, &r->dcp_frames);
+  append(second.telemetry, &r->telemetry);
+  append(second.states, &r->states);
+  r->bytes[1] = std::move(second.bytes[1]);
+}
+
+}  // namespace
+
+Recording ReadRecording(session::SessionLog& log, const session::SessionLog::TwoParts& parts) {
+  Recording r, second;
   r.suffix = log.suffix();
-  log.Read({wire::channels::kOperatorInput, wire::channels::kDcpFrame,
-            wire::channels::kDcpTelemetry, wire::channels::kDcpState},
-           [&](const session::LogMessage& ev) {
-             if (ev.base == wire::channels::kOperatorInput) {
-               operator_input_t m;
-               if (!log.Decode(ev, &m)) return;
-               const auto* p = static_cast<const std::uint8_t*>(ev.data);
-               r.inputs.push_back(
-                   {m.frame, ev.log_us, r.input_bytes.size(), static_cast<std::size_t>(ev.size)});
-               r.input_bytes.insert(r.input_bytes.end(), p, p + ev.size);
-             } else if (ev.base == wire::channels::kDcpFrame) {
-               dcp_frame_t m;
-               if (log.Decode(ev, &m)) r.dcp_frames.push_back(m);
-             } else if (ev.base == wire::channels::kDcpTelemetry) {
-               r.telemetry.emplace_back();
-               if (!log.Decode(ev, &r.telemetry.back())) r.telemetry.pop_back();
-             } else {
-               LoggedState st;
-               st.before = r.dcp_frames.size();
-               if (log.Decode(ev, &st.m)) r.states.push_back(std::move(st));
-             }
-           });
+  // The kept bytes are fewer than the log's: reserved once (pages not
+  // written are not touched, up to 1 GiB), no copy as they grow.
+  std::error_code ec;
+  const std::uintmax_t log_bytes = std::filesystem::file_size(log.log_path(), ec);
+  if (!ec) {
+    r.bytes[0].reserve(static_cast<std::size_t>(std::min<std::uintmax_t>(log_bytes, 1u << 30)));
+    second.bytes[1].reserve(static_cast<std::size_t>(std::min<std::uintmax_t>(
+        static_cast<std::uintmax_t>(static_cast<double>(log_bytes) * parts.second_share) + 1,
+        1u << 30)));
+  }
+  const bool in_two = log.ReadInTwo(
+      {wire::channels::kOperatorInput, wire::channels::kDcpFrame, wire::channels::kDcpTelemetry,
+       wire::channels::kDcpState},
+      [&](int part, const session::LogMessage& ev) {
+        Keep(log, ev, static_cast<std::uint8_t>(part), part == 0 ? &r : &second);
+      },
+      parts);
+  if (in_two) Append(std::move(second), &r);
+  r.read_in_two = in_two;
   SortByFrame(&r.inputs);
   SortByFrame(&r.telemetry);
   if (r.dcp_frames.empty()) {
@@ -44,7 +92,7 @@ Recording ReadRecording(session::SessionLog& log) {
   for (const auto& f : r.dcp_frames) numbers.push_back(f.frame);
   const std::vector<std::size_t> run = session::LongestIncreasingRun(numbers);
   if (run.size() != r.dcp_frames.size()) {
-    std::vector<dcp_frame_t> kept;
+    std::vector<RecordedDcpFrame> kept;
     for (const std::size_t i : run) kept.push_back(r.dcp_frames[i]);
     // A state keeps its place: the number of kept frames before it.
     for (auto& st : r.states) {
@@ -56,9 +104,27 @@ Recording ReadRecording(session::SessionLog& log) {
   return r;
 }
 
+dcp_frame_t Recording::Decoded(const RecordedDcpFrame& f) const {
+  dcp_frame_t m;
+  RMS_CHECK(wire::SafeDecode(BytesOf(f), static_cast<int>(f.size), &m) == wire::DecodeError::kNone);
+  return m;
+}
+
 std::map<std::int64_t, dcp_telemetry_t> TelemetryByFrame(const std::vector<dcp_telemetry_t>& v) {
   std::map<std::int64_t, dcp_telemetry_t> m;
   for (const auto& t : v) m.emplace_hint(m.end(), t.frame, t);
+  return m;
+}
+
+std::map<std::int64_t, dcp_telemetry_t> TelemetryByFrame(const Recording& r) {
+  std::map<std::int64_t, dcp_telemetry_t> m;
+  for (const RecordedMessage& t : r.telemetry) {
+    dcp_telemetry_t d;
+    // Checked as it was read: it decodes.
+    RMS_CHECK(wire::SafeDecode(r.BytesOf(t), static_cast<int>(t.size), &d) ==
+              wire::DecodeError::kNone);
+    m.emplace_hint(m.end(), t.frame, d);
+  }
   return m;
 }
 
@@ -126,7 +192,7 @@ Plan MakePlan(const Recording& r) {
     for (; next_state < r.states.size() && r.states[next_state].before <= k; ++next_state) {
       if (r.states[next_state].before == k) take(r.states[next_state].m, false);
     }
-    const dcp_frame_t& f = r.dcp_frames[k];
+    const RecordedDcpFrame& f = r.dcp_frames[k];
     if (pending_resume) {  // the first frame after a resume: nothing between was made
       prev_frame = f.frame - 1;
       pending_resume = false;
@@ -139,7 +205,7 @@ Plan MakePlan(const Recording& r) {
       std::vector<std::int64_t> between;
       auto it =
           std::upper_bound(r.inputs.begin(), r.inputs.end(), prev_input,
-                           [](std::int64_t f, const RecordedInput& in) { return f < in.frame; });
+                           [](std::int64_t f, const RecordedMessage& in) { return f < in.frame; });
       for (; it != r.inputs.end() && it->frame < f.input_frame; ++it) between.push_back(it->frame);
       if (static_cast<std::int64_t>(between.size()) != lost) {
         throw InputError("the log lost " + Frames(prev_frame + 1, f.frame - 1) +

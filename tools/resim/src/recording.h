@@ -4,6 +4,7 @@
 // made from them, the states it logged; and the plan that replays them in
 // order, from the state the log allows the re-simulation to start from.
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -16,12 +17,20 @@
 
 namespace rms::resim {
 
-// An operator frame as logged: its bytes are Recording::input_bytes[offset,
-// offset + size).
-struct RecordedInput {
+// A message as logged, undecoded: its bytes are Recording::bytes[part]
+// [offset, offset + size), its frame number read where it lies
+// (wire::ReadFrameNumber).
+struct RecordedMessage {
   std::int64_t frame = 0;
-  std::int64_t timestamp_us = 0;
+  std::int64_t timestamp_us = 0;  // the recorder's receive time
   std::size_t offset = 0, size = 0;
+  std::uint8_t part = 0;  // the part of the log it was read in (SessionLog::ReadInTwo)
+};
+
+// An RMS_DCP_FRAME as logged, undecoded, with the operator frame it answers
+// (read where it lies: wire::kSendTimeAt + 8).
+struct RecordedDcpFrame : RecordedMessage {
+  std::int64_t input_frame = -1;
 };
 
 // An RMS_DCP_STATE as logged, with the number of the DCP's (believed)
@@ -33,11 +42,19 @@ struct LoggedState {
 
 struct Recording {
   std::string suffix;
-  std::vector<RecordedInput> inputs;       // by operator frame (the last logged of a frame)
-  std::vector<std::uint8_t> input_bytes;   // the inputs' bytes, one after another
-  std::vector<dcp_frame_t> dcp_frames;     // in log order
-  std::vector<dcp_telemetry_t> telemetry;  // by DCP frame (the last logged of a frame)
-  std::vector<LoggedState> states;         // in log order
+  std::vector<RecordedMessage> inputs;       // by operator frame (the last logged of a frame)
+  std::vector<RecordedDcpFrame> dcp_frames;  // in log order, undecoded
+  std::vector<RecordedMessage> telemetry;    // by DCP frame (the last logged of a frame), undecoded
+  std::vector<LoggedState> states;           // in log order
+  bool read_in_two = false;                  // the log read in two parts at once
+  // The inputs' and the telemetry's, one after another, by the part of the
+  // log they were read in.
+  std::array<std::vector<std::uint8_t>, 2> bytes;
+  const std::uint8_t* BytesOf(const RecordedMessage& m) const {
+    return bytes[m.part].data() + m.offset;
+  }
+  // A recorded DCP frame decoded (it was checked as it was read).
+  dcp_frame_t Decoded(const RecordedDcpFrame& f) const;
 };
 
 // Messages with a frame number, in increasing order of it, one a frame:
@@ -66,13 +83,18 @@ const Msg* FindFrame(const std::vector<Msg>& v, std::int64_t frame) {
   return it != v.end() && it->frame == frame ? &*it : nullptr;
 }
 
-// The same as a map by frame (what the design comparison reads).
+// Telemetry by frame (what the design comparison reads): decoded messages,
+// or the recording's, decoded now.
 std::map<std::int64_t, dcp_telemetry_t> TelemetryByFrame(const std::vector<dcp_telemetry_t>& v);
+std::map<std::int64_t, dcp_telemetry_t> TelemetryByFrame(const Recording& r);
 
 // The channels re-simulation needs, read from the log (the DCP's increasing
-// run of frames only, as the summary believes them); throws InputError when
-// there is no DCP frame.
-Recording ReadRecording(session::SessionLog& log);
+// run of frames only, as the summary believes them); the operator frames,
+// the DCP's frames and its telemetry are kept as logged, undecoded (the
+// re-simulation compares them byte for byte). With another core, the log
+// is read in two parts at once (SessionLog::ReadInTwo, `parts`). Throws
+// InputError when there is no DCP frame.
+Recording ReadRecording(session::SessionLog& log, const session::SessionLog::TwoParts& parts = {});
 
 // What the re-simulation does, step by step: a logged state to take (or,
 // PERIODIC, to check against), then an operator frame to answer.

@@ -7,10 +7,12 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <thread>
 #include <vector>
 
 #include "rms/base/check.h"
 #include "rms/base/config.h"
+#include "rms/base/other_core.h"
 #include "rms/base/text.h"
 #include "rms/base/toml_reader.h"
 #include "rms/dcp_frame_t.hpp"
@@ -27,6 +29,7 @@
 #include "rms/wire/message_io.h"
 
 #include "comparison.h"
+#include "dcp_run.h"
 #include "narrative.h"
 #include "outcome.h"
 #include "recording.h"
@@ -37,8 +40,14 @@ namespace rms::resim {
 
 class RecordedSession {
  public:
-  RecordedSession(const std::string& dir, session::SessionLog log)
-      : dir_(dir), rec_(ReadRecording(log)), plan_(MakePlan(rec_)), unread_(log.unread_bytes()) {}
+  // other: another core to read half the log (SessionLog::ReadInTwo), or null.
+  // parts: how the log's reading is shared out (SessionLog::ReadInTwo).
+  RecordedSession(const std::string& dir, session::SessionLog log,
+                  const session::SessionLog::TwoParts& parts = {})
+      : dir_(dir),
+        rec_(ReadRecording(log, parts)),
+        plan_(MakePlan(rec_)),
+        unread_(log.unread_bytes()) {}
   const std::string& dir() const { return dir_; }
   const Recording& recording() const { return rec_; }
   const Plan& plan() const { return plan_; }
@@ -58,7 +67,7 @@ class RecordedSession {
   }
   // Its telemetry by DCP frame, made at the first call.
   const std::map<std::int64_t, dcp_telemetry_t>& telemetry() const {
-    if (!telemetry_) telemetry_ = TelemetryByFrame(rec_.telemetry);
+    if (!telemetry_) telemetry_ = TelemetryByFrame(rec_);
     return *telemetry_;
   }
   // Its config.toml parsed once for the designs of a batch's cells, at the
@@ -96,146 +105,10 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// A logged state: a restore, a resume, a malfunction or a start is taken as
-// the live DCP took it (another design keeps its own state at a resume: only
-// the numbering; at a malfunction, the numbering and the malfunctions in
-// force); a periodic one is checked against the re-simulated state (the same
-// design only: another one is expected to differ).
-void TakeState(const dcp_state_t& m, bool first, bool other_design,
-               dynamics_proc::DynamicsProc* node, ResimResult* result) {
-  if (m.reason == dcp_state_t::PERIODIC && !first) {
-    if (other_design || !result->state_difference.empty()) return;
-    ++result->states_checked;
-    const wire::Checkpoint logged = wire::ParseCheckpoint(m.checkpoint, "RMS_DCP_STATE");
-    if (logged.dcp != node->MakeCheckpoint().dcp) {
-      result->state_difference = "the DCP's state before DCP frame " +
-                                 std::to_string(m.next_frame) +
-                                 " differs from the state it logged there";
-    }
-    return;
-  }
-  const bool own_state =
-      other_design && (m.reason == dcp_state_t::RESUME || m.reason == dcp_state_t::MALFUNCTION);
-  node->ApplyState(m, first || !own_state);
-  ++result->states_taken;
-  // Into the new session's log too, so it can be re-simulated and its
-  // summary sees the same restores (its attempts).
-  node->PublishState(m.reason == dcp_state_t::PERIODIC ? dcp_state_t::START : m.reason);
-}
-
-// What the re-simulated DCP sent, in DCP frame order, one message a frame
-// (the last sent, were there two); Find looks one up. For a design made in
-// memory, also all of it in the order sent, with its restores: what its
-// summary is made from, as from a log of it.
-struct Outputs {
-  std::vector<dcp_frame_t> frames;
-  std::vector<dcp_telemetry_t> telemetry;
-  session::DcpRun published;
-};
-
-// The DCP's own node over a log-backed transport, step by step through the
-// plan (out_log: the new session's log, "" for none).
-Outputs RunDcp(const LabConfig& config, const Recording& rec, const Plan& plan,
-               const std::string& out_log, bool other_design, long until_frame,
-               const std::function<void(double, const std::string&)>& progress,
-               ResimResult* result) {
-  // During the run the outputs are appended to vectors reserved up front (no
-  // allocation a frame), in frame order; the comparison finds them there.
-  std::vector<dcp_frame_t> frames_run;
-  std::vector<dcp_telemetry_t> telemetry_run;
-  frames_run.reserve(plan.steps.size());
-  telemetry_run.reserve(plan.steps.size());
-  transport::LogLcm lcm("", out_log, rec.suffix);
-  dynamics_proc::DynamicsProc node(config, &lcm);
-  lcm.Subscribe(wire::channels::kDcpFrame, [&](const void* d, int n, std::int64_t) {
-    frames_run.emplace_back();
-    if (wire::SafeDecode(d, n, &frames_run.back()) != wire::DecodeError::kNone)
-      frames_run.pop_back();
-  });
-  lcm.Subscribe(wire::channels::kDcpTelemetry, [&](const void* d, int n, std::int64_t) {
-    telemetry_run.emplace_back();
-    if (wire::SafeDecode(d, n, &telemetry_run.back()) != wire::DecodeError::kNone)
-      telemetry_run.pop_back();
-  });
-  std::vector<std::size_t> restores_before;  // where a restore's RMS_DCP_STATE went among them
-  lcm.Subscribe(wire::channels::kDcpState, [&](const void* d, int n, std::int64_t) {
-    dcp_state_t m;
-    if (wire::SafeDecode(d, n, &m) == wire::DecodeError::kNone && m.reason == dcp_state_t::RESTORE)
-      restores_before.push_back(telemetry_run.size());
-  });
-  const auto t_run = Clock::now();
-  const std::size_t n = plan.steps.size();
-  for (std::size_t k = 0; k < n; ++k) {
-    const Step& step = plan.steps[k];
-    if (step.state) {
-      TakeState(*step.state, step.first, other_design, &node, result);
-      continue;
-    }
-    const RecordedInput* input = FindFrame(rec.inputs, step.input_frame);
-    if (!input) {
-      throw InputError(
-          "operator frame " + std::to_string(step.input_frame) +
-          ", which the DCP answered, is not in the log: the re-simulation cannot be exact");
-    }
-    lcm.SetNowUs(input->timestamp_us);
-    lcm.Publish(wire::channels::kOperatorInput, rec.input_bytes.data() + input->offset,
-                static_cast<int>(input->size));
-    lcm.HandleSubscriptions(0);  // the input to the DCP
-    lcm.HandleSubscriptions(0);  // its outputs to the comparison
-    if (until_frame >= 0 && !frames_run.empty() && frames_run.back().frame >= until_frame) break;
-    if (n >= 20 && k % (n / 20) == 0)
-      progress(static_cast<double>(k) / n,
-               std::to_string(k) + " of " + std::to_string(n) + " steps");
-  }
-  result->run_seconds = std::chrono::duration<double>(Clock::now() - t_run).count();
-  if (until_frame >= 0) result->checkpoint_text = wire::CheckpointText(node.MakeCheckpoint());
-  Outputs out;
-  if (other_design && out_log.empty())
-    out.published = session::DcpRun{frames_run, telemetry_run, std::move(restores_before)};
-  out.frames = std::move(frames_run);
-  out.telemetry = std::move(telemetry_run);
-  SortByFrame(&out.frames);
-  SortByFrame(&out.telemetry);
-  result->frames = static_cast<long>(out.frames.size());
-  if (!result->out_dir.empty()) {
-    transport::WriteStatsJson((fs::path(result->out_dir) / "stats" / "dynamics_proc.json").string(),
-                              "dynamics_proc", node.counters(), node.latencies());
-  }
-  return out;
-}
-
-// Word for word against the recording, from the plan's first frame.
-void CompareWithRecording(const Recording& rec, std::size_t first, long until_frame,
-                          const Outputs& out, ResimResult* result) {
-  for (std::size_t i = first; i < rec.dcp_frames.size(); ++i) {
-    const dcp_frame_t& r = rec.dcp_frames[i];
-    if (until_frame >= 0 && r.frame > until_frame) break;
-    ++result->compared;
-    const dcp_frame_t* made = FindFrame(out.frames, r.frame);
-    std::string what;
-    bool same = made && SameFrame(*made, r, &what);
-    if (!same && result->first_decision_frame < 0) {  // the DCP's words: its decisions
-      result->first_decision_frame = static_cast<long>(r.frame);
-      result->first_decision = made ? what : "missing";
-    }
-    if (same) {
-      const dcp_telemetry_t* rt = FindFrame(rec.telemetry, r.frame);
-      const dcp_telemetry_t* nt = FindFrame(out.telemetry, r.frame);
-      if (rt && nt) same = SameTelemetry(*nt, *rt, &what);
-    } else if (!made) {
-      what = "missing";
-    }
-    if (same) {
-      ++result->identical;
-    } else if (result->first_difference.empty()) {
-      result->first_difference = "DCP frame " + std::to_string(r.frame) + ": " + what;
-      result->first_difference_frame = static_cast<long>(r.frame);
-    }
-  }
-  if (result->first_difference.empty() && !result->state_difference.empty()) {
-    result->first_difference = result->state_difference;
-  }
-}
+// The other core's share of the log's bytes when it reads while this thread
+// parses the session's configuration first (about a third of the time the
+// log's reading takes here: docs/performance.md "Two cores").
+constexpr double kOtherCoresShare = 0.6;
 
 // A branch (scripts/lab demo --from; docs/sessions.md "Branching"): its
 // recorded session re-simulated up to the instant, word for word, and the
@@ -449,24 +322,38 @@ ResimResult Resimulate(const ResimOptions& opt) {
   if (!fs::exists(session / "lcmlog"))
     throw InputError(opt.session + ": not a session folder (no lcmlog)");
   const bool other_design = OtherDesign(opt);
+  // The session's own design to its end: another core reads half the log
+  // and runs half the DCP (docs/sessions.md "Re-simulation"), made first so
+  // that its start overlaps the configuration's reading.
+  std::optional<OtherCore> other_core;
+  if (!other_design && opt.until_frame < 0 &&
+      (opt.threads == 2 || (opt.threads == 0 && std::thread::hardware_concurrency() >= 2)))
+    other_core.emplace(opt.threads == 2);
+  OtherCore* other = other_core ? &*other_core : nullptr;
   // A batch's cell (the session read before, its own config with keys set,
   // nothing written) takes the config the session's read parsed once; the
   // text is needed only for a session written.
   const bool batch_cell = opt.recorded && opt.discard && opt.config_path.empty() && other_design;
-  const std::string config_text = batch_cell ? "" : EffectiveConfigText(opt);
   const std::string config_path = ConfigSource(opt);
-  const LabConfig config = batch_cell
-                               ? opt.recorded->config_designs().With(opt.settings, config_path)
-                               : ParseConfig(config_text, config_path);
+  std::string config_text;
+  LabConfig config;
+  auto read_config = [&] {
+    config_text = batch_cell ? "" : EffectiveConfigText(opt);
+    config = batch_cell ? opt.recorded->config_designs().With(opt.settings, config_path)
+                        : ParseConfig(config_text, config_path);
+  };
   auto progress = [&](double f, const std::string& line) {
     if (opt.progress) opt.progress(f, line);
   };
+  // Another design's configuration first; the session's own is read while
+  // the other core reads its share of the log (kOtherCoresShare).
+  if (other_design) read_config();
   progress(0.0, "reading " + (session / "lcmlog").string());
-  // The session's own config is read once (another design's is not its).
   std::shared_ptr<const RecordedSession> recorded = opt.recorded;
   if (!other_design) {
     recorded = std::make_shared<const RecordedSession>(
-        opt.session, session::SessionLog(opt.session, config.session.frame_rate_hz));
+        opt.session, session::SessionLog(opt.session, session::SessionLog::kNoSessionTime),
+        session::SessionLog::TwoParts{other, read_config, kOtherCoresShare});
   } else if (!recorded) {
     recorded = ReadRecordedSession(opt.session);
   }
@@ -487,10 +374,9 @@ ResimResult Resimulate(const ResimOptions& opt) {
   const bool written = other_design && !opt.discard;
   const std::string out_log = written ? OpenNewSession(opt, config_text, &result) : "";
   if (opt.until_frame >= 0) CheckUntil(rec, plan, opt, other_design);
-  const Outputs out =
-      RunDcp(config, rec, plan, out_log, other_design, opt.until_frame, progress, &result);
+  const Outputs out = RunAndCompare(
+      config, rec, plan, {out_log, other_design, opt.until_frame, other, progress}, &result);
   progress(1.0, "done");
-  CompareWithRecording(rec, plan.first, opt.until_frame, out, &result);
   if (!other_design && opt.until_frame < 0) {
     const std::string own = result.first_difference;
     CheckBranchPrefix(session, rec, &result);
@@ -498,6 +384,7 @@ ResimResult Resimulate(const ResimOptions& opt) {
   }
   result.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   result.read_seconds = std::chrono::duration<double>(t_read - t0).count();
+  result.read_in_two = rec.read_in_two;
   if (!rec.inputs.empty()) {
     result.recorded_seconds =
         (rec.inputs.back().timestamp_us - rec.inputs.front().timestamp_us) / 1e6;

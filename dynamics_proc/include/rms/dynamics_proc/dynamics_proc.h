@@ -63,6 +63,11 @@ class DynamicsProc {
   // restore or a resume, and every kStateEverySeconds of frames.
   static constexpr double kStateEverySeconds = 5.0;
   void PublishState(std::int8_t reason);
+  // Whether the periodic RMS_DCP_STATE is sent (true unless set; a
+  // re-simulation that writes no log sets false: nobody reads it, and the
+  // checkpoint's JSON is most of its cost). The count to the next one runs
+  // on either way.
+  void set_periodic_states(bool on) { periodic_states_ = on; }
   // Re-simulation (docs/sessions.md "Re-simulation"): takes a logged
   // RMS_DCP_STATE as the live DCP had it, the state and its numbering; with
   // with_state false, the numbering only (another design's DCP keeps its
@@ -105,6 +110,7 @@ class DynamicsProc {
       resume_;  // (DCP frame, input frame) of the state resumed
   std::int64_t state_written_us_ = 0;
   std::int64_t frames_since_state_ = 0;
+  bool periodic_states_ = true;
   bool made_a_frame_ = false;
   std::uint32_t state_key_ = 0;  // mode, acquired, docked, released: a change writes at once
 };

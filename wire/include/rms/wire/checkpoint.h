@@ -36,6 +36,13 @@ Checkpoint ReadCheckpoint(const std::string& path);
 std::string CheckpointText(const Checkpoint& c);
 // The same from the file's text (path names it in errors).
 Checkpoint ParseCheckpoint(std::string_view text, const std::string& path);
+// True when a checkpoint's text, as CheckpointText writes it, holds this
+// DCP state: its last member, "dcp", is this state's text to the byte (the
+// same text parses to the same state). False says only that it does not
+// read so: ParseCheckpoint and compare to know whether the states differ.
+// (A re-simulation checks the DCP's logged states this way, without
+// parsing each: docs/sessions.md "Re-simulation".)
+bool TextHoldsDcp(std::string_view text, const nlohmann::json& dcp);
 
 // The session's checkpoints folder (docs/security.md "The control channel"):
 // RMS_CONTROL names a checkpoint, never a path, and the name is looked up

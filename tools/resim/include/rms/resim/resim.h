@@ -41,6 +41,12 @@ struct ResimOptions {
   // Another design only: the session as read before (ReadRecordedSession
   // of the same folder), or null to read it now.
   std::shared_ptr<const RecordedSession> recorded;
+  // The session's own design to its end is read and run in two shares at
+  // once, one on another core (docs/sessions.md "Re-simulation"): 0, when
+  // that core comes in time (else this thread does its share); 1, on one
+  // thread; 2, always on two (waiting for the other core). The same result
+  // each way.
+  int threads = 0;
   // Progress (0..1) with a line to show; called every few percent.
   std::function<void(double, const std::string&)> progress;
 };
@@ -61,7 +67,9 @@ struct ResimResult {
   std::string state_difference;       // the first of those that differed ("" if none)
   double seconds = 0.0;               // wall time of the re-simulation, all of it
   double read_seconds = 0.0;          // of which reading and decoding the session's log
+  bool read_in_two = false;           // ... in two parts at once (SessionLog::ReadInTwo)
   double run_seconds = 0.0;           // of which the DCP over its LCM interface, frame by frame
+  bool in_halves = false;             // ... in two halves at once (ResimOptions::threads)
   double recorded_seconds = 0.0;      // the session's own duration (first to last input frame)
   std::string out_dir;                // the new session (with another configuration)
   nlohmann::ordered_json comparison;  // with another configuration: comparison.json

@@ -1,0 +1,390 @@
+#include "dcp_run.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+
+#include "rms/base/check.h"
+#include "rms/base/other_core.h"
+#include "rms/dcp_state_t.hpp"
+#include "rms/dynamics_proc/dynamics_proc.h"
+#include "rms/transport/lcm_interface.h"
+#include "rms/transport/process.h"
+#include "rms/wire/channels.h"
+#include "rms/wire/checkpoint.h"
+#include "rms/wire/message_io.h"
+
+#include "comparison.h"
+
+namespace fs = std::filesystem;
+
+namespace rms::resim {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using Progress = std::function<void(double, const std::string&)>;
+
+// A logged state: a restore, a resume, a malfunction or a start is taken as
+// the live DCP took it (another design keeps its own state at a resume: only
+// the numbering; at a malfunction, the numbering and the malfunctions in
+// force); a periodic one is checked against the re-simulated state (the same
+// design only: another one is expected to differ).
+void TakeState(const dcp_state_t& m, bool first, bool other_design,
+               dynamics_proc::DynamicsProc* node, ResimResult* result) {
+  if (m.reason == dcp_state_t::PERIODIC && !first) {
+    if (other_design || !result->state_difference.empty()) return;
+    ++result->states_checked;
+    const nlohmann::json now = node->MakeCheckpoint().dcp;
+    if (!wire::TextHoldsDcp(m.checkpoint, now) &&
+        wire::ParseCheckpoint(m.checkpoint, "RMS_DCP_STATE").dcp != now) {
+      result->state_difference = "the DCP's state before DCP frame " +
+                                 std::to_string(m.next_frame) +
+                                 " differs from the state it logged there";
+    }
+    return;
+  }
+  const bool own_state =
+      other_design && (m.reason == dcp_state_t::RESUME || m.reason == dcp_state_t::MALFUNCTION);
+  node->ApplyState(m, first || !own_state);
+  ++result->states_taken;
+  // Into the new session's log too, so it can be re-simulated and its
+  // summary sees the same restores (its attempts).
+  node->PublishState(m.reason == dcp_state_t::PERIODIC ? dcp_state_t::START : m.reason);
+}
+
+// One DCP node over a log-backed transport (out_log: the new session's log,
+// "" for none), stepped through a stretch of the plan, with what it sent in
+// the order sent. During the run the outputs go to vectors reserved up front
+// (no allocation a frame).
+class DcpRunner {
+ public:
+  DcpRunner(const LabConfig& config, const Recording& rec, const std::string& out_log,
+            bool other_design, std::size_t steps)
+      : rec_(rec),
+        other_design_(other_design),
+        lcm_("", out_log, rec.suffix),
+        node_(config, &lcm_) {
+    frame_verdicts.reserve(steps);
+    telemetry_verdicts.reserve(steps);
+    if (other_design) {
+      frames.reserve(steps);
+      telemetry.reserve(steps);
+    }
+    // Nobody reads a periodic state unless it is written.
+    node_.set_periodic_states(!out_log.empty());
+    Subscribe();
+  }
+  DcpRunner(const DcpRunner&) = delete;
+  DcpRunner& operator=(const DcpRunner&) = delete;
+
+  // Steps [begin, end) of the plan; with until_frame >= 0, up to the DCP
+  // frame of that number.
+  void Run(const Plan& plan, std::size_t begin, std::size_t end, long until_frame,
+           const Progress& progress, ResimResult* result) {
+    const std::size_t n = plan.steps.size();
+    for (std::size_t k = begin; k < end; ++k) {
+      const Step& step = plan.steps[k];
+      if (step.state) {
+        TakeState(*step.state, step.first, other_design_, &node_, result);
+        continue;
+      }
+      Answer(step.input_frame);
+      if (until_frame >= 0 && !frame_verdicts.empty() && frame_verdicts.back().frame >= until_frame)
+        break;
+      if (progress && n >= 20 && k % (n / 20) == 0)
+        progress(static_cast<double>(k) / n,
+                 std::to_string(k) + " of " + std::to_string(n) + " steps");
+    }
+  }
+  // A periodic state logged in the plan taken as this node's start: the
+  // second half's.
+  void StartFrom(const dcp_state_t& m, ResimResult* result) {
+    TakeState(m, true, other_design_, &node_, result);
+  }
+  const dynamics_proc::DynamicsProc& node() const { return node_; }
+
+  std::vector<Verdict> frame_verdicts, telemetry_verdicts;
+  std::vector<dcp_frame_t> frames;           // decoded, another design only
+  std::vector<dcp_telemetry_t> telemetry;    // decoded, another design only
+  std::vector<std::size_t> restores_before;  // where a restore's RMS_DCP_STATE went among them
+
+ private:
+  // The DCP answers the operator frame as logged.
+  void Answer(std::int64_t input_frame) {
+    const RecordedMessage* input = FindFrame(rec_.inputs, input_frame);
+    if (!input) {
+      throw InputError(
+          "operator frame " + std::to_string(input_frame) +
+          ", which the DCP answered, is not in the log: the re-simulation cannot be exact");
+    }
+    lcm_.SetNowUs(input->timestamp_us);
+    lcm_.Publish(wire::channels::kOperatorInput, rec_.BytesOf(*input),
+                 static_cast<int>(input->size));
+    lcm_.HandleSubscriptions(0);  // the input to the DCP
+    lcm_.HandleSubscriptions(0);  // its outputs to the runner
+  }
+  void Subscribe();
+
+  const Recording& rec_;
+  bool other_design_;
+  transport::LogLcm lcm_;
+  dynamics_proc::DynamicsProc node_;
+};
+
+// Its verdict on a message it sent of type Msg: the frame's, from its bytes
+// (false for a message not whole); `recorded`, the recorded one of that
+// frame or null; `what`, the first field that differs, asked only when the
+// bytes differ.
+template <class Msg>
+bool Judge(const void* d, int n, const Recording& rec,
+           const RecordedMessage* (*find)(const Recording&, std::int64_t),
+           const std::function<std::string(const Msg&, const RecordedMessage&)>& what, Verdict* v) {
+  if (wire::CheckEncoded<Msg>(d, n) != wire::DecodeError::kNone ||
+      !wire::ReadFrameNumber(d, n, &v->frame))
+    return false;
+  const RecordedMessage* recorded = find(rec, v->frame);
+  if (!recorded) return true;  // kNoneRecorded
+  if (SameButSenderAndTime<Msg>(rec.BytesOf(*recorded), static_cast<const std::uint8_t*>(d))) {
+    v->kind = Verdict::kSame;
+    return true;
+  }
+  v->kind = Verdict::kDiffers;
+  Msg made;
+  RMS_CHECK(wire::SafeDecode(d, n, &made) == wire::DecodeError::kNone);
+  v->what = what(made, *recorded);
+  return true;
+}
+
+const RecordedMessage* FindDcpFrame(const Recording& rec, std::int64_t frame) {
+  return FindFrame(rec.dcp_frames, frame);
+}
+const RecordedMessage* FindTelemetry(const Recording& rec, std::int64_t frame) {
+  return FindFrame(rec.telemetry, frame);
+}
+
+void DcpRunner::Subscribe() {
+  lcm_.Subscribe(wire::channels::kDcpFrame, [this](const void* d, int n, std::int64_t) {
+    Verdict v;
+    const auto what = [this](const dcp_frame_t& made, const RecordedMessage& recorded) {
+      std::string field;
+      return SameFrame(made, rec_.Decoded(static_cast<const RecordedDcpFrame&>(recorded)), &field)
+                 ? std::string("frame")  // (the bytes differ, so some field does)
+                 : field;
+    };
+    if (!Judge<dcp_frame_t>(d, n, rec_, &FindDcpFrame, what, &v)) return;
+    frame_verdicts.push_back(std::move(v));
+    if (other_design_) {
+      frames.emplace_back();
+      RMS_CHECK(wire::SafeDecode(d, n, &frames.back()) == wire::DecodeError::kNone);
+    }
+  });
+  lcm_.Subscribe(wire::channels::kDcpTelemetry, [this](const void* d, int n, std::int64_t) {
+    Verdict v;
+    const auto what = [](const dcp_telemetry_t&, const RecordedMessage&) {
+      return std::string("telemetry");
+    };
+    if (!Judge<dcp_telemetry_t>(d, n, rec_, &FindTelemetry, what, &v)) return;
+    telemetry_verdicts.push_back(std::move(v));
+    if (other_design_) {
+      telemetry.emplace_back();
+      RMS_CHECK(wire::SafeDecode(d, n, &telemetry.back()) == wire::DecodeError::kNone);
+    }
+  });
+  lcm_.Subscribe(wire::channels::kDcpState, [this](const void* d, int n, std::int64_t) {
+    dcp_state_t m;
+    if (wire::SafeDecode(d, n, &m) == wire::DecodeError::kNone && m.reason == dcp_state_t::RESTORE)
+      restores_before.push_back(telemetry_verdicts.size());
+  });
+}
+
+// The runners' outputs one after another, then by frame.
+Outputs Collect(const std::vector<const DcpRunner*>& runners, bool in_memory) {
+  Outputs out;
+  for (const DcpRunner* r : runners) {
+    for (const std::size_t i : r->restores_before)
+      out.published.restores_before.push_back(out.telemetry_verdicts.size() + i);
+    auto append = [](const auto& from, auto* to) {
+      to->insert(to->end(), from.begin(), from.end());
+    };
+    append(r->frame_verdicts, &out.frame_verdicts);
+    append(r->telemetry_verdicts, &out.telemetry_verdicts);
+    append(r->frames, &out.frames);
+    append(r->telemetry, &out.telemetry);
+  }
+  if (in_memory) {
+    out.published.frames = out.frames;
+    out.published.telemetry = out.telemetry;
+  }
+  SortByFrame(&out.frame_verdicts);
+  SortByFrame(&out.telemetry_verdicts);
+  SortByFrame(&out.frames);
+  SortByFrame(&out.telemetry);
+  return out;
+}
+
+// Word for word against the recording: its DCP frames [begin, end) (up to
+// until_frame, when >= 0) against the re-simulated frames and telemetry
+// verdicts, each in increasing order of frame. Counts, and notes the first
+// difference.
+void CompareRange(const Recording& rec, std::size_t begin, std::size_t end, long until_frame,
+                  const std::vector<Verdict>& frames, const std::vector<Verdict>& telemetry,
+                  ResimResult* result) {
+  for (std::size_t i = begin; i < end; ++i) {
+    const std::int64_t frame = rec.dcp_frames[i].frame;
+    if (until_frame >= 0 && frame > until_frame) break;
+    ++result->compared;
+    const Verdict* made = FindFrame(frames, frame);
+    bool same = made && made->kind == Verdict::kSame;
+    std::string what = made ? made->what : "missing";
+    if (!same && result->first_decision_frame < 0) {  // the DCP's words: its decisions
+      result->first_decision_frame = static_cast<long>(frame);
+      result->first_decision = what;
+    }
+    if (same) {
+      const Verdict* t = FindFrame(telemetry, frame);
+      if (t && t->kind == Verdict::kDiffers) {
+        same = false;
+        what = t->what;
+      }
+    }
+    if (same) {
+      ++result->identical;
+    } else if (result->first_difference.empty()) {
+      result->first_difference = "DCP frame " + std::to_string(frame) + ": " + what;
+      result->first_difference_frame = static_cast<long>(frame);
+    }
+  }
+}
+
+// The whole comparison, from the plan's first frame; a state that differed
+// is the first difference when no frame is.
+void CompareWithRecording(const Recording& rec, std::size_t first, long until_frame,
+                          const Outputs& out, ResimResult* result) {
+  CompareRange(rec, first, rec.dcp_frames.size(), until_frame, out.frame_verdicts,
+               out.telemetry_verdicts, result);
+  if (result->first_difference.empty() && !result->state_difference.empty()) {
+    result->first_difference = result->state_difference;
+  }
+}
+
+// Where the run can be cut in two: the periodic state logged nearest the
+// plan's middle, with at least kMinHalf steps on either side; 0 for none.
+std::size_t SplitStep(const Plan& plan) {
+  constexpr std::size_t kMinHalf = 300;
+  const std::size_t n = plan.steps.size(), middle = n / 2;
+  std::size_t best = 0;
+  auto distance = [&](std::size_t k) { return k > middle ? k - middle : middle - k; };
+  for (std::size_t k = kMinHalf; k + kMinHalf < n; ++k) {
+    const Step& s = plan.steps[k];
+    if (s.state && !s.first && s.state->reason == dcp_state_t::PERIODIC &&
+        (best == 0 || distance(k) < distance(best)))
+      best = k;
+  }
+  return best;
+}
+
+// A half's outputs, each message a frame of its own, in increasing order,
+// all below `below` (or at or above `from`); one of them compared with the
+// recorded frames [begin, end) and found identical, its states agreeing.
+template <class Msg>
+bool Within(const std::vector<Msg>& v, std::int64_t from, std::int64_t below) {
+  return std::adjacent_find(v.begin(), v.end(),
+                            [](const Msg& a, const Msg& b) { return a.frame >= b.frame; }) ==
+             v.end() &&
+         (v.empty() || (v.front().frame >= from && v.back().frame < below));
+}
+bool HalfAgrees(const Recording& rec, std::size_t begin, std::size_t end, std::int64_t from,
+                std::int64_t below, const DcpRunner& half, ResimResult* result) {
+  if (!Within(half.frame_verdicts, from, below) || !Within(half.telemetry_verdicts, from, below))
+    return false;
+  CompareRange(rec, begin, end, -1, half.frame_verdicts, half.telemetry_verdicts, result);
+  return result->first_difference.empty() && result->state_difference.empty() &&
+         result->identical == result->compared;
+}
+
+// The two halves at once (RunAndCompare): true, with the outputs and the
+// result, when both agree with the recording, each in its own range of
+// frames; false otherwise (the second not started, or anything differing),
+// `first` then having run through the state at the split (checked there).
+bool RunInHalves(const LabConfig& config, const Recording& rec, const Plan& plan, std::size_t split,
+                 const Progress& progress, OtherCore* other, DcpRunner* first, Outputs* out,
+                 ResimResult* result) {
+  const std::size_t n = plan.steps.size();
+  const dcp_state_t& at = *plan.steps[split].state;
+  // The recorded frames made after the state at the split: the second half's.
+  const std::int64_t boundary = at.next_frame;
+  const std::size_t begin = plan.first, end = rec.dcp_frames.size();
+  const std::size_t middle = static_cast<std::size_t>(
+      std::lower_bound(rec.dcp_frames.begin() + static_cast<std::ptrdiff_t>(begin),
+                       rec.dcp_frames.end(), boundary,
+                       [](const RecordedDcpFrame& f, std::int64_t b) { return f.frame < b; }) -
+      rec.dcp_frames.begin());
+  std::optional<DcpRunner> second;
+  ResimResult second_result;
+  bool second_agrees = false;
+  other->Start([&] {
+    second.emplace(config, rec, "", false, n - split);
+    second->StartFrom(at, &second_result);
+    second->Run(plan, split + 1, n, -1, {}, &second_result);
+    second_agrees = HalfAgrees(rec, middle, end, boundary, INT64_MAX, *second, &second_result);
+  });
+  try {
+    first->Run(plan, 0, split + 1, -1, progress, result);  // through the state at the split
+  } catch (...) {
+    other->Finish();  // the other half refers to this frame's variables
+    throw;
+  }
+  ResimResult whole = *result;
+  const bool first_agrees = HalfAgrees(rec, begin, middle, INT64_MIN, boundary, *first, &whole);
+  if (!other->Finish() || other->error() || !first_agrees || !second_agrees) return false;
+  whole.compared += second_result.compared;
+  whole.identical += second_result.identical;
+  whole.states_checked += second_result.states_checked;
+  whole.states_taken += second_result.states_taken - 1;  // its start is no state the DCP took
+  for (const DcpRunner* half : {first, &*second}) {      // each in order, the second after
+    out->frame_verdicts.insert(out->frame_verdicts.end(), half->frame_verdicts.begin(),
+                               half->frame_verdicts.end());
+    out->telemetry_verdicts.insert(out->telemetry_verdicts.end(), half->telemetry_verdicts.begin(),
+                                   half->telemetry_verdicts.end());
+  }
+  *result = std::move(whole);
+  return true;
+}
+
+}  // namespace
+
+Outputs RunAndCompare(const LabConfig& config, const Recording& rec, const Plan& plan,
+                      const RunOptions& options, ResimResult* result) {
+  const std::size_t n = plan.steps.size();
+  const bool whole_own_run = !options.other_design && options.out_log.empty() &&
+                             options.until_frame < 0 && options.other_core;
+  const std::size_t split = whole_own_run ? SplitStep(plan) : 0;
+  const auto t_run = Clock::now();
+  DcpRunner first(config, rec, options.out_log, options.other_design, n);
+  Outputs out;
+  if (split > 0 && RunInHalves(config, rec, plan, split, options.progress, options.other_core,
+                               &first, &out, result)) {
+    result->run_seconds = std::chrono::duration<double>(Clock::now() - t_run).count();
+    result->frames = static_cast<long>(out.frame_verdicts.size());
+    result->in_halves = true;
+    return out;
+  }
+  // One run (or the first half on through the second).
+  first.Run(plan, split > 0 ? split + 1 : 0, n, options.until_frame, options.progress, result);
+  result->run_seconds = std::chrono::duration<double>(Clock::now() - t_run).count();
+  if (options.until_frame >= 0)
+    result->checkpoint_text = wire::CheckpointText(first.node().MakeCheckpoint());
+  out = Collect({&first}, options.other_design && options.out_log.empty());
+  result->frames = static_cast<long>(out.frame_verdicts.size());
+  CompareWithRecording(rec, plan.first, options.until_frame, out, result);
+  if (!result->out_dir.empty()) {
+    transport::WriteStatsJson((fs::path(result->out_dir) / "stats" / "dynamics_proc.json").string(),
+                              "dynamics_proc", first.node().counters(), first.node().latencies());
+  }
+  return out;
+}
+
+}  // namespace rms::resim
