@@ -65,14 +65,13 @@ class DcpRunner {
             bool other_design, std::size_t steps)
       : rec_(rec),
         other_design_(other_design),
+        in_memory_(other_design && out_log.empty()),
         lcm_("", out_log, rec.suffix),
         node_(config, &lcm_) {
     frame_verdicts.reserve(steps);
     telemetry_verdicts.reserve(steps);
-    if (other_design) {
-      frames.reserve(steps);
-      telemetry.reserve(steps);
-    }
+    if (in_memory_) frames.reserve(steps);
+    if (other_design) telemetry.reserve(steps);
     // Nobody reads a periodic state unless it is written.
     node_.set_periodic_states(!out_log.empty());
     Subscribe();
@@ -107,7 +106,7 @@ class DcpRunner {
   const dynamics_proc::DynamicsProc& node() const { return node_; }
 
   std::vector<Verdict> frame_verdicts, telemetry_verdicts;
-  std::vector<dcp_frame_t> frames;           // decoded, another design only
+  std::vector<dcp_frame_t> frames;           // decoded, another design made in memory only
   std::vector<dcp_telemetry_t> telemetry;    // decoded, another design only
   std::vector<std::size_t> restores_before;  // where a restore's RMS_DCP_STATE went among them
 
@@ -129,65 +128,53 @@ class DcpRunner {
   void Subscribe();
 
   const Recording& rec_;
-  bool other_design_;
+  bool other_design_, in_memory_;
   transport::LogLcm lcm_;
   dynamics_proc::DynamicsProc node_;
 };
 
-// Its verdict on a message it sent of type Msg: the frame's, from its bytes
-// (false for a message not whole); `recorded`, the recorded one of that
-// frame or null; `what`, the first field that differs, asked only when the
-// bytes differ.
-template <class Msg>
-bool Judge(const void* d, int n, const Recording& rec,
-           const RecordedMessage* (*find)(const Recording&, std::int64_t),
-           const std::function<std::string(const Msg&, const RecordedMessage&)>& what, Verdict* v) {
-  if (wire::CheckEncoded<Msg>(d, n) != wire::DecodeError::kNone ||
-      !wire::ReadFrameNumber(d, n, &v->frame))
-    return false;
-  const RecordedMessage* recorded = find(rec, v->frame);
-  if (!recorded) return true;  // kNoneRecorded
-  if (SameButSenderAndTime<Msg>(rec.BytesOf(*recorded), static_cast<const std::uint8_t*>(d))) {
-    v->kind = Verdict::kSame;
-    return true;
+// A message the DCP sent (of type Msg, found whole by wire::CheckEncoded)
+// against the recorded one of its frame among `recorded`; `what` names the
+// first field that differs, asked only when the bytes do.
+template <class Msg, class Recorded>
+Verdict Judge(const void* d, int n, const Recording& rec, const std::vector<Recorded>& recorded,
+              const std::function<std::string(const Recorded&)>& what) {
+  Verdict v;
+  RMS_CHECK(wire::ReadFrameNumber(d, n, &v.frame));
+  const Recorded* r = FindFrame(recorded, v.frame);
+  if (!r) return v;  // kNoneRecorded
+  if (SameButSenderAndTime<Msg>(rec.BytesOf(*r), static_cast<const std::uint8_t*>(d))) {
+    v.kind = Verdict::kSame;
+  } else {
+    v.kind = Verdict::kDiffers;
+    v.what = what(*r);
   }
-  v->kind = Verdict::kDiffers;
-  Msg made;
-  RMS_CHECK(wire::SafeDecode(d, n, &made) == wire::DecodeError::kNone);
-  v->what = what(made, *recorded);
-  return true;
-}
-
-const RecordedMessage* FindDcpFrame(const Recording& rec, std::int64_t frame) {
-  return FindFrame(rec.dcp_frames, frame);
-}
-const RecordedMessage* FindTelemetry(const Recording& rec, std::int64_t frame) {
-  return FindFrame(rec.telemetry, frame);
+  return v;
 }
 
 void DcpRunner::Subscribe() {
   lcm_.Subscribe(wire::channels::kDcpFrame, [this](const void* d, int n, std::int64_t) {
-    Verdict v;
-    const auto what = [this](const dcp_frame_t& made, const RecordedMessage& recorded) {
+    if (wire::CheckEncoded<dcp_frame_t>(d, n) != wire::DecodeError::kNone) return;
+    dcp_frame_t here;  // decoded once, where it is kept (a design made in memory) or here
+    dcp_frame_t* made = in_memory_ ? &frames.emplace_back() : &here;
+    bool decoded = false;
+    const auto what = [&](const RecordedDcpFrame& recorded) {
+      if (!decoded) RMS_CHECK(wire::SafeDecode(d, n, made) == wire::DecodeError::kNone);
+      decoded = true;
       std::string field;
-      return SameFrame(made, rec_.Decoded(static_cast<const RecordedDcpFrame&>(recorded)), &field)
+      return SameFrame(*made, rec_.Decoded(recorded), &field)
                  ? std::string("frame")  // (the bytes differ, so some field does)
                  : field;
     };
-    if (!Judge<dcp_frame_t>(d, n, rec_, &FindDcpFrame, what, &v)) return;
-    frame_verdicts.push_back(std::move(v));
-    if (other_design_) {
-      frames.emplace_back();
-      RMS_CHECK(wire::SafeDecode(d, n, &frames.back()) == wire::DecodeError::kNone);
-    }
+    frame_verdicts.push_back(
+        Judge<dcp_frame_t, RecordedDcpFrame>(d, n, rec_, rec_.dcp_frames, what));
+    if (in_memory_ && !decoded) RMS_CHECK(wire::SafeDecode(d, n, made) == wire::DecodeError::kNone);
   });
   lcm_.Subscribe(wire::channels::kDcpTelemetry, [this](const void* d, int n, std::int64_t) {
-    Verdict v;
-    const auto what = [](const dcp_telemetry_t&, const RecordedMessage&) {
-      return std::string("telemetry");
-    };
-    if (!Judge<dcp_telemetry_t>(d, n, rec_, &FindTelemetry, what, &v)) return;
-    telemetry_verdicts.push_back(std::move(v));
+    if (wire::CheckEncoded<dcp_telemetry_t>(d, n) != wire::DecodeError::kNone) return;
+    const auto what = [](const RecordedMessage&) { return std::string("telemetry"); };
+    telemetry_verdicts.push_back(
+        Judge<dcp_telemetry_t, RecordedMessage>(d, n, rec_, rec_.telemetry, what));
     if (other_design_) {
       telemetry.emplace_back();
       RMS_CHECK(wire::SafeDecode(d, n, &telemetry.back()) == wire::DecodeError::kNone);
@@ -200,27 +187,19 @@ void DcpRunner::Subscribe() {
   });
 }
 
-// The runners' outputs one after another, then by frame.
-Outputs Collect(const std::vector<const DcpRunner*>& runners, bool in_memory) {
+// The runner's outputs by frame, moved out of it; for a design made in
+// memory, also as sent.
+Outputs Collect(DcpRunner* r, bool in_memory) {
   Outputs out;
-  for (const DcpRunner* r : runners) {
-    for (const std::size_t i : r->restores_before)
-      out.published.restores_before.push_back(out.telemetry_verdicts.size() + i);
-    auto append = [](const auto& from, auto* to) {
-      to->insert(to->end(), from.begin(), from.end());
-    };
-    append(r->frame_verdicts, &out.frame_verdicts);
-    append(r->telemetry_verdicts, &out.telemetry_verdicts);
-    append(r->frames, &out.frames);
-    append(r->telemetry, &out.telemetry);
-  }
+  out.frame_verdicts = std::move(r->frame_verdicts);
+  out.telemetry_verdicts = std::move(r->telemetry_verdicts);
   if (in_memory) {
-    out.published.frames = out.frames;
-    out.published.telemetry = out.telemetry;
+    out.published =
+        session::DcpRun{std::move(r->frames), r->telemetry, std::move(r->restores_before)};
   }
+  out.telemetry = std::move(r->telemetry);
   SortByFrame(&out.frame_verdicts);
   SortByFrame(&out.telemetry_verdicts);
-  SortByFrame(&out.frames);
   SortByFrame(&out.telemetry);
   return out;
 }
@@ -377,7 +356,7 @@ Outputs RunAndCompare(const LabConfig& config, const Recording& rec, const Plan&
   result->run_seconds = std::chrono::duration<double>(Clock::now() - t_run).count();
   if (options.until_frame >= 0)
     result->checkpoint_text = wire::CheckpointText(first.node().MakeCheckpoint());
-  out = Collect({&first}, options.other_design && options.out_log.empty());
+  out = Collect(&first, options.other_design && options.out_log.empty());
   result->frames = static_cast<long>(out.frame_verdicts.size());
   CompareWithRecording(rec, plan.first, options.until_frame, out, result);
   if (!result->out_dir.empty()) {

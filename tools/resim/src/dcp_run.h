@@ -28,14 +28,12 @@ struct Verdict {
 };
 
 // What the re-simulated DCP sent, in DCP frame order, one message a frame
-// (the last sent, were there two); FindFrame looks one up. The messages
-// themselves decoded for another design only (its comparison and summary
-// read them). For a design made in memory, also all of it in the order
-// sent, with its restores: what its summary is made from, as from a log of
-// it.
+// (the last sent, were there two); FindFrame looks one up. Its telemetry
+// decoded for another design only (its comparison reads it). For a design
+// made in memory, also all of it in the order sent, with its restores: what
+// its summary is made from, as from a log of it.
 struct Outputs {
   std::vector<Verdict> frame_verdicts, telemetry_verdicts;
-  std::vector<dcp_frame_t> frames;
   std::vector<dcp_telemetry_t> telemetry;
   session::DcpRun published;
 };

@@ -326,7 +326,9 @@ ResimResult Resimulate(const ResimOptions& opt) {
   // and runs half the DCP (docs/sessions.md "Re-simulation"), made first so
   // that its start overlaps the configuration's reading.
   std::optional<OtherCore> other_core;
+  std::error_code no_size;
   if (!other_design && opt.until_frame < 0 &&
+      fs::file_size(session / "lcmlog", no_size) >= session::SessionLog::kTwoPartsFromBytes &&
       (opt.threads == 2 || (opt.threads == 0 && std::thread::hardware_concurrency() >= 2)))
     other_core.emplace(opt.threads == 2);
   OtherCore* other = other_core ? &*other_core : nullptr;

@@ -91,9 +91,6 @@ void SessionLog::ReadEvents(RawLogReader& log, std::initializer_list<std::string
   }
 }
 
-// A log smaller than this is read on one thread (a thread's start costs more).
-constexpr std::uintmax_t kTwoPartsFromBytes = 1 << 20;
-
 bool SessionLog::ReadInTwo(std::initializer_list<std::string_view> channels,
                            const std::function<void(int part, const LogMessage&)>& visit,
                            const TwoParts& parts) {

@@ -74,6 +74,7 @@ class SessionLog {
   // and what part 1 visited is to be dropped. Every message of part 1
   // before its own first RMS_OPERATOR_INPUT has session_time_s 0 (a reader
   // that needs the session time reads with Read).
+  static constexpr std::uintmax_t kTwoPartsFromBytes = 1 << 20;  // smaller: one part
   bool ReadInTwo(std::initializer_list<std::string_view> channels,
                  const std::function<void(int part, const LogMessage&)>& visit,
                  const TwoParts& parts);
