@@ -1,8 +1,16 @@
 #include "rms/base/other_core.h"
 
+#include <algorithm>
 #include <thread>
 
 namespace rms {
+
+int OtherCore::UsableCpus() {
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  if (sched_getaffinity(0, sizeof allowed, &allowed) != 0) return 1;
+  return std::max(1, CPU_COUNT(&allowed));
+}
 
 OtherCore::OtherCore(bool always_start) : always_start_(always_start) {
   pthread_attr_t attr;

@@ -96,6 +96,13 @@ void DynamicsProc::ApplyState(const dcp_state_t& m, bool with_state) {
   frames_since_state_ = 0;
 }
 
+bool DynamicsProc::NumberingIs(const dcp_state_t& m) const {
+  return next_frame_ == m.next_frame && last_input_frame_ == m.input_frame &&
+         resume_.has_value() == static_cast<bool>(m.resume_pending) &&
+         (!resume_ ||
+          (resume_->first == m.resume_dcp_frame && resume_->second == m.resume_input_frame));
+}
+
 void DynamicsProc::MatchMalfunctions(const std::vector<std::string>& texts) {
   const std::vector<wire::Malfunction> now = dcp_.malfunctions().active();
   std::vector<wire::Malfunction> want;

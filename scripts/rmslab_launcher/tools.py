@@ -18,7 +18,7 @@ def ensure(rel, no_build=False):
 
 
 def resim(argv):
-    """scripts/lab resim SESSION [--config FILE] [--set KEY=VALUE]... [--out DIR] [--video]:
+    """scripts/lab resim SESSION [--config FILE] [--set KEY=VALUE]... [--out DIR] [--threads N] [--video]:
     the DCP again on the recorded inputs. Without --config or --set, exit 0
     only if every output is identical; with them (another design), a new
     session (default SESSION-resim) with comparison.md; --video replays it
@@ -29,12 +29,16 @@ def resim(argv):
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="a configuration key set over the session's (or --config's), e.g. dcp.tpob_ft=0.4")
     p.add_argument("--out")
+    p.add_argument("--threads", choices=["auto", "1", "2"],
+                   help="the session's own design on two cores at once (auto, the default), one thread, or always two")
     p.add_argument("--video", action="store_true")
     p.add_argument("--no-build", action="store_true")
     a = p.parse_args(argv)
     if not a.no_build:
         install_and_build()
     cmd = [binary("tools/rms_resim"), a.session]
+    if a.threads:
+        cmd += ["--threads", a.threads]
     if a.config:
         cmd += ["--config", a.config]
     for kv in a.set:

@@ -7,6 +7,7 @@
 // one.
 #include <signal.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <gtest/gtest.h>
@@ -94,8 +95,8 @@ TEST_F(RecordedSession, ItReSimulatesBitForBit) {
       << "progress lines with no terminal to show them";
 }
 
-// rms_resim SESSION with --threads N: its output but the timing line, the
-// timing line apart.
+// rms_resim SESSION with --threads N: its output but the timing line (and the
+// wall times: the first line's, the log lines'), the timing line apart.
 struct ResimRun {
   int rc = -1;
   std::string result, timing;
@@ -111,6 +112,8 @@ ResimRun ResimWithThreads(const std::string& session, const std::string& threads
       out.timing = line;
     else if (line.rfind("re-simulated ", 0) == 0)  // its first line has the wall time
       out.result += line.substr(line.find(';')) + "\n";
+    else if (line.rfind("[20", 0) == 0 && line.find("] ") != std::string::npos)
+      out.result += line.substr(line.find("] ") + 2) + "\n";  // a log line, its time left out
     else
       out.result += line + "\n";
   }
@@ -183,6 +186,20 @@ TEST_F(RecordedSession, ADifferenceInEitherHalfIsFoundWhereOneThreadFindsIt) {
   const std::size_t early_frame = frames[frames.size() / 4];
   const std::size_t late_telemetry = telemetry[telemetry.size() * 3 / 4];
   const std::size_t middle_state = states[states.size() / 2];
+  // The first operator frame after each periodic state: where the second
+  // half may begin.
+  std::vector<std::int64_t> after_states;
+  {
+    lcm::LogFile in(*dir_ + "/lcmlog", "r");
+    std::size_t i = 0;
+    for (const lcm::LogEvent* ev; (ev = in.readNextEvent()); ++i) {
+      dcp_state_t m;
+      if (std::binary_search(states.begin(), states.end(), i) &&
+          m.decode(ev->data, 0, ev->datalen) > 0)
+        after_states.push_back(m.input_frame + 1);
+    }
+  }
+  ASSERT_EQ(after_states.size(), states.size());
   struct Case {
     std::string name;
     std::function<void(std::size_t, lcm::LogEvent*)> edit;
@@ -191,7 +208,7 @@ TEST_F(RecordedSession, ADifferenceInEitherHalfIsFoundWhereOneThreadFindsIt) {
   auto byte_at = [](lcm::LogEvent* ev, int at) -> std::uint8_t& {
     return static_cast<std::uint8_t*>(ev->data)[at];
   };
-  const std::vector<Case> cases = {
+  std::vector<Case> cases = {
       {"an arm word early",
        [&](std::size_t i, lcm::LogEvent* ev) {
          if (i == early_frame) byte_at(ev, wire::kDcpFrameInputFrameAt + 16 + 3) ^= 1;
@@ -225,6 +242,28 @@ TEST_F(RecordedSession, ADifferenceInEitherHalfIsFoundWhereOneThreadFindsIt) {
        },
        ""},
   };
+  // Operator frames numbered 2^21 further on from one periodic state on (the
+  // DCP frames' and the telemetry's input_frame with them), a copy for each
+  // state: one run refuses them as far ahead of the last, so a second half
+  // started there must not take them (it begins with no last).
+  for (const std::int64_t from : after_states) {
+    cases.push_back({"inputs far ahead from operator frame " + std::to_string(from),
+                     [&, from](std::size_t, lcm::LogEvent* ev) {
+                       const bool input = ev->channel.rfind("RMS_OPERATOR_INPUT", 0) == 0;
+                       if (!input && ev->channel.rfind("RMS_DCP_FRAME", 0) != 0 &&
+                           ev->channel.rfind("RMS_DCP_TELEMETRY", 0) != 0)
+                         return;
+                       // Both outputs carry input_frame where RMS_DCP_FRAME does.
+                       const int at = input ? wire::kFrameAt : wire::kDcpFrameInputFrameAt;
+                       std::int64_t f = 0;
+                       ASSERT_TRUE(wire::ReadInt64At(ev->data, ev->datalen, at, &f));
+                       if (f < from) return;
+                       const auto moved = static_cast<std::uint64_t>(f + (std::int64_t{1} << 21));
+                       for (int b = 0; b < 8; ++b)
+                         byte_at(ev, at + b) = static_cast<std::uint8_t>(moved >> (56 - 8 * b));
+                     },
+                     "first difference: DCP frame"});
+  }
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
     const std::string copy = *tmp_ + "/edited-" + std::to_string(&c - cases.data());

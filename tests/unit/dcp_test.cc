@@ -411,6 +411,34 @@ TEST_F(Dcp, ABadCheckpointIsRefusedNamingWhatIsWrong) {
   EXPECT_EQ(dcp.mode(), 1);
 }
 
+// wire::TextHoldsDcp (the re-simulation's check of a logged state): a
+// checkpoint's text holds its own state and no other; a text ParseCheckpoint
+// refuses is refused the same, even when its state is the one asked about.
+TEST_F(Dcp, ACheckpointsTextHoldsItsStateAndIsReadAsParseCheckpointReadsIt) {
+  DynamicCollisionProgram dcp(config);
+  wire::Checkpoint c;
+  c.config = "config.toml";
+  c.dcp = dcp.SaveState();
+  const std::string text = wire::CheckpointText(c);
+  EXPECT_TRUE(wire::TextHoldsDcp(text, c.dcp, "it"));
+  EXPECT_EQ(wire::ParseCheckpoint(text, "it").dcp, c.dcp);
+  nlohmann::json other = c.dcp;
+  other["mode"] = 2;
+  EXPECT_FALSE(wire::TextHoldsDcp(text, other, "it"));
+  // Damaged before the state: refused as ParseCheckpoint refuses it.
+  for (const auto& [from, to] : std::vector<std::pair<std::string, std::string>>{
+           {"\"format\"", "GARBAGE \"format\""},
+           {"rmslab-checkpoint-1", "rmslab-checkpoint-9"},
+           {"\"saved_us\"", "\"saved\""},
+           {"\"operator_inputs\": {", "\"operator_inputs\": [{"}}) {
+    std::string bad = text;
+    ASSERT_NE(bad.find(from), std::string::npos) << from;
+    bad.replace(bad.find(from), from.size(), to);
+    EXPECT_THROW(wire::ParseCheckpoint(bad, "it"), InputError) << to;
+    EXPECT_THROW(wire::TextHoldsDcp(bad, c.dcp, "it"), InputError) << to;
+  }
+}
+
 }  // namespace
 }  // namespace rms::dynamics_proc
 

@@ -186,7 +186,8 @@ int main(int argc, char** argv) {
   app.add_option("--threads", threads,
                  "The session's own design: its log read and its DCP run in two shares at once, "
                  "one on another core: auto (when that core comes in time), 1 (one thread) or 2 "
-                 "(always two); the same result each way (docs/sessions.md \"Re-simulation\")")
+                 "(always two); the same result each way (docs/sessions.md \"Re-simulation\"); "
+                 "--verbose runs on one")
       ->check(CLI::IsMember({"auto", "1", "2"}))
       ->capture_default_str();
   app.add_flag("--quiet", quiet, "No progress lines (they go only to a terminal anyway)");
@@ -195,6 +196,9 @@ int main(int argc, char** argv) {
                "Also the DCP's own log lines (mode changes, collisions) as it re-flies");
   if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   opt.threads = threads == "auto" ? 0 : std::stoi(threads);
+  // The DCP's own lines in the order one run makes them (two halves would
+  // interleave theirs, and a half not kept would have said its own).
+  if (verbose) opt.threads = 1;
   // The re-flown DCP's log lines only when asked for: the result is the output.
   spdlog::set_level(verbose ? spdlog::level::info : spdlog::level::warn);
   // With --result-json stdout is the result alone: log lines go to stderr.

@@ -30,14 +30,21 @@ std::string CheckpointText(const Checkpoint& c) {
   return j.dump(2) + "\n";
 }
 
-bool TextHoldsDcp(std::string_view text, const nlohmann::json& dcp) {
+bool TextHoldsDcp(std::string_view text, const nlohmann::json& dcp, const std::string& path) {
   // CheckpointText's last lines: ',\n  "dcp": ...\n}\n', as {"dcp": dcp}
   // dumps them after its "{".
   nlohmann::ordered_json last;
   last["dcp"] = dcp;
   const std::string tail = last.dump(2).substr(1) + "\n";
-  return text.size() > tail.size() && text.substr(text.size() - tail.size()) == tail &&
-         text[text.size() - tail.size() - 1] == ',';
+  if (text.size() <= tail.size() || text.substr(text.size() - tail.size()) != tail ||
+      text[text.size() - tail.size() - 1] != ',')
+    return false;
+  // The rest, with a null in the state's place: the same JSON or not as the
+  // whole, and the same members for ParseCheckpoint to check.
+  std::string rest(text.substr(0, text.size() - tail.size()));
+  rest += "\n  \"dcp\": null\n}\n";
+  ParseCheckpoint(rest, path);
+  return true;
 }
 
 namespace {

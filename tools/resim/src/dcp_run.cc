@@ -4,7 +4,11 @@
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <mutex>
 #include <optional>
+#include <spdlog/sinks/base_sink.h>
+#include <spdlog/spdlog.h>
+#include <thread>
 
 #include "rms/base/check.h"
 #include "rms/base/other_core.h"
@@ -14,6 +18,7 @@
 #include "rms/transport/process.h"
 #include "rms/wire/channels.h"
 #include "rms/wire/checkpoint.h"
+#include "rms/wire/frame_numbers.h"
 #include "rms/wire/message_io.h"
 
 #include "comparison.h"
@@ -38,7 +43,7 @@ void TakeState(const dcp_state_t& m, bool first, bool other_design,
     if (other_design || !result->state_difference.empty()) return;
     ++result->states_checked;
     const nlohmann::json now = node->MakeCheckpoint().dcp;
-    if (!wire::TextHoldsDcp(m.checkpoint, now) &&
+    if (!wire::TextHoldsDcp(m.checkpoint, now, "RMS_DCP_STATE") &&
         wire::ParseCheckpoint(m.checkpoint, "RMS_DCP_STATE").dcp != now) {
       result->state_difference = "the DCP's state before DCP frame " +
                                  std::to_string(m.next_frame) +
@@ -284,6 +289,59 @@ bool HalfAgrees(const Recording& rec, std::size_t begin, std::size_t end, std::i
          result->identical == result->compared;
 }
 
+// Whether one run, going on from the first half's node at the split, is
+// where the second half starts: the logged state's numbering is the first
+// half's, and the second half's fresh node takes its first operator frame as
+// the first half's node would (a fresh one takes any: one run takes it only
+// after its last, not a duplicate, stale or too far ahead). The DCP's own
+// state at the split is checked as any periodic state is.
+bool ContinuesAsLogged(const Plan& plan, std::size_t split,
+                       const dynamics_proc::DynamicsProc& first) {
+  if (!first.NumberingIs(*plan.steps[split].state)) return false;
+  const wire::SequenceTracker& seen = first.input_sequence();
+  for (std::size_t k = split + 1; k < plan.steps.size(); ++k) {
+    const std::int64_t f = plan.steps[k].input_frame;
+    if (plan.steps[k].state || f < 0) continue;
+    return !seen.started() ||
+           (f > seen.last() && f - seen.last() <= wire::SequenceTracker::kMaxJump);
+  }
+  return true;  // no input after it
+}
+
+// The default logger's lines, but those of one thread (the second half's):
+// counted, never shown. One run says the lines a half would have said, in
+// their order, so a second half that said any is not kept.
+class SecondHalfLines : public spdlog::sinks::base_sink<std::mutex> {
+ public:
+  SecondHalfLines() : logger_(spdlog::default_logger()), sinks_(logger_->sinks()) {}
+  // Installed while it lives (no other thread logging as it comes and goes).
+  void Install(const std::shared_ptr<SecondHalfLines>& self) { logger_->sinks() = {self}; }
+  ~SecondHalfLines() override = default;
+  void Restore() { logger_->sinks() = sinks_; }
+  // The calling thread's lines are held from now on.
+  void HoldThisThread() { held_ = std::this_thread::get_id(); }
+  int held_lines() const { return held_lines_; }
+
+ protected:
+  void sink_it_(const spdlog::details::log_msg& m) override {
+    if (std::this_thread::get_id() == held_.load()) {
+      ++held_lines_;
+      return;
+    }
+    for (const spdlog::sink_ptr& s : sinks_)
+      if (s->should_log(m.level)) s->log(m);
+  }
+  void flush_() override {
+    for (const spdlog::sink_ptr& s : sinks_) s->flush();
+  }
+
+ private:
+  std::shared_ptr<spdlog::logger> logger_;
+  std::vector<spdlog::sink_ptr> sinks_;
+  std::atomic<std::thread::id> held_{};
+  std::atomic<int> held_lines_ = 0;
+};
+
 // The two halves at once (RunAndCompare): true, with the outputs and the
 // result, when both agree with the recording, each in its own range of
 // frames; false otherwise (the second not started, or anything differing),
@@ -304,21 +362,33 @@ bool RunInHalves(const LabConfig& config, const Recording& rec, const Plan& plan
   std::optional<DcpRunner> second;
   ResimResult second_result;
   bool second_agrees = false;
+  const auto lines = std::make_shared<SecondHalfLines>();
+  lines->Install(lines);
+  struct Restore {
+    SecondHalfLines* lines;
+    ~Restore() { lines->Restore(); }
+  } restore{lines.get()};
   other->Start([&] {
+    lines->HoldThisThread();
     second.emplace(config, rec, "", false, n - split);
     second->StartFrom(at, &second_result);
     second->Run(plan, split + 1, n, -1, {}, &second_result);
     second_agrees = HalfAgrees(rec, middle, end, boundary, INT64_MAX, *second, &second_result);
   });
+  ResimResult whole;
+  bool first_agrees = false;
   try {
     first->Run(plan, 0, split + 1, -1, progress, result);  // through the state at the split
+    whole = *result;
+    first_agrees = ContinuesAsLogged(plan, split, first->node()) &&
+                   HalfAgrees(rec, begin, middle, INT64_MIN, boundary, *first, &whole);
   } catch (...) {
     other->Finish();  // the other half refers to this frame's variables
     throw;
   }
-  ResimResult whole = *result;
-  const bool first_agrees = HalfAgrees(rec, begin, middle, INT64_MIN, boundary, *first, &whole);
-  if (!other->Finish() || other->error() || !first_agrees || !second_agrees) return false;
+  if (!other->Finish() || other->error() || !first_agrees || !second_agrees ||
+      lines->held_lines() > 0)
+    return false;
   whole.compared += second_result.compared;
   whole.identical += second_result.identical;
   whole.states_checked += second_result.states_checked;

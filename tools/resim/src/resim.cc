@@ -7,7 +7,6 @@
 #include <fstream>
 #include <map>
 #include <sstream>
-#include <thread>
 #include <vector>
 
 #include "rms/base/check.h"
@@ -329,7 +328,7 @@ ResimResult Resimulate(const ResimOptions& opt) {
   std::error_code no_size;
   if (!other_design && opt.until_frame < 0 &&
       fs::file_size(session / "lcmlog", no_size) >= session::SessionLog::kTwoPartsFromBytes &&
-      (opt.threads == 2 || (opt.threads == 0 && std::thread::hardware_concurrency() >= 2)))
+      (opt.threads == 2 || (opt.threads == 0 && OtherCore::UsableCpus() >= 2)))
     other_core.emplace(opt.threads == 2);
   OtherCore* other = other_core ? &*other_core : nullptr;
   // A batch's cell (the session read before, its own config with keys set,

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 
 #include "rms/base/check.h"
 #include "rms/base/config.h"
@@ -116,12 +117,13 @@ bool SessionLog::ReadInTwo(std::initializer_list<std::string_view> channels,
     second_start = log.first_event_start();
     second_unread = log.size() - log.good_end();
   });
-  RawLogReader log(log_path_);
-  log.StopAt(middle);
+  std::optional<RawLogReader> reader;
   Pass first{&check_};
   try {
     if (parts.meanwhile) parts.meanwhile();
-    ReadEvents(log, channels, &first, [&](const LogMessage& m) { visit(0, m); });
+    reader.emplace(log_path_);
+    reader->StopAt(middle);
+    ReadEvents(*reader, channels, &first, [&](const LogMessage& m) { visit(0, m); });
   } catch (...) {
     other->Finish();  // the other part's reading refers to this frame's variables
     throw;
@@ -129,6 +131,7 @@ bool SessionLog::ReadInTwo(std::initializer_list<std::string_view> channels,
   // An event of the whole log starts where this thread stopped; the other
   // began at the first sync word at or after the middle: the same event
   // exactly when both name one place.
+  RawLogReader& log = *reader;
   const bool stands = other->Finish() && !other->error() && log.stopped() && second.events > 0 &&
                       log.stopped_at() == second_start;
   if (stands) {

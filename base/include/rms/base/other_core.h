@@ -25,6 +25,10 @@ class OtherCore {
  public:
   static constexpr std::chrono::milliseconds kIdleSpin{20};
 
+  // The CPUs this thread may run on (its affinity: taskset, a cgroup), at
+  // least 1: another core is worth making only when there are two.
+  static int UsableCpus();
+
   // Makes the thread (none when it cannot be made: every Finish() then
   // says the work did not start). With always_start, Finish() waits for a
   // share to start rather than taking it back (a test, or a measurement of

@@ -74,6 +74,12 @@ class DynamicsProc {
   // own state), and from a MALFUNCTION state the malfunctions in force
   // (MatchMalfunctions). Throws InputError for a checkpoint it cannot read.
   void ApplyState(const dcp_state_t& m, bool with_state);
+  // Whether the node's frame numbering is the state's: what ApplyState would
+  // set (the next DCP frame, the last operator frame, a resume pending).
+  bool NumberingIs(const dcp_state_t& m) const;
+  // The operator frames' numbers as received (docs/protocol.md "Frame
+  // numbers"): which the next input must follow. No state carries it.
+  const wire::SequenceTracker& input_sequence() const { return inputs_; }
   // The malfunctions in force become these (their text): those not among
   // them repaired, those new injected where this DCP's arm is now.
   void MatchMalfunctions(const std::vector<std::string>& texts);

@@ -38,11 +38,13 @@ std::string CheckpointText(const Checkpoint& c);
 Checkpoint ParseCheckpoint(std::string_view text, const std::string& path);
 // True when a checkpoint's text, as CheckpointText writes it, holds this
 // DCP state: its last member, "dcp", is this state's text to the byte (the
-// same text parses to the same state). False says only that it does not
+// same text parses to the same state), the rest read as ParseCheckpoint
+// reads it (which throws rms::InputError, path naming it, where
+// ParseCheckpoint would for the whole). False says only that it does not
 // read so: ParseCheckpoint and compare to know whether the states differ.
-// (A re-simulation checks the DCP's logged states this way, without
-// parsing each: docs/sessions.md "Re-simulation".)
-bool TextHoldsDcp(std::string_view text, const nlohmann::json& dcp);
+// (A re-simulation checks the DCP's logged states this way without parsing
+// each state again: docs/sessions.md "Re-simulation".)
+bool TextHoldsDcp(std::string_view text, const nlohmann::json& dcp, const std::string& path);
 
 // The session's checkpoints folder (docs/security.md "The control channel"):
 // RMS_CONTROL names a checkpoint, never a path, and the name is looked up
