@@ -139,11 +139,12 @@ class DcpRunner {
 };
 
 // A message the DCP sent (of type Msg, found whole by wire::CheckEncoded)
-// against the recorded one of its frame among `recorded`; `what` names the
-// first field that differs, asked only when the bytes do.
-template <class Msg, class Recorded>
+// against the recorded one of its frame among `recorded`; what(recorded)
+// names the first field that differs, asked only when the bytes do (a
+// callable, not a std::function: nothing allocated a message).
+template <class Msg, class Recorded, class What>
 Verdict Judge(const void* d, int n, const Recording& rec, const std::vector<Recorded>& recorded,
-              const std::function<std::string(const Recorded&)>& what) {
+              const What& what) {
   Verdict v;
   RMS_CHECK(wire::ReadFrameNumber(d, n, &v.frame));
   const Recorded* r = FindFrame(recorded, v.frame);
@@ -171,15 +172,13 @@ void DcpRunner::Subscribe() {
                  ? std::string("frame")  // (the bytes differ, so some field does)
                  : field;
     };
-    frame_verdicts.push_back(
-        Judge<dcp_frame_t, RecordedDcpFrame>(d, n, rec_, rec_.dcp_frames, what));
+    frame_verdicts.push_back(Judge<dcp_frame_t>(d, n, rec_, rec_.dcp_frames, what));
     if (in_memory_ && !decoded) RMS_CHECK(wire::SafeDecode(d, n, made) == wire::DecodeError::kNone);
   });
   lcm_.Subscribe(wire::channels::kDcpTelemetry, [this](const void* d, int n, std::int64_t) {
     if (wire::CheckEncoded<dcp_telemetry_t>(d, n) != wire::DecodeError::kNone) return;
     const auto what = [](const RecordedMessage&) { return std::string("telemetry"); };
-    telemetry_verdicts.push_back(
-        Judge<dcp_telemetry_t, RecordedMessage>(d, n, rec_, rec_.telemetry, what));
+    telemetry_verdicts.push_back(Judge<dcp_telemetry_t>(d, n, rec_, rec_.telemetry, what));
     if (other_design_) {
       telemetry.emplace_back();
       RMS_CHECK(wire::SafeDecode(d, n, &telemetry.back()) == wire::DecodeError::kNone);
