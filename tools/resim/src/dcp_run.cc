@@ -168,7 +168,7 @@ void DcpRunner::Subscribe() {
       if (!decoded) RMS_CHECK(wire::SafeDecode(d, n, made) == wire::DecodeError::kNone);
       decoded = true;
       std::string field;
-      return SameFrame(*made, rec_.Decoded(recorded), &field)
+      return SameFrame(*made, rec_.Decoded<dcp_frame_t>(recorded), &field)
                  ? std::string("frame")  // (the bytes differ, so some field does)
                  : field;
     };
@@ -312,10 +312,14 @@ bool ContinuesAsLogged(const Plan& plan, std::size_t split,
 // their order, so a second half that said any is not kept.
 class SecondHalfLines : public spdlog::sinks::base_sink<std::mutex> {
  public:
+  // In the default logger's place until Restore() (no other thread logging
+  // as it comes and goes).
+  static std::shared_ptr<SecondHalfLines> Installed() {
+    auto lines = std::make_shared<SecondHalfLines>();
+    lines->logger_->sinks() = {lines};
+    return lines;
+  }
   SecondHalfLines() : logger_(spdlog::default_logger()), sinks_(logger_->sinks()) {}
-  // Installed while it lives (no other thread logging as it comes and goes).
-  void Install(const std::shared_ptr<SecondHalfLines>& self) { logger_->sinks() = {self}; }
-  ~SecondHalfLines() override = default;
   void Restore() { logger_->sinks() = sinks_; }
   // The calling thread's lines are held from now on.
   void HoldThisThread() { held_ = std::this_thread::get_id(); }
@@ -361,8 +365,7 @@ bool RunInHalves(const LabConfig& config, const Recording& rec, const Plan& plan
   std::optional<DcpRunner> second;
   ResimResult second_result;
   bool second_agrees = false;
-  const auto lines = std::make_shared<SecondHalfLines>();
-  lines->Install(lines);
+  const auto lines = SecondHalfLines::Installed();
   struct Restore {
     SecondHalfLines* lines;
     ~Restore() { lines->Restore(); }

@@ -104,12 +104,6 @@ Recording ReadRecording(session::SessionLog& log, const session::SessionLog::Two
   return r;
 }
 
-dcp_frame_t Recording::Decoded(const RecordedDcpFrame& f) const {
-  dcp_frame_t m;
-  RMS_CHECK(wire::SafeDecode(BytesOf(f), static_cast<int>(f.size), &m) == wire::DecodeError::kNone);
-  return m;
-}
-
 std::map<std::int64_t, dcp_telemetry_t> TelemetryByFrame(const std::vector<dcp_telemetry_t>& v) {
   std::map<std::int64_t, dcp_telemetry_t> m;
   for (const auto& t : v) m.emplace_hint(m.end(), t.frame, t);
@@ -118,13 +112,8 @@ std::map<std::int64_t, dcp_telemetry_t> TelemetryByFrame(const std::vector<dcp_t
 
 std::map<std::int64_t, dcp_telemetry_t> TelemetryByFrame(const Recording& r) {
   std::map<std::int64_t, dcp_telemetry_t> m;
-  for (const RecordedMessage& t : r.telemetry) {
-    dcp_telemetry_t d;
-    // Checked as it was read: it decodes.
-    RMS_CHECK(wire::SafeDecode(r.BytesOf(t), static_cast<int>(t.size), &d) ==
-              wire::DecodeError::kNone);
-    m.emplace_hint(m.end(), t.frame, d);
-  }
+  for (const RecordedMessage& t : r.telemetry)
+    m.emplace_hint(m.end(), t.frame, r.Decoded<dcp_telemetry_t>(t));
   return m;
 }
 

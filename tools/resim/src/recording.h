@@ -10,10 +10,12 @@
 #include <string>
 #include <vector>
 
+#include "rms/base/check.h"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_state_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/session/session_log.h"
+#include "rms/wire/message_io.h"
 
 namespace rms::resim {
 
@@ -53,8 +55,15 @@ struct Recording {
   const std::uint8_t* BytesOf(const RecordedMessage& m) const {
     return bytes[m.part].data() + m.offset;
   }
-  // A recorded DCP frame decoded (it was checked as it was read).
-  dcp_frame_t Decoded(const RecordedDcpFrame& f) const;
+  // A recorded message decoded as the Msg it was checked to be as it was
+  // read (RMS_DCP_FRAME, RMS_DCP_TELEMETRY).
+  template <class Msg>
+  Msg Decoded(const RecordedMessage& m) const {
+    Msg out;
+    RMS_CHECK(wire::SafeDecode(BytesOf(m), static_cast<int>(m.size), &out) ==
+              wire::DecodeError::kNone);
+    return out;
+  }
 };
 
 // Messages with a frame number, in increasing order of it, one a frame:

@@ -39,7 +39,6 @@ namespace rms::resim {
 
 class RecordedSession {
  public:
-  // other: another core to read half the log (SessionLog::ReadInTwo), or null.
   // parts: how the log's reading is shared out (SessionLog::ReadInTwo).
   RecordedSession(const std::string& dir, session::SessionLog log,
                   const session::SessionLog::TwoParts& parts = {})
