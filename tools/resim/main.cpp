@@ -3,7 +3,7 @@
 //   rms_resim SESSION                      exit 0 only if identical, word for word
 //   rms_resim SESSION --config FILE [--out DIR]   the same inputs, another design
 //   rms_resim SESSION --set KEY=VALUE... [--discard] [--result-json]   a sweep's cell
-//   rms_resim --cells FILE|-               a sweep's batch of cells, a result line each
+//   rms_resim --cells FILE|- [--jobs N]   a sweep's batch of cells, a result line each
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -67,74 +67,6 @@ int Usage(const char* what) {
   return rms::kUsageExitCode;
 }
 
-// The fields of a tab-separated line.
-std::vector<std::string> Fields(const std::string& line) {
-  std::vector<std::string> f;
-  std::size_t at = 0;
-  for (std::size_t tab; (tab = line.find('\t', at)) != std::string::npos; at = tab + 1)
-    f.push_back(line.substr(at, tab - at));
-  f.push_back(line.substr(at));
-  return f;
-}
-
-// JSON as text; a string that is no UTF-8 (a path's bytes) has U+FFFD in
-// its place instead of throwing.
-template <class Json>
-std::string Dump(const Json& j) {
-  return j.dump(-1, ' ', false, Json::error_handler_t::replace);
-}
-
-// A sweep's batch of cells (docs/sessions.md "Sweeps"): each line of `in`,
-// "INDEX<TAB>KEY<TAB>SESSION<TAB>KEY=VALUE..." (a line of the sweep's
-// cells.tsv; KEY, the cache key, is not used here), re-simulated in
-// memory as --discard does; its result "INDEX<TAB>JSON" on stdout
-// as soon as it is made ({"error": ...} when it has none). A session's log
-// is read once for its designs that follow one another (a sweep's lines
-// are session by session); only one session is held at a time. Exit 0
-// when every cell had its result, 1 when a cell had an error line (so GNU
-// parallel --retries tries the batch on another host), 2 when a line was
-// no cell.
-int RunCells(std::istream& in) {
-  std::shared_ptr<const rms::resim::RecordedSession> recorded;
-  std::string recorded_dir;  // the session `recorded` is
-  int rc = 0;
-  for (std::string line; std::getline(in, line);) {
-    if (line.empty()) continue;
-    const std::vector<std::string> f = Fields(line);
-    if (f.size() < 3 || f[0].empty() || f[0].size() > 18 ||
-        f[0].find_first_not_of("0123456789") != std::string::npos) {
-      std::fprintf(stderr, "rms_resim: --cells: not a cell (INDEX<TAB>KEY<TAB>SESSION...): %s\n",
-                   line.c_str());
-      rc = 2;
-      continue;
-    }
-    std::string out;
-    try {
-      rms::resim::ResimOptions opt;
-      opt.session = f[2];
-      opt.discard = true;
-      for (std::size_t i = 3; i < f.size(); ++i)
-        opt.settings.push_back(rms::ParseConfigSetting(f[i]));
-      if (!rms::resim::OtherDesign(opt))
-        throw rms::InputError("a cell needs at least one KEY=VALUE (another design)");
-      if (!recorded || recorded_dir != opt.session) {
-        recorded.reset();  // the last session's memory freed before the next is read
-        recorded = rms::resim::ReadRecordedSession(opt.session);
-        recorded_dir = opt.session;
-      }
-      opt.recorded = recorded;
-      out = Dump(rms::resim::Resimulate(opt).cell);
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "rms_resim: cell %s: %s\n", f[0].c_str(), e.what());
-      out = Dump(nlohmann::json{{"error", e.what()}});
-      rc = std::max(rc, 1);
-    }
-    std::printf("%s\t%s\n", f[0].c_str(), out.c_str());
-    std::fflush(stdout);
-  }
-  return rc;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -156,6 +88,12 @@ int main(int argc, char** argv) {
                  "INDEX<TAB>KEY<TAB>SESSION<TAB>KEY=VALUE..., re-simulated as --set ... "
                  "--discard --result-json would; a line 'INDEX<TAB>JSON' each on stdout")
       ->type_name("FILE");
+  int jobs = 1;
+  app.add_option("--jobs", jobs,
+                 "With --cells: cells at once, each on its own thread (a sweep on this machine "
+                 "gives its cores)")
+      ->check(CLI::Range(1, 256))
+      ->capture_default_str();
   app.add_option("--config", opt.config_path, "Another configuration (a different design)")
       ->check(CLI::ExistingFile);
   app.add_option("--out", opt.out_dir,
@@ -211,22 +149,23 @@ int main(int argc, char** argv) {
   if (app.count("--cells") > 0) {
     if (!opt.session.empty() || !sets.empty() || !opt.config_path.empty() || check_only ||
         !opt.out_dir.empty() || opt.discard || result_json || opt.until_frame >= 0 ||
-        !checkpoint_out.empty())
+        !checkpoint_out.empty() || app.count("--threads") > 0)
       return Usage(
           "--cells: the sessions and keys are in its lines, each cell's result is its line "
-          "(no SESSION, --set, --config, --out, --discard, --result-json, --check, --until or "
-          "--checkpoint-out beside it)");
+          "(no SESSION, --set, --config, --out, --discard, --result-json, --check, --until, "
+          "--checkpoint-out or --threads beside it)");
     if (cells.empty()) return Usage("--cells: a FILE, or - for standard input");
     spdlog::set_default_logger(spdlog::stderr_color_mt("rms_resim"));
-    if (cells == "-") return RunCells(std::cin);
+    if (cells == "-") return rms::resim::RunCells(std::cin, jobs);
     std::ifstream in(cells);
     if (!in || std::filesystem::is_directory(cells)) {
       std::fprintf(stderr, "rms_resim: --cells %s: cannot be read\n", cells.c_str());
       return 2;
     }
-    return RunCells(in);
+    return rms::resim::RunCells(in, jobs);
   }
   if (opt.session.empty()) return Usage("session is required (or --cells)");
+  if (app.count("--jobs") > 0) return Usage("--jobs: only with --cells (cells at once)");
   try {
     for (const std::string& s : sets) opt.settings.push_back(rms::ParseConfigSetting(s));
     if (check_only) {
@@ -252,14 +191,15 @@ int main(int argc, char** argv) {
       rms::WriteWholeFile(checkpoint_out, r.checkpoint_text);
     }
     if (result_json) {
-      std::printf("%s\n", Dump(r.cell).c_str());
+      std::printf("%s\n", rms::resim::JsonLine(r.cell).c_str());
       return 0;
     }
     return Report(r, rms::resim::OtherDesign(opt));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rms_resim: %s\n", e.what());
     // A sweep's cell says why it has no result, on its one line.
-    if (result_json) std::printf("%s\n", Dump(nlohmann::json{{"error", e.what()}}).c_str());
+    if (result_json)
+      std::printf("%s\n", rms::resim::JsonLine(nlohmann::json{{"error", e.what()}}).c_str());
     return 2;
   }
 }

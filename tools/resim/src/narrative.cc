@@ -5,14 +5,18 @@
 #include <string>
 #include <vector>
 
+#include "rms/base/check.h"
 #include "rms/wire/acquisition_conditions.h"
 #include "rms/wire/collision_bits.h"
+
+#include "recording.h"
 
 namespace rms::resim {
 
 namespace {
 
-using Telemetry = std::map<std::int64_t, dcp_telemetry_t>;
+// In increasing order of frame, one a frame: FindFrame looks one up.
+using Telemetry = std::vector<dcp_telemetry_t>;
 
 struct Outcome {
   std::int64_t acquired = -1, clear = -1, docked = -1;  // first DCP frame of each (-1: never)
@@ -21,9 +25,10 @@ struct Outcome {
   std::uint32_t first_collision_bits = 0;
 };
 
-Outcome OutcomeOf(const std::map<std::int64_t, dcp_telemetry_t>& tm) {
+Outcome OutcomeOf(const Telemetry& tm) {
   Outcome o;
-  for (const auto& [f, t] : tm) {
+  for (const dcp_telemetry_t& t : tm) {
+    const std::int64_t f = t.frame;
     if (t.mode == 2 && o.acquired < 0) o.acquired = f;
     if (t.mode == 3 && o.clear < 0) o.clear = f;
     if (t.docked && o.docked < 0) o.docked = f;
@@ -51,11 +56,13 @@ struct Apart {
 };
 Apart PointAApart(const Telemetry& recorded, const Telemetry& now) {
   Apart a;
-  for (const auto& [f, t] : now) {
-    const auto it = recorded.find(f);
-    if (it == recorded.end()) continue;
+  auto r = recorded.begin();  // both in increasing order of frame
+  for (const dcp_telemetry_t& t : now) {
+    const std::int64_t f = t.frame;
+    while (r != recorded.end() && r->frame < f) ++r;
+    if (r == recorded.end() || r->frame != f) continue;
     double d2 = 0;
-    for (int i = 0; i < 3; ++i) d2 += std::pow(t.p_RoA_R_ft[i] - it->second.p_RoA_R_ft[i], 2);
+    for (int i = 0; i < 3; ++i) d2 += std::pow(t.p_RoA_R_ft[i] - r->p_RoA_R_ft[i], 2);
     const double d = std::sqrt(d2);
     if (d > 1e-9 && a.first < 0) a.first = f;
     if (d > a.max_ft) {
@@ -87,9 +94,8 @@ std::string ExplainAcquisition(const Outcome& a, const Outcome& b, const Telemet
     std::string s =
         Fmt("No acquisition: at %.1f s, where the recorded session acquired the payload,",
             a.acquired / rate_hz);
-    const auto it = now.find(a.acquired);
-    if (it != now.end()) {
-      const std::string failing = FailingConditions(it->second, cfg);
+    if (const dcp_telemetry_t* t = FindFrame(now, a.acquired)) {
+      const std::string failing = FailingConditions(*t, cfg);
       s += " the conditions that failed: " +
            (failing.empty() ? std::string("none (but the slave was held)") : failing) + ".";
     }
@@ -110,9 +116,8 @@ std::string ExplainDocking(const Outcome& a, const Outcome& b, const Telemetry& 
   if (a.docked >= 0 && b.docked < 0) {
     std::string s =
         Fmt("No docking: at %.1f s, where the recorded session docked,", a.docked / rate_hz);
-    const auto it = now.find(a.docked);
-    if (it != now.end()) {
-      const auto& t = it->second;
+    if (const dcp_telemetry_t* found = FindFrame(now, a.docked)) {
+      const dcp_telemetry_t& t = *found;
       s += Fmt(
           " the probe's tip was %.3f ft from the port's centre (at most %.2f ft) and %.2f deg off "
           "its axis "
@@ -124,7 +129,9 @@ std::string ExplainDocking(const Outcome& a, const Outcome& b, const Telemetry& 
     return s;
   }
   if (b.docked >= 0) {
-    const auto& t = now.at(b.docked);
+    const dcp_telemetry_t* found = FindFrame(now, b.docked);
+    RMS_CHECK(found != nullptr);  // b.docked is one of its frames
+    const dcp_telemetry_t& t = *found;
     return Fmt("Docked at %.1f s: %.3f ft, %.3f deg.", b.docked / rate_hz, t.dock_distance_ft,
                t.dock_angle_deg);
   }

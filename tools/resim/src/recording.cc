@@ -104,17 +104,11 @@ Recording ReadRecording(session::SessionLog& log, const session::SessionLog::Two
   return r;
 }
 
-std::map<std::int64_t, dcp_telemetry_t> TelemetryByFrame(const std::vector<dcp_telemetry_t>& v) {
-  std::map<std::int64_t, dcp_telemetry_t> m;
-  for (const auto& t : v) m.emplace_hint(m.end(), t.frame, t);
-  return m;
-}
-
-std::map<std::int64_t, dcp_telemetry_t> TelemetryByFrame(const Recording& r) {
-  std::map<std::int64_t, dcp_telemetry_t> m;
-  for (const RecordedMessage& t : r.telemetry)
-    m.emplace_hint(m.end(), t.frame, r.Decoded<dcp_telemetry_t>(t));
-  return m;
+std::vector<dcp_telemetry_t> DecodedTelemetry(const Recording& r) {
+  std::vector<dcp_telemetry_t> v;
+  v.reserve(r.telemetry.size());
+  for (const RecordedMessage& t : r.telemetry) v.push_back(r.Decoded<dcp_telemetry_t>(t));
+  return v;
 }
 
 namespace {

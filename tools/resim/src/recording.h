@@ -92,10 +92,9 @@ const Msg* FindFrame(const std::vector<Msg>& v, std::int64_t frame) {
   return it != v.end() && it->frame == frame ? &*it : nullptr;
 }
 
-// Telemetry by frame (what the design comparison reads): decoded messages,
-// or the recording's, decoded now.
-std::map<std::int64_t, dcp_telemetry_t> TelemetryByFrame(const std::vector<dcp_telemetry_t>& v);
-std::map<std::int64_t, dcp_telemetry_t> TelemetryByFrame(const Recording& r);
+// The recording's telemetry decoded (what the design comparison reads), in
+// increasing order of frame, one a frame, as Recording::telemetry.
+std::vector<dcp_telemetry_t> DecodedTelemetry(const Recording& r);
 
 // The channels re-simulation needs, read from the log (the DCP's increasing
 // run of frames only, as the summary believes them); the operator frames,

@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <mutex>
+#include <optional>
 #include <sstream>
 #include <vector>
 
@@ -50,9 +52,11 @@ class RecordedSession {
   const Recording& recording() const { return rec_; }
   const Plan& plan() const { return plan_; }
   std::int64_t unread_bytes() const { return unread_; }
-  // The recorded session's summary.json (made now when it has none), read at the first call.
+  // Each of the following is made at the first call, once, whichever of
+  // the threads running a batch's cells at once comes first (RunCells).
+  // The recorded session's summary.json (made now when it has none).
   const nlohmann::json& summary() const {
-    if (summary_.is_null()) {
+    std::call_once(summary_once_, [this] {
       const fs::path session(dir_);
       try {
         summary_ = nlohmann::json::parse(
@@ -60,31 +64,30 @@ class RecordedSession {
       } catch (const std::exception&) {
         summary_ = session::Summarize(dir_);
       }
-    }
+    });
     return summary_;
   }
-  // Its telemetry by DCP frame, made at the first call.
-  const std::map<std::int64_t, dcp_telemetry_t>& telemetry() const {
-    if (!telemetry_) telemetry_ = TelemetryByFrame(rec_);
-    return *telemetry_;
+  // Its telemetry by DCP frame.
+  const std::vector<dcp_telemetry_t>& telemetry() const {
+    std::call_once(telemetry_once_, [this] { telemetry_ = DecodedTelemetry(rec_); });
+    return telemetry_;
   }
-  // Its config.toml parsed once for the designs of a batch's cells, at the
-  // first call.
+  // Its config.toml parsed once for the designs of a batch's cells.
   const ConfigDesigns& config_designs() const {
-    if (!designs_) {
+    std::call_once(designs_once_, [this] {
       const std::string path = (fs::path(dir_) / "config.toml").string();
       designs_ =
           std::make_unique<const ConfigDesigns>(ReadTextFile(path, "the configuration file"), path);
-    }
+    });
     return *designs_;
   }
-  // Its config.toml's keys, read at the first call.
+  // Its config.toml's keys.
   const std::optional<ConfigKeys>& config_keys() const {
-    if (!config_keys_) {
+    std::call_once(config_keys_once_, [this] {
       config_keys_ = FlattenConfig(
           ReadTextFile((fs::path(dir_) / "config.toml").string(), "the session's configuration"));
-    }
-    return *config_keys_;
+    });
+    return config_keys_;
   }
 
  private:
@@ -93,9 +96,11 @@ class RecordedSession {
   Plan plan_;
   std::int64_t unread_ = 0;
   // Made once, at the first call (a batch's designs share them).
+  // (A call_once whose function throws leaves its flag unset: the next call tries again.)
+  mutable std::once_flag summary_once_, telemetry_once_, designs_once_, config_keys_once_;
   mutable nlohmann::json summary_;
-  mutable std::optional<std::map<std::int64_t, dcp_telemetry_t>> telemetry_;
-  mutable std::optional<std::optional<ConfigKeys>> config_keys_;
+  mutable std::vector<dcp_telemetry_t> telemetry_;
+  mutable std::optional<ConfigKeys> config_keys_;
   mutable std::unique_ptr<const ConfigDesigns> designs_;
 };
 
@@ -390,8 +395,8 @@ ResimResult Resimulate(const ResimOptions& opt) {
         (rec.inputs.back().timestamp_us - rec.inputs.front().timestamp_us) / 1e6;
   }
   if (other_design) {
-    result.comparison = DesignComparison(recorded->telemetry(), TelemetryByFrame(out.telemetry),
-                                         config, config.session.frame_rate_hz);
+    result.comparison = DesignComparison(recorded->telemetry(), out.telemetry, config,
+                                         config.session.frame_rate_hz);
   }
   if (written) {
     WriteNewSession(*recorded, config_path, config_text, config, &result);

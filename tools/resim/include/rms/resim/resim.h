@@ -7,6 +7,7 @@
 // session folder showing how the same inputs fare with that design, and a
 // comparison of the two.
 #include <functional>
+#include <istream>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -97,5 +98,24 @@ bool OtherDesign(const ResimOptions& options);
 // be re-simulated (DCP frames missing from it with their inputs ambiguous,
 // a restored checkpoint file gone), or a bad configuration.
 ResimResult Resimulate(const ResimOptions& options);
+
+// A sweep's batch of cells (rms_resim --cells; docs/sessions.md "Sweeps"):
+// each line of `in`, "INDEX<TAB>KEY<TAB>SESSION<TAB>KEY=VALUE..." (a line
+// of the sweep's cells.tsv; KEY, the cache key, is not used here),
+// re-simulated in memory as --discard does, `jobs` cells at once on their
+// own threads (the session's own design, ResimOptions::threads, is no cell).
+// Each result line, "INDEX<TAB>JSON" ({"error": ...} when it has none), is
+// written whole on stdout as soon as it is made, so lines come in the order
+// the cells end. A session's log is read once for its designs that follow
+// one another (a sweep's lines are session by session); only one session
+// is held at a time. Returns 0 when every cell had its result, 1 when a
+// cell had an error line (so GNU parallel --retries tries the batch on
+// another host), 2 when a line was no cell (said on stderr).
+int RunCells(std::istream& in, int jobs);
+
+// JSON as one line of text; a string that is no UTF-8 (a path's bytes) has
+// U+FFFD in its place instead of throwing.
+std::string JsonLine(const nlohmann::json& j);
+std::string JsonLine(const nlohmann::ordered_json& j);
 
 }  // namespace rms::resim
