@@ -1,13 +1,13 @@
 """scripts/lab sweep: recorded sessions re-simulated under every combination
 of configuration values (docs/sessions.md "Sweeps").
 
-The cells run through GNU parallel (Debian's `parallel`): on this machine's
-cores, or on a lab's hosts (--hosts LABFILE: parallel's ssh logins; a
-"netns:NAME" host through scripts/rmslab_launcher/netns-login), or, with
---slurm, as a Slurm array job written for a cluster. The cells go in
-batches (scripts/sweep-cell --cells: one rms_resim --cells a batch), each
-cell what rms_resim SESSION --set KEY=VALUE... --discard --result-json
-gives. Results are cached by the log's hash, the configuration's hash and
+On this machine the cells run in one rms_resim --cells process
+(scripts/sweep-cell --cells), --jobs cells at once on its threads; on a
+lab's hosts (--hosts LABFILE) through GNU parallel (Debian's `parallel`:
+its ssh logins; a "netns:NAME" host through
+scripts/rmslab_launcher/netns-login), in batches, one rms_resim --cells a
+batch; with --slurm, as a Slurm array job written for a cluster. A cell is
+what rms_resim SESSION --set KEY=VALUE... --discard --result-json gives. Results are cached by the log's hash, the configuration's hash and
 the software's version, so a rerun does only what is missing.
 """
 import argparse
@@ -16,6 +16,7 @@ import hashlib
 import itertools
 import json
 import os
+import select
 import shlex
 import shutil
 import signal
@@ -35,6 +36,7 @@ NETNS_LOGIN = os.path.join(ROOT, "scripts", "rmslab_launcher", "netns-login")
 SSH_OPTIONS = "ssh -o BatchMode=yes -o ConnectTimeout=5 -o ServerAliveInterval=15 -o ServerAliveCountMax=4"
 FAILED_SHOWN = 20  # failed cells named on the terminal (the table has them all)
 PROBE_TIMEOUT_S = 10  # a login that runs `true`, as GNU parallel allows its own probes
+MAX_JOBS = 256  # cells at once (rms_resim --cells --jobs takes up to this many)
 
 
 def split_values(text):
@@ -375,6 +377,14 @@ def timeout_override():
     return value
 
 
+def largest_log_mib(todo):
+    mib = 0.0
+    for s in {c["session"] for c in todo}:
+        with contextlib.suppress(OSError):
+            mib = max(mib, os.path.getsize(os.path.join(s, "lcmlog")) / 2**20)
+    return mib
+
+
 def batch_timeout_s(todo, per_job):
     """The seconds after which GNU parallel stops a batch (--timeout) and
     tries it again (on another host, if there is one): a host that stalls
@@ -382,11 +392,15 @@ def batch_timeout_s(todo, per_job):
     value = timeout_override()
     if value is not None:
         return value
-    mib = 0.0
-    for s in {c["session"] for c in todo}:
-        with contextlib.suppress(OSError):
-            mib = max(mib, os.path.getsize(os.path.join(s, "lcmlog")) / 2**20)
-    return round(BATCH_S_BASE + per_job * (CELL_S_BASE + CELL_S_A_MIB * mib))
+    return round(BATCH_S_BASE + per_job * (CELL_S_BASE + CELL_S_A_MIB * largest_log_mib(todo)))
+
+
+def stall_limit_s(todo):
+    """The seconds the process running the cells on this machine may go
+    without writing a line before it is stopped (a cell that stalled): a
+    batch's time limit for one cell."""
+    value = timeout_override()
+    return value if value is not None else batch_timeout_s(todo, 1)
 
 
 class NoHostAnswers(Exception):
@@ -483,13 +497,76 @@ def why_no_line(todo, joblog, per_job, workers, timeout_s):
                           f"{code}" + (f", signal {sig}" if sig != "0" else "") + " before this cell's line")
 
 
+class ResultLines:
+    """The cells' result lines ("INDEX<TAB>JSON") as they arrive: each
+    cell's first usable line is its result (a batch tried again on another
+    host says its cells again); a line that is no cell's is kept in errors."""
+
+    def __init__(self, todo, progress, on_result, errors):
+        self.by_index = {c["index"]: c for c in todo}
+        self.done = set()
+        self.progress, self.on_result, self.errors = progress, on_result, errors
+        for c in todo:
+            c.pop("line", None)
+
+    def take(self, line):
+        idx, _, payload = line.rstrip("\n").partition("\t")
+        try:
+            res, cell = json.loads(payload), self.by_index[int(idx)]
+        except (ValueError, KeyError):
+            self.errors.append(line.rstrip())
+            return
+        if cell["index"] in self.done:
+            return
+        first = "line" not in cell
+        cell["line"] = True
+        ok = self.on_result(cell, res)
+        if ok:
+            self.done.add(cell["index"])
+        self.progress.step(ok) if first else self.progress.recovered(ok)
+
+    def count_lost(self):
+        """The progress of the cells that had no line (failed)."""
+        for c in self.by_index.values():
+            if "line" not in c:
+                self.progress.step(False)
+
+
+@contextlib.contextmanager
+def cells_process(cmd, todo, sweep_dir, errors, stop, prefix=""):
+    """A process (cmd) with the cells' lines (cells.tsv's form) on its
+    standard input, each line of its standard error kept in errors (after
+    prefix); stopped with stop(proc) when the block is left by an exception,
+    waited for when it ends."""
+    todo_file = os.path.join(sweep_dir, f"todo-{os.getpid()}.tsv")
+    write_manifest(todo_file, todo)
+    try:
+        with open(todo_file) as cells_in:
+            # RMSLAB_SWEEP names the sweep in the environment of what runs its cells (on this machine).
+            proc = subprocess.Popen(cmd, stdin=cells_in, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                    text=True, start_new_session=True,
+                                    env=dict(os.environ, RMSLAB_SWEEP=sweep_dir))
+        t = threading.Thread(target=lambda: errors.extend(prefix + line.rstrip() for line in proc.stderr),
+                             daemon=True)
+        t.start()
+        try:
+            yield proc
+            proc.wait()
+        except BaseException:
+            stop(proc)
+            raise
+        t.join(timeout=5)
+    finally:
+        with contextlib.suppress(OSError):
+            os.remove(todo_file)
+
+
 def run_parallel(todo, sweep_dir, args, progress, round_no, on_result):
-    """The cells through GNU parallel; on_result(cell, result) as each line
-    arrives (so a sweep stopped part way keeps what it finished). Returns
-    the lines GNU parallel wrote to its standard error."""
+    """The cells through GNU parallel on the lab's hosts; on_result(cell,
+    result) as each line arrives (so a sweep stopped part way keeps what it
+    finished). Returns the lines GNU parallel wrote to its standard error."""
     if not shutil.which("parallel"):
         raise LabError("GNU parallel is not installed: run scripts/install-deps", 1)
-    todo_file = os.path.join(sweep_dir, f"todo-{os.getpid()}.tsv")
     joblog = os.path.join(sweep_dir, f"joblog-{time.strftime('%Y%m%dT%H%M%S')}-{os.getpid()}-try{round_no}")
     try:
         cmd, per_job, timeout = parallel_command(args, joblog, todo)
@@ -498,50 +575,88 @@ def run_parallel(todo, sweep_dir, args, progress, round_no, on_result):
             c["error"] = f"no host of {args.hosts} answered ({why})"
             progress.step(False)
         return []
-    write_manifest(todo_file, todo)
-    by_index = {c["index"]: c for c in todo}
-    for c in todo:
-        c.pop("line", None)
-    done = set()  # a batch tried again on another host says its cells again
     errors = []
-    try:
-        with open(todo_file) as cells_in:
-            # RMSLAB_SWEEP names the sweep in a batch's environment (on this machine).
-            proc = subprocess.Popen(cmd, stdin=cells_in, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                    text=True, start_new_session=True,
-                                    env=dict(os.environ, RMSLAB_SWEEP=sweep_dir))
-        t = threading.Thread(target=lambda: errors.extend(line.rstrip() for line in proc.stderr),
-                             daemon=True)
-        t.start()
-        try:
-            for line in proc.stdout:
-                idx, _, payload = line.rstrip("\n").partition("\t")
-                try:
-                    res, cell = json.loads(payload), by_index[int(idx)]
-                except (ValueError, KeyError):
-                    errors.append(line.rstrip())
-                    continue
-                if cell["index"] in done:
-                    continue
-                first = "line" not in cell
-                cell["line"] = True
-                ok = on_result(cell, res)
-                if ok:
-                    done.add(cell["index"])
-                progress.step(ok) if first else progress.recovered(ok)
-            proc.wait()
-        except BaseException:
-            stop_parallel(proc)
-            raise
-        t.join(timeout=5)
-    finally:
-        with contextlib.suppress(OSError):
-            os.remove(todo_file)
+    lines = ResultLines(todo, progress, on_result, errors)
+    with cells_process(cmd, todo, sweep_dir, errors, stop_parallel, "parallel: ") as proc:
+        for line in proc.stdout:
+            lines.take(line)
     why_no_line(todo, joblog, per_job, args.workers, timeout)
+    lines.count_lost()
+    return errors
+
+
+class Stalled(Exception):
+    """No line came for the time limit."""
+
+
+def lines_within(stream, limit_s):
+    """A process's standard output line by line as each is written (text,
+    the newline dropped); raises Stalled when nothing comes for limit_s."""
+    fd, rest = stream.fileno(), b""
+    while True:
+        ready, _, _ = select.select([fd], [], [], limit_s)
+        if not ready:
+            raise Stalled()
+        chunk = os.read(fd, 1 << 16)
+        if not chunk:
+            if rest:
+                yield rest.decode("utf-8", "replace")
+            return
+        *whole, rest = (rest + chunk).split(b"\n")
+        for line in whole:
+            yield line.decode("utf-8", "replace")
+
+
+def run_here(todo, sweep_dir, args, progress, on_result):
+    """The cells on this machine: one rms_resim --cells process
+    (scripts/sweep-cell --cells), --jobs cells at once on its threads
+    (default: the CPUs this process may use); on_result(cell, result) as
+    each line arrives. A process that writes no line for its time limit
+    (stall_limit_s) is stopped. Returns what it wrote to its standard error."""
+    jobs = args.jobs or min(MAX_JOBS, len(os.sched_getaffinity(0)))
+    limit = stall_limit_s(todo)
+    errors = []
+    lines = ResultLines(todo, progress, on_result, errors)
+    stalled = False
+    with cells_process([CELL, "--cells", "--jobs", str(jobs)], todo, sweep_dir, errors, stop_here) as proc:
+        try:
+            for line in lines_within(proc.stdout, limit):
+                lines.take(line)
+            proc.wait(timeout=limit)  # (its output closed, it ends)
+        except (Stalled, subprocess.TimeoutExpired):
+            stalled = True
+            stop_here(proc)
+    why = "no result: its process on this machine (rms_resim --cells) "
+    if stalled:
+        why += (f"ran past its time limit ({limit:g} s) and was stopped: no line came for that long "
+                "(a cell that stalled?)")
+    elif proc.returncode < 0:
+        try:
+            name = f" ({signal.Signals(-proc.returncode).name})"
+        except ValueError:
+            name = ""
+        why += f"ended on signal {-proc.returncode}{name} before this cell's line"
+    else:
+        why += (f"ended with exit code {proc.returncode} before this cell's line"
+                + (" (see its lines below)" if errors else ""))
     for c in todo:
         if "line" not in c:
-            progress.step(False)
+            c["error"] = why
+    lines.count_lost()
     return errors
+
+
+def stop_here(proc):
+    """The process running the cells on this machine stopped with its group:
+    SIGTERM, then SIGKILL to what is left after 5 s."""
+    for sig in (signal.SIGTERM, signal.SIGKILL):
+        with contextlib.suppress(ProcessLookupError, PermissionError):
+            os.killpg(proc.pid, sig)
+        try:
+            proc.wait(timeout=5)
+            return
+        except subprocess.TimeoutExpired:
+            pass
 
 
 def stop_parallel(proc):
@@ -632,6 +747,8 @@ def parse_args(argv):
         raise LabError("--cached-only runs nothing: not with --slurm or --hosts")
     if a.jobs < 0 or a.retries < 0:
         raise LabError("--jobs and --retries: must not be negative")
+    if a.jobs > MAX_JOBS:
+        raise LabError(f"--jobs {a.jobs}: at most {MAX_JOBS} cells at once")
     a.grid = parse_vary(a.vary)
     return a
 
@@ -660,7 +777,8 @@ def run_cells(a, cells, todo, sweep_dir, cache, cached):
         for c in pending:
             c["error"] = "no result"  # until its line says otherwise
         progress = Progress(len(cells), len(cells) - len(pending), cached)
-        errors += run_parallel(pending, sweep_dir, a, progress, round_no, on_result)
+        errors += (run_parallel(pending, sweep_dir, a, progress, round_no, on_result) if a.workers
+                   else run_here(pending, sweep_dir, a, progress, on_result))
         progress.show(end=True)
         pending = [c for c in pending if "error" in c]
     return retried, errors
@@ -819,7 +937,7 @@ def finish(a, cells, results, todo, sweep_dir, cached, retried, errors, elapsed)
     if len(failed) > FAILED_SHOWN:
         say(f"  ... and {len(failed) - FAILED_SHOWN} more failed cells: each with why in {csv_path}")
     for e in errors[-5:] if failed else []:  # their last lines, when a cell failed
-        say(f"  parallel: {e}")
+        say(f"  {e}")
     say(f"table: {csv_path}")
     say(f"page:  {html_path}")
     return 1 if failed else 0

@@ -98,7 +98,7 @@ class Cache:
         fd, tmp = tempfile.mkstemp(dir=self.folder, prefix=f".{key}.", suffix=".tmp")
         try:
             with os.fdopen(fd, "w") as f:
-                json.dump(res, f)
+                f.write(json.dumps(res))  # (json.dump's text, by the C encoder: it does not use it)
             os.replace(tmp, self.path(key))
         except OSError as e:
             try:

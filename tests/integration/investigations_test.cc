@@ -297,6 +297,36 @@ TEST_F(Investigations, ABatchOfCellsGivesEachCellsResultAsASingleRunAndAWrittenS
     }
   }
   EXPECT_FALSE(std::getline(lines, line)) << "a line more: " << line;
+  // Cells at once on their threads: the same lines (in the order they end)
+  // and exit code, a session's cells one after another as several at once.
+  std::ofstream more(dir + "/cells.tsv", std::ios::app);
+  for (int i = 1; i <= 6; ++i)
+    more << 20 + i << "\tkey\t" << *a_ << "\tdcp.tpob_ft=0.2" << i << "\n";
+  more.close();
+  auto sorted_lines = [](const std::string& text) {
+    std::vector<std::string> v;
+    std::istringstream in(text);
+    for (std::string l; std::getline(in, l);) v.push_back(l);
+    std::sort(v.begin(), v.end());
+    return v;
+  };
+  const ScriptRun one =
+      Stdout(Quoted(resim) + " --cells " + Quoted(dir + "/cells.tsv"), dir + "/one.log");
+  for (const char* jobs : {"2", "3"}) {
+    const ScriptRun at_once =
+        Stdout(Quoted(resim) + " --cells " + Quoted(dir + "/cells.tsv") + " --jobs " + jobs,
+               dir + "/jobs" + jobs + ".log");
+    EXPECT_EQ(at_once.rc, one.rc) << jobs;
+    EXPECT_EQ(sorted_lines(at_once.out), sorted_lines(one.out)) << "--jobs " << jobs;
+    EXPECT_EQ(sorted_lines(at_once.out).size(), cells.size() + 6);
+  }
+  // --jobs is a count of cells at once, and only for --cells; --threads
+  // (the session's own design) is none of a batch's.
+  for (const std::string& args :
+       {" --cells " + Quoted(dir + "/cells.tsv") + " --jobs 0",
+        " --cells " + Quoted(dir + "/cells.tsv") + " --jobs two",
+        " --cells " + Quoted(dir + "/cells.tsv") + " --threads 2", " " + Quoted(*a_) + " --jobs 2"})
+    EXPECT_EQ(Stdout(Quoted(resim) + args, dir + "/usage.log").rc, 2) << args;
 }
 
 TEST_F(Investigations, TheSameSweepAcrossTheNamespaceHostsThroughGnuParallel) {
@@ -549,9 +579,8 @@ TEST_F(Investigations, ABatchThatDiesOrALogThatChangesLeavesItsCellsFailedWithWh
   ASSERT_EQ(rows.size(), 2u) << r.out;
   for (const auto& row : rows) {
     EXPECT_EQ(row.at("status"), "failed");
-    // A batch of one cell each here (two cells, one job slot: ceil(2 / 2)).
-    EXPECT_NE(row.at("error").find("its batch (GNU parallel's job " + row.at("cell") +
-                                   ", on this machine) ended with exit code 137"),
+    EXPECT_NE(row.at("error").find("its process on this machine (rms_resim --cells) ended on "
+                                   "signal 9 (SIGKILL) before this cell's line"),
               std::string::npos)
         << row.at("error");
   }
