@@ -95,6 +95,30 @@ TEST_F(RecordedSession, ItReSimulatesBitForBit) {
       << "progress lines with no terminal to show them";
 }
 
+// A session whose manifest is another log's, or whose config.toml is a
+// folder: refused, saying why.
+TEST_F(RecordedSession, AManifestOfAnotherLogOrAConfigurationThatIsAFolderIsRefusedSayingWhy) {
+  const std::string copy = *tmp_ + "/foreign";
+  fs::copy(*dir_, copy, fs::copy_options::recursive);
+  auto m = nlohmann::json::parse(ReadFile(copy + "/manifest.json"));
+  const std::string id = m["session_id"].get<std::string>();
+  m["session_id"] = id == "0x0123456789abcdef" ? "0x0123456789abcdee" : "0x0123456789abcdef";
+  std::ofstream(copy + "/manifest.json") << m.dump(2);
+  ScriptRun r = Script({testing::BuildPath("tools/rms_resim"), copy, "--quiet"}, copy + ".log");
+  EXPECT_EQ(r.rc, 2) << r.out;
+  EXPECT_NE(r.out.find("no RMS_DCP_FRAME recorded"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("sent by session " + id + ", not the manifest's"), std::string::npos)
+      << r.out;
+  fs::remove_all(copy);
+  fs::copy(*dir_, copy, fs::copy_options::recursive);
+  fs::remove(copy + "/config.toml");
+  fs::create_directory(copy + "/config.toml");
+  r = Script({testing::BuildPath("tools/rms_resim"), copy, "--quiet"}, copy + ".log");
+  EXPECT_EQ(r.rc, 2) << r.out;
+  EXPECT_NE(r.out.find("config.toml': it is a folder"), std::string::npos) << r.out;
+  fs::remove_all(copy);
+}
+
 // rms_resim SESSION with --threads N: its output but the timing line (and the
 // wall times: the first line's, the log lines'), the timing line apart.
 struct ResimRun {

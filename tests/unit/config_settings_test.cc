@@ -3,6 +3,8 @@
 // that is no TOML or of another kind, and a table are refused with the key.
 #include "rms/base/config_settings.h"
 
+#include <filesystem>
+#include <fstream>
 #include <gtest/gtest.h>
 
 #include "rms/base/check.h"
@@ -119,6 +121,28 @@ TEST(ConfigSettings, DesignsFromTheTextParsedOnceAreTheTextSetAndParsedAgain) {
     EXPECT_FALSE(a.empty()) << bad[0].key << "=" << bad[0].value;
     EXPECT_EQ(a, b);
   }
+}
+
+// A file that cannot be read says why: a folder (which opens, and reads
+// as nothing), or what the open's errno says.
+TEST(ReadTextFile, SaysWhyAFileCannotBeRead) {
+  const std::string dir = ::testing::TempDir() + "/read_text_file_test";
+  std::filesystem::create_directories(dir + "/config.toml");
+  auto why = [](const std::string& path) {
+    try {
+      ReadTextFile(path, "the configuration file");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(read)");
+  };
+  EXPECT_EQ(why(dir + "/config.toml"),
+            "cannot read the configuration file '" + dir + "/config.toml': it is a folder");
+  EXPECT_EQ(why(dir + "/none.toml"), "cannot read the configuration file '" + dir +
+                                         "/none.toml': No such file or directory");
+  std::ofstream(dir + "/ok.toml") << "a = 1\n";
+  EXPECT_EQ(ReadTextFile(dir + "/ok.toml", "x"), "a = 1\n");
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "rms/base/check.h"
+#include "rms/session/sender_check.h"
 #include "rms/session/session_summary.h"
 #include "rms/wire/channels.h"
 #include "rms/wire/message_io.h"
@@ -57,6 +58,26 @@ void Append(Recording&& second, Recording* r) {
   r->bytes[1] = std::move(second.bytes[1]);
 }
 
+// What the sender check left out, said for a log with nothing to
+// re-simulate (" (N messages ...)", or ""): a manifest whose session id is
+// not the log's leaves out every message.
+std::string LeftOut(const session::SenderCheck& check) {
+  if (check.ignored_total() == 0) return "";
+  const nlohmann::ordered_json j = check.Json();
+  std::string why;
+  for (const auto& [reason, n] : j["by_reason"].items())
+    why += (why.empty() ? "" : ", ") + reason + " " + std::to_string(n.get<std::int64_t>());
+  std::string others;
+  for (const auto& id : j["other_sessions"])
+    others += (others.empty() ? "" : ", ") + id.get<std::string>();
+  return " (" + std::to_string(check.ignored_total()) +
+         " messages left out as not the session's: " + why +
+         (others.empty() ? ""
+                         : "; sent by session " + others +
+                               ", not the manifest's: is manifest.json this log's?") +
+         ")";
+}
+
 }  // namespace
 
 Recording ReadRecording(session::SessionLog& log, const session::SessionLog::TwoParts& parts) {
@@ -83,9 +104,9 @@ Recording ReadRecording(session::SessionLog& log, const session::SessionLog::Two
   r.read_in_two = in_two;
   SortByFrame(&r.inputs);
   SortByFrame(&r.telemetry);
-  if (r.dcp_frames.empty()) {
-    throw InputError(log.log_path() + ": no RMS_DCP_FRAME recorded: nothing to re-simulate");
-  }
+  if (r.dcp_frames.empty())
+    throw InputError(log.log_path() + ": no RMS_DCP_FRAME recorded: nothing to re-simulate" +
+                     LeftOut(log.check()));
   // Only the DCP's increasing run of frames, as the summary believes them: a
   // frame forged far ahead or behind is not one the DCP made.
   std::vector<std::int64_t> numbers;

@@ -6,7 +6,10 @@
 //   "config/rmslab.toml: key 'arm.upper_boom_ft': must be > 0, got -3"
 #include <Eigen/Core>
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <optional>
 #include <set>
@@ -185,12 +188,18 @@ class TomlReader {
   std::set<std::string> used_;
 };
 
-// A whole text file; an InputError "cannot read WHAT 'PATH'" when it can't be read.
+// A whole text file; an InputError "cannot read WHAT 'PATH': WHY" when it can't be read.
 inline std::string ReadTextFile(const std::string& path, const std::string& what) {
+  const std::string cannot = "cannot read " + what + " '" + path + "'";
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw InputError(cannot + ": it is a folder");
+  errno = 0;
   std::ifstream f(path);
-  if (!f) throw InputError("cannot read " + what + " '" + path + "'");
+  // (why: the open's errno, e.g. "No such file or directory", "Too many open files")
+  if (!f) throw InputError(cannot + (errno != 0 ? ": " + std::string(std::strerror(errno)) : ""));
   std::stringstream ss;
   ss << f.rdbuf();
+  if (f.bad()) throw InputError(cannot + ": a read error part way");
   return ss.str();
 }
 
