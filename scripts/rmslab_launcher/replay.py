@@ -148,13 +148,13 @@ class Replay:
             c = json.loads(r.stdout)
         except ValueError:
             c = None
-        lost, missed = reported_losses(self.out, summary_path)
-        if c and c["identical"] + c["missing"] == c["recorded"] and c["missing"] <= lost + missed:
+        lost, missed, late = reported_losses(self.out, summary_path)
+        if c and c["identical"] + c["missing"] == c["recorded"] and c["missing"] <= lost + missed + late:
             # No frame differs, and every one missing is one a reported loss
             # accounts for (a loaded machine at --speed above 1).
             say(f"every ESG frame replayed identical to the recording, word for word (identical: {c['identical']}); "
                 f"{c['missing']} not in the replay's log, each a reported loss (the record lost {lost} ESG frames, "
-                f"scene_proc missed {missed} DCP frames)")
+                f"scene_proc missed {missed} DCP frames and dropped {late} that came too late)")
             return 0
         say("the replay differs from the recording: " + " ".join(r.stdout.split()))
         return 1
@@ -162,9 +162,11 @@ class Replay:
 
 def reported_losses(out, summary_path):
     """The losses the replay reported: ESG frames its record lost (its
-    summary) and DCP frames that never reached scene_proc (its counter
-    dcp.missing). Either is 0 when its file is not there."""
-    lost = missed = 0
+    summary), DCP frames that never reached scene_proc (its counter
+    dcp.missing) and those it dropped as too late to act on (dropped.late:
+    a stalled, loaded machine; docs/protocol.md "Frame numbers and times"). Each is 0
+    when its file is not there."""
+    lost = missed = late = 0
     try:
         with open(summary_path or os.path.join(out, "summary.json")) as f:
             lost = json.load(f)["record"]["by_channel"]["RMS_ESG_FRAME"]["lost"]
@@ -172,10 +174,11 @@ def reported_losses(out, summary_path):
         pass
     try:
         with open(os.path.join(out, "stats", "scene_proc.json")) as f:
-            missed = json.load(f)["counters"].get("dcp.missing", 0)
+            counters = json.load(f)["counters"]
+        missed, late = counters.get("dcp.missing", 0), counters.get("dropped.late", 0)
     except (OSError, ValueError, KeyError, TypeError, AttributeError):
         pass
-    return int(lost), int(missed)
+    return int(lost), int(missed), int(late)
 
 
 def run(argv):

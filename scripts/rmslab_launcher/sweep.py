@@ -316,6 +316,7 @@ class Progress:
         those that came from the cache)."""
         self.total, self.done, self.failed, self.t0 = total, done, 0, time.monotonic()
         self.start, self.cached, self.tty, self.last_tenth = done, cached, sys.stderr.isatty(), -1
+        self.last_said = None
         self.show()
 
     def recovered(self, ok):
@@ -337,8 +338,9 @@ class Progress:
                 f"{self.failed} failed) {rate:.1f} cells/s")
         if self.tty:
             print("\r" + line + ("\n" if end else ""), end="", file=sys.stderr, flush=True)
-        elif end or int(10 * frac) != self.last_tenth:
-            self.last_tenth = int(10 * frac)
+        elif (end or int(10 * frac) != self.last_tenth) and line[:line.rindex(")")] != self.last_said:
+            # (the end's line is not said again when only its rate is new)
+            self.last_tenth, self.last_said = int(10 * frac), line[:line.rindex(")")]
             say(line)
 
 
@@ -395,12 +397,13 @@ def batch_timeout_s(todo, per_job):
     return round(BATCH_S_BASE + per_job * (CELL_S_BASE + CELL_S_A_MIB * largest_log_mib(todo)))
 
 
-def stall_limit_s(todo):
+def stall_limit_s(todo, cells_a_cpu):
     """The seconds the process running the cells on this machine may go
     without writing a line before it is stopped (a cell that stalled): a
-    batch's time limit for one cell."""
+    batch's time limit for the cells each CPU runs at once (more cells at
+    once than CPUs share them, each taking longer)."""
     value = timeout_override()
-    return value if value is not None else batch_timeout_s(todo, 1)
+    return value if value is not None else batch_timeout_s(todo, cells_a_cpu)
 
 
 class NoHostAnswers(Exception):
@@ -613,8 +616,9 @@ def run_here(todo, sweep_dir, args, progress, on_result):
     (default: the CPUs this process may use); on_result(cell, result) as
     each line arrives. A process that writes no line for its time limit
     (stall_limit_s) is stopped. Returns what it wrote to its standard error."""
-    jobs = args.jobs or min(MAX_JOBS, len(os.sched_getaffinity(0)))
-    limit = stall_limit_s(todo)
+    cpus = len(os.sched_getaffinity(0))
+    jobs = args.jobs or min(MAX_JOBS, cpus)
+    limit = stall_limit_s(todo, -(-jobs // cpus))
     errors = []
     lines = ResultLines(todo, progress, on_result, errors)
     stalled = False
@@ -648,14 +652,15 @@ def run_here(todo, sweep_dir, args, progress, on_result):
 
 def stop_here(proc):
     """The process running the cells on this machine stopped with its group:
-    SIGTERM, then SIGKILL to what is left after 5 s."""
+    SIGTERM, then SIGKILL to what is left after 5 s (at once, when another
+    Ctrl-C or signal comes while it waits)."""
     for sig in (signal.SIGTERM, signal.SIGKILL):
         with contextlib.suppress(ProcessLookupError, PermissionError):
             os.killpg(proc.pid, sig)
         try:
             proc.wait(timeout=5)
             return
-        except subprocess.TimeoutExpired:
+        except (subprocess.TimeoutExpired, Interrupted):
             pass
 
 
@@ -667,11 +672,12 @@ def stop_parallel(proc):
         proc.send_signal(signal.SIGINT)
     try:
         proc.wait(timeout=10)
-    except subprocess.TimeoutExpired:
+    except (subprocess.TimeoutExpired, Interrupted):  # (another signal: on at once)
         pass
     with contextlib.suppress(ProcessLookupError, PermissionError):
         os.killpg(proc.pid, signal.SIGKILL)
-    proc.wait()
+    with contextlib.suppress(Interrupted):
+        proc.wait()
 
 
 def write_slurm(sweep_dir, cells, cache_dir, rerun):
@@ -736,7 +742,8 @@ def parse_args(argv):
                    help="run nothing: the table from the cache (after a Slurm job); a missing cell is a failed row")
     p.add_argument("--cache", help="the results' cache (default sessions/sweep-cache)")
     p.add_argument("--retries", type=int, default=2,
-                   help="a failed cell is tried again up to N times (default 2), through GNU parallel again")
+                   help="a failed cell is tried again up to N times (default 2), in a new process (on a lab's "
+                        "hosts through GNU parallel again)")
     p.add_argument("--no-build", action="store_true", help="do not install or build first")
     a = p.parse_args(argv)
     if not a.vary:
@@ -773,7 +780,9 @@ def run_cells(a, cells, todo, sweep_dir, cache, cached):
         if round_no > 1:
             retried += len(pending)
             cells_word = "cell" if len(pending) == 1 else "cells"
-            say(f"sweep: trying {len(pending)} failed {cells_word} again (try {round_no} of {a.retries + 1})")
+            whys = sorted({c.get("error", "") for c in pending})
+            say(f"sweep: trying {len(pending)} failed {cells_word} again (try {round_no} of {a.retries + 1}): "
+                + whys[0] + (f" (and {len(whys) - 1} other reasons)" if len(whys) > 1 else ""))
         for c in pending:
             c["error"] = "no result"  # until its line says otherwise
         progress = Progress(len(cells), len(cells) - len(pending), cached)
@@ -879,6 +888,11 @@ def run_sweep(argv):
             say(f"sweep interrupted ({e.name}): the {done} cells finished in this run are in the cache; "
                 "the same command again runs only what is missing")
             return 128 + e.signum
+        except LabError:  # (the cache cannot be written: a full disk)
+            done = sum(1 for c in todo if "error" not in c)
+            say(f"sweep stopped: the {done} cells finished in this run before it are in the cache; "
+                "the same command again, once the reason below is put right, runs only what is missing")
+            raise
         for c in todo:
             results[c["index"]] = None if "error" in c else cache.load(c["key"])
     elapsed = time.monotonic() - t0
@@ -931,6 +945,12 @@ def finish(a, cells, results, todo, sweep_dir, cached, retried, errors, elapsed)
     say(f"sweep: {ran} cells run in {elapsed:.2f} s"
         + (f" ({ran / elapsed:.1f} cells/s)" if ran > 0 and elapsed > 0 else "")
         + f", {cached} from the cache, {retried} tries again, {len(failed)} failed")
+    notes = {}  # a session's log note, once a session (its cells share it)
+    for c, res in rows:
+        if res is not None and res.get("note"):
+            notes.setdefault(c["session"], res["note"])
+    for session_path, note in notes.items():
+        say(f"note: {session_path}: {note} (its cells' note column)")
     for c in failed[:FAILED_SHOWN]:
         say(f"  cell {c['index']} FAILED ({os.path.basename(c['session'])} "
             f"{' '.join(f'{k}={v}' for k, v in c['sets'])}): {c['error']}")

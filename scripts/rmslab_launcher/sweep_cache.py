@@ -10,6 +10,12 @@ import tempfile
 
 from .common import LabError
 
+# The process's umask (read once, at the start): an entry is made as an
+# ordinary file is (mkstemp makes its file 0600), so a cache shared by a
+# lab's users is readable by them.
+_UMASK = os.umask(0)
+os.umask(_UMASK)
+
 def _number(x):
     return (isinstance(x, (int, float)) and not isinstance(x, bool)) or x is None
 
@@ -57,6 +63,8 @@ def valid_result(res):
             return f"'{name}' is of the wrong kind"
     if "first_divergence" not in res:
         return "'first_divergence' is missing"
+    if not isinstance(res.get("note", ""), str):
+        return "'note' is not text"
     return None
 
 
@@ -97,6 +105,7 @@ class Cache:
     def store(self, key, res):
         fd, tmp = tempfile.mkstemp(dir=self.folder, prefix=f".{key}.", suffix=".tmp")
         try:
+            os.fchmod(fd, 0o666 & ~_UMASK)
             with os.fdopen(fd, "w") as f:
                 f.write(json.dumps(res))  # (json.dump's text, by the C encoder: it does not use it)
             os.replace(tmp, self.path(key))

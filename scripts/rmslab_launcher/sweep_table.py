@@ -58,21 +58,21 @@ def changes_text(res):
 def header(grid):
     cols = ["cell", "session", "subject"] + [k for k, _ in grid] + ["status"]
     cols += [f"{n} [{u}]" if u else n for n, u, _ in OUTCOME_COLUMNS]
-    return cols + ["what changed", "error"]
+    return cols + ["what changed", "note", "error"]
 
 
 def row_values(cell, res, grid):
     sets = dict(cell["sets"])
     row = [cell["index"], cell["session"], cell["subject"]] + [sets[k] for k, _ in grid]
     if res is None:
-        return row + ["failed"] + [""] * len(OUTCOME_COLUMNS) + ["", cell.get("error", "")]
+        return row + ["failed"] + [""] * len(OUTCOME_COLUMNS) + ["", "", cell.get("error", "")]
     row.append("ok")
     for _, _, get in OUTCOME_COLUMNS:
         try:
             row.append(cell_text(get(res)))
         except (KeyError, TypeError, AttributeError):
             row.append("")
-    return row + [changes_text(res), ""]
+    return row + [changes_text(res), res.get("note", ""), ""]
 
 
 def numeric(text):

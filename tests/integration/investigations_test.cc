@@ -329,6 +329,49 @@ TEST_F(Investigations, ABatchOfCellsGivesEachCellsResultAsASingleRunAndAWrittenS
     EXPECT_EQ(Stdout(Quoted(resim) + args, dir + "/usage.log").rc, 2) << args;
 }
 
+// Each cell's line comes as it is made, not when the batch's input ends: a
+// writer that waits for the first line before it closes the input is not
+// kept waiting (one cell at a time, and several at once).
+TEST_F(Investigations, ACellsLineComesBeforeTheBatchsInputEnds) {
+  const std::string dir = *tmp_ + "/streaming";
+  fs::create_directories(dir);
+  for (const char* jobs : {"1", "2"}) {
+    const std::string out = dir + "/out" + jobs;
+    const std::string script =
+        "{ printf '7\\tkey\\t%s\\tdcp.tpob_ft=0.4\\n' \"$1\"; "
+        "while [ ! -s \"$2\" ]; do sleep 0.1; done; } | \"$3\" --cells - --jobs \"$4\" > \"$2\"";
+    testing::Subprocess batch(
+        {"/bin/sh", "-c", script, "sh", *a_, out, testing::BuildPath("tools/rms_resim"), jobs},
+        out + ".log");
+    EXPECT_EQ(batch.Wait(120), 0) << "--jobs " << jobs
+                                  << ": the line came only at the input's end? "
+                                  << ReadFile(out + ".log");
+    EXPECT_EQ(ReadFile(out).rfind("7\t{\"outcome\"", 0), 0u) << ReadFile(out);
+  }
+}
+
+// A session whose log was cut short: swept up to the cut, each cell's row
+// says so (its note), and so does the sweep, once; the design is not blamed
+// silently for what the log lacks.
+TEST_F(Investigations, ASessionWhoseLogIsCutShortIsSweptWithANoteSaid) {
+  const std::string dir = *tmp_ + "/cut";
+  fs::create_directories(dir);
+  fs::copy(*a_, dir + "/session", fs::copy_options::recursive);
+  fs::resize_file(dir + "/session/lcmlog", fs::file_size(dir + "/session/lcmlog") * 2 / 3 + 5);
+  const ScriptRun r = Script(
+      {SourcePath("scripts/lab"), "sweep", dir + "/session", "--vary", "dcp.tpob_ft=0.25,0.35",
+       "--out", dir + "/out", "--cache", dir + "/cache", "--no-build"},
+      dir + "/out.log");
+  ASSERT_EQ(r.rc, 0) << r.out;
+  EXPECT_NE(r.out.find("note: " + dir + "/session: the log ends in "), std::string::npos) << r.out;
+  const auto rows = ReadCsv(dir + "/out/sweep.csv");
+  ASSERT_EQ(rows.size(), 2u);
+  for (const auto& row : rows) {
+    EXPECT_EQ(row.at("status"), "ok");
+    EXPECT_NE(row.at("note").find("no whole event"), std::string::npos) << row.at("note");
+  }
+}
+
 TEST_F(Investigations, TheSameSweepAcrossTheNamespaceHostsThroughGnuParallel) {
   const std::string dir = *tmp_ + "/hosts";
   fs::create_directories(dir);

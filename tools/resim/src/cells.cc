@@ -2,10 +2,16 @@
 // their own threads.
 #include <algorithm>
 #include <atomic>
+#include <condition_variable>
 #include <cstdio>
+#include <deque>
+#include <functional>
 #include <memory>
 #include <mutex>
+#include <new>
+#include <optional>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -69,6 +75,11 @@ std::string CellResult(const CellLine& c, SharedSession* session, bool* failed) 
     if (!OtherDesign(opt)) throw InputError("a cell needs at least one KEY=VALUE (another design)");
     opt.recorded = session->Get();
     return JsonLine(Resimulate(opt).cell);
+  } catch (const std::bad_alloc&) {
+    const char* why = "out of memory (std::bad_alloc): fewer cells at once (--jobs) may fit";
+    std::fprintf(stderr, "rms_resim: cell %s: %s\n", c.index.c_str(), why);
+    *failed = true;
+    return JsonLine(nlohmann::json{{"error", why}});
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rms_resim: cell %s: %s\n", c.index.c_str(), e.what());
     *failed = true;
@@ -76,29 +87,82 @@ std::string CellResult(const CellLine& c, SharedSession* session, bool* failed) 
   }
 }
 
-// The cells of one session, `jobs` at once: each result line written whole
-// as soon as it is made. True when a cell had an error line.
-bool RunSessionsCells(const std::vector<CellLine>& cells, int jobs) {
-  SharedSession session(cells.front().session);
-  std::atomic<std::size_t> next{0};
-  std::atomic<bool> failed{false};
-  std::mutex out;
-  auto work = [&] {
-    for (std::size_t i; (i = next.fetch_add(1)) < cells.size();) {
-      bool bad = false;
-      const std::string json = CellResult(cells[i], &session, &bad);
-      if (bad) failed = true;
-      const std::lock_guard<std::mutex> lock(out);
-      std::printf("%s\t%s\n", cells[i].index.c_str(), json.c_str());
-      std::fflush(stdout);
+// A cell as read, with the session it shares with the cells of that
+// session that come before and after it.
+struct QueuedCell {
+  CellLine line;
+  std::shared_ptr<SharedSession> session;
+};
+
+// The cells read and not yet taken by the threads that run them.
+class CellQueue {
+ public:
+  void Push(QueuedCell c) {
+    {
+      const std::lock_guard<std::mutex> lock(mu_);
+      cells_.push_back(std::move(c));
     }
-  };
-  const int threads = static_cast<int>(std::min<std::size_t>(jobs, cells.size()));
-  std::vector<std::thread> others;
-  for (int t = 1; t < threads; ++t) others.emplace_back(work);
-  work();
-  for (std::thread& t : others) t.join();
-  return failed;
+    ready_.notify_one();
+  }
+  // No more cells: each thread takes what is left, then ends.
+  void Close() {
+    {
+      const std::lock_guard<std::mutex> lock(mu_);
+      closed_ = true;
+    }
+    ready_.notify_all();
+  }
+  // The next cell; none once closed and empty.
+  std::optional<QueuedCell> Pop() {
+    std::unique_lock<std::mutex> lock(mu_);
+    ready_.wait(lock, [this] { return closed_ || !cells_.empty(); });
+    if (cells_.empty()) return std::nullopt;
+    QueuedCell c = std::move(cells_.front());
+    cells_.pop_front();
+    return c;
+  }
+
+ private:
+  std::mutex mu_;
+  std::condition_variable ready_;
+  std::deque<QueuedCell> cells_;
+  bool closed_ = false;
+};
+
+// Runs a cell and writes its result line whole, whichever thread runs it.
+class CellRunner {
+ public:
+  void Run(const QueuedCell& c) {
+    bool bad = false;
+    const std::string json = CellResult(c.line, c.session.get(), &bad);
+    if (bad) failed_ = true;
+    const std::lock_guard<std::mutex> lock(out_);
+    std::printf("%s\t%s\n", c.line.index.c_str(), json.c_str());
+    std::fflush(stdout);
+  }
+  bool failed() const { return failed_; }
+
+ private:
+  std::mutex out_;
+  std::atomic<bool> failed_{false};
+};
+
+// Up to n threads running `work`: as many as could be started (a process
+// limit, an address-space limit), said when fewer.
+std::vector<std::thread> StartThreads(int n, const std::function<void()>& work) {
+  std::vector<std::thread> threads;
+  for (int i = 0; i < n; ++i) {
+    try {
+      threads.emplace_back(work);
+    } catch (const std::system_error& e) {
+      std::fprintf(stderr,
+                   "rms_resim: --cells --jobs %d: %d threads could be started (%s): the cells "
+                   "run on %d at once\n",
+                   n, i, e.what(), std::max(i, 1));
+      break;
+    }
+  }
+  return threads;
 }
 
 }  // namespace
@@ -113,11 +177,15 @@ std::string JsonLine(const nlohmann::ordered_json& j) {
 int RunCells(std::istream& in, int jobs) {
   RMS_CHECK(jobs >= 1);
   int rc = 0;
-  std::vector<CellLine> run;  // consecutive cells of one session
-  auto flush = [&] {
-    if (!run.empty() && RunSessionsCells(run, jobs)) rc = std::max(rc, 1);
-    run.clear();
-  };
+  CellRunner runner;
+  CellQueue queue;
+  // With one job (or no thread to be had) each cell runs as it is read.
+  std::vector<std::thread> threads;
+  if (jobs > 1)
+    threads = StartThreads(jobs, [&] {
+      while (const std::optional<QueuedCell> c = queue.Pop()) runner.Run(*c);
+    });
+  std::shared_ptr<SharedSession> session;  // the last cell's (read once for its run of cells)
   for (std::string line; std::getline(in, line);) {
     if (line.empty()) continue;
     const std::vector<std::string> f = Fields(line);
@@ -128,10 +196,18 @@ int RunCells(std::istream& in, int jobs) {
       rc = 2;
       continue;
     }
-    if (!run.empty() && run.front().session != f[2]) flush();
-    run.push_back({f[0], f[2], std::vector<std::string>(f.begin() + 3, f.end())});
+    // A session is freed with the last of its run of cells.
+    if (!session || session->dir() != f[2]) session = std::make_shared<SharedSession>(f[2]);
+    QueuedCell c{{f[0], f[2], std::vector<std::string>(f.begin() + 3, f.end())}, session};
+    if (threads.empty())
+      runner.Run(c);
+    else
+      queue.Push(std::move(c));
   }
-  flush();
+  session.reset();
+  queue.Close();
+  for (std::thread& t : threads) t.join();
+  if (runner.failed()) rc = std::max(rc, 1);
   return rc;
 }
 

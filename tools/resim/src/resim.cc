@@ -257,6 +257,11 @@ nlohmann::ordered_json CellJson(const nlohmann::json& recorded, const LabConfig&
   cell["frames_identical"] = result.identical;
   cell["frames_compared"] = result.compared;
   cell["explanation"] = result.comparison["explanation"];
+  // What the log lacks or ends in (re-simulated up to there): with the
+  // result, so that a sweep's table does not blame the design for it.
+  std::string note = result.note;
+  if (!result.log_note.empty()) note += (note.empty() ? "" : "; ") + result.log_note;
+  if (!note.empty()) cell["note"] = note;
   return cell;
 }
 
