@@ -106,9 +106,12 @@ ResimResult Resimulate(const ResimOptions& options);
 // own threads (the session's own design, ResimOptions::threads, is no cell).
 // Each result line, "INDEX<TAB>JSON" ({"error": ...} when it has none), is
 // written whole on stdout as soon as it is made, so lines come in the order
-// the cells end. A session's log is read once for its designs that follow
-// one another (a sweep's lines are session by session); only one session
-// is held at a time. Returns 0 when every cell had its result, 1 when a
+// the cells end; a cell runs as soon as its line is read and a thread is
+// free. A session's log is read once for its designs that follow one
+// another (a sweep's lines are session by session), and freed with the last
+// of them: only the sessions of the cells running are held. When fewer
+// threads than `jobs` can be started, it says so and runs on those.
+// Returns 0 when every cell had its result, 1 when a
 // cell had an error line (so GNU parallel --retries tries the batch on
 // another host), 2 when a line was no cell (said on stderr).
 int RunCells(std::istream& in, int jobs);
