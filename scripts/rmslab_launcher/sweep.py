@@ -7,7 +7,8 @@ lab's hosts (--hosts LABFILE) through GNU parallel (Debian's `parallel`:
 its ssh logins; a "netns:NAME" host through
 scripts/rmslab_launcher/netns-login), in batches, one rms_resim --cells a
 batch; with --slurm, as a Slurm array job written for a cluster. A cell is
-what rms_resim SESSION --set KEY=VALUE... --discard --result-json gives. Results are cached by the log's hash, the configuration's hash and
+what rms_resim SESSION --set KEY=VALUE... --discard --result-json gives.
+Results are cached by the log's hash, the configuration's hash and
 the software's version, so a rerun does only what is missing.
 """
 import argparse
@@ -411,31 +412,28 @@ class NoHostAnswers(Exception):
 
 
 def parallel_command(args, joblog, todo):
-    """GNU parallel's command line, the cells a job and its time limit: the
-    cells' lines (cells.tsv's form) on its standard input, --pipe hands each
-    job a batch of them. Raises NoHostAnswers when no host of the lab answers."""
-    cells = len(todo)
-    cell, env_build, slots = CELL, {}, args.jobs or os.cpu_count() or 1
+    """GNU parallel's command line for the lab's hosts, the cells a job and
+    its time limit: the cells' lines (cells.tsv's form) on its standard
+    input, --pipe hands each job a batch of them. Raises NoHostAnswers when
+    no host of the lab answers."""
+    cells, env_build = len(todo), {}
     cmd = ["parallel", "--will-cite", "--pipe", "--line-buffer", "--halt", "never", "--joblog", joblog]
-    if args.workers:
-        logins, cell, remote_build, per_host = args.workers
-        live, whys = answering(logins)
-        if not live:
-            raise NoHostAnswers("; ".join(f"{host}: {why}" for host, why in whys.items()))
-        for login in live:
-            cmd += ["--sshlogin", login.sshlogin]
-        cmd += ["--ssh", SSH_OPTIONS]
-        if per_host > 0:
-            cmd += ["--jobs", str(per_host)]
-        if len(live) > 1:
-            # A batch that fails on one host (an error line, or no line) is
-            # tried on another within the try.
-            cmd += ["--retries", str(len(live))]
-        if remote_build:
-            env_build = {"RMSLAB_BUILD": remote_build}
-        slots = len(live) * (per_host if per_host > 0 else 2)
-    else:
-        cmd += ["--jobs", str(slots)]
+    logins, cell, remote_build, per_host = args.workers
+    live, whys = answering(logins)
+    if not live:
+        raise NoHostAnswers("; ".join(f"{host}: {why}" for host, why in whys.items()))
+    for login in live:
+        cmd += ["--sshlogin", login.sshlogin]
+    cmd += ["--ssh", SSH_OPTIONS]
+    if per_host > 0:
+        cmd += ["--jobs", str(per_host)]
+    if len(live) > 1:
+        # A batch that fails on one host (an error line, or no line) is
+        # tried on another within the try.
+        cmd += ["--retries", str(len(live))]
+    if remote_build:
+        env_build = {"RMSLAB_BUILD": remote_build}
+    slots = len(live) * (per_host if per_host > 0 else 2)
     # Nothing of the user's in the command: GNU parallel reads {...} in it
     # as its replacement strings (check_parallel_paths refused braces in these).
     prefix = " ".join(f"{k}={shlex.quote(v)}" for k, v in env_build.items())
@@ -477,7 +475,7 @@ def why_no_line(todo, joblog, per_job, workers, timeout_s):
     """The reason of each cell of todo that had no line: its batch's end as
     the joblog tells it (job N got todo's lines (N-1)K+1..NK, in order)."""
     ends = job_ends(joblog)
-    names = {login.login: login.host for login in workers[0]} if workers else {":": "this machine"}
+    names = {login.login: login.host for login in workers[0]}
     for i, c in enumerate(todo):
         if "line" in c:
             continue
