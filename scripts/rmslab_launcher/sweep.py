@@ -12,6 +12,7 @@ Results are cached by the log's hash, the configuration's hash and
 the software's version, so a rerun does only what is missing.
 """
 import argparse
+import collections
 import contextlib
 import hashlib
 import itertools
@@ -650,16 +651,22 @@ def run_here(todo, sweep_dir, args, progress, on_result):
 
 def stop_here(proc):
     """The process running the cells on this machine stopped with its group:
-    SIGTERM, then SIGKILL to what is left after 5 s (at once, when another
-    Ctrl-C or signal comes while it waits)."""
+    SIGTERM, then SIGKILL to what is left after 5 s (at once, when a Ctrl-C
+    or signal comes while it waits: that interruption is raised again once
+    the process is stopped)."""
+    interrupted = None
     for sig in (signal.SIGTERM, signal.SIGKILL):
         with contextlib.suppress(ProcessLookupError, PermissionError):
             os.killpg(proc.pid, sig)
         try:
             proc.wait(timeout=5)
-            return
-        except (subprocess.TimeoutExpired, Interrupted):
+            break
+        except subprocess.TimeoutExpired:
             pass
+        except Interrupted as e:
+            interrupted = e
+    if interrupted:
+        raise interrupted
 
 
 def stop_parallel(proc):
@@ -668,14 +675,22 @@ def stop_parallel(proc):
     its login does), then SIGKILL to what is left of its group."""
     with contextlib.suppress(ProcessLookupError):
         proc.send_signal(signal.SIGINT)
+    interrupted = None
     try:
         proc.wait(timeout=10)
-    except (subprocess.TimeoutExpired, Interrupted):  # (another signal: on at once)
+    except subprocess.TimeoutExpired:
         pass
+    except Interrupted as e:  # (another signal: on at once, and raised again at the end)
+        interrupted = e
     with contextlib.suppress(ProcessLookupError, PermissionError):
         os.killpg(proc.pid, signal.SIGKILL)
-    with contextlib.suppress(Interrupted):
+    try:
         proc.wait()
+    except Interrupted as e:
+        interrupted = e
+        proc.wait()
+    if interrupted:
+        raise interrupted
 
 
 def write_slurm(sweep_dir, cells, cache_dir, rerun):
@@ -778,9 +793,9 @@ def run_cells(a, cells, todo, sweep_dir, cache, cached):
         if round_no > 1:
             retried += len(pending)
             cells_word = "cell" if len(pending) == 1 else "cells"
-            whys = sorted({c.get("error", "") for c in pending})
+            whys = collections.Counter(c.get("error", "") for c in pending).most_common()
             say(f"sweep: trying {len(pending)} failed {cells_word} again (try {round_no} of {a.retries + 1}): "
-                + whys[0] + (f" (and {len(whys) - 1} other reasons)" if len(whys) > 1 else ""))
+                + whys[0][0] + (f" (and {len(whys) - 1} other reasons)" if len(whys) > 1 else ""))
         for c in pending:
             c["error"] = "no result"  # until its line says otherwise
         progress = Progress(len(cells), len(cells) - len(pending), cached)
@@ -886,7 +901,7 @@ def run_sweep(argv):
             say(f"sweep interrupted ({e.name}): the {done} cells finished in this run are in the cache; "
                 "the same command again runs only what is missing")
             return 128 + e.signum
-        except LabError:  # (the cache cannot be written: a full disk)
+        except sweep_cache.CannotWrite:  # (a full disk)
             done = sum(1 for c in todo if "error" not in c)
             say(f"sweep stopped: the {done} cells finished in this run before it are in the cache; "
                 "the same command again, once the reason below is put right, runs only what is missing")

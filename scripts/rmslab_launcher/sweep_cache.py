@@ -10,6 +10,10 @@ import tempfile
 
 from .common import LabError
 
+class CannotWrite(LabError):
+    """An entry could not be written (a full disk, a folder taken away)."""
+
+
 # The process's umask (read once, at the start): an entry is made as an
 # ordinary file is (mkstemp makes its file 0600), so a cache shared by a
 # lab's users is readable by them.
@@ -114,4 +118,4 @@ class Cache:
                 os.remove(tmp)
             except OSError:
                 pass
-            raise LabError(f"cannot write the cache {self.folder} ({e.strerror})", 1)
+            raise CannotWrite(f"cannot write the cache {self.folder} ({e.strerror})", 1)

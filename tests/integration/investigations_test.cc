@@ -356,19 +356,33 @@ TEST_F(Investigations, ACellsLineComesBeforeTheBatchsInputEnds) {
 TEST_F(Investigations, ASessionWhoseLogIsCutShortIsSweptWithANoteSaid) {
   const std::string dir = *tmp_ + "/cut";
   fs::create_directories(dir);
-  fs::copy(*a_, dir + "/session", fs::copy_options::recursive);
-  fs::resize_file(dir + "/session/lcmlog", fs::file_size(dir + "/session/lcmlog") * 2 / 3 + 5);
+  // Torn: cut inside an event. Clean: cut where an event begins (its sync
+  // word), so the log is whole but shorter than its summary counted.
+  const std::string log = ReadFile(*a_ + "/lcmlog");
+  const std::string sync("\xED\xA1\xDA\x01", 4);
+  const std::size_t event_start = log.find(sync, log.size() * 2 / 3);
+  ASSERT_NE(event_start, std::string::npos);
+  for (const auto& [name, size] :
+       {std::pair{"torn", log.size() * 2 / 3 + 5}, std::pair{"clean", event_start}}) {
+    fs::copy(*a_, dir + "/" + name, fs::copy_options::recursive);
+    fs::resize_file(dir + "/" + name + "/lcmlog", size);
+  }
   const ScriptRun r = Script(
-      {SourcePath("scripts/lab"), "sweep", dir + "/session", "--vary", "dcp.tpob_ft=0.25,0.35",
-       "--out", dir + "/out", "--cache", dir + "/cache", "--no-build"},
+      {SourcePath("scripts/lab"), "sweep", dir + "/torn", dir + "/clean", "--vary",
+       "dcp.tpob_ft=0.25,0.35", "--out", dir + "/out", "--cache", dir + "/cache", "--no-build"},
       dir + "/out.log");
   ASSERT_EQ(r.rc, 0) << r.out;
-  EXPECT_NE(r.out.find("note: " + dir + "/session: the log ends in "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("note: " + dir + "/torn: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("note: " + dir + "/clean: "), std::string::npos) << r.out;
   const auto rows = ReadCsv(dir + "/out/sweep.csv");
-  ASSERT_EQ(rows.size(), 2u);
+  ASSERT_EQ(rows.size(), 4u);
   for (const auto& row : rows) {
     EXPECT_EQ(row.at("status"), "ok");
-    EXPECT_NE(row.at("note").find("no whole event"), std::string::npos) << row.at("note");
+    EXPECT_NE(row.at("note").find("its summary.json counted logged"), std::string::npos)
+        << row.at("note");
+    if (row.at("session") == dir + "/torn") {
+      EXPECT_NE(row.at("note").find("no whole event"), std::string::npos) << row.at("note");
+    }
   }
 }
 

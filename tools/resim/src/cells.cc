@@ -147,22 +147,20 @@ class CellRunner {
   std::atomic<bool> failed_{false};
 };
 
-// Up to n threads running `work`: as many as could be started (a process
-// limit, an address-space limit), said when fewer.
-std::vector<std::thread> StartThreads(int n, const std::function<void()>& work) {
-  std::vector<std::thread> threads;
-  for (int i = 0; i < n; ++i) {
-    try {
-      threads.emplace_back(work);
-    } catch (const std::system_error& e) {
-      std::fprintf(stderr,
-                   "rms_resim: --cells --jobs %d: %d threads could be started (%s): the cells "
-                   "run on %d at once\n",
-                   n, i, e.what(), std::max(i, 1));
-      break;
-    }
+// One more thread running `work` (a cell's: one a cell read, up to --jobs).
+// False when it cannot be started (a process limit, an address-space
+// limit): said, and the cells run on those there are.
+bool StartThread(const std::function<void()>& work, int jobs, std::vector<std::thread>* threads) {
+  try {
+    threads->emplace_back(work);
+    return true;
+  } catch (const std::system_error& e) {
+    std::fprintf(stderr,
+                 "rms_resim: --cells --jobs %d: %zu threads could be started (%s): the cells run "
+                 "on %zu at once\n",
+                 jobs, threads->size(), e.what(), std::max<std::size_t>(threads->size(), 1));
+    return false;
   }
-  return threads;
 }
 
 }  // namespace
@@ -179,12 +177,13 @@ int RunCells(std::istream& in, int jobs) {
   int rc = 0;
   CellRunner runner;
   CellQueue queue;
-  // With one job (or no thread to be had) each cell runs as it is read.
+  const std::function<void()> work = [&] {
+    while (const std::optional<QueuedCell> c = queue.Pop()) runner.Run(*c);
+  };
+  // A thread started with each cell read, up to `jobs` (with one job, or no
+  // thread to be had, each cell runs as it is read).
   std::vector<std::thread> threads;
-  if (jobs > 1)
-    threads = StartThreads(jobs, [&] {
-      while (const std::optional<QueuedCell> c = queue.Pop()) runner.Run(*c);
-    });
+  bool more = jobs > 1;
   std::shared_ptr<SharedSession> session;  // the last cell's (read once for its run of cells)
   for (std::string line; std::getline(in, line);) {
     if (line.empty()) continue;
@@ -199,6 +198,7 @@ int RunCells(std::istream& in, int jobs) {
     // A session is freed with the last of its run of cells.
     if (!session || session->dir() != f[2]) session = std::make_shared<SharedSession>(f[2]);
     QueuedCell c{{f[0], f[2], std::vector<std::string>(f.begin() + 3, f.end())}, session};
+    if (more && static_cast<int>(threads.size()) < jobs) more = StartThread(work, jobs, &threads);
     if (threads.empty())
       runner.Run(c);
     else

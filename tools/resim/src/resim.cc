@@ -191,6 +191,26 @@ void CheckBranchPrefix(const fs::path& session, const Recording& rec, ResimResul
                         "branch's first state";
 }
 
+// "" when the log holds the RMS_DCP_FRAMEs the session's summary counted
+// logged (record.by_channel); else what it lacks, said.
+std::string LogShorterThanSummary(const nlohmann::json& summary, const Recording& rec) {
+  const nlohmann::json* logged = nullptr;
+  try {
+    logged = &summary.at("record").at("by_channel").at(wire::channels::kDcpFrame).at("logged");
+  } catch (const nlohmann::json::exception&) {
+    return "";  // a summary without the count (an older session's): nothing to say
+  }
+  if (!logged->is_number_integer()) return "";
+  const std::int64_t counted = logged->get<std::int64_t>();
+  const auto held = static_cast<std::int64_t>(rec.dcp_frames.size());
+  if (held >= counted) return "";
+  return "the log holds " + std::to_string(held) + " of the " + std::to_string(counted) +
+         " RMS_DCP_FRAMEs its summary.json counted logged (cut short or changed since): "
+         "re-simulated up to DCP frame " +
+         std::to_string(rec.dcp_frames.back().frame) +
+         ", and the recorded outcome is the whole session's";
+}
+
 // --until: a frame the re-simulation reaches, with its own design.
 void CheckUntil(const Recording& rec, const Plan& plan, const ResimOptions& opt,
                 bool other_design) {
@@ -379,6 +399,13 @@ ResimResult Resimulate(const ResimOptions& opt) {
                       "re-simulated up to them";
   }
   result.note = plan.note;
+  // Another design is judged against the recorded outcome: a log cut short
+  // (or changed) since the session's summary was made holds less than it,
+  // and the difference is the log's, not the design's.
+  if (other_design) {
+    const std::string cut = LogShorterThanSummary(recorded->summary(), rec);
+    if (!cut.empty()) result.note += (result.note.empty() ? "" : "; ") + cut;
+  }
   result.skipped = static_cast<long>(plan.first);
   // Another design discarded (a sweep's cell) is made in memory: no session written.
   const bool written = other_design && !opt.discard;
