@@ -169,16 +169,16 @@ def reported_losses(out, summary_path):
     lost = missed = late = 0
     try:
         with open(summary_path or os.path.join(out, "summary.json")) as f:
-            lost = json.load(f)["record"]["by_channel"]["RMS_ESG_FRAME"]["lost"]
+            lost = int(json.load(f)["record"]["by_channel"]["RMS_ESG_FRAME"]["lost"])
     except (OSError, ValueError, KeyError, TypeError):
         pass
     try:
         with open(os.path.join(out, "stats", "scene_proc.json")) as f:
             counters = json.load(f)["counters"]
-        missed, late = counters.get("dcp.missing", 0), counters.get("dropped.late", 0)
+        missed, late = int(counters.get("dcp.missing", 0)), int(counters.get("dropped.late", 0))
     except (OSError, ValueError, KeyError, TypeError, AttributeError):
-        pass
-    return int(lost), int(missed), int(late)
+        missed = late = 0
+    return lost, missed, late
 
 
 def run(argv):
