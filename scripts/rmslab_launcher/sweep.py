@@ -749,7 +749,9 @@ def parse_args(argv):
                    help="a configuration key and its values (TOML), e.g. dcp.tpob_ft=0.2,0.3")
     p.add_argument("--out", help="the sweep's folder (default sessions/sweep-<UTC time>)")
     p.add_argument("--hosts", metavar="LABFILE", help="run the cells on the lab's hosts (GNU parallel over ssh)")
-    p.add_argument("--jobs", type=int, default=0, help="cells at once (a host): default its cores")
+    p.add_argument("--jobs", type=int, default=0,
+                   help=f"cells at once: on this machine, rms_resim's threads (default: the CPUs the sweep may "
+                        f"use); with --hosts, on each host (default: its cores); at most {MAX_JOBS}")
     p.add_argument("--slurm", action="store_true", help="write a Slurm array job instead of running")
     p.add_argument("--cached-only", action="store_true",
                    help="run nothing: the table from the cache (after a Slurm job); a missing cell is a failed row")
