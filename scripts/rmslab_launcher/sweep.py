@@ -381,31 +381,19 @@ def timeout_override():
     return value
 
 
-def largest_log_mib(todo):
+def batch_timeout_s(todo, per_job):
+    """The seconds after which GNU parallel stops a batch of per_job cells
+    (--timeout) and tries it again (on another host, if there is one), or
+    this machine's process that gave no line for that long is stopped: a
+    host that stalls part way does not hold the sweep for ever."""
+    value = timeout_override()
+    if value is not None:
+        return value
     mib = 0.0
     for s in {c["session"] for c in todo}:
         with contextlib.suppress(OSError):
             mib = max(mib, os.path.getsize(os.path.join(s, "lcmlog")) / 2**20)
-    return mib
-
-
-def batch_timeout_s(todo, per_job):
-    """The seconds after which GNU parallel stops a batch (--timeout) and
-    tries it again (on another host, if there is one): a host that stalls
-    part way does not hold the sweep for ever."""
-    value = timeout_override()
-    if value is not None:
-        return value
-    return round(BATCH_S_BASE + per_job * (CELL_S_BASE + CELL_S_A_MIB * largest_log_mib(todo)))
-
-
-def stall_limit_s(todo, cells_a_cpu):
-    """The seconds the process running the cells on this machine may go
-    without writing a line before it is stopped (a cell that stalled): a
-    batch's time limit for the cells each CPU runs at once (more cells at
-    once than CPUs share them, each taking longer)."""
-    value = timeout_override()
-    return value if value is not None else batch_timeout_s(todo, cells_a_cpu)
+    return round(BATCH_S_BASE + per_job * (CELL_S_BASE + CELL_S_A_MIB * mib))
 
 
 class NoHostAnswers(Exception):
@@ -614,10 +602,12 @@ def run_here(todo, sweep_dir, args, progress, on_result):
     (scripts/sweep-cell --cells), --jobs cells at once on its threads
     (default: the CPUs this process may use); on_result(cell, result) as
     each line arrives. A process that writes no line for its time limit
-    (stall_limit_s) is stopped. Returns what it wrote to its standard error."""
+    (a batch's, for the cells a CPU runs at once: more cells at once than
+    CPUs share them, each taking longer) is stopped. Returns what it wrote
+    to its standard error."""
     cpus = len(os.sched_getaffinity(0))
     jobs = args.jobs or min(MAX_JOBS, cpus)
-    limit = stall_limit_s(todo, -(-jobs // cpus))
+    limit = batch_timeout_s(todo, -(-jobs // cpus))
     errors = []
     lines = ResultLines(todo, progress, on_result, errors)
     stalled = False

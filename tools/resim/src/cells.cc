@@ -165,13 +165,6 @@ bool StartThread(const std::function<void()>& work, int jobs, std::vector<std::t
 
 }  // namespace
 
-std::string JsonLine(const nlohmann::json& j) {
-  return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-}
-std::string JsonLine(const nlohmann::ordered_json& j) {
-  return j.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
-}
-
 int RunCells(std::istream& in, int jobs) {
   RMS_CHECK(jobs >= 1);
   int rc = 0;

@@ -118,7 +118,9 @@ int RunCells(std::istream& in, int jobs);
 
 // JSON as one line of text; a string that is no UTF-8 (a path's bytes) has
 // U+FFFD in its place instead of throwing.
-std::string JsonLine(const nlohmann::json& j);
-std::string JsonLine(const nlohmann::ordered_json& j);
+template <class Json>
+std::string JsonLine(const Json& j) {
+  return j.dump(-1, ' ', false, Json::error_handler_t::replace);
+}
 
 }  // namespace rms::resim
