@@ -5,7 +5,8 @@
                    [--restore CHECKPOINT | --from SESSION@TIME] [--lab LABFILE] [--config FILE] [--speed X]
                    [--png-every N] [--width W] [--height H] [--no-video] [--window]
                    [--instructor [PORT]] [--gl osmesa|egl] [--visibility priority|depth]
-                   [--lcm-url URL] [--channel-suffix S] [--share-network] [--no-build]
+                   [--lcm-url URL] [--channel-suffix S] [--share-network]
+                   [--cpu-wake-latency-us US|off] [--no-build]
   scripts/lab replay SESSION [options]       scene and ESG driven from the log: frames, video
   scripts/lab resim SESSION [--config FILE] [--set KEY=VALUE]  the DCP again on the recorded inputs
   scripts/lab sweep SESSION... --vary KEY=V1,V2,... [--hosts LABFILE | --slurm]

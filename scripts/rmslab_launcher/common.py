@@ -171,3 +171,18 @@ def check_speed(speed):
     if not (0.01 <= s <= MAX_SPEED):
         raise LabError(f"--speed {speed}: must be within 0.01 .. {MAX_SPEED:g}")
     return s
+
+
+MAX_CPU_WAKE_LATENCY_US = 1000000  # rms/base/cpu_wake_latency.h kMaxCpuWakeLatencyUs
+
+
+def check_cpu_wake_latency(value):
+    """--cpu-wake-latency-us: "off", or whole microseconds 0 .. 1,000,000
+    (docs/performance.md "Wake latency"); returned as the processes'
+    RMSLAB_CPU_WAKE_LATENCY_US."""
+    if value == "off":
+        return value
+    if not value.isdigit() or int(value) > MAX_CPU_WAKE_LATENCY_US:
+        raise LabError(f"--cpu-wake-latency-us '{value}': \"off\" or whole microseconds, "
+                       f"0 .. {MAX_CPU_WAKE_LATENCY_US}")
+    return str(int(value))

@@ -13,8 +13,8 @@ import time
 
 from . import disk, session
 from .branch import Branch
-from .common import (BUILD, DEFAULT_URL, ROOT, LabError, binary, check_speed, check_suffix, ensure_multicast_route,
-                     file_sha256, frame_rate_hz, check_lcm_url, install_and_build, require_built, say,
+from .common import (BUILD, DEFAULT_URL, ROOT, LabError, binary, check_cpu_wake_latency, check_speed, check_suffix,
+                     ensure_multicast_route, file_sha256, frame_rate_hz, check_lcm_url, install_and_build, require_built, say,
                      timeline_length_s)
 from .hosts import Host, check_hosts
 from .supervisor import Spec, Supervisor
@@ -56,6 +56,10 @@ def add_arguments(p):
                    help="the instructor's station: a web page of live views, status, events and controls, "
                         "served on PORT (default 8080; 0: any free port) of 127.0.0.1, or where the lab file "
                         "says (docs/instructor.md)")
+    p.add_argument("--cpu-wake-latency-us", default="0", metavar="US|off",
+                   help="hold the CPUs' wake-up latency at most this while the session runs (Linux PM QoS, "
+                        "/dev/cpu_dma_latency; 0: idle CPUs poll, the frames reach the pixels sooner); "
+                        "off: leave it to the system (docs/performance.md \"Wake latency\")")
     p.add_argument("--no-build", action="store_true")
 
 
@@ -94,6 +98,7 @@ class Demo:
             self.notes.append("--window: no DISPLAY here; the ESG rendered headless")
             a.window = False
         self.speed = check_speed(a.speed)
+        self.wake_latency = check_cpu_wake_latency(a.cpu_wake_latency_us)
         check_suffix(a.channel_suffix)
         if a.width < 16 or a.height < 16 or a.width % 2 or a.height % 2:
             raise LabError(f"--width {a.width} --height {a.height}: even sizes, at least 16")
@@ -329,7 +334,8 @@ class Demo:
             self.sup.interrupted = True
 
     def start(self):
-        env = {"RMSLAB_SESSION_ID": self.session_id, "RMSLAB_SESSION_EPOCH_US": str(int(time.time() * 1e6))}
+        env = {"RMSLAB_SESSION_ID": self.session_id, "RMSLAB_SESSION_EPOCH_US": str(int(time.time() * 1e6)),
+               "RMSLAB_CPU_WAKE_LATENCY_US": self.wake_latency}
         self.sup = Supervisor(os.path.join(self.out, "run"), env)
         self.sup.start_reaper(self.out, [binary("tools/rms_session"), "summary", self.out])
         for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
@@ -352,6 +358,7 @@ class Demo:
         err = self.sup.wait_ready(["esg_renderer", "scene_proc", "dynamics_proc"])
         if err:
             raise LabError(err, 2 if "usage or configuration" in err else 1)
+        self.say_wake_latency(["esg_renderer", "scene_proc", "dynamics_proc"])
         if self.interrupted is not None:
             return
         if self.a.instructor is not None:
@@ -367,6 +374,22 @@ class Demo:
         n = "five" if self.a.instructor is not None else "four"
         say(f"{n} processes up on {where}, {self.url}{suffix}; session {self.session_id}; flying: {flying}")
         self.sup.add(self.operator_spec())
+
+    def say_wake_latency(self, names):
+        """Says once which processes could not hold the CPUs' wake latency
+        asked for, and why (their ready files; a remote one's log)."""
+        if self.wake_latency == "off":
+            return
+        not_held = {}  # state -> host -> processes
+        for n in names:
+            state = self.sup.wake_latency_state(n)
+            if state and not state.startswith("held"):
+                not_held.setdefault(state, {}).setdefault(str(self.hosts[n]), []).append(n)
+        for state, by_host in not_held.items():
+            who = "; ".join(f"{', '.join(ps)} on {h}" for h, ps in by_host.items())
+            say(f"the CPUs' wake latency is {state} ({who}): the frames reach the pixels later "
+                f"(docs/performance.md \"Wake latency\"); run as root, let this user write "
+                f"/dev/cpu_dma_latency, or say --cpu-wake-latency-us off")
 
     def watch(self):
         """Until the pilot ends, a signal comes, or the session must stop."""

@@ -232,6 +232,30 @@ class Supervisor:
             write_run_file(os.path.join(self.run_dir, "restarts"),
                            f"{c.spec.name} {c.n} {c.last_rc} {c.down_at:.6f} {time.time():.6f}\n")
 
+    def wake_latency_state(self, name):
+        """What `name`'s CPU wake-latency request came to (its ready file's
+        "cpu_wake_latency"; for a process on another host, its log's last
+        "cpu wake latency:" line), or None when it did not say."""
+        c = self.children.get(name)
+        if c is None:
+            return None
+        try:
+            with open(os.path.join(self.run_dir, f"{name}.ready")) as f:
+                state = json.load(f).get("cpu_wake_latency")
+            if isinstance(state, str):
+                return state
+        except (OSError, ValueError, AttributeError):
+            pass
+        try:
+            with open(c.spec.log_path, errors="replace") as f:
+                said = [l for l in f if "] cpu wake latency: " in l]
+        except OSError:
+            return None
+        if not said:
+            return None
+        state = said[-1].split("] cpu wake latency: ", 1)[1].strip()
+        return state.split(": frames reach the pixels later")[0]
+
     # ---- watching ----
     def poll(self):
         """One look at every process: restarts what died, notes what is

@@ -10,6 +10,7 @@
 #include <cstring>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <spdlog/sinks/stdout_sinks.h>
 #include <spdlog/spdlog.h>
 #include <thread>
@@ -17,6 +18,7 @@
 #include "rms/base/check.h"
 #include "rms/base/command_line.h"
 #include "rms/base/config.h"
+#include "rms/base/cpu_wake_latency.h"
 #include "rms/base/text.h"
 #include "rms/base/version.h"
 #include "rms/process_status_t.hpp"
@@ -54,6 +56,29 @@ void AddCommonOptions(CLI::App& app, CommonOptions* o) {
   app.set_version_flag("--version", VersionString(), "Print the software version and exit");
 }
 
+namespace {
+
+// What the process's CPU wake-latency request came to, for its ready file.
+std::string g_cpu_wake_latency = "off";
+
+// The launcher's request (RMSLAB_CPU_WAKE_LATENCY_US), held for the
+// process's life and said in its log; one that cannot be held is a warning
+// (docs/performance.md "Wake latency").
+CpuWakeLatencyRequest HoldCpuWakeLatency() {
+  const std::optional<std::int32_t> us = CpuWakeLatencyFromEnv();
+  if (!us) return {};
+  CpuWakeLatencyRequest wake(*us);
+  g_cpu_wake_latency = wake.state();
+  if (wake.held())
+    spdlog::info("cpu wake latency: {}", wake.state());
+  else
+    spdlog::warn("cpu wake latency: {}: frames reach the pixels later (docs/performance.md)",
+                 wake.state());
+  return wake;
+}
+
+}  // namespace
+
 int ProcessMain(CLI::App& app, int argc, char** argv, const std::string& process,
                 CommonOptions* common,
                 const std::function<int(const LabConfig&, LcmInterface&)>& body,
@@ -68,6 +93,7 @@ int ProcessMain(CLI::App& app, int argc, char** argv, const std::string& process
       const LabConfig config = LoadConfig(common->config_path);
       ValidateChannelSuffix(common->lcm.channel_suffix);
       if (!common->session_id.empty()) (void)ParseSessionId(common->session_id, "--session-id");
+      (void)CpuWakeLatencyFromEnv();
       if (check) check(config);
       spdlog::info("check: {} and this process's files are good", common->config_path);
       return 0;
@@ -81,6 +107,7 @@ int ProcessMain(CLI::App& app, int argc, char** argv, const std::string& process
     const std::int64_t session = common->session_id.empty()
                                      ? SessionIdFromEnv()
                                      : ParseSessionId(common->session_id, "--session-id");
+    const CpuWakeLatencyRequest wake = HoldCpuWakeLatency();
     UdpLcm lcm(common->lcm);
     lcm.SetSender({session, wire::ProcessCode(process), static_cast<std::int32_t>(getpid())});
     if (session != 0) spdlog::info("session {}", wire::FormatSessionId(session));
@@ -141,7 +168,11 @@ void WriteReadyFile(const std::string& path) {
   const std::string tmp = path + ".tmp";
   {
     std::ofstream f(tmp);
-    f << nlohmann::json{{"pid", static_cast<int>(getpid())}, {"host", host}}.dump() << "\n";
+    f << nlohmann::json{{"pid", static_cast<int>(getpid())},
+                        {"host", host},
+                        {"cpu_wake_latency", g_cpu_wake_latency}}
+             .dump()
+      << "\n";
     f.close();
     if (!f) throw InputError("cannot write the ready file '" + tmp + "'");
   }

@@ -35,7 +35,9 @@ void AddCommonOptions(CLI::App& app, CommonOptions* options);
 
 // The main() every process shares: adds the common options to `app`, parses
 // the command line, sets up logging and the stop signals, loads the
-// configuration, opens LCM and runs `body`. Bad input (a config error, no
+// configuration, holds the CPUs' wake latency the launcher asked for
+// (RMSLAB_CPU_WAKE_LATENCY_US, rms/base/cpu_wake_latency.h) while `body`
+// runs, opens LCM and runs `body`. Bad input (a config error, no
 // multicast route) is logged with its reason and exits 2. With --check it
 // loads the configuration, runs `check` (the process's own files: throws
 // rms::InputError naming what is wrong), says so on stderr and exits: 0 when
@@ -80,7 +82,8 @@ void WatchLifeline();
 bool StopRequested();
 void RequestStop();
 
-// The ready file launchers wait for (--ready-file): {"pid": N, "host": H},
+// The ready file launchers wait for (--ready-file): {"pid": N, "host": H,
+// "cpu_wake_latency": what the request came to (CpuWakeLatencyRequest::state)},
 // written whole (a temporary file renamed), so a reader never sees half of
 // it; the launcher trusts the session's messages by these pids
 // (docs/sessions.md "The launcher"). Throws InputError when it cannot.
