@@ -57,9 +57,11 @@ std::optional<std::int32_t> CpuWakeLatencyFromEnv() {
   const char* v = std::getenv(kCpuWakeLatencyEnv);
   if (v == nullptr || *v == '\0' || std::string_view(v) == "off") return std::nullopt;
   const std::string_view s(v);
+  // Digits only (from_chars alone would take "-0"), as the launcher's check.
   std::int64_t us = -1;
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), us);
-  if (ec != std::errc() || end != s.data() + s.size() || us < 0 || us > kMaxCpuWakeLatencyUs) {
+  if (s.size() <= 7 && s.find_first_not_of("0123456789") == std::string_view::npos)
+    std::from_chars(s.data(), s.data() + s.size(), us);
+  if (us < 0 || us > kMaxCpuWakeLatencyUs) {
     throw InputError(std::string(kCpuWakeLatencyEnv) + "='" + std::string(s) +
                      "': must be \"off\" or a whole number of microseconds, 0.." +
                      std::to_string(kMaxCpuWakeLatencyUs));

@@ -32,6 +32,7 @@ summary.json, and stops everything at the end, on Ctrl-C, when the terminal
 closes -- and, through its reaper, when it is itself killed. Each other
 command explains itself with --help.
 """
+import os
 import sys
 
 from . import demo, replay, sweep, tools
@@ -39,6 +40,9 @@ from .common import LabError, say
 
 
 def main(argv):
+    # The launcher's own request to its processes (demo sets it): one left
+    # in the shell would reach the processes of a replay, or the checks.
+    os.environ.pop("RMSLAB_CPU_WAKE_LATENCY_US", None)
     cmd = argv[0] if argv else "help"
     rest = argv[1:]
     try:

@@ -6,6 +6,7 @@ package is that launcher.
 """
 import hashlib
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -119,8 +120,8 @@ def read_toml(path, what):
 def check_lcm_url(url):
     """An LCM URL the processes can open: udpm://GROUP:PORT[?options], GROUP
     an IPv4 multicast address (224.0.0.0 to 239.255.255.255), PORT 1..65535."""
-    import re
-    m = re.fullmatch(r"udpm://(\d{1,3})\.(\d{1,3})\.(\d{1,3})\.(\d{1,3}):(\d{1,5})(\?[A-Za-z0-9_=&.]*)?", url)
+    m = re.fullmatch(r"udpm://(\d{1,3})\.(\d{1,3})\.(\d{1,3})\.(\d{1,3}):(\d{1,5})(\?[A-Za-z0-9_=&.]*)?", url,
+                     re.ASCII)
     if not m:
         raise LabError(f"--lcm-url '{url}': not udpm://GROUP:PORT[?ttl=N] (e.g. {DEFAULT_URL})")
     octets = [int(m.group(i)) for i in range(1, 5)]
@@ -182,7 +183,7 @@ def check_cpu_wake_latency(value):
     RMSLAB_CPU_WAKE_LATENCY_US."""
     if value == "off":
         return value
-    if not value.isdigit() or int(value) > MAX_CPU_WAKE_LATENCY_US:
+    if not re.fullmatch(r"[0-9]{1,7}", value, re.ASCII) or int(value) > MAX_CPU_WAKE_LATENCY_US:
         raise LabError(f"--cpu-wake-latency-us '{value}': \"off\" or whole microseconds, "
                        f"0 .. {MAX_CPU_WAKE_LATENCY_US}")
     return str(int(value))

@@ -57,9 +57,11 @@ def add_arguments(p):
                         "served on PORT (default 8080; 0: any free port) of 127.0.0.1, or where the lab file "
                         "says (docs/instructor.md)")
     p.add_argument("--cpu-wake-latency-us", default="0", metavar="US|off",
-                   help="hold the CPUs' wake-up latency at most this while the session runs (Linux PM QoS, "
-                        "/dev/cpu_dma_latency; 0: idle CPUs poll, the frames reach the pixels sooner); "
-                        "off: leave it to the system (docs/performance.md \"Wake latency\")")
+                   help="while the session runs, hold this machine's CPUs' wake-up latency at most this many "
+                        "microseconds (default 0: idle CPUs poll instead of halting, and the frames reach the "
+                        "pixels sooner; Linux PM QoS through /dev/cpu_dma_latency, which needs root: without "
+                        "it the session runs and says so); off: leave it to the system "
+                        "(docs/performance.md \"Wake latency\")")
     p.add_argument("--no-build", action="store_true")
 
 
@@ -99,6 +101,10 @@ class Demo:
             a.window = False
         self.speed = check_speed(a.speed)
         self.wake_latency = check_cpu_wake_latency(a.cpu_wake_latency_us)
+        # The session's own request, for the checks before the start too
+        # (its processes' --check reads it): never one left in the shell.
+        os.environ["RMSLAB_CPU_WAKE_LATENCY_US"] = self.wake_latency
+        self.wake_said = set()  # (state, host) said not held
         check_suffix(a.channel_suffix)
         if a.width < 16 or a.height < 16 or a.width % 2 or a.height % 2:
             raise LabError(f"--width {a.width} --height {a.height}: even sizes, at least 16")
@@ -363,6 +369,7 @@ class Demo:
             return
         if self.a.instructor is not None:
             self.start_instructor()
+            self.say_wake_latency(["instructor_station"])
         time.sleep(0.2)
         flying = {"timeline": f"the timeline {os.path.basename(self.a.timeline or '')}",
                   "autopilot": "the autopilot",
@@ -380,12 +387,14 @@ class Demo:
         asked for, and why (their ready files; a remote one's log)."""
         if self.wake_latency == "off":
             return
-        not_held = {}  # state -> host -> processes
+        not_held = {}  # state -> host -> processes, not said before
         for n in names:
             state = self.sup.wake_latency_state(n)
-            if state and not state.startswith("held"):
-                not_held.setdefault(state, {}).setdefault(str(self.hosts[n]), []).append(n)
+            host = "this host" if str(self.hosts[n]) == "localhost" else str(self.hosts[n])
+            if state and not state.startswith("held") and (state, host) not in self.wake_said:
+                not_held.setdefault(state, {}).setdefault(host, []).append(n)
         for state, by_host in not_held.items():
+            self.wake_said.update((state, h) for h in by_host)
             who = "; ".join(f"{', '.join(ps)} on {h}" for h, ps in by_host.items())
             say(f"the CPUs' wake latency is {state} ({who}): the frames reach the pixels later "
                 f"(docs/performance.md \"Wake latency\"); run as root, let this user write "
@@ -395,8 +404,13 @@ class Demo:
         """Until the pilot ends, a signal comes, or the session must stop."""
         threshold = disk.stop_threshold(self.bytes_per_s)
         next_disk = 0.0
+        station_said = self.pilot == "by-hand"  # its screen is the terminal's: nothing said over it
         while not self.sup.pilot_done and self.interrupted is None and self.sup.fatal is None:
             self.sup.poll()
+            station = self.sup.children.get("operator_station")
+            if not station_said and station is not None and station.ready:
+                station_said = True
+                self.say_wake_latency(["operator_station"])
             now = time.time()
             if now >= next_disk:
                 next_disk = now + 1.0

@@ -153,22 +153,29 @@ TEST(LabDemo, TheWakeLatencyRequestIsOffWhenAskedAndABadOneIsRefusedNamingIt) {
   };
   const std::vector<std::string> env = {std::string("RMSLAB_BUILD=") + RMSLAB_BUILD_DIR};
   std::string output;
-  EXPECT_EQ(run({SourcePath("scripts/lab"), "demo", "--no-build", "--out", tmp + "/refused",
-                 "--cpu-wake-latency-us", "12us"},
-                "refused", env, &output),
-            2)
-      << output;
-  EXPECT_NE(output.find("--cpu-wake-latency-us '12us': \"off\" or whole microseconds"),
-            std::string::npos)
-      << output;
-  EXPECT_FALSE(fs::exists(tmp + "/refused"));
+  // Not ASCII digits (an Arabic-Indic three, a superscript two, 5,000 digits), or out of range.
+  for (const std::string& bad : std::vector<std::string>{"12us", "\xd9\xa3", "\xc2\xb2",
+                                                         std::string(5000, '1'), "1000001"}) {
+    EXPECT_EQ(run({SourcePath("scripts/lab"), "demo", "--no-build", "--out", tmp + "/refused",
+                   "--cpu-wake-latency-us", bad},
+                  "refused", env, &output),
+              2)
+        << output;
+    EXPECT_NE(output.find("--cpu-wake-latency-us '" + bad + "': \"off\" or whole microseconds"),
+              std::string::npos)
+        << output;
+    EXPECT_FALSE(fs::exists(tmp + "/refused"));
+  }
 
+  // A request left in the shell is the launcher's to set, not the session's.
+  std::vector<std::string> with_leftover = env;
+  with_leftover.push_back("RMSLAB_CPU_WAKE_LATENCY_US=abc");
   const std::string out = tmp + "/session";
   ASSERT_EQ(run({SourcePath("scripts/lab"), "demo", "--no-build", "--out", out, "--timeline",
                  SourcePath("scripts/timelines/short.tl"), "--lcm-url", testing::UniqueLcmUrl(8200),
                  "--png-every", "0", "--no-video", "--width", "320", "--height", "240",
                  "--cpu-wake-latency-us", "off"},
-                "off", env, &output),
+                "off", with_leftover, &output),
             0)
       << output;
   for (const char* p : {"dynamics_proc", "scene_proc", "esg_renderer"}) {

@@ -91,7 +91,8 @@ TEST(CpuWakeLatency, TheLaunchersRequestIsReadStrictly) {
   EXPECT_EQ(with("off"), std::nullopt);
   EXPECT_EQ(with("0"), 0);
   EXPECT_EQ(with("1000000"), 1000000);
-  for (const char* bad : {"-1", "1000001", "12us", " 5", "0x10", "on", "99999999999999999999"}) {
+  for (const char* bad : {"-1", "-0", "+5", "1000001", "0001000001", "12us", " 5", "5 ", "0x10",
+                          "on", "OFF", "\xd9\xa3", "99999999999999999999"}) {
     try {
       with(bad);
       ADD_FAILURE() << bad << " was taken";

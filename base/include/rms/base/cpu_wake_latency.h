@@ -8,10 +8,12 @@
 // request (/dev/cpu_dma_latency, the kernel's Documentation/power/pm_qos_
 // interface.rst) of at most N microseconds keeps the idle CPUs in the idle
 // states that wake within N: at 0, the idle loop polls instead of halting.
-// It costs no time to other tasks (the polling CPU runs whatever becomes
-// ready at once), only the host's power. The request lasts as long as the
-// file stays open: the kernel drops it when the process ends, however it
-// ends.
+// The request is the whole machine's, not the process's: every CPU polls
+// while any process holds it. Tasks on the machine lose no time to it (a
+// polling CPU runs whatever becomes ready at once); it costs power, and the
+// polling CPUs are busy to whatever shares them (a hyperthread's sibling, a
+// virtual machine's host). The request lasts as long as the file stays
+// open: the kernel drops it when the process ends, however it ends.
 #include <cstdint>
 #include <optional>
 #include <string>
