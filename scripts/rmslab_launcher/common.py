@@ -184,6 +184,8 @@ def check_cpu_wake_latency(value):
     if value == "off":
         return value
     if not re.fullmatch(r"[0-9]{1,7}", value, re.ASCII) or int(value) > MAX_CPU_WAKE_LATENCY_US:
-        raise LabError(f"--cpu-wake-latency-us '{value}': \"off\" or whole microseconds, "
+        shown = value if len(value) <= 40 and value.isprintable() else \
+            repr(value[:40])[1:-1] + ("..." if len(value) > 40 else "")
+        raise LabError(f"--cpu-wake-latency-us '{shown}': \"off\" or whole microseconds, at most 7 digits, "
                        f"0 .. {MAX_CPU_WAKE_LATENCY_US}")
     return str(int(value))

@@ -387,18 +387,19 @@ class Demo:
         asked for, and why (their ready files; a remote one's log)."""
         if self.wake_latency == "off":
             return
-        not_held = {}  # state -> host -> processes, not said before
         for n in names:
             state = self.sup.wake_latency_state(n)
             host = "this host" if str(self.hosts[n]) == "localhost" else str(self.hosts[n])
-            if state and not state.startswith("held") and (state, host) not in self.wake_said:
-                not_held.setdefault(state, {}).setdefault(host, []).append(n)
-        for state, by_host in not_held.items():
-            self.wake_said.update((state, h) for h in by_host)
-            who = "; ".join(f"{', '.join(ps)} on {h}" for h, ps in by_host.items())
-            say(f"the CPUs' wake latency is {state} ({who}): the frames reach the pixels later "
-                f"(docs/performance.md \"Wake latency\"); run as root, let this user write "
-                f"/dev/cpu_dma_latency, or say --cpu-wake-latency-us off")
+            if not state or state.startswith("held") or (state, host) in self.wake_said:
+                continue
+            # Said for the host: its other processes ask as this one did
+            # (their ready files and logs say each one's).
+            self.wake_said.add((state, host))
+            what, _, why = state.partition(": ")
+            say(f"the CPUs' wake latency is {what} on {host} ({why or 'no reason given'}): the session's "
+                f"processes there run on, and the frames reach the pixels later (docs/performance.md "
+                f"\"Wake latency\"); run as root, let this user write /dev/cpu_dma_latency, or say "
+                f"--cpu-wake-latency-us off")
 
     def watch(self):
         """Until the pilot ends, a signal comes, or the session must stop."""

@@ -13,7 +13,7 @@ import subprocess
 import time
 
 from . import disk, session
-from .common import (DEFAULT_REPLAY_URL, LabError, binary, check_speed, ensure_multicast_route, install_and_build,
+from .common import (DEFAULT_REPLAY_URL, LabError, binary, check_lcm_url, check_speed, ensure_multicast_route, install_and_build,
                      require_built, say)
 from .hosts import Host
 from .supervisor import Spec, Supervisor
@@ -197,6 +197,7 @@ def run(argv):
         raise LabError("give a session folder (with an lcmlog)")
     r = Replay(a)
     r.speed = check_speed(a.speed)
+    check_lcm_url(a.lcm_url)
     if not a.no_build:
         install_and_build()
     require_built("scene_proc/scene_proc", "esg_renderer/esg_renderer", "tools/rms_session")

@@ -72,8 +72,10 @@ CpuWakeLatencyRequest HoldCpuWakeLatency() {
   if (wake.held())
     spdlog::info("cpu wake latency: {}", wake.state());
   else
-    spdlog::warn("cpu wake latency: {}: frames reach the pixels later (docs/performance.md)",
-                 wake.state());
+    spdlog::warn(
+        "cpu wake latency: {}: frames reach the pixels later (docs/performance.md \"Wake "
+        "latency\")",
+        wake.state());
   return wake;
 }
 
@@ -258,6 +260,7 @@ void WriteStatsJson(const std::string& path, const std::string& process, const C
                     const LatencyMap& latencies) {
   nlohmann::ordered_json j;
   j["process"] = process;
+  j["cpu_wake_latency"] = g_cpu_wake_latency;
   j["counters"] = nlohmann::ordered_json::object();
   for (const auto& [k, v] : counters.ByName()) j["counters"][k] = v;
   j["latency_us"] = nlohmann::ordered_json::object();

@@ -37,6 +37,29 @@ void FrameLines(const Json& j, std::ostream& os) {
   }
 }
 
+// "; the CPUs' wake latency held at 0 us" after the latency, from what
+// each process's request came to (summary.json timing.cpu_wake_latency):
+// one state for all, or each with its processes; "" for a summary without.
+std::string WakeLatencyNote(const Json& j) {
+  if (!j.contains("timing") || !j["timing"].contains("cpu_wake_latency")) return "";
+  std::map<std::string, std::string> by_state;  // state -> processes
+  for (const auto& [process, v] : j["timing"]["cpu_wake_latency"].items()) {
+    std::string state = v.is_string() ? v.get<std::string>() : "not said";
+    if (state.rfind("held", 0) == 0) state = state.substr(0, state.find(" ("));
+    std::string& who = by_state[state];
+    who += (who.empty() ? "" : ", ") + process;
+  }
+  if (by_state.empty()) return "";
+  if (by_state.size() == 1) return "; the CPUs' wake latency " + by_state.begin()->first;
+  std::string note = "; the CPUs' wake latency";
+  const char* sep = " ";
+  for (const auto& [state, who] : by_state) {
+    note += sep + state + " (" + who + ")";
+    sep = "; ";
+  }
+  return note;
+}
+
 // What the record, the renderer and the video lost, and the latency.
 void LossLines(const Json& j, std::ostream& os) {
   const auto& fr = j["frames"];
@@ -71,7 +94,7 @@ void LossLines(const Json& j, std::ostream& os) {
   if (j["latency"].contains("input_to_render")) {
     const auto& l = j["latency"]["input_to_render"];
     os << "operator input to rendered frame: median " << l["p50_ms"].get<double>() << " ms, p99 "
-       << l["p99_ms"].get<double>() << " ms\n";
+       << l["p99_ms"].get<double>() << " ms" << WakeLatencyNote(j) << "\n";
   }
 }
 

@@ -657,6 +657,16 @@ nlohmann::ordered_json TimingJson(const std::map<std::string, nlohmann::json>& s
              &scene = stats.at("scene_proc"), &esg = stats.at("esg_renderer");
   nlohmann::ordered_json timing;
   timing["frame_period_ms"] = 1000.0 / rate_hz;
+  // What each process's CPU wake-latency request came to (docs/sessions.md
+  // "The launcher"); a process without a stats file did not say.
+  nlohmann::ordered_json wake;
+  for (const char* p : {"operator_station", "dynamics_proc", "scene_proc", "esg_renderer"}) {
+    const auto& st = stats.at(p);
+    wake[p] = st.contains("cpu_wake_latency") && st["cpu_wake_latency"].is_string()
+                  ? st["cpu_wake_latency"].get<std::string>()
+                  : "not said";
+  }
+  timing["cpu_wake_latency"] = wake;
   timing["operator_station"] = {{"late_frames", CounterOf(op, rms::Counter::kFramesLate)}};
   timing["dynamics_proc"] = {{"dropped_frames", CounterOf(dcp, rms::Counter::kInputMissing)},
                              {"late_frames", CounterOf(dcp, rms::Counter::kFramesLate)},

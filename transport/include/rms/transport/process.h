@@ -129,7 +129,8 @@ void RunNodeLoop(LcmInterface& lcm, const std::string& process, Counters& counte
                  const std::function<void()>& after_wait, const std::string& stats_path,
                  int wait_ms = 100);
 
-// Writes {"process":..., "counters":{...}, "latency_us":{NAME:{count,p50,p99,max,mean}}}.
+// Writes {"process":..., "cpu_wake_latency": what its request came to (as in
+// the ready file), "counters":{...}, "latency_us":{NAME:{count,p50,p99,max,mean}}}.
 void WriteStatsJson(const std::string& path, const std::string& process, const Counters& counters,
                     const LatencyMap& latencies);
 
