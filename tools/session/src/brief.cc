@@ -54,7 +54,7 @@ std::string WakeLatencyNote(const Json& j) {
   std::string note = "; the CPUs' wake latency";
   const char* sep = " ";
   for (const auto& [state, who] : by_state) {
-    note += sep + state + " (" + who + ")";
+    note.append(sep).append(state).append(" (").append(who).append(")");
     sep = "; ";
   }
   return note;
