@@ -14,8 +14,8 @@ import time
 from . import disk, session
 from .branch import Branch
 from .common import (BUILD, DEFAULT_URL, ROOT, LabError, binary, check_cpu_wake_latency, check_speed, check_suffix,
-                     ensure_multicast_route, file_sha256, frame_rate_hz, check_lcm_url, install_and_build, require_built, say,
-                     timeline_length_s)
+                     ensure_multicast_route, file_sha256, frame_rate_hz, check_lcm_url, install_and_build,
+                     require_built, say, timeline_length_s)
 from .hosts import Host, check_hosts
 from .supervisor import Spec, Supervisor
 
@@ -383,8 +383,9 @@ class Demo:
         self.sup.add(self.operator_spec())
 
     def say_wake_latency(self, names):
-        """Says once which processes could not hold the CPUs' wake latency
-        asked for, and why (their ready files; a remote one's log)."""
+        """Says, once for each host and reason, that the processes there
+        could not hold the CPUs' wake latency asked for, and why (from
+        their ready files; a remote one's log)."""
         if self.wake_latency == "off":
             return
         for n in names:

@@ -13,8 +13,8 @@ import subprocess
 import time
 
 from . import disk, session
-from .common import (DEFAULT_REPLAY_URL, LabError, binary, check_lcm_url, check_speed, ensure_multicast_route, install_and_build,
-                     require_built, say)
+from .common import (DEFAULT_REPLAY_URL, LabError, binary, check_lcm_url, check_speed, ensure_multicast_route,
+                     install_and_build, require_built, say)
 from .hosts import Host
 from .supervisor import Spec, Supervisor
 
