@@ -67,6 +67,7 @@ class SharedSession {
 // One cell's result line's JSON (its {"error": ...} when it has none);
 // *failed set when it has none.
 std::string CellResult(const CellLine& c, SharedSession* session, bool* failed) {
+  std::string why;
   try {
     ResimOptions opt;
     opt.session = c.session;
@@ -76,15 +77,13 @@ std::string CellResult(const CellLine& c, SharedSession* session, bool* failed) 
     opt.recorded = session->Get();
     return JsonLine(Resimulate(opt).cell);
   } catch (const std::bad_alloc&) {
-    const char* why = "out of memory (std::bad_alloc): fewer cells at once (--jobs) may fit";
-    std::fprintf(stderr, "rms_resim: cell %s: %s\n", c.index.c_str(), why);
-    *failed = true;
-    return JsonLine(nlohmann::json{{"error", why}});
+    why = "out of memory (std::bad_alloc): fewer cells at once (--jobs) may fit";
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "rms_resim: cell %s: %s\n", c.index.c_str(), e.what());
-    *failed = true;
-    return JsonLine(nlohmann::json{{"error", e.what()}});
+    why = e.what();
   }
+  std::fprintf(stderr, "rms_resim: cell %s: %s\n", c.index.c_str(), why.c_str());
+  *failed = true;
+  return JsonLine(nlohmann::json{{"error", why}});
 }
 
 // A cell as read, with the session it shares with the cells of that

@@ -191,6 +191,13 @@ void CheckBranchPrefix(const fs::path& session, const Recording& rec, ResimResul
                         "branch's first state";
 }
 
+// `more` after `*notes`, "; " between them; nothing when it is "".
+void AddNote(const std::string& more, std::string* notes) {
+  if (more.empty()) return;
+  if (!notes->empty()) *notes += "; ";
+  *notes += more;
+}
+
 // "" when the log holds the RMS_DCP_FRAMEs the session's summary counted
 // logged (record.by_channel); else what it lacks, said.
 std::string LogShorterThanSummary(const nlohmann::json& summary, const Recording& rec) {
@@ -280,7 +287,7 @@ nlohmann::ordered_json CellJson(const nlohmann::json& recorded, const LabConfig&
   // What the log lacks or ends in (re-simulated up to there): with the
   // result, so that a sweep's table does not blame the design for it.
   std::string note = result.note;
-  if (!result.log_note.empty()) note += (note.empty() ? "" : "; ") + result.log_note;
+  AddNote(result.log_note, &note);
   if (!note.empty()) cell["note"] = note;
   return cell;
 }
@@ -403,8 +410,7 @@ ResimResult Resimulate(const ResimOptions& opt) {
   // (or changed) since the session's summary was made holds less than it,
   // and the difference is the log's, not the design's.
   if (other_design) {
-    const std::string cut = LogShorterThanSummary(recorded->summary(), rec);
-    if (!cut.empty()) result.note += (result.note.empty() ? "" : "; ") + cut;
+    AddNote(LogShorterThanSummary(recorded->summary(), rec), &result.note);
   }
   result.skipped = static_cast<long>(plan.first);
   // Another design discarded (a sweep's cell) is made in memory: no session written.
