@@ -215,6 +215,7 @@ class Demo:
                         f"{self.pilot}, {a.width}x{a.height}, PNG every {a.png_every}, video "
                         f"{'no' if a.no_video else 'yes'}")
         self.out = session.make_folder(a.out, os.path.join(ROOT, "sessions"))
+        os.makedirs(os.path.join(self.out, "journal"), exist_ok=True)
         self.name = os.path.basename(self.out)
         self.remote_run = f"/tmp/rmslab-{self.name}"
         run = os.path.join(self.out, "run")
@@ -267,7 +268,8 @@ class Demo:
 
     def spec(self, name, extra, **kw):
         exe, cfg, stats, ready = self.proc_paths(name)
-        argv = [exe, "--config", cfg, "--lcm-url", self.url, "--stats", stats, "--ready-file", ready]
+        argv = [exe, "--config", cfg, "--lcm-url", self.url, "--stats", stats, "--ready-file", ready,
+                "--journal-dir", self.journal_dir(name)]
         if self.a.channel_suffix:
             argv += ["--channel-suffix", self.a.channel_suffix]
         h = self.hosts[name]
@@ -281,11 +283,19 @@ class Demo:
                 os.remove(ready)
         return Spec(name, h, argv + extra, log, ready=ready_fn, remote_run=self.remote_run if h.remote else None, **kw)
 
+    def journal_dir(self, name):
+        """Where `name` journals what it publishes (docs/sessions.md "The
+        record"): the session's journal/ here or in a namespace; on an ssh
+        host its run folder's, copied back at the end."""
+        if self.hosts[name].remote:
+            return f"{self.remote_run}/journal"
+        return os.path.join(self.out, "journal")
+
     def recorder_spec(self):
         chans = f"RMS_({'|'.join(c[4:] for c in session.CHANNELS)}){self.a.channel_suffix}"
         def argv(n):
             return ["lcm-logger", f"--lcm-url={self.url}", "--force", "--quiet", f"--channel={chans}",
-                    os.path.join(self.out, "lcmlog" if n == 0 else f"lcmlog.{n}")]
+                    os.path.join(self.out, session.WIRE_LOG if n == 0 else f"{session.WIRE_LOG}.{n}")]
         def ready(c):
             return os.path.exists(argv(c.n)[-1])
         def may_restart():
@@ -293,7 +303,8 @@ class Demo:
             if free < disk.stop_threshold(self.bytes_per_s):
                 return (f"the recorder stopped: the disk of {self.out} is full ({free / disk.MB:.1f} MB left); "
                         f"stopping the session, its record ends here")
-            self.notes.append("the recorder died and was restarted: the record has a gap (see summary.json 'record')")
+            self.notes.append("the recorder died and was restarted: what the network delivered has a gap there "
+                              "(the record holds it from the processes' journals; summary.json 'record')")
             return None
         return Spec("lcm-logger", self.hosts["recorder"], argv(0), os.path.join(self.out, "logs", "lcm-logger.log"),
                     ready=ready, next_argv=argv, lifeline=False, may_restart=may_restart)
@@ -434,20 +445,21 @@ class Demo:
         time.sleep(0.3)
         self.sup.stop(["lcm-logger"])
         self.sup.record_exit_codes()
-        for p in PROCESSES:
+        for p in PROCESSES + (["instructor_station"] if self.a.instructor is not None else []):
             h = self.hosts[p]
             if h.remote:
                 h.copy_from(f"{self.remote_run}/{p}.json", os.path.join(self.out, "stats", f"{p}.json"))
+                h.copy_from(f"{self.remote_run}/journal/{p}.*.lcmlog", os.path.join(self.out, "journal"))
         self.sup.finish_reaper()
-        note = session.join_record_parts(self.out)
-        if note:
-            self.notes.append(note)
+        self.notes += session.close_record(self.out)
 
     def finish(self):
         """The summary and the exit code."""
         if self.sup.fatal:
             say(self.sup.fatal[0])  # why the session stopped, before anything else
+        resimulates = session.resimulate(self.out)
         lines, where = session.summarize(self.out, f"{self.name}-{self.session_id}")
+        lines, verdict = session.verdict_of(lines, resimulates)  # said last, below
         op = self.sup.children.get("operator_station")
         op_rc = op.exit_code if op and op.exit_code is not None else None
         if self.sup.fatal:
@@ -467,6 +479,14 @@ class Demo:
             say(f"summary: {where}")
         if where is None:
             say("no summary could be written (each place tried said why, above)")
+        rc = self.exit_code(op, op_rc)
+        # Last: whether the record re-simulates (docs/sessions.md "Does it re-simulate").
+        say(verdict)
+        if rc == 0 and resimulates is not True:
+            return session.EXIT_NOT_RESIMULATED
+        return rc
+
+    def exit_code(self, op, op_rc):
         if self.sup.fatal:
             return self.sup.fatal[1]
         if self.interrupted is not None or op_rc == 130:
@@ -492,7 +512,7 @@ def run(argv, command_line):
     if not a.no_build:
         install_and_build()
     require_built("operator_station/operator_station", "dynamics_proc/dynamics_proc", "scene_proc/scene_proc",
-                  "esg_renderer/esg_renderer", "tools/rms_session",
+                  "esg_renderer/esg_renderer", "tools/rms_session", "tools/rms_resim",
                   *(["instructor_station/instructor_station"] if a.instructor is not None else []))
     if d.branch:
         require_built("tools/rms_resim")

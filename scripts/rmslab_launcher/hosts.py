@@ -41,7 +41,7 @@ class Host:
                     list(argv))
         # ssh: the remote shell writes the process's pid (for signals), then
         # becomes it; its standard input is the launcher's lifeline.
-        pre = f"mkdir -p {shlex.quote(remote_run)} && " if remote_run else ""
+        pre = f"mkdir -p {shlex.quote(remote_run)}/journal && " if remote_run else ""
         if remote_run and pid_name:
             pre += f"echo $$ >{shlex.quote(remote_run)}/{shlex.quote(pid_name)}.pid && "
         cmd = pre + "exec env " + " ".join(shlex.quote(a) for a in env_args + list(argv))

@@ -17,6 +17,7 @@ import sys
 import time
 
 from .common import sudo_prefix, write_run_file
+from .session import close_record, resimulate
 from .hosts import SSH
 
 
@@ -120,6 +121,15 @@ def reap(session, summary_argv):
     stop_all([k for k in kids if k[0] == "lcm-logger"], session_id)
     write_run_file(os.path.join(run_dir, "exit_codes"), "launcher 137\n")
     write_run_file(os.path.join(run_dir, "launcher_died"), f"{time.time():.6f}\n", append=False)
+    # The journals of processes on ssh hosts, as the launcher would have
+    # fetched them (docs/sessions.md "The record").
+    for name, _, host, _, remote_run in kids:
+        if host.startswith("ssh:") and remote_run != "-":
+            subprocess.run(["scp", "-q", "-o", "BatchMode=yes", f"{host[4:]}:{remote_run}/journal/{name}.*.lcmlog",
+                            os.path.join(session, "journal")], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    for note in close_record(session):
+        log(f"{time.strftime('%H:%M:%S')} {note}")
+    resimulate(session)  # its verdict into the summary (docs/sessions.md "Does it re-simulate")
     if summary_argv:
         r = subprocess.run(summary_argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
         if r.returncode != 0:

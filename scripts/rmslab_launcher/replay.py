@@ -42,6 +42,7 @@ class Replay:
         a = self.a
         out = a.out or os.path.join(self.src, "replay-" + time.strftime("%Y%m%dT%H%M%SZ", time.gmtime()))
         self.out = session.make_folder(out, self.src)
+        os.makedirs(os.path.join(self.out, "journal"), exist_ok=True)
         shutil.copyfile(os.path.join(self.src, "config.toml"), os.path.join(self.out, "config.toml"))
         with open(os.path.join(self.out, "run", "pilot"), "w") as f:
             f.write("replay\n")
@@ -63,7 +64,8 @@ class Replay:
     def spec(self, name, extra):
         ready = os.path.join(self.out, "run", f"{name}.ready")
         argv = [binary(f"{name}/{name}"), "--config", os.path.join(self.out, "config.toml"), "--lcm-url",
-                self.a.lcm_url, "--stats", os.path.join(self.out, "stats", f"{name}.json"), "--ready-file", ready]
+                self.a.lcm_url, "--stats", os.path.join(self.out, "stats", f"{name}.json"), "--ready-file", ready,
+                "--journal-dir", os.path.join(self.out, "journal")]
         if self.suffix:
             argv += ["--channel-suffix", self.suffix]
         return Spec(name, Host("localhost"), argv + extra, os.path.join(self.out, "logs", f"{name}.log"),
@@ -77,7 +79,7 @@ class Replay:
         for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
             signal.signal(sig, lambda s, f: setattr(self, "interrupted", s))
         chans = f"RMS_(DCP_FRAME|ESG_FRAME|STATUS){self.suffix}"
-        log = os.path.join(self.out, "lcmlog")
+        log = os.path.join(self.out, session.WIRE_LOG)
         self.sup.add(Spec("lcm-logger", Host("localhost"),
                           ["lcm-logger", f"--lcm-url={a.lcm_url}", "--force", "--quiet", f"--channel={chans}", log],
                           os.path.join(self.out, "logs", "lcm-logger.log"), ready=lambda c: os.path.exists(log),
@@ -115,6 +117,8 @@ class Replay:
         self.sup.stop(["lcm-logger"])
         self.sup.record_exit_codes()
         self.sup.finish_reaper()
+        for n in session.close_record(self.out):
+            say("note: " + n)
 
     def finish(self):
         lines, summary_path = session.summarize(self.out, os.path.basename(self.out))

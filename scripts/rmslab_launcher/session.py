@@ -145,27 +145,104 @@ def write_manifest(out, fields):
         raise LabError(f"cannot write the manifest: {r.stderr.strip()}", 1)
 
 
-def join_record_parts(out):
-    """The recorder, restarted after it died, wrote lcmlog.1, lcmlog.2, ...:
-    appended to lcmlog (an LCM log is a run of events), in order."""
+WIRE_LOG = "wire.lcmlog"  # what the network delivered to the session's recorder (docs/sessions.md "The record")
+
+
+def join_wire_parts(out):
+    """The recorder, restarted after it died, wrote wire.lcmlog.1, .2, ...:
+    appended to wire.lcmlog (an LCM log is a run of events), in order."""
     parts = []
     n = 1
-    while os.path.exists(os.path.join(out, f"lcmlog.{n}")):
-        parts.append(os.path.join(out, f"lcmlog.{n}"))
+    while os.path.exists(os.path.join(out, f"{WIRE_LOG}.{n}")):
+        parts.append(os.path.join(out, f"{WIRE_LOG}.{n}"))
         n += 1
     if not parts:
         return None
     try:
-        with open(os.path.join(out, "lcmlog"), "ab") as dst:
+        with open(os.path.join(out, WIRE_LOG), "ab") as dst:
             for p in parts:
                 with open(p, "rb") as src:
                     shutil.copyfileobj(src, dst)
         for p in parts:
             os.remove(p)
-        return f"the record was restarted {len(parts)} time(s); its parts are joined into lcmlog"
+        return f"the recorder was restarted {len(parts)} time(s); its parts are joined into {WIRE_LOG}"
     except OSError as e:
-        return f"the record's parts ({', '.join(os.path.basename(p) for p in parts)}) could not be joined ({e}): " \
-               f"lcmlog holds only the first"
+        return f"the recorder's parts ({', '.join(os.path.basename(p) for p in parts)}) could not be joined ({e}): " \
+               f"{WIRE_LOG} holds only the first"
+
+
+def close_record(out):
+    """At the session's end: the recorder's parts joined, then the record,
+    lcmlog, made from the processes' journals and what the network delivered
+    (rms_session record; docs/sessions.md "The record"). Returns the notes
+    to say. When the record cannot be made (a full disk), lcmlog is what the
+    network delivered (a second name for wire.lcmlog, no space taken) and
+    the journals stay, so nothing is lost and the summary still reads it."""
+    notes = []
+    joined = join_wire_parts(out)
+    if joined:
+        notes.append(joined)
+    if not os.path.isdir(os.path.join(out, "journal")):
+        return notes
+    r = subprocess.run([binary("tools/rms_session"), "record", out], capture_output=True, text=True)
+    if r.returncode == 0:
+        try:
+            rec = json.loads(r.stdout)
+        except ValueError:
+            rec = {}
+        missed = rec.get("wire", {}).get("missed", {}).get("total", 0)
+        if missed:
+            by = rec["wire"]["missed"]["by_channel"]
+            notes.append(f"the network's recorder missed {missed} message(s) ("
+                         + ", ".join(f"{c} {n}" for c, n in sorted(by.items())) +
+                         f"): the record holds them from the processes' journals; {WIRE_LOG} is what the "
+                         f"network delivered")
+        return notes
+    why = r.stderr.strip().removeprefix("rms_session: ")
+    wire = os.path.join(out, WIRE_LOG)
+    lcmlog = os.path.join(out, "lcmlog")
+    if os.path.exists(wire) and not os.path.exists(lcmlog):
+        try:
+            os.link(wire, lcmlog)
+        except OSError:
+            pass
+    notes.append(f"the record could not be made from the journals ({why}): lcmlog is what the network delivered "
+                 f"({WIRE_LOG}), and journal/ keeps every process's own record; run "
+                 f"build/tools/rms_session record {out} where there is room")
+    return notes
+
+
+RESIM_FILE = "resimulation.json"  # what the session's re-simulation came to (docs/sessions.md "Does it re-simulate")
+EXIT_NOT_RESIMULATED = 4  # a session that ran but does not re-simulate (docs/sessions.md "The launcher")
+
+
+def resimulate(out):
+    """The session's own design re-simulated at its end (rms_resim, tens of
+    milliseconds), its verdict written to SESSION/resimulation.json, which
+    the summary takes in and its brief says ("re-simulates: ..."). Returns
+    True when it re-simulates; None when no verdict could be written."""
+    path = os.path.join(out, RESIM_FILE)
+    r = subprocess.run([binary("tools/rms_resim"), out, "--quiet", "--verdict-json", path], capture_output=True,
+                       text=True)
+    try:
+        with open(path) as f:
+            return json.load(f).get("verdict") == "identical"
+    except (OSError, ValueError):
+        why = (r.stderr.strip().splitlines() or [f"rms_resim exited with {r.returncode}"])[-1]
+        say(f"the re-simulation's verdict could not be written ({why})")
+        return None
+
+
+def verdict_of(lines, resimulates):
+    """The brief's "re-simulates:" line taken out of `lines` (said last), or
+    one saying why there is none."""
+    said = [l for l in lines if l.startswith("re-simulates:")]
+    rest = [l for l in lines if not l.startswith("re-simulates:")]
+    if said:
+        return rest, said[-1]
+    if resimulates is None:
+        return rest, "re-simulates: NOT KNOWN -- its verdict could not be written (above)"
+    return rest, "re-simulates: NOT KNOWN -- the summary could not be written (above)"
 
 
 def summarize(out, fallback_name):

@@ -19,6 +19,7 @@
 
 #include "rms/dcp_state_t.hpp"
 
+#include "cpu_load.h"
 #include "lab_processes.h"
 #include "subprocess.h"
 #include "tmux.h"
@@ -35,33 +36,6 @@ using testing::Subprocess;
 using testing::Tmux;
 
 void Sleep(double s) { std::this_thread::sleep_for(std::chrono::duration<double>(s)); }
-
-// Busy processes, one a core, for as long as the object lives.
-class CpuLoad {
- public:
-  explicit CpuLoad(const std::string& dir) {
-    const long cores = std::max(1L, sysconf(_SC_NPROCESSORS_ONLN));
-    for (long i = 0; i < cores; ++i) {
-      busy_.push_back(std::make_unique<Subprocess>(
-          std::vector<std::string>{"/usr/bin/timeout", "300", "/bin/sh", "-c",
-                                   "while :; do :; done"},
-          dir + "/busy.log"));
-    }
-    std::printf("CPU load: %ld busy processes\n", cores);
-  }
-  // SIGTERM, which timeout passes on to its busy loop (a SIGKILL would end
-  // timeout alone and leave the loop running); timeout ends it anyway after
-  // 300 s if this process dies first.
-  ~CpuLoad() {
-    for (auto& b : busy_) {
-      b->Signal(SIGTERM);
-      b->Wait(5);
-    }
-  }
-
- private:
-  std::vector<std::unique_ptr<Subprocess>> busy_;
-};
 
 bool WaitFor(const std::function<bool()>& done, double timeout_s) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
@@ -117,7 +91,7 @@ class HandFlownSession : public ::testing::Test {
   static void SetUpTestSuite() {
     tmp_ = new std::string(testing::MakeTempDir("handflown"));
     out_ = new std::string(*tmp_ + "/session");
-    CpuLoad load(*tmp_);
+    testing::CpuLoad load(*tmp_);
     Tmux tmux(*tmp_);
     const std::string cmd =
         "RMSLAB_BUILD=" RMSLAB_BUILD_DIR " " + SourcePath("scripts/lab") +

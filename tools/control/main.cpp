@@ -25,6 +25,7 @@
 #include "rms/sender_t.hpp"
 #include "rms/session/session_summary.h"
 #include "rms/session_control_t.hpp"
+#include "rms/transport/journal.h"
 #include "rms/transport/lcm_interface.h"
 #include "rms/wire/channels.h"
 #include "rms/wire/checkpoint.h"
@@ -93,6 +94,18 @@ class ControlLink {
       for (int i = 0; i < st.num_counters; ++i) counts[st.counter_names[i]] = st.counter_values[i];
       ++reports_[st.process];
     });
+  }
+  // Journals what it sends in the session's journal/ (rms/transport/journal.h);
+  // one it cannot make is said, and the command still goes.
+  void JournalIn(const std::string& dir) {
+    try {
+      lcm_.SetJournal(rms::transport::Journal::CreateIn(dir, "rms_control"));
+    } catch (const rms::InputError& e) {
+      std::fprintf(stderr,
+                   "rms_control: no journal (%s): the command reaches the record only if "
+                   "the session's recorder hears it\n",
+                   e.what());
+    }
   }
   void Send(std::int8_t command, const std::string& name = "") {
     rms::session_control_t m;
@@ -383,6 +396,10 @@ int main(int argc, char** argv) {
       name = rms::wire::MalfunctionText(rms::wire::ParseMalfunction(Joined(words)));
     if (repair->parsed()) name = rms::wire::RepairText(rms::wire::ParseRepair(Joined(words)));
     ControlLink link(lcm_options, id);
+    // A running session's record has the command from this tool's own
+    // journal too (docs/sessions.md "The record").
+    if (!session_dir.empty() && fs::is_directory(fs::path(session_dir) / "journal"))
+      link.JournalIn((fs::path(session_dir) / "journal").string());
     if (malfunction->parsed())
       return Malfunction(link, rms::session_control_t::MALFUNCTION, name, lcm_options, id);
     if (repair->parsed())

@@ -61,6 +61,37 @@ int Report(const rms::resim::ResimResult& r, bool other_design) {
   return r.first_difference.empty() ? 0 : 1;
 }
 
+// The session's own design re-simulated, as one JSON object
+// (--verdict-json; docs/sessions.md "Does it re-simulate"): what a session's
+// summary says of it. `why` when it could not be re-simulated at all.
+nlohmann::ordered_json Verdict(const rms::resim::ResimResult* r, const std::string& why) {
+  nlohmann::ordered_json v;
+  v["format"] = "rmslab-resimulation-1";
+  if (!r) {
+    v["verdict"] = "cannot be re-simulated";
+    v["exact"] = false;
+    v["why"] = why;
+    v["exit_code"] = 2;
+    return v;
+  }
+  const bool same = r->first_difference.empty() && r->identical == r->compared;
+  v["verdict"] = same ? "identical" : "differs";
+  v["exact"] = same && r->unchecked_frames == 0 && r->skipped == 0;
+  v["frames_compared"] = r->compared;
+  v["frames_identical"] = r->identical;
+  v["frames_unchecked"] = r->unchecked_frames;
+  v["frames_skipped_at_start"] = r->skipped;
+  v["unchecked"] = r->unchecked;
+  v["first_difference"] = r->first_difference.empty() ? nlohmann::ordered_json(nullptr)
+                                                      : nlohmann::ordered_json(r->first_difference);
+  v["states_checked"] = r->states_checked;
+  v["note"] = r->note;
+  v["log_note"] = r->log_note;
+  v["seconds"] = r->seconds;
+  v["exit_code"] = same ? 0 : 1;
+  return v;
+}
+
 // A usage error, as rms::ParseCommandLine reports one (exit 2).
 int Usage(const char* what) {
   std::fprintf(stderr, "%s\nRun with --help for more information.\n", what);
@@ -111,6 +142,12 @@ int main(int argc, char** argv) {
   app.add_flag("--check", check_only,
                "Only check the design (the configuration with its --set keys) and exit: 0 if "
                "it is valid");
+  std::string verdict_json;
+  app.add_option("--verdict-json", verdict_json,
+                 "The session's own design: also write what it came to here, as JSON, whatever "
+                 "it came to (identical, differs, cannot be re-simulated: docs/sessions.md \"Does "
+                 "it re-simulate\"); scripts/lab writes SESSION/resimulation.json so")
+      ->type_name("FILE");
   std::string checkpoint_out;
   app.add_option(
          "--until", opt.until_frame,
@@ -180,7 +217,12 @@ int main(int argc, char** argv) {
       throw rms::InputError("--discard writes no session: --out has no place beside it");
     if (!checkpoint_out.empty() && opt.until_frame < 0)
       throw rms::InputError("--checkpoint-out needs --until FRAME");
+    if (!verdict_json.empty() && (rms::resim::OtherDesign(opt) || opt.until_frame >= 0))
+      throw rms::InputError(
+          "--verdict-json is for the session's own design, to its end (no "
+          "--config, --set or --until)");
     const rms::resim::ResimResult r = rms::resim::Resimulate(opt);
+    if (!verdict_json.empty()) rms::WriteWholeFile(verdict_json, Verdict(&r, "").dump(2) + "\n");
     if (!checkpoint_out.empty()) {
       if (!r.first_difference.empty()) {
         throw rms::InputError(
@@ -197,6 +239,13 @@ int main(int argc, char** argv) {
     return Report(r, rms::resim::OtherDesign(opt));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rms_resim: %s\n", e.what());
+    if (!verdict_json.empty() && !rms::resim::OtherDesign(opt) && opt.until_frame < 0) {
+      try {
+        rms::WriteWholeFile(verdict_json, Verdict(nullptr, e.what()).dump(2) + "\n");
+      } catch (const std::exception& w) {
+        std::fprintf(stderr, "rms_resim: %s\n", w.what());
+      }
+    }
     // A sweep's cell says why it has no result, on its one line.
     if (result_json)
       std::printf("%s\n", rms::resim::JsonLine(nlohmann::json{{"error", e.what()}}).c_str());

@@ -15,6 +15,7 @@
 #include "rms/session/brief.h"
 #include "rms/session/export_csv.h"
 #include "rms/session/lab_file.h"
+#include "rms/session/record.h"
 #include "rms/session/session_folder.h"
 #include "rms/session/session_summary.h"
 
@@ -49,6 +50,29 @@ Command Summary(CLI::App& app) {
               session::PrintBrief(j, std::cout);
             else
               std::cout << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
+            return 0;
+          }};
+}
+
+// record: SESSION/lcmlog from the processes' journals and the recorder's log.
+Command Record(CLI::App& app) {
+  struct O {
+    std::string dir;
+    session::RecordOptions options;
+  };
+  auto o = std::make_shared<O>();
+  CLI::App* c = app.add_subcommand(
+      "record",
+      "Make SESSION/lcmlog from its processes' journals (journal/) and what the network "
+      "delivered (wire.lcmlog); say what each source held and what the network missed "
+      "(SESSION/record.json; docs/sessions.md \"The record\")");
+  c->add_option("session", o->dir, "Session folder")->required()->check(CLI::ExistingDirectory);
+  c->add_flag("--keep-journals", o->options.keep_journals,
+              "Leave journal/ as it is once the record is made");
+  return {c, [o] {
+            std::cout << session::MakeRecord(o->dir, o->options)
+                             .dump(2, ' ', false, nlohmann::json::error_handler_t::replace)
+                      << "\n";
             return 0;
           }};
 }
@@ -205,9 +229,9 @@ Command Counters(CLI::App& app) {
 int main(int argc, char** argv) {
   CLI::App app{"rmslab session tools"};
   app.require_subcommand(1);
-  const std::vector<Command> commands = {Summary(app), Manifest(app), CompareEsg(app),
-                                         Export(app),  Folder(app),   LabFile(app),
-                                         Probe(app),   Counters(app)};
+  const std::vector<Command> commands = {Summary(app),    Record(app), Manifest(app),
+                                         CompareEsg(app), Export(app), Folder(app),
+                                         LabFile(app),    Probe(app),  Counters(app)};
   if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   try {
     for (const Command& c : commands) {

@@ -9,6 +9,7 @@
 #include <spdlog/spdlog.h>
 
 #include "rms/base/check.h"
+#include "rms/transport/journal.h"
 #include "rms/wire/channels.h"
 #include "rms/wire/message_io.h"
 
@@ -33,6 +34,14 @@ void ValidateChannelSuffix(std::string_view suffix) {
 
 LcmInterface::LcmInterface(std::string suffix) : suffix_(std::move(suffix)) {
   ValidateChannelSuffix(suffix_);
+}
+
+LcmInterface::~LcmInterface() = default;
+
+void LcmInterface::SetJournal(std::unique_ptr<Journal> journal) { journal_ = std::move(journal); }
+
+void LcmInterface::Journalize(const std::string& full_channel, const void* data, int size) {
+  if (journal_) journal_->Append(full_channel, data, size, WallTimeUs());
 }
 
 std::int64_t ParseSessionId(const std::string& text, const std::string& what) {
@@ -153,7 +162,11 @@ UdpLcm::UdpLcm(const LcmOptions& options)
 UdpLcm::~UdpLcm() = default;
 
 bool UdpLcm::Publish(std::string_view channel, const void* data, int size) {
-  return lcm_->publish(FullChannel(channel), data, static_cast<unsigned>(size)) == 0;
+  // The journal first: the record holds what was sent even when the
+  // process dies right after (docs/sessions.md "The record").
+  const std::string full = FullChannel(channel);
+  Journalize(full, data, size);
+  return lcm_->publish(full, data, static_cast<unsigned>(size)) == 0;
 }
 
 void UdpLcm::Subscribe(std::string_view channel, Handler handler) {

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -22,6 +23,7 @@
 #include "rms/base/text.h"
 #include "rms/base/version.h"
 #include "rms/process_status_t.hpp"
+#include "rms/transport/journal.h"
 #include "rms/wire/channels.h"
 #include "rms/wire/message_io.h"
 
@@ -50,6 +52,9 @@ void AddCommonOptions(CLI::App& app, CommonOptions* o) {
       "The session this process belongs to (default: $RMSLAB_SESSION_ID; none: takes every "
       "session's "
       "messages); messages of other sessions are dropped and counted (docs/security.md)");
+  app.add_option("--journal-dir", o->journal_dir,
+                 "Append every message this process publishes to a journal in this folder, "
+                 "PROCESS.N.lcmlog, before it goes on the wire (docs/sessions.md \"The record\")");
   app.add_flag("--check", o->check,
                "Check the configuration (and this process's own files), say what is wrong, and "
                "exit (0: good)");
@@ -57,6 +62,24 @@ void AddCommonOptions(CLI::App& app, CommonOptions* o) {
 }
 
 namespace {
+
+// The journal's folder can take it: a folder this process may write in.
+void CheckJournalDir(const std::string& dir) {
+  if (!std::filesystem::is_directory(dir))
+    throw InputError("--journal-dir " + dir + ": no such folder");
+  if (access(dir.c_str(), W_OK | X_OK) != 0)
+    throw InputError("--journal-dir " + dir + ": cannot be written (" + std::strerror(errno) + ")");
+}
+
+// The launcher's restart count (RMSLAB_RESTART), 0 without one: the
+// journal's first run number to try.
+int RestartNumber() {
+  const char* r = std::getenv("RMSLAB_RESTART");
+  if (!r || !*r) return 0;
+  char* end = nullptr;
+  const long n = std::strtol(r, &end, 10);
+  return *end == '\0' && n >= 0 && n < 1000 ? static_cast<int>(n) : 0;
+}
 
 // What the process's CPU wake-latency request came to, for its ready file.
 std::string g_cpu_wake_latency = "off";
@@ -96,6 +119,7 @@ int ProcessMain(CLI::App& app, int argc, char** argv, const std::string& process
       ValidateChannelSuffix(common->lcm.channel_suffix);
       if (!common->session_id.empty()) (void)ParseSessionId(common->session_id, "--session-id");
       (void)CpuWakeLatencyFromEnv();
+      if (!common->journal_dir.empty()) CheckJournalDir(common->journal_dir);
       if (check) check(config);
       spdlog::info("check: {} and this process's files are good", common->config_path);
       return 0;
@@ -112,6 +136,10 @@ int ProcessMain(CLI::App& app, int argc, char** argv, const std::string& process
     const CpuWakeLatencyRequest wake = HoldCpuWakeLatency();
     UdpLcm lcm(common->lcm);
     lcm.SetSender({session, wire::ProcessCode(process), static_cast<std::int32_t>(getpid())});
+    if (!common->journal_dir.empty()) {
+      lcm.SetJournal(Journal::CreateIn(common->journal_dir, process, RestartNumber()));
+      spdlog::info("journal: {}", lcm.journal()->path());
+    }
     if (session != 0) spdlog::info("session {}", wire::FormatSessionId(session));
     return body(config, lcm);
   } catch (const std::exception& e) {
@@ -225,6 +253,10 @@ void NoteTransportCounters(const LcmInterface& lcm, Counters* counters) {
     counters->Set(Counter::kDroppedOtherSession, n);
   if (const std::int64_t n = lcm.other_sender_dropped(); n > 0)
     counters->Set(Counter::kDroppedOtherSender, n);
+  if (const Journal* j = lcm.journal()) {
+    counters->Set(Counter::kJournalEvents, j->events());
+    if (j->failed() > 0) counters->Set(Counter::kJournalFailed, j->failed());
+  }
 }
 
 std::map<std::string, std::int64_t> StatusFigures(const Counters& counters,

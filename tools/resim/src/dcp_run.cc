@@ -212,12 +212,13 @@ Outputs Collect(DcpRunner* r, bool in_memory) {
 // until_frame, when >= 0) against the re-simulated frames and telemetry
 // verdicts, each in increasing order of frame. Counts, and notes the first
 // difference.
-void CompareRange(const Recording& rec, std::size_t begin, std::size_t end, long until_frame,
-                  const std::vector<Verdict>& frames, const std::vector<Verdict>& telemetry,
-                  ResimResult* result) {
+void CompareRange(const Recording& rec, const Plan& plan, std::size_t begin, std::size_t end,
+                  long until_frame, const std::vector<Verdict>& frames,
+                  const std::vector<Verdict>& telemetry, ResimResult* result) {
   for (std::size_t i = begin; i < end; ++i) {
     const std::int64_t frame = rec.dcp_frames[i].frame;
     if (until_frame >= 0 && frame > until_frame) break;
+    if (!plan.Checked(i)) continue;  // lost before it from every source: not re-made
     ++result->compared;
     const Verdict* made = FindFrame(frames, frame);
     bool same = made && made->kind == Verdict::kSame;
@@ -244,9 +245,9 @@ void CompareRange(const Recording& rec, std::size_t begin, std::size_t end, long
 
 // The whole comparison, from the plan's first frame; a state that differed
 // is the first difference when no frame is.
-void CompareWithRecording(const Recording& rec, std::size_t first, long until_frame,
+void CompareWithRecording(const Recording& rec, const Plan& plan, long until_frame,
                           const Outputs& out, ResimResult* result) {
-  CompareRange(rec, first, rec.dcp_frames.size(), until_frame, out.frame_verdicts,
+  CompareRange(rec, plan, plan.first, rec.dcp_frames.size(), until_frame, out.frame_verdicts,
                out.telemetry_verdicts, result);
   if (result->first_difference.empty() && !result->state_difference.empty()) {
     result->first_difference = result->state_difference;
@@ -279,11 +280,11 @@ bool Within(const std::vector<Msg>& v, std::int64_t from, std::int64_t below) {
              v.end() &&
          (v.empty() || (v.front().frame >= from && v.back().frame < below));
 }
-bool HalfAgrees(const Recording& rec, std::size_t begin, std::size_t end, std::int64_t from,
-                std::int64_t below, const DcpRunner& half, ResimResult* result) {
+bool HalfAgrees(const Recording& rec, const Plan& plan, std::size_t begin, std::size_t end,
+                std::int64_t from, std::int64_t below, const DcpRunner& half, ResimResult* result) {
   if (!Within(half.frame_verdicts, from, below) || !Within(half.telemetry_verdicts, from, below))
     return false;
-  CompareRange(rec, begin, end, -1, half.frame_verdicts, half.telemetry_verdicts, result);
+  CompareRange(rec, plan, begin, end, -1, half.frame_verdicts, half.telemetry_verdicts, result);
   return result->first_difference.empty() && result->state_difference.empty() &&
          result->identical == result->compared;
 }
@@ -375,7 +376,8 @@ bool RunInHalves(const LabConfig& config, const Recording& rec, const Plan& plan
     second.emplace(config, rec, "", false, n - split);
     second->StartFrom(at, &second_result);
     second->Run(plan, split + 1, n, -1, {}, &second_result);
-    second_agrees = HalfAgrees(rec, middle, end, boundary, INT64_MAX, *second, &second_result);
+    second_agrees =
+        HalfAgrees(rec, plan, middle, end, boundary, INT64_MAX, *second, &second_result);
   });
   ResimResult whole;
   bool first_agrees = false;
@@ -383,7 +385,7 @@ bool RunInHalves(const LabConfig& config, const Recording& rec, const Plan& plan
     first->Run(plan, 0, split + 1, -1, progress, result);  // through the state at the split
     whole = *result;
     first_agrees = ContinuesAsLogged(plan, split, first->node()) &&
-                   HalfAgrees(rec, begin, middle, INT64_MIN, boundary, *first, &whole);
+                   HalfAgrees(rec, plan, begin, middle, INT64_MIN, boundary, *first, &whole);
   } catch (...) {
     other->Finish();  // the other half refers to this frame's variables
     throw;
@@ -412,7 +414,8 @@ Outputs RunAndCompare(const LabConfig& config, const Recording& rec, const Plan&
   const std::size_t n = plan.steps.size();
   const bool whole_own_run = !options.other_design && options.out_log.empty() &&
                              options.until_frame < 0 && options.other_core;
-  const std::size_t split = whole_own_run ? SplitStep(plan) : 0;
+  // (A plan that goes on past frames lost from every source runs as one.)
+  const std::size_t split = whole_own_run && plan.unchecked.empty() ? SplitStep(plan) : 0;
   const auto t_run = Clock::now();
   DcpRunner first(config, rec, options.out_log, options.other_design, n);
   Outputs out;
@@ -430,7 +433,7 @@ Outputs RunAndCompare(const LabConfig& config, const Recording& rec, const Plan&
     result->checkpoint_text = wire::CheckpointText(first.node().MakeCheckpoint());
   out = Collect(&first, options.other_design && options.out_log.empty());
   result->frames = static_cast<long>(out.frame_verdicts.size());
-  CompareWithRecording(rec, plan.first, options.until_frame, out, result);
+  CompareWithRecording(rec, plan, options.until_frame, out, result);
   if (!result->out_dir.empty()) {
     transport::WriteStatsJson((fs::path(result->out_dir) / "stats" / "dynamics_proc.json").string(),
                               "dynamics_proc", first.node().counters(), first.node().latencies());

@@ -78,6 +78,31 @@ std::string LeftOut(const session::SenderCheck& check) {
          ")";
 }
 
+// Of each DCP frame's telemetry, the first logged that answers the operator
+// frame the (kept) DCP frame of its number answered, as the summary believes
+// it (docs/security.md "What the summary trusts"); a frame with none keeps
+// its first.
+void KeepAnsweringTelemetry(Recording* r) {
+  std::vector<std::int64_t> frames, inputs;
+  for (const RecordedDcpFrame& f : r->dcp_frames) {
+    frames.push_back(f.frame);
+    inputs.push_back(f.input_frame);
+  }
+  SortByFrameKeeping(&r->telemetry, [&](auto first, auto last) {
+    const auto at = std::lower_bound(frames.begin(), frames.end(), first->frame);
+    if (last - first == 1 || at == frames.end() || *at != first->frame) return first;
+    const std::int64_t want = inputs[static_cast<std::size_t>(at - frames.begin())];
+    for (auto it = first; it != last; ++it) {
+      std::int64_t input = -1;
+      if (wire::ReadInt64At(r->BytesOf(*it), static_cast<int>(it->size),
+                            wire::kDcpFrameInputFrameAt, &input) &&
+          input == want)
+        return it;
+    }
+    return first;
+  });
+}
+
 }  // namespace
 
 Recording ReadRecording(session::SessionLog& log, const session::SessionLog::TwoParts& parts) {
@@ -102,8 +127,9 @@ Recording ReadRecording(session::SessionLog& log, const session::SessionLog::Two
       parts);
   if (in_two) Append(std::move(second), &r);
   r.read_in_two = in_two;
-  SortByFrame(&r.inputs);
-  SortByFrame(&r.telemetry);
+  // The first of a frame's inputs: the one the live DCP took (a later copy
+  // is a duplicate it dropped).
+  SortByFrameKeeping(&r.inputs, [](auto first, auto) { return first; });
   if (r.dcp_frames.empty())
     throw InputError(log.log_path() + ": no RMS_DCP_FRAME recorded: nothing to re-simulate" +
                      LeftOut(log.check()));
@@ -122,6 +148,7 @@ Recording ReadRecording(session::SessionLog& log, const session::SessionLog::Two
     }
     r.dcp_frames = std::move(kept);
   }
+  KeepAnsweringTelemetry(&r);
   return r;
 }
 
@@ -176,58 +203,115 @@ const LoggedState* StartState(const Recording& r, Plan* plan) {
 
 }  // namespace
 
-Plan MakePlan(const Recording& r) {
-  Plan plan;
-  const LoggedState* start = StartState(r, &plan);
-  std::int64_t prev_frame = -1, prev_input = -1;
-  bool pending_resume = false;
+namespace {
+
+// The inputs logged after `after` and before `before`, operator frames in order.
+std::vector<std::int64_t> InputsBetween(const Recording& r, std::int64_t after,
+                                        std::int64_t before) {
+  std::vector<std::int64_t> between;
+  auto it =
+      std::upper_bound(r.inputs.begin(), r.inputs.end(), after,
+                       [](std::int64_t f, const RecordedMessage& in) { return f < in.frame; });
+  for (; it != r.inputs.end() && it->frame < before; ++it) between.push_back(it->frame);
+  return between;
+}
+
+// Builds the plan frame by frame (MakePlan).
+class Planner {
+ public:
+  explicit Planner(const Recording& r) : r_(r) {}
+
+  Plan Make() {
+    const LoggedState* start = StartState(r_, &plan_);
+    if (start) Take(start->m, true);
+    next_state_ = start ? static_cast<std::size_t>(start - r_.states.data()) + 1 : 0;
+    for (std::size_t k = plan_.first; k < r_.dcp_frames.size();) k = Frame(k);
+    return std::move(plan_);
+  }
+
+ private:
   // Where a state leaves the numbering: the next frame's, or (a resumed
   // process) the first frame after it sets it.
-  auto take = [&](const dcp_state_t& m, bool first) {
-    plan.steps.push_back({&m, -1, first});
+  void Take(const dcp_state_t& m, bool first) {
+    plan_.steps.push_back({&m, -1, first});
     if (m.reason == dcp_state_t::PERIODIC && !first) return;
-    pending_resume = m.resume_pending;
-    prev_frame = m.next_frame - 1;
-    prev_input = m.input_frame;
-  };
-  if (start) take(start->m, true);
-  std::size_t next_state = start ? static_cast<std::size_t>(start - r.states.data()) + 1 : 0;
-  for (std::size_t k = plan.first; k < r.dcp_frames.size(); ++k) {
-    for (; next_state < r.states.size() && r.states[next_state].before <= k; ++next_state) {
-      if (r.states[next_state].before == k) take(r.states[next_state].m, false);
+    pending_resume_ = m.resume_pending;
+    prev_frame_ = m.next_frame - 1;
+    prev_input_ = m.input_frame;
+  }
+
+  // Recorded DCP frame k, with the states logged before it; the index of
+  // the next frame to plan.
+  std::size_t Frame(std::size_t k) {
+    const std::size_t steps_before = plan_.steps.size();
+    for (; next_state_ < r_.states.size() && r_.states[next_state_].before <= k; ++next_state_) {
+      if (r_.states[next_state_].before == k) Take(r_.states[next_state_].m, false);
     }
-    const RecordedDcpFrame& f = r.dcp_frames[k];
-    if (pending_resume) {  // the first frame after a resume: nothing between was made
-      prev_frame = f.frame - 1;
-      pending_resume = false;
+    const RecordedDcpFrame& f = r_.dcp_frames[k];
+    if (pending_resume_) {  // the first frame after a resume: nothing between was made
+      prev_frame_ = f.frame - 1;
+      pending_resume_ = false;
     }
-    const std::int64_t lost = f.frame - prev_frame - 1;
+    const std::int64_t lost = f.frame - prev_frame_ - 1;
+    std::string why;
+    std::vector<std::int64_t> between;
     if (lost > 0) {
       // The DCP answered `lost` inputs between prev_input and this frame's
       // that the log does not show: unambiguous only if exactly that many
       // were logged.
-      std::vector<std::int64_t> between;
-      auto it =
-          std::upper_bound(r.inputs.begin(), r.inputs.end(), prev_input,
-                           [](std::int64_t f, const RecordedMessage& in) { return f < in.frame; });
-      for (; it != r.inputs.end() && it->frame < f.input_frame; ++it) between.push_back(it->frame);
-      if (static_cast<std::int64_t>(between.size()) != lost) {
-        throw InputError("the log lost " + Frames(prev_frame + 1, f.frame - 1) +
-                         " and which operator frames they answered cannot be told (" +
-                         std::to_string(between.size()) +
-                         " logged between): the re-simulation cannot be exact");
-      }
-      for (const std::int64_t in : between) plan.steps.push_back({nullptr, in, false});
+      between = InputsBetween(r_, prev_input_, f.input_frame);
+      if (static_cast<std::int64_t>(between.size()) != lost)
+        why = "lost from every source, and which operator frames they answered cannot be told (" +
+              std::to_string(between.size()) + " logged between)";
     } else if (lost < 0) {
-      throw InputError("DCP frame " + std::to_string(f.frame) + " follows " +
-                       Frames(prev_frame, prev_frame) +
-                       " with no RMS_DCP_STATE between to say why: the log cannot be re-simulated");
+      why = "DCP frame " + std::to_string(f.frame) + " follows DCP frame " +
+            std::to_string(prev_frame_) + " with no RMS_DCP_STATE between to say why";
     }
-    plan.steps.push_back({nullptr, f.input_frame, false});
-    prev_frame = f.frame;
-    prev_input = f.input_frame;
+    if (why.empty() && !FindFrame(r_.inputs, f.input_frame))
+      why = "operator frame " + std::to_string(f.input_frame) + ", which DCP frame " +
+            std::to_string(f.frame) + " answered, is not in the log";
+    if (!why.empty())
+      return Skip(k, steps_before, lost > 0 ? prev_frame_ + 1 : f.frame,
+                  lost > 0 ? f.frame - 1 : f.frame, why);
+    for (const std::int64_t in : between) plan_.steps.push_back({nullptr, in, false});
+    plan_.steps.push_back({nullptr, f.input_frame, false});
+    prev_frame_ = f.frame;
+    prev_input_ = f.input_frame;
+    return k + 1;
   }
-  return plan;
-}
+
+  // Frames from recorded frame k on cannot be re-made from here: the run
+  // goes on from the next state logged at or after k (the states of k taken
+  // above are undone: the one to go on from is taken as a start), the
+  // frames before it left unchecked. Returns the index to go on from.
+  std::size_t Skip(std::size_t k, std::size_t steps_before, std::int64_t lost_from,
+                   std::int64_t lost_to, const std::string& why) {
+    plan_.steps.resize(steps_before);
+    // A state taken to go on from, that frame k does not follow either, is
+    // not taken again: the next one is.
+    std::size_t s = min_state_;
+    while (s < r_.states.size() && r_.states[s].before < k) ++s;
+    Unchecked u{k, r_.dcp_frames.size(), lost_from, lost_to, why};
+    if (s < r_.states.size() && r_.states[s].before < r_.dcp_frames.size()) {
+      u.end = r_.states[s].before;
+      Take(r_.states[s].m, true);
+      next_state_ = min_state_ = s + 1;
+    } else {
+      next_state_ = min_state_ = r_.states.size();
+    }
+    plan_.unchecked.push_back(u);
+    return u.end;
+  }
+
+  const Recording& r_;
+  Plan plan_;
+  std::size_t next_state_ = 0, min_state_ = 0;
+  std::int64_t prev_frame_ = -1, prev_input_ = -1;
+  bool pending_resume_ = false;
+};
+
+}  // namespace
+
+Plan MakePlan(const Recording& r) { return Planner(r).Make(); }
 
 }  // namespace rms::resim

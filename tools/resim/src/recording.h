@@ -44,11 +44,13 @@ struct LoggedState {
 
 struct Recording {
   std::string suffix;
-  std::vector<RecordedMessage> inputs;       // by operator frame (the last logged of a frame)
+  std::vector<RecordedMessage> inputs;       // by operator frame (the first logged of a frame)
   std::vector<RecordedDcpFrame> dcp_frames;  // in log order, undecoded
-  std::vector<RecordedMessage> telemetry;    // by DCP frame (the last logged of a frame), undecoded
-  std::vector<LoggedState> states;           // in log order
-  bool read_in_two = false;                  // the log read in two parts at once
+  // By DCP frame, undecoded: of a frame's, the first logged that answers the
+  // operator frame its DCP frame answered (else the first).
+  std::vector<RecordedMessage> telemetry;
+  std::vector<LoggedState> states;  // in log order
+  bool read_in_two = false;         // the log read in two parts at once
   // The inputs' and the telemetry's, one after another, by the part of the
   // log they were read in.
   std::array<std::vector<std::uint8_t>, 2> bytes;
@@ -84,6 +86,23 @@ void SortByFrame(std::vector<Msg>* v) {
   v->swap(kept);
 }
 
+// The same, keeping of each frame's messages the one `pick` chooses among
+// [first, last) (in the order they were logged).
+template <class Msg, class Pick>
+void SortByFrameKeeping(std::vector<Msg>* v, const Pick& pick) {
+  std::stable_sort(v->begin(), v->end(),
+                   [](const Msg& a, const Msg& b) { return a.frame < b.frame; });
+  std::vector<Msg> kept;
+  kept.reserve(v->size());
+  for (auto it = v->begin(); it != v->end();) {
+    auto end = it + 1;
+    while (end != v->end() && end->frame == it->frame) ++end;
+    kept.push_back(std::move(*pick(it, end)));
+    it = end;
+  }
+  v->swap(kept);
+}
+
 // The message of a frame in a vector SortByFrame made, or null.
 template <class Msg>
 const Msg* FindFrame(const std::vector<Msg>& v, std::int64_t frame) {
@@ -112,16 +131,37 @@ struct Step {
   bool first = false;  // the state the re-simulation starts from (taken, whatever its reason)
 };
 
+// Recorded DCP frames the re-simulation could not check: lost from every
+// source before them (a crash), so which inputs the DCP answered there
+// cannot be told; the run goes on from the next state logged after them
+// (docs/sessions.md "Re-simulation", "Through what is lost").
+struct Unchecked {
+  std::size_t begin = 0, end = 0;           // recorded DCP frames [begin, end), by index
+  std::int64_t lost_from = 0, lost_to = 0;  // the DCP frames lost before them
+  std::string why;
+};
+
 struct Plan {
   std::vector<Step> steps;
   std::size_t first = 0;  // the index of the first recorded DCP frame re-simulated
   std::string note;       // what the log lacks, when it does not start at the session's start
+  std::vector<Unchecked> unchecked;  // in order, after `first`
+  // Whether recorded DCP frame i is checked: at or after `first`, in no
+  // unchecked stretch.
+  bool Checked(std::size_t i) const {
+    if (i < first) return false;
+    for (const Unchecked& u : unchecked)
+      if (i >= u.begin && i < u.end) return false;
+    return true;
+  }
 };
 
 // The operator frame each DCP frame answered, in DCP frame order, with the
 // logged states in their places, and DCP frames the recorder lost filled in
-// where that is unambiguous; throws InputError where the log cannot be
-// re-simulated exactly.
+// where that is unambiguous; where it is not (frames lost from every
+// source), the stretch up to the next logged state is left unchecked
+// (Plan::unchecked) and the run goes on from that state. Throws InputError
+// only where nothing can be re-simulated.
 Plan MakePlan(const Recording& r);
 
 }  // namespace rms::resim

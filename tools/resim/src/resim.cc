@@ -218,6 +218,40 @@ std::string LogShorterThanSummary(const nlohmann::json& summary, const Recording
          ", and the recorded outcome is the whole session's";
 }
 
+// The stretches of recorded frames left unchecked after frames lost from
+// every source (Plan::unchecked), in words and as the result's list.
+void NoteUnchecked(const Recording& rec, const Plan& plan, ResimResult* result) {
+  for (const Unchecked& u : plan.unchecked) {
+    const long frames = static_cast<long>(u.end - u.begin);
+    result->unchecked_frames += frames;
+    nlohmann::ordered_json e = {{"lost_from", u.lost_from}, {"lost_to", u.lost_to}, {"why", u.why}};
+    std::string where;
+    if (frames > 0) {
+      const std::int64_t a = rec.dcp_frames[u.begin].frame, b = rec.dcp_frames[u.end - 1].frame;
+      e["unchecked_from"] = a;
+      e["unchecked_to"] = b;
+      e["unchecked_frames"] = frames;
+      where = "DCP frames " + std::to_string(a) + ".." + std::to_string(b) + " (" +
+              std::to_string(frames) + " recorded) not checked: ";
+    }
+    const std::string lost =
+        u.lost_from == u.lost_to
+            ? "DCP frame " + std::to_string(u.lost_from)
+            : "DCP frames " + std::to_string(u.lost_from) + ".." + std::to_string(u.lost_to);
+    std::string goes_on = "nothing after them was re-simulated (no RMS_DCP_STATE logged later)";
+    if (u.end < rec.dcp_frames.size()) {
+      e["resumed_at"] = rec.dcp_frames[u.end].frame;
+      goes_on = "re-simulated again from the state logged before DCP frame " +
+                std::to_string(rec.dcp_frames[u.end].frame);
+    }
+    std::string said = where;
+    said.append("before them, ").append(lost).append(": ").append(u.why).append("; ");
+    said += goes_on;
+    AddNote(said, &result->note);
+    result->unchecked.push_back(std::move(e));
+  }
+}
+
 // --until: a frame the re-simulation reaches, with its own design.
 void CheckUntil(const Recording& rec, const Plan& plan, const ResimOptions& opt,
                 bool other_design) {
@@ -406,6 +440,7 @@ ResimResult Resimulate(const ResimOptions& opt) {
                       "re-simulated up to them";
   }
   result.note = plan.note;
+  NoteUnchecked(rec, plan, &result);
   // Another design is judged against the recorded outcome: a log cut short
   // (or changed) since the session's summary was made holds less than it,
   // and the difference is the log's, not the design's.

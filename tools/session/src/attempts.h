@@ -67,7 +67,7 @@ class AttemptLog {
   void Clearances(const dcp_telemetry_t& m, Attempt* a) const;
   nlohmann::ordered_json AttemptJson(const Attempt& a) const;
 
-  const LabConfig& config_;
+  const LabConfig config_;  // a copy: the summary builds the log from a temporary
   std::vector<Attempt> attempts_;
   std::string pending_restore_;
   bool last_reset_ = false;

@@ -73,6 +73,15 @@ void LossLines(const Json& j, std::ostream& os) {
     }
     os << "\n";
   }
+  if (j["record"].contains("network") && j["record"]["network"].value("missed", 0) > 0) {
+    os << "the network's recorder missed " << j["record"]["network"]["missed"]
+       << " messages (a loaded machine, a stopped recorder): the record has each from the "
+          "journal of the process that sent it\n";
+  }
+  if (j["record"].value("journal_failed", 0) > 0) {
+    os << "the processes' journals could not hold " << j["record"]["journal_failed"]
+       << " messages (a full disk): the record has those the network's recorder heard\n";
+  }
   if (j["ignored"].value("total", 0) > 0) {
     os << "left out " << j["ignored"]["total"]
        << " logged messages (another session's, or not believed):";
@@ -184,6 +193,37 @@ void SessionLines(const Json& j, std::ostream& os) {
   }
 }
 
+// A number of the verdict, as text ("?" when it is not one).
+std::string Count(const Json& v, const char* key) {
+  return v.contains(key) && v[key].is_number_integer() ? std::to_string(v[key].get<std::int64_t>())
+                                                       : "?";
+}
+
+// Whether the session re-simulates (summary.json "resimulation";
+// docs/sessions.md "Does it re-simulate"): one line, "re-simulates: ...".
+void ResimulationLine(const Json& j, std::ostream& os) {
+  if (!j.contains("resimulation") || !j["resimulation"].is_object()) return;
+  const Json& v = j["resimulation"];
+  const std::string what = v.value("verdict", "");
+  if (what == "identical") {
+    os << "re-simulates: identical (" << Count(v, "frames_identical") << " of "
+       << Count(v, "frames_compared") << " DCP frames, word for word";
+    const std::int64_t unchecked = v.value("frames_unchecked", std::int64_t{0}) +
+                                   v.value("frames_skipped_at_start", std::int64_t{0});
+    if (unchecked > 0 || !v.value("exact", true))
+      os << "; " << unchecked << " not checked: " << v.value("note", std::string());
+    os << ")\n";
+  } else if (what == "differs") {
+    os << "re-simulates: NO -- it differs from the recording at "
+       << (v["first_difference"].is_string() ? v["first_difference"].get<std::string>() : "?")
+       << " (" << Count(v, "frames_identical") << " of " << Count(v, "frames_compared")
+       << " DCP frames identical; scripts/lab resim SESSION says more)\n";
+  } else {
+    os << "re-simulates: NO -- it cannot be re-simulated: "
+       << (v.contains("why") && v["why"].is_string() ? v["why"].get<std::string>() : what) << "\n";
+  }
+}
+
 }  // namespace
 
 void PrintBrief(const Json& summary, std::ostream& os) {
@@ -191,6 +231,7 @@ void PrintBrief(const Json& summary, std::ostream& os) {
   LossLines(summary, os);
   OutcomeLines(summary, os);
   SessionLines(summary, os);
+  ResimulationLine(summary, os);
 }
 
 }  // namespace rms::session

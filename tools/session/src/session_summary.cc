@@ -578,6 +578,21 @@ nlohmann::ordered_json Restarts(const fs::path& root) {
   return restarts;
 }
 
+// What the session's re-simulation at its end came to (SESSION/
+// resimulation.json, written by rms_resim --verdict-json; docs/sessions.md
+// "Does it re-simulate"), or null when it was not run.
+nlohmann::ordered_json Resimulation(const fs::path& root) {
+  const nlohmann::json v = ReadJson(root / "resimulation.json");
+  if (!v.is_object() || !v.contains("verdict") || !v["verdict"].is_string()) return nullptr;
+  nlohmann::ordered_json out;
+  for (const char* k :
+       {"verdict", "exact", "frames_compared", "frames_identical", "frames_unchecked",
+        "frames_skipped_at_start", "unchecked", "first_difference", "why", "note"}) {
+    if (v.contains(k)) out[k] = v[k];
+  }
+  return out;
+}
+
 void AddMission(int final_mode, const std::set<int>& modes, const TelemetryLog& telemetry,
                 nlohmann::ordered_json* out) {
   nlohmann::ordered_json& j = *out;
@@ -691,24 +706,57 @@ nlohmann::ordered_json TimingJson(const std::map<std::string, nlohmann::json>& s
 // its publisher says it sent against those the log holds -- frames the
 // recorder lost (it fell behind, was stopped, or its disk filled), distinct
 // from frames lost on the way between the processes.
+// A count in record.json (docs/sessions.md "The record"), 0 when it is not
+// there or not a count.
+std::int64_t RecordCount(const nlohmann::json& j, std::initializer_list<const char*> path) {
+  const nlohmann::json* at = &j;
+  for (const char* k : path) {
+    if (!at->is_object() || !at->contains(k)) return 0;
+    at = &(*at)[k];
+  }
+  return at->is_number_integer() ? at->get<std::int64_t>() : 0;
+}
+
+// What the processes' journals hold of a channel (record.json), or -1 when
+// the record was not made from journals.
+std::int64_t Journaled(const nlohmann::json& record, const std::string& channel) {
+  if (!record.is_object() || !(record.value("made", false) == true) ||
+      !record.contains("journals") || !record["journals"].is_array())
+    return -1;
+  std::int64_t n = 0;
+  for (const auto& jf : record["journals"]) n += RecordCount(jf, {"by_channel", channel.c_str()});
+  return n;
+}
+
+// The record's own losses (docs/sessions.md "Losses", "The record"): each
+// channel's frames its publisher sent -- what its journals hold, or (a
+// session without journals) the publisher's own count -- against those the
+// log holds; and what the network's recorder missed, which the journals made
+// good.
 nlohmann::ordered_json RecordJson(const std::map<std::string, nlohmann::json>& stats,
-                                  const LogScan& s) {
+                                  const LogScan& s, const nlohmann::json& record,
+                                  const std::string& suffix) {
   struct Row {
     const char* channel;
     std::int64_t published, logged;
   };
+  const bool journals = Journaled(record, "") >= 0;
+  auto published = [&](const char* channel, const char* process) {
+    return journals ? Journaled(record, channel + suffix)
+                    : CounterOf(stats.at(process), rms::Counter::kPublished);
+  };
   const Row rows[] = {
       {wire::channels::kOperatorInput,
-       CounterOf(stats.at("operator_station"), rms::Counter::kPublished), s.input.received()},
-      {wire::channels::kDcpFrame, CounterOf(stats.at("dynamics_proc"), rms::Counter::kPublished),
+       published(wire::channels::kOperatorInput, "operator_station"), s.input.received()},
+      {wire::channels::kDcpFrame, published(wire::channels::kDcpFrame, "dynamics_proc"),
        s.dcp.received()},
-      {wire::channels::kDcpTelemetry,
-       CounterOf(stats.at("dynamics_proc"), rms::Counter::kPublished),
+      {wire::channels::kDcpTelemetry, published(wire::channels::kDcpTelemetry, "dynamics_proc"),
        static_cast<std::int64_t>(s.telemetry_logged.size())},
-      {wire::channels::kEsgFrame, CounterOf(stats.at("scene_proc"), rms::Counter::kPublished),
+      {wire::channels::kEsgFrame, published(wire::channels::kEsgFrame, "scene_proc"),
        s.esg.received()},
   };
   nlohmann::ordered_json r;
+  r["source"] = journals ? "journals" : "network";
   std::int64_t lost = 0;
   for (const Row& row : rows) {
     if (row.published <= 0)
@@ -719,6 +767,26 @@ nlohmann::ordered_json RecordJson(const std::map<std::string, nlohmann::json>& s
     lost += l;
   }
   r["lost"] = lost;
+  std::int64_t journal_failed = 0;
+  for (const auto& [p, st] : stats) journal_failed += CounterOf(st, rms::Counter::kJournalFailed);
+  r["journal_failed"] = journal_failed;
+  if (journals) {
+    nlohmann::ordered_json missed = nlohmann::ordered_json::object();
+    if (record["wire"].is_object() && record["wire"].contains("missed") &&
+        record["wire"]["missed"].contains("by_channel") &&
+        record["wire"]["missed"]["by_channel"].is_object()) {
+      for (const auto& [ch, n] : record["wire"]["missed"]["by_channel"].items()) {
+        std::string base = ch;
+        if (!suffix.empty() && base.size() > suffix.size() &&
+            base.compare(base.size() - suffix.size(), suffix.size(), suffix) == 0)
+          base.resize(base.size() - suffix.size());
+        if (n.is_number_integer()) missed[base] = n.get<std::int64_t>();
+      }
+    }
+    r["network"] = {{"missed", RecordCount(record, {"wire", "missed", "total"})},
+                    {"missed_by_channel", missed},
+                    {"only_in_network", RecordCount(record, {"wire", "only_there"})}};
+  }
   return r;
 }
 
@@ -845,6 +913,7 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
 
   nlohmann::ordered_json j;
   AddSessionFields(root, s, duration_s, check.session_id(), &j);
+  j["resimulation"] = Resimulation(root);
   j["restarts"] = Restarts(root);
   for (std::size_t i = 0; i < j["restarts"].size(); ++i) attempts.ObserveRestart();
   nlohmann::ordered_json a = attempts.Json();
@@ -869,7 +938,7 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
   j["frames"] = FramesJson(stats);
   j["latency"] = LatencyJson(stats);
   j["timing"] = TimingJson(stats, rate_hz);
-  j["record"] = RecordJson(stats, s);
+  j["record"] = RecordJson(stats, s, ReadJson(root / "record.json"), log.suffix());
   j["log"] = LogSection(s, log, stats);
   j["ignored"] = check.Json();
   ForPeople(&j);

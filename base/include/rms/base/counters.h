@@ -210,6 +210,8 @@ enum class Counter : std::uint16_t {
   kHttpRequests,
   kHttpRefused,
   kControlSent,
+  kJournalEvents,
+  kJournalFailed,
   kNumCounters
 };
 inline constexpr int kNumCounters = static_cast<int>(Counter::kNumCounters);
@@ -573,6 +575,12 @@ inline constexpr std::array<CounterInfo, kNumCounters> kCounterTable = {{
      "web requests refused: no or a wrong token, a bad path or parameter (docs/security.md)"},
     {Counter::kControlSent, "control.sent", "I",
      "RMS_CONTROL commands sent from the web page (docs/instructor.md)"},
+    {Counter::kJournalEvents, "journal.events", "O, D, S, E, I",
+     "messages this run wrote whole to its journal, every channel (docs/sessions.md \"The "
+     "record\")"},
+    {Counter::kJournalFailed, "journal.failed", "O, D, S, E, I",
+     "messages its journal could not hold (a full disk): the record has them only if the "
+     "recorder heard them"},
 }};
 
 constexpr bool CounterTableInOrder() {

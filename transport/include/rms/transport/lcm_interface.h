@@ -20,6 +20,8 @@ class LogFile;
 
 namespace rms::transport {
 
+class Journal;
+
 // Default URL: UDP multicast on this host only (TTL 0). docs/protocol.md "Transport".
 inline constexpr const char* kDefaultLcmUrl = "udpm://239.255.76.67:7667?ttl=0";
 
@@ -63,7 +65,7 @@ class LcmInterface {
   // UDP, the log's timestamp for a log).
   using Handler = std::function<void(const void* data, int size, std::int64_t recv_time_us)>;
 
-  virtual ~LcmInterface() = default;
+  virtual ~LcmInterface();
   LcmInterface(const LcmInterface&) = delete;
   LcmInterface& operator=(const LcmInterface&) = delete;
 
@@ -93,6 +95,12 @@ class LcmInterface {
   // docs/security.md "Sessions know each other").
   std::int64_t other_sender_dropped() const { return other_sender_dropped_; }
 
+  // What this process publishes goes to its journal too, before the wire
+  // (rms/transport/journal.h; docs/sessions.md "The record"). UdpLcm only: a
+  // log-backed transport writes its own log.
+  void SetJournal(std::unique_ptr<Journal> journal);
+  const Journal* journal() const { return journal_.get(); }
+
   // A one-publisher channel takes another publisher (a restarted process's
   // new pid) only after the current one has been silent this long.
   static constexpr std::int64_t kPublisherSilenceUs = 100000;
@@ -102,9 +110,13 @@ class LcmInterface {
   // The session filter every transport applies before dispatching: true
   // to hand the message on.
   bool Admit(const std::string& channel, const void* data, int size);
+  // A message about to be published, into the journal when there is one
+  // (a failure is the journal's to count).
+  void Journalize(const std::string& full_channel, const void* data, int size);
 
  private:
   bool AdmitPublisher(const std::string& channel, const void* data, int size);
+  std::unique_ptr<Journal> journal_;
   struct Publisher {
     std::int8_t process = 0;
     std::int32_t pid = 0;

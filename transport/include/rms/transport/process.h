@@ -29,6 +29,9 @@ struct CommonOptions {
   std::string log_level = "info";  // --log-level
   bool check = false;  // --check: check the configuration (and the process's own files), then exit
   std::string session_id;  // --session-id (default: RMSLAB_SESSION_ID, else 0: no session)
+  // --journal-dir: every message published goes to DIR/PROCESS.N.lcmlog
+  // too, before the wire (rms/transport/journal.h); "" for none.
+  std::string journal_dir;
 };
 
 void AddCommonOptions(CLI::App& app, CommonOptions* options);

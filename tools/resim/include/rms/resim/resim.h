@@ -62,6 +62,12 @@ struct ResimResult {
   std::string first_decision;        // ... which word ("control_word", "arm_words[3]", "missing")
   long skipped = 0;  // recorded DCP frames not re-simulated (the log lacks the state before them)
   std::string note;  // ... said in words ("" if none)
+  // Recorded DCP frames not checked because frames before them were lost
+  // from every source (a crash): how many, and each stretch (lost_from,
+  // lost_to, why, unchecked_from, unchecked_to, unchecked_frames,
+  // resumed_at); said in `note` too.
+  long unchecked_frames = 0;
+  nlohmann::ordered_json unchecked = nlohmann::ordered_json::array();
   std::string log_note;     // the log's end is no whole event ("" if it is)
   long states_taken = 0;    // logged RMS_DCP_STATE taken (start, restores, resumes)
   long states_checked = 0;  // periodic RMS_DCP_STATE the re-simulated state was checked against
