@@ -27,6 +27,7 @@ TOOLS = [
     "chromium",  # the report's browser test
     "ssh", "nsenter", "ping", "ip", "tc", "nft", "mount", "umount",  # hosts, namespaces, disks
     "ps", "pkill", "timeout", "jq", "python3", "flock", "parallel",  # parallel: scripts/lab sweep
+    "bash", "sudo",  # scripts/lab (python3 installed first where missing), root where the user is not
     "clang-format", "clang-tidy", "run-clang-tidy",  # scripts/lint
 ]
 
