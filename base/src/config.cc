@@ -33,6 +33,19 @@ CameraMount ParseMount(TableReader& r) {
   r.Fail("mount", "must be one of \"shuttle\", \"elbow\", \"wrist\", \"cae\"; got \"" + m + "\"");
 }
 
+// Bounds on the physical keys (docs/config.md "Bounds"): what the models
+// and the wire hold, with room for any design a lab would try. The 24-bit
+// FT12 word holds +-2048 ft; a position is kept within kMaxPositionFt so the
+// arm's reach and the models around it stay within it.
+constexpr double kMaxPositionFt = 1000.0;  // any coordinate of a base, payload, port
+constexpr double kMaxSceneFt = 200.0;      // a cargo bay's or the CAE's extent
+constexpr double kMaxBoomFt = 100.0;       // a boom: twice the flown arm's 50 ft 3 in
+constexpr double kMaxWristFt = 20.0;       // wrist to palm
+constexpr double kMaxPartFt = 10.0;        // the end effector's parts, the boom's diameter
+constexpr double kMaxProbeFt = 20.0;       // the payload's docking probe
+constexpr double kMaxTpobFt = 5.0;         // TPOB
+constexpr double kMaxDockDistanceFt = 10.0;
+
 // [session]
 void ReadSession(TableReader& top, LabConfig* config) {
   LabConfig& c = *config;
@@ -45,9 +58,9 @@ void ReadSession(TableReader& top, LabConfig* config) {
 void ReadShuttle(TableReader& top, LabConfig* config) {
   LabConfig& c = *config;
   TableReader r = top.Sub("shuttle");
-  c.shuttle.bay_length_ft = r.Positive("bay_length_ft");
-  c.shuttle.bay_width_ft = r.Positive("bay_width_ft");
-  c.shuttle.bay_depth_ft = r.Positive("bay_depth_ft");
+  c.shuttle.bay_length_ft = r.Positive("bay_length_ft", kMaxSceneFt);
+  c.shuttle.bay_width_ft = r.Positive("bay_width_ft", kMaxSceneFt);
+  c.shuttle.bay_depth_ft = r.Positive("bay_depth_ft", kMaxSceneFt);
   c.shuttle.door_open_deg = r.Number("door_open_deg", 0.0, 180.0);
   r.Finish();
 }
@@ -56,11 +69,11 @@ void ReadShuttle(TableReader& top, LabConfig* config) {
 void ReadArm(TableReader& top, LabConfig* config) {
   LabConfig& c = *config;
   TableReader r = top.Sub("arm");
-  c.arm.p_RoB_R_ft = r.Vec3("base_position_ft");
-  c.arm.upper_boom_ft = r.Positive("upper_boom_ft");
-  c.arm.lower_boom_ft = r.Positive("lower_boom_ft");
-  c.arm.wrist_to_palm_ft = r.Positive("wrist_to_palm_ft");
-  c.arm.boom_diameter_ft = r.Positive("boom_diameter_ft");
+  c.arm.p_RoB_R_ft = r.Vec3("base_position_ft", kMaxPositionFt);
+  c.arm.upper_boom_ft = r.Positive("upper_boom_ft", kMaxBoomFt);
+  c.arm.lower_boom_ft = r.Positive("lower_boom_ft", kMaxBoomFt);
+  c.arm.wrist_to_palm_ft = r.Positive("wrist_to_palm_ft", kMaxWristFt);
+  c.arm.boom_diameter_ft = r.Positive("boom_diameter_ft", kMaxPartFt);
   const std::vector<double> lo = r.Numbers("joint_min_deg", 6, -180.0, 180.0);
   const std::vector<double> hi = r.Numbers("joint_max_deg", 6, -180.0, 180.0);
   for (int i = 0; i < 6; ++i) {
@@ -81,13 +94,13 @@ void ReadEndEffector(TableReader& top, LabConfig* config) {
   LabConfig& c = *config;
   TableReader r = top.Sub("end_effector");
   auto& e = c.end_effector;
-  e.palm_length_ft = r.Positive("palm_length_ft");
-  e.palm_half_width_ft = r.Positive("palm_half_width_ft");
-  e.palm_half_height_ft = r.Positive("palm_half_height_ft");
-  e.finger_length_ft = r.Positive("finger_length_ft");
-  e.finger_thickness_ft = r.Positive("finger_thickness_ft");
-  e.finger_gap_open_ft = r.Positive("finger_gap_open_ft");
-  e.finger_gap_closed_ft = r.Number("finger_gap_closed_ft", 0.0, 1e4);
+  e.palm_length_ft = r.Positive("palm_length_ft", kMaxPartFt);
+  e.palm_half_width_ft = r.Positive("palm_half_width_ft", kMaxPartFt);
+  e.palm_half_height_ft = r.Positive("palm_half_height_ft", kMaxPartFt);
+  e.finger_length_ft = r.Positive("finger_length_ft", kMaxPartFt);
+  e.finger_thickness_ft = r.Positive("finger_thickness_ft", kMaxPartFt);
+  e.finger_gap_open_ft = r.Positive("finger_gap_open_ft", kMaxPartFt);
+  e.finger_gap_closed_ft = r.Number("finger_gap_closed_ft", 0.0, kMaxPartFt);
   if (e.finger_gap_closed_ft >= e.finger_gap_open_ft) {
     r.Fail("finger_gap_closed_ft", "must be less than end_effector.finger_gap_open_ft");
   }
@@ -104,16 +117,17 @@ void ReadPayload(TableReader& top, LabConfig* config) {
   LabConfig& c = *config;
   TableReader r = top.Sub("payload");
   auto& p = c.payload;
-  p.diameter_ft = r.Positive("diameter_ft");
-  p.length_ft = r.Positive("length_ft");
-  p.probe_diameter_ft = r.Positive("probe_diameter_ft");
+  // The payload rides in the bay in Mode 1: it must fit in it.
+  p.diameter_ft = r.Positive("diameter_ft", c.shuttle.bay_width_ft);
+  p.length_ft = r.Positive("length_ft", c.shuttle.bay_length_ft);
+  p.probe_diameter_ft = r.Positive("probe_diameter_ft", kMaxProbeFt);
   if (p.probe_diameter_ft >= p.diameter_ft)
     r.Fail("probe_diameter_ft", "must be less than payload.diameter_ft");
-  p.probe_length_ft = r.Positive("probe_length_ft");
-  p.p_RoPo_R_ft = r.Vec3("position_ft");
+  p.probe_length_ft = r.Positive("probe_length_ft", kMaxProbeFt);
+  p.p_RoPo_R_ft = r.Vec3("position_ft", kMaxPositionFt);
   p.R_RP = r.Rotation("y_axis", "z_axis");
-  p.p_PoBar_P_ft = r.Vec3("bar_center_ft");
-  p.bar_size_P_ft = r.Vec3("bar_size_ft");
+  p.p_PoBar_P_ft = r.Vec3("bar_center_ft", kMaxSceneFt);
+  p.bar_size_P_ft = r.Vec3("bar_size_ft", kMaxPartFt);
   for (int i = 0; i < 3; ++i) {
     if (!(p.bar_size_P_ft[i] > 0)) r.Fail("bar_size_ft", "every extent must be > 0");
   }
@@ -125,11 +139,11 @@ void ReadCae(TableReader& top, LabConfig* config) {
   LabConfig& c = *config;
   TableReader r = top.Sub("cae");
   auto& a = c.cae;
-  a.p_RoCo_R_ft = r.Vec3("port_position_ft");
+  a.p_RoCo_R_ft = r.Vec3("port_position_ft", kMaxPositionFt);
   a.R_RC = r.Rotation("y_axis", "z_axis");
-  a.across_flats_ft = r.Positive("across_flats_ft");
-  a.length_ft = r.Positive("length_ft");
-  a.port_diameter_ft = r.Positive("port_diameter_ft");
+  a.across_flats_ft = r.Positive("across_flats_ft", kMaxSceneFt);
+  a.length_ft = r.Positive("length_ft", kMaxSceneFt);
+  a.port_diameter_ft = r.Positive("port_diameter_ft", a.across_flats_ft);
   r.Finish();
 }
 
@@ -137,9 +151,9 @@ void ReadCae(TableReader& top, LabConfig* config) {
 void ReadDcp(TableReader& top, LabConfig* config) {
   LabConfig& c = *config;
   TableReader r = top.Sub("dcp");
-  c.dcp.d3y_ft = r.Positive("d3y_ft");
-  c.dcp.tpob_ft = r.Positive("tpob_ft");
-  c.dcp.dock_distance_ft = r.Positive("dock_distance_ft");
+  c.dcp.d3y_ft = r.Positive("d3y_ft", kMaxPartFt);
+  c.dcp.tpob_ft = r.Positive("tpob_ft", kMaxTpobFt);
+  c.dcp.dock_distance_ft = r.Positive("dock_distance_ft", kMaxDockDistanceFt);
   c.dcp.dock_angle_deg = r.Number("dock_angle_deg", 0.0, 90.0, true);
   if (c.dcp.d3y_ft <= c.end_effector.finger_gap_closed_ft) {
     r.Fail("d3y_ft",

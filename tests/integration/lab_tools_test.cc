@@ -41,8 +41,9 @@ using testing::Subprocess;
 using testing::Script;
 using testing::ScriptRun;
 
-// One recorded session (the autopilot, at 4x, small frames), shared by the
-// tests that only read it.
+// One recorded session (the autopilot, at 4x, small frames, on suffixed
+// channels as a station beside others records), shared by the tests that
+// only read it.
 class RecordedSession : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -50,6 +51,7 @@ class RecordedSession : public ::testing::Test {
     dir_ = new std::string(*tmp_ + "/session");
     const ScriptRun r = Script({SourcePath("scripts/lab"), "demo", "--no-build", "--out", *dir_,
                                 "--speed", "4", "--lcm-url", testing::UniqueLcmUrl(9100),
+                                "--channel-suffix", "_BAY2",
                                 "--png-every", "200", "--width", "160", "--height", "120"},
                                *tmp_ + "/lab.log");
     ASSERT_EQ(r.rc, 0) << r.out;
@@ -336,6 +338,52 @@ TEST_F(RecordedSession, ALongerArmFaresOtherwiseAndTheComparisonSaysWhy) {
   EXPECT_NE(why.find("TPOB"), std::string::npos) << why;  // the palm did not come down onto the bar
   EXPECT_NE(why.find("No docking"), std::string::npos) << why;
   EXPECT_NE(ReadFile(out + "/comparison.md").find("arm.upper_boom_ft"), std::string::npos);
+}
+
+// docs/sessions.md "Re-simulation": --set as the README gives it, on a
+// suffixed session and on its own re-simulation; a design out of bounds is
+// refused naming the key; a re-simulation that fails leaves nothing behind.
+TEST_F(RecordedSession, ResimSetWorksOnItAndOnItsReSimulationAndAFailureLeavesNothing) {
+  const std::string lab = SourcePath("scripts/lab");
+  const std::string first = *tmp_ + "/tpob", second = *tmp_ + "/tpob_boom";
+  const ScriptRun a = Script({lab, "resim", *dir_, "--no-build", "--set", "dcp.tpob_ft=0.4",
+                              "--out", first},
+                             *tmp_ + "/set.log");
+  ASSERT_EQ(a.rc, 0) << a.out;
+  const auto s = nlohmann::json::parse(ReadFile(first + "/summary.json"));
+  EXPECT_TRUE(s["docked"].get<bool>()) << "a slacker TPOB changes nothing the autopilot did";
+  EXPECT_EQ(s["result_attempt"], 1) << s.dump(2);
+  EXPECT_EQ(nlohmann::json::parse(ReadFile(first + "/manifest.json"))["lcm"]["channel_suffix"],
+            "_BAY2");
+  // A re-simulation of the re-simulation, with another key set.
+  const ScriptRun b = Script({lab, "resim", first, "--no-build", "--set",
+                              "arm.upper_boom_ft=21.5", "--out", second},
+                             *tmp_ + "/set2.log");
+  ASSERT_EQ(b.rc, 0) << b.out;
+  const auto c = nlohmann::json::parse(ReadFile(second + "/comparison.json"));
+  EXPECT_EQ(c["config_changes"].size(), 1u) << c["config_changes"].dump();
+  EXPECT_EQ(Script({lab, "resim", first, "--no-build"}, *tmp_ + "/own.log").rc, 0);
+  // Out of bounds: refused before anything is made.
+  const ScriptRun far = Script({lab, "resim", *dir_, "--no-build", "--set",
+                                "arm.upper_boom_ft=9000", "--out", *tmp_ + "/far"},
+                               *tmp_ + "/far.log");
+  EXPECT_EQ(far.rc, 2) << far.out;
+  EXPECT_NE(far.out.find("arm.upper_boom_ft"), std::string::npos) << far.out;
+  EXPECT_NE(far.out.find("<= 100"), std::string::npos) << far.out;
+  EXPECT_FALSE(fs::exists(*tmp_ + "/far"));
+  // A run that fails part way (its files cannot be written: a file-size
+  // limit, as a full disk) leaves no folder to refuse the next try.
+  const std::string cut = *tmp_ + "/cut";
+  const ScriptRun fail = Script({"/bin/bash", "-c",
+                                 "trap '' XFSZ; ulimit -f 64; exec " + testing::BuildPath("tools/rms_resim") +
+                                     " " + *dir_ + " --set dcp.tpob_ft=0.4 --out " + cut},
+                                *tmp_ + "/cut.log");
+  EXPECT_NE(fail.rc, 0) << fail.out;
+  EXPECT_FALSE(fs::exists(cut)) << fail.out;
+  EXPECT_EQ(Script({lab, "resim", *dir_, "--no-build", "--set", "dcp.tpob_ft=0.4", "--out", cut},
+                   *tmp_ + "/cut2.log")
+                .rc,
+            0);
 }
 
 TEST_F(RecordedSession, ItReplaysThroughTheSceneAndTheRendererToTheSameFrames) {

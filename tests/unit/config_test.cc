@@ -85,6 +85,13 @@ TEST(Config, EveryProblemNamesTheKeyAndTheReason) {
       {R"(d3y_ft = 0.6)", "d3y_ft = 1.28", "dcp.d3y_ft", "could not let the payload go"},
       {R"(finger_gap_closed_ft = 0.35)", "finger_gap_closed_ft = 0.45", "dcp.d3y_ft",
        "finger could not close onto the bar"},
+      // Upper bounds on the design keys (docs/config.md "Bounds").
+      {R"(upper_boom_ft = 20.9)", "upper_boom_ft = 9000", "arm.upper_boom_ft",
+       "must be <= 100, got 9000"},
+      {R"(diameter_ft = 10.0)", "diameter_ft = 16.0", "payload.diameter_ft", "must be <= 15"},
+      {R"(port_position_ft = \[40.0, 0.0, 40.0\])", "port_position_ft = [40.0, 0.0, 4000.0]",
+       "cae.port_position_ft", "must be <= 1000"},
+      {R"(tpob_ft = 0.3)", "tpob_ft = 50", "dcp.tpob_ft", "must be <= 5"},
   };
   for (const Case& c : cases) {
     const std::string err = ErrorOf(Edit(c.pattern, c.replacement));

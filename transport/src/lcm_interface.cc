@@ -3,6 +3,7 @@
 #include <cctype>
 #include <cerrno>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <lcm/lcm-cpp.hpp>
@@ -228,10 +229,22 @@ bool LogLcm::Publish(std::string_view channel, const void* data, int size) {
     ev.data = const_cast<void*>(data);
     if (out_->writeEvent(&ev) != 0) {
       --pending_count_;  // not sent
+      if (write_failures_++ == 0) write_errno_ = errno ? errno : EIO;
       return false;
     }
   }
   return true;
+}
+
+bool LogLcm::FinishOutput(std::string* why) {
+  if (!out_) return true;
+  FILE* f = out_->getFilePtr();
+  if (write_failures_ == 0 && f && std::fflush(f) == 0 && !std::ferror(f)) return true;
+  const int e = write_failures_ > 0 ? write_errno_ : (errno ? errno : EIO);
+  *why = std::to_string(write_failures_) + " event(s) could not be written, and the log " +
+         (write_failures_ > 0 ? "is short of them" : "could not be flushed") + " (" +
+         std::strerror(e) + ")";
+  return false;
 }
 
 void LogLcm::Subscribe(std::string_view channel, Handler handler) {

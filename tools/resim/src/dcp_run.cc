@@ -109,6 +109,12 @@ class DcpRunner {
     TakeState(m, true, other_design_, &node_, result);
   }
   const dynamics_proc::DynamicsProc& node() const { return node_; }
+  // The new session's log written whole, or InputError naming it.
+  void FinishLog(const std::string& path) {
+    std::string why;
+    if (!lcm_.FinishOutput(&why))
+      throw InputError("cannot write the new session's log " + path + ": " + why);
+  }
 
   std::vector<Verdict> frame_verdicts, telemetry_verdicts;
   std::vector<dcp_frame_t> frames;           // decoded, another design made in memory only
@@ -428,6 +434,7 @@ Outputs RunAndCompare(const LabConfig& config, const Recording& rec, const Plan&
   }
   // One run (or the first half on through the second).
   first.Run(plan, split > 0 ? split + 1 : 0, n, options.until_frame, options.progress, result);
+  if (!options.out_log.empty()) first.FinishLog(options.out_log);
   result->run_seconds = std::chrono::duration<double>(Clock::now() - t_run).count();
   if (options.until_frame >= 0)
     result->checkpoint_text = wire::CheckpointText(first.node().MakeCheckpoint());

@@ -10,7 +10,10 @@ namespace {
 // The summary's result attempt, or an empty object.
 nlohmann::json ResultAttempt(const nlohmann::json& summary) {
   const auto& attempts = summary.value("attempts", nlohmann::json::array());
-  const long i = summary.value("result_attempt", 0L);
+  // null when the session had no attempt (no DCP frame it believed)
+  const nlohmann::json& r = summary.contains("result_attempt") ? summary["result_attempt"]
+                                                               : nlohmann::json();
+  const long i = r.is_number_integer() ? r.get<long>() : 0;
   if (i >= 1 && i <= static_cast<long>(attempts.size())) return attempts[i - 1];
   return nlohmann::json::object();
 }

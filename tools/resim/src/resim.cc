@@ -337,6 +337,9 @@ void WriteNewSession(const RecordedSession& recorded, const std::string& config_
   mf.kind = "re-simulation";
   mf.parent = fs::absolute(session).lexically_normal().string();
   mf.config_source = config_path;
+  // Its log's channels carry the recorded session's suffix: its manifest
+  // says so, or no reader of it would find them.
+  mf.suffix = recorded.recording().suffix;
   if (fs::exists(session / "manifest.json")) {
     try {
       const auto parent =
@@ -450,6 +453,31 @@ ResimResult Resimulate(const ResimOptions& opt) {
   result.skipped = static_cast<long>(plan.first);
   // Another design discarded (a sweep's cell) is made in memory: no session written.
   const bool written = other_design && !opt.discard;
+  // A re-simulation that fails leaves no half-made session behind (it would
+  // refuse the next try): the folder it made goes, or, in a folder given
+  // that was there, what it wrote (docs/sessions.md "Re-simulation").
+  struct NewSession {
+    fs::path dir;
+    bool made_folder = false, done = false;
+    ~NewSession() {
+      if (dir.empty() || done) return;
+      std::error_code ec;
+      if (made_folder) {
+        fs::remove_all(dir, ec);
+        return;
+      }
+      for (const char* f : {"lcmlog", "config.toml", "manifest.json", "summary.json",
+                            "comparison.json", "comparison.md", "run/pilot",
+                            "stats/dynamics_proc.json"})
+        fs::remove(dir / f, ec);
+    }
+  } new_session;
+  if (written) {
+    new_session.dir = opt.out_dir.empty()
+                          ? fs::path(fs::path(opt.session).lexically_normal().string() + "-resim")
+                          : fs::path(opt.out_dir);
+    new_session.made_folder = !fs::exists(new_session.dir);
+  }
   const std::string out_log = written ? OpenNewSession(opt, config_text, &result) : "";
   if (opt.until_frame >= 0) CheckUntil(rec, plan, opt, other_design);
   const Outputs out = RunAndCompare(
@@ -473,6 +501,7 @@ ResimResult Resimulate(const ResimOptions& opt) {
   }
   if (written) {
     WriteNewSession(*recorded, config_path, config_text, config, &result);
+    new_session.done = true;
   } else if (other_design) {
     result.cell = CellJson(recorded->summary(), config,
                            session::SummarizeDcpRun(config, out.published), result);

@@ -1020,7 +1020,9 @@ nlohmann::ordered_json MakeManifest(const std::string& dir, const ManifestFields
   char host[256] = {};
   gethostname(host, sizeof host - 1);
   j["lab_host"] = host;
-  if (!url.empty()) j["lcm"] = {{"url", url}, {"channel_suffix", suffix}};
+  // A re-simulation ran on no network (no url), but its log's channels may
+  // carry a suffix: said, so its readers find them.
+  if (!url.empty() || !suffix.empty()) j["lcm"] = {{"url", url}, {"channel_suffix", suffix}};
   nlohmann::ordered_json layout = nlohmann::ordered_json::object();
   for (const char* p :
        {"operator_station", "dynamics_proc", "scene_proc", "esg_renderer", "lcm-logger"})

@@ -170,6 +170,10 @@ class LogLcm final : public LcmInterface {
   // Sets the time used for publishing when there is no input log.
   void SetNowUs(std::int64_t t) { now_us_ = t; }
   bool at_end() const { return input_done_ && pending_count_ == 0; }
+  // The output log on the disk, every event of it: false (with the reason in
+  // *why) when an event could not be written, or the rest cannot be flushed
+  // (a full disk). Nothing is lost in silence: its writer says so.
+  bool FinishOutput(std::string* why);
 
  private:
   struct Pending {
@@ -188,6 +192,8 @@ class LogLcm final : public LcmInterface {
   std::vector<Pending> pending_, dispatching_;
   std::size_t pending_count_ = 0;
   bool dispatching_now_ = false;
+  std::int64_t write_failures_ = 0;
+  int write_errno_ = 0;
 };
 
 // Wall clock, microseconds since 1970 (CLOCK_REALTIME): the send_time_us of
