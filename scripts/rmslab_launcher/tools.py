@@ -164,10 +164,14 @@ def compare(argv):
     sessions it flew (scripts/lab demo --subject NAME), as DIR/compare.html
     (self-contained, plots by Chart.js) and DIR/compare.csv (a row an
     attempt); default DIR: sessions/compare-<UTC time>. Re-simulations
-    (scripts/lab resim --config) are sessions of their own in it."""
+    (scripts/lab resim --config) are sessions of their own in it. A session
+    whose result began with a restore, a reset or a branch is flagged and
+    left off the learning curves (--all-trials puts it on)."""
     p = argparse.ArgumentParser(prog="scripts/lab compare", description=compare.__doc__)
     p.add_argument("sessions", nargs="+")
     p.add_argument("--out")
+    p.add_argument("--all-trials", action="store_true",
+                   help="learning curves with the sessions whose result began with a restore, a reset or a branch")
     p.add_argument("--no-build", action="store_true")
     a = p.parse_args(argv)
     for s in a.sessions:
@@ -175,7 +179,8 @@ def compare(argv):
             raise LabError(f"{s}: not a session folder (no lcmlog)", 2)
     ensure("tools/rms_compare", a.no_build)
     out = a.out or os.path.join(ROOT, "sessions", "compare-" + time.strftime("%Y%m%dT%H%M%SZ", time.gmtime()))
-    return subprocess.run([binary("tools/rms_compare")] + a.sessions + ["--out", out]).returncode
+    return subprocess.run([binary("tools/rms_compare")] + a.sessions + ["--out", out] +
+                          (["--all-trials"] if a.all_trials else [])).returncode
 
 
 def monitor(argv):

@@ -7,7 +7,9 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <gtest/gtest.h>
@@ -137,6 +139,12 @@ class HandFlownSession : public ::testing::Test {
     press("p", 1, 1.5);  // freeze, a step, run
     press("period", 1, 0.5);
     press("p", 1, 1.0);
+    // The same from the session's control: freeze, three steps, run.
+    ASSERT_EQ(Control(*out_, {"freeze"}, *tmp_ + "/freeze.log").rc, 0)
+        << ReadFile(*tmp_ + "/freeze.log");
+    ASSERT_EQ(Control(*out_, {"step", "3"}, *tmp_ + "/step.log").rc, 0)
+        << ReadFile(*tmp_ + "/step.log");
+    ASSERT_EQ(Control(*out_, {"run"}, *tmp_ + "/run.log").rc, 0) << ReadFile(*tmp_ + "/run.log");
     press("e", 2, 0.3);
     press("Q", 1, 0.5);
     ASSERT_TRUE(WaitFor([&] { return fs::exists(*tmp_ + "/lab.rc"); }, 120))
@@ -270,6 +278,79 @@ TEST_F(HandFlownSession, TheSummaryListsEveryAttempt) {
   EXPECT_EQ(m["note"], "first try");
 }
 
+// Every time field of summary.json is session time at full precision
+// (docs/sessions.md "Session time"): none is seconds since 1970 nor rounded;
+// the freeze, each of three steps and the run read successive frames.
+void CheckTimes(const nlohmann::json& j, const std::string& at, double rate_hz, bool time = false) {
+  if (j.is_object()) {
+    for (const auto& [k, v] : j.items()) {
+      const bool t = time || (k.size() > 2 && k.compare(k.size() - 2, 2, "_s") == 0);
+      CheckTimes(v, at + "." + k, rate_hz, t);
+    }
+  } else if (j.is_array()) {
+    for (std::size_t i = 0; i < j.size(); ++i)
+      CheckTimes(j[i], at + "[" + std::to_string(i) + "]", rate_hz, time);
+  } else if (time && j.is_number()) {
+    const double v = j.get<double>();
+    EXPECT_LT(std::abs(v), 1e6) << at << " = " << v << ": seconds since 1970?";
+  }
+}
+
+TEST_F(HandFlownSession, EveryTimeIsSessionTimeAtFullPrecision) {
+  const auto s = nlohmann::json::parse(ReadFile(*out_ + "/summary.json"));
+  const double rate = 30.0;
+  CheckTimes(s, "summary", rate);
+  // Frame times at full precision: frames over the rate, exactly.
+  auto on_a_frame = [&](double t_s) {
+    return std::abs(t_s * rate - std::round(t_s * rate)) < 1e-6;
+  };
+  std::vector<std::pair<std::string, double>> control;
+  for (const auto& c : s["control"]) {
+    ASSERT_TRUE(c["time_s"].is_number()) << c.dump();
+    EXPECT_TRUE(on_a_frame(c["time_s"].get<double>())) << c.dump();
+    EXPECT_TRUE(c["wall_s"].is_number()) << c.dump();
+    control.emplace_back(c["command"].get<std::string>(), c["time_s"].get<double>());
+  }
+  for (const auto& m : s["mode_changes"]) EXPECT_TRUE(on_a_frame(m["time_s"].get<double>()));
+  for (const auto& a : s["attempts"]) EXPECT_TRUE(on_a_frame(a["start_s"].get<double>()));
+  // freeze at frame F, three steps (sent at once: each at the frame made
+  // last before it), run at F + 3: the session stood still but for the steps.
+  // (the last freeze: scripts/lab control's, after the station's keys)
+  const auto last = std::find_if(control.rbegin(), control.rend(),
+                                 [](const auto& c) { return c.first == "freeze"; });
+  ASSERT_NE(last, control.rend()) << s["control"].dump();
+  const auto freeze = std::prev(last.base());
+  ASSERT_GE(control.end() - freeze, 5) << s["control"].dump();
+  for (int i = 1; i <= 3; ++i) {
+    EXPECT_EQ(freeze[i].first, "step") << s["control"].dump();
+    EXPECT_GE(freeze[i].second, freeze[i - 1].second - 1e-9) << s["control"].dump();
+    EXPECT_LT(freeze[i].second, freeze[0].second + 3.0 / rate - 1e-9) << s["control"].dump();
+  }
+  EXPECT_EQ(freeze[4].first, "run");
+  EXPECT_NEAR(freeze[4].second - freeze[0].second, 3.0 / rate, 1e-9) << s["control"].dump();
+  EXPECT_GT(s["wall_duration_s"].get<double>(), s["duration_s"].get<double>() - 1.0);
+  // The CSV's DCP rows: the frame they answer and its session time.
+  const std::string csv = *tmp_ + "/csv_times";
+  ASSERT_EQ(Script({SourcePath("scripts/lab"), "export", *out_, "--no-build", "--out", csv},
+                   *tmp_ + "/export_times.log")
+                .rc,
+            0);
+  std::ifstream rows(csv + "/dcp_frame.csv");
+  std::string line;
+  std::getline(rows, line);
+  int checked = 0;
+  while (std::getline(rows, line)) {
+    std::vector<std::string> cells;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+    ASSERT_GE(cells.size(), 5u);
+    EXPECT_EQ(std::stod(cells[1]), std::stoll(cells[4]) / rate)
+        << line;  // session_time, input_frame
+    ++checked;
+  }
+  EXPECT_GT(checked, 100);
+}
+
 TEST_F(HandFlownSession, ALogThatMissesTheStartReSimulatesFromALaterState) {
   // The recorder started 6 s late: the DCP's start and its first states are
   // not in the log; the first periodic state (every 5 s of frames) is.
@@ -347,6 +428,20 @@ TEST_F(HandFlownSession, ItsReportShowsEveryAttemptThePathAndTheTimeline) {
   for (const char* k : {"reset", "restore", "freeze", "restart"})
     EXPECT_TRUE(kinds.count(k)) << k << " not in the timeline";
   EXPECT_GE(d["attempts"].size(), 3u);
+  // A freeze is session time standing still: a point on the session's axis
+  // with its wall length said, never a stall (docs/sessions.md "Report").
+  const auto summary = nlohmann::json::parse(ReadFile(*out_ + "/summary.json"));
+  std::size_t collisions = 0;
+  for (const auto& e : d["events"]) {
+    if (e["kind"] == "freeze") {
+      EXPECT_FALSE(e.contains("duration_s")) << e.dump();
+      EXPECT_NE(e["text"].get<std::string>().find("of wall time"), std::string::npos) << e.dump();
+    }
+    collisions += e["kind"] == "collision";
+  }
+  EXPECT_EQ(html.find("a stall"), std::string::npos) << "a freeze read as a stall";
+  // One set of collisions: the timeline's are the summary's.
+  EXPECT_EQ(collisions, summary["collisions"].size()) << summary["collisions"].dump();
   const std::string dom = BrowserDom(page, *tmp_ + "/report_dom.html");
   EXPECT_GE(ChartsRendered(dom), 6) << dom.substr(0, 1500);
   for (const char* want :
@@ -401,11 +496,26 @@ TEST_F(HandFlownSession, CompareShowsTheSubjectsLearningCurveAndAReSimulationApa
   ASSERT_NE(a, std::string::npos);
   const auto data =
       nlohmann::json::parse(html.substr(a + 21, html.find(";\n</script>", a) - a - 21));
+  // The flown session's result is its last attempt, which began with a
+  // restore: flagged, and no trial for the learning curve unless asked.
   ASSERT_TRUE(data["subjects"].contains("ann")) << data["subjects"].dump();
-  EXPECT_EQ(data["subjects"]["ann"].size(), 2u)
-      << "the subject's two sessions, not the re-simulation";
+  EXPECT_EQ(data["subjects"]["ann"].size(), 1u)
+      << "the subject's fresh trial only: not the restored attempt, not the re-simulation";
+  EXPECT_EQ(data["left_off"], nlohmann::json::array({"session"})) << data["left_off"].dump();
+  EXPECT_NE(html.find("(from a restore)"), std::string::npos);
+  EXPECT_NE(csv.find(",restore,"), std::string::npos) << csv;
   const std::string dom = BrowserDom(*tmp_ + "/compare/compare.html", *tmp_ + "/compare_dom.html");
   EXPECT_GE(ChartsRendered(dom), 2) << dom.substr(0, 1500);
+  const ScriptRun all =
+      Script({SourcePath("scripts/lab"), "compare", *out_, second, *tmp_ + "/wide", "--no-build",
+              "--all-trials", "--out", *tmp_ + "/compare_all"},
+             *tmp_ + "/compare_all.log", 120);
+  ASSERT_EQ(all.rc, 0) << all.out;
+  const std::string html_all = ReadFile(*tmp_ + "/compare_all/compare.html");
+  const auto b = html_all.find("window.RMS_COMPARE = ");
+  const auto data_all =
+      nlohmann::json::parse(html_all.substr(b + 21, html_all.find(";\n</script>", b) - b - 21));
+  EXPECT_EQ(data_all["subjects"]["ann"].size(), 2u) << "asked for: the two sessions";
 }
 
 TEST_F(HandFlownSession, ItsMcapExportHoldsEveryMessageAndEachMatchesItsSchema) {

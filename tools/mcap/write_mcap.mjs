@@ -9,12 +9,14 @@
 //
 // Each line is one message (scripts/lab export --mcap prints them):
 //   {"channel": "RMS_DCP_FRAME", "type": "rms.dcp_frame_t",
-//    "log_time_ns": 1733090000000000000, "publish_time_ns": 1733090000000000000,
+//    "log_time_ns": 19733333333, "publish_time_ns": 1733090000000000000,
 //    "message": {...}}
 // channel: the LCM channel (the MCAP topic); type: the LCM type, PACKAGE.T,
-// whose schema is DIR/PACKAGE.T.json; log_time_ns (when the log recorded it)
-// and publish_time_ns (optional, log_time_ns when absent): integers, ns since
-// 1970, read from the line's text exactly (beyond 2^53 too); message: the
+// whose schema is DIR/PACKAGE.T.json; log_time_ns (the message's session
+// time, ns from the session's first frame: docs/sessions.md "Session time")
+// and publish_time_ns (optional, log_time_ns when absent; the sender's wall
+// clock, ns since 1970): integers, read from the line's text exactly (beyond
+// 2^53 too); message: the
 // object, written byte for byte as it is on the line (int64 values stay
 // exact). Blank lines are skipped; any other line that is not such an object
 // is an error naming its line number: exit 1 and no output file.

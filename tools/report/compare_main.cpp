@@ -23,9 +23,13 @@ int main(int argc, char** argv) {
   app.add_option("--out", out, "The folder for compare.html and compare.csv")
       ->capture_default_str();
   app.add_option("--chart-js", chart_js, "Chart.js to embed")->capture_default_str();
+  bool all_trials = false;
+  app.add_flag("--all-trials", all_trials,
+               "Put on the learning curves too the sessions whose result began with a restore, "
+               "a reset or a branch (flagged either way)");
   if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   try {
-    const rms::report::Comparison c = rms::report::CompareSessions(sessions, chart_js);
+    const rms::report::Comparison c = rms::report::CompareSessions(sessions, chart_js, all_trials);
     std::filesystem::create_directories(out);
     rms::WriteWholeFile(out + "/compare.html", c.html);
     rms::WriteWholeFile(out + "/compare.csv", c.csv);

@@ -21,6 +21,8 @@ namespace {
 struct Session {
   std::string dir, name, subject, note, kind, started_utc, parent;
   std::int64_t started_us = 0;
+  bool branch = false;          // scripts/lab demo --from: it began from another's instant
+  bool restored_start = false;  // scripts/lab demo --restore: it began from a checkpoint
   nlohmann::ordered_json summary;
 };
 
@@ -41,6 +43,8 @@ Session Load(const std::string& dir) {
       s.started_utc = m.value("started_utc", "");
       s.started_us = m.value("started_us", std::int64_t{0});
       s.parent = m.value("resimulation_of", "");
+      s.branch = m.contains("branch");
+      s.restored_start = m.contains("restored_from");
     } catch (const nlohmann::json::parse_error& e) {
       throw InputError(dir + "/manifest.json: not valid JSON (at byte " + std::to_string(e.byte) +
                        "): not a session's manifest");
@@ -82,7 +86,21 @@ std::string CsvField(std::string v) {
 
 // The figures of one attempt that the page and the CSV show (the CSV's
 // columns, in Csv's kColumns order).
-nlohmann::ordered_json Figures(const nlohmann::ordered_json& a) {
+// How an attempt began (docs/sessions.md "Compare"): "start" (a fresh
+// flight from the session's own start), "reset", "restore", or "branch" (the
+// first attempt of a session branched from another's instant). Only a
+// fresh start is a trial for a learning curve.
+std::string StartedFrom(const Session& s, const nlohmann::ordered_json& a) {
+  const std::string by = a.value("started_by", "start");
+  if (by == "start" && s.branch) return "branch";
+  if (by == "start" && s.restored_start) return "restore";
+  return by;
+}
+bool FreshStart(const nlohmann::ordered_json& figures) {
+  return figures.is_object() && figures.value("started_from", "") == "start";
+}
+
+nlohmann::ordered_json Figures(const Session& s, const nlohmann::ordered_json& a) {
   const auto& sc = a["scorecard"];
   const auto& d = a["docking"];
   std::int64_t actions = 0;
@@ -90,6 +108,7 @@ nlohmann::ordered_json Figures(const nlohmann::ordered_json& a) {
     actions += n.get<std::int64_t>();
   return {{"index", a["index"]},
           {"started_by", a["started_by"]},
+          {"started_from", StartedFrom(s, a)},
           {"outcome", a["outcome"]},
           {"task_time_s", sc["task_time_s"]},
           {"acquisition_s", a["phase_durations_s"]["acquisition"]},
@@ -121,13 +140,14 @@ nlohmann::ordered_json Best(const Session& s) {
   if (attempts.empty()) return nullptr;
   const int result = s.summary.value("result_attempt", static_cast<int>(attempts.size()));
   return Figures(
-      attempts[static_cast<std::size_t>(std::clamp<int>(result, 1, attempts.size()) - 1)]);
+      s, attempts[static_cast<std::size_t>(std::clamp<int>(result, 1, attempts.size()) - 1)]);
 }
 
 std::string Csv(const std::vector<Session>& sessions) {
   std::ostringstream c;
   static const char* const kColumns[] = {"index",
                                          "started_by",
+                                         "started_from",
                                          "outcome",
                                          "task_time_s",
                                          "acquisition_s",
@@ -151,15 +171,15 @@ std::string Csv(const std::vector<Session>& sessions) {
                                          "rate_limited_s",
                                          "finger_closures",
                                          "closures_not_acquiring"};
-  c << "session,subject,note,kind,started_utc,resimulation_of,attempt_count";
+  c << "session,subject,note,kind,started_utc,resimulation_of,attempt_count,fresh_trial";
   for (const char* k : kColumns) c << "," << (std::string(k) == "index" ? "attempt" : k);
   c << "\n";
   for (const Session& s : sessions) {
     for (const auto& a : s.summary["attempts"]) {
+      const auto fig = Figures(s, a);
       c << CsvField(s.name) << "," << CsvField(s.subject) << "," << CsvField(s.note) << ","
         << s.kind << "," << s.started_utc << "," << CsvField(s.parent) << ","
-        << s.summary["attempts"].size();
-      const auto fig = Figures(a);
+        << s.summary["attempts"].size() << "," << (FreshStart(fig) ? 1 : 0);
       for (const char* k : kColumns) {
         const auto& v = fig[k];
         c << ","
@@ -197,7 +217,9 @@ std::string Table(const std::vector<Session>& sessions) {
       h << "<td colspan=\"14\">no DCP frame in the log</td></tr>";
       continue;
     }
-    h << "<td>" << Esc(b["outcome"].get<std::string>()) << "</td>";
+    const std::string from = b["started_from"].get<std::string>();
+    h << "<td>" << Esc(b["outcome"].get<std::string>())
+      << (from == "start" ? "" : " <b>(from a " + Esc(from) + ")</b>") << "</td>";
     for (const char* k :
          {"task_time_s", "acquisition_s", "extraction_s", "maneuvering_s", "docking_s"}) {
       h << "<td>" << (b[k].is_null() ? "-" : Num(b[k], 2)) << "</td>";
@@ -213,9 +235,16 @@ std::string Table(const std::vector<Session>& sessions) {
   return h.str();
 }
 
+std::string JoinNames(const nlohmann::ordered_json& names) {
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n.get<std::string>();
+  return out;
+}
+
 }  // namespace
 
-Comparison CompareSessions(const std::vector<std::string>& dirs, const std::string& chart_js_path) {
+Comparison CompareSessions(const std::vector<std::string>& dirs, const std::string& chart_js_path,
+                           bool all_trials) {
   if (dirs.empty()) throw InputError("no session to compare");
   std::vector<Session> sessions;
   for (const auto& d : dirs) sessions.push_back(Load(d));
@@ -224,10 +253,11 @@ Comparison CompareSessions(const std::vector<std::string>& dirs, const std::stri
   nlohmann::ordered_json data;
   data["sessions"] = nlohmann::ordered_json::array();
   nlohmann::ordered_json subjects = nlohmann::ordered_json::object();
+  nlohmann::ordered_json left_off = nlohmann::ordered_json::array();
   for (std::size_t i = 0; i < sessions.size(); ++i) {
     const Session& s = sessions[i];
     nlohmann::ordered_json attempts = nlohmann::ordered_json::array();
-    for (const auto& a : s.summary["attempts"]) attempts.push_back(Figures(a));
+    for (const auto& a : s.summary["attempts"]) attempts.push_back(Figures(s, a));
     data["sessions"].push_back({{"name", s.name},
                                 {"subject", s.subject},
                                 {"note", s.note},
@@ -235,11 +265,18 @@ Comparison CompareSessions(const std::vector<std::string>& dirs, const std::stri
                                 {"kind", s.kind},
                                 {"attempts", attempts},
                                 {"best", Best(s)}});
-    // A learning curve is the subject's own sessions (not other designs' re-simulations).
-    if (s.kind != "re-simulation")
-      subjects[s.subject.empty() ? "(no subject)" : s.subject].push_back(i);
+    // A learning curve is the subject's own trials: not other designs'
+    // re-simulations, nor a result that began with a restore, a reset or a
+    // branch (unless asked for: all_trials).
+    if (s.kind == "re-simulation") continue;
+    if (!all_trials && !FreshStart(Best(s))) {
+      left_off.push_back(s.name);
+      continue;
+    }
+    subjects[s.subject.empty() ? "(no subject)" : s.subject].push_back(i);
   }
   data["subjects"] = subjects;
+  data["left_off"] = left_off;
   std::ifstream js(chart_js_path);
   if (!js)
     throw InputError("cannot read Chart.js at '" + chart_js_path +
@@ -261,9 +298,15 @@ Comparison CompareSessions(const std::vector<std::string>& dirs, const std::stri
     << "<p>Made by <code>scripts/lab compare</code> from the session folders alone; the figures "
        "are each session's "
        "summary (docs/sessions.md). compare.csv beside this page has a row an attempt.</p>\n"
-    << Table(sessions)
-    << "<h2>Learning curves</h2>\n<div id=\"rms-charts\"></div>\n<script>\nwindow.RMS_COMPARE = "
-    << json << ";\n</script>\n<script>\n"
+    << Table(sessions) << "<h2>Learning curves</h2>\n"
+    << (left_off.empty()
+            ? std::string()
+            : "<p>Left off the learning curves (a trial is a fresh start; rms_compare "
+              "--all-trials puts them on): " +
+                  Esc(JoinNames(left_off)) +
+                  ": each one's result began with a restore, a reset or a branch.</p>\n")
+    << "<div id=\"rms-charts\"></div>\n<script>\nwindow.RMS_COMPARE = " << json
+    << ";\n</script>\n<script>\n"
     << charts << "\n</script>\n</body></html>\n";
   return {h.str(), Csv(sessions)};
 }

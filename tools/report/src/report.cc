@@ -97,12 +97,12 @@ struct TraceReader {
   Traces t;
   std::size_t every = 1;  // keep one telemetry sample in `every`
   int last_mode = 0;
-  std::uint32_t last_bits = 0;
-  std::array<double, wire::collision_bits::kCount> bit_since{};
   bool last_held = false;
   double held_since = 0;
   std::int64_t last_input_send = -1;
   bool frozen = false;
+  bool froze_since_input = false;  // a freeze (or a restore, which freezes) since the last input
+  bool last_input_frozen = false;  // the last input was made frozen (a step)
   std::int64_t frozen_us = 0;
   double frozen_at_s = 0;
   std::map<std::string, int> status_pid;
@@ -138,13 +138,8 @@ struct TraceReader {
         Event(t_s, "mode", "Mode " + std::to_string(last_mode) + " -> " + std::to_string(m.mode));
       last_mode = m.mode;
     }
-    const auto bits = static_cast<std::uint32_t>(m.collisions);
-    for (int b = 0; b < wire::collision_bits::kCount; ++b) {
-      const bool on = bits & (1u << b), was = last_bits & (1u << b);
-      if (on && !was) bit_since[b] = t_s;
-      if (was && !on) Event(bit_since[b], "collision", wire::CollisionName(b), t_s - bit_since[b]);
-    }
-    last_bits = bits;
+    // (Collisions: the summary's own, in Finish: one set in the timeline,
+    // the tables and summary.json.)
     if (m.held && !last_held) held_since = t_s;
     if (!m.held && last_held) Event(held_since, "hold", "arm held", t_s - held_since);
     last_held = m.held;
@@ -161,11 +156,13 @@ struct TraceReader {
                                            : nlohmann::json(m.dock_angle_deg));
     t.inputs.push_back(std::vector<double>(hand.begin(), hand.end()));
   }
-  void Finish(double t_s) {
-    for (int b = 0; b < wire::collision_bits::kCount; ++b) {
-      if (last_bits & (1u << b))
-        Event(bit_since[b], "collision", wire::CollisionName(b) + std::string(" (to the end)"),
-              t_s - bit_since[b]);
+  void Finish(double t_s, const nlohmann::ordered_json& collisions) {
+    // The summary's collisions (the detrimental ones: the finger resting on
+    // the bar is the essential contact, docs/collision.md), as it counts them.
+    for (const auto& c : collisions) {
+      Event(c["start_s"].get<double>(), "collision",
+            c["kind"].get<std::string>() + (c.value("open", false) ? " (to the end)" : ""),
+            c["duration_s"].get<double>());
     }
     if (last_held) Event(held_since, "hold", "arm held (to the end)", t_s - held_since);
     for (const auto& a : attempts) {
@@ -186,13 +183,24 @@ struct TraceReader {
       frozen_at_s = t_s;
     } else if (m.command == session_control_t::RUN && frozen) {
       frozen = false;
+      // Session time stood still: a point on the session's axis, its wall
+      // length said (docs/sessions.md "Session time").
       const double d = (log_us - frozen_us) * 1e-6;
-      Event(frozen_at_s, "freeze", "frozen " + HumanNumber(d, 1) + " s", d);
+      Event(frozen_at_s, "freeze",
+            "frozen " + HumanNumber(d, 1) + " s of wall time (session time stood still)");
     }
+    if (m.command == session_control_t::FREEZE || m.command == session_control_t::RESTORE)
+      froze_since_input = true;
   }
   void Input(const operator_input_t& m) {
-    // An interval across a freeze is the freeze, not a stall.
-    if (last_input_send >= 0 && !frozen) {
+    // An interval across a freeze is the freeze, not a stall: frozen now, or
+    // frozen (and run again) since the last input.
+    // (A step's frame is made while frozen: the interval from it to the next
+    // one is frozen time too.)
+    const bool across_freeze = frozen || froze_since_input || last_input_frozen;
+    froze_since_input = false;
+    last_input_frozen = frozen;
+    if (last_input_send >= 0 && !across_freeze) {
       const double ms = (m.send_time_us - last_input_send) / 1000.0;
       t.intervals_ms.push_back(ms);
       if (ms > t.longest_stall_ms) {
@@ -250,7 +258,7 @@ Traces ReadTraces(const std::string& dir, const LabConfig& config,
                if (log.Decode(ev, &m)) r.OperatorState(m);
              }
            });
-  r.Finish(last_t + 1.0 / rate);
+  r.Finish(last_t + 1.0 / rate, summary["collisions"]);
   return std::move(r.t);
 }
 
@@ -351,7 +359,8 @@ std::string SessionSection(const nlohmann::ordered_json& m, const nlohmann::orde
       hosts += (hosts.empty() ? "" : ", ") + p + " on " + host.get<std::string>();
     field("hosts", hosts);
   }
-  if (s.contains("duration_s")) h << Row("wall time", {Cell(s["duration_s"], " s", 1)});
+  if (s.contains("duration_s")) h << Row("session time", {Cell(s["duration_s"], " s", 1)});
+  if (s.contains("wall_duration_s")) h << Row("wall time", {Cell(s["wall_duration_s"], " s", 1)});
   h << "</table>\n";
   return h.str();
 }

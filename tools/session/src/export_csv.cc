@@ -14,13 +14,16 @@
 #include "rms/base/check.h"
 #include "rms/base/config.h"
 #include "rms/dcp_frame_t.hpp"
+#include "rms/dcp_state_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/esg_frame_t.hpp"
 #include "rms/operator_input_t.hpp"
+#include "rms/operator_state_t.hpp"
 #include "rms/process_status_t.hpp"
 #include "rms/session/session_log.h"
 #include "rms/session/session_summary.h"
 #include "rms/session_control_t.hpp"
+#include "rms/window_keys_t.hpp"
 #include "rms/wire/acquisition_conditions.h"
 #include "rms/wire/channels.h"
 #include "rms/wire/control_word.h"
@@ -227,12 +230,23 @@ std::vector<std::string> InputRow(const LogMessage& msg, const std::string& t,
   return row;
 }
 
-std::vector<std::string> DcpRow(const LogMessage& msg, const std::string& t,
-                                const std::string& st) {
+// The session time of a frame that answers operator frame `input_frame`
+// (docs/sessions.md "Session time"): the DCP's, the scene's and the
+// telemetry's rows carry the frame they answer and its time, not the time
+// the record has them at.
+std::string SessionTimeOf(std::int64_t input_frame, double rate_hz) {
+  return N(static_cast<double>(input_frame) / rate_hz);
+}
+
+std::vector<std::string> DcpRow(const LogMessage& msg, const std::string& t, double rate_hz) {
   const auto m = Decoded<dcp_frame_t>(msg);
   const wire::DcpFrameData d = wire::UnpackDcpFrame(m);
-  std::vector<std::string> row = {
-      t, st, I(m.frame), I(m.send_time_us), I(m.input_frame), I(m.input_send_time_us)};
+  std::vector<std::string> row = {t,
+                                  SessionTimeOf(m.input_frame, rate_hz),
+                                  I(m.frame),
+                                  I(m.send_time_us),
+                                  I(m.input_frame),
+                                  I(m.input_send_time_us)};
   for (int i = 0; i < 6; ++i) row.push_back(N(Deg(d.arm[i])));
   ControlCells(&row, d.control);
   for (int k = 0; k < 3; ++k) {
@@ -246,12 +260,11 @@ std::vector<std::string> DcpRow(const LogMessage& msg, const std::string& t,
   return row;
 }
 
-std::vector<std::string> EsgRow(const LogMessage& msg, const std::string& t,
-                                const std::string& st) {
+std::vector<std::string> EsgRow(const LogMessage& msg, const std::string& t, double rate_hz) {
   const auto m = Decoded<esg_frame_t>(msg);
   const wire::EsgFrameData d = wire::UnpackEsgWords(m.words);
   std::vector<std::string> row = {t,
-                                  st,
+                                  SessionTimeOf(m.input_frame, rate_hz),
                                   I(m.frame),
                                   I(m.send_time_us),
                                   I(m.dcp_frame),
@@ -276,11 +289,10 @@ std::vector<std::string> EsgRow(const LogMessage& msg, const std::string& t,
   return row;
 }
 
-std::vector<std::string> TelemetryRow(const LogMessage& msg, const std::string& t,
-                                      const std::string& st) {
+std::vector<std::string> TelemetryRow(const LogMessage& msg, const std::string& t, double rate_hz) {
   const auto m = Decoded<dcp_telemetry_t>(msg);
   std::vector<std::string> row = {t,
-                                  st,
+                                  SessionTimeOf(m.input_frame, rate_hz),
                                   I(m.frame),
                                   I(m.send_time_us),
                                   I(m.input_frame),
@@ -311,9 +323,85 @@ std::vector<std::string> TelemetryRow(const LogMessage& msg, const std::string& 
   return row;
 }
 
+std::vector<std::string> OperatorStateColumns() {
+  std::vector<std::string> cols = {"log_time [us]",  "session_time [s]", "frame",
+                                   "send_time [us]", "source",           "control_mode",
+                                   "command_frame",  "vernier",          "joint"};
+  for (const char* a : {"x", "y", "z", "roll", "pitch", "yaw"})
+    cols.push_back(std::string("hand_rate_") + a + " [1]");
+  Add(&cols,
+      {"joint_limits [bits]", "singular", "sigma_min [ft]", "guidance_valid", "mode", "target"});
+  for (const auto& c : Vec3Columns("offset", "ft")) cols.push_back(c);
+  Add(&cols,
+      {"rotation_x [deg]", "rotation_y [deg]", "rotation_z [deg]", "distance [ft]", "angle [deg]"});
+  for (int i = 1; i <= 6; ++i) cols.push_back("condition_" + std::to_string(i));
+  for (int i = 1; i <= 6; ++i) cols.push_back("margin_" + std::to_string(i) + " [ft]");
+  Add(&cols, {"close_gap [ft]", "close_ok", "bay_clearance [ft]", "dock_distance [ft]",
+              "dock_angle [deg]", "show_guidance", "key_actions", "rate_limited", "devices"});
+  return cols;
+}
+
+std::vector<std::string> OperatorStateRow(const LogMessage& msg, const std::string& t,
+                                          double rate_hz) {
+  const auto m = Decoded<operator_state_t>(msg);
+  std::vector<std::string> row = {t,
+                                  SessionTimeOf(m.frame, rate_hz),
+                                  I(m.frame),
+                                  I(m.send_time_us),
+                                  I(m.source),
+                                  I(m.control_mode),
+                                  I(m.command_frame),
+                                  B(m.vernier),
+                                  I(m.joint)};
+  for (double r : m.hand_rate) row.push_back(N(r));
+  Add(&row, {I(m.joint_limits), B(m.singular), N(m.sigma_min_ft), B(m.guidance_valid), I(m.mode),
+             I(m.target)});
+  for (double v : m.offset_ft) row.push_back(N(v));
+  for (double v : m.rotation_deg) row.push_back(N(v));
+  Add(&row, {N(m.distance_ft), N(m.angle_deg)});
+  for (bool c : m.conditions) row.push_back(B(c));
+  for (double v : m.margin_ft) row.push_back(N(v));
+  std::string devices;
+  for (int i = 0; i < m.num_devices; ++i)
+    devices += (i ? "; " : "") + m.device_names[i] + " " + I(m.device_actions[i]);
+  Add(&row,
+      {N(m.close_gap_ft), B(m.close_ok), N(m.bay_clearance_ft), N(m.dock_distance_ft),
+       N(m.dock_angle_deg), B(m.show_guidance), I(m.key_actions), B(m.rate_limited), devices});
+  return row;
+}
+
+// The DCP's logged state (its checkpoint a JSON text, in one cell).
+std::vector<std::string> DcpStateRow(const LogMessage& msg, const std::string& t,
+                                     const std::string& st) {
+  const auto m = Decoded<dcp_state_t>(msg);
+  static constexpr const char* kReasons[] = {"?",       "start",  "periodic",
+                                             "restore", "resume", "malfunction"};
+  return {t,
+          st,
+          I(m.send_time_us),
+          m.reason >= 1 && m.reason <= 5 ? kReasons[m.reason] : "?",
+          I(m.next_frame),
+          I(m.input_frame),
+          B(m.resume_pending),
+          I(m.resume_dcp_frame),
+          I(m.resume_input_frame),
+          m.checkpoint};
+}
+
+std::vector<std::string> WindowKeysRow(const LogMessage& msg, const std::string& t,
+                                       const std::string& st) {
+  const auto m = Decoded<window_keys_t>(msg);
+  auto keys = [](const std::vector<std::int16_t>& v) {
+    std::string out;
+    for (std::size_t i = 0; i < v.size(); ++i) out += (i ? " " : "") + I(v[i]);
+    return out;
+  };
+  return {t, st, I(m.send_time_us), I(m.sequence), keys(m.held), keys(m.pressed), B(m.focused)};
+}
+
 // The session's files, one a channel.
 struct ChannelFiles {
-  Csv in, dcp, esg, tm, st, ctl;
+  Csv in, dcp, esg, tm, st, ctl, op_state, dcp_state, keys;
   ChannelFiles(const fs::path& out, const LabConfig& config)
       : in(out / "operator_input.csv", InputColumns(config)),
         dcp(out / "dcp_frame.csv", DcpColumns()),
@@ -321,8 +409,16 @@ struct ChannelFiles {
         tm(out / "dcp_telemetry.csv", TelemetryColumns()),
         st(out / "status.csv", {"log_time [us]", "session_time [s]", "send_time [us]", "process",
                                 "host", "pid", "frame", "final", "counter", "value"}),
-        ctl(out / "control.csv", {"log_time [us]", "session_time [s]", "send_time [us]", "sequence",
-                                  "command", "name"}) {}
+        ctl(out / "control.csv",
+            {"log_time [us]", "session_time [s]", "send_time [us]", "sequence", "command", "name"}),
+        op_state(out / "operator_state.csv", OperatorStateColumns()),
+        dcp_state(out / "dcp_state.csv",
+                  {"log_time [us]", "session_time [s]", "send_time [us]", "reason", "next_frame",
+                   "input_frame", "resume_pending", "resume_dcp_frame", "resume_input_frame",
+                   "checkpoint [json]"}),
+        keys(out / "window_keys.csv",
+             {"log_time [us]", "session_time [s]", "send_time [us]", "sequence", "held [key codes]",
+              "pressed [key codes]", "focused"}) {}
 
   void Write(const LogMessage& msg, const LabConfig& config) {
     const std::string_view base = msg.base;
@@ -330,11 +426,11 @@ struct ChannelFiles {
     if (base == wire::channels::kOperatorInput) {
       in.Row(InputRow(msg, t, st_s, config));
     } else if (base == wire::channels::kDcpFrame) {
-      dcp.Row(DcpRow(msg, t, st_s));
+      dcp.Row(DcpRow(msg, t, config.session.frame_rate_hz));
     } else if (base == wire::channels::kEsgFrame) {
-      esg.Row(EsgRow(msg, t, st_s));
+      esg.Row(EsgRow(msg, t, config.session.frame_rate_hz));
     } else if (base == wire::channels::kDcpTelemetry) {
-      tm.Row(TelemetryRow(msg, t, st_s));
+      tm.Row(TelemetryRow(msg, t, config.session.frame_rate_hz));
     } else if (base == wire::channels::kStatus) {
       const auto m = Decoded<process_status_t>(msg);
       for (int i = 0; i < m.num_counters; ++i) {
@@ -345,6 +441,12 @@ struct ChannelFiles {
       const auto m = Decoded<session_control_t>(msg);
       ctl.Row(
           {t, st_s, I(m.send_time_us), I(m.sequence), wire::ControlCommandName(m.command), m.name});
+    } else if (base == wire::channels::kOperatorState) {
+      op_state.Row(OperatorStateRow(msg, t, config.session.frame_rate_hz));
+    } else if (base == wire::channels::kDcpState) {
+      dcp_state.Row(DcpStateRow(msg, t, st_s));
+    } else if (base == wire::channels::kWindowKeys) {
+      keys.Row(WindowKeysRow(msg, t, st_s));
     }
   }
 };
@@ -370,7 +472,8 @@ std::vector<std::pair<std::string, long>> ExportCsv(
     }
   });
   std::vector<std::pair<std::string, long>> written;
-  for (Csv* c : {&files.in, &files.dcp, &files.esg, &files.tm, &files.st, &files.ctl}) {
+  for (Csv* c : {&files.in, &files.dcp, &files.esg, &files.tm, &files.st, &files.ctl,
+                 &files.op_state, &files.dcp_state, &files.keys}) {
     c->Close();
     written.emplace_back(c->path().string(), c->rows());
   }

@@ -1,5 +1,7 @@
 // ExportJsonLines (export_csv.h): the session's log as JSON lines for MCAP.
+#include <cmath>
 #include <ostream>
+#include <type_traits>
 
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_state_t.hpp"
@@ -19,6 +21,24 @@ namespace rms::session {
 
 namespace {
 
+// The message's session time (docs/sessions.md "Session time"): a frame
+// that answers an operator frame (the DCP's, its telemetry, the scene's),
+// or the operator's state of a frame, at that frame's; anything else at
+// the operator's last frame before it.
+template <class Msg>
+double SessionTimeS(const LogMessage& ev, const Msg& m, double rate_hz) {
+  if constexpr (std::is_same_v<Msg, dcp_frame_t> || std::is_same_v<Msg, dcp_telemetry_t> ||
+                std::is_same_v<Msg, esg_frame_t>)
+    return static_cast<double>(m.input_frame) / rate_hz;
+  else if constexpr (std::is_same_v<Msg, operator_state_t> || std::is_same_v<Msg, operator_input_t>)
+    return static_cast<double>(m.frame) / rate_hz;
+  else
+    return ev.session_time_s;
+}
+
+// The MCAP's log time is session time, in ns from the session's first frame
+// (so a plot's axis is the session as flown: standing still in a freeze);
+// its publish time the wall clock's send time, ns since 1970.
 template <class Msg>
 bool Line(SessionLog& log, const LogMessage& ev, const char* type, std::ostream& out) {
   Msg m{};
@@ -26,7 +46,8 @@ bool Line(SessionLog& log, const LogMessage& ev, const char* type, std::ostream&
   nlohmann::ordered_json j;
   j["channel"] = ev.channel;
   j["type"] = type;
-  j["log_time_ns"] = ev.log_us * 1000;
+  j["log_time_ns"] =
+      static_cast<std::int64_t>(std::llround(SessionTimeS(ev, m, log.frame_rate_hz()) * 1e9));
   if constexpr (requires { m.send_time_us; }) {
     if (m.send_time_us > 0) j["publish_time_ns"] = m.send_time_us * 1000;
   }

@@ -221,17 +221,21 @@ class TelemetryLog {
   explicit TelemetryLog(double rate_hz = 30.0) : rate_hz_(rate_hz) {
     for (const char* name : wire::kCollisionNames) totals_[name] = {0, 0, 0};
   }
-  void Observe(const dcp_telemetry_t& m, std::int64_t t_us, std::int64_t first_us) {
+  // wall_s: the message's wall time, s from the session's first logged
+  // message (-1 where there is no log: a run made in memory).
+  void Observe(const dcp_telemetry_t& m, double wall_s) {
     ++frames_;
-    const double t_s = (t_us - first_us) * 1e-6;
+    // Session time (docs/sessions.md "Session time"): the operator frame it
+    // answers over the frame rate.
+    const double t_s = m.input_frame / rate_hz_;
     // (Phases and docking are each attempt's: AttemptLog.)
     if (m.mode != last_mode_) {
       if (last_mode_ != 0) {
-        mode_changes.push_back({{"frame", m.frame},
-                                {"time_s", m.input_frame / rate_hz_},
-                                {"log_time_s", t_s},
-                                {"from", last_mode_},
-                                {"to", m.mode}});
+        nlohmann::ordered_json e = {{"frame", m.frame}, {"time_s", t_s}};
+        if (wall_s >= 0) e["wall_s"] = wall_s;
+        e["from"] = last_mode_;
+        e["to"] = m.mode;
+        mode_changes.push_back(std::move(e));
       }
       last_mode_ = m.mode;
     }
@@ -245,19 +249,19 @@ class TelemetryLog {
     for (int b = 0; b < kCollisionBits; ++b) {
       const bool on = bits & (1u << b), was = last_bits_ & (1u << b);
       if (on && !was) {
-        run_start_us_[b] = t_us;
+        run_start_s_[b] = t_s;
+        run_start_wall_s_[b] = wall_s;
         run_frames_[b] = 0;
       }
       if (on) ++run_frames_[b];
-      if (was && !on) EndRun(b, first_us, false);
+      if (was && !on) EndRun(b, false);
     }
     last_bits_ = bits;
-    prev_us_ = t_us;
   }
   // Collisions still on at the end of the log; events in time order.
-  void Finish(std::int64_t first_us) {
+  void Finish() {
     for (int b = 0; b < kCollisionBits; ++b) {
-      if (last_bits_ & (1u << b)) EndRun(b, first_us, true);
+      if (last_bits_ & (1u << b)) EndRun(b, true);
     }
     std::sort(collisions.begin(), collisions.end(), [](const auto& a, const auto& b) {
       return a["start_s"].template get<double>() < b["start_s"].template get<double>();
@@ -280,12 +284,15 @@ class TelemetryLog {
   std::int64_t held_frames = 0;
 
  private:
-  void EndRun(int b, std::int64_t first_us, bool open) {
-    const double dur = (prev_us_ - run_start_us_[b]) * 1e-6;
+  // A run's session time: a frame period each of its frames (as the
+  // attempts' collisions count it).
+  void EndRun(int b, bool open) {
+    const double dur = static_cast<double>(run_frames_[b]) / rate_hz_;
     nlohmann::ordered_json e = {{"kind", wire::kCollisionNames[b]},
-                                {"start_s", (run_start_us_[b] - first_us) * 1e-6},
+                                {"start_s", run_start_s_[b]},
                                 {"duration_s", dur},
                                 {"frames", run_frames_[b]}};
+    if (run_start_wall_s_[b] >= 0) e["wall_s"] = run_start_wall_s_[b];
     if (open) e["open"] = true;
     collisions.push_back(e);
     auto& tot = totals_[wire::kCollisionNames[b]];
@@ -294,10 +301,11 @@ class TelemetryLog {
     tot[2] += dur;
   }
   std::map<std::string, std::array<double, 3>> totals_;  // events, frames, seconds; every kind
-  std::array<std::int64_t, kCollisionBits> run_start_us_{}, run_frames_{};
+  std::array<double, kCollisionBits> run_start_s_{}, run_start_wall_s_{};
+  std::array<std::int64_t, kCollisionBits> run_frames_{};
   std::uint32_t last_bits_ = 0;
   int last_mode_ = 0;
-  std::int64_t frames_ = 0, prev_us_ = 0;
+  std::int64_t frames_ = 0;
   double rate_hz_;
 };
 
@@ -313,6 +321,7 @@ struct StatusRuns {
 struct LogScan {
   std::map<std::string, std::int64_t> by_channel;
   std::int64_t events = 0, first_us = -1, last_us = -1, malformed = 0;
+  double session_s = 0;  // the session time its operator frames reach (the last one's end)
   wire::SequenceTracker input, dcp, esg;  // frame numbers as logged
   double rate_hz = 30.0;
   std::set<std::int64_t> telemetry_frames;  // believed
@@ -354,7 +363,7 @@ void ScanTelemetry(const LogMessage& ev, const std::map<std::int64_t, DcpFrameRe
   }
   if (dcp.count(m.frame)) s->telemetry_logged.insert(m.frame);  // in the record, believed or not
   if (const char* why = Disbelief(m, dcp, &s->telemetry_frames)) return check->Count(why);
-  s->telemetry.Observe(m, ev.log_us, s->first_us);
+  s->telemetry.Observe(m, (ev.log_us - s->first_us) * 1e-6);
   s->attempts->ObserveFrame(m, dcp.at(m.frame).word.reset, m.input_frame / s->rate_hz);
 }
 
@@ -379,7 +388,10 @@ void ScanControl(const LogMessage& ev, LogScan* s) {
     return;
   }
   const char* what = wire::ControlCommandName(m.command);
-  nlohmann::ordered_json e = {{"time_s", (ev.log_us - s->first_us) * 1e-6},
+  // Session time: the operator's last frame before it (it stands still in
+  // a freeze; each step moves it one frame); wall_s the wall clock's.
+  nlohmann::ordered_json e = {{"time_s", ev.session_time_s},
+                              {"wall_s", (ev.log_us - s->first_us) * 1e-6},
                               {"command", what},
                               {"process", wire::ProcessCodeName(m.sender.process)},
                               {"pid", m.sender.pid}};
@@ -393,17 +405,19 @@ void ScanFrameNumbers(const std::string& base, const LogMessage& ev,
   if (base == wire::channels::kOperatorState) {
     operator_state_t m;
     if (wire::SafeDecode(ev.data, ev.size, &m) == wire::DecodeError::kNone) {
-      s->hand.Observe(m, (ev.log_us - s->first_us) * 1e-6);
+      s->hand.Observe(m, m.frame / s->rate_hz);
       s->attempts->ObserveOperator(m);
     } else {
       ++s->malformed;
     }
   } else if (base == wire::channels::kOperatorInput) {
     operator_input_t m;
-    if (wire::SafeDecode(ev.data, ev.size, &m) == wire::DecodeError::kNone)
+    if (wire::SafeDecode(ev.data, ev.size, &m) == wire::DecodeError::kNone) {
       s->input.Accept(m.frame);
-    else
+      s->session_s = std::max(s->session_s, (m.frame + 1) / s->rate_hz);
+    } else {
       ++s->malformed;
+    }
   } else if (base == wire::channels::kDcpFrame) {
     // Only the frames of the increasing run (ReadDcpFrames) count.
     dcp_frame_t m;
@@ -467,7 +481,7 @@ void ScanState(const LogMessage& ev, LogScan* s) {
   // Session time as mode_changes has it: the operator frames answered over
   // the frame rate (it stands still in a freeze).
   s->malfunctions.push_back({{"time_s", (m.input_frame + 1) / s->rate_hz},
-                             {"log_time_s", (ev.log_us - s->first_us) * 1e-6},
+                             {"wall_s", (ev.log_us - s->first_us) * 1e-6},
                              {"dcp_frame", m.next_frame},
                              {"why", m.reason >= 1 && m.reason <= 5 ? kReasons[m.reason] : "?"},
                              {"injected", injected},
@@ -485,7 +499,8 @@ LogScan ScanLog(SessionLog& log, const std::map<std::int64_t, DcpFrameRecord>& d
   s.telemetry = TelemetryLog(s.rate_hz);
   SenderCheck* check = &log.check();
   log.Read({}, [&](const LogMessage& ev) {
-    if (s.first_us < 0) s.first_us = log.first_us();
+    // The wall clock's zero: the session's first message logged.
+    if (s.first_us < 0) s.first_us = ev.log_us;
     ++s.by_channel[std::string(ev.channel)];
     if (ev.base == wire::channels::kDcpTelemetry)
       ScanTelemetry(ev, dcp, check, &s);
@@ -499,10 +514,10 @@ LogScan ScanLog(SessionLog& log, const std::map<std::int64_t, DcpFrameRecord>& d
       ScanFrameNumbers(std::string(ev.base), ev, dcp, &s);
   });
   s.events = log.events();
-  s.first_us = log.first_us();
+  if (s.first_us < 0) s.first_us = log.first_us();  // none of the session's own
   s.last_us = log.last_us();
   s.malformed += log.malformed();
-  s.telemetry.Finish(s.first_us);
+  s.telemetry.Finish();
   return s;
 }
 
@@ -807,17 +822,27 @@ nlohmann::ordered_json LogJson(const LogScan& s) {
 
 }  // namespace
 
-// Every number to 9 significant digits, so the summary reads 20.9 and not
-// 20.899999999999999 (its times are whole microseconds; docs/sessions.md
-// "summary.json").
-static void ForPeople(nlohmann::ordered_json* j) {
+// Every number but the times to 9 significant digits, so the summary reads
+// 20.9 ft and not 20.899999999999999 (docs/sessions.md "summary.json").
+// Times -- every key ending in "_s", and what is under one (reached_s,
+// phase_durations_s) -- are kept at full precision (the shortest text that
+// reads back as the same double): session time is frames over the frame
+// rate, and 9 digits would round 41.13333333333333 s (docs/sessions.md
+// "Session time").
+static bool IsTimeKey(const std::string& key) {
+  return key.size() >= 2 && key.compare(key.size() - 2, 2, "_s") == 0;
+}
+static void ForPeople(nlohmann::ordered_json* j, bool time = false) {
   if (j->is_number_float()) {
     const double v = j->get<double>();
-    if (std::isfinite(v)) *j = std::strtod(Sprintf("%.9g", v).c_str(), nullptr);
+    if (std::isfinite(v) && !time) *j = std::strtod(Sprintf("%.9g", v).c_str(), nullptr);
     return;
   }
-  if (j->is_structured()) {
-    for (auto& child : *j) ForPeople(&child);
+  if (j->is_object()) {
+    for (auto it = j->begin(); it != j->end(); ++it)
+      ForPeople(&it.value(), time || IsTimeKey(it.key()));
+  } else if (j->is_array()) {
+    for (auto& child : *j) ForPeople(&child, time);
   }
 }
 
@@ -833,13 +858,15 @@ LabConfig SessionConfig(const fs::path& root) {
 }
 
 // Which session, how long, the mission and who flew it.
-void AddSessionFields(const fs::path& root, const LogScan& s, double duration_s,
+void AddSessionFields(const fs::path& root, const LogScan& s, double wall_s,
                       std::int64_t session_id, nlohmann::ordered_json* j) {
   (*j)["session"] = fs::absolute(root).lexically_normal().filename().string();
   if ((*j)["session"].get<std::string>().empty())
     (*j)["session"] = fs::absolute(root).parent_path().filename().string();
   if (session_id != 0) (*j)["session_id"] = wire::FormatSessionId(session_id);
-  (*j)["duration_s"] = duration_s;
+  // Session time (docs/sessions.md "Session time"), and the wall clock's.
+  (*j)["duration_s"] = s.session_s;
+  (*j)["wall_duration_s"] = wall_s;
   AddMission(s.final_mode, s.modes, s.telemetry, j);
   std::ifstream pilot((root / "run" / "pilot").string());
   std::string who;
@@ -908,11 +935,11 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
   AttemptLog attempts(SessionConfig(root));
   const LogScan s = ScanLog(log, dcp_frames.by_frame, &attempts);
   const double rate_hz = FrameRate(root);
-  const double duration_s = s.first_us >= 0 ? (s.last_us - s.first_us) * 1e-6 : 0.0;
-  const auto stats = MergedStats(root, s.status, duration_s, rate_hz, &check);
+  const double wall_s = s.first_us >= 0 ? (s.last_us - s.first_us) * 1e-6 : 0.0;
+  const auto stats = MergedStats(root, s.status, wall_s, rate_hz, &check);
 
   nlohmann::ordered_json j;
-  AddSessionFields(root, s, duration_s, check.session_id(), &j);
+  AddSessionFields(root, s, wall_s, check.session_id(), &j);
   j["resimulation"] = Resimulation(root);
   j["restarts"] = Restarts(root);
   for (std::size_t i = 0; i < j["restarts"].size(); ++i) attempts.ObserveRestart();
@@ -968,7 +995,7 @@ nlohmann::ordered_json SummarizeDcpRun(const LabConfig& config, const DcpRun& ru
       attempts.ObserveRestore("");  // no RMS_CONTROL in such a log: no checkpoint's name
     const dcp_telemetry_t& m = run.telemetry[i];
     if (Disbelief(m, believed, &seen)) continue;
-    telemetry.Observe(m, 0, 0);
+    telemetry.Observe(m, -1);
     attempts.ObserveFrame(m, believed.at(m.frame).word.reset, m.input_frame / rate_hz);
   }
   nlohmann::ordered_json j;

@@ -14,8 +14,10 @@ struct Comparison {
   std::string html, csv;
 };
 
-// Throws rms::InputError naming a folder that is no session.
+// Throws rms::InputError naming a folder that is no session. A learning
+// curve holds a subject's fresh trials: a session whose result began with a
+// restore, a reset or a branch is flagged and left off it, unless all_trials.
 Comparison CompareSessions(const std::vector<std::string>& session_dirs,
-                           const std::string& chart_js_path);
+                           const std::string& chart_js_path, bool all_trials = false);
 
 }  // namespace rms::report
