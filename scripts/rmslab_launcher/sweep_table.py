@@ -37,13 +37,16 @@ OUTCOME_COLUMNS = [
 ]
 
 
-def cell_text(v):
+def cell_text(v, unit=""):
+    """A cell as the CSV writes it: a time (unit s: session time, docs/sessions.md
+    "Session time") at full precision, the shortest text that reads back as the
+    same double; any other number to 9 significant digits."""
     if v is None:
         return ""
     if isinstance(v, bool):
         return "1" if v else "0"
     if isinstance(v, float):
-        return f"{v:.9g}"
+        return repr(v) if unit == "s" else f"{v:.9g}"
     return str(v)
 
 
@@ -67,9 +70,9 @@ def row_values(cell, res, grid):
     if res is None:
         return row + ["failed"] + [""] * len(OUTCOME_COLUMNS) + ["", "", cell.get("error", "")]
     row.append("ok")
-    for _, _, get in OUTCOME_COLUMNS:
+    for _, unit, get in OUTCOME_COLUMNS:
         try:
-            row.append(cell_text(get(res)))
+            row.append(cell_text(get(res), unit))
         except (KeyError, TypeError, AttributeError):
             row.append("")
     return row + [changes_text(res), res.get("note", ""), ""]

@@ -49,11 +49,11 @@ class RecordedSession : public ::testing::Test {
   static void SetUpTestSuite() {
     tmp_ = new std::string(testing::MakeTempDir("recorded"));
     dir_ = new std::string(*tmp_ + "/session");
-    const ScriptRun r = Script({SourcePath("scripts/lab"), "demo", "--no-build", "--out", *dir_,
-                                "--speed", "4", "--lcm-url", testing::UniqueLcmUrl(9100),
-                                "--channel-suffix", "_BAY2",
-                                "--png-every", "200", "--width", "160", "--height", "120"},
-                               *tmp_ + "/lab.log");
+    const ScriptRun r =
+        Script({SourcePath("scripts/lab"), "demo", "--no-build", "--out", *dir_, "--speed", "4",
+                "--lcm-url", testing::UniqueLcmUrl(9100), "--channel-suffix", "_BAY2",
+                "--png-every", "200", "--width", "160", "--height", "120"},
+               *tmp_ + "/lab.log");
     ASSERT_EQ(r.rc, 0) << r.out;
   }
   static void TearDownTestSuite() {
@@ -177,6 +177,52 @@ std::vector<std::size_t> EventsOn(
   for (const lcm::LogEvent* ev; (ev = in.readNextEvent()); ++i)
     if (ev->channel.rfind(channel, 0) == 0 && take(*ev)) at.push_back(i);
   return at;
+}
+
+// docs/sessions.md "Through what is lost": DCP frames 400..429 gone from the
+// log, and ten of the operator frames they answered: which inputs the DCP
+// answered there cannot be told. The re-simulation goes on from the next
+// logged state, names the frames it could not check, and is exact for the
+// rest.
+TEST_F(RecordedSession, FramesLostFromEverySourceAreNamedAndTheRestCheckedWordForWord) {
+  const std::string cut = *tmp_ + "/lost_frames";
+  fs::copy(*dir_, cut, fs::copy_options::recursive);
+  {
+    lcm::LogFile in(*dir_ + "/lcmlog", "r"), out(cut + "/lcmlog", "w");
+    while (const lcm::LogEvent* ev = in.readNextEvent()) {
+      std::int64_t frame = -1;
+      wire::ReadFrameNumber(ev->data, static_cast<int>(ev->datalen), &frame);
+      const bool dcp = ev->channel.rfind("RMS_DCP_FRAME", 0) == 0 ||
+                       ev->channel.rfind("RMS_DCP_TELEMETRY", 0) == 0;
+      const bool input = ev->channel.rfind("RMS_OPERATOR_INPUT", 0) == 0;
+      if ((dcp && frame >= 400 && frame < 430) || (input && frame >= 410 && frame < 420)) continue;
+      out.writeEvent(const_cast<lcm::LogEvent*>(ev));
+    }
+  }
+  const std::string verdict = *tmp_ + "/lost_frames.json";
+  const ScriptRun r =
+      Script({testing::BuildPath("tools/rms_resim"), cut, "--verdict-json", verdict},
+             *tmp_ + "/lost_frames.log");
+  EXPECT_EQ(r.rc, 0) << r.out;
+  EXPECT_NE(r.out.find("not checked: before them, DCP frames 400..429"), std::string::npos)
+      << r.out;
+  const auto v = nlohmann::json::parse(ReadFile(verdict));
+  EXPECT_EQ(v["verdict"], "identical") << v.dump(2);
+  EXPECT_FALSE(v["exact"].get<bool>());
+  ASSERT_EQ(v["unchecked"].size(), 1u) << v.dump(2);
+  const auto& u = v["unchecked"][0];
+  EXPECT_EQ(u["lost_from"], 400);
+  EXPECT_EQ(u["lost_to"], 429);
+  EXPECT_EQ(u["unchecked_from"], 430);
+  // Up to the next periodic state (every 5 s of frames: 150 at 30 Hz).
+  EXPECT_GT(u["unchecked_frames"].get<long>(), 0);
+  EXPECT_LE(u["unchecked_frames"].get<long>(), 150);
+  EXPECT_EQ(u["resumed_at"].get<long>(), 430 + u["unchecked_frames"].get<long>());
+  const long recorded =
+      nlohmann::json::parse(ReadFile(*dir_ + "/summary.json"))["log"]["dcp_frames"];
+  EXPECT_EQ(v["frames_compared"].get<long>() + v["frames_unchecked"].get<long>() + 30, recorded)
+      << v.dump(2);
+  EXPECT_EQ(v["frames_identical"], v["frames_compared"]);
 }
 
 // Re-simulated on two cores (the log read in two parts, the DCP run in two
@@ -346,9 +392,9 @@ TEST_F(RecordedSession, ALongerArmFaresOtherwiseAndTheComparisonSaysWhy) {
 TEST_F(RecordedSession, ResimSetWorksOnItAndOnItsReSimulationAndAFailureLeavesNothing) {
   const std::string lab = SourcePath("scripts/lab");
   const std::string first = *tmp_ + "/tpob", second = *tmp_ + "/tpob_boom";
-  const ScriptRun a = Script({lab, "resim", *dir_, "--no-build", "--set", "dcp.tpob_ft=0.4",
-                              "--out", first},
-                             *tmp_ + "/set.log");
+  const ScriptRun a =
+      Script({lab, "resim", *dir_, "--no-build", "--set", "dcp.tpob_ft=0.4", "--out", first},
+             *tmp_ + "/set.log");
   ASSERT_EQ(a.rc, 0) << a.out;
   const auto s = nlohmann::json::parse(ReadFile(first + "/summary.json"));
   EXPECT_TRUE(s["docked"].get<bool>()) << "a slacker TPOB changes nothing the autopilot did";
@@ -356,9 +402,9 @@ TEST_F(RecordedSession, ResimSetWorksOnItAndOnItsReSimulationAndAFailureLeavesNo
   EXPECT_EQ(nlohmann::json::parse(ReadFile(first + "/manifest.json"))["lcm"]["channel_suffix"],
             "_BAY2");
   // A re-simulation of the re-simulation, with another key set.
-  const ScriptRun b = Script({lab, "resim", first, "--no-build", "--set",
-                              "arm.upper_boom_ft=21.5", "--out", second},
-                             *tmp_ + "/set2.log");
+  const ScriptRun b = Script(
+      {lab, "resim", first, "--no-build", "--set", "arm.upper_boom_ft=21.5", "--out", second},
+      *tmp_ + "/set2.log");
   ASSERT_EQ(b.rc, 0) << b.out;
   const auto c = nlohmann::json::parse(ReadFile(second + "/comparison.json"));
   EXPECT_EQ(c["config_changes"].size(), 1u) << c["config_changes"].dump();
@@ -374,10 +420,11 @@ TEST_F(RecordedSession, ResimSetWorksOnItAndOnItsReSimulationAndAFailureLeavesNo
   // A run that fails part way (its files cannot be written: a file-size
   // limit, as a full disk) leaves no folder to refuse the next try.
   const std::string cut = *tmp_ + "/cut";
-  const ScriptRun fail = Script({"/bin/bash", "-c",
-                                 "trap '' XFSZ; ulimit -f 64; exec " + testing::BuildPath("tools/rms_resim") +
-                                     " " + *dir_ + " --set dcp.tpob_ft=0.4 --out " + cut},
-                                *tmp_ + "/cut.log");
+  const ScriptRun fail =
+      Script({"/bin/bash", "-c",
+              "trap '' XFSZ; ulimit -f 64; exec " + testing::BuildPath("tools/rms_resim") + " " +
+                  *dir_ + " --set dcp.tpob_ft=0.4 --out " + cut},
+             *tmp_ + "/cut.log");
   EXPECT_NE(fail.rc, 0) << fail.out;
   EXPECT_FALSE(fs::exists(cut)) << fail.out;
   EXPECT_EQ(Script({lab, "resim", *dir_, "--no-build", "--set", "dcp.tpob_ft=0.4", "--out", cut},

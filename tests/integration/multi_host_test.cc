@@ -67,6 +67,16 @@ TEST(MultiHost, ASessionRunsAcrossNamespaceHosts) {
   EXPECT_EQ(s["timing"]["dynamics_proc"]["dropped_frames"], 0);
   EXPECT_EQ(s["log"]["final_status_from"].size(), 4u);
   EXPECT_NE(ReadFile(dir + "/lab.log").find("hosts checked"), std::string::npos);
+  // Each host's process journaled what it published into the session's
+  // folder: the record lost nothing, it re-simulates, and another design of
+  // it can be flown (docs/sessions.md "The record", "Re-simulation").
+  EXPECT_EQ(s["record"]["source"], "journals");
+  EXPECT_EQ(s["record"]["lost"], 0) << s["record"].dump();
+  EXPECT_EQ(s["resimulation"]["verdict"], "identical") << s["resimulation"].dump();
+  const auto other = testing::Script({SourcePath("scripts/lab"), "resim", dir + "/session",
+                                      "--no-build", "--set", "dcp.tpob_ft=0.4"},
+                                     dir + "/resim_set.log");
+  EXPECT_EQ(other.rc, 0) << other.out;
   // A host that is not there is refused before anything starts.
   std::string bad = ReadFile(lab_file);
   bad.replace(bad.find(net.host(3)), net.host(3).size(), "netns:no-such-host");
@@ -127,6 +137,10 @@ TEST(MultiHost, OverALossyLinkEveryGapIsCountedAndTheAutopilotStillDocks) {
   // good frame through a gap.
   EXPECT_EQ(s["frames"]["rendered"].get<long>() + s["frames"]["superseded"].get<long>(),
             scene_sent);
+  // Losses on the wire are the wire's: the record holds every frame sent,
+  // and the DCP's answers to the inputs that reached it re-simulate.
+  EXPECT_EQ(s["record"]["lost"], 0) << s["record"].dump();
+  EXPECT_EQ(s["resimulation"]["verdict"], "identical") << s["resimulation"].dump();
   net.Down();
   fs::remove_all(dir);
 }

@@ -359,6 +359,11 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
   EXPECT_LT(fr["dcp_published"].get<long>(), 100000);
   EXPECT_GE(fr["refused"]["far_ahead"].get<long>(), 1);
   EXPECT_GE(fr["refused"]["other_sender"].get<long>(), 85);
+  // Forged telemetry and frames in the record do not stop it re-simulating:
+  // the re-simulation takes, as the summary believes, the DCP's own
+  // (docs/sessions.md "Re-simulation"), and the record lost nothing.
+  EXPECT_EQ(sum["record"]["lost"], 0) << sum["record"].dump();
+  EXPECT_EQ(sum["resimulation"]["verdict"], "identical") << sum["resimulation"].dump();
   fs::remove_all(tmp);
 }
 
@@ -399,6 +404,14 @@ TEST(SessionSecurity, ASecondSessionOnTheAddressIsRefusedOrWithShareNetworkBothD
     EXPECT_EQ(sum["mode_changes"].size(), 2u);
     EXPECT_EQ(sum["session_id"].get<std::string>(), wire::FormatSessionId(x->session_id()));
     EXPECT_GT(Counter(x->out(), "dynamics_proc", "dropped.other_session"), 0);
+    // Its record is its own, whole, and re-simulates; another design of it
+    // can be flown (docs/sessions.md "Re-simulation").
+    EXPECT_EQ(sum["record"]["lost"], 0) << sum["record"].dump();
+    EXPECT_EQ(sum["resimulation"]["verdict"], "identical") << sum["resimulation"].dump();
+    const auto other = Script({testing::SourcePath("scripts/lab"), "resim", x->out(), "--no-build",
+                               "--set", "dcp.tpob_ft=0.4"},
+                              x->out() + "-resim-set.log");
+    EXPECT_EQ(other.rc, 0) << other.out;
   }
   // The second's traffic is in the first's record, and left out by its
   // summary (the first was running all the while the second flew).

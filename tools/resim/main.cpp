@@ -76,7 +76,9 @@ nlohmann::ordered_json Verdict(const rms::resim::ResimResult* r, const std::stri
   }
   const bool same = r->first_difference.empty() && r->identical == r->compared;
   v["verdict"] = same ? "identical" : "differs";
-  v["exact"] = same && r->unchecked_frames == 0 && r->skipped == 0;
+  // Exact: every frame the DCP made checked (none lost from the log, none
+  // left unchecked after such a loss, none before its first state).
+  v["exact"] = same && r->unchecked.empty() && r->skipped == 0;
   v["frames_compared"] = r->compared;
   v["frames_identical"] = r->identical;
   v["frames_unchecked"] = r->unchecked_frames;
