@@ -415,7 +415,7 @@ class Demo:
 
     def watch(self):
         """Until the pilot ends, a signal comes, or the session must stop."""
-        threshold = disk.stop_threshold(self.bytes_per_s)
+        journals = os.path.join(self.out, "journal")
         next_disk = 0.0
         station_said = self.pilot == "by-hand"  # its screen is the terminal's: nothing said over it
         while not self.sup.pilot_done and self.interrupted is None and self.sup.fatal is None:
@@ -428,7 +428,7 @@ class Demo:
             if now >= next_disk:
                 next_disk = now + 1.0
                 free = disk.free_bytes(self.out)
-                if free < threshold:
+                if free < disk.stop_threshold(self.bytes_per_s, journals):
                     self.sup.fatal = (f"the disk of {self.out} is nearly full ({free / disk.MB:.1f} MB left): stopping "
                                       f"the session now, while its record and summary still fit", 1)
             time.sleep(0.05)

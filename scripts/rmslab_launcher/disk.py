@@ -14,6 +14,10 @@ MB = 1 << 20
 # 0.0026 bytes a pixel a frame (libx264 ultrafast). Taken at about twice
 # that, for busier scenes; the margin covers logs and stats.
 LOG_BYTES_PER_FRAME = 1800
+# The log is written three times over (docs/sessions.md "The record"): the
+# processes' journals, what the network delivered (wire.lcmlog), and the
+# record made from them at the end (the journals removed once it is made).
+LOG_COPIES = 3
 STATUS_BYTES_PER_S = 8000
 PNG_FRACTION = 1 / 50
 VIDEO_BYTES_PER_PIXEL_FRAME = 0.005
@@ -23,7 +27,7 @@ STOP_BELOW_BYTES = 4 * MB
 
 
 def session_bytes_per_s(rate_hz, width, height, png_every, video):
-    b = LOG_BYTES_PER_FRAME * rate_hz + STATUS_BYTES_PER_S
+    b = (LOG_BYTES_PER_FRAME * rate_hz + STATUS_BYTES_PER_S) * LOG_COPIES
     if png_every > 0:
         b += width * height * 4 * PNG_FRACTION * rate_hz / png_every
     if video:
@@ -50,10 +54,29 @@ def check_room(path, bytes_per_s, duration_s, what):
     return need, free
 
 
-def stop_threshold(bytes_per_s):
+def stop_threshold(bytes_per_s, journal_dir=None):
     """Below this much free space a running session stops, while its record
-    and summary still fit: 10 s of writing, at least 4 MB."""
-    return max(STOP_BELOW_BYTES, 10 * bytes_per_s)
+    and summary still fit: 10 s of writing, at least 4 MB, and at least what
+    the record still to be made from the journals needs (their size so far,
+    and a tenth more)."""
+    return max(STOP_BELOW_BYTES, 10 * bytes_per_s, 1.1 * journal_bytes(journal_dir))
+
+
+def journal_bytes(journal_dir):
+    """The journals' size so far (0 without the folder)."""
+    if not journal_dir:
+        return 0
+    total = 0
+    try:
+        with os.scandir(journal_dir) as it:
+            for e in it:
+                try:
+                    total += e.stat().st_size
+                except OSError:
+                    pass
+    except OSError:
+        return 0
+    return total
 
 
 def fallback_dirs():

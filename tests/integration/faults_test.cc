@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "load_gauge.h"
 #include "subprocess.h"
 
 namespace rms {
@@ -47,6 +48,7 @@ TEST(Faults, EachProcessKilledIsRestartedTheDcpResumesAndTheAutopilotDocks) {
   const std::string tmp = testing::MakeTempDir("faults");
   const std::string out = tmp + "/session";
   const std::string url = testing::UniqueLcmUrl(8400);
+  testing::LoadGauge load;  // how loaded the machine is, for the restarts' times
   Subprocess lab({SourcePath("scripts/lab"), "demo", "--no-build", "--out", out, "--lcm-url", url,
                   "--png-every", "0", "--no-video", "--width", "320", "--height", "240"},
                  tmp + "/lab.log", {std::string("RMSLAB_BUILD=") + RMSLAB_BUILD_DIR});
@@ -77,10 +79,18 @@ TEST(Faults, EachProcessKilledIsRestartedTheDcpResumesAndTheAutopilotDocks) {
   const nlohmann::json s = nlohmann::json::parse(sf);
   EXPECT_TRUE(s["docked"].get<bool>()) << s.dump(2);
   ASSERT_EQ(s["restarts"].size(), 4u) << s["restarts"].dump();
+  // Each is back within 2 s on an idle machine; a loaded one's slowdown
+  // (wall over CPU time for a process that wants a CPU, measured all along)
+  // stretches that, and is said.
+  const double slowdown = load.Slowdown(0.9);
+  std::printf("machine slowdown: median %.2f, p90 %.2f (wall / CPU time of a 2 ms spin)\n",
+              load.Slowdown(0.5), slowdown);
   for (const auto& r : s["restarts"]) {
     std::printf("restart: %s\n", r.dump().c_str());
     EXPECT_EQ(r["exit_code"].get<int>(), 137);
-    EXPECT_LT(r["restart_s"].get<double>(), 2.0) << r.dump();
+    EXPECT_GT(r["restart_s"].get<double>(), 0.0) << r.dump();
+    EXPECT_LT(r["restart_s"].get<double>(), 2.0 * slowdown)
+        << r.dump() << " (machine slowdown p90 " << slowdown << ")";
   }
   // The gaps each restart left, counted downstream by frame numbers: a
   // restart within a frame period loses nothing; the ESG's restart (longer:
@@ -97,7 +107,7 @@ TEST(Faults, EachProcessKilledIsRestartedTheDcpResumesAndTheAutopilotDocks) {
   // a restart beyond the downtime.
   double down_s = 0.0;
   for (const auto& r : s["restarts"]) down_s += r["restart_s"].get<double>();
-  const double allowed = 30.0 * down_s + 8.0 * static_cast<double>(s["restarts"].size());
+  const double allowed = 30.0 * down_s + 8.0 * slowdown * static_cast<double>(s["restarts"].size());
   EXPECT_LT(d["operator_to_dcp"].get<long>() + d["dcp_to_scene"].get<long>() +
                 d["scene_to_esg"].get<long>(),
             allowed)

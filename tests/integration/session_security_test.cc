@@ -238,7 +238,11 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
   // Forged telemetry: from a stranger, from a pid none of the session's
   // processes has, and as the DCP itself (its id and pid) for frames it has
   // already sent. A forged status with absurd counts, as the ESG.
-  const std::int64_t now = peer.Listen(0.2);
+  // (Past DCP frame 400, whatever the machine's load made of the steps
+  // above: the forgeries below take frames 300 and 200 before it.)
+  std::int64_t now = peer.Listen(0.2);
+  for (int i = 0; i < 300 && now < 400; ++i) now = peer.Listen(0.1);
+  ASSERT_GE(now, 400) << "the session did not reach DCP frame 400 in 30 s";
   const transport::Sender as_stranger_dcp{stranger_id, sender_t::PROCESS_DYNAMICS, dcp_pid};
   const transport::Sender as_fake_pid{id, sender_t::PROCESS_DYNAMICS, 1};
   const transport::Sender as_dcp{id, sender_t::PROCESS_DYNAMICS, dcp_pid};
@@ -564,7 +568,7 @@ TEST(SessionSecurity, ADiskThatFillsStopsTheSessionAndTheSummaryIsWrittenElsewhe
   const std::string tmp = testing::MakeTempDir("full_disk");
   const RemovedAfter cleanup{tmp};
   // The session's folder is the tmpfs; the launcher's own output is not on it.
-  SmallDisk disk(tmp + "/session", 24);
+  SmallDisk disk(tmp + "/session", 48);  // room at start for the log three times over
   if (!disk.mounted()) GTEST_SKIP() << "cannot mount a tmpfs here (not root?)";
   LiveSession s(tmp, testing::UniqueLcmUrl(8690));
   ASSERT_TRUE(s.WaitRunning(60)) << ReadFile(s.log());

@@ -28,6 +28,7 @@ TOOLS = [
     "ssh", "nsenter", "ping", "ip", "tc", "nft", "mount", "umount",  # hosts, namespaces, disks
     "ps", "pkill", "timeout", "jq", "python3", "flock", "parallel",  # parallel: scripts/lab sweep
     "bash", "sudo",  # scripts/lab (python3 installed first where missing), root where the user is not
+    "debootstrap", "chroot",  # scripts/fresh-bookworm
     "clang-format", "clang-tidy", "run-clang-tidy",  # scripts/lint
 ]
 

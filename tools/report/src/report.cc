@@ -289,6 +289,11 @@ std::string LossesSection(const nlohmann::ordered_json& s) {
             r.value("published", nlohmann::ordered_json()).dump() + " published)",
         r.value("lost", nlohmann::ordered_json()));
   }
+  const nlohmann::ordered_json& network = part(s, "record", "network");
+  if (network.contains("missed_by_channel") && network["missed_by_channel"].is_object()) {
+    for (const auto& [ch, n] : network["missed_by_channel"].items())
+      row("missed by the network's recorder (the record has them from the journals): " + ch, n);
+  }
   for (const auto& [k, v] : part(s, "ignored", "by_reason").items()) {
     row("left out of this report (another session's, or not believed): " + k, v);
   }
