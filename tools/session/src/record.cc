@@ -196,30 +196,17 @@ nlohmann::ordered_json TallyJson(const Tally& t) {
   return {{"events", t.events}, {"by_channel", t.by_channel}, {"unread_bytes", t.unread_bytes}};
 }
 
-}  // namespace
+// What the merge made of its sources.
+struct Merged {
+  std::int64_t events = 0, from_journals = 0, wire_only = 0;
+  Tally wire;
+};
 
-nlohmann::ordered_json MakeRecord(const std::string& session_dir, const RecordOptions& options) {
-  const fs::path root(session_dir);
-  const fs::path jdir = root / kJournalDir, wire_path = root / kWireLog;
-  nlohmann::ordered_json j;
-  j["format"] = "rmslab-record-1";
-  if (!fs::is_directory(jdir)) {
-    j["made"] = false;
-    j["why"] = fs::exists(root / "lcmlog") ? "no journal/ folder: the record is made already, or "
-                                             "the session kept no journals"
-                                           : "no journal/ folder and no lcmlog";
-    return j;
-  }
-  const std::vector<JournalFile> journals = FindJournals(jdir);
-  if (journals.empty()) {
-    // Nothing to make it from (a session whose processes kept no journal,
-    // or a re-simulation's folder): whatever lcmlog there is stays.
-    j["made"] = false;
-    j["why"] = "no journal in journal/";
-    return j;
-  }
-  Counts held;
-  const std::vector<Tally> tallies = CountJournals(journals, &held);
+// Pass two: the journals' events and the recorder's that no journal holds,
+// in time order (of one time: journals by name, the recorder last: every
+// source's own order kept), written to `out_path` whole.
+Merged Merge(const std::vector<JournalFile>& journals, const std::vector<Tally>& tallies,
+             const fs::path& wire_path, Counts* held, const fs::path& out_path) {
   std::vector<Source> sources;
   for (std::size_t i = 0; i < journals.size(); ++i) {
     sources.push_back(
@@ -229,10 +216,7 @@ nlohmann::ordered_json MakeRecord(const std::string& session_dir, const RecordOp
   if (have_wire)
     sources.push_back(
         {std::make_unique<RawLogReader>(wire_path.string()), {}, false, true, journals.size()});
-  Tally wire;
-  std::int64_t wire_only = 0;
-  // Earliest first; of one time, the source listed first (journals by name,
-  // the recorder last): every source's own order is kept.
+  Merged m;
   auto later = [&](std::size_t x, std::size_t y) {
     const Source &a = sources[x], &b = sources[y];
     return a.ev.timestamp_us != b.ev.timestamp_us ? a.ev.timestamp_us > b.ev.timestamp_us
@@ -240,43 +224,55 @@ nlohmann::ordered_json MakeRecord(const std::string& session_dir, const RecordOp
   };
   std::priority_queue<std::size_t, std::vector<std::size_t>, decltype(later)> next(later);
   for (std::size_t i = 0; i < sources.size(); ++i)
-    if (Advance(&sources[i], &held, &wire, &wire_only)) next.push(i);
-  LogWriter out((root / "lcmlog.making").string());
+    if (Advance(&sources[i], held, &m.wire, &m.wire_only)) next.push(i);
+  LogWriter out(out_path.string() + ".making");
   while (!next.empty()) {
     const std::size_t i = next.top();
     next.pop();
     out.Write(sources[i].ev);
-    if (Advance(&sources[i], &held, &wire, &wire_only)) next.push(i);
+    if (Advance(&sources[i], held, &m.wire, &m.wire_only)) next.push(i);
   }
   if (have_wire)
-    wire.unread_bytes = static_cast<std::int64_t>(sources.back().reader->size() -
-                                                  sources.back().reader->good_end());
-  std::int64_t from_journals = 0;
-  for (const Tally& t : tallies) from_journals += t.events;
-  RMS_CHECK(out.events() == from_journals + wire_only);
-  out.Finish((root / "lcmlog").string());
+    m.wire.unread_bytes = static_cast<std::int64_t>(sources.back().reader->size() -
+                                                    sources.back().reader->good_end());
+  for (const Tally& t : tallies) m.from_journals += t.events;
+  m.events = out.events();
+  RMS_CHECK(m.events == m.from_journals + m.wire_only);
+  out.Finish(out_path.string());
+  return m;
+}
 
-  // What the recorder missed: the journals' messages it never heard.
+// The journals' messages no recorder event answered (`held` after the
+// merge), by channel: what the network's recorder missed.
+std::map<std::string, std::int64_t> MissedByWire(const std::vector<JournalFile>& journals,
+                                                 Counts held, std::int64_t* total) {
   std::map<std::string, std::int64_t> missed;
-  std::int64_t missed_total = 0;
-  {
-    Counts left = held;  // what no recorder event answered, by message
-    for (std::size_t i = 0; i < journals.size(); ++i) {
-      RawLogReader r(journals[i].path.string());
-      RawLogEvent ev;
-      while (r.Next(&ev)) {
-        const auto it = left.find(KeyOf(ev));
-        if (it != left.end() && it->second > 0) {
-          --it->second;
-          ++missed[std::string(ev.channel)];
-          ++missed_total;
-        }
+  *total = 0;
+  for (const JournalFile& jf : journals) {
+    RawLogReader r(jf.path.string());
+    RawLogEvent ev;
+    while (r.Next(&ev)) {
+      const auto it = held.find(KeyOf(ev));
+      if (it != held.end() && it->second > 0) {
+        --it->second;
+        ++missed[std::string(ev.channel)];
+        ++*total;
       }
     }
   }
+  return missed;
+}
+
+// record.json (docs/sessions.md "The record").
+nlohmann::ordered_json RecordJson(const std::vector<JournalFile>& journals,
+                                  const std::vector<Tally>& tallies, const Merged& m,
+                                  bool have_wire, const std::map<std::string, std::int64_t>& missed,
+                                  std::int64_t missed_total, bool kept) {
+  nlohmann::ordered_json j;
+  j["format"] = "rmslab-record-1";
   j["made"] = true;
   j["lcmlog"] = {
-      {"events", out.events()}, {"from_journals", from_journals}, {"from_wire_only", wire_only}};
+      {"events", m.events}, {"from_journals", m.from_journals}, {"from_wire_only", m.wire_only}};
   j["journals"] = nlohmann::ordered_json::array();
   for (std::size_t i = 0; i < journals.size(); ++i) {
     nlohmann::ordered_json e = {
@@ -287,10 +283,39 @@ nlohmann::ordered_json MakeRecord(const std::string& session_dir, const RecordOp
     j["journals"].push_back(std::move(e));
   }
   j["wire"] = {{"file", kWireLog}, {"present", have_wire}};
-  if (have_wire) j["wire"].update(TallyJson(wire));
-  j["wire"]["only_there"] = wire_only;
+  if (have_wire) j["wire"].update(TallyJson(m.wire));
+  j["wire"]["only_there"] = m.wire_only;
   j["wire"]["missed"] = {{"total", missed_total}, {"by_channel", missed}};
-  j["journals_kept"] = options.keep_journals;
+  j["journals_kept"] = kept;
+  return j;
+}
+
+nlohmann::ordered_json NotMade(const std::string& why) {
+  return {{"format", "rmslab-record-1"}, {"made", false}, {"why", why}};
+}
+
+}  // namespace
+
+nlohmann::ordered_json MakeRecord(const std::string& session_dir, const RecordOptions& options) {
+  const fs::path root(session_dir);
+  const fs::path jdir = root / kJournalDir, wire_path = root / kWireLog;
+  if (!fs::is_directory(jdir)) {
+    return NotMade(fs::exists(root / "lcmlog")
+                       ? "no journal/ folder: the record is made already, or the session kept "
+                         "no journals"
+                       : "no journal/ folder and no lcmlog");
+  }
+  const std::vector<JournalFile> journals = FindJournals(jdir);
+  // Nothing to make it from (a session whose processes kept no journal, or
+  // a re-simulation's folder): whatever lcmlog there is stays.
+  if (journals.empty()) return NotMade("no journal in journal/");
+  Counts held;
+  const std::vector<Tally> tallies = CountJournals(journals, &held);
+  const Merged m = Merge(journals, tallies, wire_path, &held, root / "lcmlog");
+  std::int64_t missed_total = 0;
+  const auto missed = MissedByWire(journals, held, &missed_total);
+  const nlohmann::ordered_json j = RecordJson(journals, tallies, m, fs::exists(wire_path), missed,
+                                              missed_total, options.keep_journals);
   WriteWholeFile((root / "record.json").string(), j.dump(2) + "\n");
   if (!options.keep_journals) {
     for (const JournalFile& jf : journals) fs::remove(jf.path);
