@@ -285,7 +285,7 @@ void CheckTimes(const nlohmann::json& j, const std::string& at, double rate_hz, 
   if (j.is_object()) {
     for (const auto& [k, v] : j.items()) {
       const bool t = time || (k.size() > 2 && k.compare(k.size() - 2, 2, "_s") == 0);
-      CheckTimes(v, at + "." + k, rate_hz, t);
+      CheckTimes(v, std::string(at).append(".").append(k), rate_hz, t);
     }
   } else if (j.is_array()) {
     for (std::size_t i = 0; i < j.size(); ++i)

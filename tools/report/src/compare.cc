@@ -91,7 +91,7 @@ std::string CsvField(std::string v) {
 // first attempt of a session branched from another's instant). Only a
 // fresh start is a trial for a learning curve.
 std::string StartedFrom(const Session& s, const nlohmann::ordered_json& a) {
-  const std::string by = a.value("started_by", "start");
+  std::string by = a.value("started_by", "start");
   if (by == "start" && s.branch) return "branch";
   if (by == "start" && s.restored_start) return "restore";
   return by;

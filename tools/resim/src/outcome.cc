@@ -11,8 +11,8 @@ namespace {
 nlohmann::json ResultAttempt(const nlohmann::json& summary) {
   const auto& attempts = summary.value("attempts", nlohmann::json::array());
   // null when the session had no attempt (no DCP frame it believed)
-  const nlohmann::json& r = summary.contains("result_attempt") ? summary["result_attempt"]
-                                                               : nlohmann::json();
+  const nlohmann::json& r =
+      summary.contains("result_attempt") ? summary["result_attempt"] : nlohmann::json();
   const long i = r.is_number_integer() ? r.get<long>() : 0;
   if (i >= 1 && i <= static_cast<long>(attempts.size())) return attempts[i - 1];
   return nlohmann::json::object();

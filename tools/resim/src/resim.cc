@@ -466,9 +466,9 @@ ResimResult Resimulate(const ResimOptions& opt) {
         fs::remove_all(dir, ec);
         return;
       }
-      for (const char* f : {"lcmlog", "config.toml", "manifest.json", "summary.json",
-                            "comparison.json", "comparison.md", "run/pilot",
-                            "stats/dynamics_proc.json"})
+      for (const char* f :
+           {"lcmlog", "config.toml", "manifest.json", "summary.json", "comparison.json",
+            "comparison.md", "run/pilot", "stats/dynamics_proc.json"})
         fs::remove(dir / f, ec);
     }
   } new_session;

@@ -314,8 +314,8 @@ nlohmann::ordered_json MakeRecord(const std::string& session_dir, const RecordOp
   const Merged m = Merge(journals, tallies, wire_path, &held, root / "lcmlog");
   std::int64_t missed_total = 0;
   const auto missed = MissedByWire(journals, held, &missed_total);
-  const nlohmann::ordered_json j = RecordJson(journals, tallies, m, fs::exists(wire_path), missed,
-                                              missed_total, options.keep_journals);
+  nlohmann::ordered_json j = RecordJson(journals, tallies, m, fs::exists(wire_path), missed,
+                                        missed_total, options.keep_journals);
   WriteWholeFile((root / "record.json").string(), j.dump(2) + "\n");
   if (!options.keep_journals) {
     for (const JournalFile& jf : journals) fs::remove(jf.path);
