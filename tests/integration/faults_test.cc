@@ -127,6 +127,12 @@ TEST(Faults, EachProcessKilledIsRestartedTheDcpResumesAndTheAutopilotDocks) {
   int dcp_runs = 0;
   for (const auto& j : record["journals"]) dcp_runs += j["process"] == "dynamics_proc";
   EXPECT_EQ(dcp_runs, 2) << "the killed run's journal and its restart's: " << record.dump(2);
+  // The frames each process published count every run's (the killed one's
+  // too), as the brief says them.
+  EXPECT_EQ(s["frames"]["dcp_published"], s["record"]["by_channel"]["RMS_DCP_FRAME"]["published"]);
+  EXPECT_EQ(s["frames"]["operator_published"],
+            s["record"]["by_channel"]["RMS_OPERATOR_INPUT"]["published"]);
+  EXPECT_EQ(s["frames"]["esg_published"], s["record"]["by_channel"]["RMS_ESG_FRAME"]["published"]);
   // And the session says it re-simulates, word for word: the DCP's resume
   // is in the record, as the frames of both its runs.
   const nlohmann::json v = nlohmann::json::parse(ReadFile(out + "/resimulation.json"));

@@ -205,10 +205,15 @@ TEST(LabDemo, TheWakeLatencyRequestIsOffWhenAskedAndABadOneIsRefusedNamingIt) {
   // (as root, this test runs one as nobody to see it).
   if (geteuid() == 0 && access("/usr/bin/setpriv", X_OK) == 0) {
     fs::permissions(tmp, fs::perms::all);
+    // The configuration from where nobody may read it (a checkout under
+    // /root, as in a container, is not).
+    const std::string config = tmp + "/rmslab.toml";
+    fs::copy_file(SourcePath("config/rmslab.toml"), config);
+    fs::permissions(config, fs::perms::owner_read | fs::perms::group_read | fs::perms::others_read);
     const std::string ready = tmp + "/scene_proc.ready";
     Subprocess p({"/usr/bin/setpriv", "--reuid=65534", "--regid=65534", "--clear-groups",
-                  std::string(RMSLAB_BUILD_DIR) + "/scene_proc/scene_proc", "--lcm-url",
-                  testing::UniqueLcmUrl(8300), "--ready-file", ready},
+                  std::string(RMSLAB_BUILD_DIR) + "/scene_proc/scene_proc", "--config", config,
+                  "--lcm-url", testing::UniqueLcmUrl(8300), "--ready-file", ready},
                  tmp + "/nobody.log", {"RMSLAB_CPU_WAKE_LATENCY_US=0"});
     ASSERT_TRUE(testing::WaitForFile(ready, 30)) << testing::ReadFile(tmp + "/nobody.log");
     const auto said = nlohmann::json::parse(testing::ReadFile(ready));

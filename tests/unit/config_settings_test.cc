@@ -142,6 +142,10 @@ TEST(ReadTextFile, SaysWhyAFileCannotBeRead) {
                                          "/none.toml': No such file or directory");
   std::ofstream(dir + "/ok.toml") << "a = 1\n";
   EXPECT_EQ(ReadTextFile(dir + "/ok.toml", "x"), "a = 1\n");
+  // A device without end is refused once past the limit, not read on.
+  EXPECT_EQ(why("/dev/zero"),
+            "cannot read the configuration file '/dev/zero': it is larger than 64 MiB (not a "
+            "text file of this kind?)");
   std::filesystem::remove_all(dir);
 }
 

@@ -456,9 +456,18 @@ ResimResult Resimulate(const ResimOptions& opt) {
   // A re-simulation that fails leaves no half-made session behind (it would
   // refuse the next try): the folder it made goes, or, in a folder given
   // that was there, what it wrote (docs/sessions.md "Re-simulation").
+  static constexpr const char* kFiles[] = {
+      "lcmlog",          "config.toml",   "manifest.json", "summary.json",
+      "comparison.json", "comparison.md", "run/pilot",     "stats/dynamics_proc.json"};
   struct NewSession {
     fs::path dir;
     bool made_folder = false, done = false;
+    std::vector<bool> was_there;  // each of kFiles, before: never removed
+    void Claim(fs::path target) {
+      dir = std::move(target);
+      made_folder = !fs::exists(dir);
+      for (const char* f : kFiles) was_there.push_back(fs::exists(dir / f));
+    }
     ~NewSession() {
       if (dir.empty() || done) return;
       std::error_code ec;
@@ -466,19 +475,20 @@ ResimResult Resimulate(const ResimOptions& opt) {
         fs::remove_all(dir, ec);
         return;
       }
-      for (const char* f :
-           {"lcmlog", "config.toml", "manifest.json", "summary.json", "comparison.json",
-            "comparison.md", "run/pilot", "stats/dynamics_proc.json"})
-        fs::remove(dir / f, ec);
+      for (size_t i = 0; i < was_there.size(); ++i)
+        if (!was_there[i]) fs::remove(dir / kFiles[i], ec);
     }
   } new_session;
+  std::string out_log;
   if (written) {
-    new_session.dir = opt.out_dir.empty()
+    // Claimed before the folder is opened, so that a folder made and then
+    // refused goes; a folder refused because it holds a session (the
+    // source itself, an earlier re-simulation) keeps every file it had.
+    new_session.Claim(opt.out_dir.empty()
                           ? fs::path(fs::path(opt.session).lexically_normal().string() + "-resim")
-                          : fs::path(opt.out_dir);
-    new_session.made_folder = !fs::exists(new_session.dir);
+                          : fs::path(opt.out_dir));
+    out_log = OpenNewSession(opt, config_text, &result);
   }
-  const std::string out_log = written ? OpenNewSession(opt, config_text, &result) : "";
   if (opt.until_frame >= 0) CheckUntil(rec, plan, opt, other_design);
   const Outputs out = RunAndCompare(
       config, rec, plan, {out_log, other_design, opt.until_frame, other, progress}, &result);

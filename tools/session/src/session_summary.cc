@@ -630,13 +630,23 @@ std::int64_t Malformed(const nlohmann::json& st) {
   return n;
 }
 
-nlohmann::ordered_json FramesJson(const std::map<std::string, nlohmann::json>& stats) {
+std::int64_t Journaled(const nlohmann::json& record, const std::string& channel);
+
+// Frames each process published: what its journals hold (every run's, a
+// process killed and restarted among them: the exact count, docs/sessions.md
+// "The record"), or, in a session without journals, its own final counter.
+nlohmann::ordered_json FramesJson(const std::map<std::string, nlohmann::json>& stats,
+                                  const nlohmann::json& record, const std::string& suffix) {
   const auto &op = stats.at("operator_station"), &dcp = stats.at("dynamics_proc"),
              &scene = stats.at("scene_proc"), &esg = stats.at("esg_renderer");
+  const bool journals = Journaled(record, "") >= 0;
+  auto published = [&](const nlohmann::json& st, const char* channel) {
+    return journals ? Journaled(record, channel + suffix) : CounterOf(st, rms::Counter::kPublished);
+  };
   nlohmann::ordered_json frames;
-  frames["operator_published"] = CounterOf(op, rms::Counter::kPublished);
-  frames["dcp_published"] = CounterOf(dcp, rms::Counter::kPublished);
-  frames["esg_published"] = CounterOf(scene, rms::Counter::kPublished);
+  frames["operator_published"] = published(op, wire::channels::kOperatorInput);
+  frames["dcp_published"] = published(dcp, wire::channels::kDcpFrame);
+  frames["esg_published"] = published(scene, wire::channels::kEsgFrame);
   frames["rendered"] = CounterOf(esg, rms::Counter::kRendered);
   frames["superseded"] = CounterOf(esg, rms::Counter::kSuperseded);
   frames["scenes_drawn"] = CounterOf(esg, rms::Counter::kRenderedScenes);
@@ -962,10 +972,11 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
   j["collisions_by_kind"] = s.telemetry.ByKind();
   j["held_frames"] = s.telemetry.held_frames;
   j["telemetry_frames"] = s.telemetry.frames();
-  j["frames"] = FramesJson(stats);
+  const nlohmann::json record = ReadJson(root / "record.json");
+  j["frames"] = FramesJson(stats, record, log.suffix());
   j["latency"] = LatencyJson(stats);
   j["timing"] = TimingJson(stats, rate_hz);
-  j["record"] = RecordJson(stats, s, ReadJson(root / "record.json"), log.suffix());
+  j["record"] = RecordJson(stats, s, record, log.suffix());
   j["log"] = LogSection(s, log, stats);
   j["ignored"] = check.Json();
   ForPeople(&j);

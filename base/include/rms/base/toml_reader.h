@@ -188,7 +188,13 @@ class TomlReader {
   std::set<std::string> used_;
 };
 
-// A whole text file; an InputError "cannot read WHAT 'PATH': WHY" when it can't be read.
+// The largest text file read (a configuration, lab file or summary is
+// kilobytes; /dev/zero, or a log given by mistake, is refused, not read
+// into memory without end).
+inline constexpr std::size_t kMaxTextFileBytes = std::size_t{64} << 20;
+
+// A whole text file; an InputError "cannot read WHAT 'PATH': WHY" when it
+// can't be read or is larger than kMaxTextFileBytes.
 inline std::string ReadTextFile(const std::string& path, const std::string& what) {
   const std::string cannot = "cannot read " + what + " '" + path + "'";
   std::error_code ec;
@@ -197,10 +203,15 @@ inline std::string ReadTextFile(const std::string& path, const std::string& what
   std::ifstream f(path);
   // (why: the open's errno, e.g. "No such file or directory", "Too many open files")
   if (!f) throw InputError(cannot + (errno != 0 ? ": " + std::string(std::strerror(errno)) : ""));
-  std::stringstream ss;
-  ss << f.rdbuf();
+  std::string text;
+  char block[65536];
+  while (f.read(block, sizeof block) || f.gcount() > 0) {
+    text.append(block, static_cast<std::size_t>(f.gcount()));
+    if (text.size() > kMaxTextFileBytes)
+      throw InputError(cannot + ": it is larger than 64 MiB (not a text file of this kind?)");
+  }
   if (f.bad()) throw InputError(cannot + ": a read error part way");
-  return ss.str();
+  return text;
 }
 
 // Parses TOML text; a syntax error is an InputError "SOURCE:LINE:COLUMN:
