@@ -185,6 +185,35 @@ TEST(Record, HoldsEveryJournalEventAndWhatOnlyTheNetworkHeardInTimeOrder) {
   EXPECT_EQ(ReadWithLiblcm(s / "lcmlog"), want);
 }
 
+// A journal damaged part way (its second event's sync word overwritten):
+// what follows the damage comes from the wire, the unread bytes are counted,
+// and every journal is kept to look into.
+TEST(Record, ADamagedJournalIsCountedAndKept) {
+  const fs::path s = FreshDir("damaged");
+  fs::create_directories(s / "journal");
+  const Event a1{100, "RMS_DCP_FRAME", "a1"}, a2{200, "RMS_DCP_FRAME", "a2"},
+      a3{300, "RMS_DCP_FRAME", "a3"};
+  Journalize(s / "journal", "dynamics_proc", {a1, a2, a3});
+  Journalize(s / "journal", "scene_proc", {{150, "RMS_ESG_FRAME", "b1"}});
+  const fs::path dcp = s / "journal" / "dynamics_proc.0.lcmlog";
+  ASSERT_TRUE(fs::exists(dcp));
+  const auto first_event_bytes = static_cast<std::streamoff>(4 + 8 + 8 + 4 + 4 + 13 + 2);
+  {
+    std::fstream f(dcp, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(first_event_bytes);
+    f.write("XXXX", 4);
+  }
+  WriteWithLiblcm(s / "wire.lcmlog", {{201, a2.channel, a2.data}, {301, a3.channel, a3.data}});
+  const auto record = session::MakeRecord(s.string());
+  EXPECT_TRUE(record["made"].get<bool>());
+  EXPECT_GT(record["journals"][0]["unread_bytes"].get<long>(), 0) << record.dump(2);
+  EXPECT_EQ(record["journals"][0]["events"], 0) << "an event is taken only when a sync follows";
+  EXPECT_EQ(record["lcmlog"]["from_wire_only"], 2);
+  EXPECT_TRUE(record["journals_kept"].get<bool>());
+  EXPECT_TRUE(fs::exists(dcp));
+  EXPECT_TRUE(fs::exists(s / "journal" / "scene_proc.0.lcmlog"));
+}
+
 // Random journals and a recorder that hears a random part of them (seeded,
 // the seed printed): every journal event is in the record once, every
 // recorder event no journal has too, each source's order is kept.

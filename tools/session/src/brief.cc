@@ -82,6 +82,13 @@ void LossLines(const Json& j, std::ostream& os) {
     os << "the processes' journals could not hold " << j["record"]["journal_failed"]
        << " messages (a full disk): the record has those the network's recorder heard\n";
   }
+  if (j["record"].value("journal_unread_bytes", 0) > 0) {
+    os << "the journals " << j["record"]["journals_damaged"].dump() << " end in "
+       << j["record"]["journal_unread_bytes"]
+       << " bytes that are no whole event (damaged, or cut short): the record has what the "
+          "network's recorder heard of what they held past it, the counts of what was "
+          "published are what could be read, and the journals are kept in journal/\n";
+  }
   if (j["ignored"].value("total", 0) > 0) {
     os << "left out " << j["ignored"]["total"]
        << " logged messages (another session's, or not believed):";

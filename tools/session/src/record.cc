@@ -314,10 +314,16 @@ nlohmann::ordered_json MakeRecord(const std::string& session_dir, const RecordOp
   const Merged m = Merge(journals, tallies, wire_path, &held, root / "lcmlog");
   std::int64_t missed_total = 0;
   const auto missed = MissedByWire(journals, held, &missed_total);
-  nlohmann::ordered_json j = RecordJson(journals, tallies, m, fs::exists(wire_path), missed,
-                                        missed_total, options.keep_journals);
+  // A journal that ends in bytes that are no whole event (damaged, or cut
+  // short by a full disk) is kept, with every other, for whoever looks into
+  // it: what it holds past the damage is not in the record.
+  const bool damaged = std::any_of(tallies.begin(), tallies.end(),
+                                   [](const Tally& t) { return t.unread_bytes > 0; });
+  const bool keep = options.keep_journals || damaged;
+  nlohmann::ordered_json j =
+      RecordJson(journals, tallies, m, fs::exists(wire_path), missed, missed_total, keep);
   WriteWholeFile((root / "record.json").string(), j.dump(2) + "\n");
-  if (!options.keep_journals) {
+  if (!keep) {
     for (const JournalFile& jf : journals) fs::remove(jf.path);
     std::error_code ec;
     fs::remove(jdir, ec);  // only when empty: anything else there stays

@@ -796,6 +796,19 @@ nlohmann::ordered_json RecordJson(const std::map<std::string, nlohmann::json>& s
   for (const auto& [p, st] : stats) journal_failed += CounterOf(st, rms::Counter::kJournalFailed);
   r["journal_failed"] = journal_failed;
   if (journals) {
+    // Journals that end in bytes that are no whole event (damaged; a disk
+    // that filled mid-write and could not be cut back): their counts are
+    // what could be read, and what followed is only the network's.
+    std::int64_t unread = 0;
+    nlohmann::ordered_json damaged = nlohmann::ordered_json::array();
+    for (const auto& jf : record["journals"]) {
+      const std::int64_t n = RecordCount(jf, {"unread_bytes"});
+      if (n <= 0) continue;
+      unread += n;
+      damaged.push_back(jf.value("file", std::string()));
+    }
+    r["journal_unread_bytes"] = unread;
+    r["journals_damaged"] = damaged;
     nlohmann::ordered_json missed = nlohmann::ordered_json::object();
     if (record["wire"].is_object() && record["wire"].contains("missed") &&
         record["wire"]["missed"].contains("by_channel") &&
