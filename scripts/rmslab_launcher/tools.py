@@ -105,6 +105,8 @@ def export(argv):
     a = p.parse_args(argv)
     if not os.path.isfile(os.path.join(a.session, "lcmlog")):
         raise LabError(f"{a.session}: not a session folder (no lcmlog)", 2)
+    if a.mcap:
+        refuse_record_file(a.out)
     ensure("tools/rms_session", a.no_build)
     if not a.mcap:
         cmd = [binary("tools/rms_session"), "export", a.session] + (["--out", a.out] if a.out else [])
@@ -139,6 +141,23 @@ def export_mcap(session, out):
     return 0
 
 
+# A session's record and what is made from it at its end (docs/sessions.md
+# "The session folder"): an --out never writes over one of them.
+RECORD_FILES = ("lcmlog", "wire.lcmlog", "record.json", "resimulation.json", "summary.json",
+                "manifest.json", "config.toml", "timeline.tl", "bindings.toml", "session.mp4")
+
+
+def refuse_record_file(out):
+    """A LabError when OUT names a file of a session's record (a folder
+    holding an lcmlog): writing there would lose it."""
+    if not out:
+        return
+    folder = os.path.dirname(os.path.abspath(out))
+    if os.path.basename(out) in RECORD_FILES and os.path.exists(os.path.join(folder, "lcmlog")):
+        raise LabError(f"--out {out}: that is the session's own {os.path.basename(out)} "
+                       f"(docs/sessions.md \"The session folder\"): give another file", 2)
+
+
 def report(argv):
     """scripts/lab report SESSION [--out FILE]: one self-contained HTML report
     (default SESSION/report.html): the session, its tolerances, every
@@ -154,6 +173,7 @@ def report(argv):
         raise LabError(f"{a.session}: not a session folder (no lcmlog)", 2)
     if a.out and not os.path.isdir(os.path.dirname(os.path.abspath(a.out))):
         raise LabError(f"--out {a.out}: its folder does not exist", 2)
+    refuse_record_file(a.out)
     ensure("tools/rms_report", a.no_build)
     return subprocess.run([binary("tools/rms_report"), a.session] + (["--out", a.out] if a.out else [])).returncode
 

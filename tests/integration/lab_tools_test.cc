@@ -557,6 +557,39 @@ TEST_F(RecordedSession, ItExportsEveryChannelToCsvWithUnits) {
   EXPECT_EQ(column(last, docked_col), "1");
 }
 
+// A log cut short is exported up to the cut, saying so; a log with nothing
+// of the session in it exports nothing and fails; an --out that names one
+// of the session's own record files is refused and the file kept.
+TEST_F(RecordedSession, AnExportSaysWhatItCouldNotReadAndKeepsTheRecord) {
+  const std::string lab = SourcePath("scripts/lab");
+  const std::string cut = *tmp_ + "/cut_export";
+  fs::create_directories(cut);
+  for (const char* f : {"config.toml", "manifest.json", "summary.json"})
+    fs::copy_file(*dir_ + "/" + f, cut + "/" + f);
+  const std::string whole = ReadFile(*dir_ + "/lcmlog");
+  std::ofstream(cut + "/lcmlog", std::ios::binary) << whole.substr(0, whole.size() / 2);
+  const ScriptRun half = Script({lab, "export", cut, "--no-build"}, *tmp_ + "/cut_export.log");
+  EXPECT_EQ(half.rc, 0) << half.out;
+  EXPECT_NE(half.out.find("bytes that are no whole event (it was cut short or damaged there): "
+                          "exported up to them"),
+            std::string::npos)
+      << half.out;
+  std::ofstream(cut + "/lcmlog", std::ios::binary | std::ios::trunc) << "";
+  const ScriptRun none = Script({lab, "export", cut, "--no-build"}, *tmp_ + "/none_export.log");
+  EXPECT_EQ(none.rc, 1) << none.out;
+  EXPECT_NE(none.out.find("holds no message of this session"), std::string::npos) << none.out;
+  for (const std::vector<std::string>& over :
+       {std::vector<std::string>{lab, "report", *dir_, "--no-build", "--out", *dir_ + "/lcmlog"},
+        std::vector<std::string>{lab, "export", *dir_, "--no-build", "--mcap", "--out",
+                                 *dir_ + "/summary.json"}}) {
+    const ScriptRun r = Script(over, *tmp_ + "/over.log");
+    EXPECT_EQ(r.rc, 2) << r.out;
+    EXPECT_NE(r.out.find("that is the session's own"), std::string::npos) << r.out;
+  }
+  EXPECT_EQ(ReadFile(*dir_ + "/lcmlog"), whole);
+  EXPECT_NO_THROW(nlohmann::json::parse(ReadFile(*dir_ + "/summary.json")));
+}
+
 TEST_F(RecordedSession, ItsReportOpensInABrowserWithPlots) {
   const ScriptRun r =
       Script({SourcePath("scripts/lab"), "report", *dir_, "--out", *tmp_ + "/report.html"},

@@ -163,9 +163,20 @@ Command Export(CLI::App& app) {
             std::function<void(const std::string&)> progress;
             if (isatty(STDERR_FILENO))
               progress = [](const std::string& line) { std::cerr << line << "\n"; };
-            const auto files =
-                session::ExportCsv(o->dir, o->out.empty() ? o->dir + "/csv" : o->out, progress);
+            session::ExportRead read;
+            const auto files = session::ExportCsv(o->dir, o->out.empty() ? o->dir + "/csv" : o->out,
+                                                  progress, &read);
             for (const auto& [f, n] : files) std::cout << f << ": " << n << " rows\n";
+            // What could not be read is said, never left to a count of rows.
+            if (read.unread_bytes > 0)
+              std::cerr << "rms_session export: the log ends in " << read.unread_bytes
+                        << " bytes that are no whole event (it was cut short or damaged there): "
+                           "exported up to them\n";
+            if (read.events == 0) {
+              std::cerr << "rms_session export: " << o->dir
+                        << "/lcmlog holds no message of this session: nothing was exported\n";
+              return 1;
+            }
             return 0;
           }};
 }

@@ -455,7 +455,7 @@ struct ChannelFiles {
 
 std::vector<std::pair<std::string, long>> ExportCsv(
     const std::string& session_dir, const std::string& out_dir,
-    const std::function<void(const std::string&)>& progress) {
+    const std::function<void(const std::string&)>& progress, ExportRead* read) {
   const fs::path root(session_dir), out(out_dir);
   const LabConfig config = LoadConfig((root / "config.toml").string());
   fs::create_directories(out);
@@ -463,7 +463,7 @@ std::vector<std::pair<std::string, long>> ExportCsv(
   long skipped = 0, events = 0;
   SessionLog log(session_dir);  // only the session's own messages (docs/security.md)
   log.Read({}, [&](const LogMessage& msg) {
-    if (progress && ++events % 100000 == 0)
+    if (++events % 100000 == 0 && progress)
       progress("export: " + std::to_string(events) + " messages");
     try {
       files.Write(msg, config);
@@ -477,6 +477,7 @@ std::vector<std::pair<std::string, long>> ExportCsv(
     c->Close();
     written.emplace_back(c->path().string(), c->rows());
   }
+  if (read) *read = {events, log.unread_bytes()};
   written.emplace_back("skipped (malformed)", skipped);
   written.emplace_back("not exported (not the session's own: other sessions, other senders)",
                        static_cast<long>(log.check().ignored_total()));

@@ -3,6 +3,7 @@
 // (operator_input, dcp_frame, esg_frame, dcp_telemetry, status, control),
 // every message decoded into engineering units, the unit in each column's
 // header ("shoulder_yaw [deg]"), one row a message (status: one a counter).
+#include <cstdint>
 #include <functional>
 #include <iosfwd>
 #include <string>
@@ -11,11 +12,17 @@
 
 namespace rms::session {
 
+// What the export read of the log, beside what it wrote.
+struct ExportRead {
+  long events = 0;                // the session's own messages read
+  std::int64_t unread_bytes = 0;  // at the log's end, no whole event: not exported
+};
+
 // Returns each file written with its rows, and the count of malformed
 // messages skipped. Throws rms::InputError for an unreadable session.
 std::vector<std::pair<std::string, long>> ExportCsv(
     const std::string& session_dir, const std::string& out_dir,
-    const std::function<void(const std::string&)>& progress = {});
+    const std::function<void(const std::string&)>& progress = {}, ExportRead* read = nullptr);
 
 }  // namespace rms::session
 
