@@ -47,6 +47,9 @@ int main(int argc, char** argv) {
                  "Start from a checkpoint's operator inputs (with dynamics_proc --restore; "
                  "docs/sessions.md)")
       ->check(CLI::ExistingFile);
+  app.add_option("--dcp-state-file", opt.dcp_state_path,
+                 "The DCP's state file (dynamics_proc --state-file): restarted, send the inputs it "
+                 "holds until the DCP's first telemetry (docs/sessions.md \"Faults\")");
   app.add_option(
       "--checkpoint-dir", opt.checkpoint_dir,
       "The session's checkpoints folder: RMS_CONTROL's RESTORE names a file in it and nowhere else "

@@ -412,6 +412,30 @@ void OperatorStation::ResumeFromTelemetry() {
                static_cast<int>(t.mode), t.frame);
 }
 
+// A restarted station must not send the task's initial inputs while it
+// waits for the DCP's first telemetry (the DCP answers only inputs): in Mode
+// 2 or 3 an open finger lets the payload go. It sends, until then, the
+// inputs the DCP last took, as its state file holds them (written on every
+// change of mode and at least every 0.5 s).
+void OperatorStation::ResumeFromDcpState() {
+  try {
+    const wire::Checkpoint c = wire::ReadCheckpoint(options_.dcp_state_path);
+    wire::OperatorInputs from = c.inputs;
+    from.reset = false;
+    last_ = from;
+    source_->Resume(from, false);
+    spdlog::warn(
+        "restarted: sending the inputs of the DCP's last state (DCP frame {}) until its "
+        "first telemetry",
+        c.dcp_frame);
+  } catch (const std::exception& e) {
+    spdlog::warn(
+        "restarted: the DCP's state could not be read ({}): resuming from its first "
+        "telemetry only",
+        e.what());
+  }
+}
+
 // One frame: the source's inputs, published as the input block and the
 // operator's state, the status and the screen. False when the source ended.
 bool OperatorStation::StepFrame(transport::StatusReporter* status) {
@@ -490,6 +514,7 @@ int OperatorStation::Run(const std::string& stats_path, const std::string& ready
 
   std::int64_t next_ns = MonotonicNs();
   last_ = wire::InitialInputs(config_.inputs);
+  if (resume_from_telemetry && !options_.dcp_state_path.empty()) ResumeFromDcpState();
   while (!transport::StopRequested()) {
     if (options_.max_frames >= 0 && frames_ >= options_.max_frames) break;
     if (lcm_.HandleSubscriptions(0) < 0) counters_.Add(Counter::kTransportErrors);

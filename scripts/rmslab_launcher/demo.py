@@ -328,6 +328,9 @@ class Demo:
         extra = ["--checkpoint-dir", self.remote_run if remote else os.path.join(self.out, "checkpoints")]
         if a.restore:
             extra += ["--restore", os.path.join(self.out, "run", "restore.json")]
+        if not remote and not self.hosts["dynamics_proc"].remote:
+            # restarted, it sends the DCP's last inputs until it hears the DCP ("Faults")
+            extra += ["--dcp-state-file", os.path.join(self.out, "run", "dcp_state.json")]
         tty = False
         if self.pilot == "timeline":
             extra += ["--timeline", os.path.join(self.out, "timeline.tl"), "--speed", str(self.speed)]

@@ -1,7 +1,8 @@
 // Process faults (docs/sessions.md "Faults"): scripts/lab demo as a user
 // runs it, the autopilot flying the whole task, while the test kills each
 // of the four processes with SIGKILL in turn -- the operator station in
-// Mode 1, the DCP once the payload is acquired, then the scene and the ESG.
+// Mode 1, the DCP once the payload is acquired, then the scene and the ESG,
+// and the operator station again in Mode 3.
 // The launcher restarts each one; the DCP resumes from its last state (the
 // payload attached), not from Mode 1; the others count the gap; the
 // autopilot still docks; the LCM log keeps what was sent.
@@ -64,6 +65,13 @@ TEST(Faults, EachProcessKilledIsRestartedTheDcpResumesAndTheAutopilotDocks) {
   ASSERT_TRUE(Kill(out, "scene_proc"));
   std::this_thread::sleep_for(std::chrono::seconds(3));
   ASSERT_TRUE(Kill(out, "esg_renderer"));
+  // The operator station again, the payload held (Mode 3): restarted, it
+  // sends the DCP's last inputs until it hears the DCP, so the finger stays
+  // closed and the payload held.
+  ASSERT_TRUE(WaitForText(out + "/logs/dynamics_proc.log", "Mode 2 -> Mode 3", lab, 90))
+      << ReadFile(tmp + "/lab.log");
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  ASSERT_TRUE(Kill(out, "operator_station"));
   ASSERT_EQ(lab.Wait(180), 0) << ReadFile(tmp + "/lab.log");
 
   // The DCP resumed with the payload attached (Mode 2 or 3), not in Mode 1.
@@ -78,7 +86,12 @@ TEST(Faults, EachProcessKilledIsRestartedTheDcpResumesAndTheAutopilotDocks) {
   std::ifstream sf(out + "/summary.json");
   const nlohmann::json s = nlohmann::json::parse(sf);
   EXPECT_TRUE(s["docked"].get<bool>()) << s.dump(2);
-  ASSERT_EQ(s["restarts"].size(), 4u) << s["restarts"].dump();
+  ASSERT_EQ(s["restarts"].size(), 5u) << s["restarts"].dump();
+  // Killed in Mode 3, the station's restart never let the payload go.
+  EXPECT_EQ(dcp_log.find("the finger opened"), std::string::npos) << dcp_log;
+  EXPECT_NE(ReadFile(out + "/logs/operator_station.log")
+                .find("restarted: sending the inputs of the DCP's last state"),
+            std::string::npos);
   // Each is back within 2 s on an idle machine; a loaded one's slowdown
   // (wall over CPU time for a process that wants a CPU, measured all along)
   // stretches that, and is said.

@@ -49,6 +49,10 @@ struct OperatorOptions {
       restore_path;  // --restore CHECKPOINT: start from its operator inputs (by hand, autopilot)
   std::string
       checkpoint_dir;  // --checkpoint-dir: RMS_CONTROL's RESTORE names a checkpoint here only
+  // --dcp-state-file: the DCP's state file (dynamics_proc --state-file); a
+  // restarted station (RMSLAB_RESTART) sends the inputs it holds from its
+  // first frame, not the task's initial ones (docs/sessions.md "Faults").
+  std::string dcp_state_path;
 };
 
 // Builds the numbered, time-stamped input blocks.
@@ -87,6 +91,7 @@ class OperatorStation {
 
  private:
   void ResumeFromTelemetry();
+  void ResumeFromDcpState();
   bool StepFrame(transport::StatusReporter* status);
   int Finish(const std::string& stats_path, transport::StatusReporter* status);
   void Subscribe();
