@@ -424,10 +424,16 @@ void OperatorStation::ResumeFromDcpState() {
     from.reset = false;
     last_ = from;
     source_->Resume(from, false);
+    // Numbered on from the operator frame the state answered, by the
+    // station's own rate (at --speed 4, four frames a session period; the
+    // session's clock alone numbered far behind, and the DCP refused them).
+    const double since_s = std::max<double>(0.0, (lcm_.NowUs() - c.saved_us) * 1e-6);
+    const auto next = c.input_frame + 1 + static_cast<std::int64_t>(since_s * rate_hz_);
+    if (c.input_frame >= 0 && next > builder_.next_frame()) builder_.set_next_frame(next);
     spdlog::warn(
         "restarted: sending the inputs of the DCP's last state (DCP frame {}) until its "
-        "first telemetry",
-        c.dcp_frame);
+        "first telemetry, from frame {}",
+        c.dcp_frame, builder_.next_frame());
   } catch (const std::exception& e) {
     spdlog::warn(
         "restarted: the DCP's state could not be read ({}): resuming from its first "
@@ -509,7 +515,7 @@ int OperatorStation::Run(const std::string& stats_path, const std::string& ready
     screen_ = std::make_unique<StatusScreen>(config_);
   }
   transport::StatusReporter status(&lcm_, "operator_station");
-  builder_.set_next_frame(transport::FirstFrameNumber(config_.session.frame_rate_hz));
+  builder_.set_next_frame(transport::FirstFrameNumber(rate_hz_));
   if (!ready_path.empty()) transport::WriteReadyFile(ready_path);
 
   std::int64_t next_ns = MonotonicNs();
