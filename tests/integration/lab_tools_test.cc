@@ -604,6 +604,18 @@ TEST_F(RecordedSession, ItsReportOpensInABrowserWithPlots) {
     EXPECT_NE(html.find(want), std::string::npos) << want;
   }
   EXPECT_EQ(html.find("<script src="), std::string::npos) << "not self-contained";
+  // Times shown rounded carry the exact session time (docs/sessions.md
+  // "Session time"): the session's length, each attempt's start and length.
+  const auto summary = nlohmann::json::parse(ReadFile(*dir_ + "/summary.json"));
+  auto exact = [](const nlohmann::json& t) {
+    return "data-s=\"" + nlohmann::json(t.get<double>()).dump() + "\"";
+  };
+  EXPECT_NE(html.find(exact(summary["duration_s"])), std::string::npos)
+      << exact(summary["duration_s"]);
+  ASSERT_FALSE(summary["attempts"].empty());
+  for (const auto& a : summary["attempts"])
+    for (const char* k : {"start_s", "duration_s"})
+      EXPECT_NE(html.find(exact(a[k])), std::string::npos) << k << " " << exact(a[k]);
   EXPECT_EQ(html.find("<pre>"), std::string::npos) << "raw JSON in the report";
   // A real browser: headless Chromium draws the charts (path top and side,
   // joints, distance to goal, timeline; no inputs plot for the autopilot).

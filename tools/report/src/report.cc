@@ -323,6 +323,16 @@ std::string Cell(const nlohmann::ordered_json& v, const char* unit = "", int dec
   return Html(v.dump());
 }
 
+// A time (session time, s; docs/sessions.md "Session time"): shown rounded
+// for reading, the exact value -- the shortest text that reads back as the
+// same double -- in the cell's title and data-s, so nothing is lost.
+std::string TimeCell(const nlohmann::ordered_json& v, const char* unit = "", int decimals = 3) {
+  if (!v.is_number()) return Cell(v, unit, decimals);
+  const std::string exact = nlohmann::json(v.get<double>()).dump();
+  return "<span data-s=\"" + exact + "\" title=\"" + exact + " s\">" + Cell(v, unit, decimals) +
+         "</span>";
+}
+
 std::string Row(const std::string& th, const std::vector<std::string>& cells) {
   std::string r = "<tr><th>" + th + "</th>";
   for (const auto& c : cells) r += "<td>" + c + "</td>";
@@ -364,8 +374,9 @@ std::string SessionSection(const nlohmann::ordered_json& m, const nlohmann::orde
       hosts += (hosts.empty() ? "" : ", ") + p + " on " + host.get<std::string>();
     field("hosts", hosts);
   }
-  if (s.contains("duration_s")) h << Row("session time", {Cell(s["duration_s"], " s", 1)});
-  if (s.contains("wall_duration_s")) h << Row("wall time", {Cell(s["wall_duration_s"], " s", 1)});
+  if (s.contains("duration_s")) h << Row("session time", {TimeCell(s["duration_s"], " s", 1)});
+  if (s.contains("wall_duration_s"))
+    h << Row("wall time", {TimeCell(s["wall_duration_s"], " s", 1)});
   h << "</table>\n";
   return h.str();
 }
@@ -403,7 +414,7 @@ std::string AttemptsSection(const nlohmann::ordered_json& s) {
     const auto& d = a["docking"];
     h << "<tr><td>" << a["index"] << "</td><td>" << Cell(a["started_by"])
       << (a.contains("restored") ? " " + Cell(a["restored"]) : "") << "</td><td>"
-      << Cell(a["start_s"], "", 2) << "</td><td>" << Cell(a["duration_s"], "", 2)
+      << TimeCell(a["start_s"], "", 2) << "</td><td>" << TimeCell(a["duration_s"], "", 2)
       << "</td><td class=\"" << (a["outcome"] == "docked" ? "ok" : "bad") << "\">"
       << Cell(a["outcome"]) << "</td>";
     for (const char* p : {"acquisition", "extraction", "maneuvering", "docking"}) {
@@ -412,11 +423,11 @@ std::string AttemptsSection(const nlohmann::ordered_json& s) {
                 ? std::string(a["started_in_mode"].get<int>() > 1 && std::string(p) == "acquisition"
                                   ? "before this attempt"
                                   : "not reached")
-                : Cell(ph[p], "", 2))
+                : TimeCell(ph[p], "", 2))
         << "</td>";
     }
     h << "<td>" << a["collisions"]["events"] << "</td><td>"
-      << Cell(a["holds"]["arm"]["duration_s"], "", 2) << "</td><td>"
+      << TimeCell(a["holds"]["arm"]["duration_s"], "", 2) << "</td><td>"
       << (d.is_object() ? Cell(d["distance_ft"], "", 4) : "-") << "</td><td>"
       << (d.is_object() ? Cell(d["angle_deg"], "", 3) : "-") << "</td></tr>";
   }
@@ -443,7 +454,7 @@ std::string MalfunctionsSection(const nlohmann::ordered_json& s) {
        "<table><tr><th>time, s</th><th>from DCP frame</th><th>by</th><th>injected</th>"
        "<th>repaired</th><th>in force after</th></tr>";
   for (const auto& m : list) {
-    h << "<tr><td>" << Cell(m["time_s"], "", 2) << "</td><td>" << m["dcp_frame"] << "</td><td>"
+    h << "<tr><td>" << TimeCell(m["time_s"], "", 2) << "</td><td>" << m["dcp_frame"] << "</td><td>"
       << Cell(m["why"]) << "</td><td" << (m["injected"].empty() ? "" : " class=\"bad\"") << ">"
       << texts(m["injected"]) << "</td><td>" << texts(m["repaired"])
       << (m["replaced"].empty() ? "" : " (replaced: " + texts(m["replaced"]) + ")") << "</td><td>"
@@ -467,7 +478,7 @@ std::string ScorecardSection(const nlohmann::ordered_json& s) {
     h << Row(th, cells);
   };
   line("task time (start to docked), s",
-       [](const auto& c) { return Cell(c["task_time_s"], "", 2); });
+       [](const auto& c) { return TimeCell(c["task_time_s"], "", 2); });
   line("least clearance, point A to the payload's surface, ft", [](const auto& c) {
     return Cell(c["least_clearance_ft"]["end_effector_to_payload"], "", 3);
   });
@@ -481,7 +492,7 @@ std::string ScorecardSection(const nlohmann::ordered_json& s) {
                                                         {"dock_distance", "the docking distance"},
                                                         {"dock_angle", "the docking angle"}}) {
     line("time within 10% of " + label + ", s",
-         [k = k](const auto& c) { return Cell(c["near_tolerance_s"][k], "", 2); });
+         [k = k](const auto& c) { return TimeCell(c["near_tolerance_s"][k], "", 2); });
   }
   line("finger closures / that did not acquire", [](const auto& c) {
     return Cell(c["finger_closures"]) + " / " + Cell(c["closures_not_acquiring"]);
@@ -494,12 +505,12 @@ std::string ScorecardSection(const nlohmann::ordered_json& s) {
   });
   line("reversals (an axis commanded back the other way)",
        [](const auto& c) { return Cell(c["inputs"]["reversals"]); });
-  line("time moving, s", [](const auto& c) { return Cell(c["inputs"]["moving_s"], "", 2); });
+  line("time moving, s", [](const auto& c) { return TimeCell(c["inputs"]["moving_s"], "", 2); });
   line("share of it moving more than one axis at once", [](const auto& c) {
     return HumanNumber(100 * c["inputs"]["multi_axis_share"].template get<double>(), 1) + "%";
   });
   line("time slowed at a joint's rate limit, s",
-       [](const auto& c) { return Cell(c["inputs"]["rate_limited_s"], "", 2); });
+       [](const auto& c) { return TimeCell(c["inputs"]["rate_limited_s"], "", 2); });
   h << "</table>\n<table><tr><th>collisions by kind (events, s)</th>";
   for (const auto& a : attempts) h << "<th>" << a["index"] << "</th>";
   h << "</tr>";
@@ -511,8 +522,8 @@ std::string ScorecardSection(const nlohmann::ordered_json& s) {
     std::vector<std::string> cells;
     for (const auto& a : attempts) {
       const auto& b = a["collisions"]["by_kind"];
-      cells.push_back(b.contains(k) ? b[k]["events"].dump() + ", " + Cell(b[k]["duration_s"], "", 2)
-                                    : "-");
+      cells.push_back(
+          b.contains(k) ? b[k]["events"].dump() + ", " + TimeCell(b[k]["duration_s"], "", 2) : "-");
     }
     h << Row(Html(k), cells);
   }
@@ -532,7 +543,7 @@ std::string TimingSection(const nlohmann::ordered_json& s, const Traces& t) {
   h << "</table>\n";
   if (t.longest_stall_ms > 3000.0 / 30) {
     h << "<p class=\"bad\">The longest operator frame interval outside a freeze: "
-      << HumanNumber(t.longest_stall_ms, 0) << " ms at " << HumanNumber(t.longest_stall_at_s, 1)
+      << HumanNumber(t.longest_stall_ms, 0) << " ms at " << TimeCell(t.longest_stall_at_s, "", 1)
       << " s: a stall (the station did not run for that long).</p>\n";
   }
   h << "<table><tr><th>process</th><th>frames lost on the way in</th><th>late</th><th>too late, "
