@@ -502,10 +502,29 @@ TEST_F(HandFlownSession, CompareShowsTheSubjectsLearningCurveAndAReSimulationApa
   EXPECT_EQ(data["subjects"]["ann"].size(), 1u)
       << "the subject's fresh trial only: not the restored attempt, not the re-simulation";
   EXPECT_EQ(data["left_off"], nlohmann::json::array({"session"})) << data["left_off"].dump();
+  EXPECT_EQ(data["no_attempt"], nlohmann::json::array()) << data["no_attempt"].dump();
   EXPECT_NE(html.find("(from a restore)"), std::string::npos);
   EXPECT_NE(csv.find(",restore,"), std::string::npos) << csv;
   const std::string dom = BrowserDom(*tmp_ + "/compare/compare.html", *tmp_ + "/compare_dom.html");
   EXPECT_GE(ChartsRendered(dom), 2) << dom.substr(0, 1500);
+  // A session whose log holds no flight (empty) has no attempt: said as
+  // such, not as a restore.
+  const std::string empty = *tmp_ + "/empty";
+  fs::create_directories(empty);
+  for (const char* f : {"config.toml", "manifest.json"})
+    fs::copy_file(second + "/" + f, empty + "/" + f);
+  std::ofstream(empty + "/lcmlog").close();
+  ASSERT_EQ(Script({testing::BuildPath("tools/rms_session"), "summary", empty},
+                   *tmp_ + "/empty_summary.log")
+                .rc,
+            0);
+  const ScriptRun ce = Script({SourcePath("scripts/lab"), "compare", second, empty, "--no-build",
+                               "--out", *tmp_ + "/compare_empty"},
+                              *tmp_ + "/compare_empty.log", 120);
+  ASSERT_EQ(ce.rc, 0) << ce.out;
+  const std::string html_empty = ReadFile(*tmp_ + "/compare_empty/compare.html");
+  EXPECT_NE(html_empty.find("No attempt in the summary of empty"), std::string::npos);
+  EXPECT_EQ(html_empty.find("Left off the learning curves"), std::string::npos);
   const ScriptRun all =
       Script({SourcePath("scripts/lab"), "compare", *out_, second, *tmp_ + "/wide", "--no-build",
               "--all-trials", "--out", *tmp_ + "/compare_all"},

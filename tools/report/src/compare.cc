@@ -254,6 +254,7 @@ Comparison CompareSessions(const std::vector<std::string>& dirs, const std::stri
   data["sessions"] = nlohmann::ordered_json::array();
   nlohmann::ordered_json subjects = nlohmann::ordered_json::object();
   nlohmann::ordered_json left_off = nlohmann::ordered_json::array();
+  nlohmann::ordered_json no_attempt = nlohmann::ordered_json::array();
   for (std::size_t i = 0; i < sessions.size(); ++i) {
     const Session& s = sessions[i];
     nlohmann::ordered_json attempts = nlohmann::ordered_json::array();
@@ -269,6 +270,10 @@ Comparison CompareSessions(const std::vector<std::string>& dirs, const std::stri
     // re-simulations, nor a result that began with a restore, a reset or a
     // branch (unless asked for: all_trials).
     if (s.kind == "re-simulation") continue;
+    if (Best(s).is_null()) {
+      no_attempt.push_back(s.name);
+      continue;
+    }
     if (!all_trials && !FreshStart(Best(s))) {
       left_off.push_back(s.name);
       continue;
@@ -277,6 +282,7 @@ Comparison CompareSessions(const std::vector<std::string>& dirs, const std::stri
   }
   data["subjects"] = subjects;
   data["left_off"] = left_off;
+  data["no_attempt"] = no_attempt;
   std::ifstream js(chart_js_path);
   if (!js)
     throw InputError("cannot read Chart.js at '" + chart_js_path +
@@ -305,6 +311,11 @@ Comparison CompareSessions(const std::vector<std::string>& dirs, const std::stri
               "--all-trials puts them on): " +
                   Esc(JoinNames(left_off)) +
                   ": each one's result began with a restore, a reset or a branch.</p>\n")
+    << (no_attempt.empty()
+            ? std::string()
+            : "<p class=\"bad\">No attempt in the summary of " + Esc(JoinNames(no_attempt)) +
+                  " (its log holds no flight: empty, cut short or damaged; rms_session summary "
+                  "says what it read): not on the learning curves.</p>\n")
     << "<div id=\"rms-charts\"></div>\n<script>\nwindow.RMS_COMPARE = " << json
     << ";\n</script>\n<script>\n"
     << charts << "\n</script>\n</body></html>\n";
