@@ -64,9 +64,16 @@ std::string WakeLatencyNote(const Json& j) {
 void LossLines(const Json& j, std::ostream& os) {
   const auto& fr = j["frames"];
   if (j["record"].value("lost", 0) > 0) {
-    os << "the record lost " << j["record"]["lost"]
-       << " frames (the recorder fell behind, was stopped or its "
-       << "disk filled):";
+    // Made from journals, the log holds every frame they hold: a frame
+    // counted lost is one the log's reader did not take as the session's
+    // (its number went back or repeated), not one the recorder missed.
+    if (j["record"].value("source", "") == "journals")
+      os << "the log holds " << j["record"]["lost"]
+         << " frames fewer than the journals as the session's frames (numbers that went back "
+            "or repeated: a restart's, or a sender that is not believed):";
+    else
+      os << "the record lost " << j["record"]["lost"]
+         << " frames (the recorder fell behind, was stopped or its disk filled):";
     for (const auto& [ch, r] : j["record"]["by_channel"].items()) {
       if (r["lost"].get<std::int64_t>() > 0)
         os << " " << ch << " " << r["lost"] << " of " << r["published"];
