@@ -131,7 +131,12 @@ TEST(MultiHost, OverALossyLinkEveryGapIsCountedAndTheAutopilotStillDocks) {
   EXPECT_GT(op_sent - dcp_sent, 0);
   EXPECT_GT(dcp_sent - scene_sent, 0);
   EXPECT_NEAR(static_cast<double>(dcp_missing), static_cast<double>(op_sent - dcp_sent), 2.0);
-  EXPECT_NEAR(static_cast<double>(scene_missing), static_cast<double>(dcp_sent - scene_sent), 2.0);
+  // A DCP frame that reached the scene too late to act on (a loaded
+  // machine) makes no ESG frame either, and is counted as such.
+  const long scene_late = scene.value("dropped.late", 0L) + scene.value("dropped.far_ahead", 0L);
+  EXPECT_NEAR(static_cast<double>(scene_missing + scene_late),
+              static_cast<double>(dcp_sent - scene_sent), 2.0)
+      << "scene_proc's counters: " << scene.dump();
   EXPECT_GT(dups, 0);
   // The ESG drew every frame the scene sent: the picture stays on the last
   // good frame through a gap.
