@@ -630,7 +630,36 @@ std::int64_t Malformed(const nlohmann::json& st) {
   return n;
 }
 
-std::int64_t Journaled(const nlohmann::json& record, const std::string& channel);
+// A count in record.json (docs/sessions.md "The record"), 0 when it is not
+// there or not a count.
+std::int64_t RecordCount(const nlohmann::json& j, std::initializer_list<const char*> path) {
+  const nlohmann::json* at = &j;
+  for (const char* k : path) {
+    if (!at->is_object() || !at->contains(k)) return 0;
+    at = &(*at)[k];
+  }
+  return at->is_number_integer() ? at->get<std::int64_t>() : 0;
+}
+
+// What the processes' journals hold of a channel (record.json), or -1 when
+// the record was not made from journals.
+std::int64_t Journaled(const nlohmann::json& record, const std::string& channel) {
+  if (!record.is_object() || !(record.value("made", false) == true) ||
+      !record.contains("journals") || !record["journals"].is_array())
+    return -1;
+  std::int64_t n = 0;
+  for (const auto& jf : record["journals"]) n += RecordCount(jf, {"by_channel", channel.c_str()});
+  return n;
+}
+
+// What a process published on CHANNEL (with the session's suffix): what
+// its journals hold, every run's (docs/sessions.md "The record"), or, in a
+// session without journals, its own final counter (PROCESS_STATS).
+std::int64_t Published(const nlohmann::json& process_stats, const nlohmann::json& record,
+                       const std::string& channel) {
+  const std::int64_t journaled = Journaled(record, channel);
+  return journaled >= 0 ? journaled : CounterOf(process_stats, rms::Counter::kPublished);
+}
 
 // Frames each process published: what its journals hold (every run's, a
 // process killed and restarted among them: the exact count, docs/sessions.md
@@ -639,14 +668,10 @@ nlohmann::ordered_json FramesJson(const std::map<std::string, nlohmann::json>& s
                                   const nlohmann::json& record, const std::string& suffix) {
   const auto &op = stats.at("operator_station"), &dcp = stats.at("dynamics_proc"),
              &scene = stats.at("scene_proc"), &esg = stats.at("esg_renderer");
-  const bool journals = Journaled(record, "") >= 0;
-  auto published = [&](const nlohmann::json& st, const char* channel) {
-    return journals ? Journaled(record, channel + suffix) : CounterOf(st, rms::Counter::kPublished);
-  };
   nlohmann::ordered_json frames;
-  frames["operator_published"] = published(op, wire::channels::kOperatorInput);
-  frames["dcp_published"] = published(dcp, wire::channels::kDcpFrame);
-  frames["esg_published"] = published(scene, wire::channels::kEsgFrame);
+  frames["operator_published"] = Published(op, record, wire::channels::kOperatorInput + suffix);
+  frames["dcp_published"] = Published(dcp, record, wire::channels::kDcpFrame + suffix);
+  frames["esg_published"] = Published(scene, record, wire::channels::kEsgFrame + suffix);
   frames["rendered"] = CounterOf(esg, rms::Counter::kRendered);
   frames["superseded"] = CounterOf(esg, rms::Counter::kSuperseded);
   frames["scenes_drawn"] = CounterOf(esg, rms::Counter::kRenderedScenes);
@@ -727,30 +752,20 @@ nlohmann::ordered_json TimingJson(const std::map<std::string, nlohmann::json>& s
   return timing;
 }
 
-// The record's own losses (docs/sessions.md "Losses"): each channel's frames
-// its publisher says it sent against those the log holds -- frames the
-// recorder lost (it fell behind, was stopped, or its disk filled), distinct
-// from frames lost on the way between the processes.
-// A count in record.json (docs/sessions.md "The record"), 0 when it is not
-// there or not a count.
-std::int64_t RecordCount(const nlohmann::json& j, std::initializer_list<const char*> path) {
-  const nlohmann::json* at = &j;
-  for (const char* k : path) {
-    if (!at->is_object() || !at->contains(k)) return 0;
-    at = &(*at)[k];
+// Journals that end in bytes that are no whole event (damaged; a disk that
+// filled mid-write and could not be cut back): their counts are what could
+// be read, and what followed is only the network's.
+void AddDamagedJournals(const nlohmann::json& record, nlohmann::ordered_json* r) {
+  std::int64_t unread = 0;
+  nlohmann::ordered_json damaged = nlohmann::ordered_json::array();
+  for (const auto& jf : record["journals"]) {
+    const std::int64_t n = RecordCount(jf, {"unread_bytes"});
+    if (n <= 0) continue;
+    unread += n;
+    damaged.push_back(jf.value("file", std::string()));
   }
-  return at->is_number_integer() ? at->get<std::int64_t>() : 0;
-}
-
-// What the processes' journals hold of a channel (record.json), or -1 when
-// the record was not made from journals.
-std::int64_t Journaled(const nlohmann::json& record, const std::string& channel) {
-  if (!record.is_object() || !(record.value("made", false) == true) ||
-      !record.contains("journals") || !record["journals"].is_array())
-    return -1;
-  std::int64_t n = 0;
-  for (const auto& jf : record["journals"]) n += RecordCount(jf, {"by_channel", channel.c_str()});
-  return n;
+  (*r)["journal_unread_bytes"] = unread;
+  (*r)["journals_damaged"] = damaged;
 }
 
 // The record's own losses (docs/sessions.md "Losses", "The record"): each
@@ -767,8 +782,7 @@ nlohmann::ordered_json RecordJson(const std::map<std::string, nlohmann::json>& s
   };
   const bool journals = Journaled(record, "") >= 0;
   auto published = [&](const char* channel, const char* process) {
-    return journals ? Journaled(record, channel + suffix)
-                    : CounterOf(stats.at(process), rms::Counter::kPublished);
+    return Published(stats.at(process), record, channel + suffix);
   };
   const Row rows[] = {
       {wire::channels::kOperatorInput,
@@ -796,19 +810,7 @@ nlohmann::ordered_json RecordJson(const std::map<std::string, nlohmann::json>& s
   for (const auto& [p, st] : stats) journal_failed += CounterOf(st, rms::Counter::kJournalFailed);
   r["journal_failed"] = journal_failed;
   if (journals) {
-    // Journals that end in bytes that are no whole event (damaged; a disk
-    // that filled mid-write and could not be cut back): their counts are
-    // what could be read, and what followed is only the network's.
-    std::int64_t unread = 0;
-    nlohmann::ordered_json damaged = nlohmann::ordered_json::array();
-    for (const auto& jf : record["journals"]) {
-      const std::int64_t n = RecordCount(jf, {"unread_bytes"});
-      if (n <= 0) continue;
-      unread += n;
-      damaged.push_back(jf.value("file", std::string()));
-    }
-    r["journal_unread_bytes"] = unread;
-    r["journals_damaged"] = damaged;
+    AddDamagedJournals(record, &r);
     nlohmann::ordered_json missed = nlohmann::ordered_json::object();
     if (record["wire"].is_object() && record["wire"].contains("missed") &&
         record["wire"]["missed"].contains("by_channel") &&
