@@ -11,9 +11,14 @@ int main(int argc, char** argv) {
       "(RMS_DCP_FRAME) into the selected camera's view and packs the ESG frame "
       "(RMS_ESG_FRAME, at most 64 twenty-four-bit words)."};
   rms::transport::CommonOptions common;
+  bool every_frame = false;
+  app.add_flag("--every-frame", every_frame,
+               "answer every DCP frame however late it comes (a replay: nothing there is real "
+               "time, so a stall slows it and loses nothing; docs/sessions.md \"Replay\")");
   return rms::transport::ProcessMain(
       app, argc, argv, "scene_proc", &common,
       [&](const rms::LabConfig& config, rms::transport::LcmInterface& lcm) {
-        return rms::scene_proc::RunSceneProc(config, lcm, common.stats_path, common.ready_path);
+        return rms::scene_proc::RunSceneProc(config, lcm, common.stats_path, common.ready_path,
+                                             every_frame);
       });
 }

@@ -17,9 +17,9 @@ SceneProc::SceneProc(const LabConfig& config, transport::LcmInterface* lcm)
                   [this](const void* d, int n, std::int64_t t) { OnDcpFrame(d, n, t); });
 }
 
-void SceneProc::EnableLiveChecks(double frame_rate_hz) {
+void SceneProc::EnableLiveChecks(double frame_rate_hz, bool late_drops) {
   dcp_frames_.SetClock(transport::SessionFrameClock(frame_rate_hz));
-  late_ = wire::LateFrameFilter(frame_rate_hz);
+  if (late_drops) late_ = wire::LateFrameFilter(frame_rate_hz);
 }
 
 void SceneProc::OnDcpFrame(const void* data, int size, std::int64_t recv_time_us) {
@@ -57,9 +57,11 @@ void SceneProc::OnDcpFrame(const void* data, int size, std::int64_t recv_time_us
 }
 
 int RunSceneProc(const LabConfig& config, transport::LcmInterface& lcm,
-                 const std::string& stats_path, const std::string& ready_path) {
+                 const std::string& stats_path, const std::string& ready_path,
+                 bool every_frame) {
   SceneProc node(config, &lcm);
-  node.EnableLiveChecks(config.session.frame_rate_hz);
+  node.EnableLiveChecks(config.session.frame_rate_hz, !every_frame);
+  if (every_frame) spdlog::info("every DCP frame answered however late (--every-frame)");
   if (!ready_path.empty()) transport::WriteReadyFile(ready_path);
   spdlog::info("ready: {} -> {}", lcm.FullChannel(wire::channels::kDcpFrame),
                lcm.FullChannel(wire::channels::kEsgFrame));

@@ -25,6 +25,25 @@ double Toward(double current, double target, double max_step) {
 }
 }  // namespace
 
+int VisualSceneProgram::DriveSteps(std::int64_t dcp_frame) {
+  const std::int64_t since = last_frame_ ? dcp_frame - *last_frame_ : 1;
+  last_frame_ = dcp_frame;
+  // A restore or a restart that numbers afresh (backward, or further on
+  // than a drive could take to slew anywhere): one frame's.
+  const auto most = static_cast<std::int64_t>(kMostCatchUp_s / dt_s_);
+  return since >= 1 && since <= most ? static_cast<int>(since) : 1;
+}
+
+void VisualSceneProgram::Slew(const CameraStationConfig& cam, double pan_cmd, double tilt_cmd,
+                              double zoom_cmd, int steps, Drive* drv) const {
+  for (int k = 0; k < steps; ++k) {
+    if (drv->pan_deg == pan_cmd && drv->tilt_deg == tilt_cmd && drv->zoom == zoom_cmd) return;
+    drv->pan_deg = Toward(drv->pan_deg, pan_cmd, cam.pan_rate_deg_s * dt_s_);
+    drv->tilt_deg = Toward(drv->tilt_deg, tilt_cmd, cam.tilt_rate_deg_s * dt_s_);
+    drv->zoom = Toward(drv->zoom, zoom_cmd, cam.zoom_rate_per_s * dt_s_);
+  }
+}
+
 wire::EsgFrameData VisualSceneProgram::Step(const wire::DcpFrameData& dcp,
                                             std::uint32_t frame_count, Counters* counters) {
   const int station = dcp.control.camera_station;
@@ -32,10 +51,13 @@ wire::EsgFrameData VisualSceneProgram::Step(const wire::DcpFrameData& dcp,
   // The selected station's drive slews toward the command, clamped to its limits.
   double pan_cmd = dcp.camera_pan_deg, tilt_cmd = dcp.camera_tilt_deg;
   ClampPanTilt(cam, &pan_cmd, &tilt_cmd, counters);
+  // The drive runs in session time: a DCP frame that never came (lost on
+  // the way, refused as late) is a frame's slew made up with the next one's
+  // command, step by step as if it had come with it, so a scene that missed
+  // frames (live, or in a replay) agrees with one that had them all once the
+  // command holds (docs/scene.md "Camera drives").
   Drive& drv = drives_[station - 1];
-  drv.pan_deg = Toward(drv.pan_deg, pan_cmd, cam.pan_rate_deg_s * dt_s_);
-  drv.tilt_deg = Toward(drv.tilt_deg, tilt_cmd, cam.tilt_rate_deg_s * dt_s_);
-  drv.zoom = Toward(drv.zoom, std::clamp(dcp.camera_zoom, 0.0, 1.0), cam.zoom_rate_per_s * dt_s_);
+  Slew(cam, pan_cmd, tilt_cmd, std::clamp(dcp.camera_zoom, 0.0, 1.0), DriveSteps(dcp.frame), &drv);
 
   const arm::ArmPose arm = arm::ComputeArmPose(config_.arm, dcp.arm, dcp.shoulder_height_ft);
   const CameraView view =

@@ -89,7 +89,8 @@ class Replay:
         if not a.no_video:
             esg += ["--video", os.path.join(self.out, "session.mp4")]
         self.sup.add(self.spec("esg_renderer", esg))
-        self.sup.add(self.spec("scene_proc", []))
+        # Nothing in a replay is real time: a stall slows it, no frame is dropped as late.
+        self.sup.add(self.spec("scene_proc", ["--every-frame"]))
         err = self.sup.wait_ready(["lcm-logger", "esg_renderer", "scene_proc"])
         if err:
             raise LabError(err, 1)

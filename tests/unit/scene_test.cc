@@ -197,6 +197,46 @@ TEST_F(Scene, CameraDrivesSlewAtTheirRates) {
   EXPECT_EQ(vs.drive(2).pan_deg, 0);  // other stations keep their drives
 }
 
+// docs/scene.md "Camera drives": the drive runs in session time. A scene
+// that missed DCP frames 10..19 (lost on the way) makes up their slew with
+// frame 20's command and from there agrees bit for bit with one that had
+// them all; a frame numbered backward or a fresh numbering is one step.
+TEST_F(Scene, ADriveMakesUpTheFramesLostOnTheWay) {
+  scene_proc::VisualSceneProgram all(config), missed(config), renumbered(config);
+  wire::DcpFrameData d;
+  d.arm = arm::SinCosFromDegrees({0, 0, 0, 0, 0, 0});
+  d.control.camera_station = 1;
+  d.shoulder_height_ft = 3;
+  d.camera_pan_deg = 60;
+  d.camera_tilt_deg = -20;
+  d.camera_zoom = 1;
+  d.R_RP = config.payload.R_RP;
+  for (std::int64_t f = 0; f <= 60; ++f) {
+    d.frame = f;
+    const wire::EsgFrameData a = all.Step(d, static_cast<std::uint32_t>(f), nullptr);
+    if (f >= 10 && f < 20) continue;
+    const wire::EsgFrameData b = missed.Step(d, static_cast<std::uint32_t>(f), nullptr);
+    if (f < 20) continue;
+    SCOPED_TRACE("DCP frame " + std::to_string(f));
+    EXPECT_EQ(missed.drive(1).pan_deg, all.drive(1).pan_deg);
+    EXPECT_EQ(missed.drive(1).tilt_deg, all.drive(1).tilt_deg);
+    EXPECT_EQ(missed.drive(1).zoom, all.drive(1).zoom);
+    EXPECT_EQ(wire::PackEsgWords(b, nullptr), wire::PackEsgWords(a, nullptr));
+  }
+  // Still slewing at frame 20 (the test means something): 60 deg at the rate.
+  const double dt = 1.0 / config.session.frame_rate_hz;
+  ASSERT_GT(60.0, config.cameras[0].pan_rate_deg_s * dt * 21);
+  const double one_step = config.cameras[0].pan_rate_deg_s * dt;
+  d.frame = 100;
+  renumbered.Step(d, 100, nullptr);
+  d.frame = 50;  // a restore to an earlier frame
+  renumbered.Step(d, 50, nullptr);
+  EXPECT_NEAR(renumbered.drive(1).pan_deg, 2 * one_step, 1e-12);
+  d.frame = 50 + static_cast<std::int64_t>(61.0 / dt);  // a fresh numbering
+  renumbered.Step(d, 0, nullptr);
+  EXPECT_NEAR(renumbered.drive(1).pan_deg, 3 * one_step, 1e-12);
+}
+
 TEST_F(Scene, PriorityDrawsWhatTheDepthBufferDrawsOverTheMissionFromEveryStation) {
   // Every 15th frame of the mission from all eight stations at 320 x 240;
   // build/tools/rms_visibility measures every frame at 1024 x 768.

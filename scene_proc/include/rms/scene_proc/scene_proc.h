@@ -21,8 +21,9 @@ class SceneProc {
   Counters& counters() { return counters_; }
   const transport::LatencyMap& latencies() const { return latencies_; }
   std::int64_t last_frame() const { return next_frame_ - 1; }
-  // A live session's receive checks (as DynamicsProc::EnableLiveChecks).
-  void EnableLiveChecks(double frame_rate_hz);
+  // A live session's receive checks (as DynamicsProc::EnableLiveChecks);
+  // with late_drops false (a replay) a late frame is answered all the same.
+  void EnableLiveChecks(double frame_rate_hz, bool late_drops = true);
 
  private:
   const LabConfig& config_;
@@ -35,7 +36,9 @@ class SceneProc {
   std::int64_t next_frame_ = 0;
 };
 
+// every_frame: no DCP frame is dropped as late (scene_proc --every-frame).
 int RunSceneProc(const LabConfig& config, transport::LcmInterface& lcm,
-                 const std::string& stats_path, const std::string& ready_path);
+                 const std::string& stats_path, const std::string& ready_path,
+                 bool every_frame = false);
 
 }  // namespace rms::scene_proc
