@@ -236,6 +236,59 @@ TEST_F(RecordedSession, FramesLostFromEverySourceAreNamedAndTheRestCheckedWordFo
   EXPECT_EQ(v["frames_identical"], v["frames_compared"]);
 }
 
+// A log made from the wire alone, where the network delivered each logged
+// state twice, its second copy heard after three more DCP frames, and the
+// DCP frame before each state twice, its second copy heard after the state:
+// each copy is the first one's, not a message logged there, and it
+// re-simulates word for word (docs/sessions.md "The record").
+TEST_F(RecordedSession, AMessageTheWireDeliveredTwiceLaterIsTheFirstOnes) {
+  const std::string twice = *tmp_ + "/states_twice";
+  fs::copy(*dir_, twice, fs::copy_options::recursive);
+  int copies = 0;
+  {
+    lcm::LogFile in(*dir_ + "/lcmlog", "r"), out(twice + "/lcmlog", "w");
+    struct Held {
+      lcm::LogEvent ev;
+      std::vector<std::uint8_t> data;
+      std::string channel;
+      int frames_to_go = 3;
+    };
+    std::vector<Held> held;
+    std::optional<Held> last_frame;
+    while (const lcm::LogEvent* ev = in.readNextEvent()) {
+      out.writeEvent(const_cast<lcm::LogEvent*>(ev));
+      const auto* d = static_cast<const std::uint8_t*>(ev->data);
+      if (ev->channel.rfind("RMS_DCP_STATE", 0) == 0) {
+        held.push_back({*ev, {d, d + ev->datalen}, ev->channel, 3});
+        if (last_frame) {
+          last_frame->ev.data = last_frame->data.data();
+          last_frame->ev.channel = last_frame->channel;
+          last_frame->ev.timestamp = ev->timestamp;
+          out.writeEvent(&last_frame->ev);
+          last_frame.reset();
+        }
+      } else if (ev->channel.rfind("RMS_DCP_FRAME", 0) == 0) {
+        last_frame = Held{*ev, {d, d + ev->datalen}, ev->channel, 0};
+        for (Held& h : held) {
+          if (--h.frames_to_go != 0) continue;
+          h.ev.data = h.data.data();
+          h.ev.channel = h.channel;
+          h.ev.timestamp = ev->timestamp;
+          out.writeEvent(&h.ev);
+          ++copies;
+        }
+        std::erase_if(held, [](const Held& h) { return h.frames_to_go <= 0; });
+      }
+    }
+  }
+  ASSERT_GT(copies, 3);
+  const ResimRun one = ResimWithThreads(twice, "1", twice + "-1.log");
+  EXPECT_EQ(one.rc, 0) << one.result;
+  EXPECT_NE(one.result.find("identical, word for word"), std::string::npos) << one.result;
+  const ResimRun two = ResimWithThreads(twice, "2", twice + "-2.log");
+  EXPECT_EQ(two.result, one.result);
+}
+
 // Re-simulated on two cores (the log read in two parts, the DCP run in two
 // halves at once: docs/sessions.md "Re-simulation") it says what it says on
 // one, to the word.

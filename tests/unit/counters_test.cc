@@ -186,6 +186,7 @@ TEST(LongestIncreasingRun, KeepsTheRealSequenceAndDropsForgeriesAheadAndBehind) 
   std::vector<std::int64_t> kept;
   for (std::size_t i : run) kept.push_back(frames[i]);
   EXPECT_EQ(kept, (std::vector<std::int64_t>{0, 1, 2, 3, 4, 7, 8, 9, 10, 11}));
+  EXPECT_EQ(run[8], 12u) << "of frame 10 logged twice, the first copy";
   EXPECT_TRUE(session::LongestIncreasingRun({}).empty());
   // Seeded random sequences: the run is increasing, and no increasing
   // subsequence found by brute force on short ones is longer.

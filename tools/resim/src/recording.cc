@@ -58,6 +58,22 @@ void Append(Recording&& second, Recording* r) {
   r->bytes[1] = std::move(second.bytes[1]);
 }
 
+// A state logged again (the network's second copy, in a log made from the
+// wire alone) is the first one's: taken at its receive time it would stand
+// after frames the DCP made after it.
+void DropRepeatedStates(Recording* r) {
+  std::vector<LoggedState> kept;
+  kept.reserve(r->states.size());
+  for (LoggedState& st : r->states) {
+    const bool seen = std::any_of(kept.begin(), kept.end(), [&](const LoggedState& k) {
+      return k.m.send_time_us == st.m.send_time_us && k.m.reason == st.m.reason &&
+             k.m.next_frame == st.m.next_frame && k.m.checkpoint == st.m.checkpoint;
+    });
+    if (!seen) kept.push_back(std::move(st));
+  }
+  r->states = std::move(kept);
+}
+
 // What the sender check left out, said for a log with nothing to
 // re-simulate (" (N messages ...)", or ""): a manifest whose session id is
 // not the log's leaves out every message.
@@ -127,6 +143,7 @@ Recording ReadRecording(session::SessionLog& log, const session::SessionLog::Two
       parts);
   if (in_two) Append(std::move(second), &r);
   r.read_in_two = in_two;
+  DropRepeatedStates(&r);
   // The first of a frame's inputs: the one the live DCP took (a later copy
   // is a duplicate it dropped).
   SortByFrameKeeping(&r.inputs, [](auto first, auto) { return first; });

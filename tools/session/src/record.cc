@@ -174,19 +174,35 @@ std::vector<Tally> CountJournals(const std::vector<JournalFile>& journals, Count
   return tallies;
 }
 
+// What the merge made of the recorder's events.
+struct WireTally {
+  Tally heard;                 // every event of wire.lcmlog
+  std::int64_t only = 0;       // kept: no journal holds the message
+  std::int64_t duplicated = 0; // left out: a journal's message the wire delivered again
+  std::map<std::string, std::int64_t> duplicated_by_channel;
+};
+
 // The next event of a source; the recorder's own only where no journal
-// holds the message (each journal event answers one of the recorder's).
-bool Advance(Source* s, Counts* held, Tally* wire, std::int64_t* wire_only) {
+// holds the message (each journal event answers one of the recorder's; a
+// copy of a journal's message beyond those is the network's duplicate, not
+// something published: counted and left out, since its receive time would
+// put it after what its sender published next).
+bool Advance(Source* s, Counts* held, WireTally* wire) {
   while (s->reader->Next(&s->ev)) {
     if (!s->wire) return s->has = true;
-    ++wire->events;
-    ++wire->by_channel[std::string(s->ev.channel)];
+    ++wire->heard.events;
+    ++wire->heard.by_channel[std::string(s->ev.channel)];
     const auto it = held->find(KeyOf(s->ev));
-    if (it != held->end() && it->second > 0) {
-      --it->second;
+    if (it != held->end()) {
+      if (it->second > 0) {
+        --it->second;
+      } else {
+        ++wire->duplicated;
+        ++wire->duplicated_by_channel[std::string(s->ev.channel)];
+      }
       continue;
     }
-    ++*wire_only;
+    ++wire->only;
     return s->has = true;
   }
   return s->has = false;
@@ -198,8 +214,8 @@ nlohmann::ordered_json TallyJson(const Tally& t) {
 
 // What the merge made of its sources.
 struct Merged {
-  std::int64_t events = 0, from_journals = 0, wire_only = 0;
-  Tally wire;
+  std::int64_t events = 0, from_journals = 0;
+  WireTally wire;
 };
 
 // Pass two: the journals' events and the recorder's that no journal holds,
@@ -224,20 +240,20 @@ Merged Merge(const std::vector<JournalFile>& journals, const std::vector<Tally>&
   };
   std::priority_queue<std::size_t, std::vector<std::size_t>, decltype(later)> next(later);
   for (std::size_t i = 0; i < sources.size(); ++i)
-    if (Advance(&sources[i], held, &m.wire, &m.wire_only)) next.push(i);
+    if (Advance(&sources[i], held, &m.wire)) next.push(i);
   LogWriter out(out_path.string() + ".making");
   while (!next.empty()) {
     const std::size_t i = next.top();
     next.pop();
     out.Write(sources[i].ev);
-    if (Advance(&sources[i], held, &m.wire, &m.wire_only)) next.push(i);
+    if (Advance(&sources[i], held, &m.wire)) next.push(i);
   }
   if (have_wire)
-    m.wire.unread_bytes = static_cast<std::int64_t>(sources.back().reader->size() -
+    m.wire.heard.unread_bytes = static_cast<std::int64_t>(sources.back().reader->size() -
                                                     sources.back().reader->good_end());
   for (const Tally& t : tallies) m.from_journals += t.events;
   m.events = out.events();
-  RMS_CHECK(m.events == m.from_journals + m.wire_only);
+  RMS_CHECK(m.events == m.from_journals + m.wire.only);
   out.Finish(out_path.string());
   return m;
 }
@@ -272,7 +288,7 @@ nlohmann::ordered_json RecordJson(const std::vector<JournalFile>& journals,
   j["format"] = "rmslab-record-1";
   j["made"] = true;
   j["lcmlog"] = {
-      {"events", m.events}, {"from_journals", m.from_journals}, {"from_wire_only", m.wire_only}};
+      {"events", m.events}, {"from_journals", m.from_journals}, {"from_wire_only", m.wire.only}};
   j["journals"] = nlohmann::ordered_json::array();
   for (std::size_t i = 0; i < journals.size(); ++i) {
     nlohmann::ordered_json e = {
@@ -283,8 +299,10 @@ nlohmann::ordered_json RecordJson(const std::vector<JournalFile>& journals,
     j["journals"].push_back(std::move(e));
   }
   j["wire"] = {{"file", kWireLog}, {"present", have_wire}};
-  if (have_wire) j["wire"].update(TallyJson(m.wire));
-  j["wire"]["only_there"] = m.wire_only;
+  if (have_wire) j["wire"].update(TallyJson(m.wire.heard));
+  j["wire"]["only_there"] = m.wire.only;
+  j["wire"]["duplicated"] = {{"total", m.wire.duplicated},
+                             {"by_channel", m.wire.duplicated_by_channel}};
   j["wire"]["missed"] = {{"total", missed_total}, {"by_channel", missed}};
   j["journals_kept"] = kept;
   return j;

@@ -135,6 +135,9 @@ std::vector<std::size_t> LongestIncreasingRun(const std::vector<std::int64_t>& v
   for (std::size_t i = 0; i < v.size(); ++i) {
     const auto it = std::lower_bound(tails.begin(), tails.end(), v[i],
                                      [&v](std::size_t a, std::int64_t x) { return v[a] < x; });
+    // A repeat of the value its run ends in (the network's second copy):
+    // the first copy stays on the run.
+    if (it != tails.end() && v[*it] == v[i]) continue;
     if (it != tails.begin()) parent[i] = static_cast<std::ptrdiff_t>(*(it - 1));
     if (it == tails.end())
       tails.push_back(i);
@@ -825,7 +828,8 @@ nlohmann::ordered_json RecordJson(const std::map<std::string, nlohmann::json>& s
     }
     r["network"] = {{"missed", RecordCount(record, {"wire", "missed", "total"})},
                     {"missed_by_channel", missed},
-                    {"only_in_network", RecordCount(record, {"wire", "only_there"})}};
+                    {"only_in_network", RecordCount(record, {"wire", "only_there"})},
+                    {"duplicated", RecordCount(record, {"wire", "duplicated", "total"})}};
   }
   return r;
 }

@@ -38,7 +38,9 @@ nlohmann::ordered_json SummarizeDcpRun(const LabConfig& config, const DcpRun& ru
 // The indices of the longest run of strictly increasing values in v, in
 // order (patience sorting, O(n log n)): the DCP's frames a reader of a log
 // believes (the DCP numbers its frames upward; a frame off the run is a
-// forgery: docs/security.md "What the summary trusts").
+// forgery: docs/security.md "What the summary trusts"). Of a value repeated
+// where the run takes it, the first copy's index: what a reader placed after
+// the first copy stays after it.
 std::vector<std::size_t> LongestIncreasingRun(const std::vector<std::int64_t>& v);
 
 // A logged channel's name without the session's channel suffix
