@@ -57,8 +57,7 @@ void SceneProc::OnDcpFrame(const void* data, int size, std::int64_t recv_time_us
 }
 
 int RunSceneProc(const LabConfig& config, transport::LcmInterface& lcm,
-                 const std::string& stats_path, const std::string& ready_path,
-                 bool every_frame) {
+                 const std::string& stats_path, const std::string& ready_path, bool every_frame) {
   SceneProc node(config, &lcm);
   node.EnableLiveChecks(config.session.frame_rate_hz, !every_frame);
   if (every_frame) spdlog::info("every DCP frame answered however late (--every-frame)");

@@ -176,9 +176,9 @@ std::vector<Tally> CountJournals(const std::vector<JournalFile>& journals, Count
 
 // What the merge made of the recorder's events.
 struct WireTally {
-  Tally heard;                 // every event of wire.lcmlog
-  std::int64_t only = 0;       // kept: no journal holds the message
-  std::int64_t duplicated = 0; // left out: a journal's message the wire delivered again
+  Tally heard;                  // every event of wire.lcmlog
+  std::int64_t only = 0;        // kept: no journal holds the message
+  std::int64_t duplicated = 0;  // left out: a journal's message the wire delivered again
   std::map<std::string, std::int64_t> duplicated_by_channel;
 };
 
@@ -250,7 +250,7 @@ Merged Merge(const std::vector<JournalFile>& journals, const std::vector<Tally>&
   }
   if (have_wire)
     m.wire.heard.unread_bytes = static_cast<std::int64_t>(sources.back().reader->size() -
-                                                    sources.back().reader->good_end());
+                                                          sources.back().reader->good_end());
   for (const Tally& t : tallies) m.from_journals += t.events;
   m.events = out.events();
   RMS_CHECK(m.events == m.from_journals + m.wire.only);
