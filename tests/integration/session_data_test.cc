@@ -193,8 +193,8 @@ TEST_F(HandFlownSession, AnotherDesignsCellMadeInMemoryIsTheWrittenSessionsCell)
   }
 }
 
-// The same over a forged log: the DCP's RESTORE state logged again just
-// before its last frame, so the re-simulated DCP makes frames it made
+// The same over a forged log: a second RESTORE to the DCP's checkpoint
+// logged just before its last frame, so the re-simulated DCP makes frames it made
 // already (the summary's own rules for repeated frames and restores apply).
 TEST_F(HandFlownSession, ARestoreLoggedAgainGivesTheSameCellInMemoryAsWritten) {
   struct Event {
@@ -222,8 +222,17 @@ TEST_F(HandFlownSession, ARestoreLoggedAgainGivesTheSameCellInMemoryAsWritten) {
   }
   ASSERT_LT(restore, events.size()) << "the session has no restore";
   ASSERT_LT(restore, last_frame);
+  // A second restore (sent later: not the network's copy of the first,
+  // which the re-simulation would take as the first one's).
   Event again = events[restore];
   again.timestamp = events[last_frame - 1].timestamp;
+  {
+    rms::dcp_state_t m;
+    ASSERT_GT(m.decode(again.data.data(), 0, static_cast<int>(again.data.size())), 0);
+    m.send_time_us += again.timestamp - events[restore].timestamp;
+    again.data.resize(static_cast<std::size_t>(m.getEncodedSize()));
+    ASSERT_GT(m.encode(again.data.data(), 0, static_cast<int>(again.data.size())), 0);
+  }
   events.insert(events.begin() + static_cast<std::ptrdiff_t>(last_frame), again);
   const std::string forged = *tmp_ + "/forged";
   fs::copy(*out_, forged, fs::copy_options::recursive);
