@@ -222,8 +222,10 @@ void ReadCameras(TableReader& top, LabConfig* config) {
   for (const toml::node& n : *cams) {
     ++i;
     const toml::table* t = n.as_table();
-    const std::string path = "cameras[" + std::to_string(i) + "]";
-    if (t == nullptr) top.Fail("cameras", "entry " + std::to_string(i) + " must be a table");
+    // Indexed from 0, as a TOML path and `--set cameras[2].tilt_deg=...`
+    // name it (station i is cameras[i - 1]).
+    const std::string path = "cameras[" + std::to_string(i - 1) + "]";
+    if (t == nullptr) top.Fail("cameras", "entry " + std::to_string(i - 1) + " must be a table");
     TableReader r(t, path, &c.source);
     CameraStationConfig cam;
     cam.name = r.String("name");
