@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <set>
+#include <string>
+#include <tuple>
 
 #include "rms/base/check.h"
 #include "rms/session/sender_check.h"
@@ -62,14 +65,13 @@ void Append(Recording&& second, Recording* r) {
 // wire alone) is the first one's: taken at its receive time it would stand
 // after frames the DCP made after it.
 void DropRepeatedStates(Recording* r) {
+  using Key = std::tuple<std::int64_t, int, std::int64_t, std::string>;
+  std::set<Key> seen;  // a set: a log of many states stays n log n
   std::vector<LoggedState> kept;
   kept.reserve(r->states.size());
   for (LoggedState& st : r->states) {
-    const bool seen = std::any_of(kept.begin(), kept.end(), [&](const LoggedState& k) {
-      return k.m.send_time_us == st.m.send_time_us && k.m.reason == st.m.reason &&
-             k.m.next_frame == st.m.next_frame && k.m.checkpoint == st.m.checkpoint;
-    });
-    if (!seen) kept.push_back(std::move(st));
+    if (seen.emplace(st.m.send_time_us, st.m.reason, st.m.next_frame, st.m.checkpoint).second)
+      kept.push_back(std::move(st));
   }
   r->states = std::move(kept);
 }
