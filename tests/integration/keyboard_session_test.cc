@@ -63,7 +63,8 @@ TEST(KeyboardSession, APressIsOneIncrementAndTheScreenShowsGuidance) {
   Tmux tmux(dir);
   const std::string cmd = testing::BuildPath("operator_station/operator_station") + " --lcm-url '" +
                           lab.url() + "' --keyboard --no-gamepad --no-spacemouse --stats " + dir +
-                          "/op.json 2>" + dir + "/op.log; echo $? >" + dir + "/op.rc";
+                          "/op.json 2>" + dir + "/op.log; echo $? >" + dir + "/op.rc.tmp; mv " +
+                          dir + "/op.rc.tmp " + dir + "/op.rc";  // whole when it is there
   ASSERT_EQ(tmux.Start(cmd, 120, 45), 0);
   for (int i = 0; i < 100 && !(tm && state); ++i) pump(0.1);
   ASSERT_TRUE(tm.has_value()) << "no telemetry: the station did not start?\n"

@@ -99,7 +99,8 @@ class HandFlownSession : public ::testing::Test {
         "RMSLAB_BUILD=" RMSLAB_BUILD_DIR " " + SourcePath("scripts/lab") +
         " demo --by-hand --no-build --out " + *out_ + " --lcm-url '" + testing::UniqueLcmUrl(9700) +
         "' --png-every 0 --no-video --width 160 --height 120 --subject ann --note 'first try' >" +
-        *tmp_ + "/lab.log 2>&1; echo $? >" + *tmp_ + "/lab.rc";
+        *tmp_ + "/lab.log 2>&1; echo $? >" + *tmp_ + "/lab.rc.tmp; mv " + *tmp_ + "/lab.rc.tmp " +
+        *tmp_ + "/lab.rc";  // whole when it is there (a loaded machine read it empty)
     ASSERT_EQ(tmux.Start(cmd, 120, 45), 0);
     const std::string op_log = *out_ + "/logs/operator_station.log";
     ASSERT_TRUE(WaitFor(

@@ -30,7 +30,8 @@ struct HandSession {
     const std::string cmd =
         "RMSLAB_BUILD=" + std::string(RMSLAB_BUILD_DIR) + " " + SourcePath("scripts/lab") +
         " demo --by-hand --no-build --no-video --png-every 0 --out " + out + " --lcm-url '" +
-        UniqueLcmUrl(port) + "' 2>" + dir + "/lab.log; echo $? >" + dir + "/lab.rc";
+        UniqueLcmUrl(port) + "' 2>" + dir + "/lab.log; echo $? >" + dir + "/lab.rc.tmp; mv " + dir +
+        "/lab.rc.tmp " + dir + "/lab.rc";  // whole when it is there
     tmux->Start(cmd, 132, 50);
   }
   // Q, and the launcher's summary.
