@@ -5,9 +5,13 @@
 
 #include <cerrno>
 #include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
 #include "rms/base/check.h"
+#include "rms/base/text.h"
+#include "rms/base/toml_reader.h"
 #include "rms/operator_state_t.hpp"
 #include "rms/operator_station/telemetry_check.h"
 #include "rms/process_status_t.hpp"
@@ -417,6 +421,31 @@ void OperatorStation::ResumeFromTelemetry() {
 // 2 or 3 an open finger lets the payload go. It sends, until then, the
 // inputs the DCP last took, as its state file holds them (written on every
 // change of mode and at least every 0.5 s).
+std::string OperatorStation::ClockFilePath() const {
+  if (options_.dcp_state_path.empty()) return "";
+  return (std::filesystem::path(options_.dcp_state_path).parent_path() / "operator_clock.json")
+      .string();
+}
+
+// Written when the station freezes, steps while frozen or runs again: a
+// station killed while frozen comes back frozen at the same frame, and one
+// killed after a freeze numbers on from the run, not through the freeze.
+void OperatorStation::WriteClockFileOnChange() {
+  const std::string path = ClockFilePath();
+  if (path.empty()) return;
+  const std::int64_t frame = builder_.next_frame();
+  if (frozen_ == clock_written_frozen_ && (!frozen_ || frame == clock_written_frame_)) return;
+  clock_written_frozen_ = frozen_;
+  clock_written_frame_ = frame;
+  const nlohmann::json j = {{"frozen", frozen_}, {"next_frame", frame}, {"wall_us", lcm_.NowUs()}};
+  try {
+    WriteWholeFile(path + ".tmp", j.dump() + "\n");
+    std::filesystem::rename(path + ".tmp", path);
+  } catch (const std::exception& e) {
+    spdlog::error("cannot write the session's clock file: {}", e.what());
+  }
+}
+
 void OperatorStation::ResumeFromDcpState() {
   try {
     const wire::Checkpoint c = wire::ReadCheckpoint(options_.dcp_state_path);
@@ -427,9 +456,29 @@ void OperatorStation::ResumeFromDcpState() {
     // Numbered on from the operator frame the state answered, by the
     // station's own rate (at --speed 4, four frames a session period; the
     // session's clock alone numbered far behind, and the DCP refused them).
-    const double since_s = std::max<double>(0.0, (lcm_.NowUs() - c.saved_us) * 1e-6);
-    const auto next = c.input_frame + 1 + static_cast<std::int64_t>(since_s * rate_hz_);
-    if (c.input_frame >= 0 && next > builder_.next_frame()) builder_.set_next_frame(next);
+    std::int64_t base_frame = c.input_frame + 1, base_us = c.saved_us;
+    bool frozen = false;
+    if (std::filesystem::exists(ClockFilePath())) {
+      // Frozen time is no session time: from the freeze's frame, or from
+      // the run that ended it when that came after the state was written.
+      const auto clock = nlohmann::json::parse(ReadTextFile(ClockFilePath(), "the clock file"));
+      frozen = clock.at("frozen").get<bool>();
+      const std::int64_t clock_us = clock.at("wall_us").get<std::int64_t>();
+      if (frozen || clock_us > base_us) {
+        base_frame = clock.at("next_frame").get<std::int64_t>();
+        base_us = frozen ? lcm_.NowUs() : clock_us;
+      }
+    }
+    const double since_s = std::max<double>(0.0, (lcm_.NowUs() - base_us) * 1e-6);
+    const auto next = base_frame + static_cast<std::int64_t>(since_s * rate_hz_);
+    // Not the session's wall clock (FirstFrameNumber): that counts frozen time.
+    if (c.input_frame >= 0) builder_.set_next_frame(next);
+    if (frozen) {
+      frozen_ = clock_written_frozen_ = true;
+      clock_written_frame_ = builder_.next_frame();
+      spdlog::warn("restarted while the session was frozen: frozen still, at frame {}",
+                   builder_.next_frame());
+    }
     spdlog::warn(
         "restarted: sending the inputs of the DCP's last state (DCP frame {}) until its "
         "first telemetry, from frame {}",
@@ -526,6 +575,7 @@ int OperatorStation::Run(const std::string& stats_path, const std::string& ready
     if (lcm_.HandleSubscriptions(0) < 0) counters_.Add(Counter::kTransportErrors);
     transport::NoteTransportCounters(lcm_, &counters_);
     if (restored_from_) ApplyRestore();
+    WriteClockFileOnChange();
     if (frozen_ && steps_pending_ == 0) {
       if (!RunFrozen()) break;
       status.Tick(builder_.next_frame() - 1, counters_);
@@ -539,6 +589,7 @@ int OperatorStation::Run(const std::string& stats_path, const std::string& ready
       resume_from_telemetry = false;
     }
     if (!StepFrame(&status)) break;
+    WriteClockFileOnChange();
     next_ns += period_ns_;
     const std::int64_t now = MonotonicNs();
     if (now > next_ns + period_ns_) {

@@ -154,5 +154,61 @@ TEST(Faults, EachProcessKilledIsRestartedTheDcpResumesAndTheAutopilotDocks) {
   fs::remove_all(tmp);
 }
 
+// Runs `scripts/lab control --session OUT ARGS...`; its exit code.
+int Control(const std::string& out, const std::vector<std::string>& args, const std::string& log) {
+  std::vector<std::string> cmd = {SourcePath("scripts/lab"), "control", "--session", out};
+  cmd.insert(cmd.end(), args.begin(), args.end());
+  Subprocess c(cmd, log);
+  return c.Wait(60);
+}
+
+// The operator station is the session's clock (docs/sessions.md "Faults"):
+// killed while the session is frozen it comes back frozen at the same frame
+// (frozen time is no session time), and killed after the run that ended a
+// freeze it numbers on from that run, not through the freeze.
+TEST(Faults, AStationKilledWhileFrozenComesBackFrozenAndFrozenTimeIsNoSessionTime) {
+  const std::string tmp = testing::MakeTempDir("faults_frozen");
+  const std::string out = tmp + "/session";
+  testing::LoadGauge load;
+  Subprocess lab({SourcePath("scripts/lab"), "demo", "--no-build", "--out", out, "--lcm-url",
+                  testing::UniqueLcmUrl(8450), "--speed", "2", "--png-every", "0", "--no-video",
+                  "--width", "160", "--height", "120"},
+                 tmp + "/lab.log", {std::string("RMSLAB_BUILD=") + RMSLAB_BUILD_DIR});
+  const std::string op_log = out + "/logs/operator_station.log";
+  ASSERT_TRUE(WaitForText(op_log, "autopilot", lab, 60)) << ReadFile(tmp + "/lab.log");
+  std::this_thread::sleep_for(std::chrono::seconds(3));
+  ASSERT_EQ(Control(out, {"freeze"}, tmp + "/freeze.log"), 0) << ReadFile(tmp + "/freeze.log");
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  ASSERT_TRUE(Kill(out, "operator_station"));
+  ASSERT_TRUE(WaitForText(op_log, "restarted while the session was frozen", lab, 60))
+      << ReadFile(op_log);
+  std::this_thread::sleep_for(std::chrono::seconds(3));  // frozen: 180 frames at --speed 2
+  ASSERT_EQ(Control(out, {"run"}, tmp + "/run.log"), 0) << ReadFile(tmp + "/run.log");
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  ASSERT_TRUE(Kill(out, "operator_station"));
+  ASSERT_EQ(lab.Wait(180), 0) << ReadFile(tmp + "/lab.log");
+  const nlohmann::json s = nlohmann::json::parse(ReadFile(out + "/summary.json"));
+  EXPECT_TRUE(s["docked"].get<bool>());
+  ASSERT_EQ(s["restarts"].size(), 2u) << s["restarts"].dump();
+  // Only the second restart's downtime is a gap (the first came back
+  // frozen), plus at most half a second (the DCP's state file is written
+  // every 0.5 s) and a few frames while it rejoins; the freeze (3 s, 180
+  // frames) and the killed station's frozen second are none.
+  const double slowdown = load.Slowdown(0.9);
+  const double down_s = s["restarts"][1]["restart_s"].get<double>();
+  const long gap = s["frames"]["dropped"]["operator_to_dcp"].get<long>();
+  std::printf("operator frames lost %ld; second restart down %.3f s; slowdown p90 %.2f\n", gap,
+              down_s, slowdown);
+  EXPECT_LT(gap, 60.0 * (down_s + 0.5) + 8.0 * slowdown) << s["frames"].dump();
+  // Session time is the frames': no frozen time in it.
+  const double rate = 30.0;
+  EXPECT_LT(s["duration_s"].get<double>() * rate - s["frames"]["dcp_published"].get<double>(),
+            gap + 2.0)
+      << s["duration_s"] << " s for " << s["frames"]["dcp_published"] << " DCP frames";
+  const nlohmann::json v = nlohmann::json::parse(ReadFile(out + "/resimulation.json"));
+  EXPECT_EQ(v["verdict"], "identical") << v.dump(2);
+  if (!HasFailure()) fs::remove_all(tmp);  // kept to look into
+}
+
 }  // namespace
 }  // namespace rms

@@ -92,6 +92,11 @@ class OperatorStation {
  private:
   void ResumeFromTelemetry();
   void ResumeFromDcpState();
+  // The session's clock as this station last left it (frozen or not, the
+  // next frame, when), beside the DCP's state file: a restarted station
+  // resumes a freeze and does not count frozen time (docs/sessions.md "Faults").
+  std::string ClockFilePath() const;
+  void WriteClockFileOnChange();
   bool StepFrame(transport::StatusReporter* status);
   int Finish(const std::string& stats_path, transport::StatusReporter* status);
   void Subscribe();
@@ -143,6 +148,8 @@ class OperatorStation {
   // RMS_CONTROL.
   bool frozen_ = false;
   int steps_pending_ = 0;
+  bool clock_written_frozen_ = false;  // what the clock file says (none: running)
+  std::int64_t clock_written_frame_ = -1;
   bool reset_pending_ = false;                // RMS_CONTROL RESET: the next frame's reset button
   std::optional<std::string> restored_from_;  // a checkpoint name (CheckpointFolder)
   wire::CheckpointFolder checkpoints_;
