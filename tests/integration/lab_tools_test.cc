@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <regex>
+#include <set>
 #include <sstream>
 
 #include "rms/base/config.h"
@@ -233,6 +234,48 @@ TEST_F(RecordedSession, FramesLostFromEverySourceAreNamedAndTheRestCheckedWordFo
       nlohmann::json::parse(ReadFile(*dir_ + "/summary.json"))["log"]["dcp_frames"];
   EXPECT_EQ(v["frames_compared"].get<long>() + v["frames_unchecked"].get<long>() + 30, recorded)
       << v.dump(2);
+  EXPECT_EQ(v["frames_identical"], v["frames_compared"]);
+}
+
+// The DCP frame just before each periodic state lost from every source:
+// one input fits each gap, so each is filled in, and each state is checked
+// after the frame filled in before it, not before it (that read as "the
+// DCP's state before DCP frame 1050 differs"): word for word, no frame
+// left unchecked.
+TEST_F(RecordedSession, AFrameLostJustBeforeAPeriodicStateIsFilledInBeforeTheCheck) {
+  const std::string cut = *tmp_ + "/lost_before_states";
+  fs::copy(*dir_, cut, fs::copy_options::recursive);
+  std::set<std::int64_t> before_states;
+  {
+    lcm::LogFile in(*dir_ + "/lcmlog", "r");
+    while (const lcm::LogEvent* ev = in.readNextEvent()) {
+      dcp_state_t m;
+      if (ev->channel.rfind("RMS_DCP_STATE", 0) == 0 &&
+          m.decode(ev->data, 0, static_cast<int>(ev->datalen)) > 0 &&
+          m.reason == dcp_state_t::PERIODIC)
+        before_states.insert(m.next_frame - 1);
+    }
+  }
+  ASSERT_GE(before_states.size(), 5u);
+  {
+    lcm::LogFile in(*dir_ + "/lcmlog", "r"), out(cut + "/lcmlog", "w");
+    while (const lcm::LogEvent* ev = in.readNextEvent()) {
+      std::int64_t frame = -1;
+      wire::ReadFrameNumber(ev->data, static_cast<int>(ev->datalen), &frame);
+      const bool dcp = ev->channel.rfind("RMS_DCP_FRAME", 0) == 0 ||
+                       ev->channel.rfind("RMS_DCP_TELEMETRY", 0) == 0;
+      if (dcp && before_states.count(frame)) continue;
+      out.writeEvent(const_cast<lcm::LogEvent*>(ev));
+    }
+  }
+  const std::string verdict = *tmp_ + "/lost_before_states.json";
+  const ScriptRun r =
+      Script({testing::BuildPath("tools/rms_resim"), cut, "--verdict-json", verdict},
+             *tmp_ + "/lost_before_states.log");
+  EXPECT_EQ(r.rc, 0) << r.out;
+  const auto v = nlohmann::json::parse(ReadFile(verdict));
+  EXPECT_EQ(v["verdict"], "identical") << v.dump(2);
+  EXPECT_EQ(v["unchecked"].size(), 0u) << v.dump(2);
   EXPECT_EQ(v["frames_identical"], v["frames_compared"]);
 }
 

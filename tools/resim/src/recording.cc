@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <limits>
 #include <set>
 #include <string>
 #include <tuple>
@@ -263,9 +264,7 @@ class Planner {
   // the next frame to plan.
   std::size_t Frame(std::size_t k) {
     const std::size_t steps_before = plan_.steps.size();
-    for (; next_state_ < r_.states.size() && r_.states[next_state_].before <= k; ++next_state_) {
-      if (r_.states[next_state_].before == k) Take(r_.states[next_state_].m, false);
-    }
+    const std::vector<const dcp_state_t*> periodic = TakeStatesBefore(k);
     const RecordedDcpFrame& f = r_.dcp_frames[k];
     if (pending_resume_) {  // the first frame after a resume: nothing between was made
       prev_frame_ = f.frame - 1;
@@ -292,11 +291,38 @@ class Planner {
     if (!why.empty())
       return Skip(k, steps_before, lost > 0 ? prev_frame_ + 1 : f.frame,
                   lost > 0 ? f.frame - 1 : f.frame, why);
-    for (const std::int64_t in : between) plan_.steps.push_back({nullptr, in, false});
+    // A periodic state is checked before the frame it names: among the
+    // frames filled in, not before them all (DCP frame 1049 lost, the state
+    // before 1050 was checked before 1049 was made, and "differed").
+    std::size_t p = 0;
+    auto check_before = [&](std::int64_t frame) {
+      for (; p < periodic.size() && periodic[p]->next_frame <= frame; ++p)
+        plan_.steps.push_back({periodic[p], -1, false});
+    };
+    std::int64_t n = prev_frame_ + 1;
+    for (const std::int64_t in : between) {
+      check_before(n++);
+      plan_.steps.push_back({nullptr, in, false});
+    }
+    check_before(std::numeric_limits<std::int64_t>::max());
     plan_.steps.push_back({nullptr, f.input_frame, false});
     prev_frame_ = f.frame;
     prev_input_ = f.input_frame;
     return k + 1;
+  }
+
+  // Takes the states logged before recorded frame k; the periodic ones at
+  // their end (checks, which change no numbering) are returned instead, to
+  // be placed by the frame each names among frames the log lost.
+  std::vector<const dcp_state_t*> TakeStatesBefore(std::size_t k) {
+    std::vector<const dcp_state_t*> slot;
+    for (; next_state_ < r_.states.size() && r_.states[next_state_].before <= k; ++next_state_) {
+      if (r_.states[next_state_].before == k) slot.push_back(&r_.states[next_state_].m);
+    }
+    std::size_t take = slot.size();
+    while (take > 0 && slot[take - 1]->reason == dcp_state_t::PERIODIC) --take;
+    for (std::size_t i = 0; i < take; ++i) Take(*slot[i], false);
+    return {slot.begin() + static_cast<std::ptrdiff_t>(take), slot.end()};
   }
 
   // Frames from recorded frame k on cannot be re-made from here: the run
