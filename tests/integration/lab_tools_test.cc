@@ -279,6 +279,32 @@ TEST_F(RecordedSession, AFrameLostJustBeforeAPeriodicStateIsFilledInBeforeTheChe
   EXPECT_EQ(v["frames_identical"], v["frames_compared"]);
 }
 
+// A log damaged half way (an event's sync word overwritten): re-simulated
+// up to the damage and identical there, but not exact -- what the log held
+// past it was not checked -- and the brief's line says so.
+TEST_F(RecordedSession, ALogDamagedHalfWayIsNotExact) {
+  const std::string cut = *tmp_ + "/damaged_half_way";
+  fs::copy(*dir_, cut, fs::copy_options::recursive);
+  {
+    std::string bytes = ReadFile(cut + "/lcmlog");
+    const std::string sync("\xED\xA1\xDA\x01", 4);
+    const auto at = bytes.find(sync, bytes.size() / 2);
+    ASSERT_NE(at, std::string::npos);
+    bytes[at] = 0;
+    std::ofstream(cut + "/lcmlog", std::ios::binary) << bytes;
+  }
+  const ScriptRun r = Script(
+      {testing::BuildPath("tools/rms_resim"), cut, "--verdict-json", cut + "/resimulation.json"},
+      *tmp_ + "/damaged_half_way.log");
+  const auto v = nlohmann::json::parse(ReadFile(cut + "/resimulation.json"));
+  EXPECT_FALSE(v["exact"].get<bool>()) << v.dump(2);
+  EXPECT_NE(v["log_note"].get<std::string>().find("cut short or damaged"), std::string::npos);
+  const ScriptRun brief =
+      Script({testing::BuildPath("tools/rms_session"), "summary", cut, "--brief"},
+             *tmp_ + "/damaged_half_way_brief.log");
+  EXPECT_NE(brief.out.find("NOT EXACT: the log ends in"), std::string::npos) << brief.out;
+}
+
 // A log made from the wire alone, where the network delivered each logged
 // state twice, its second copy heard after three more DCP frames, and the
 // DCP frame before each state twice, its second copy heard after the state:

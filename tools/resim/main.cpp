@@ -77,8 +77,9 @@ nlohmann::ordered_json Verdict(const rms::resim::ResimResult* r, const std::stri
   const bool same = r->first_difference.empty() && r->identical == r->compared;
   v["verdict"] = same ? "identical" : "differs";
   // Exact: every frame the DCP made checked (none lost from the log, none
-  // left unchecked after such a loss, none before its first state).
-  v["exact"] = same && r->unchecked.empty() && r->skipped == 0;
+  // left unchecked after such a loss, none before its first state, and the
+  // log not cut short or damaged: what it held past that was not checked).
+  v["exact"] = same && r->unchecked.empty() && r->skipped == 0 && r->log_note.empty();
   v["frames_compared"] = r->compared;
   v["frames_identical"] = r->identical;
   v["frames_unchecked"] = r->unchecked_frames;

@@ -224,8 +224,11 @@ void ResimulationLine(const Json& j, std::ostream& os) {
        << Count(v, "frames_compared") << " DCP frames, word for word";
     const std::int64_t unchecked = v.value("frames_unchecked", std::int64_t{0}) +
                                    v.value("frames_skipped_at_start", std::int64_t{0});
-    if (unchecked > 0 || !v.value("exact", true))
-      os << "; " << unchecked << " not checked: " << v.value("note", std::string());
+    const std::string note = v.value("note", std::string()),
+                      log_note = v.value("log_note", std::string());
+    if (unchecked > 0 || (!v.value("exact", true) && !note.empty()))
+      os << "; " << unchecked << " not checked: " << note;
+    if (!log_note.empty()) os << "; NOT EXACT: " << log_note;
     os << ")\n";
   } else if (what == "differs") {
     os << "re-simulates: NO -- it differs from the recording at "

@@ -605,7 +605,7 @@ nlohmann::ordered_json Resimulation(const fs::path& root) {
   nlohmann::ordered_json out;
   for (const char* k :
        {"verdict", "exact", "frames_compared", "frames_identical", "frames_unchecked",
-        "frames_skipped_at_start", "unchecked", "first_difference", "why", "note"}) {
+        "frames_skipped_at_start", "unchecked", "first_difference", "why", "note", "log_note"}) {
     if (v.contains(k)) out[k] = v[k];
   }
   return out;
