@@ -305,6 +305,56 @@ TEST_F(RecordedSession, ALogDamagedHalfWayIsNotExact) {
   EXPECT_NE(brief.out.find("NOT EXACT: the log ends in"), std::string::npos) << brief.out;
 }
 
+// The record remade from journals one of which is damaged half way (the
+// DCP's: a sync word overwritten) and a network's record that missed the
+// DCP's frames from 1000 on: what neither holds is a loss of the record,
+// held against the DCP's own count, not none; the journal is named.
+TEST_F(RecordedSession, ADamagedJournalIsALossOfTheRecordNotNone) {
+  const std::string s = *tmp_ + "/damaged_journal";
+  fs::copy(*dir_, s, fs::copy_options::recursive);
+  fs::create_directories(s + "/journal");
+  {
+    lcm::LogFile in(*dir_ + "/lcmlog", "r");
+    lcm::LogFile op(s + "/journal/operator_station.0.lcmlog", "w"),
+        dcp(s + "/journal/dynamics_proc.0.lcmlog", "w"),
+        scene(s + "/journal/scene_proc.0.lcmlog", "w");
+    while (const lcm::LogEvent* ev = in.readNextEvent()) {
+      auto* e = const_cast<lcm::LogEvent*>(ev);
+      if (ev->channel.rfind("RMS_OPERATOR_INPUT", 0) == 0) op.writeEvent(e);
+      if (ev->channel.rfind("RMS_DCP_", 0) == 0) dcp.writeEvent(e);
+      if (ev->channel.rfind("RMS_ESG_FRAME", 0) == 0) scene.writeEvent(e);
+    }
+  }
+  {
+    const std::string path = s + "/journal/dynamics_proc.0.lcmlog";
+    std::string bytes = ReadFile(path);
+    const auto at = bytes.find(std::string("\xED\xA1\xDA\x01", 4), bytes.size() / 2);
+    ASSERT_NE(at, std::string::npos);
+    bytes[at] = 0;
+    std::ofstream(path, std::ios::binary) << bytes;
+  }
+  {  // the network's recorder missed the DCP's frames from 1000 on
+    lcm::LogFile in(*dir_ + "/lcmlog", "r"), out(s + "/wire.lcmlog", "w");
+    while (const lcm::LogEvent* ev = in.readNextEvent()) {
+      std::int64_t frame = -1;
+      wire::ReadFrameNumber(ev->data, static_cast<int>(ev->datalen), &frame);
+      if (ev->channel.rfind("RMS_DCP_FRAME", 0) == 0 && frame >= 1000) continue;
+      out.writeEvent(const_cast<lcm::LogEvent*>(ev));
+    }
+  }
+  fs::remove(s + "/lcmlog");
+  fs::remove(s + "/record.json");
+  const std::string tools = testing::BuildPath("tools/rms_session");
+  ASSERT_EQ(Script({tools, "record", s}, *tmp_ + "/damaged_journal_record.log").rc, 0);
+  ASSERT_EQ(Script({tools, "summary", s}, *tmp_ + "/damaged_journal_summary.log").rc, 0);
+  const auto r = nlohmann::json::parse(ReadFile(s + "/summary.json"))["record"];
+  const auto stats = nlohmann::json::parse(ReadFile(s + "/stats/dynamics_proc.json"));
+  EXPECT_EQ(r["journals_damaged"].size(), 1u) << r.dump(2);
+  EXPECT_EQ(r["by_channel"]["RMS_DCP_FRAME"]["published"], stats["counters"]["published"])
+      << r.dump(2);
+  EXPECT_GT(r["lost"].get<long>(), 0) << r.dump(2);
+}
+
 // A log made from the wire alone, where the network delivered each logged
 // state twice, its second copy heard after three more DCP frames, and the
 // DCP frame before each state twice, its second copy heard after the state:

@@ -655,13 +655,26 @@ std::int64_t Journaled(const nlohmann::json& record, const std::string& channel)
   return n;
 }
 
-// What a process published on CHANNEL (with the session's suffix): what
-// its journals hold, every run's (docs/sessions.md "The record"), or, in a
-// session without journals, its own final counter (PROCESS_STATS).
+// Whether a journal of PROCESS ends in bytes that are no whole event
+// (damaged, or cut where the cut could not be made): its count is short.
+bool JournalDamaged(const nlohmann::json& record, const std::string& process) {
+  for (const auto& jf : record["journals"])
+    if (jf.value("process", std::string()) == process && RecordCount(jf, {"unread_bytes"}) > 0)
+      return true;
+  return false;
+}
+
+// What PROCESS published on CHANNEL (with the session's suffix): what its
+// journals hold, every run's (docs/sessions.md "The record"), or, in a
+// session without journals, its own final counter (PROCESS_STATS); with a
+// damaged journal, the larger of the two (what the journal could not hold
+// up is then a loss of the record, not none).
 std::int64_t Published(const nlohmann::json& process_stats, const nlohmann::json& record,
-                       const std::string& channel) {
+                       const std::string& channel, const std::string& process) {
   const std::int64_t journaled = Journaled(record, channel);
-  return journaled >= 0 ? journaled : CounterOf(process_stats, rms::Counter::kPublished);
+  const std::int64_t counted = CounterOf(process_stats, rms::Counter::kPublished);
+  if (journaled < 0) return counted;
+  return JournalDamaged(record, process) ? std::max(journaled, counted) : journaled;
 }
 
 // Frames each process published: what its journals hold (every run's, a
@@ -672,9 +685,12 @@ nlohmann::ordered_json FramesJson(const std::map<std::string, nlohmann::json>& s
   const auto &op = stats.at("operator_station"), &dcp = stats.at("dynamics_proc"),
              &scene = stats.at("scene_proc"), &esg = stats.at("esg_renderer");
   nlohmann::ordered_json frames;
-  frames["operator_published"] = Published(op, record, wire::channels::kOperatorInput + suffix);
-  frames["dcp_published"] = Published(dcp, record, wire::channels::kDcpFrame + suffix);
-  frames["esg_published"] = Published(scene, record, wire::channels::kEsgFrame + suffix);
+  frames["operator_published"] =
+      Published(op, record, wire::channels::kOperatorInput + suffix, "operator_station");
+  frames["dcp_published"] =
+      Published(dcp, record, wire::channels::kDcpFrame + suffix, "dynamics_proc");
+  frames["esg_published"] =
+      Published(scene, record, wire::channels::kEsgFrame + suffix, "scene_proc");
   frames["rendered"] = CounterOf(esg, rms::Counter::kRendered);
   frames["superseded"] = CounterOf(esg, rms::Counter::kSuperseded);
   frames["scenes_drawn"] = CounterOf(esg, rms::Counter::kRenderedScenes);
@@ -785,7 +801,7 @@ nlohmann::ordered_json RecordJson(const std::map<std::string, nlohmann::json>& s
   };
   const bool journals = Journaled(record, "") >= 0;
   auto published = [&](const char* channel, const char* process) {
-    return Published(stats.at(process), record, channel + suffix);
+    return Published(stats.at(process), record, channel + suffix, process);
   };
   const Row rows[] = {
       {wire::channels::kOperatorInput,
