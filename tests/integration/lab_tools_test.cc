@@ -626,6 +626,21 @@ TEST_F(RecordedSession, ResimSetWorksOnItAndOnItsReSimulationAndAFailureLeavesNo
              *tmp_ + "/cut.log");
   EXPECT_NE(fail.rc, 0) << fail.out;
   EXPECT_FALSE(fs::exists(cut)) << fail.out;
+  // The same into a folder that was there, holding a file of the user's:
+  // it is left as it was, with no empty session folders in it.
+  const std::string there = *tmp_ + "/there";
+  fs::create_directories(there);
+  std::ofstream(there + "/notes.txt") << "mine\n";
+  const ScriptRun fail_there =
+      Script({"/bin/bash", "-c",
+              "trap '' XFSZ; ulimit -f 64; exec " + testing::BuildPath("tools/rms_resim") + " " +
+                  *dir_ + " --set dcp.tpob_ft=0.4 --out " + there},
+             *tmp_ + "/there.log");
+  EXPECT_NE(fail_there.rc, 0) << fail_there.out;
+  std::vector<std::string> left;
+  for (const auto& e : fs::recursive_directory_iterator(there))
+    left.push_back(e.path().lexically_relative(there).string());
+  EXPECT_EQ(left, std::vector<std::string>{"notes.txt"}) << fail_there.out;
   EXPECT_EQ(Script({lab, "resim", *dir_, "--no-build", "--set", "dcp.tpob_ft=0.4", "--out", cut},
                    *tmp_ + "/cut2.log")
                 .rc,

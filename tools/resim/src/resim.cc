@@ -462,11 +462,14 @@ ResimResult Resimulate(const ResimOptions& opt) {
   struct NewSession {
     fs::path dir;
     bool made_folder = false, done = false;
-    std::vector<bool> was_there;  // each of kFiles, before: never removed
+    std::vector<bool> was_there;         // each of kFiles, before: never removed
+    std::vector<bool> folder_was_there;  // each of kSessionSubfolders, before
     void Claim(fs::path target) {
       dir = std::move(target);
       made_folder = !fs::exists(dir);
       for (const char* f : kFiles) was_there.push_back(fs::exists(dir / f));
+      for (const char* f : session::kSessionSubfolders)
+        folder_was_there.push_back(fs::exists(dir / f));
     }
     ~NewSession() {
       if (dir.empty() || done) return;
@@ -477,6 +480,9 @@ ResimResult Resimulate(const ResimOptions& opt) {
       }
       for (size_t i = 0; i < was_there.size(); ++i)
         if (!was_there[i]) fs::remove(dir / kFiles[i], ec);
+      // The folders it made, when empty (fs::remove leaves one that is not).
+      for (size_t i = 0; i < folder_was_there.size(); ++i)
+        if (!folder_was_there[i]) fs::remove(dir / session::kSessionSubfolders[i], ec);
     }
   } new_session;
   std::string out_log;

@@ -15,7 +15,7 @@ std::string CreateSessionFolder(const std::string& dir) {
   const fs::path root(dir);
   if (fs::exists(root / "lcmlog")) throw InputError(dir + " already holds a session");
   std::error_code ec;
-  for (const char* sub : {"logs", "stats", "frames", "run", "checkpoints"}) {
+  for (const char* sub : kSessionSubfolders) {
     fs::create_directories(root / sub, ec);
     if (ec) {
       throw InputError(dir + ": cannot make the session's folder there (" + ec.message() + ": " +
