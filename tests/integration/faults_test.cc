@@ -9,6 +9,7 @@
 #include <signal.h>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <gtest/gtest.h>
@@ -200,10 +201,16 @@ TEST(Faults, AStationKilledWhileFrozenComesBackFrozenAndFrozenTimeIsNoSessionTim
   std::printf("operator frames lost %ld; second restart down %.3f s; slowdown p90 %.2f\n", gap,
               down_s, slowdown);
   EXPECT_LT(gap, 60.0 * (down_s + 0.5) + 8.0 * slowdown) << s["frames"].dump();
-  // Session time is the frames': no frozen time in it.
+  // Session time is the frames': no frozen time in it. Frames never made
+  // are the gap and, on a loaded machine, those the DCP refused as late
+  // (half a second's at --speed 2 allowed for them); the freeze alone would
+  // be 180, and the station's frozen second 60 more.
   const double rate = 30.0;
-  EXPECT_LT(s["duration_s"].get<double>() * rate - s["frames"]["dcp_published"].get<double>(),
-            gap + 2.0)
+  const auto& refused = s["frames"]["refused"];
+  const long never_made =
+      std::lround(s["duration_s"].get<double>() * rate) - s["frames"]["dcp_published"].get<long>();
+  std::printf("session frames never made: %ld (refused %s)\n", never_made, refused.dump().c_str());
+  EXPECT_LT(never_made, gap + refused["late"].get<long>() + 30)
       << s["duration_s"] << " s for " << s["frames"]["dcp_published"] << " DCP frames";
   const nlohmann::json v = nlohmann::json::parse(ReadFile(out + "/resimulation.json"));
   EXPECT_EQ(v["verdict"], "identical") << v.dump(2);
