@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 #include <map>
@@ -191,6 +192,22 @@ std::vector<std::size_t> EventsOn(
   return at;
 }
 
+// Copies the LCM log FROM to TO without the events `drop` says yes to
+// (given the channel and the frame number the message carries, -1 if none).
+void CopyLogDropping(const std::string& from, const std::string& to,
+                     const std::function<bool(const std::string&, std::int64_t)>& drop) {
+  lcm::LogFile in(from, "r"), out(to, "w");
+  while (const lcm::LogEvent* ev = in.readNextEvent()) {
+    std::int64_t frame = -1;
+    wire::ReadFrameNumber(ev->data, static_cast<int>(ev->datalen), &frame);
+    if (!drop(ev->channel, frame)) out.writeEvent(const_cast<lcm::LogEvent*>(ev));
+  }
+}
+
+bool IsDcpFrameOrTelemetry(const std::string& channel) {
+  return channel.rfind("RMS_DCP_FRAME", 0) == 0 || channel.rfind("RMS_DCP_TELEMETRY", 0) == 0;
+}
+
 // docs/sessions.md "Through what is lost": DCP frames 400..429 gone from the
 // log, and ten of the operator frames they answered: which inputs the DCP
 // answered there cannot be told. The re-simulation goes on from the next
@@ -199,18 +216,10 @@ std::vector<std::size_t> EventsOn(
 TEST_F(RecordedSession, FramesLostFromEverySourceAreNamedAndTheRestCheckedWordForWord) {
   const std::string cut = *tmp_ + "/lost_frames";
   fs::copy(*dir_, cut, fs::copy_options::recursive);
-  {
-    lcm::LogFile in(*dir_ + "/lcmlog", "r"), out(cut + "/lcmlog", "w");
-    while (const lcm::LogEvent* ev = in.readNextEvent()) {
-      std::int64_t frame = -1;
-      wire::ReadFrameNumber(ev->data, static_cast<int>(ev->datalen), &frame);
-      const bool dcp = ev->channel.rfind("RMS_DCP_FRAME", 0) == 0 ||
-                       ev->channel.rfind("RMS_DCP_TELEMETRY", 0) == 0;
-      const bool input = ev->channel.rfind("RMS_OPERATOR_INPUT", 0) == 0;
-      if ((dcp && frame >= 400 && frame < 430) || (input && frame >= 410 && frame < 420)) continue;
-      out.writeEvent(const_cast<lcm::LogEvent*>(ev));
-    }
-  }
+  CopyLogDropping(*dir_ + "/lcmlog", cut + "/lcmlog", [](const std::string& ch, std::int64_t f) {
+    const bool input = ch.rfind("RMS_OPERATOR_INPUT", 0) == 0;
+    return (IsDcpFrameOrTelemetry(ch) && f >= 400 && f < 430) || (input && f >= 410 && f < 420);
+  });
   const std::string verdict = *tmp_ + "/lost_frames.json";
   const ScriptRun r =
       Script({testing::BuildPath("tools/rms_resim"), cut, "--verdict-json", verdict},
@@ -257,17 +266,9 @@ TEST_F(RecordedSession, AFrameLostJustBeforeAPeriodicStateIsFilledInBeforeTheChe
     }
   }
   ASSERT_GE(before_states.size(), 5u);
-  {
-    lcm::LogFile in(*dir_ + "/lcmlog", "r"), out(cut + "/lcmlog", "w");
-    while (const lcm::LogEvent* ev = in.readNextEvent()) {
-      std::int64_t frame = -1;
-      wire::ReadFrameNumber(ev->data, static_cast<int>(ev->datalen), &frame);
-      const bool dcp = ev->channel.rfind("RMS_DCP_FRAME", 0) == 0 ||
-                       ev->channel.rfind("RMS_DCP_TELEMETRY", 0) == 0;
-      if (dcp && before_states.count(frame)) continue;
-      out.writeEvent(const_cast<lcm::LogEvent*>(ev));
-    }
-  }
+  CopyLogDropping(*dir_ + "/lcmlog", cut + "/lcmlog", [&](const std::string& ch, std::int64_t f) {
+    return IsDcpFrameOrTelemetry(ch) && before_states.count(f) > 0;
+  });
   const std::string verdict = *tmp_ + "/lost_before_states.json";
   const ScriptRun r =
       Script({testing::BuildPath("tools/rms_resim"), cut, "--verdict-json", verdict},
@@ -333,15 +334,10 @@ TEST_F(RecordedSession, ADamagedJournalIsALossOfTheRecordNotNone) {
     bytes[at] = 0;
     std::ofstream(path, std::ios::binary) << bytes;
   }
-  {  // the network's recorder missed the DCP's frames from 1000 on
-    lcm::LogFile in(*dir_ + "/lcmlog", "r"), out(s + "/wire.lcmlog", "w");
-    while (const lcm::LogEvent* ev = in.readNextEvent()) {
-      std::int64_t frame = -1;
-      wire::ReadFrameNumber(ev->data, static_cast<int>(ev->datalen), &frame);
-      if (ev->channel.rfind("RMS_DCP_FRAME", 0) == 0 && frame >= 1000) continue;
-      out.writeEvent(const_cast<lcm::LogEvent*>(ev));
-    }
-  }
+  // The network's recorder missed the DCP's frames from 1000 on.
+  CopyLogDropping(*dir_ + "/lcmlog", s + "/wire.lcmlog", [](const std::string& ch, std::int64_t f) {
+    return ch.rfind("RMS_DCP_FRAME", 0) == 0 && f >= 1000;
+  });
   fs::remove(s + "/lcmlog");
   fs::remove(s + "/record.json");
   const std::string tools = testing::BuildPath("tools/rms_session");
