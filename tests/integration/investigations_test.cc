@@ -802,6 +802,30 @@ TEST_F(Investigations, ABranchedSessionReproducesItsParentsPrefixWordForWord) {
       << resim.out;
   EXPECT_NE(resim.out.find("recorded frames identical, word for word"), std::string::npos)
       << resim.out;
+  // Flown again under another design, the branch is still a branch: compare
+  // says so of both (no fresh trial), not "start".
+  const ScriptRun other = Script({SourcePath("scripts/lab"), "resim", child, "--no-build", "--set",
+                                  "dcp.tpob_ft=0.4", "--out", child + "-tpob"},
+                                 child + "-tpob.log");
+  ASSERT_EQ(other.rc, 0) << other.out;
+  EXPECT_EQ(nlohmann::json::parse(ReadFile(child + "-tpob/manifest.json"))["began_from"], "branch");
+  const ScriptRun cmp = Script({SourcePath("scripts/lab"), "compare", child, child + "-tpob",
+                                "--no-build", "--out", child + "-compare"},
+                               child + "-compare.log");
+  ASSERT_EQ(cmp.rc, 0) << cmp.out;
+  {
+    std::istringstream rows(ReadFile(child + "-compare/compare.csv"));
+    std::string line;
+    std::getline(rows, line);
+    int branch_rows = 0, fresh_rows = 0;
+    while (std::getline(rows, line)) {
+      // ... started_by, started_from, ...: the log's start, from a branch.
+      branch_rows += line.find(",start,branch,") != std::string::npos;
+      fresh_rows += line.find(",start,start,") != std::string::npos;
+    }
+    EXPECT_EQ(branch_rows, 2) << ReadFile(child + "-compare/compare.csv");
+    EXPECT_EQ(fresh_rows, 0) << ReadFile(child + "-compare/compare.csv");
+  }
   // A branch whose first state is not its parent's state there is caught:
   // the manifest pointed at another instant.
   auto moved = m;

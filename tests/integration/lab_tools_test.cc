@@ -246,6 +246,62 @@ TEST_F(RecordedSession, FramesLostFromEverySourceAreNamedAndTheRestCheckedWordFo
   EXPECT_EQ(v["frames_identical"], v["frames_compared"]);
 }
 
+// 200 DCP frames lost from every source around a periodic state, which the
+// log still holds: the stretch before the state cannot be told, the one
+// after it is made again from the logged inputs (no recorded frame left
+// unchecked), or, where inputs after the state are lost too, is one
+// stretch from the first lost frame on -- never two that overlap.
+TEST_F(RecordedSession, AStateLoggedAmongLostFramesIsGoneOnFromAndTheStretchIsOne) {
+  std::vector<std::int64_t> periodic;
+  {
+    lcm::LogFile in(*dir_ + "/lcmlog", "r");
+    while (const lcm::LogEvent* ev = in.readNextEvent()) {
+      dcp_state_t m;
+      if (ev->channel.rfind("RMS_DCP_STATE", 0) == 0 &&
+          m.decode(ev->data, 0, static_cast<int>(ev->datalen)) > 0 &&
+          m.reason == dcp_state_t::PERIODIC)
+        periodic.push_back(m.next_frame);
+    }
+  }
+  ASSERT_GE(periodic.size(), 4u);
+  const std::int64_t n = periodic[2], lost_from = n - 100, lost_to = n + 100;
+  for (const bool after_too : {false, true}) {
+    const std::string cut = *tmp_ + "/lost_around_state" + (after_too ? "_after" : "");
+    fs::copy(*dir_, cut, fs::copy_options::recursive);
+    CopyLogDropping(*dir_ + "/lcmlog", cut + "/lcmlog", [&](const std::string& ch, std::int64_t f) {
+      const bool input = ch.rfind("RMS_OPERATOR_INPUT", 0) == 0;
+      return (IsDcpFrameOrTelemetry(ch) && f >= lost_from && f <= lost_to) ||
+             (input && f >= n - 50 && f < n - 40) ||
+             (input && after_too && f >= n + 50 && f < n + 55);
+    });
+    const std::string verdict = cut + ".json";
+    const ScriptRun r = Script(
+        {testing::BuildPath("tools/rms_resim"), cut, "--verdict-json", verdict}, cut + ".log");
+    EXPECT_EQ(r.rc, 0) << r.out;
+    const auto v = nlohmann::json::parse(ReadFile(verdict));
+    EXPECT_EQ(v["verdict"], "identical") << v.dump(2);
+    ASSERT_EQ(v["unchecked"].size(), 1u) << "state for DCP frame " << n << ": " << v.dump(2);
+    const auto& u = v["unchecked"][0];
+    EXPECT_EQ(u["lost_from"], lost_from) << u.dump();
+    EXPECT_EQ(u["lost_to"], lost_to) << u.dump();
+    if (!after_too) {
+      EXPECT_FALSE(u.contains("unchecked_frames")) << u.dump();
+      EXPECT_EQ(u["resumed_from_state"], n) << u.dump();
+      EXPECT_EQ(u["resumed_at"], lost_to + 1) << u.dump();
+      EXPECT_NE(r.out.find("no recorded frame left unchecked: re-simulated again from the state "
+                           "logged for DCP frame " +
+                           std::to_string(n)),
+                std::string::npos)
+          << r.out;
+    } else {
+      EXPECT_EQ(u["unchecked_from"], lost_to + 1) << u.dump();
+      EXPECT_GT(u["resumed_from_state"].get<std::int64_t>(), lost_to) << u.dump();
+      EXPECT_EQ(u["resumed_at"], u["resumed_from_state"]) << u.dump();
+    }
+    EXPECT_EQ(r.out.find("note: before them"), std::string::npos) << r.out;
+  }
+}
+
 // The DCP frame just before each periodic state lost from every source:
 // one input fits each gap, so each is filled in, and each state is checked
 // after the frame filled in before it, not before it (that read as "the

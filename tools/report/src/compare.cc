@@ -43,8 +43,10 @@ Session Load(const std::string& dir) {
       s.started_utc = m.value("started_utc", "");
       s.started_us = m.value("started_us", std::int64_t{0});
       s.parent = m.value("resimulation_of", "");
-      s.branch = m.contains("branch");
-      s.restored_start = m.contains("restored_from");
+      // A re-simulation's began as its recorded session's did.
+      const std::string began = session::BeganFrom(m);
+      s.branch = began == "branch";
+      s.restored_start = began == "restore";
     } catch (const nlohmann::json::parse_error& e) {
       throw InputError(dir + "/manifest.json: not valid JSON (at byte " + std::to_string(e.byte) +
                        "): not a session's manifest");

@@ -336,15 +336,27 @@ class Planner {
     // not taken again: the next one is.
     std::size_t s = min_state_;
     while (s < r_.states.size() && r_.states[s].before < k) ++s;
-    Unchecked u{k, r_.dcp_frames.size(), lost_from, lost_to, why};
+    Unchecked u{k, r_.dcp_frames.size(), lost_from, lost_to, why, -1};
     if (s < r_.states.size() && r_.states[s].before < r_.dcp_frames.size()) {
       u.end = r_.states[s].before;
+      u.resumed_from = r_.states[s].m.next_frame;
       Take(r_.states[s].m, true);
       next_state_ = min_state_ = s + 1;
     } else {
       next_state_ = min_state_ = r_.states.size();
     }
-    plan_.unchecked.push_back(u);
+    // The state gone on from last time was logged inside the same lost
+    // stretch (frames 500..700 lost, a state at 600), and frame k does not
+    // follow from it either: one stretch, not two that overlap.
+    if (!plan_.unchecked.empty() && plan_.unchecked.back().begin == k &&
+        plan_.unchecked.back().end == k) {
+      Unchecked& last = plan_.unchecked.back();
+      u.lost_from = std::min(u.lost_from, last.lost_from);
+      u.lost_to = std::max(u.lost_to, last.lost_to);
+      last = u;
+    } else {
+      plan_.unchecked.push_back(u);
+    }
     return u.end;
   }
 

@@ -139,6 +139,7 @@ struct Unchecked {
   std::size_t begin = 0, end = 0;           // recorded DCP frames [begin, end), by index
   std::int64_t lost_from = 0, lost_to = 0;  // the DCP frames lost before them
   std::string why;
+  std::int64_t resumed_from = -1;  // the DCP frame of the state gone on from; -1: none logged later
 };
 
 struct Plan {

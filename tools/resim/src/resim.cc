@@ -241,11 +241,18 @@ void NoteUnchecked(const Recording& rec, const Plan& plan, ResimResult* result) 
     std::string goes_on = "nothing after them was re-simulated (no RMS_DCP_STATE logged later)";
     if (u.end < rec.dcp_frames.size()) {
       e["resumed_at"] = rec.dcp_frames[u.end].frame;
-      goes_on = "re-simulated again from the state logged before DCP frame " +
-                std::to_string(rec.dcp_frames[u.end].frame);
+      e["resumed_from_state"] = u.resumed_from;
+      goes_on = "re-simulated again from the state logged for DCP frame " +
+                std::to_string(u.resumed_from);
+      if (u.resumed_from < rec.dcp_frames[u.end].frame)
+        goes_on += ", the frames lost after it made again from the logged inputs";
     }
+    // With no recorded frame unchecked (a state logged among the lost
+    // frames, and the rest made again from it), the lost frames are the subject.
     std::string said = where;
-    said.append("before them, ").append(lost).append(": ").append(u.why).append("; ");
+    if (frames > 0) said += "before them, ";
+    said.append(lost).append(": ").append(u.why).append("; ");
+    if (frames == 0) said += "no recorded frame left unchecked: ";
     said += goes_on;
     AddNote(said, &result->note);
     result->unchecked.push_back(std::move(e));
@@ -346,6 +353,9 @@ void WriteNewSession(const RecordedSession& recorded, const std::string& config_
           nlohmann::json::parse(std::ifstream((session / "manifest.json").string()));
       mf.subject = parent.value("subject", "");
       mf.note = parent.value("note", "");
+      // Its log begins as the recorded one's did: a branch's re-simulation
+      // is no fresh trial (docs/sessions.md "Compare").
+      mf.began_from = session::BeganFrom(parent);
     } catch (const std::exception&) {
     }
   }

@@ -1055,6 +1055,11 @@ nlohmann::ordered_json SummarizeDcpRun(const LabConfig& config, const DcpRun& ru
   return j;
 }
 
+std::string BeganFrom(const nlohmann::json& m) {
+  if (m.contains("began_from") && m["began_from"].is_string()) return m["began_from"];
+  return m.contains("branch") ? "branch" : m.contains("restored_from") ? "restore" : "start";
+}
+
 nlohmann::ordered_json MakeManifest(const std::string& dir, const ManifestFields& f) {
   const std::string &pilot = f.pilot, &url = f.url, &suffix = f.suffix,
                     &config_sha256 = f.config_sha256, &timeline = f.timeline, &restore = f.restore,
@@ -1085,6 +1090,10 @@ nlohmann::ordered_json MakeManifest(const std::string& dir, const ManifestFields
                    {"time_s", f.branch_time_s},
                    {"parent_log_sha256", f.branch_parent_log_sha256}};
   }
+  j["began_from"] = !f.began_from.empty()  ? f.began_from
+                    : !f.branch_of.empty() ? "branch"
+                    : !restore.empty()     ? "restore"
+                                           : "start";
   j["config"] = {{"file", "config.toml"}, {"sha256", config_sha256}};
   if (!f.config_source.empty()) j["config"]["source"] = f.config_source;
   j["software"] = {{"version", VersionString()},         {"project", Version().project},

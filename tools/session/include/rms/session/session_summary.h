@@ -67,8 +67,15 @@ struct ManifestFields {
   std::int64_t branch_frame = -1;  // the last DCP frame of the recorded session's prefix
   double branch_time_s = 0;        // ... its session time (frame / frame rate)
   std::string branch_parent_log_sha256;  // SHA-256 of the recorded session's lcmlog
+  // How its log's first attempt began: "start", "restore" or "branch"
+  // (docs/sessions.md "The manifest"). "" derives it from `restore` and
+  // `branch_of`; a re-simulation sets its recorded session's.
+  std::string began_from;
 };
 nlohmann::ordered_json MakeManifest(const std::string& session_dir, const ManifestFields& f);
+// A manifest's `began_from`; for one written before that field, derived
+// from its `branch` and `restored_from`.
+std::string BeganFrom(const nlohmann::json& manifest);
 
 // What a tool needs to talk to, or read, a session: from its manifest.json.
 struct SessionInfo {
