@@ -284,7 +284,15 @@ TEST_F(RecordedSession, AStateLoggedAmongLostFramesIsGoneOnFromAndTheStretchIsOn
     const auto& u = v["unchecked"][0];
     EXPECT_EQ(u["lost_from"], lost_from) << u.dump();
     EXPECT_EQ(u["lost_to"], lost_to) << u.dump();
+    // The DCP's own receive warning does not say the gap again, otherwise.
+    EXPECT_EQ(r.out.find("gap:"), std::string::npos) << r.out;
     if (!after_too) {
+      // Made again from the logged inputs, with nothing to check them
+      // against: said, and not exact.
+      EXPECT_EQ(v["frames_filled_in"], lost_to - n + 1) << v.dump(2);
+      EXPECT_FALSE(v["exact"].get<bool>());
+      EXPECT_NE(r.out.find("made again from the logged inputs they answered"), std::string::npos)
+          << r.out;
       EXPECT_FALSE(u.contains("unchecked_frames")) << u.dump();
       EXPECT_EQ(u["resumed_from_state"], n) << u.dump();
       EXPECT_EQ(u["resumed_at"], lost_to + 1) << u.dump();
@@ -300,6 +308,26 @@ TEST_F(RecordedSession, AStateLoggedAmongLostFramesIsGoneOnFromAndTheStretchIsOn
     }
     EXPECT_EQ(r.out.find("note: before them"), std::string::npos) << r.out;
   }
+  // Two stretches, the state in the second: the run goes on from the state
+  // and still cannot follow on, so both are one stretch from the first
+  // lost frame, not two that overlap or leave frames between them unnamed.
+  const std::string two = *tmp_ + "/lost_twice_around_state";
+  fs::copy(*dir_, two, fs::copy_options::recursive);
+  CopyLogDropping(*dir_ + "/lcmlog", two + "/lcmlog", [&](const std::string& ch, std::int64_t f) {
+    const bool lost = (f >= n - 70 && f <= n - 40) || (f >= n - 30 && f <= n + 40);
+    return (IsDcpFrameOrTelemetry(ch) || ch.rfind("RMS_OPERATOR_INPUT", 0) == 0) && lost;
+  });
+  const ScriptRun r2 = Script(
+      {testing::BuildPath("tools/rms_resim"), two, "--verdict-json", two + ".json"}, two + ".log");
+  EXPECT_EQ(r2.rc, 0) << r2.out;
+  const auto v2 = nlohmann::json::parse(ReadFile(two + ".json"));
+  ASSERT_EQ(v2["unchecked"].size(), 1u) << v2.dump(2);
+  const auto& u2 = v2["unchecked"][0];
+  EXPECT_EQ(u2["lost_from"], n - 70) << u2.dump();
+  EXPECT_EQ(u2["lost_to"], n + 40) << u2.dump();
+  EXPECT_EQ(u2["unchecked_from"], n - 39) << u2.dump();
+  EXPECT_GT(u2["resumed_at"].get<std::int64_t>(), n + 40) << u2.dump();
+  EXPECT_EQ(u2["resumed_at"], u2["resumed_from_state"]) << u2.dump();
 }
 
 // The DCP frame just before each periodic state lost from every source:
@@ -405,6 +433,32 @@ TEST_F(RecordedSession, ADamagedJournalIsALossOfTheRecordNotNone) {
   EXPECT_EQ(r["by_channel"]["RMS_DCP_FRAME"]["published"], stats["counters"]["published"])
       << r.dump(2);
   EXPECT_GT(r["lost"].get<long>(), 0) << r.dump(2);
+  // The brief says what the record lacks, and that the re-simulation's
+  // "identical" is of what it holds: not exact.
+  fs::copy_file(*dir_ + "/resimulation.json", s + "/resimulation.json",
+                fs::copy_options::overwrite_existing);
+  const ScriptRun brief =
+      Script({tools, "summary", s, "--brief"}, *tmp_ + "/damaged_journal_brief.log");
+  EXPECT_NE(brief.out.find("the record lacks " + std::to_string(r["lost"].get<long>())),
+            std::string::npos)
+      << brief.out;
+  EXPECT_NE(brief.out.find("NOT EXACT: the record lacks"), std::string::npos) << brief.out;
+  EXPECT_NE(brief.out.find("the record has what the network's recorder heard"), std::string::npos)
+      << brief.out;
+  // Without the network's recording, nothing is said to come from it.
+  fs::remove(s + "/wire.lcmlog");
+  fs::remove(s + "/lcmlog");
+  fs::remove(s + "/record.json");
+  ASSERT_EQ(Script({tools, "record", s}, *tmp_ + "/damaged_journal_record2.log").rc, 0);
+  const ScriptRun alone =
+      Script({tools, "summary", s, "--brief"}, *tmp_ + "/damaged_journal_brief2.log");
+  const auto r2 = nlohmann::json::parse(ReadFile(s + "/summary.json"))["record"];
+  EXPECT_FALSE(r2["network"]["present"].get<bool>()) << r2.dump(2);
+  EXPECT_EQ(r2["network"]["missed"], 0) << r2.dump(2);
+  EXPECT_NE(alone.out.find("no network recording (wire.lcmlog)"), std::string::npos) << alone.out;
+  EXPECT_NE(alone.out.find("what they held past it is in no record"), std::string::npos)
+      << alone.out;
+  EXPECT_EQ(alone.out.find("the network's recorder missed"), std::string::npos) << alone.out;
 }
 
 // A log made from the wire alone, where the network delivered each logged
@@ -634,8 +688,15 @@ TEST_F(RecordedSession, ResimSetWorksOnItAndOnItsReSimulationAndAFailureLeavesNo
   const auto s = nlohmann::json::parse(ReadFile(first + "/summary.json"));
   EXPECT_TRUE(s["docked"].get<bool>()) << "a slacker TPOB changes nothing the autopilot did";
   EXPECT_EQ(s["result_attempt"], 1) << s.dump(2);
-  EXPECT_EQ(nlohmann::json::parse(ReadFile(first + "/manifest.json"))["lcm"]["channel_suffix"],
-            "_BAY2");
+  const auto m = nlohmann::json::parse(ReadFile(first + "/manifest.json"));
+  EXPECT_EQ(m["lcm"]["channel_suffix"], "_BAY2");
+  EXPECT_EQ(m["pilot"], "re-simulation");
+  // The new session says whether it re-simulates, as every session does,
+  // and its wall times count from its own log's start, not from 1970.
+  EXPECT_EQ(s["resimulation"]["verdict"], "identical") << s["resimulation"].dump();
+  EXPECT_TRUE(s["resimulation"]["exact"].get<bool>()) << s["resimulation"].dump();
+  EXPECT_NE(a.out.find("the new session re-simulates: identical"), std::string::npos) << a.out;
+  EXPECT_LT(s["wall_duration_s"].get<double>(), 3600) << s.dump(2);
   // A re-simulation of the re-simulation, with another key set.
   const ScriptRun b = Script(
       {lab, "resim", first, "--no-build", "--set", "arm.upper_boom_ft=21.5", "--out", second},

@@ -23,6 +23,7 @@
 #include "rms/base/text.h"
 #include "rms/base/version.h"
 #include "rms/resim/resim.h"
+#include "rms/session/session_summary.h"
 
 namespace {
 
@@ -79,11 +80,13 @@ nlohmann::ordered_json Verdict(const rms::resim::ResimResult* r, const std::stri
   // Exact: every frame the DCP made checked (none lost from the log, none
   // left unchecked after such a loss, none before its first state, and the
   // log not cut short or damaged: what it held past that was not checked).
-  v["exact"] = same && r->unchecked.empty() && r->skipped == 0 && r->log_note.empty();
+  v["exact"] =
+      same && r->unchecked.empty() && r->skipped == 0 && r->log_note.empty() && r->filled_in == 0;
   v["frames_compared"] = r->compared;
   v["frames_identical"] = r->identical;
   v["frames_unchecked"] = r->unchecked_frames;
   v["frames_skipped_at_start"] = r->skipped;
+  v["frames_filled_in"] = r->filled_in;
   v["unchecked"] = r->unchecked;
   v["first_difference"] = r->first_difference.empty() ? nlohmann::ordered_json(nullptr)
                                                       : nlohmann::ordered_json(r->first_difference);
@@ -93,6 +96,27 @@ nlohmann::ordered_json Verdict(const rms::resim::ResimResult* r, const std::stri
   v["seconds"] = r->seconds;
   v["exit_code"] = same ? 0 : 1;
   return v;
+}
+
+// Another design's new session says whether it re-simulates, as every
+// session does (docs/sessions.md "Does it re-simulate"): re-simulated
+// itself, its resimulation.json written and its summary made again with it.
+std::string CheckNewSession(const std::string& dir, int threads) {
+  rms::resim::ResimOptions own;
+  own.session = dir;
+  own.threads = threads;
+  nlohmann::ordered_json v;
+  try {
+    const rms::resim::ResimResult r = rms::resim::Resimulate(own);
+    v = Verdict(&r, "");
+  } catch (const std::exception& e) {
+    v = Verdict(nullptr, e.what());
+  }
+  const std::filesystem::path root(dir);
+  rms::WriteWholeFile((root / "resimulation.json").string(), v.dump(2) + "\n");
+  rms::WriteWholeFile((root / "summary.json").string(),
+                      rms::session::Summarize(dir).dump(2) + "\n");
+  return v.value("verdict", "?");
 }
 
 // A usage error, as rms::ParseCommandLine reports one (exit 2).
@@ -225,6 +249,9 @@ int main(int argc, char** argv) {
           "--verdict-json is for the session's own design, to its end (no "
           "--config, --set or --until)");
     const rms::resim::ResimResult r = rms::resim::Resimulate(opt);
+    const std::string new_session_verdict = rms::resim::OtherDesign(opt) && !r.out_dir.empty()
+                                                ? CheckNewSession(r.out_dir, opt.threads)
+                                                : "";
     if (!verdict_json.empty()) rms::WriteWholeFile(verdict_json, Verdict(&r, "").dump(2) + "\n");
     if (!checkpoint_out.empty()) {
       if (!r.first_difference.empty()) {
@@ -239,7 +266,10 @@ int main(int argc, char** argv) {
       std::printf("%s\n", rms::resim::JsonLine(r.cell).c_str());
       return 0;
     }
-    return Report(r, rms::resim::OtherDesign(opt));
+    const int rc = Report(r, rms::resim::OtherDesign(opt));
+    if (!new_session_verdict.empty())
+      std::printf("the new session re-simulates: %s\n", new_session_verdict.c_str());
+    return rc;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rms_resim: %s\n", e.what());
     if (!verdict_json.empty() && !rms::resim::OtherDesign(opt) && opt.until_frame < 0) {

@@ -79,6 +79,10 @@ class DcpRunner {
     if (other_design) telemetry.reserve(steps);
     // Nobody reads a periodic state unless it is written.
     node_.set_periodic_states(!out_log.empty());
+    // The new log's first event (the state it starts from, sent before any
+    // input) at the recorded log's first input's time, not at 0: its
+    // readers' wall times count from it (docs/sessions.md "Session time").
+    if (!rec.inputs.empty()) lcm_.SetNowUs(rec.inputs.front().timestamp_us);
     Subscribe();
   }
   DcpRunner(const DcpRunner&) = delete;
@@ -413,6 +417,24 @@ bool RunInHalves(const LabConfig& config, const Recording& rec, const Plan& plan
   return true;
 }
 
+// The DCP's own receive warnings ("gap: 250 frames missing before frame
+// 750 ...") over the stretches the plan already names (Plan::unchecked,
+// said once in the result's note) are not said again with other numbers,
+// unless asked for (--verbose: the info level).
+class QuietOverNamedGaps {
+ public:
+  explicit QuietOverNamedGaps(const Plan& plan) : was_(spdlog::get_level()) {
+    if (!plan.unchecked.empty() && was_ > spdlog::level::info)
+      spdlog::set_level(spdlog::level::err);
+  }
+  ~QuietOverNamedGaps() { spdlog::set_level(was_); }
+  QuietOverNamedGaps(const QuietOverNamedGaps&) = delete;
+  QuietOverNamedGaps& operator=(const QuietOverNamedGaps&) = delete;
+
+ private:
+  spdlog::level::level_enum was_;
+};
+
 }  // namespace
 
 Outputs RunAndCompare(const LabConfig& config, const Recording& rec, const Plan& plan,
@@ -424,6 +446,7 @@ Outputs RunAndCompare(const LabConfig& config, const Recording& rec, const Plan&
   const std::size_t split = whole_own_run && plan.unchecked.empty() ? SplitStep(plan) : 0;
   const auto t_run = Clock::now();
   DcpRunner first(config, rec, options.out_log, options.other_design, n);
+  const QuietOverNamedGaps quiet(plan);
   Outputs out;
   if (split > 0 && RunInHalves(config, rec, plan, split, options.progress, options.other_core,
                                &first, &out, result)) {

@@ -300,6 +300,11 @@ class Planner {
         plan_.steps.push_back({periodic[p], -1, false});
     };
     std::int64_t n = prev_frame_ + 1;
+    if (!between.empty()) {
+      plan_.filled_in += static_cast<std::int64_t>(between.size());
+      if (plan_.first_filled_in < 0) plan_.first_filled_in = n;
+      plan_.last_filled_in = f.frame - 1;
+    }
     for (const std::int64_t in : between) {
       check_before(n++);
       plan_.steps.push_back({nullptr, in, false});
@@ -345,12 +350,14 @@ class Planner {
     } else {
       next_state_ = min_state_ = r_.states.size();
     }
-    // The state gone on from last time was logged inside the same lost
-    // stretch (frames 500..700 lost, a state at 600), and frame k does not
-    // follow from it either: one stretch, not two that overlap.
-    if (!plan_.unchecked.empty() && plan_.unchecked.back().begin == k &&
-        plan_.unchecked.back().end == k) {
+    // The state gone on from last time was logged inside a lost stretch
+    // (frames 500..700 lost, a state at 600; or two stretches, 530..560 and
+    // 570..640, the state at 600 in the second) and frame k, where the run
+    // was to go on, does not follow from it either: one stretch from the
+    // first lost frame, not two that overlap.
+    if (!plan_.unchecked.empty() && plan_.unchecked.back().end == k) {
       Unchecked& last = plan_.unchecked.back();
+      u.begin = last.begin;
       u.lost_from = std::min(u.lost_from, last.lost_from);
       u.lost_to = std::max(u.lost_to, last.lost_to);
       last = u;

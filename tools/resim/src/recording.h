@@ -147,6 +147,10 @@ struct Plan {
   std::size_t first = 0;  // the index of the first recorded DCP frame re-simulated
   std::string note;       // what the log lacks, when it does not start at the session's start
   std::vector<Unchecked> unchecked;  // in order, after `first`
+  // DCP frames not in the log made again from the logged inputs they
+  // answered (unambiguous: exactly as many logged between): nothing to
+  // check them against.
+  std::int64_t filled_in = 0, first_filled_in = -1, last_filled_in = -1;
   // Whether recorded DCP frame i is checked: at or after `first`, in no
   // unchecked stretch.
   bool Checked(std::size_t i) const {

@@ -340,7 +340,7 @@ void WriteNewSession(const RecordedSession& recorded, const std::string& config_
                      const std::string& config_text, const LabConfig& config, ResimResult* result) {
   const fs::path dir(result->out_dir), session(recorded.dir());
   session::ManifestFields mf;
-  mf.pilot = "resim";
+  mf.pilot = "re-simulation";
   mf.kind = "re-simulation";
   mf.parent = fs::absolute(session).lexically_normal().string();
   mf.config_source = config_path;
@@ -454,6 +454,15 @@ ResimResult Resimulate(const ResimOptions& opt) {
   }
   result.note = plan.note;
   NoteUnchecked(rec, plan, &result);
+  if (plan.filled_in > 0) {
+    result.filled_in = static_cast<long>(plan.filled_in);
+    AddNote(std::to_string(plan.filled_in) + " DCP frame(s) between " +
+                std::to_string(plan.first_filled_in) + " and " +
+                std::to_string(plan.last_filled_in) +
+                " are not in the log: made again from the logged inputs they answered, with "
+                "nothing to check them against",
+            &result.note);
+  }
   // Another design is judged against the recorded outcome: a log cut short
   // (or changed) since the session's summary was made holds less than it,
   // and the difference is the log's, not the design's.

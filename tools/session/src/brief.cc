@@ -64,13 +64,15 @@ std::string WakeLatencyNote(const Json& j) {
 void LossLines(const Json& j, std::ostream& os) {
   const auto& fr = j["frames"];
   if (j["record"].value("lost", 0) > 0) {
-    // Made from journals, the log holds every frame they hold: a frame
-    // counted lost is one the log's reader did not take as the session's
-    // (its number went back or repeated), not one the recorder missed.
+    // Made from journals, the log holds every frame they could be read
+    // for: a frame counted lost is in no readable journal and not on the
+    // wire (a damaged journal or log), or one the log's reader did not take
+    // as the session's (its number went back or repeated).
     if (j["record"].value("source", "") == "journals")
-      os << "the log holds " << j["record"]["lost"]
-         << " frames fewer than the journals as the session's frames (numbers that went back "
-            "or repeated: a restart's, or a sender that is not believed):";
+      os << "the record lacks " << j["record"]["lost"]
+         << " of the frames the session's processes published (a damaged journal or log, or "
+            "numbers that went back or repeated: a restart's, or a sender that is not "
+            "believed):";
     else
       os << "the record lost " << j["record"]["lost"]
          << " frames (the recorder fell behind, was stopped or its disk filled):";
@@ -80,7 +82,12 @@ void LossLines(const Json& j, std::ostream& os) {
     }
     os << "\n";
   }
-  if (j["record"].contains("network") && j["record"]["network"].value("missed", 0) > 0) {
+  const bool wire =
+      !j["record"].contains("network") || j["record"]["network"].value("present", true);
+  if (!wire) {
+    os << "no network recording (wire.lcmlog): the record is the processes' journals "
+          "alone\n";
+  } else if (j["record"].contains("network") && j["record"]["network"].value("missed", 0) > 0) {
     os << "the network's recorder missed " << j["record"]["network"]["missed"]
        << " messages (a loaded machine, a stopped recorder): the record has each from the "
           "journal of the process that sent it\n";
@@ -92,9 +99,10 @@ void LossLines(const Json& j, std::ostream& os) {
   if (j["record"].value("journal_unread_bytes", 0) > 0) {
     os << "the journals " << j["record"]["journals_damaged"].dump() << " end in "
        << j["record"]["journal_unread_bytes"]
-       << " bytes that are no whole event (damaged, or cut short): the record has what the "
-          "network's recorder heard of what they held past it, the counts of what was "
-          "published are what could be read, and the journals are kept in journal/\n";
+       << " bytes that are no whole event (damaged, or cut short): "
+       << (wire ? "the record has what the network's recorder heard of what they held past it"
+                : "what they held past it is in no record (no wire.lcmlog)")
+       << ", and the journals are kept in journal/\n";
   }
   if (j["ignored"].value("total", 0) > 0) {
     os << "left out " << j["ignored"]["total"]
@@ -223,12 +231,19 @@ void ResimulationLine(const Json& j, std::ostream& os) {
     os << "re-simulates: identical (" << Count(v, "frames_identical") << " of "
        << Count(v, "frames_compared") << " DCP frames, word for word";
     const std::int64_t unchecked = v.value("frames_unchecked", std::int64_t{0}) +
-                                   v.value("frames_skipped_at_start", std::int64_t{0});
+                                   v.value("frames_skipped_at_start", std::int64_t{0}) +
+                                   v.value("frames_filled_in", std::int64_t{0});
     const std::string note = v.value("note", std::string()),
                       log_note = v.value("log_note", std::string());
     if (unchecked > 0 || (!v.value("exact", true) && !note.empty()))
       os << "; " << unchecked << " not checked: " << note;
     if (!log_note.empty()) os << "; NOT EXACT: " << log_note;
+    // What the record lacks was never re-simulated: identical is of what it holds.
+    const std::int64_t lost =
+        j["record"].is_object() ? j["record"].value("lost", std::int64_t{0}) : 0;
+    if (lost > 0)
+      os << "; NOT EXACT: the record lacks " << lost
+         << " of the frames the session published, not re-simulated";
     os << ")\n";
   } else if (what == "differs") {
     os << "re-simulates: NO -- it differs from the recording at "

@@ -842,7 +842,9 @@ nlohmann::ordered_json RecordJson(const std::map<std::string, nlohmann::json>& s
         if (n.is_number_integer()) missed[base] = n.get<std::int64_t>();
       }
     }
-    r["network"] = {{"missed", RecordCount(record, {"wire", "missed", "total"})},
+    const bool wire = !record["wire"].is_object() || record["wire"].value("present", true);
+    r["network"] = {{"present", wire},
+                    {"missed", wire ? RecordCount(record, {"wire", "missed", "total"}) : 0},
                     {"missed_by_channel", missed},
                     {"only_in_network", RecordCount(record, {"wire", "only_there"})},
                     {"duplicated", RecordCount(record, {"wire", "duplicated", "total"})}};

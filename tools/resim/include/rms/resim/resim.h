@@ -67,6 +67,9 @@ struct ResimResult {
   // lost_to, why, unchecked_from, unchecked_to, unchecked_frames,
   // resumed_at); said in `note` too.
   long unchecked_frames = 0;
+  // DCP frames the log lacks, made again from their logged inputs (Plan::
+  // filled_in): re-simulated, but not checked; said in `note` too.
+  long filled_in = 0;
   nlohmann::ordered_json unchecked = nlohmann::ordered_json::array();
   std::string log_note;     // the log's end is no whole event ("" if it is)
   long states_taken = 0;    // logged RMS_DCP_STATE taken (start, restores, resumes)
