@@ -233,7 +233,9 @@ class Demo:
             f.write(f"{os.getpid()}\n")
         self.session_id = session.new_session_id()
         session.note_address_holder(self.session_id)
+        self.key_file = session.write_session_key(os.path.join(self.out, "run"))
         fields = [("--pilot", self.pilot), ("--lcm-url", self.url), ("--session-id", self.session_id),
+                  ("--message-auth", session.MESSAGE_AUTH),
                   ("--command", self.command_line),
                   ("--config-sha256", file_sha256(os.path.join(self.out, "config.toml")))]
         for p in PROCESSES:
@@ -261,6 +263,8 @@ class Demo:
         h = self.hosts[name]
         if h.remote:
             h.copy_to(os.path.join(self.out, "config.toml"), f"{self.remote_run}/config.toml")
+            # scp makes it with the key's own mode (0600): its owner's only.
+            h.copy_to(self.key_file, f"{self.remote_run}/{session.SESSION_KEY}")
             return (f"{self.remote_bin}/{name}/{name}", f"{self.remote_run}/config.toml",
                     f"{self.remote_run}/{name}.json", f"{self.remote_run}/{name}.ready")
         return (binary(f"{name}/{name}"), os.path.join(self.out, "config.toml"),
@@ -281,6 +285,8 @@ class Demo:
             ready_fn = lambda c: os.path.exists(ready)  # noqa: E731
             if os.path.exists(ready):
                 os.remove(ready)
+        if h.remote:  # the key where that host's process reads it
+            kw["env"] = dict(kw.get("env") or {}, RMSLAB_SESSION_KEY_FILE=f"{self.remote_run}/{session.SESSION_KEY}")
         return Spec(name, h, argv + extra, log, ready=ready_fn, remote_run=self.remote_run if h.remote else None, **kw)
 
     def journal_dir(self, name):
@@ -355,6 +361,7 @@ class Demo:
 
     def start(self):
         env = {"RMSLAB_SESSION_ID": self.session_id, "RMSLAB_SESSION_EPOCH_US": str(int(time.time() * 1e6)),
+               "RMSLAB_SESSION_KEY_FILE": self.key_file,
                "RMSLAB_CPU_WAKE_LATENCY_US": self.wake_latency}
         self.sup = Supervisor(os.path.join(self.out, "run"), env)
         self.sup.start_reaper(self.out, [binary("tools/rms_session"), "summary", self.out])

@@ -37,6 +37,7 @@ class Replay:
         # The replayed frames carry the recorded session's id: the replay's
         # processes take them as their own session's.
         self.session_id = m.get("session_id", "")
+        self.message_auth = m.get("message_auth")
 
     def make(self):
         a = self.a
@@ -52,6 +53,15 @@ class Replay:
             fields.append(("--channel-suffix", self.suffix))
         if self.session_id:
             fields.append(("--session-id", self.session_id))
+        # The replayed frames carry the recorded session's tags: its key
+        # checks them, and tags what the replay's processes send.
+        key = session.read_session_key(self.src) if self.message_auth else None
+        if self.message_auth and not key:
+            raise LabError(f"{self.src}/run/{session.SESSION_KEY} is missing: the session's messages carry tags "
+                           f"(manifest.json message_auth), and without its key they cannot be replayed")
+        self.key_file = session.write_session_key(os.path.join(self.out, "run"), key) if key else None
+        if key:
+            fields.append(("--message-auth", session.MESSAGE_AUTH))
         session.write_manifest(self.out, fields)
         summary = json.load(open(os.path.join(self.src, "summary.json"))) if os.path.exists(
             os.path.join(self.src, "summary.json")) else {}
@@ -74,6 +84,8 @@ class Replay:
     def run(self):
         a = self.a
         env = {"RMSLAB_SESSION_ID": self.session_id} if self.session_id else {}
+        if self.key_file:
+            env["RMSLAB_SESSION_KEY_FILE"] = self.key_file
         self.sup = Supervisor(os.path.join(self.out, "run"), env)
         self.sup.start_reaper(self.out, [binary("tools/rms_session"), "summary", self.out])
         for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):

@@ -49,6 +49,39 @@ def make_folder(out, default_parent):
     return r.stdout.strip()
 
 
+SESSION_KEY = "session.key"  # in the session's run/ (docs/security.md "Authenticated messages")
+MESSAGE_AUTH = "blake2b-128"
+
+
+def write_session_key(run_dir, key_hex=None):
+    """The session's secret key (32 random bytes, as 64 hex digits), written
+    as run/session.key readable by its owner only, never over a file or
+    through a link; its path. key_hex: a key already made (a replay's, its
+    recorded session's)."""
+    path = os.path.join(run_dir, SESSION_KEY)
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW | os.O_CLOEXEC, 0o600)
+    with os.fdopen(fd, "w") as f:
+        f.write((key_hex or secrets.token_hex(32)) + "\n")
+    return path
+
+
+def read_session_key(session_dir):
+    """A session's key (64 hex digits) when its manifest says its messages
+    carry tags, else None; a key that cannot be read is a LabError."""
+    path = os.path.join(session_dir, "run", SESSION_KEY)
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_CLOEXEC | os.O_NONBLOCK)
+    except FileNotFoundError:
+        return None
+    except OSError as e:
+        raise LabError(f"{path}: cannot be read ({e.strerror})")
+    with os.fdopen(fd) as f:
+        text = f.read(66).strip()
+    if len(text) != 64 or any(c not in "0123456789abcdefABCDEF" for c in text):
+        raise LabError(f"{path}: not 64 hex digits")
+    return text
+
+
 def precheck(checks):
     """Runs each process with --check before anything starts: a bad file or
     option is refused here, its message shown (exit 2). checks: [(name, argv)]."""

@@ -204,10 +204,10 @@ def compare(argv):
 
 
 def monitor(argv):
-    """scripts/lab monitor [--lcm-url URL] [--channel-suffix S] [--for SECONDS]:
+    """scripts/lab monitor [--session DIR | --lcm-url URL [--channel-suffix S]] [--for SECONDS]:
     live decoded traffic per channel, and each process's last status report."""
     ensure("tools/rms_monitor")
-    if "--lcm-url" not in argv:
+    if "--lcm-url" not in argv and "--session" not in argv:
         argv = ["--lcm-url", DEFAULT_URL] + argv
     return subprocess.run([binary("tools/rms_monitor")] + argv).returncode
 

@@ -20,6 +20,7 @@
 #include "rms/wire/control_word.h"
 #include "rms/wire/message_io.h"
 
+#include "session_files.h"
 #include "subprocess.h"
 
 namespace rms {
@@ -68,14 +69,16 @@ Session RunLab(const std::string& timeline, double speed, const std::string& tag
   EXPECT_EQ(lab.Wait(300), 0) << testing::ReadFile(log);
   s.summary = nlohmann::json::parse(testing::ReadFile(s.dir + "/summary.json"));
   lcm::LogFile f(s.dir + "/lcmlog", "r");
+  // Each message ends in its tag (docs/protocol.md "Message authentication").
+  const int tag_bytes = testing::SessionTagsMessages(s.dir) ? wire::kMacBytes : 0;
   while (const lcm::LogEvent* ev = f.readNextEvent()) {
     if (ev->channel == wire::channels::kDcpTelemetry) {
       dcp_telemetry_t m;
-      EXPECT_EQ(wire::SafeDecode(ev->data, ev->datalen, &m), wire::DecodeError::kNone);
+      EXPECT_EQ(wire::SafeDecode(ev->data, ev->datalen - tag_bytes, &m), wire::DecodeError::kNone);
       s.telemetry.push_back(m);
     } else if (ev->channel == wire::channels::kDcpFrame) {
       dcp_frame_t m;
-      EXPECT_EQ(wire::SafeDecode(ev->data, ev->datalen, &m), wire::DecodeError::kNone);
+      EXPECT_EQ(wire::SafeDecode(ev->data, ev->datalen - tag_bytes, &m), wire::DecodeError::kNone);
       s.dcp_frames.push_back(m);
     }
   }

@@ -18,6 +18,7 @@
 #include "rms/sender_t.hpp"
 #include "rms/transport/lcm_interface.h"
 #include "rms/wire/channels.h"
+#include "rms/wire/message_auth.h"
 
 #include "subprocess.h"
 
@@ -55,7 +56,7 @@ TEST(InstructorStation,
             std::string::npos);
 
   // A forged status report whose process name is markup, and whose host is
-  // not UTF-8: anyone with the session's id can send one.
+  // not UTF-8: anyone with the session's key can send one.
   {
     const auto manifest = nlohmann::json::parse(ReadFile(out + "/manifest.json"));
     transport::LcmOptions lo;
@@ -63,6 +64,7 @@ TEST(InstructorStation,
     transport::UdpLcm forger(lo);
     forger.SetSender({transport::ParseSessionId(manifest["session_id"], "session_id"),
                       sender_t::PROCESS_TOOL, 4242});
+    forger.SetKey(wire::ReadSessionKeyFile(out + "/run/session.key"));
     process_status_t m{};
     m.process = "<img id=forged src=x onerror=\"document.title='pwned'\">";
     m.host = "\xff\xfe";

@@ -13,8 +13,10 @@
 
 #include "rms/base/cpu_wake_latency.h"
 #include "rms/esg_frame_t.hpp"
+#include "rms/sender_t.hpp"
 #include "rms/transport/lcm_interface.h"
 #include "rms/wire/channels.h"
+#include "rms/wire/message_auth.h"
 #include "rms/wire/message_io.h"
 
 #include "subprocess.h"
@@ -134,6 +136,12 @@ TEST(LabDemo, TheSessionFolderHoldsLogVideoFramesProcessLogsAndSummary) {
   transport::LcmOptions o;
   o.url = play_url;
   transport::UdpLcm lcm(o);
+  // As one of the session's tools: its id, and its key to check each tag.
+  lcm.SetSender({transport::ParseSessionId(
+                     nlohmann::json::parse(testing::ReadFile(out + "/manifest.json"))["session_id"],
+                     "session_id"),
+                 sender_t::PROCESS_TOOL, 1});
+  lcm.SetKey(wire::ReadSessionKeyFile(out + "/run/session.key"));
   int esg_frames = 0;
   lcm.Subscribe(wire::channels::kEsgFrame, [&](const void* d, int n, std::int64_t) {
     esg_frame_t m;

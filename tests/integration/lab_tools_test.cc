@@ -8,6 +8,7 @@
 #include <signal.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <cstdio>
 #include <filesystem>
@@ -21,17 +22,23 @@
 #include <regex>
 #include <set>
 #include <sstream>
+#include <sys/stat.h>
+#include <thread>
 
 #include "rms/base/config.h"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_state_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/esg_frame_t.hpp"
+#include "rms/process_status_t.hpp"
+#include "rms/sender_t.hpp"
 #include "rms/transport/lcm_interface.h"
 #include "rms/wire/channels.h"
+#include "rms/wire/message_auth.h"
 #include "rms/wire/message_io.h"
 
 #include "lab_processes.h"
+#include "session_files.h"
 #include "subprocess.h"
 
 namespace rms {
@@ -165,14 +172,23 @@ void CopyEditingLog(const std::string& from, const std::string& to,
                     const std::function<void(std::size_t, lcm::LogEvent*)>& edit) {
   fs::copy(from, to, fs::copy_options::recursive);
   lcm::LogFile in(from + "/lcmlog", "r"), out(to + "/lcmlog", "w");
-  std::vector<std::uint8_t> data;
+  // The edit sees the message without its tag, and the edited message is
+  // tagged again: an insider's edit, which the readers take.
+  const int tag = testing::SessionTagsMessages(from) ? wire::kMacBytes : 0;
+  std::vector<std::uint8_t> data, tagged;
   std::size_t i = 0;
   while (const lcm::LogEvent* ev = in.readNextEvent()) {
     lcm::LogEvent copy = *ev;
     const auto* d = static_cast<const std::uint8_t*>(ev->data);
-    data.assign(d, d + ev->datalen);
+    data.assign(d, d + ev->datalen - tag);
     copy.data = data.data();
+    copy.datalen = ev->datalen - tag;
     edit(i++, &copy);
+    const auto* e = static_cast<const std::uint8_t*>(copy.data);
+    tagged.assign(e, e + copy.datalen);
+    if (tag) testing::TagAsTheSession(from, copy.channel, &tagged);
+    copy.data = tagged.data();
+    copy.datalen = static_cast<std::int32_t>(tagged.size());
     out.writeEvent(&copy);
   }
 }
@@ -691,6 +707,11 @@ TEST_F(RecordedSession, ResimSetWorksOnItAndOnItsReSimulationAndAFailureLeavesNo
   const auto m = nlohmann::json::parse(ReadFile(first + "/manifest.json"));
   EXPECT_EQ(m["lcm"]["channel_suffix"], "_BAY2");
   EXPECT_EQ(m["pilot"], "re-simulation");
+  {  // its config.toml's SHA-256, as a live session's manifest has it
+    const ScriptRun sum =
+        Script({"/usr/bin/sha256sum", first + "/config.toml"}, *tmp_ + "/sha.log");
+    EXPECT_EQ(sum.out.substr(0, 64), m["config"]["sha256"].get<std::string>()) << m.dump(2);
+  }
   // The new session says whether it re-simulates, as every session does,
   // and its wall times count from its own log's start, not from 1970.
   EXPECT_EQ(s["resimulation"]["verdict"], "identical") << s["resimulation"].dump();
@@ -1110,6 +1131,63 @@ TEST(Monitor, ShowsEveryChannelsTrafficWithRates) {
     EXPECT_EQ(mm[3], "0") << ch << " gaps";
   }
   EXPECT_NE(m.out.find("dynamics_proc"), std::string::npos) << m.out;
+  fs::remove_all(dir);
+}
+
+// A session's messages carry tags (docs/security.md "Authenticated
+// messages"): without the session the monitor decodes them, tags unchecked;
+// with --session it shows only the session's own, their tags checked, and
+// a stranger's message with the session's id is not among them.
+TEST(Monitor, ShowsASessionsTaggedMessagesAndWithItsFolderOnlyItsOwn) {
+  const std::string dir = testing::MakeTempDir("monitor_tags");
+  const std::string url = testing::UniqueLcmUrl(9720);
+  const std::int64_t id = 0x1234abcd5678ef01;
+  wire::SessionKey key;
+  key.bytes.fill(0x42);
+  fs::create_directories(dir + "/session/run");
+  {  // the key, 0x42 32 times, as the launcher writes one
+    std::string hex;
+    for (int i = 0; i < 32; ++i) hex += "42";
+    std::ofstream(dir + "/session/run/session.key") << hex << "\n";
+  }
+  chmod((dir + "/session/run/session.key").c_str(), 0600);
+  std::ofstream(dir + "/session/manifest.json") << nlohmann::json{
+      {"session_id", wire::FormatSessionId(id)},
+      {"message_auth", wire::kMessageAuthName},
+      {"lcm", {{"url", url}, {"channel_suffix", ""}}}}.dump();
+  transport::LcmOptions o;
+  o.url = url;
+  transport::UdpLcm member(o), stranger(o);
+  member.SetSender({id, sender_t::PROCESS_DYNAMICS, 100});
+  member.SetKey(key);
+  stranger.SetSender({id, sender_t::PROCESS_SCENE, 200});  // the id, not the key
+  std::atomic<bool> done{false};
+  std::thread t([&] {
+    while (!done) {
+      process_status_t st{};
+      st.process = "dynamics_proc";
+      st.host = "here";
+      transport::PublishMessage(member, wire::channels::kStatus, st);
+      st.process = "impostor";
+      transport::PublishMessage(stranger, wire::channels::kStatus, st);
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+  });
+  const ScriptRun open =
+      Script({SourcePath("scripts/lab"), "monitor", "--lcm-url", url, "--for", "2"},
+             dir + "/open.log", 30);
+  const ScriptRun own =
+      Script({SourcePath("scripts/lab"), "monitor", "--session", dir + "/session", "--for", "2"},
+             dir + "/own.log", 30);
+  done = true;
+  t.join();
+  ASSERT_EQ(open.rc, 0) << open.out;
+  ASSERT_EQ(own.rc, 0) << own.out;
+  EXPECT_NE(open.out.find("2 processes reporting"), std::string::npos) << open.out;
+  EXPECT_NE(open.out.find("dynamics_proc    on here"), std::string::npos) << open.out;
+  EXPECT_NE(own.out.find("1 processes reporting"), std::string::npos) << own.out;
+  EXPECT_NE(own.out.find("dynamics_proc    on here"), std::string::npos) << own.out;
+  EXPECT_EQ(own.out.find("impostor"), std::string::npos) << own.out;
   fs::remove_all(dir);
 }
 

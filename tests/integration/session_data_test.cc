@@ -23,6 +23,7 @@
 
 #include "cpu_load.h"
 #include "lab_processes.h"
+#include "session_files.h"
 #include "subprocess.h"
 #include "tmux.h"
 
@@ -233,6 +234,7 @@ TEST_F(HandFlownSession, ARestoreLoggedAgainGivesTheSameCellInMemoryAsWritten) {
     m.send_time_us += again.timestamp - events[restore].timestamp;
     again.data.resize(static_cast<std::size_t>(m.getEncodedSize()));
     ASSERT_GT(m.encode(again.data.data(), 0, static_cast<int>(again.data.size())), 0);
+    testing::TagAsTheSession(*out_, again.channel, &again.data);  // the DCP's, as it would send it
   }
   events.insert(events.begin() + static_cast<std::ptrdiff_t>(last_frame), again);
   const std::string forged = *tmp_ + "/forged";

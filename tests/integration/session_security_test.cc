@@ -19,6 +19,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <regex>
 #include <set>
 #include <sys/mount.h>
@@ -35,6 +36,7 @@
 #include "rms/transport/lcm_interface.h"
 #include "rms/wire/channels.h"
 #include "rms/wire/control_word.h"
+#include "rms/wire/message_auth.h"
 #include "rms/wire/message_io.h"
 
 #include "live_session.h"
@@ -67,8 +69,9 @@ void Sleep(double s) { std::this_thread::sleep_for(std::chrono::duration<double>
 // `id`; -1 otherwise or when it does not decode.
 template <typename Message>
 std::int64_t FrameFrom(const lcm::LogEvent& ev, std::int64_t id, int pid) {
-  Message m;
-  if (wire::SafeDecode(ev.data, ev.datalen, &m) != wire::DecodeError::kNone) return -1;
+  Message m;  // the session's messages end in their tag
+  if (wire::SafeDecode(ev.data, ev.datalen - wire::kMacBytes, &m) != wire::DecodeError::kNone)
+    return -1;
   return m.sender.session_id == id && m.sender.pid == pid ? m.frame : -1;
 }
 
@@ -101,12 +104,16 @@ std::map<std::string, long> GenuineFramesLogged(
 }
 
 // A program on the session's network: it sees every message (session id 0
-// takes all) and publishes whatever it likes, with whatever sender.
+// takes all) and publishes whatever it likes, with whatever sender; with
+// the session's key (an insider: docs/security.md "Authenticated
+// messages") its messages carry the key's tag, without it none.
 class Peer {
  public:
-  explicit Peer(const std::string& url) : lcm_(transport::LcmOptions{url, "", 1000}) {
+  explicit Peer(const std::string& url, std::optional<wire::SessionKey> key = std::nullopt)
+      : lcm_(transport::LcmOptions{url, "", 1000}), key_(key) {
     lcm_.Subscribe(wire::channels::kDcpFrame, [this](const void* d, int n, std::int64_t) {
       dcp_frame_t m;
+      n -= wire::kMacBytes;  // the session's messages end in their tag
       if (wire::SafeDecode(d, n, &m) == wire::DecodeError::kNone && m.frame > dcp_frame_) {
         dcp_frame_ = m.frame;
         last_dcp_ = m;
@@ -125,8 +132,13 @@ class Peer {
     m.sender.session_id = as.session_id;
     m.sender.process = as.process;
     m.sender.pid = as.pid;
-    const auto bytes = wire::EncodeMessage(m);
+    auto bytes = wire::EncodeMessage(m);
     ASSERT_FALSE(bytes.empty());
+    if (key_) {
+      const auto tag =
+          wire::MessageMac(*key_, channel, bytes.data(), static_cast<int>(bytes.size()));
+      bytes.insert(bytes.end(), tag.begin(), tag.end());
+    }
     lcm_.Publish(channel, bytes.data(), static_cast<int>(bytes.size()));
   }
   void Control(std::int8_t command, const std::string& name, const transport::Sender& as) {
@@ -165,6 +177,7 @@ class Peer {
 
  private:
   transport::UdpLcm lcm_;
+  std::optional<wire::SessionKey> key_;
   std::int64_t dcp_frame_ = 0;
   dcp_frame_t last_dcp_{};
   std::int64_t sequence_ = 0;
@@ -188,7 +201,14 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
               wire::FormatSessionId(id).c_str(), dcp_pid,
               wire::FormatSessionId(stranger_id).c_str());
   const std::string cps = s.out() + "/checkpoints";
-  Peer peer(s.url());
+  // An insider: the session's key (SESSION/run/session.key) and id.
+  Peer peer(s.url(), wire::ReadSessionKeyFile(s.out() + "/run/session.key"));
+  // An outsider who hears every packet: the session's id and its processes'
+  // pids, and no key (no tag, or another key's).
+  Peer outsider(s.url());
+  wire::SessionKey guess;
+  guess.bytes.fill(0x5a);
+  Peer guesser(s.url(), guess);
   const transport::Sender stranger{stranger_id, sender_t::PROCESS_CONTROL, 4242};
   const transport::Sender insider{id, sender_t::PROCESS_CONTROL,
                                   static_cast<std::int32_t>(getpid())};
@@ -200,6 +220,22 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
   peer.Control(session_control_t::CHECKPOINT, "stranger.json", stranger);
   EXPECT_GT(peer.Listen(1.5), before + 10) << "a stranger's FREEZE froze the session";
   EXPECT_FALSE(fs::exists(cps + "/stranger.json"));
+
+  // An outsider with the session's id and the operator's real pid: its
+  // freeze, its malfunctions and a step are dropped (dropped.bad_mac), and
+  // the DCP's frames go on.
+  const transport::Sender as_operator{id, sender_t::PROCESS_OPERATOR_STATION, op_pid};
+  const transport::Sender as_control{id, sender_t::PROCESS_CONTROL, 4343};
+  for (Peer* p : {&outsider, &guesser}) {
+    p->Control(session_control_t::FREEZE, "", as_operator);
+    p->Control(session_control_t::FREEZE, "", as_control);
+    p->Control(session_control_t::MALFUNCTION, "joint 2 stuck", as_control);
+    p->Control(session_control_t::MALFUNCTION, "finger jammed open", as_control);
+    p->Control(session_control_t::CHECKPOINT, "outsider.json", as_control);
+  }
+  const std::int64_t at_outsider = peer.Listen(0.2);
+  EXPECT_GT(peer.Listen(1.5), at_outsider + 10) << "an outsider's FREEZE froze the session";
+  EXPECT_FALSE(fs::exists(cps + "/outsider.json"));
 
   // An insider's names that are paths, a link, a huge file, a FIFO, a
   // device: refused, nothing written or read outside the folder.
@@ -295,6 +331,16 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
   far.frame = std::int64_t{1} << 47;
   far.send_time_us = transport::WallTimeUs();
   peer.Send(wire::channels::kOperatorInput, far, {id, sender_t::PROCESS_OPERATOR_STATION, op_pid});
+  // ... and as an outsider, inside the clock's limit: dropped before the DCP
+  // numbers anything by it.
+  operator_input_t near = far;
+  near.frame = peer.Listen(0.05) + 60;
+  outsider.Send(wire::channels::kOperatorInput, near, as_operator);
+  for (int i = 0; i < 30; ++i) {
+    outsider.ForgeTelemetry(now + 2 + i, {id, sender_t::PROCESS_DYNAMICS, dcp_pid});
+    guesser.ForgeTelemetry(now + 2 + i, {id, sender_t::PROCESS_DYNAMICS, dcp_pid});
+    peer.Listen(0.003);
+  }
 
   ASSERT_TRUE(testing::WaitForFile(cps + "/good.json", 10))
       << "a valid checkpoint after the flood was not written";
@@ -318,6 +364,10 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
   EXPECT_GE(Counter(out, "operator_station", "control.refused"), 3);
   EXPECT_GE(Counter(out, "dynamics_proc", "dropped.other_session"), 2);
   EXPECT_GE(Counter(out, "dynamics_proc", "dropped.far_ahead"), 1);
+  // The outsider's: every one counted and dropped, by the process it was for.
+  EXPECT_GE(Counter(out, "dynamics_proc", "dropped.bad_mac"), 2 * 5 + 1);
+  EXPECT_GE(Counter(out, "operator_station", "dropped.bad_mac"), 2 * 5 + 2 * 30);
+  EXPECT_EQ(Counter(out, "dynamics_proc", "control.malfunctions"), 0);
   // The telemetry from a pid not the DCP's, while the DCP sends: an impostor.
   EXPECT_GE(Counter(out, "operator_station", "dropped.other_sender"), 85);
   EXPECT_EQ(Counter(out, "dynamics_proc", "control.checkpoints"), static_cast<long>(files) - 1);
@@ -336,6 +386,13 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
   EXPECT_GE(Reason(sum, "not_the_sessions_process"), 90 + 1);
   EXPECT_GE(Reason(sum, "telemetry_contradicts_its_dcp_frame") + Reason(sum, "repeated_frame"), 90);
   EXPECT_GE(Reason(sum, "implausible_status"), 1);
+  EXPECT_GE(Reason(sum, "bad_mac"), 2 * 5 + 1 + 2 * 30);
+  EXPECT_TRUE(sum["ignored"]["macs_checked"].get<bool>());
+  // No outsider's command is in the summary's list of those sent.
+  for (const auto& c : sum["control"]) {
+    EXPECT_NE(c.value("name", ""), "joint 2 stuck") << sum["control"].dump();
+    EXPECT_NE(c.value("name", ""), "outsider.json") << sum["control"].dump();
+  }
   EXPECT_GE(Reason(sum, "disputed_dcp_frame"), 25);
   EXPECT_GE(Reason(sum, "dcp_frame_out_of_sequence"), 3);
   // The record's losses are the recorder's own, neither made up nor hidden

@@ -15,8 +15,10 @@
 #include "rms/operator_input_t.hpp"
 #include "rms/process_status_t.hpp"
 #include "rms/sender_t.hpp"
+#include "rms/session_control_t.hpp"
 #include "rms/transport/lcm_interface.h"
 #include "rms/wire/channels.h"
+#include "rms/wire/message_auth.h"
 #include "rms/wire/message_io.h"
 
 namespace rms {
@@ -143,6 +145,111 @@ TEST(SessionSenders, AnImpostorIsDroppedWhileThePublisherSendsAndARestartIsTaken
   drain(7);
   ASSERT_EQ(inputs.size(), 7u);
   EXPECT_EQ(inputs.back(), 4343);
+}
+
+// docs/security.md "Authenticated messages": with the session's key, what
+// a process sends ends in its tag, and a receiver takes only what carries
+// a good one -- not a stranger's message with the session's id and the
+// real pid, not a real message altered, not one of another channel; a real
+// command recorded and sent again is dropped as a replay.
+TEST(SessionSenders, WithTheSessionsKeyOnlyTaggedMessagesAreTakenAndACommandOnlyOnce) {
+  transport::LcmOptions o;
+  o.url = "udpm://239.255.76.67:" + std::to_string(8030 + getpid() % 40) + "?ttl=0";
+  wire::SessionKey key, other;
+  for (int i = 0; i < wire::kSessionKeyBytes; ++i) {
+    key.bytes[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(i * 7 + 1);
+    other.bytes[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(i * 7 + 2);
+  }
+  transport::UdpLcm real(o), forger(o), control(o), rx(o);
+  lcm::LCM raw(o.url);
+  real.SetSender({0x1111, sender_t::PROCESS_OPERATOR_STATION, 4242});
+  forger.SetSender({0x1111, sender_t::PROCESS_OPERATOR_STATION, 4242});  // the real pid
+  control.SetSender({0x1111, sender_t::PROCESS_CONTROL, 77});
+  rx.SetSender({0x1111, sender_t::PROCESS_DYNAMICS, 1});
+  real.SetKey(key);
+  control.SetKey(key);
+  rx.SetKey(key);
+  forger.SetKey(other);  // a key, not the session's
+  std::vector<std::int64_t> frames, commands;
+  std::vector<std::vector<std::uint8_t>> sent_control;
+  rx.Subscribe(wire::channels::kOperatorInput, [&](const void* d, int n, std::int64_t) {
+    operator_input_t m;
+    if (wire::SafeDecode(d, n, &m) == wire::DecodeError::kNone) frames.push_back(m.frame);
+  });
+  rx.Subscribe(wire::channels::kControl, [&](const void* d, int n, std::int64_t) {
+    session_control_t m;
+    if (wire::SafeDecode(d, n, &m) == wire::DecodeError::kNone) commands.push_back(m.sequence);
+  });
+  // What the network carries of the real control messages, to send again.
+  raw.subscribeFunction(
+      wire::channels::kControl,
+      +[](const lcm::ReceiveBuffer* b, const std::string&,
+          std::vector<std::vector<std::uint8_t>>* v) {
+        const auto* p = static_cast<const std::uint8_t*>(b->data);
+        v->emplace_back(p, p + b->data_size);
+      },
+      &sent_control);
+  auto pump = [&](auto done) {
+    for (int k = 0; k < 100 && !done(); ++k) {
+      rx.HandleSubscriptions(10);
+      raw.handleTimeout(0);
+    }
+  };
+  operator_input_t m{};
+  m.frame = 1;
+  ASSERT_TRUE(transport::PublishMessage(real, wire::channels::kOperatorInput, m));
+  m.frame = 2;
+  ASSERT_TRUE(transport::PublishMessage(forger, wire::channels::kOperatorInput, m));
+  // Untagged, and tagged for another channel.
+  transport::UdpLcm untagged(o);
+  untagged.SetSender({0x1111, sender_t::PROCESS_OPERATOR_STATION, 4242});
+  m.frame = 3;
+  ASSERT_TRUE(transport::PublishMessage(untagged, wire::channels::kOperatorInput, m));
+  {
+    m.frame = 4;
+    m.sender = {};
+    m.sender.session_id = 0x1111;
+    m.sender.process = sender_t::PROCESS_OPERATOR_STATION;
+    m.sender.pid = 4242;
+    std::vector<std::uint8_t> b = wire::EncodeMessage(m);
+    const auto tag =
+        wire::MessageMac(key, wire::channels::kStatus, b.data(), static_cast<int>(b.size()));
+    b.insert(b.end(), tag.begin(), tag.end());
+    raw.publish(wire::channels::kOperatorInput, b.data(), static_cast<unsigned>(b.size()));
+    // A real message with one byte changed.
+    m.frame = 5;
+    b = wire::EncodeMessage(m);
+    const auto good =
+        wire::MessageMac(key, wire::channels::kOperatorInput, b.data(), static_cast<int>(b.size()));
+    b.insert(b.end(), good.begin(), good.end());
+    b[wire::kFrameAt + 7] ^= 0x01;
+    raw.publish(wire::channels::kOperatorInput, b.data(), static_cast<unsigned>(b.size()));
+  }
+  m.frame = 6;
+  ASSERT_TRUE(transport::PublishMessage(real, wire::channels::kOperatorInput, m));
+  session_control_t c{};
+  c.send_time_us = transport::WallTimeUs();
+  c.sequence = 1;
+  c.command = session_control_t::FREEZE;
+  ASSERT_TRUE(transport::PublishMessage(control, wire::channels::kControl, c));
+  pump([&] { return frames.size() >= 2 && commands.size() >= 1 && !sent_control.empty(); });
+  EXPECT_EQ(frames, (std::vector<std::int64_t>{1, 6}));
+  EXPECT_EQ(rx.bad_mac_dropped(), 4);
+  ASSERT_EQ(commands, (std::vector<std::int64_t>{1}));
+  ASSERT_EQ(sent_control.size(), 1u);
+  // The recorded command, sent again as it was: a replay.
+  raw.publish(wire::channels::kControl, sent_control[0].data(),
+              static_cast<unsigned>(sent_control[0].size()));
+  // A real command sent long ago (its tag good, its time 60 s old).
+  c.send_time_us = transport::WallTimeUs() - 60'000'000;
+  c.sequence = 2;
+  ASSERT_TRUE(transport::PublishMessage(control, wire::channels::kControl, c));
+  c.send_time_us = transport::WallTimeUs();
+  c.sequence = 3;
+  ASSERT_TRUE(transport::PublishMessage(control, wire::channels::kControl, c));
+  pump([&] { return commands.size() >= 2 && rx.replayed_dropped() >= 2; });
+  EXPECT_EQ(commands, (std::vector<std::int64_t>{1, 3}));
+  EXPECT_EQ(rx.replayed_dropped(), 2);
 }
 
 TEST(UdpLcm, ABadUrlIsRefusedWithTheFix) {

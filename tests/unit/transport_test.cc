@@ -6,21 +6,28 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <gtest/gtest.h>
 #include <iostream>
 #include <lcm/lcm-cpp.hpp>
 #include <random>
+#include <sys/stat.h>
 #include <thread>
 
 #include "rms/base/check.h"
 #include "rms/dcp_frame_t.hpp"
+#include "rms/dcp_state_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/esg_frame_t.hpp"
 #include "rms/operator_input_t.hpp"
+#include "rms/operator_state_t.hpp"
 #include "rms/process_status_t.hpp"
 #include "rms/sender_t.hpp"
+#include "rms/session_control_t.hpp"
 #include "rms/transport/lcm_interface.h"
+#include "rms/window_keys_t.hpp"
 #include "rms/wire/channels.h"
+#include "rms/wire/message_auth.h"
 #include "rms/wire/message_io.h"
 
 namespace rms {
@@ -30,6 +37,78 @@ std::string TempPath(const std::string& name) {
   return (std::filesystem::temp_directory_path() /
           ("rmslab_" + std::to_string(getpid()) + "_" + name))
       .string();
+}
+
+// docs/security.md "Authenticated messages": a tag depends on every byte,
+// the channel and the key.
+TEST(MessageAuth, ATagChangesWithEveryByteTheChannelAndTheKey) {
+  wire::SessionKey key;
+  for (int i = 0; i < wire::kSessionKeyBytes; ++i) key.bytes[static_cast<std::size_t>(i)] = 3 * i;
+  std::vector<std::uint8_t> msg(120);
+  for (std::size_t i = 0; i < msg.size(); ++i) msg[i] = static_cast<std::uint8_t>(i);
+  const int n = static_cast<int>(msg.size());
+  const auto tag = wire::MessageMac(key, "RMS_DCP_FRAME", msg.data(), n);
+  std::vector<std::uint8_t> tagged = msg;
+  tagged.insert(tagged.end(), tag.begin(), tag.end());
+  EXPECT_TRUE(wire::VerifyMessageMac(key, "RMS_DCP_FRAME", tagged.data(), n + wire::kMacBytes));
+  EXPECT_FALSE(wire::VerifyMessageMac(key, "RMS_DCP_FRAME_B", tagged.data(), n + wire::kMacBytes));
+  EXPECT_FALSE(wire::VerifyMessageMac(key, "RMS_DCP_FRAME", tagged.data(), n));
+  EXPECT_FALSE(wire::VerifyMessageMac(key, "RMS_DCP_FRAME", tagged.data(), 3));
+  for (std::size_t i = 0; i < tagged.size(); ++i) {
+    std::vector<std::uint8_t> bad = tagged;
+    bad[i] ^= 0x40;
+    EXPECT_FALSE(wire::VerifyMessageMac(key, "RMS_DCP_FRAME", bad.data(), n + wire::kMacBytes))
+        << "byte " << i;
+  }
+  wire::SessionKey other = key;
+  other.bytes[31] ^= 1;
+  EXPECT_FALSE(wire::VerifyMessageMac(other, "RMS_DCP_FRAME", tagged.data(), n + wire::kMacBytes));
+}
+
+// Every message type of the session is one the session filter and the
+// tags apply to (an RMS_DCP_STATE left out took other sessions' states and
+// kept its tag on: docs/protocol.md "Senders").
+TEST(MessageAuth, EverySessionMessageTypeIsKnownAsTheSessions) {
+  for (const std::int64_t fp :
+       {operator_input_t::getHash(), dcp_frame_t::getHash(), dcp_state_t::getHash(),
+        dcp_telemetry_t::getHash(), esg_frame_t::getHash(), operator_state_t::getHash(),
+        process_status_t::getHash(), session_control_t::getHash(), window_keys_t::getHash()})
+    EXPECT_TRUE(wire::IsRmslabFingerprint(fp)) << fp;
+  EXPECT_FALSE(wire::IsRmslabFingerprint(0x1234));
+}
+
+// The key file: 64 hex digits, its owner's only, no link followed; each
+// refusal names the file and what is wrong.
+TEST(MessageAuth, AKeyFileIsReadOnlyWhenItIsTheOwnersAloneAndWellFormed) {
+  const std::string dir = TempPath("keys");
+  std::filesystem::create_directories(dir);
+  auto write = [&](const std::string& name, const std::string& text, mode_t mode) {
+    std::string p = dir + "/" + name;
+    { std::ofstream(p) << text; }
+    chmod(p.c_str(), mode);
+    return p;
+  };
+  const std::string hex(64, 'a');
+  const wire::SessionKey k = wire::ReadSessionKeyFile(write("good", hex + "\n", 0600));
+  EXPECT_EQ(k.bytes[0], 0xaa);
+  EXPECT_EQ(k.bytes[31], 0xaa);
+  auto refused = [&](const std::string& path, const std::string& says) {
+    try {
+      (void)wire::ReadSessionKeyFile(path);
+      ADD_FAILURE() << path << " taken";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+  };
+  refused(write("open", hex + "\n", 0644), "readable or writable by others");
+  refused(write("short", hex.substr(2) + "\n", 0600), "not 64 hex digits");
+  refused(write("nothex", std::string(63, 'a') + "g\n", 0600), "not 64 hex digits");
+  refused(dir + "/missing", "cannot be opened");
+  std::filesystem::create_symlink(dir + "/good", dir + "/link");
+  refused(dir + "/link", "a link is not followed");
+  refused(dir, "not a regular file");
+  std::filesystem::remove_all(dir);
 }
 
 TEST(LogLcm, RecordsAndReplaysInOrderWithTimestampsAndSuffix) {

@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <optional>
 #include <thread>
 
 #include "rms/base/check.h"
@@ -30,6 +31,7 @@
 #include "rms/wire/channels.h"
 #include "rms/wire/checkpoint.h"
 #include "rms/wire/malfunction.h"
+#include "rms/wire/message_auth.h"
 #include "rms/wire/message_io.h"
 
 namespace fs = std::filesystem;
@@ -84,9 +86,12 @@ namespace {
 // a checkpoint or restore did is confirmed rather than assumed.
 class ControlLink {
  public:
-  ControlLink(const rms::transport::LcmOptions& options, std::int64_t session_id) : lcm_(options) {
+  ControlLink(const rms::transport::LcmOptions& options, std::int64_t session_id,
+              const std::optional<rms::wire::SessionKey>& key)
+      : lcm_(options) {
     lcm_.SetSender(
         {session_id, rms::sender_t::PROCESS_CONTROL, static_cast<std::int32_t>(getpid())});
+    if (key) lcm_.SetKey(*key);
     lcm_.Subscribe(rms::wire::channels::kStatus, [this](const void* d, int n, std::int64_t) {
       rms::process_status_t st;
       if (rms::wire::SafeDecode(d, n, &st) != rms::wire::DecodeError::kNone) return;
@@ -337,6 +342,10 @@ int main(int argc, char** argv) {
                  "The session's channel suffix (without --session)");
   app.add_option("--session-id", session_id,
                  "The session's id, from its manifest.json (without --session)");
+  std::string key_file;
+  app.add_option("--key-file", key_file,
+                 "The session's key file, SESSION/run/session.key (without --session; default: "
+                 "RMSLAB_SESSION_KEY_FILE)");
   app.require_subcommand(1);
   int steps = 1;
   std::string what;
@@ -381,6 +390,12 @@ int main(int argc, char** argv) {
       id = s.session_id;
       folder = (fs::path(session_dir) / "checkpoints").string();
     }
+    // The session's messages carry tags: its processes drop a command
+    // without the key's (docs/security.md "Authenticated messages").
+    const std::optional<rms::wire::SessionKey> key =
+        !session_dir.empty() ? rms::session::ReadSessionKey(session_dir)
+        : !key_file.empty()  ? std::optional(rms::wire::ReadSessionKeyFile(key_file))
+                             : rms::wire::SessionKeyFromEnv();
     std::string name;
     if (checkpoint->parsed()) {
       name = CheckpointName(what);
@@ -395,7 +410,7 @@ int main(int argc, char** argv) {
     if (malfunction->parsed())
       name = rms::wire::MalfunctionText(rms::wire::ParseMalfunction(Joined(words)));
     if (repair->parsed()) name = rms::wire::RepairText(rms::wire::ParseRepair(Joined(words)));
-    ControlLink link(lcm_options, id);
+    ControlLink link(lcm_options, id, key);
     // A running session's record has the command from this tool's own
     // journal too (docs/sessions.md "The record").
     if (!session_dir.empty() && fs::is_directory(fs::path(session_dir) / "journal"))

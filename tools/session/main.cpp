@@ -92,6 +92,8 @@ Command Manifest(CLI::App& app) {
   c->add_option("--lcm-url", f.url, "The session's LCM URL")->required();
   c->add_option("--channel-suffix", f.suffix, "The session's channel suffix");
   c->add_option("--session-id", f.session_id, "The session's id (0x and 16 hex digits)");
+  c->add_option("--message-auth", f.message_auth,
+                "The session's messages carry tags (blake2b-128; its key in run/session.key)");
   c->add_option("--config-sha256", f.config_sha256, "SHA-256 of config.toml");
   c->add_option("--timeline", f.timeline, "The timeline flown, if any");
   c->add_option("--restore", f.restore, "The checkpoint the session started from, if any");

@@ -64,20 +64,92 @@ std::int64_t SessionIdFromEnv() {
   return ParseSessionId(v, "RMSLAB_SESSION_ID");
 }
 
-bool LcmInterface::Admit(const std::string& channel, const void* data, int size) {
+const void* LcmInterface::Seal(const std::string& full_channel, const void* data, int* size) {
+  if (!key_) return data;
+  const auto tag = wire::MessageMac(*key_, full_channel, data, *size);
+  const auto* b = static_cast<const std::uint8_t*>(data);
+  sealed_.assign(b, b + *size);
+  sealed_.insert(sealed_.end(), tag.begin(), tag.end());
+  *size = static_cast<int>(sealed_.size());
+  return sealed_.data();
+}
+
+// A message of the session's (docs/security.md "Authenticated messages"):
+// its tag good, and *size then the message's own.
+bool LcmInterface::Authentic(const std::string& channel, const void* data, int* size) {
+  if (!wire::VerifyMessageMac(*key_, channel, data, *size)) {
+    ++bad_mac_dropped_;
+    if (!bad_mac_warned_) {
+      bad_mac_warned_ = true;
+      std::int8_t process = 0;
+      std::int32_t pid = 0;
+      wire::ReadSenderProcess(data, *size, &process, &pid);
+      spdlog::warn(
+          "{}: a message with this session's id (claiming {} pid {}) whose tag is not the "
+          "session key's -- dropped, as every one like it will be (dropped.bad_mac): someone "
+          "without the key is sending as the session (docs/security.md)",
+          channel, wire::ProcessCodeName(process), pid);
+    }
+    return false;
+  }
+  *size -= wire::kMacBytes;
+  return true;
+}
+
+// A control message taken once, and only while fresh: a real one recorded
+// off the network and sent again is refused (dropped.replayed).
+bool LcmInterface::FreshControl(const void* data, int size) {
+  std::int64_t sent = 0;
+  const std::int64_t now = NowUs();
+  while (!control_seen_.empty() && control_seen_.front().first < now - kControlFreshUs)
+    control_seen_.pop_front();
+  if (!wire::ReadInt64At(data, size, wire::kFrameAt, &sent) ||
+      std::abs(now - sent) > kControlFreshUs) {
+    if (replayed_dropped_++ == 0)
+      spdlog::warn(
+          "{}: a command sent at {} us, {:.1f} s from now -- dropped, as every one like it will "
+          "be (dropped.replayed): a recorded command sent again, or a host whose clock is off",
+          wire::channels::kControl, sent, (sent - now) * 1e-6);
+    return false;
+  }
+  std::array<std::uint8_t, wire::kMacBytes> tag{};
+  std::memcpy(tag.data(), static_cast<const std::uint8_t*>(data) + size, tag.size());
+  for (const auto& seen : control_seen_) {
+    if (seen.second == tag) {
+      if (replayed_dropped_++ == 0)
+        spdlog::warn(
+            "{}: a command taken before, sent again -- dropped, as every one like it will be "
+            "(dropped.replayed)",
+            wire::channels::kControl);
+      return false;
+    }
+  }
+  control_seen_.emplace_back(now, tag);
+  return true;
+}
+
+bool LcmInterface::Admit(const std::string& channel, const void* data, int* size) {
   if (sender_.session_id == 0) return true;  // no session: takes every session's messages
   std::int64_t fp = 0, id = 0;
   // Only rmslab messages carry a sender; anything else goes on to be
   // refused by the decoder (dropped.wrong_type), as before.
-  if (!wire::ReadFingerprint(data, size, &fp) || !wire::IsRmslabFingerprint(fp) ||
-      !wire::ReadSessionId(data, size, &id))
+  if (!wire::ReadFingerprint(data, *size, &fp) || !wire::IsRmslabFingerprint(fp) ||
+      !wire::ReadSessionId(data, *size, &id))
     return true;
-  if (id == sender_.session_id) return AdmitPublisher(channel, data, size);
+  if (id == sender_.session_id) {
+    if (key_) {
+      if (!Authentic(channel, data, size)) return false;
+      std::string_view base = channel;
+      if (!suffix_.empty() && base.size() >= suffix_.size()) base.remove_suffix(suffix_.size());
+      if (base == wire::channels::kControl && !FreshControl(data, *size)) return false;
+    }
+    return AdmitPublisher(channel, data, *size);
+  }
   ++other_session_dropped_;
   if (other_sessions_[id]++ == 0) {
     std::int8_t process = 0;
     std::int32_t pid = 0;
-    wire::ReadSenderProcess(data, size, &process, &pid);
+    wire::ReadSenderProcess(data, *size, &process, &pid);
     spdlog::warn(
         "{}: a message of another session (session {}, {} pid {}) -- dropped, as every one of it "
         "will be "
@@ -140,8 +212,9 @@ struct UdpLcm::Sub {
   Handler handler;
   UdpLcm* owner = nullptr;
   static void OnMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel, Sub* self) {
-    if (!self->owner->Admit(channel, rbuf->data, static_cast<int>(rbuf->data_size))) return;
-    self->handler(rbuf->data, static_cast<int>(rbuf->data_size), rbuf->recv_utime);
+    int size = static_cast<int>(rbuf->data_size);
+    if (!self->owner->Admit(channel, rbuf->data, &size)) return;
+    self->handler(rbuf->data, size, rbuf->recv_utime);
   }
 };
 
@@ -166,6 +239,7 @@ bool UdpLcm::Publish(std::string_view channel, const void* data, int size) {
   // The journal first: the record holds what was sent even when the
   // process dies right after (docs/sessions.md "The record").
   const std::string full = FullChannel(channel);
+  data = Seal(full, data, &size);
   Journalize(full, data, size);
   return lcm_->publish(full, data, static_cast<unsigned>(size)) == 0;
 }
@@ -219,6 +293,7 @@ bool LogLcm::Publish(std::string_view channel, const void* data, int size) {
   Pending& p = pending_[pending_count_++];
   p.channel.assign(channel);
   p.channel.append(channel_suffix());
+  data = Seal(p.channel, data, &size);
   const auto* bytes = static_cast<const std::uint8_t*>(data);
   p.data.assign(bytes, bytes + size);
   if (out_) {
@@ -252,7 +327,7 @@ void LogLcm::Subscribe(std::string_view channel, Handler handler) {
 }
 
 void LogLcm::Dispatch(const std::string& channel, const void* data, int size) {
-  if (!Admit(channel, data, size)) return;
+  if (!Admit(channel, data, &size)) return;
   for (auto& [name, handler] : handlers_) {
     if (name == channel) handler(data, size, now_us_);
   }

@@ -25,6 +25,7 @@
 #include "rms/process_status_t.hpp"
 #include "rms/transport/journal.h"
 #include "rms/wire/channels.h"
+#include "rms/wire/message_auth.h"
 #include "rms/wire/message_io.h"
 
 namespace rms::transport {
@@ -119,6 +120,7 @@ int ProcessMain(CLI::App& app, int argc, char** argv, const std::string& process
       ValidateChannelSuffix(common->lcm.channel_suffix);
       if (!common->session_id.empty()) (void)ParseSessionId(common->session_id, "--session-id");
       (void)CpuWakeLatencyFromEnv();
+      (void)wire::SessionKeyFromEnv();
       if (!common->journal_dir.empty()) CheckJournalDir(common->journal_dir);
       if (check) check(config);
       spdlog::info("check: {} and this process's files are good", common->config_path);
@@ -136,6 +138,10 @@ int ProcessMain(CLI::App& app, int argc, char** argv, const std::string& process
     const CpuWakeLatencyRequest wake = HoldCpuWakeLatency();
     UdpLcm lcm(common->lcm);
     lcm.SetSender({session, wire::ProcessCode(process), static_cast<std::int32_t>(getpid())});
+    if (const auto key = wire::SessionKeyFromEnv()) {
+      lcm.SetKey(*key);
+      spdlog::info("messages authenticated with the session's key (docs/security.md)");
+    }
     if (!common->journal_dir.empty()) {
       lcm.SetJournal(Journal::CreateIn(common->journal_dir, process, RestartNumber()));
       spdlog::info("journal: {}", lcm.journal()->path());
@@ -253,6 +259,10 @@ void NoteTransportCounters(const LcmInterface& lcm, Counters* counters) {
     counters->Set(Counter::kDroppedOtherSession, n);
   if (const std::int64_t n = lcm.other_sender_dropped(); n > 0)
     counters->Set(Counter::kDroppedOtherSender, n);
+  if (const std::int64_t n = lcm.bad_mac_dropped(); n > 0)
+    counters->Set(Counter::kDroppedBadMac, n);
+  if (const std::int64_t n = lcm.replayed_dropped(); n > 0)
+    counters->Set(Counter::kDroppedReplayed, n);
   if (const Journal* j = lcm.journal()) {
     counters->Set(Counter::kJournalEvents, j->events());
     if (j->failed() > 0) counters->Set(Counter::kJournalFailed, j->failed());

@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "rms/dcp_frame_t.hpp"
+#include "rms/dcp_state_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/esg_frame_t.hpp"
 #include "rms/operator_input_t.hpp"
@@ -26,7 +27,7 @@ bool IsRmslabFingerprint(std::int64_t fp) {
   static const std::int64_t kTypes[] = {
       operator_input_t::getHash(), dcp_frame_t::getHash(),      esg_frame_t::getHash(),
       process_status_t::getHash(), dcp_telemetry_t::getHash(),  session_control_t::getHash(),
-      window_keys_t::getHash(),    operator_state_t::getHash(),
+      window_keys_t::getHash(),    operator_state_t::getHash(), dcp_state_t::getHash(),
   };
   for (std::int64_t t : kTypes) {
     if (t == fp) return true;

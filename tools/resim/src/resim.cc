@@ -1,5 +1,7 @@
 #include "rms/resim/resim.h"
 
+#include <sodium.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -333,6 +335,17 @@ nlohmann::ordered_json CellJson(const nlohmann::json& recorded, const LabConfig&
   return cell;
 }
 
+// SHA-256 of a text, 64 hex digits (the manifest's config.sha256, as the
+// launcher writes it for a live session).
+std::string Sha256Hex(const std::string& text) {
+  RMS_CHECK(sodium_init() >= 0);
+  unsigned char digest[crypto_hash_sha256_BYTES];
+  crypto_hash_sha256(digest, reinterpret_cast<const unsigned char*>(text.data()), text.size());
+  char hex[2 * crypto_hash_sha256_BYTES + 1];
+  sodium_bin2hex(hex, sizeof hex, digest, sizeof digest);
+  return hex;
+}
+
 // Another design's session: its manifest (the parent's subject and note go
 // with the inputs), summary, comparison.json (result->comparison, with the
 // configuration's changes added) and comparison.md.
@@ -344,6 +357,7 @@ void WriteNewSession(const RecordedSession& recorded, const std::string& config_
   mf.kind = "re-simulation";
   mf.parent = fs::absolute(session).lexically_normal().string();
   mf.config_source = config_path;
+  mf.config_sha256 = Sha256Hex(config_text);
   // Its log's channels carry the recorded session's suffix: its manifest
   // says so, or no reader of it would find them.
   mf.suffix = recorded.recording().suffix;

@@ -201,6 +201,11 @@ void SessionLines(const Json& j, std::ostream& os) {
     }
     os << "\n";
   }
+  if (j["ignored"].value("tags_unchecked", false)) {
+    os << "the session's messages carry tags, but its key (run/session.key) is not in the "
+          "folder: they were read WITHOUT checking them, and a stranger's message with the "
+          "session's id would have been taken as its own\n";
+  }
   if (!j["ignored"].value("session_id_checked", true)) {
     os << "this session has no id (made before session ids): every message in its log was read as "
           "its own\n";

@@ -1,5 +1,6 @@
 #include "rms/session/sender_check.h"
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
@@ -41,25 +42,41 @@ bool Publishes(std::string_view base, std::int8_t process) {
 }  // namespace
 
 SenderCheck::SenderCheck(const std::string& dir) {
-  if (fs::exists(fs::path(dir) / "manifest.json")) session_id_ = ReadSessionInfo(dir).session_id;
+  if (fs::exists(fs::path(dir) / "manifest.json")) {
+    const SessionInfo info = ReadSessionInfo(dir);
+    session_id_ = info.session_id;
+    tagged_ = !info.message_auth.empty();
+    // A copy without its run/ folder is read with its tags unchecked, and
+    // says so (docs/security.md "Authenticated messages").
+    if (tagged_ && fs::exists(fs::path(dir) / "run" / "session.key")) key_ = ReadSessionKey(dir);
+    if (tags_unchecked())
+      std::fprintf(stderr,
+                   "%s: its messages carry tags but run/session.key is not there: read WITHOUT "
+                   "checking them (a stranger's message with the session's id would be taken)\n",
+                   dir.c_str());
+  }
   std::ifstream f(fs::path(dir) / "run" / "pids");
   std::string name;
   long pid = 0;
   while (f >> name >> pid) pids_[wire::ProcessCode(name)].insert(static_cast<std::int32_t>(pid));
 }
 
-const char* SenderCheck::Ignore(std::string_view base, const void* data, int size) {
+const char* SenderCheck::Ignore(std::string_view base, std::string_view channel, const void* data,
+                                int* size) {
   if (session_id_ == 0) return nullptr;  // recorded before session ids: nothing to tell them by
   const char* why = nullptr;
   std::int64_t id = 0;
   std::int8_t process = 0;
   std::int32_t pid = 0;
-  if (!wire::ReadSessionId(data, size, &id) ||
-      !wire::ReadSenderProcess(data, size, &process, &pid)) {
+  if (!wire::ReadSessionId(data, *size, &id) ||
+      !wire::ReadSenderProcess(data, *size, &process, &pid)) {
     why = "no_sender";
   } else if (id != session_id_) {
     why = "other_session";
     other_sessions_.insert(id);
+  } else if ((tagged_ && *size <= 8 + wire::kSenderBytes + wire::kMacBytes) ||
+             (key_ && !wire::VerifyMessageMac(*key_, channel, data, *size))) {
+    why = "bad_mac";
   } else if (!Publishes(base, process)) {
     why = "not_the_publisher";
   } else if (pids_.count(process) && !pids_.at(process).count(pid)) {
@@ -68,8 +85,12 @@ const char* SenderCheck::Ignore(std::string_view base, const void* data, int siz
     // the session id alone.
     why = "not_the_sessions_process";
   }
-  if (why) ++ignored_[why];
-  return why;
+  if (why) {
+    ++ignored_[why];
+    return why;
+  }
+  if (tagged_) *size -= wire::kMacBytes;  // the message's own bytes, its tag left off
+  return nullptr;
 }
 
 void SenderCheck::Add(const SenderCheck& other) {
@@ -91,6 +112,8 @@ nlohmann::ordered_json SenderCheck::Json() const {
   j["other_sessions"] = nlohmann::ordered_json::array();
   for (std::int64_t id : other_sessions_) j["other_sessions"].push_back(wire::FormatSessionId(id));
   j["session_id_checked"] = session_id_ != 0;
+  j["macs_checked"] = key_.has_value();
+  j["tags_unchecked"] = tags_unchecked();
   j["pids_checked"] = !pids_.empty();
   // The processes whose pids were checked; the others (not in run/pids: an
   // ssh host, a process that never became ready) by the id and publisher only.

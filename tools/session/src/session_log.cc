@@ -76,7 +76,8 @@ void SessionLog::ReadEvents(RawLogReader& log, std::initializer_list<std::string
                         std::find(channels.begin(), channels.end(), channel) != channels.end();
     const bool input = channel == wire::channels::kOperatorInput;
     if (!wanted && !input) continue;
-    if (pass->check->Ignore(channel, ev.data, ev.size)) continue;
+    int size = ev.size;
+    if (pass->check->Ignore(channel, ev.channel, ev.data, &size)) continue;
     std::int64_t f = 0;
     if (input && wire::ReadFrameNumber(ev.data, ev.size, &f) && f >= 0) pass->input_frame = f;
     if (!wanted) continue;
@@ -87,7 +88,7 @@ void SessionLog::ReadEvents(RawLogReader& log, std::initializer_list<std::string
     m.log_time_s = (ev.timestamp_us - pass->first_us) * 1e-6;
     m.session_time_s = pass->input_frame < 0 ? 0.0 : pass->input_frame / rate_hz_;
     m.data = ev.data;
-    m.size = ev.size;
+    m.size = size;
     visit(m);
   }
 }

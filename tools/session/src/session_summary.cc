@@ -623,9 +623,10 @@ void AddMission(int final_mode, const std::set<int>& modes, const TelemetryLog& 
 // Messages a receiver refused for a reason of its own, not malformed
 // (docs/protocol.md): too late to act on, of another session, beyond the
 // session's clock.
-constexpr rms::Counter kRefused[] = {rms::Counter::kDroppedLate, rms::Counter::kDroppedOtherSession,
-                                     rms::Counter::kDroppedOtherSender,
-                                     rms::Counter::kDroppedFarAhead};
+constexpr rms::Counter kRefused[] = {
+    rms::Counter::kDroppedLate,        rms::Counter::kDroppedOtherSession,
+    rms::Counter::kDroppedOtherSender, rms::Counter::kDroppedBadMac,
+    rms::Counter::kDroppedReplayed,    rms::Counter::kDroppedFarAhead};
 
 std::int64_t Malformed(const nlohmann::json& st) {
   std::int64_t n = SumPrefix(st, kDroppedPrefix);
@@ -1096,6 +1097,12 @@ nlohmann::ordered_json MakeManifest(const std::string& dir, const ManifestFields
                     : !f.branch_of.empty() ? "branch"
                     : !restore.empty()     ? "restore"
                                            : "start";
+  if (!f.message_auth.empty()) {
+    if (f.message_auth != wire::kMessageAuthName)
+      throw InputError("--message-auth '" + f.message_auth + "': the one kind is " +
+                       wire::kMessageAuthName);
+    j["message_auth"] = f.message_auth;
+  }
   j["config"] = {{"file", "config.toml"}, {"sha256", config_sha256}};
   if (!f.config_source.empty()) j["config"]["source"] = f.config_source;
   j["software"] = {{"version", VersionString()},         {"project", Version().project},
@@ -1179,6 +1186,7 @@ SessionInfo ReadSessionInfo(const std::string& dir) {
     if (j.contains("session_id"))
       s.session_id = transport::ParseSessionId(j.at("session_id").get<std::string>(),
                                                p.string() + " session_id");
+    if (j.contains("message_auth")) s.message_auth = j.at("message_auth").get<std::string>();
   } catch (const InputError&) {
     throw;
   } catch (const nlohmann::json::parse_error& e) {
@@ -1189,6 +1197,21 @@ SessionInfo ReadSessionInfo(const std::string& dir) {
                      std::string(e.what()).substr(std::string(e.what()).find(']') + 1) + ")");
   }
   return s;
+}
+
+std::optional<wire::SessionKey> ReadSessionKey(const std::string& dir) {
+  const SessionInfo info = ReadSessionInfo(dir);
+  if (info.message_auth.empty()) return std::nullopt;
+  if (info.message_auth != wire::kMessageAuthName)
+    throw InputError(dir + "/manifest.json: message_auth '" + info.message_auth +
+                     "' is not one this build knows (" + wire::kMessageAuthName + ")");
+  try {
+    return wire::ReadSessionKeyFile((fs::path(dir) / "run" / "session.key").string());
+  } catch (const InputError& e) {
+    throw InputError(std::string(e.what()) +
+                     ": the session's messages carry tags (manifest.json message_auth), and "
+                     "without its key no reader can tell its own from a stranger's");
+  }
 }
 
 nlohmann::ordered_json CompareEsgFrames(const std::string& original_dir,

@@ -4,13 +4,16 @@
 // subscribe through LcmInterface; UdpLcm is real LCM (UDP multicast), LogLcm
 // replays / records an LCM log file deterministically, without a network.
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "rms/wire/message_auth.h"
 #include "rms/wire/message_io.h"
 
 namespace lcm {
@@ -95,6 +98,19 @@ class LcmInterface {
   // docs/security.md "Sessions know each other").
   std::int64_t other_sender_dropped() const { return other_sender_dropped_; }
 
+  // The session's secret key (docs/security.md "Authenticated messages"):
+  // from then on every message published ends in its tag
+  // (wire::MessageMac), and every rmslab message received must end in a
+  // good one: one that does not is dropped before any handler sees it, and
+  // counted (dropped.bad_mac). Handlers get the message without its tag.
+  // On RMS_CONTROL a tagged message already taken, or sent more than
+  // kControlFreshUs from now, is a replay of a real one: dropped.replayed.
+  void SetKey(const wire::SessionKey& key) { key_ = key; }
+  bool authenticates() const { return key_.has_value(); }
+  std::int64_t bad_mac_dropped() const { return bad_mac_dropped_; }
+  std::int64_t replayed_dropped() const { return replayed_dropped_; }
+  static constexpr std::int64_t kControlFreshUs = 30'000'000;
+
   // What this process publishes goes to its journal too, before the wire
   // (rms/transport/journal.h; docs/sessions.md "The record"). UdpLcm only: a
   // log-backed transport writes its own log.
@@ -108,15 +124,28 @@ class LcmInterface {
  protected:
   explicit LcmInterface(std::string suffix);
   // The session filter every transport applies before dispatching: true
-  // to hand the message on.
-  bool Admit(const std::string& channel, const void* data, int size);
+  // to hand the message on, *size then the message's own (its tag, when
+  // the session authenticates, left off).
+  bool Admit(const std::string& channel, const void* data, int* size);
+  // A message about to be published with its tag appended (the session's
+  // key set; else the message itself): its bytes, valid until the next
+  // call, and *size updated.
+  const void* Seal(const std::string& full_channel, const void* data, int* size);
   // A message about to be published, into the journal when there is one
   // (a failure is the journal's to count).
   void Journalize(const std::string& full_channel, const void* data, int size);
 
  private:
   bool AdmitPublisher(const std::string& channel, const void* data, int size);
+  bool Authentic(const std::string& channel, const void* data, int* size);
+  bool FreshControl(const void* data, int size);
   std::unique_ptr<Journal> journal_;
+  std::optional<wire::SessionKey> key_;
+  std::vector<std::uint8_t> sealed_;
+  std::int64_t bad_mac_dropped_ = 0, replayed_dropped_ = 0;
+  bool bad_mac_warned_ = false;
+  // The tags of the control messages taken within kControlFreshUs, oldest first.
+  std::deque<std::pair<std::int64_t, std::array<std::uint8_t, wire::kMacBytes>>> control_seen_;
   struct Publisher {
     std::int8_t process = 0;
     std::int32_t pid = 0;

@@ -13,6 +13,7 @@ namespace rms::monitor {
 
 struct ChannelStats {
   std::int64_t messages = 0, malformed = 0, bytes = 0;
+  std::int64_t tagged_unchecked = 0;  // a session's, shown without checking its tag (no --session)
   wire::SequenceTracker frames;
   bool numbered = false;
   std::int64_t window_start_us = 0, window_count = 0;

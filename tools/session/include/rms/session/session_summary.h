@@ -5,12 +5,14 @@
 // process's final counters (stats/*.json).
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "rms/base/config.h"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
+#include "rms/wire/message_auth.h"
 
 namespace rms::session {
 
@@ -71,6 +73,9 @@ struct ManifestFields {
   // (docs/sessions.md "The manifest"). "" derives it from `restore` and
   // `branch_of`; a re-simulation sets its recorded session's.
   std::string began_from;
+  // The session's messages carry tags (wire::kMessageAuthName), its key in
+  // SESSION/run/session.key; "" when they do not.
+  std::string message_auth;
 };
 nlohmann::ordered_json MakeManifest(const std::string& session_dir, const ManifestFields& f);
 // A manifest's `began_from`; for one written before that field, derived
@@ -83,9 +88,15 @@ struct SessionInfo {
   std::string lcm_url;
   std::string channel_suffix;
   std::int64_t session_id = 0;  // 0: a session recorded before session ids, or none
+  std::string message_auth;     // the manifest's; "": messages carry no tag
 };
 // Throws rms::InputError when SESSION/manifest.json is missing or malformed.
 SessionInfo ReadSessionInfo(const std::string& session_dir);
+// The session's key (SESSION/run/session.key) when its manifest says its
+// messages carry tags; none when they do not. Throws InputError naming the
+// file when they do and the key cannot be read (docs/security.md
+// "Authenticated messages").
+std::optional<wire::SessionKey> ReadSessionKey(const std::string& session_dir);
 
 // Every rmslab session heard on an LCM address within `seconds`:
 // {"url", "seconds", "sessions": [{"session_id", "channels": {name: n},
