@@ -38,6 +38,13 @@ class Replay:
         # processes take them as their own session's.
         self.session_id = m.get("session_id", "")
         self.message_auth = m.get("message_auth")
+        # The replayed frames carry the recorded session's tags: its key
+        # checks them, and tags what the replay's processes send. Read (and
+        # refused) before any folder is made.
+        self.key = session.read_session_key(self.src) if self.message_auth else None
+        if self.message_auth and not self.key:
+            raise LabError(f"{self.src}/run/{session.SESSION_KEY} is missing: the session's messages carry tags "
+                           f"(manifest.json message_auth), and without its key they cannot be replayed")
 
     def make(self):
         a = self.a
@@ -53,12 +60,7 @@ class Replay:
             fields.append(("--channel-suffix", self.suffix))
         if self.session_id:
             fields.append(("--session-id", self.session_id))
-        # The replayed frames carry the recorded session's tags: its key
-        # checks them, and tags what the replay's processes send.
-        key = session.read_session_key(self.src) if self.message_auth else None
-        if self.message_auth and not key:
-            raise LabError(f"{self.src}/run/{session.SESSION_KEY} is missing: the session's messages carry tags "
-                           f"(manifest.json message_auth), and without its key they cannot be replayed")
+        key = self.key
         self.key_file = session.write_session_key(os.path.join(self.out, "run"), key) if key else None
         if key:
             fields.append(("--message-auth", session.MESSAGE_AUTH))

@@ -1,8 +1,10 @@
 """A session folder and what is done to it before and after its processes
 run: the folder, the id, the manifest, the checks (files, network, disk),
 the record's parts, the summary (docs/sessions.md)."""
+import errno
 import json
 import os
+import stat
 import tempfile
 import secrets
 import shutil
@@ -74,8 +76,16 @@ def read_session_key(session_dir):
     except FileNotFoundError:
         return None
     except OSError as e:
-        raise LabError(f"{path}: cannot be read ({e.strerror})")
+        raise LabError(f"session key {path}: cannot be read ({e.strerror}"
+                       f"{': a link is not followed' if e.errno == errno.ELOOP else ''})")
     with os.fdopen(fd) as f:
+        st = os.fstat(f.fileno())
+        if not stat.S_ISREG(st.st_mode):
+            raise LabError(f"session key {path}: not a regular file")
+        if st.st_uid != os.geteuid() and os.geteuid() != 0:
+            raise LabError(f"session key {path}: owned by uid {st.st_uid}, not by this user")
+        if st.st_mode & 0o077:
+            raise LabError(f"session key {path}: readable or writable by others (chmod 600 it)")
         text = f.read(66).strip()
     if len(text) != 64 or any(c not in "0123456789abcdefABCDEF" for c in text):
         raise LabError(f"{path}: not 64 hex digits")

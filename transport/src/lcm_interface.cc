@@ -33,7 +33,8 @@ void ValidateChannelSuffix(std::string_view suffix) {
   }
 }
 
-LcmInterface::LcmInterface(std::string suffix) : suffix_(std::move(suffix)) {
+LcmInterface::LcmInterface(std::string suffix, std::int64_t started_us)
+    : suffix_(std::move(suffix)), started_us_(started_us) {
   ValidateChannelSuffix(suffix_);
 }
 
@@ -103,8 +104,10 @@ bool LcmInterface::FreshControl(const void* data, int size) {
   const std::int64_t now = NowUs();
   while (!control_seen_.empty() && control_seen_.front().first < now - kControlFreshUs)
     control_seen_.pop_front();
+  // Sent before this process began: a restarted process has not seen the
+  // tags its predecessor took, and takes no command older than itself.
   if (!wire::ReadInt64At(data, size, wire::kFrameAt, &sent) ||
-      std::abs(now - sent) > kControlFreshUs) {
+      std::abs(now - sent) > kControlFreshUs || sent < started_us_) {
     if (replayed_dropped_++ == 0)
       spdlog::warn(
           "{}: a command sent at {} us, {:.1f} s from now -- dropped, as every one like it will "
@@ -219,7 +222,7 @@ struct UdpLcm::Sub {
 };
 
 UdpLcm::UdpLcm(const LcmOptions& options)
-    : LcmInterface(options.channel_suffix),
+    : LcmInterface(options.channel_suffix, WallTimeUs()),
       url_(options.url),
       queue_capacity_(options.queue_capacity) {
   if (queue_capacity_ < 1) throw InputError("LCM queue capacity must be >= 1");

@@ -201,6 +201,17 @@ void SessionLines(const Json& j, std::ostream& os) {
     }
     os << "\n";
   }
+  // Every message of the session refused by its tag, none taken: the key
+  // in the folder is not the one it ran with.
+  const bool refused_by_tag =
+      j["ignored"].contains("by_reason") && j["ignored"]["by_reason"].value("bad_mac", 0) > 0;
+  const bool nothing_read = j.contains("log") && j["log"].is_object() &&
+                            j["log"].value("dcp_frames", 0) == 0 &&
+                            j["log"].value("operator_frames", 0) == 0;
+  if (refused_by_tag && nothing_read) {
+    os << "no message in the log carries a tag made with run/session.key: it is not the key "
+          "this session ran with (another session's?), and nothing of the session was read\n";
+  }
   if (j["ignored"].value("tags_unchecked", false)) {
     os << "the session's messages carry tags, but its key (run/session.key) is not in the "
           "folder: they were read WITHOUT checking them, and a stranger's message with the "

@@ -104,7 +104,9 @@ class LcmInterface {
   // good one: one that does not is dropped before any handler sees it, and
   // counted (dropped.bad_mac). Handlers get the message without its tag.
   // On RMS_CONTROL a tagged message already taken, or sent more than
-  // kControlFreshUs from now, is a replay of a real one: dropped.replayed.
+  // kControlFreshUs from now, or sent before this process began (a restart
+  // has not seen the tags its predecessor took), is a replay of a real one:
+  // dropped.replayed.
   void SetKey(const wire::SessionKey& key) { key_ = key; }
   bool authenticates() const { return key_.has_value(); }
   std::int64_t bad_mac_dropped() const { return bad_mac_dropped_; }
@@ -122,7 +124,9 @@ class LcmInterface {
   static constexpr std::int64_t kPublisherSilenceUs = 100000;
 
  protected:
-  explicit LcmInterface(std::string suffix);
+  // started_us: when this process's transport began (wall clock; 0: a log's,
+  // which takes any command's time).
+  explicit LcmInterface(std::string suffix, std::int64_t started_us = 0);
   // The session filter every transport applies before dispatching: true
   // to hand the message on, *size then the message's own (its tag, when
   // the session authenticates, left off).
@@ -154,6 +158,7 @@ class LcmInterface {
   };
 
   std::string suffix_;
+  std::int64_t started_us_ = 0;
   Sender sender_;
   std::int64_t other_session_dropped_ = 0;
   std::int64_t other_sender_dropped_ = 0;
