@@ -220,6 +220,21 @@ void CopyLogDropping(const std::string& from, const std::string& to,
   }
 }
 
+// The DCP frame each periodic RMS_DCP_STATE of a log was logged for (its
+// next_frame), in log order.
+std::vector<std::int64_t> PeriodicStateFrames(const std::string& log) {
+  std::vector<std::int64_t> frames;
+  lcm::LogFile in(log, "r");
+  while (const lcm::LogEvent* ev = in.readNextEvent()) {
+    dcp_state_t m;
+    if (ev->channel.rfind("RMS_DCP_STATE", 0) == 0 &&
+        m.decode(ev->data, 0, static_cast<int>(ev->datalen)) > 0 &&
+        m.reason == dcp_state_t::PERIODIC)
+      frames.push_back(m.next_frame);
+  }
+  return frames;
+}
+
 bool IsDcpFrameOrTelemetry(const std::string& channel) {
   return channel.rfind("RMS_DCP_FRAME", 0) == 0 || channel.rfind("RMS_DCP_TELEMETRY", 0) == 0;
 }
@@ -268,17 +283,7 @@ TEST_F(RecordedSession, FramesLostFromEverySourceAreNamedAndTheRestCheckedWordFo
 // unchecked), or, where inputs after the state are lost too, is one
 // stretch from the first lost frame on -- never two that overlap.
 TEST_F(RecordedSession, AStateLoggedAmongLostFramesIsGoneOnFromAndTheStretchIsOne) {
-  std::vector<std::int64_t> periodic;
-  {
-    lcm::LogFile in(*dir_ + "/lcmlog", "r");
-    while (const lcm::LogEvent* ev = in.readNextEvent()) {
-      dcp_state_t m;
-      if (ev->channel.rfind("RMS_DCP_STATE", 0) == 0 &&
-          m.decode(ev->data, 0, static_cast<int>(ev->datalen)) > 0 &&
-          m.reason == dcp_state_t::PERIODIC)
-        periodic.push_back(m.next_frame);
-    }
-  }
+  const std::vector<std::int64_t> periodic = PeriodicStateFrames(*dir_ + "/lcmlog");
   ASSERT_GE(periodic.size(), 4u);
   const std::int64_t n = periodic[2], lost_from = n - 100, lost_to = n + 100;
   for (const bool after_too : {false, true}) {
@@ -355,16 +360,8 @@ TEST_F(RecordedSession, AFrameLostJustBeforeAPeriodicStateIsFilledInBeforeTheChe
   const std::string cut = *tmp_ + "/lost_before_states";
   fs::copy(*dir_, cut, fs::copy_options::recursive);
   std::set<std::int64_t> before_states;
-  {
-    lcm::LogFile in(*dir_ + "/lcmlog", "r");
-    while (const lcm::LogEvent* ev = in.readNextEvent()) {
-      dcp_state_t m;
-      if (ev->channel.rfind("RMS_DCP_STATE", 0) == 0 &&
-          m.decode(ev->data, 0, static_cast<int>(ev->datalen)) > 0 &&
-          m.reason == dcp_state_t::PERIODIC)
-        before_states.insert(m.next_frame - 1);
-    }
-  }
+  for (const std::int64_t next : PeriodicStateFrames(*dir_ + "/lcmlog"))
+    before_states.insert(next - 1);
   ASSERT_GE(before_states.size(), 5u);
   CopyLogDropping(*dir_ + "/lcmlog", cut + "/lcmlog", [&](const std::string& ch, std::int64_t f) {
     return IsDcpFrameOrTelemetry(ch) && before_states.count(f) > 0;
