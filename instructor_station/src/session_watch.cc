@@ -4,10 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "rms/dcp_state_t.hpp"
-#include "rms/process_status_t.hpp"
 #include "rms/session_control_t.hpp"
+#include "rms/transport/process.h"
 #include "rms/wire/acquisition_conditions.h"
 #include "rms/wire/channels.h"
 #include "rms/wire/checkpoint.h"
@@ -61,10 +62,12 @@ SessionWatch::SessionWatch(const LabConfig& config, transport::LcmInterface* lcm
       lcm_(lcm),
       counters_(counters),
       instance_(std::to_string(getpid()) + "-" + std::to_string(lcm->NowUs())) {
+  dcp_frames_.SetClock(transport::SessionFrameClock(config.session.frame_rate_hz));
+  telemetry_seq_.SetClock(transport::SessionFrameClock(config.session.frame_rate_hz));
   lcm_->Subscribe(wire::channels::kDcpFrame,
                   [this](const void* d, int n, std::int64_t t) { OnDcpFrame(d, n, t); });
   lcm_->Subscribe(wire::channels::kDcpTelemetry,
-                  [this](const void* d, int n, std::int64_t) { OnTelemetry(d, n); });
+                  [this](const void* d, int n, std::int64_t t) { OnTelemetry(d, n, t); });
   lcm_->Subscribe(wire::channels::kStatus,
                   [this](const void* d, int n, std::int64_t) { OnStatus(d, n); });
   lcm_->Subscribe(wire::channels::kControl,
@@ -86,7 +89,7 @@ void SessionWatch::OnDcpFrame(const void* data, int size, std::int64_t recv_us) 
   counters_->Set(Counter::kDcpMissing, dcp_frames_.missing());
 }
 
-void SessionWatch::OnTelemetry(const void* data, int size) {
+void SessionWatch::OnTelemetry(const void* data, int size, std::int64_t recv_us) {
   dcp_telemetry_t t{};
   if (const wire::DecodeError e = wire::SafeDecode(data, size, &t); e != wire::DecodeError::kNone) {
     counters_->Add(wire::DroppedTelemetryCounter(e));
@@ -97,11 +100,27 @@ void SessionWatch::OnTelemetry(const void* data, int size) {
     return;
   }
   std::lock_guard<std::mutex> lock(mu_);
-  if (telemetry_ && t.frame <= telemetry_->frame && t.frame != 0) return;  // old or repeated
+  // As the operator station: old, repeated and impossible frame numbers are
+  // refused, so one forged packet from the far future cannot stand for the
+  // session (docs/instructor.md "Bounds").
+  switch (telemetry_seq_.Accept(t.frame, recv_us)) {
+    case wire::SequenceTracker::Verdict::kDuplicate:
+    case wire::SequenceTracker::Verdict::kStale:
+      return;
+    case wire::SequenceTracker::Verdict::kFarAhead:
+      counters_->Add(Counter::kDroppedFarAhead);
+      return;
+    default:
+      break;
+  }
   TelemetryEvents(t);
   if (t.frame - last_path_frame_ >= kPathEveryFrames || t.frame < last_path_frame_) {
     path_.push_back({t.frame / config_.session.frame_rate_hz, t.p_RoA_R_ft[0], t.p_RoA_R_ft[1],
                      t.p_RoA_R_ft[2]});
+    if (path_.size() > kMaxPathPoints) {
+      path_.pop_front();
+      ++path_first_;
+    }
     last_path_frame_ = t.frame;
   }
   telemetry_ = t;
@@ -134,38 +153,81 @@ void SessionWatch::OnStatus(const void* data, int size) {
     return;
   }
   std::lock_guard<std::mutex> lock(mu_);
-  const std::int64_t now = lcm_->NowUs();
-  auto [it, is_new] = processes_.try_emplace(m.process);
-  Process& p = it->second;
-  if (is_new) {
+  if (!TakeStatus(m)) counters_->Add(Counter::kDroppedStatusRefused);
+}
+
+namespace {
+
+// The counters of a process the page shows by name (docs/instructor.md "/api/status").
+constexpr const char* kShownCounters[] = {
+    "frames.late",     "superseded",       "input.missing", "dcp.missing",
+    "esg.missing",     "control.freezes",  "control.steps", "control.malfunctions",
+    "control.repairs", "arm.not_following"};
+
+bool Shown(const std::string& name) {
+  for (const char* k : kShownCounters) {
+    if (name == k) return true;
+  }
+  return false;
+}
+
+bool EndsWith(const std::string& s, const char* tail) {
+  const std::size_t n = std::strlen(tail);
+  return s.size() >= n && s.compare(s.size() - n, n, tail) == 0;
+}
+
+}  // namespace
+
+// A status is its sender's own: its name is the one its sender's process
+// code stands for (any name for a tool) and its pid the sender's. A new
+// process beyond kMaxProcesses is refused.
+bool SessionWatch::TakeStatus(const process_status_t& m) {
+  if (m.pid != m.sender.pid || wire::ProcessCode(m.process) != m.sender.process) return false;
+  auto it = processes_.find(m.process);
+  if (it == processes_.end()) {
+    if (processes_.size() >= kMaxProcesses) return false;
+    it = processes_.emplace(m.process, Process{}).first;
     AddEvent("process", m.process + " up (pid " + std::to_string(m.pid) + " on " + m.host + ")");
-  } else if (p.pid != m.pid) {
+    it->second.pid = m.pid;
+  }
+  Process& p = it->second;
+  const std::int64_t now = lcm_->NowUs();
+  if (p.pid != m.pid) {
     AddEvent("process", m.process + " RESTARTED (pid " + std::to_string(p.pid) + " -> " +
                             std::to_string(m.pid) + ")");
     p.rate_hz = 0;
+    p.not_following = 0;
   } else if (p.last_us > 0 && now > p.last_us) {
     p.rate_hz = static_cast<double>(m.frame - p.frame) * 1e6 / static_cast<double>(now - p.last_us);
   }
   if (m.final && !p.ended) AddEvent("process", m.process + " ended");
+  p.dropped = 0;
+  p.figures.clear();
+  p.latency.clear();
+  std::int64_t not_following = 0;
+  for (int i = 0; i < m.num_counters; ++i) {
+    const std::string& k = m.counter_names[i];
+    const std::int64_t v = m.counter_values[i];
+    if (k.rfind("dropped.", 0) == 0) p.dropped += v;
+    if (k == CounterName(Counter::kNotFollowing)) not_following = v;
+    if (Shown(k)) p.figures[k] = v;
+    if (k.rfind("latency.", 0) == 0 && (EndsWith(k, ".p50_us") || EndsWith(k, ".p99_us")) &&
+        p.latency.size() < kMaxLatencyFigures)
+      p.latency[k] = v;
+  }
   // The operator station saw a joint or the finger stop following its
   // command (docs/operator.md "A joint that does not follow").
-  const std::string kNotFollowing(CounterName(Counter::kNotFollowing));
-  std::int64_t before = 0, after = 0;
-  if (auto f = p.figures.find(kNotFollowing); f != p.figures.end()) before = f->second;
-  for (int i = 0; i < m.num_counters; ++i) {
-    if (m.counter_names[i] == kNotFollowing) after = m.counter_values[i];
-  }
-  if (after > before && p.pid == m.pid) {
+  if (not_following > p.not_following) {
     AddEvent("failure", m.process + " reports a joint or the finger NOT FOLLOWING its command (" +
-                            std::to_string(after) + " so far)");
+                            std::to_string(not_following) + " so far)");
   }
+  p.not_following = not_following;
   p.ended = m.final;
   p.pid = m.pid;
   p.host = m.host;
   p.frame = m.frame;
   p.last_us = now;
-  p.figures.clear();
-  for (int i = 0; i < m.num_counters; ++i) p.figures[m.counter_names[i]] = m.counter_values[i];
+  return true;
 }
 
 void SessionWatch::OnControl(const void* data, int size) {
@@ -229,12 +291,13 @@ void SessionWatch::NoteLocal(const std::string& kind, const std::string& text) {
 
 void SessionWatch::AddEvent(const std::string& kind, const std::string& text) {
   Event e;
-  e.seq = static_cast<std::int64_t>(events_.size());
+  e.seq = next_event_seq_++;
   e.wall_us = lcm_->NowUs();
   e.session_s = dcp_ ? static_cast<double>(dcp_->frame) / config_.session.frame_rate_hz : 0.0;
   e.kind = kind;
   e.text = text;
   events_.push_back(std::move(e));
+  if (events_.size() > kMaxEvents) events_.pop_front();
 }
 
 std::optional<wire::DcpFrameData> SessionWatch::LatestDcpFrame() const {
@@ -244,15 +307,17 @@ std::optional<wire::DcpFrameData> SessionWatch::LatestDcpFrame() const {
 
 std::int64_t SessionWatch::events_seen() const {
   std::lock_guard<std::mutex> lock(mu_);
-  return static_cast<std::int64_t>(events_.size());
+  return next_event_seq_;
 }
 
 nlohmann::json SessionWatch::EventsJson(std::int64_t since, int limit) const {
   std::lock_guard<std::mutex> lock(mu_);
   nlohmann::json out = nlohmann::json::array();
-  for (std::int64_t i = std::max<std::int64_t>(0, since);
-       i < static_cast<std::int64_t>(events_.size()) && static_cast<int>(out.size()) < limit; ++i) {
-    const Event& e = events_[static_cast<std::size_t>(i)];
+  limit = std::min(limit, kMaxEventsAnswer);
+  const std::int64_t first = next_event_seq_ - static_cast<std::int64_t>(events_.size());
+  for (std::int64_t i = std::max(first, since);
+       i < next_event_seq_ && static_cast<int>(out.size()) < limit; ++i) {
+    const Event& e = events_[static_cast<std::size_t>(i - first)];
     out.push_back({{"seq", e.seq},
                    {"wall_us", e.wall_us},
                    {"session_s", e.session_s},
@@ -265,9 +330,13 @@ nlohmann::json SessionWatch::EventsJson(std::int64_t since, int limit) const {
 nlohmann::json SessionWatch::PathJson(std::size_t since) const {
   std::lock_guard<std::mutex> lock(mu_);
   nlohmann::json points = nlohmann::json::array();
-  for (std::size_t i = since; i < path_.size(); ++i)
-    points.push_back({path_[i][0], path_[i][1], path_[i][2], path_[i][3]});
-  return {{"next", path_.size()}, {"points", points}};
+  std::size_t i = std::max(since, path_first_);
+  const std::size_t end = path_first_ + path_.size();
+  for (; i < end && points.size() < kMaxPathAnswer; ++i) {
+    const auto& q = path_[i - path_first_];
+    points.push_back({q[0], q[1], q[2], q[3]});
+  }
+  return {{"first", path_first_}, {"next", std::max(i, since)}, {"points", points}};
 }
 
 namespace {
@@ -319,26 +388,17 @@ nlohmann::json SessionWatch::StatusJson() const {
                         {"state", p.ended                       ? "ended"
                                   : now - p.last_us > kSilentUs ? "silent"
                                                                 : "running"}};
-    std::int64_t dropped = 0;
     nlohmann::json latency = nlohmann::json::object();
-    for (const auto& [k, v] : p.figures) {
-      if (k.rfind("dropped.", 0) == 0) dropped += v;
-      if (k.rfind("latency.", 0) == 0 && k.size() > 7 && k.compare(k.size() - 7, 7, ".p50_us") == 0)
-        latency[k.substr(8, k.size() - 15)]["p50_ms"] = v / 1000.0;
-      if (k.rfind("latency.", 0) == 0 && k.size() > 7 && k.compare(k.size() - 7, 7, ".p99_us") == 0)
-        latency[k.substr(8, k.size() - 15)]["p99_ms"] = v / 1000.0;
-    }
-    q["dropped"] = dropped;
+    for (const auto& [k, v] : p.latency)  // latency.NAME.p50_us -> NAME: p50_ms
+      latency[k.substr(8, k.size() - 15)][EndsWith(k, ".p50_us") ? "p50_ms" : "p99_ms"] =
+          v / 1000.0;
+    q["dropped"] = p.dropped;
     q["latency"] = latency;
-    for (const char* k : {"frames.late", "superseded", "input.missing", "dcp.missing",
-                          "esg.missing", "control.freezes", "control.steps", "control.malfunctions",
-                          "control.repairs", "arm.not_following"}) {
-      if (auto f = p.figures.find(k); f != p.figures.end()) q["counters"][k] = f->second;
-    }
+    for (const auto& [k, v] : p.figures) q["counters"][k] = v;
     procs[name] = q;
   }
   j["processes"] = procs;
-  j["events"] = static_cast<std::int64_t>(events_.size());
+  j["events"] = next_event_seq_;
   j["malfunctions"] = malfunctions_;
   // This station's run: a page that sees it change (the station restarted)
   // reads the events and the path again from the start.

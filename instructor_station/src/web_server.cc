@@ -1,10 +1,14 @@
 #include "rms/instructor_station/web_server.h"
 
-#include <httplib.h>
+#include <microhttpd.h>
+#include <netdb.h>
 
+#include <arpa/inet.h>
 #include <atomic>
+#include <cstring>
 #include <filesystem>
-#include <thread>
+#include <map>
+#include <sys/socket.h>
 
 #include "rms/base/check.h"
 #include "rms/esg_renderer/draw_order.h"
@@ -88,17 +92,34 @@ bool SameToken(const std::string& a, const std::string& b) {
   return diff == 0;
 }
 
-std::int64_t IntParam(const httplib::Request& req, const char* name, std::int64_t fallback,
-                      std::int64_t lo, std::int64_t hi) {
-  if (!req.has_param(name)) return fallback;
-  const std::string v = req.get_param_value(name);
-  if (v.empty() || !std::isdigit(static_cast<unsigned char>(v[0]))) {
-    throw InputError(std::string("parameter ") + name + "='" + v.substr(0, 32) + "': a number " +
-                     std::to_string(lo) + ".." + std::to_string(hi));
+// One request, as the routes see it: the query's and a form body's
+// parameters together (the first of each name).
+struct Request {
+  std::string method, path, token;
+  std::map<std::string, std::string> params;
+  bool has_param(const char* n) const { return params.count(n) > 0; }
+  std::string param(const char* n) const {
+    auto it = params.find(n);
+    return it == params.end() ? std::string() : it->second;
   }
+};
+
+struct Answer {
+  unsigned status = 200;
+  std::string content_type = "application/json";
+  std::string body;
+  std::vector<std::pair<std::string, std::string>> headers;
+};
+
+std::int64_t IntParam(const Request& req, const char* name, std::int64_t fallback, std::int64_t lo,
+                      std::int64_t hi) {
+  if (!req.has_param(name)) return fallback;
+  const std::string v = req.param(name);
   char* end = nullptr;
-  const long long n = std::strtoll(v.c_str(), &end, 10);
-  if (v.empty() || *end != '\0' || n < lo || n > hi) {
+  const long long n = v.empty() || !std::isdigit(static_cast<unsigned char>(v[0]))
+                          ? -1
+                          : std::strtoll(v.c_str(), &end, 10);
+  if (n < 0 || !end || *end != '\0' || n < lo || n > hi) {
     throw InputError(std::string("parameter ") + name + "='" + v.substr(0, 32) + "': a number " +
                      std::to_string(lo) + ".." + std::to_string(hi));
   }
@@ -118,10 +139,46 @@ std::int8_t CommandCode(const std::string& c) {
                    "': freeze, run, step, checkpoint, restore, reset, malfunction or repair");
 }
 
+// What a connection has sent so far (libmicrohttpd calls back as a body arrives).
+struct Upload {
+  Request request;
+  MHD_PostProcessor* form = nullptr;
+  std::size_t bytes = 0;
+  bool too_large = false;
+  ~Upload() {
+    if (form) MHD_destroy_post_processor(form);
+  }
+};
+
+MHD_Result TakeFormValue(void* cls, MHD_ValueKind, const char* key, const char*, const char*,
+                         const char*, const char* data, std::uint64_t off, std::size_t size) {
+  auto* u = static_cast<Upload*>(cls);
+  if (!key) return MHD_YES;
+  std::string& v = u->request.params[key];
+  if (off == 0 && !v.empty()) return MHD_YES;  // the first of each name
+  v.append(data ? data : "", size);
+  return MHD_YES;
+}
+
+MHD_Result TakeQueryValue(void* cls, MHD_ValueKind, const char* key, const char* value) {
+  auto* r = static_cast<Request*>(cls);
+  if (key) r->params.emplace(key, value ? value : "");
+  return MHD_YES;
+}
+
 }  // namespace
 
-// Requests answered at once; more wait in the listen queue.
-constexpr int kWorkers = 32;
+// Connections (docs/instructor.md "Bounds"): served by a few threads over
+// epoll, so an idle or slow client holds no worker; at most kMaxConnections
+// at once and kMaxPerClient from one address (more are refused as they
+// connect); a connection silent for kIdleSeconds -- before its header is
+// whole, or between requests -- is closed; a request's header and body
+// together at most kMaxRequestBytes.
+constexpr unsigned kWorkers = 4;
+constexpr unsigned kMaxConnections = 512;
+constexpr unsigned kMaxPerClient = 64;
+constexpr unsigned kIdleSeconds = 5;
+constexpr std::size_t kMaxRequestBytes = 64 * 1024;
 
 struct WebServer::Impl {
   const LabConfig& config;
@@ -130,115 +187,110 @@ struct WebServer::Impl {
   StationViews* views;
   ControlQueue* controls;
   Counters* counters;
-  httplib::Server server;
-  std::thread thread;
+  MHD_Daemon* daemon = nullptr;
   std::string map_json;
   std::atomic<std::int64_t> requests{0}, refused{0}, sent{0};
 
   // Every request needs the token, on loopback too: a page from elsewhere
   // in the same browser (or one reached through DNS rebinding) can then
   // neither send commands nor read the session.
-  bool Allowed(const httplib::Request& req) const {
+  bool Allowed(const Request& req) const {
     if (options.token.empty()) return true;
-    std::string t = req.get_header_value("X-Rmslab-Token");
-    if (t.empty() && req.has_param("token")) t = req.get_param_value("token");
+    std::string t = req.token;
+    if (t.empty()) t = req.param("token");
     return SameToken(t, options.token);
   }
 
-  void Routes();
-  void Control(const httplib::Request& req, httplib::Response& res);
-  void Checkpoints(httplib::Response& res) const;
+  Answer Serve(const Request& req);
+  Answer Route(const Request& req);
+  Answer Control(const Request& req);
+  Answer Checkpoints() const;
+  static MHD_Result OnRequest(void* cls, MHD_Connection* c, const char* url, const char* method,
+                              const char* version, const char* upload, std::size_t* upload_size,
+                              void** con_cls);
+  static void OnCompleted(void* cls, MHD_Connection* c, void** con_cls,
+                          MHD_RequestTerminationCode toe);
 };
 
-void WebServer::Impl::Routes() {
-  // Without SO_REUSEPORT (cpp-httplib sets it by default): a second station
-  // on a port in use must fail, not share it and mix two sessions' pages.
-  server.set_socket_options([](socket_t sock) {
-    int yes = 1;
-    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
-  });
-  // A slow or idle client cannot hold a worker for long, nor send much.
-  server.set_read_timeout(3, 0);
-  server.set_write_timeout(5, 0);
-  server.set_keep_alive_timeout(2);
-  server.set_payload_max_length(64 * 1024);
-  server.new_task_queue = [] { return new httplib::ThreadPool(kWorkers); };
-  server.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
-    ++requests;
-    if (req.path == "/favicon.ico") {  // browsers ask, without the page's token: nothing to give
-      res.status = 204;
-      return httplib::Server::HandlerResponse::Handled;
-    }
-    if (Allowed(req)) return httplib::Server::HandlerResponse::Unhandled;
+Answer WebServer::Impl::Serve(const Request& req) {
+  ++requests;
+  Answer a;
+  if (req.path == "/favicon.ico") {  // browsers ask, without the page's token: nothing to give
+    a.status = 204;
+    return a;
+  }
+  if (!Allowed(req)) {
     ++refused;
-    res.status = 403;
-    res.set_content("403: this needs the session's token (the URL the launcher printed)\n",
-                    "text/plain");
-    return httplib::Server::HandlerResponse::Handled;
-  });
-  server.set_exception_handler(
-      [this](const httplib::Request&, httplib::Response& res, const std::exception_ptr& ep) {
-        ++refused;
-        std::string what = "error";
-        try {
-          std::rethrow_exception(ep);
-        } catch (const std::exception& e) {
-          what = e.what();
-        } catch (...) {
-        }
-        res.status = 400;
-        res.set_content(Json(nlohmann::json{{"error", what}}), "application/json");
-      });
-  server.Get("/", [](const httplib::Request&, httplib::Response& res) {
-    res.set_content(kPageHtml, "text/html; charset=utf-8");
-  });
-  server.Get("/api/status", [this](const httplib::Request&, httplib::Response& res) {
-    res.set_content(Json(watch->StatusJson()), "application/json");
-  });
-  server.Get("/api/events", [this](const httplib::Request& req, httplib::Response& res) {
+    a.status = 403;
+    a.content_type = "text/plain";
+    a.body = "403: this needs the session's token (the URL the launcher printed)\n";
+    return a;
+  }
+  try {
+    return Route(req);
+  } catch (const std::exception& e) {
+    ++refused;
+    a.status = 400;
+    a.body = Json(nlohmann::json{{"error", e.what()}});
+    return a;
+  }
+}
+
+Answer WebServer::Impl::Route(const Request& req) {
+  Answer a;
+  const bool get = req.method == "GET" || req.method == "HEAD";
+  if (get && req.path == "/") {
+    a.content_type = "text/html; charset=utf-8";
+    a.body = kPageHtml;
+  } else if (get && req.path == "/api/status") {
+    a.body = Json(watch->StatusJson());
+  } else if (get && req.path == "/api/events") {
     const std::int64_t since = IntParam(req, "since", 0, 0, std::int64_t{1} << 40);
-    res.set_content(Json(watch->EventsJson(since, 1000)), "application/json");
-  });
-  server.Get("/api/path", [this](const httplib::Request& req, httplib::Response& res) {
+    a.body = Json(watch->EventsJson(since, SessionWatch::kMaxEventsAnswer));
+  } else if (get && req.path == "/api/path") {
     const auto since =
         static_cast<std::size_t>(IntParam(req, "since", 0, 0, std::int64_t{1} << 40));
-    res.set_content(Json(watch->PathJson(since)), "application/json");
-  });
-  server.Get("/api/map", [this](const httplib::Request&, httplib::Response& res) {
-    res.set_content(map_json, "application/json");
-  });
-  server.Get("/api/checkpoints",
-             [this](const httplib::Request&, httplib::Response& res) { Checkpoints(res); });
-  server.Get("/api/view", [this](const httplib::Request& req, httplib::Response& res) {
+    a.body = Json(watch->PathJson(since));
+  } else if (get && req.path == "/api/map") {
+    a.body = map_json;
+  } else if (get && req.path == "/api/checkpoints") {
+    return Checkpoints();
+  } else if (get && req.path == "/api/view") {
     const int v = static_cast<int>(IntParam(req, "v", 0, 0, kNumViews - 1));
     views->Request(v);
     const ViewImage img = views->Latest(v);
-    res.set_header("Cache-Control", "no-store");
-    res.set_header("X-Rmslab-Frame", std::to_string(img.frame));
+    a.headers = {{"Cache-Control", "no-store"}, {"X-Rmslab-Frame", std::to_string(img.frame)}};
     if (img.png.empty()) {
-      res.status = 503;  // not drawn yet: asked for now, try again shortly
-      res.set_content("not drawn yet\n", "text/plain");
-      return;
+      a.status = 503;  // not drawn yet: asked for now, try again shortly
+      a.content_type = "text/plain";
+      a.body = "not drawn yet\n";
+    } else {
+      a.content_type = "image/png";
+      a.body.assign(reinterpret_cast<const char*>(img.png.data()), img.png.size());
     }
-    res.set_content(reinterpret_cast<const char*>(img.png.data()), img.png.size(), "image/png");
-  });
-  server.Post("/api/control",
-              [this](const httplib::Request& req, httplib::Response& res) { Control(req, res); });
+  } else if (req.method == "POST" && req.path == "/api/control") {
+    return Control(req);
+  } else {
+    ++refused;
+    a.status = 404;
+    a.content_type = "text/plain";
+    a.body = "404: no such page\n";
+  }
+  return a;
 }
 
-void WebServer::Impl::Control(const httplib::Request& req, httplib::Response& res) {
-  const std::string command =
-      req.has_param("command") ? req.get_param_value("command") : std::string();
+Answer WebServer::Impl::Control(const Request& req) {
+  const std::string command = req.param("command");
   ControlRequest r;
   r.command = CommandCode(command);
   if (r.command == session_control_t::CHECKPOINT || r.command == session_control_t::RESTORE) {
-    r.name = req.has_param("name") ? req.get_param_value("name") : std::string();
+    r.name = req.param("name");
     if (r.name.size() < 5 || r.name.compare(r.name.size() - 5, 5, ".json") != 0) r.name += ".json";
     wire::CheckpointFolder::ValidateName(r.name);  // InputError: said to the page
   }
   // docs/sessions.md "Malfunctions": checked here (InputError: said to the
   // page), sent in the canonical text.
-  const std::string what = req.has_param("name") ? req.get_param_value("name") : std::string();
+  const std::string what = req.param("name");
   if (r.command == session_control_t::MALFUNCTION)
     r.name = wire::MalfunctionText(wire::ParseMalfunction(what));
   if (r.command == session_control_t::REPAIR) r.name = wire::RepairText(wire::ParseRepair(what));
@@ -246,40 +298,129 @@ void WebServer::Impl::Control(const httplib::Request& req, httplib::Response& re
       r.command == session_control_t::STEP ? static_cast<int>(IntParam(req, "n", 1, 1, 300)) : 1;
   for (int i = 0; i < steps; ++i) controls->Push(r);
   sent += steps;
-  res.set_content(Json(nlohmann::json{{"sent", command}, {"name", r.name}, {"times", steps}}),
-                  "application/json");
+  Answer a;
+  a.body = Json(nlohmann::json{{"sent", command}, {"name", r.name}, {"times", steps}});
+  return a;
 }
 
-void WebServer::Impl::Checkpoints(httplib::Response& res) const {
+Answer WebServer::Impl::Checkpoints() const {
   nlohmann::json names = nlohmann::json::array();
   std::error_code ec;
   if (!options.checkpoint_dir.empty()) {
     for (const auto& e : std::filesystem::directory_iterator(options.checkpoint_dir, ec)) {
       const std::string n = e.path().filename().string();
-      if (e.is_regular_file(ec) && n.size() > 5 && n.compare(n.size() - 5, 5, ".json") == 0)
+      if (e.is_regular_file(ec) && !e.is_symlink(ec) && n.size() > 5 &&
+          n.compare(n.size() - 5, 5, ".json") == 0 && names.size() < 1000)
         names.push_back(n);
     }
   }
-  res.set_content(Json(names), "application/json");
+  Answer a;
+  a.body = Json(names);
+  return a;
+}
+
+// libmicrohttpd's callback: first with the header (an Upload made), then
+// with each piece of the body, then once more to answer.
+MHD_Result WebServer::Impl::OnRequest(void* cls, MHD_Connection* c, const char* url,
+                                      const char* method, const char*, const char* upload,
+                                      std::size_t* upload_size, void** con_cls) {
+  auto* self = static_cast<Impl*>(cls);
+  auto* u = static_cast<Upload*>(*con_cls);
+  if (!u) {
+    u = new Upload;
+    *con_cls = u;
+    u->request.method = method ? method : "";
+    u->request.path = url ? url : "";
+    if (const char* t = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "X-Rmslab-Token"))
+      u->request.token = t;
+    if (u->request.method == "POST") u->form = MHD_create_post_processor(c, 4096, TakeFormValue, u);
+    return MHD_YES;
+  }
+  if (*upload_size > 0) {
+    u->bytes += *upload_size;
+    if (u->bytes > kMaxRequestBytes) u->too_large = true;
+    if (!u->too_large && u->form) MHD_post_process(u->form, upload, *upload_size);
+    *upload_size = 0;
+    return MHD_YES;
+  }
+  Request& req = u->request;
+  MHD_get_connection_values(c, MHD_GET_ARGUMENT_KIND, TakeQueryValue, &req);
+  Answer a;
+  if (u->too_large) {
+    ++self->requests;
+    ++self->refused;
+    a.status = 413;
+    a.content_type = "text/plain";
+    a.body = "413: a request is at most 64 KiB\n";
+  } else {
+    a = self->Serve(req);
+  }
+  MHD_Response* res =
+      MHD_create_response_from_buffer(a.body.size(), a.body.data(), MHD_RESPMEM_MUST_COPY);
+  MHD_add_response_header(res, "Content-Type", a.content_type.c_str());
+  for (const auto& [k, v] : a.headers) MHD_add_response_header(res, k.c_str(), v.c_str());
+  const MHD_Result ok = MHD_queue_response(c, a.status, res);
+  MHD_destroy_response(res);
+  return ok;
+}
+
+void WebServer::Impl::OnCompleted(void*, MHD_Connection*, void** con_cls,
+                                  MHD_RequestTerminationCode) {
+  delete static_cast<Upload*>(*con_cls);
+  *con_cls = nullptr;
 }
 
 WebServer::WebServer(const LabConfig& config, const InstructorOptions& options, SessionWatch* watch,
                      StationViews* views, ControlQueue* controls, Counters* counters)
-    : impl_(new Impl{config, options, watch, views, controls, counters, {}, {}, {}, {}, {}, {}}) {
+    : impl_(new Impl{config, options, watch, views, controls, counters, nullptr, {}, {}, {}, {}}) {
   impl_->map_json = Json(MapJson(config));
-  impl_->Routes();
 }
 
 WebServer::~WebServer() { Stop(); }
 
+namespace {
+
+// The address to serve on, numeric or a name this host resolves.
+sockaddr_storage BindAddress(const std::string& bind, int port) {
+  addrinfo hints{};
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_STREAM;
+  hints.ai_flags = AI_PASSIVE;
+  addrinfo* found = nullptr;
+  const std::string service = std::to_string(port);
+  if (getaddrinfo(bind.c_str(), service.c_str(), &hints, &found) != 0 || !found) {
+    throw transport::TransportError("cannot serve the page on " + bind +
+                                    ": not an address of this host");
+  }
+  sockaddr_storage a{};
+  std::memcpy(&a, found->ai_addr, std::min<std::size_t>(found->ai_addrlen, sizeof a));
+  freeaddrinfo(found);
+  return a;
+}
+
+int BoundPort(const sockaddr_storage& a) {
+  return ntohs(a.ss_family == AF_INET6 ? reinterpret_cast<const sockaddr_in6&>(a).sin6_port
+                                       : reinterpret_cast<const sockaddr_in&>(a).sin_port);
+}
+
+}  // namespace
+
 int WebServer::Start() {
   Impl& s = *impl_;
-  int port = s.options.port;
-  if (port == 0) {
-    port = s.server.bind_to_any_port(s.options.bind);
-    if (port < 0) port = 0;
-  } else if (!s.server.bind_to_port(s.options.bind, port)) {
-    port = 0;
+  sockaddr_storage addr = BindAddress(s.options.bind, s.options.port);
+  unsigned flags = MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_EPOLL;
+  if (addr.ss_family == AF_INET6) flags |= MHD_USE_IPv6;
+  s.daemon = MHD_start_daemon(
+      flags, static_cast<std::uint16_t>(s.options.port), nullptr, nullptr, &Impl::OnRequest, &s,
+      MHD_OPTION_SOCK_ADDR, reinterpret_cast<sockaddr*>(&addr), MHD_OPTION_THREAD_POOL_SIZE,
+      kWorkers, MHD_OPTION_CONNECTION_LIMIT, kMaxConnections, MHD_OPTION_PER_IP_CONNECTION_LIMIT,
+      kMaxPerClient, MHD_OPTION_CONNECTION_TIMEOUT, kIdleSeconds,
+      MHD_OPTION_CONNECTION_MEMORY_LIMIT, static_cast<std::size_t>(128 * 1024),
+      MHD_OPTION_NOTIFY_COMPLETED, &Impl::OnCompleted, &s, MHD_OPTION_END);
+  int port = 0;
+  if (s.daemon) {
+    const MHD_DaemonInfo* info = MHD_get_daemon_info(s.daemon, MHD_DAEMON_INFO_BIND_PORT);
+    port = info ? info->port : BoundPort(addr);
   }
   if (port == 0) {
     throw transport::TransportError("cannot serve the page on " + s.options.bind + ":" +
@@ -287,14 +428,13 @@ int WebServer::Start() {
                                     " (in use, or not an address of this host): choose another "
                                     "with --instructor PORT");
   }
-  s.thread = std::thread([&s] { s.server.listen_after_bind(); });
   return port;
 }
 
 void WebServer::Stop() {
-  if (!impl_) return;
-  impl_->server.stop();
-  if (impl_->thread.joinable()) impl_->thread.join();
+  if (!impl_ || !impl_->daemon) return;
+  MHD_stop_daemon(impl_->daemon);
+  impl_->daemon = nullptr;
 }
 
 std::int64_t WebServer::requests() const { return impl_->requests; }

@@ -134,17 +134,70 @@ def probe_network(host, url, suffix, share):
 _address_lock = None  # held for the launcher's life
 
 
+def private_dir():
+    """This user's own folder for locks and temporary files
+    (docs/security.md "Locks and temporary files"): $XDG_RUNTIME_DIR/rmslab,
+    else /tmp/rmslab-UID, made 0700; refused, with what is wrong, when it is
+    a link, not a folder, another user's, or open to others."""
+    base = os.environ.get("XDG_RUNTIME_DIR")
+    path = os.path.join(base, "rmslab") if base and os.path.isabs(base) else \
+        os.path.join(tempfile.gettempdir(), f"rmslab-{os.getuid()}")
+    try:
+        os.mkdir(path, 0o700)
+    except FileExistsError:
+        pass
+    except OSError as e:
+        raise LabError(f"cannot make {path} for this user's locks: {e.strerror}", 2)
+    st = os.lstat(path)
+    if not stat.S_ISDIR(st.st_mode):
+        raise LabError(f"{path} should be this user's folder for locks but is a "
+                       f"{'link' if stat.S_ISLNK(st.st_mode) else 'file'}: remove it (or set XDG_RUNTIME_DIR)", 2)
+    if st.st_uid != os.getuid():
+        raise LabError(f"{path} belongs to {_user_name(st.st_uid)}, not to you: another user made it to take "
+                       f"this user's locks. Remove it (or set XDG_RUNTIME_DIR)", 2)
+    if st.st_mode & 0o077:
+        os.chmod(path, 0o700)
+    return path
+
+
+def _user_name(uid):
+    try:
+        import pwd
+        return f"user {pwd.getpwuid(uid).pw_name} (uid {uid})"
+    except (KeyError, ImportError):
+        return f"uid {uid}"
+
+
+def open_private(name, flags=os.O_RDWR | os.O_CREAT):
+    """A file in private_dir(), opened without following a link (O_NOFOLLOW,
+    O_CLOEXEC, mode 0600) and refused unless it is a regular file of this user."""
+    folder = private_dir()
+    path = os.path.join(folder, name)
+    try:
+        fd = os.open(path, flags | os.O_NOFOLLOW | os.O_CLOEXEC, 0o600)
+    except OSError as e:
+        raise LabError(f"cannot open {path}: {e.strerror}"
+                       f"{' (a link: refused)' if e.errno == errno.ELOOP else ''}", 2)
+    st = os.fstat(fd)
+    if not stat.S_ISREG(st.st_mode) or st.st_uid != os.getuid():
+        os.close(fd)
+        raise LabError(f"{path} is not a file of yours ({_user_name(st.st_uid)}): refused", 2)
+    return path, fd
+
+
 def claim_address(url, suffix, share, network="localhost"):
     """Two launchers on this host started at once on one address and channels
     would both hear silence in probe_network: a lock file per address, suffix
     and network (this host's, or the namespace host the recorder listens in:
-    namespace labs are networks of their own) makes the second refuse."""
+    namespace labs are networks of their own) makes the second refuse. The
+    lock is in this user's own folder (private_dir): another user can neither
+    hold it nor plant a link in its place; their sessions on the address are
+    heard by probe_network instead."""
     global _address_lock
     import fcntl
     import hashlib
     key = hashlib.sha1(f"{url}|{suffix}|{network}".encode()).hexdigest()[:16]
-    path = os.path.join(tempfile.gettempdir(), f"rmslab-address-{key}.lock")
-    fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o666)
+    path, fd = open_private(f"address-{key}.lock")
     try:
         fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except OSError:

@@ -7,13 +7,24 @@
 // autopilot reports, and repairs them; the commands are in the session's log
 // (summary.json "control" and "malfunctions") and re-simulate word for word. Requests without the
 // token, or with bad parameters, are refused and counted; a second station
-// cannot take the port.
+// cannot take the port. A station that hears forgeries and idle
+// connections stays bounded (docs/instructor.md "Bounds").
 #include <httplib.h>
+#include <poll.h>
+#include <unistd.h>
 
+#include <arpa/inet.h>
+#include <chrono>
+#include <csignal>
 #include <filesystem>
+#include <fstream>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
 #include <nlohmann/json.hpp>
+#include <sys/socket.h>
+#include <thread>
 
+#include "rms/dcp_telemetry_t.hpp"
 #include "rms/process_status_t.hpp"
 #include "rms/sender_t.hpp"
 #include "rms/transport/lcm_interface.h"
@@ -174,6 +185,175 @@ TEST(InstructorStation,
       tmp + "/resim.log");
   EXPECT_EQ(resim.rc, 0) << resim.out;
   EXPECT_NE(resim.out.find("identical, word for word"), std::string::npos) << resim.out;
+}
+
+// The station's resident memory, kB (Linux /proc).
+long RssKb(pid_t pid) {
+  std::ifstream f("/proc/" + std::to_string(pid) + "/status");
+  std::string line;
+  while (std::getline(f, line)) {
+    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+  }
+  return -1;
+}
+
+// A TCP connection to 127.0.0.1:port from the loopback address `from`
+// (another client as the station sees it); -1 when refused.
+int ConnectFrom(const char* from, int port) {
+  const int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  inet_pton(AF_INET, from, &a.sin_addr);
+  if (bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
+    close(fd);
+    return -1;
+  }
+  a.sin_port = htons(static_cast<std::uint16_t>(port));
+  inet_pton(AF_INET, "127.0.0.1", &a.sin_addr);
+  if (connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
+    close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+// True when the station has closed the connection (EOF or reset) within timeout_ms.
+bool ClosedBy(int fd, int timeout_ms) {
+  pollfd p{fd, POLLIN, 0};
+  if (poll(&p, 1, timeout_ms) <= 0) return false;
+  char b[256];
+  return recv(fd, b, sizeof b, MSG_DONTWAIT) <= 0;
+}
+
+// docs/instructor.md "Bounds": a station with no session key (started by
+// hand) hears anyone. 10,000 forged statuses of new processes, a flood of
+// made-up restarts and a telemetry packet from the far future leave its
+// memory flat and its answers small; 100 idle and 100 slow connections
+// from other clients leave its page answering.
+TEST(InstructorStation, StaysBoundedUnderForgedStatusesAndAnswersUnderIdleConnections) {
+  const std::string tmp = testing::MakeTempDir("instructor-bounds");
+  const std::string lcm_url = testing::UniqueLcmUrl(8700);
+  const std::string token = "bounds-test-token-0123456789";
+  const std::int64_t epoch_us = std::chrono::duration_cast<std::chrono::microseconds>(
+                                    std::chrono::system_clock::now().time_since_epoch())
+                                    .count();
+  Subprocess station(
+      {BuildPath("instructor_station/instructor_station"), "--lcm-url", lcm_url, "--port", "0",
+       "--token", token, "--url-file", tmp + "/url", "--stats", tmp + "/stats.json"},
+      tmp + "/station.log", {"RMSLAB_SESSION_EPOCH_US=" + std::to_string(epoch_us)});
+  ASSERT_TRUE(testing::WaitForFile(tmp + "/url", 60)) << ReadFile(tmp + "/station.log");
+  int port = 0;
+  std::string got_token;
+  SplitUrl(ReadFile(tmp + "/url"), &port, &got_token);
+  ASSERT_EQ(got_token, token);
+  httplib::Client web("127.0.0.1", port);
+  web.set_read_timeout(10, 0);
+  const std::string auth = "token=" + token;
+
+  transport::LcmOptions lo;
+  lo.url = lcm_url;
+  transport::UdpLcm forger(lo);
+  auto statuses = [&](int n, int counters, bool restarts) {
+    for (int i = 0; i < n; ++i) {
+      process_status_t m{};
+      m.pid = restarts ? 1000 + i : 4242;
+      forger.SetSender({0, sender_t::PROCESS_TOOL, m.pid});
+      m.process = restarts ? "forged-" + std::to_string(i % 4) : "forged-" + std::to_string(i);
+      m.host = "host";
+      for (int k = 0; k < counters; ++k) {
+        m.counter_names.push_back("latency." + std::string(80, 'x') + std::to_string(k) +
+                                  ".p50_us");
+        m.counter_values.push_back(k);
+      }
+      m.num_counters = static_cast<std::int16_t>(counters);
+      transport::PublishMessage(forger, wire::channels::kStatus, m);
+      if (i % 50 == 49) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+  };
+  statuses(500, 200, false);
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  const long rss_before = RssKb(station.pid());
+  statuses(10000, 200, false);
+  // A name that is not the sender's: a tool claiming to be the DCP.
+  {
+    process_status_t m{};
+    m.pid = 4242;
+    forger.SetSender({0, sender_t::PROCESS_TOOL, 4242});
+    m.process = "dynamics_proc";
+    transport::PublishMessage(forger, wire::channels::kStatus, m);
+  }
+  statuses(12000, 0, true);
+  // Telemetry from the far future: DOCKED, Mode 3.
+  {
+    dcp_telemetry_t t{};
+    forger.SetSender({0, sender_t::PROCESS_DYNAMICS, 4243});
+    t.frame = std::int64_t{1} << 40;
+    t.mode = 3;
+    t.docked = true;
+    transport::PublishMessage(forger, wire::channels::kDcpTelemetry, t);
+  }
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  const long rss_after = RssKb(station.pid());
+  std::printf("station RSS %ld kB after 500 forged statuses, %ld kB after 22,000 more\n",
+              rss_before, rss_after);
+  EXPECT_LT(rss_after - rss_before, 30 * 1024) << "kB";
+
+  const auto status = web.Get("/api/status?" + auth);
+  ASSERT_TRUE(status);
+  ASSERT_EQ(status->status, 200);
+  EXPECT_LT(status->body.size(), 256u * 1024) << "bytes";
+  const auto sj = nlohmann::json::parse(status->body);
+  EXPECT_LE(sj["processes"].size(), 16u);
+  EXPECT_FALSE(sj["processes"].contains("dynamics_proc")) << sj["processes"].dump();
+  EXPECT_TRUE(sj["dcp"].is_null()) << sj["dcp"].dump();  // the far-future packet refused
+  const std::int64_t events = sj["events"].get<std::int64_t>();
+  EXPECT_GT(events, 10500) << "the restarts heard";
+  const auto ev = web.Get("/api/events?since=0&" + auth);
+  ASSERT_TRUE(ev);
+  const auto ej = nlohmann::json::parse(ev->body);
+  ASSERT_FALSE(ej.empty());
+  EXPECT_LE(ej.size(), 1000u);
+  EXPECT_EQ(ej[0]["seq"].get<std::int64_t>(), events - 10000) << "the last 10,000 kept";
+
+  // 100 idle connections from one client, 100 slow ones from another.
+  std::vector<int> idle, slow;
+  for (int i = 0; i < 100; ++i) {
+    if (int fd = ConnectFrom("127.0.0.2", port); fd >= 0) idle.push_back(fd);
+    if (int fd = ConnectFrom("127.0.0.3", port); fd >= 0) {
+      const char head[] = "GET /api/status HTTP/1.1\r\nHost: x\r\n";
+      (void)send(fd, head, sizeof head - 1, MSG_NOSIGNAL);
+      slow.push_back(fd);
+    }
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto answered = web.Get("/api/status?" + auth);
+  const double took_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ASSERT_TRUE(answered) << "no answer under 200 held connections";
+  EXPECT_EQ(answered->status, 200);
+  std::printf("answered in %.3f s beside %zu idle and %zu slow connections\n", took_s, idle.size(),
+              slow.size());
+  EXPECT_LT(took_s, 3.0);
+  // One client holds at most 64: the rest are closed as they come.
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  int closed_soon = 0;
+  for (int fd : idle) closed_soon += ClosedBy(fd, 0);
+  EXPECT_GE(closed_soon, 36) << "beyond 64 a client";
+  // The idle ones are closed after 5 s of silence, header or not.
+  std::this_thread::sleep_for(std::chrono::seconds(7));
+  int closed_idle = 0, closed_slow = 0;
+  for (int fd : idle) closed_idle += ClosedBy(fd, 100);
+  for (int fd : slow) closed_slow += ClosedBy(fd, 100);
+  EXPECT_EQ(closed_idle, static_cast<int>(idle.size()));
+  EXPECT_EQ(closed_slow, static_cast<int>(slow.size()));
+  for (int fd : idle) close(fd);
+  for (int fd : slow) close(fd);
+
+  station.Signal(SIGTERM);
+  ASSERT_EQ(station.Wait(30), 0) << ReadFile(tmp + "/station.log");
+  const auto stats = nlohmann::json::parse(ReadFile(tmp + "/stats.json"));
+  EXPECT_GE(stats["counters"].value("dropped.status_refused", 0), 1);
+  EXPECT_GE(stats["counters"].value("dropped.far_ahead", 0), 1);
 }
 
 }  // namespace

@@ -531,6 +531,62 @@ TEST(SessionSecurity, KillingTheLauncherLeavesNoProcessAndASummary) {
 
 // Bad input is refused before anything starts, with the reason shown:
 // a bad config key, a width of 0, a channel suffix with a pattern in it.
+// docs/security.md "Locks and temporary files": the address lock lives in
+// the user's own 0700 folder; a link or another user's folder in its place
+// is refused at start, said, and nothing is written through it.
+TEST(SessionSecurity, LocksLiveInTheUsersOwnFolder) {
+  const std::string tmp = testing::MakeTempDir("locks");
+  const std::string xdg = tmp + "/xdg";
+  fs::create_directories(xdg);
+  fs::create_directories(tmp + "/elsewhere");
+  auto demo = [&](const std::string& name) {
+    return Script({"/usr/bin/env", "XDG_RUNTIME_DIR=" + xdg, SourcePath("scripts/lab"), "demo",
+                   "--no-build", "--out", tmp + "/" + name, "--lcm-url",
+                   testing::UniqueLcmUrl(8680), "--png-every", "0", "--no-video"},
+                  tmp + "/" + name + ".log", 120);
+  };
+  fs::create_directory_symlink(tmp + "/elsewhere", xdg + "/rmslab");
+  const auto linked = demo("linked");
+  EXPECT_EQ(linked.rc, 2) << linked.out;
+  EXPECT_NE(linked.out.find("is a link"), std::string::npos) << linked.out;
+  EXPECT_TRUE(fs::is_empty(tmp + "/elsewhere"));
+  fs::remove(xdg + "/rmslab");
+  if (geteuid() == 0) {  // another user's folder (root can make one for the test)
+    fs::create_directory(xdg + "/rmslab");
+    ASSERT_EQ(chown((xdg + "/rmslab").c_str(), 65534, 65534), 0);
+    const auto theirs = demo("theirs");
+    EXPECT_EQ(theirs.rc, 2) << theirs.out;
+    EXPECT_NE(theirs.out.find("not to you"), std::string::npos) << theirs.out;
+    EXPECT_TRUE(fs::is_empty(xdg + "/rmslab"));
+    fs::remove(xdg + "/rmslab");
+  } else {
+    std::printf("not root: another user's folder not tried\n");
+  }
+  // A folder open to others is closed; the lock is made there, 0600, and
+  // removed at the launcher's exit.
+  fs::create_directory(xdg + "/rmslab");
+  fs::permissions(xdg + "/rmslab", fs::perms::all);
+  testing::Subprocess lab(
+      {"/usr/bin/env", "XDG_RUNTIME_DIR=" + xdg, SourcePath("scripts/lab"), "demo", "--no-build",
+       "--out", tmp + "/ours", "--lcm-url", testing::UniqueLcmUrl(8690), "--png-every", "0",
+       "--no-video", "--speed", "4"},
+      tmp + "/ours.log");
+  ASSERT_TRUE(testing::WaitForFile(tmp + "/ours/run/operator_station.ready", 90))
+      << ReadFile(tmp + "/ours.log");
+  EXPECT_EQ(fs::status(xdg + "/rmslab").permissions() & fs::perms::all, fs::perms::owner_all);
+  int locks = 0;
+  for (const auto& e : fs::directory_iterator(xdg + "/rmslab")) {
+    if (e.path().filename().string().rfind("address-", 0) != 0) continue;
+    ++locks;
+    EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(e.path())));
+    EXPECT_EQ(fs::status(e.path()).permissions() & fs::perms::all,
+              fs::perms::owner_read | fs::perms::owner_write);
+  }
+  EXPECT_EQ(locks, 1);
+  EXPECT_EQ(lab.Wait(240), 0) << ReadFile(tmp + "/ours.log");
+  EXPECT_TRUE(fs::is_empty(xdg + "/rmslab"));
+}
+
 TEST(SessionSecurity, BadInputIsRefusedBeforeAnythingStartsWithTheReasonShown) {
   const std::string tmp = testing::MakeTempDir("bad_input");
   {

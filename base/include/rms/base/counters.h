@@ -52,6 +52,7 @@ enum class Counter : std::uint16_t {
   kDroppedReplayed,
   kDroppedControlMalformed,
   kDroppedStatusMalformed,
+  kDroppedStatusRefused,
   kDroppedStateMalformed,
   kDroppedTelemetryTooLarge,
   kDroppedTelemetryWrongType,
@@ -282,6 +283,9 @@ inline constexpr std::array<CounterInfo, kNumCounters> kCounterTable = {{
      "RMS_CONTROL messages that could not be decoded"},
     {Counter::kDroppedStatusMalformed, "dropped.status_malformed", "O, I",
      "RMS_STATUS messages that could not be decoded"},
+    {Counter::kDroppedStatusRefused, "dropped.status_refused", "I",
+     "RMS_STATUS messages whose process name or pid is not their sender's, or from a new process "
+     "beyond the ones the station keeps (docs/instructor.md \"Bounds\")"},
     {Counter::kDroppedStateMalformed, "dropped.state_malformed", "I",
      "RMS_DCP_STATE messages that could not be decoded or whose checkpoint could not be read"},
     {Counter::kDroppedTelemetryTooLarge, "dropped.telemetry_too_large", "O, I",

@@ -1,8 +1,10 @@
 #pragma once
-// The instructor station's web server (cpp-httplib, Debian's
-// libcpp-httplib-dev): the page, its JSON and images, and its commands
-// (docs/instructor.md "The page and its API"). Requests are answered on the
-// server's own threads; commands are queued for the LCM thread to send.
+// The instructor station's web server (GNU libmicrohttpd, Debian's
+// libmicrohttpd-dev: per-client connection limits and idle timeouts over
+// epoll, which cpp-httplib 0.11 lacks): the page, its JSON and images, and
+// its commands (docs/instructor.md "The page and its API", "Bounds").
+// Requests are answered on the server's own threads; commands are queued
+// for the LCM thread to send.
 #include <cstdint>
 #include <deque>
 #include <memory>
