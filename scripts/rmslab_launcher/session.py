@@ -349,9 +349,11 @@ def summarize(out, fallback_name):
     for t in targets:
         r = subprocess.run([binary("tools/rms_session"), "summary", out, "--brief", "--out", t], capture_output=True,
                            text=True)
-        if r.returncode == 0:
+        if r.returncode in (0, 3):  # 3: written, from a log damaged inside (said in the brief)
             if t != targets[0]:
                 say(f"the session's folder could not take its summary: written to {t} instead")
+            if r.returncode == 3:
+                say(f"summary: {r.stderr.strip()}")
             return r.stdout.splitlines(), t
         say(f"summary: {r.stderr.strip()}")
     return [], None

@@ -188,8 +188,8 @@ TEST(Record, HoldsEveryJournalEventAndWhatOnlyTheNetworkHeardInTimeOrder) {
 }
 
 // A journal damaged part way (its second event's sync word overwritten):
-// what follows the damage comes from the wire, the unread bytes are counted,
-// and every journal is kept to look into.
+// read past the damage, the event it spoiled comes from the wire, the bytes
+// passed over are counted, and every journal is kept to look into.
 TEST(Record, ADamagedJournalIsCountedAndKept) {
   const fs::path s = FreshDir("damaged");
   fs::create_directories(s / "journal");
@@ -208,9 +208,11 @@ TEST(Record, ADamagedJournalIsCountedAndKept) {
   WriteWithLiblcm(s / "wire.lcmlog", {{201, a2.channel, a2.data}, {301, a3.channel, a3.data}});
   const auto record = session::MakeRecord(s.string());
   EXPECT_TRUE(record["made"].get<bool>());
-  EXPECT_GT(record["journals"][0]["unread_bytes"].get<long>(), 0) << record.dump(2);
-  EXPECT_EQ(record["journals"][0]["events"], 0) << "an event is taken only when a sync follows";
-  EXPECT_EQ(record["lcmlog"]["from_wire_only"], 2);
+  EXPECT_EQ(record["journals"][0]["skipped_bytes"].get<long>(), first_event_bytes)
+      << record.dump(2);
+  EXPECT_EQ(record["journals"][0]["unread_bytes"].get<long>(), 0) << record.dump(2);
+  EXPECT_EQ(record["journals"][0]["events"], 2) << "a1 and a3: read past a2";
+  EXPECT_EQ(record["lcmlog"]["from_wire_only"], 1) << "a2";
   EXPECT_TRUE(record["journals_kept"].get<bool>());
   EXPECT_TRUE(fs::exists(dcp));
   EXPECT_TRUE(fs::exists(s / "journal" / "scene_proc.0.lcmlog"));

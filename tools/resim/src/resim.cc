@@ -49,11 +49,13 @@ class RecordedSession {
       : dir_(dir),
         rec_(ReadRecording(log, parts)),
         plan_(MakePlan(rec_)),
-        unread_(log.unread_bytes()) {}
+        unread_(log.unread_bytes()),
+        skipped_(log.skipped_bytes()) {}
   const std::string& dir() const { return dir_; }
   const Recording& recording() const { return rec_; }
   const Plan& plan() const { return plan_; }
   std::int64_t unread_bytes() const { return unread_; }
+  std::int64_t skipped_bytes() const { return skipped_; }  // damage inside the log
   // Each of the following is made at the first call, once, whichever of
   // the threads running a batch's cells at once comes first (RunCells).
   // The recorded session's summary.json (made now when it has none).
@@ -96,7 +98,7 @@ class RecordedSession {
   std::string dir_;
   Recording rec_;
   Plan plan_;
-  std::int64_t unread_ = 0;
+  std::int64_t unread_ = 0, skipped_ = 0;
   // Made once, at the first call (a batch's designs share them).
   // (A call_once whose function throws leaves its flag unset: the next call tries again.)
   mutable std::once_flag summary_once_, telemetry_once_, designs_once_, config_keys_once_;
@@ -465,6 +467,12 @@ ResimResult Resimulate(const ResimOptions& opt) {
     result.log_note = "the log ends in " + std::to_string(recorded->unread_bytes()) +
                       " bytes that are no whole event (it was cut short or damaged there): "
                       "re-simulated up to them";
+  }
+  if (recorded->skipped_bytes() > 0) {
+    result.log_note += std::string(result.log_note.empty() ? "" : "; ") +
+                       "the log is damaged: " + std::to_string(recorded->skipped_bytes()) +
+                       " bytes inside it are no event (read past): what they held was not "
+                       "checked";
   }
   result.note = plan.note;
   NoteUnchecked(rec, plan, &result);

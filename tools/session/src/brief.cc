@@ -63,6 +63,13 @@ std::string WakeLatencyNote(const Json& j) {
 // What the record, the renderer and the video lost, and the latency.
 void LossLines(const Json& j, std::ostream& os) {
   const auto& fr = j["frames"];
+  if (j["log"].value("skipped_bytes", 0) > 0) {
+    os << "THE LOG IS DAMAGED: " << j["log"]["skipped_bytes"] << " bytes in "
+       << j["log"]["skipped_places"] << " place(s) are no event (the first from byte "
+       << j["log"]["skipped_stretches"][0]["from_byte"]
+       << "): read past them; what they held is not in this summary, whose counts may be "
+          "short\n";
+  }
   if (j["record"].value("lost", 0) > 0) {
     // Made from journals, the log holds every frame they could be read
     // for: a frame counted lost is in no readable journal and not on the
@@ -97,11 +104,11 @@ void LossLines(const Json& j, std::ostream& os) {
        << " messages (a full disk): the record has those the network's recorder heard\n";
   }
   if (j["record"].value("journal_unread_bytes", 0) > 0) {
-    os << "the journals " << j["record"]["journals_damaged"].dump() << " end in "
+    os << "the journals " << j["record"]["journals_damaged"].dump() << " hold "
        << j["record"]["journal_unread_bytes"]
-       << " bytes that are no whole event (damaged, or cut short): "
-       << (wire ? "the record has what the network's recorder heard of what they held past it"
-                : "what they held past it is in no record (no wire.lcmlog)")
+       << " bytes that are no event (damaged inside, or cut short): "
+       << (wire ? "the record has what the network's recorder heard of what the damage held"
+                : "what the damage held is in no record (no wire.lcmlog)")
        << ", and the journals are kept in journal/\n";
   }
   if (j["ignored"].value("total", 0) > 0) {

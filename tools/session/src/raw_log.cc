@@ -17,6 +17,9 @@ namespace {
 constexpr std::uint8_t kSync[4] = {0xED, 0xA1, 0xDA, 0x01};
 constexpr std::size_t kHeaderBytes = 8 + 8 + 4 + 4;  // event number, time, two lengths
 constexpr std::size_t kBlockBytes = 1 << 16;         // read in blocks of 64 KiB
+// No rmslab message is larger (lcmtypes' bounds): a header saying more is
+// damage, not an event to buffer.
+constexpr std::int32_t kMaxDataBytes = 64 << 20;
 
 std::uint64_t BigEndian(const std::uint8_t* p, int bytes) {
   std::uint64_t v = 0;
@@ -40,6 +43,7 @@ RawLogReader::RawLogReader(const std::string& path, std::size_t from) : RawLogRe
   if (::lseek(fd_, static_cast<off_t>(from), SEEK_SET) < 0)
     throw InputError("cannot read the LCM log '" + path + "': " + std::strerror(errno));
   offset_ = good_end_ = from;
+  from_start_ = from == 0;
 }
 
 RawLogReader::~RawLogReader() {
@@ -77,49 +81,70 @@ bool RawLogReader::Have(std::size_t n) {
   return true;
 }
 
-bool RawLogReader::Next(RawLogEvent* ev) {
-  // The sync word: the first place at or after the last event's end where
-  // its four bytes stand (liblcm reads byte by byte until they do).
-  for (;;) {
-    if (!Have(4)) return false;
-    // Where the last event ended, as a whole log has it (memmem's set-up
-    // costs more than the event's own reading).
-    if (std::memcmp(buf_.get() + begin_, kSync, 4) == 0) break;
-    const void* found = ::memmem(buf_.get() + begin_, end_ - begin_, kSync, 4);
-    if (found) {
-      begin_ = static_cast<std::size_t>(static_cast<const std::uint8_t*>(found) - buf_.get());
-      break;
-    }
-    begin_ = end_ - 3;  // a sync word may begin in the last three bytes
-  }
-  if (offset_ + begin_ >= stop_at_) {
-    stopped_ = true;
-    stopped_at_ = offset_ + begin_;
-    return false;
-  }
+bool RawLogReader::WholeEventAt(std::size_t* total) {
   if (!Have(4 + kHeaderBytes)) return false;
+  const std::uint8_t* h = buf_.get() + begin_ + 4;
+  const auto channel_len = static_cast<std::int32_t>(BigEndian(h + 16, 4));
+  const auto data_len = static_cast<std::int32_t>(BigEndian(h + 20, 4));
+  if (channel_len <= 0 || channel_len >= 1000 || data_len < 0 || data_len > kMaxDataBytes)
+    return false;
+  *total =
+      4 + kHeaderBytes + static_cast<std::size_t>(channel_len) + static_cast<std::size_t>(data_len);
+  return Have(*total);
+}
+
+// Damage passed over before the event taken at `start`.
+void RawLogReader::NoteTaken(std::size_t start) {
+  const bool first = first_event_start_ == kNoStop;
+  if (first) first_event_start_ = start;
+  if ((first && !from_start_) || start <= good_end_) return;
+  skipped_bytes_ += start - good_end_;
+  ++skipped_count_;
+  if (stretches_.size() < kMaxStretches) stretches_.push_back({good_end_, start - good_end_});
+}
+
+bool RawLogReader::Next(RawLogEvent* ev) {
+  std::size_t total = 0;
+  for (;;) {
+    // The sync word: the first place at or after the last event's end where
+    // its four bytes stand (liblcm reads byte by byte until they do).
+    for (;;) {
+      if (!Have(4)) return false;
+      // Where the last event ended, as a whole log has it (memmem's set-up
+      // costs more than the event's own reading).
+      if (std::memcmp(buf_.get() + begin_, kSync, 4) == 0) break;
+      const void* found = ::memmem(buf_.get() + begin_, end_ - begin_, kSync, 4);
+      if (found) {
+        begin_ = static_cast<std::size_t>(static_cast<const std::uint8_t*>(found) - buf_.get());
+        break;
+      }
+      begin_ = end_ - 3;  // a sync word may begin in the last three bytes
+    }
+    if (offset_ + begin_ >= stop_at_) {
+      stopped_ = true;
+      stopped_at_ = offset_ + begin_;
+      return false;
+    }
+    if (WholeEventAt(&total)) break;
+    if (!Have(4)) return false;
+    ++begin_;  // no event starts here: the next sync word after this one
+  }
+  // A whole log has the next event's sync word after this one, or fewer than
+  // four bytes (which liblcm's look for the sync word takes up). (Have may
+  // move the buffer: the pointers into it are taken after.)
+  const std::size_t start = offset_ + begin_;
+  std::size_t end = start + total;
+  if (!Have(total + 4)) end = file_size_;
+  NoteTaken(start);
   const std::uint8_t* h = buf_.get() + begin_ + 4;
   const auto timestamp_us = static_cast<std::int64_t>(BigEndian(h + 8, 8));
   const auto channel_len = static_cast<std::int32_t>(BigEndian(h + 16, 4));
   const auto data_len = static_cast<std::int32_t>(BigEndian(h + 20, 4));
-  if (channel_len <= 0 || channel_len >= 1000 || data_len < 0) return false;
-  const std::size_t total =
-      4 + kHeaderBytes + static_cast<std::size_t>(channel_len) + static_cast<std::size_t>(data_len);
-  if (!Have(total)) return false;
-  // liblcm takes an event only when the next one's sync word follows it, or
-  // fewer than four bytes do (which its look for the sync word takes up).
-  std::size_t end = offset_ + begin_ + total;
-  if (Have(total + 4)) {
-    if (std::memcmp(buf_.get() + begin_ + total, kSync, 4) != 0) return false;
-  } else {
-    end = file_size_;
-  }
   const std::uint8_t* p = buf_.get() + begin_ + 4 + kHeaderBytes;
   ev->timestamp_us = timestamp_us;
   ev->channel = std::string_view(reinterpret_cast<const char*>(p), channel_len);
   ev->data = p + channel_len;
   ev->size = data_len;
-  if (first_event_start_ == kNoStop) first_event_start_ = offset_ + begin_;
   begin_ += total;
   good_end_ = end;
   return true;

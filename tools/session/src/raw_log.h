@@ -4,16 +4,24 @@
 // (docs/sessions.md "The log"): the sync word 0xEDA1DA01 searched for from
 // the start, then the event number, the time (us), the channel's length
 // (1..999) and the data's length (>= 0), big-endian, then the channel and
-// the data; a length out of range, an event cut short, or an event not
-// followed by the next one's sync word (or the file's last bytes) ends the
-// log there, that event not taken. The file is read up to the size it had
-// when opened. An event's channel and data point into the buffer until the
+// the data. Unlike liblcm, which ends the log at the first damage, the
+// reader reads past damage inside the log (docs/sessions.md "A damaged
+// log"): a header whose lengths are out of range, or an event that would
+// run past the file's end, is no event, and the next sync word after its
+// own is looked for; an event followed by bytes that are not the next sync
+// word is taken (its bytes are whole; a message damaged inside fails its
+// decode or its tag further on), and the search for the next sync word
+// skips what follows it. The bytes passed over between events are counted
+// (skipped_bytes, and the places in skipped_stretches); those after the
+// last whole event are not (size() - good_end()). The file is read up to
+// the size it had when opened. An event's channel and data point into the buffer until the
 // next call; a reader skips a channel it does not want by its length alone.
 #include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace rms::session {
 
@@ -58,6 +66,16 @@ class RawLogReader {
   }
   // The start (byte from the file's start) of the first event taken.
   std::size_t first_event_start() const { return first_event_start_; }
+  // Bytes passed over between whole events (and before the first, in a
+  // reader from the file's start): damage inside the log.
+  std::size_t skipped_bytes() const { return skipped_bytes_; }
+  // Where they were: the first kMaxStretches stretches, {from, bytes}.
+  static constexpr std::size_t kMaxStretches = 16;
+  struct Stretch {
+    std::size_t from = 0, bytes = 0;
+  };
+  const std::vector<Stretch>& skipped_stretches() const { return stretches_; }
+  std::size_t skipped_count() const { return skipped_count_; }  // stretches, all of them
 
  private:
   // At least n bytes from begin_ in the buffer: reads on, moving the unread
@@ -76,6 +94,13 @@ class RawLogReader {
   static constexpr std::size_t kNoStop = ~std::size_t{0};
   std::size_t stop_at_ = kNoStop, stopped_at_ = 0, first_event_start_ = kNoStop;
   bool stopped_ = false;
+  bool from_start_ = true;
+  std::size_t skipped_bytes_ = 0, skipped_count_ = 0;
+  std::vector<Stretch> stretches_;
+  // Whether the event whose sync word stands at begin_ is whole: its
+  // lengths in range and all of it in the file; *total its bytes.
+  bool WholeEventAt(std::size_t* total);
+  void NoteTaken(std::size_t start);
 };
 
 }  // namespace rms::session

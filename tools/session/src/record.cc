@@ -153,7 +153,8 @@ struct Source {
 struct Tally {
   std::int64_t events = 0;
   std::map<std::string, std::int64_t> by_channel;
-  std::int64_t unread_bytes = 0;
+  std::int64_t unread_bytes = 0;   // at its end: no whole event
+  std::int64_t skipped_bytes = 0;  // inside it: damage read past
 };
 
 using Counts = std::unordered_map<MessageKey, std::int64_t, MessageKeyHash>;
@@ -170,6 +171,7 @@ std::vector<Tally> CountJournals(const std::vector<JournalFile>& journals, Count
       ++tallies[i].by_channel[std::string(ev.channel)];
     }
     tallies[i].unread_bytes = static_cast<std::int64_t>(r.size() - r.good_end());
+    tallies[i].skipped_bytes = static_cast<std::int64_t>(r.skipped_bytes());
   }
   return tallies;
 }
@@ -209,7 +211,10 @@ bool Advance(Source* s, Counts* held, WireTally* wire) {
 }
 
 nlohmann::ordered_json TallyJson(const Tally& t) {
-  return {{"events", t.events}, {"by_channel", t.by_channel}, {"unread_bytes", t.unread_bytes}};
+  return {{"events", t.events},
+          {"by_channel", t.by_channel},
+          {"unread_bytes", t.unread_bytes},
+          {"skipped_bytes", t.skipped_bytes}};
 }
 
 // What the merge made of its sources.
@@ -248,9 +253,11 @@ Merged Merge(const std::vector<JournalFile>& journals, const std::vector<Tally>&
     out.Write(sources[i].ev);
     if (Advance(&sources[i], held, &m.wire)) next.push(i);
   }
-  if (have_wire)
-    m.wire.heard.unread_bytes = static_cast<std::int64_t>(sources.back().reader->size() -
-                                                          sources.back().reader->good_end());
+  if (have_wire) {
+    const RawLogReader& w = *sources.back().reader;
+    m.wire.heard.unread_bytes = static_cast<std::int64_t>(w.size() - w.good_end());
+    m.wire.heard.skipped_bytes = static_cast<std::int64_t>(w.skipped_bytes());
+  }
   for (const Tally& t : tallies) m.from_journals += t.events;
   m.events = out.events();
   RMS_CHECK(m.events == m.from_journals + m.wire.only);
@@ -332,11 +339,12 @@ nlohmann::ordered_json MakeRecord(const std::string& session_dir, const RecordOp
   const Merged m = Merge(journals, tallies, wire_path, &held, root / "lcmlog");
   std::int64_t missed_total = 0;
   const auto missed = MissedByWire(journals, held, &missed_total);
-  // A journal that ends in bytes that are no whole event (damaged, or cut
+  // A journal that holds bytes that are no event (damaged inside, or cut
   // short by a full disk) is kept, with every other, for whoever looks into
-  // it: what it holds past the damage is not in the record.
-  const bool damaged = std::any_of(tallies.begin(), tallies.end(),
-                                   [](const Tally& t) { return t.unread_bytes > 0; });
+  // it: what the damage held is not in the record.
+  const bool damaged = std::any_of(tallies.begin(), tallies.end(), [](const Tally& t) {
+    return t.unread_bytes > 0 || t.skipped_bytes > 0;
+  });
   const bool keep = options.keep_journals || damaged;
   nlohmann::ordered_json j =
       RecordJson(journals, tallies, m, fs::exists(wire_path), missed, missed_total, keep);

@@ -54,6 +54,19 @@ void SessionLog::Read(std::initializer_list<std::string_view> channels,
   first_us_ = pass.first_us;
   last_us_ = pass.last_us;
   unread_bytes_ = static_cast<std::int64_t>(log.size() - log.good_end());
+  skipped_bytes_ = skipped_places_ = 0;
+  skipped_stretches_.clear();
+  NoteSkipped(log);
+}
+
+void SessionLog::NoteSkipped(const RawLogReader& log) {
+  skipped_bytes_ += static_cast<std::int64_t>(log.skipped_bytes());
+  skipped_places_ += static_cast<std::int64_t>(log.skipped_count());
+  for (const auto& st : log.skipped_stretches()) {
+    if (skipped_stretches_.size() < RawLogReader::kMaxStretches)
+      skipped_stretches_.emplace_back(static_cast<std::int64_t>(st.from),
+                                      static_cast<std::int64_t>(st.bytes));
+  }
 }
 
 void SessionLog::ReadEvents(RawLogReader& log, std::initializer_list<std::string_view> channels,
@@ -109,11 +122,12 @@ bool SessionLog::ReadInTwo(std::initializer_list<std::string_view> channels,
   SenderCheck second_check = check_;
   Pass second{&second_check};
   std::size_t second_start = 0, second_unread = 0;
+  std::optional<RawLogReader> second_reader;
   other->Start([&] {
     RawLogEvent ev;
     RawLogReader start(log_path_);  // the log's first time, for log_time_s
     if (start.Next(&ev)) second.first_us = ev.timestamp_us;
-    RawLogReader log(log_path_, middle);
+    RawLogReader& log = second_reader.emplace(log_path_, middle);
     ReadEvents(log, channels, &second, [&](const LogMessage& m) { visit(1, m); });
     second_start = log.first_event_start();
     second_unread = log.size() - log.good_end();
@@ -133,6 +147,8 @@ bool SessionLog::ReadInTwo(std::initializer_list<std::string_view> channels,
   // began at the first sync word at or after the middle: the same event
   // exactly when both name one place.
   RawLogReader& log = *reader;
+  skipped_bytes_ = skipped_places_ = 0;
+  skipped_stretches_.clear();
   const bool stands = other->Finish() && !other->error() && log.stopped() && second.events > 0 &&
                       log.stopped_at() == second_start;
   if (stands) {
@@ -141,6 +157,15 @@ bool SessionLog::ReadInTwo(std::initializer_list<std::string_view> channels,
     first_us_ = first.first_us;
     last_us_ = second.last_us;
     unread_bytes_ = static_cast<std::int64_t>(second_unread);
+    NoteSkipped(log);
+    if (second_start > log.good_end()) {  // damage just before the second part's first event
+      skipped_bytes_ += static_cast<std::int64_t>(second_start - log.good_end());
+      ++skipped_places_;
+      if (skipped_stretches_.size() < RawLogReader::kMaxStretches)
+        skipped_stretches_.emplace_back(static_cast<std::int64_t>(log.good_end()),
+                                        static_cast<std::int64_t>(second_start - log.good_end()));
+    }
+    NoteSkipped(*second_reader);
     return true;
   }
   log.Resume();  // this thread reads on through the second part
@@ -149,6 +174,7 @@ bool SessionLog::ReadInTwo(std::initializer_list<std::string_view> channels,
   first_us_ = first.first_us;
   last_us_ = first.last_us;
   unread_bytes_ = static_cast<std::int64_t>(log.size() - log.good_end());
+  NoteSkipped(log);
   return false;
 }
 

@@ -656,12 +656,17 @@ std::int64_t Journaled(const nlohmann::json& record, const std::string& channel)
   return n;
 }
 
-// Whether a journal of PROCESS ends in bytes that are no whole event
-// (damaged, or cut where the cut could not be made): its count is short.
+// The bytes of a journal (record.json's entry) that are no event: at its
+// end (cut short) and inside it (damage read past).
+std::int64_t JournalBadBytes(const nlohmann::json& jf) {
+  return RecordCount(jf, {"unread_bytes"}) + RecordCount(jf, {"skipped_bytes"});
+}
+
+// Whether a journal of PROCESS holds bytes that are no event (damaged, or
+// cut where the cut could not be made): its count is short.
 bool JournalDamaged(const nlohmann::json& record, const std::string& process) {
   for (const auto& jf : record["journals"])
-    if (jf.value("process", std::string()) == process && RecordCount(jf, {"unread_bytes"}) > 0)
-      return true;
+    if (jf.value("process", std::string()) == process && JournalBadBytes(jf) > 0) return true;
   return false;
 }
 
@@ -772,14 +777,14 @@ nlohmann::ordered_json TimingJson(const std::map<std::string, nlohmann::json>& s
   return timing;
 }
 
-// Journals that end in bytes that are no whole event (damaged; a disk that
-// filled mid-write and could not be cut back): their counts are what could
-// be read, and what followed is only the network's.
+// Journals that hold bytes that are no event (damaged inside or at the end;
+// a disk that filled mid-write and could not be cut back): their counts are
+// what could be read, and what the damage held is only the network's.
 void AddDamagedJournals(const nlohmann::json& record, nlohmann::ordered_json* r) {
   std::int64_t unread = 0;
   nlohmann::ordered_json damaged = nlohmann::ordered_json::array();
   for (const auto& jf : record["journals"]) {
-    const std::int64_t n = RecordCount(jf, {"unread_bytes"});
+    const std::int64_t n = JournalBadBytes(jf);
     if (n <= 0) continue;
     unread += n;
     damaged.push_back(jf.value("file", std::string()));
@@ -962,6 +967,13 @@ nlohmann::ordered_json LogSection(const LogScan& s, const SessionLog& log,
                                   const std::map<std::string, nlohmann::json>& stats) {
   nlohmann::ordered_json l = LogJson(s);
   l["unread_bytes"] = log.unread_bytes();  // a log cut short or damaged at its end
+  // Damage inside the log, read past (docs/sessions.md "A damaged log").
+  l["skipped_bytes"] = log.skipped_bytes();
+  l["skipped_places"] = log.skipped_places();
+  nlohmann::ordered_json where = nlohmann::ordered_json::array();
+  for (const auto& [from, bytes] : log.skipped_stretches())
+    where.push_back({{"from_byte", from}, {"bytes", bytes}});
+  l["skipped_stretches"] = where;
   l["stats_from_log"] = nlohmann::json::array();
   for (const auto& [p, st] : stats) {
     if (st.value("from_log", false)) l["stats_from_log"].push_back(p);

@@ -71,7 +71,7 @@ struct ResimResult {
   // filled_in): re-simulated, but not checked; said in `note` too.
   long filled_in = 0;
   nlohmann::ordered_json unchecked = nlohmann::ordered_json::array();
-  std::string log_note;     // the log's end is no whole event ("" if it is)
+  std::string log_note;     // the log ends in, or holds, bytes that are no event ("" if not)
   long states_taken = 0;    // logged RMS_DCP_STATE taken (start, restores, resumes)
   long states_checked = 0;  // periodic RMS_DCP_STATE the re-simulated state was checked against
   std::string state_difference;       // the first of those that differed ("" if none)

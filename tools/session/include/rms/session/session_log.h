@@ -106,6 +106,14 @@ class SessionLog {
   // Of the last Read: bytes at the log's end that are no whole event (a log
   // cut short, or garbage after it): left out, and said by its readers.
   std::int64_t unread_bytes() const { return unread_bytes_; }
+  // Of the last Read: bytes passed over inside the log, between whole
+  // events (damage: docs/sessions.md "A damaged log"), in how many places,
+  // and the first few of them ({from byte, bytes}).
+  std::int64_t skipped_bytes() const { return skipped_bytes_; }
+  std::int64_t skipped_places() const { return skipped_places_; }
+  const std::vector<std::pair<std::int64_t, std::int64_t>>& skipped_stretches() const {
+    return skipped_stretches_;
+  }
   SenderCheck& check() { return check_; }
 
  private:
@@ -121,6 +129,9 @@ class SessionLog {
   double rate_hz_ = 30.0;
   SenderCheck check_;
   std::int64_t events_ = 0, first_us_ = -1, last_us_ = -1, unread_bytes_ = 0;
+  std::int64_t skipped_bytes_ = 0, skipped_places_ = 0;
+  std::vector<std::pair<std::int64_t, std::int64_t>> skipped_stretches_;
+  void NoteSkipped(const RawLogReader& log);  // adds the reader's damage
   // Counted by both parts' readers (ReadInTwo); copied with the log.
   struct Count {
     std::atomic<std::int64_t> n = 0;
