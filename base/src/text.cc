@@ -1,6 +1,7 @@
 #include "rms/base/text.h"
 
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -59,6 +60,73 @@ std::string HumanNumber(double v, int decimals) {
   }
   if (s == "-0") s = "0";
   return s;
+}
+
+std::string HtmlText(std::string_view s) {
+  std::string o;
+  o.reserve(s.size());
+  for (char c : s) {
+    switch (c) {
+      case '&':
+        o += "&amp;";
+        break;
+      case '<':
+        o += "&lt;";
+        break;
+      case '>':
+        o += "&gt;";
+        break;
+      case '"':
+        o += "&quot;";
+        break;
+      case '\'':
+        o += "&#39;";
+        break;
+      default:
+        o += c;
+    }
+  }
+  return o;
+}
+
+namespace {
+
+bool IsNumber(std::string_view s) {
+  double v = 0;
+  const auto r = std::from_chars(s.data() + (s.size() > 1 && s[0] == '+'), s.data() + s.size(), v);
+  return r.ec == std::errc() && r.ptr == s.data() + s.size();
+}
+
+}  // namespace
+
+std::string CsvField(std::string_view s) {
+  std::string v(s);
+  if (!v.empty() && std::string_view("=+-@\t\r").find(v[0]) != std::string_view::npos &&
+      !IsNumber(v))
+    v.insert(0, 1, '\'');
+  if (v.find_first_of(",\"\r\n") == std::string::npos) return v;
+  std::string o = "\"";
+  for (char c : v) o += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return o + "\"";
+}
+
+std::string TerminalText(std::string_view s) {
+  std::string o;
+  o.reserve(s.size());
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    const bool c1_utf8 = c == 0xC2 && i + 1 < s.size() &&
+                         static_cast<unsigned char>(s[i + 1]) >= 0x80 &&
+                         static_cast<unsigned char>(s[i + 1]) <= 0x9F;
+    if ((c < 0x20 && c != '\n' && c != '\t') || c == 0x7F) {
+      o += Sprintf("\\x%02x", c);
+    } else if (c1_utf8) {
+      o += Sprintf("\\u%04x", static_cast<unsigned char>(s[++i]));
+    } else {
+      o += static_cast<char>(c);
+    }
+  }
+  return o;
 }
 
 }  // namespace rms

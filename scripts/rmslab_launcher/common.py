@@ -27,11 +27,22 @@ class LabError(Exception):
         self.code = code
 
 
+_CONTROL = re.compile("[\x00-\x08\x0b-\x1f\x7f\x80-\x9f]")
+
+
+def terminal_text(text):
+    """Text safe to print on a terminal (as rms::TerminalText): every control
+    character but LF and TAB as \\xNN, so a name from a message or a folder
+    cannot clear the screen or set the window's title."""
+    return _CONTROL.sub(lambda m: f"\\x{ord(m.group()):02x}", text)
+
+
 def say(*parts):
     """A line for the person at the terminal (stderr, prefixed "lab:"); a
-    terminal that has gone (closed) is no reason to stop."""
+    terminal that has gone (closed) is no reason to stop. Control characters
+    from what it quotes are shown, not obeyed (terminal_text)."""
     try:
-        print("lab: " + " ".join(str(p) for p in parts), file=sys.stderr, flush=True)
+        print(terminal_text("lab: " + " ".join(str(p) for p in parts)), file=sys.stderr, flush=True)
     except OSError:
         pass
 

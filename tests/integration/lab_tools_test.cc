@@ -980,6 +980,63 @@ TEST_F(RecordedSession, ItsReportOpensInABrowserWithPlots) {
       << "charts not drawn: " << dom.substr(dom.find("<body"), 200);
 }
 
+// docs/security.md "Text from messages and folders": a session folder whose
+// manifest's note and subject, and a stats file's name, are markup that
+// once hid the report's sections and charts (`<!--<script>` inside the
+// page's inline script). The report and the comparison show them as text,
+// draw every chart, run no script of theirs, and the CSV keeps a formula a
+// text.
+TEST_F(RecordedSession, AReportAndAComparisonOfAHostileFolderShowTextNotMarkup) {
+  const std::string hostile = *tmp_ + "/hostile";
+  fs::copy(*dir_, hostile, fs::copy_options::recursive);
+  const std::string note = "<!--<script>";
+  const std::string subject = "\"><img src=x onerror=\"document.title='pwned'\">";
+  {
+    auto m = nlohmann::json::parse(ReadFile(hostile + "/manifest.json"));
+    m["note"] = note;
+    m["subject"] = subject;
+    std::ofstream(hostile + "/manifest.json") << m.dump(2);
+  }
+  fs::copy_file(hostile + "/stats/esg_renderer.json", hostile + "/stats/" + note + ".json");
+  auto dom_of = [&](const std::string& page, const std::string& out) {
+    Subprocess chrome({"/usr/bin/chromium", "--headless=new", "--no-sandbox", "--disable-gpu",
+                       "--virtual-time-budget=5000", "--dump-dom", "file://" + page},
+                      out);
+    EXPECT_EQ(chrome.Wait(120), 0);
+    return ReadFile(out);
+  };
+  const ScriptRun r = Script(
+      {SourcePath("scripts/lab"), "report", hostile, "--out", *tmp_ + "/hostile-report.html"},
+      *tmp_ + "/hostile-report.log");
+  ASSERT_EQ(r.rc, 0) << r.out;
+  const std::string html = ReadFile(*tmp_ + "/hostile-report.html");
+  EXPECT_EQ(html.find(note), std::string::npos) << "raw in the page";
+  const std::string dom = dom_of(*tmp_ + "/hostile-report.html", *tmp_ + "/hostile-dom.html");
+  EXPECT_NE(dom.find("data-charts-rendered=\"5\""), std::string::npos)
+      << dom.substr(0, std::min<std::size_t>(dom.size(), 3000));
+  for (const char* section : {"Losses", "Frame times and latency", "&lt;!--&lt;script&gt;"})
+    EXPECT_NE(dom.find(section), std::string::npos) << section;
+  auto title = [](const std::string& d) {
+    const auto a = d.find("<title>");
+    return a == std::string::npos ? std::string() : d.substr(a, d.find("</title>", a) - a);
+  };
+  EXPECT_EQ(title(dom).find("pwned"), std::string::npos) << "the subject's script ran";
+  EXPECT_EQ(dom.find("<img src=\"x\""), std::string::npos) << "the subject is markup";
+  const ScriptRun c = Script({SourcePath("scripts/lab"), "compare", hostile, *dir_, "--no-build",
+                              "--out", *tmp_ + "/hostile-compare"},
+                             *tmp_ + "/hostile-compare.log", 120);
+  ASSERT_EQ(c.rc, 0) << c.out;
+  const std::string cdom =
+      dom_of(*tmp_ + "/hostile-compare/compare.html", *tmp_ + "/hostile-compare-dom.html");
+  EXPECT_EQ(ReadFile(*tmp_ + "/hostile-compare/compare.html").find(note), std::string::npos);
+  const auto at = cdom.find("data-charts-rendered=\"");
+  ASSERT_NE(at, std::string::npos) << "no charts: " << cdom.substr(0, 3000);
+  EXPECT_GT(std::atoi(cdom.c_str() + at + 22), 0);
+  EXPECT_NE(cdom.find("&lt;!--&lt;script&gt;"), std::string::npos);
+  EXPECT_EQ(title(cdom).find("pwned"), std::string::npos) << "the subject's script ran";
+  EXPECT_EQ(cdom.find("<img src=\"x\""), std::string::npos) << "the subject is markup";
+}
+
 // A short timeline run live (3 s), listening on LCM.
 struct Listener {
   explicit Listener(const std::string& url) {
@@ -1161,6 +1218,42 @@ TEST(Monitor, ShowsEveryChannelsTrafficWithRates) {
     EXPECT_EQ(mm[3], "0") << ch << " gaps";
   }
   EXPECT_NE(m.out.find("dynamics_proc"), std::string::npos) << m.out;
+  fs::remove_all(dir);
+}
+
+// A forged process name with terminal escapes (clear the screen, set the
+// window's title, a C1 control): the monitor prints them as text
+// (docs/security.md "Text from messages and folders").
+TEST(Monitor, ShowsAForgedNamesControlCharactersAsText) {
+  const std::string dir = testing::MakeTempDir("monitor_escapes");
+  const std::string url = testing::UniqueLcmUrl(9750);
+  std::atomic<bool> done{false};
+  std::thread forger([&] {
+    transport::LcmOptions o;
+    o.url = url;
+    transport::UdpLcm lcm(o);
+    lcm.SetSender({0, sender_t::PROCESS_TOOL, 4242});
+    process_status_t m{};
+    m.process = "\x1b]0;owned\x07\x1b[2Jforged";
+    m.host =
+        "host\xC2\x9B"
+        "31m";
+    m.pid = 4242;
+    while (!done) {
+      transport::PublishMessage(lcm, wire::channels::kStatus, m);
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+  });
+  const ScriptRun m =
+      Script({SourcePath("scripts/lab"), "monitor", "--lcm-url", url, "--for", "2.5"},
+             dir + "/monitor.log", 30);
+  done = true;
+  forger.join();
+  ASSERT_EQ(m.rc, 0) << m.out;
+  EXPECT_NE(m.out.find("\\x1b]0;owned\\x07\\x1b[2Jforged"), std::string::npos) << m.out;
+  EXPECT_NE(m.out.find("host\\u009b31m"), std::string::npos) << m.out;
+  EXPECT_EQ(m.out.find('\x1b'), std::string::npos) << "an escape reached the terminal";
+  EXPECT_EQ(m.out.find("\xC2\x9B"), std::string::npos) << "a C1 control reached the terminal";
   fs::remove_all(dir);
 }
 

@@ -7,6 +7,7 @@
 #include <functional>
 #include <iostream>
 #include <memory>
+#include <sstream>
 #include <vector>
 
 #include "rms/base/command_line.h"
@@ -46,9 +47,11 @@ Command Summary(CLI::App& app) {
             rms::WriteWholeFile(
                 o->out.empty() ? o->dir + "/summary.json" : o->out,
                 j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
-            if (o->brief)
-              session::PrintBrief(j, std::cout);
-            else
+            if (o->brief) {
+              std::ostringstream brief;  // names from messages: shown, not obeyed
+              session::PrintBrief(j, brief);
+              std::cout << rms::TerminalText(brief.str());
+            } else
               std::cout << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
             // Written, but not to be stood behind: damage inside the log
             // (docs/sessions.md "A damaged log").

@@ -172,6 +172,8 @@ bool Monitor::Status(const void* d, int n, ChannelStats* c) {
     const std::string k(CounterName(c));
     return v.count(k) ? v[k] : 0;
   };
+  // At most kMaxProcesses names (forged statuses cannot grow it without end).
+  if (!processes_.count(m.process) && processes_.size() >= kMaxProcesses) return true;
   processes_[m.process] =
       Sprintf("%-16s on %s (pid %d): frame %lld, published %lld, late %lld, missing %lld%s",
               m.process.c_str(), m.host.c_str(), m.pid, static_cast<long long>(m.frame),
@@ -199,7 +201,9 @@ std::string Monitor::Render() const {
   }
   os << "processes:\n";
   for (const auto& [p, line] : processes_) os << "  " << line << "\n";
-  return os.str();
+  // Names, hosts and checkpoint names come from messages: their control
+  // characters are shown, not obeyed (docs/security.md).
+  return TerminalText(os.str());
 }
 
 std::string Monitor::Run(double for_s) {

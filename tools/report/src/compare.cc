@@ -58,32 +58,8 @@ Session Load(const std::string& dir) {
   return s;
 }
 
-std::string Esc(const std::string& v) {
-  std::string o;
-  for (char c : v) {
-    if (c == '<')
-      o += "&lt;";
-    else if (c == '>')
-      o += "&gt;";
-    else if (c == '&')
-      o += "&amp;";
-    else if (c == '"')
-      o += "&quot;";
-    else
-      o += c;
-  }
-  return o;
-}
-
 std::string Num(const nlohmann::ordered_json& v, int decimals = 3) {
   return v.is_number() ? HumanNumber(v.get<double>(), decimals) : std::string();
-}
-
-std::string CsvField(std::string v) {
-  if (v.find_first_of(",\"\n") == std::string::npos) return v;
-  std::string o = "\"";
-  for (char c : v) o += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return o + "\"";
 }
 
 // The figures of one attempt that the page and the CSV show (the CSV's
@@ -210,18 +186,18 @@ std::string Table(const std::vector<Session>& sessions) {
        "<th>closures not acquiring</th></tr>";
   for (const Session& s : sessions) {
     const auto b = Best(s);
-    h << "<tr><td>" << Esc(s.name) << "</td><td>" << Esc(s.subject) << "</td><td>" << Esc(s.note)
-      << "</td><td>" << Esc(s.kind)
-      << (s.parent.empty() ? "" : " of " + Esc(fs::path(s.parent).filename().string()))
-      << "</td><td>" << Esc(s.started_utc) << "</td><td>" << s.summary["attempts"].size()
+    h << "<tr><td>" << HtmlText(s.name) << "</td><td>" << HtmlText(s.subject) << "</td><td>"
+      << HtmlText(s.note) << "</td><td>" << HtmlText(s.kind)
+      << (s.parent.empty() ? "" : " of " + HtmlText(fs::path(s.parent).filename().string()))
+      << "</td><td>" << HtmlText(s.started_utc) << "</td><td>" << s.summary["attempts"].size()
       << "</td>";
     if (b.is_null()) {
       h << "<td colspan=\"14\">no DCP frame in the log</td></tr>";
       continue;
     }
     const std::string from = b["started_from"].get<std::string>();
-    h << "<td>" << Esc(b["outcome"].get<std::string>())
-      << (from == "start" ? "" : " <b>(from a " + Esc(from) + ")</b>") << "</td>";
+    h << "<td>" << HtmlText(b["outcome"].get<std::string>())
+      << (from == "start" ? "" : " <b>(from a " + HtmlText(from) + ")</b>") << "</td>";
     for (const char* k :
          {"task_time_s", "acquisition_s", "extraction_s", "maneuvering_s", "docking_s"}) {
       h << "<td>" << (b[k].is_null() ? "-" : Num(b[k], 2)) << "</td>";
@@ -311,11 +287,11 @@ Comparison CompareSessions(const std::vector<std::string>& dirs, const std::stri
             ? std::string()
             : "<p>Left off the learning curves (a trial is a fresh start; rms_compare "
               "--all-trials puts them on): " +
-                  Esc(JoinNames(left_off)) +
+                  HtmlText(JoinNames(left_off)) +
                   ": each one's result began with a restore, a reset or a branch.</p>\n")
     << (no_attempt.empty()
             ? std::string()
-            : "<p class=\"bad\">No attempt in the summary of " + Esc(JoinNames(no_attempt)) +
+            : "<p class=\"bad\">No attempt in the summary of " + HtmlText(JoinNames(no_attempt)) +
                   " (its log holds no flight: empty, cut short or damaged; rms_session summary "
                   "says what it read): not on the learning curves.</p>\n")
     << "<div id=\"rms-charts\"></div>\n<script>\nwindow.RMS_COMPARE = " << json

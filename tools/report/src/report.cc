@@ -36,29 +36,6 @@ std::string DefaultChartJsPath() { return "/usr/share/javascript/chart.js/chart.
 
 namespace {
 
-std::string Html(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    switch (c) {
-      case '<':
-        o += "&lt;";
-        break;
-      case '>':
-        o += "&gt;";
-        break;
-      case '&':
-        o += "&amp;";
-        break;
-      case '"':
-        o += "&quot;";
-        break;
-      default:
-        o += c;
-    }
-  }
-  return o;
-}
-
 std::string F(double v, int digits = 3) {
   std::ostringstream os;
   os.setf(std::ios::fixed);
@@ -269,8 +246,8 @@ std::string LossesSection(const nlohmann::ordered_json& s) {
   std::ostringstream h;
   h << "<h2>Losses and refusals</h2>\n<table><tr><th>what</th><th>frames or messages</th></tr>";
   auto row = [&h](const std::string& what, const nlohmann::ordered_json& n) {
-    h << "<tr><td>" << Html(what) << "</td><td>" << (n.is_number() ? n.dump() : std::string("-"))
-      << "</td></tr>";
+    h << "<tr><td>" << HtmlText(what) << "</td><td>"
+      << (n.is_number() ? n.dump() : std::string("-")) << "</td></tr>";
   };
   const auto empty = nlohmann::ordered_json::object();
   auto part = [&empty](const nlohmann::ordered_json& j, const char* a,
@@ -302,11 +279,11 @@ std::string LossesSection(const nlohmann::ordered_json& s) {
 }
 
 std::string StatsRow(const std::string& name, const std::vector<double>& v) {
-  if (v.empty()) return "<tr><td>" + Html(name) + "</td><td colspan=5>none</td></tr>";
+  if (v.empty()) return "<tr><td>" + HtmlText(name) + "</td><td colspan=5>none</td></tr>";
   double mean = 0;
   for (double x : v) mean += x;
   mean /= v.size();
-  return "<tr><td>" + Html(name) + "</td><td>" + std::to_string(v.size()) + "</td><td>" +
+  return "<tr><td>" + HtmlText(name) + "</td><td>" + std::to_string(v.size()) + "</td><td>" +
          F(mean, 2) + "</td><td>" + F(Pct(v, 0.5), 2) + "</td><td>" + F(Pct(v, 0.99), 2) +
          "</td><td>" + F(*std::max_element(v.begin(), v.end()), 2) + "</td></tr>";
 }
@@ -319,8 +296,8 @@ std::string Cell(const nlohmann::ordered_json& v, const char* unit = "", int dec
   if (v.is_null()) return "-";
   if (v.is_number()) return HumanNumber(v.get<double>(), decimals) + unit;
   if (v.is_boolean()) return v.get<bool>() ? "yes" : "no";
-  if (v.is_string()) return Html(v.get<std::string>());
-  return Html(v.dump());
+  if (v.is_string()) return HtmlText(v.get<std::string>());
+  return HtmlText(v.dump());
 }
 
 // A time (session time, s; docs/sessions.md "Session time"): shown rounded
@@ -446,7 +423,7 @@ std::string MalfunctionsSection(const nlohmann::ordered_json& s) {
   std::ostringstream h;
   auto texts = [](const nlohmann::ordered_json& a) {
     std::string out;
-    for (const auto& t : a) out += (out.empty() ? "" : "; ") + Html(t.get<std::string>());
+    for (const auto& t : a) out += (out.empty() ? "" : "; ") + HtmlText(t.get<std::string>());
     return out.empty() ? std::string("-") : out;
   };
   h << "<h2>Malfunctions</h2>\n<p>As the DCP took them (its logged states): each from the DCP "
@@ -500,7 +477,7 @@ std::string ScorecardSection(const nlohmann::ordered_json& s) {
   line("actions by device", [](const auto& c) {
     std::string out;
     for (const auto& [dev, n] : c["inputs"]["actions_by_device"].items())
-      out += (out.empty() ? "" : "<br>") + Html(dev) + ": " + n.dump();
+      out += (out.empty() ? "" : "<br>") + HtmlText(dev) + ": " + n.dump();
     return out.empty() ? std::string("-") : out;
   });
   line("reversals (an axis commanded back the other way)",
@@ -525,7 +502,7 @@ std::string ScorecardSection(const nlohmann::ordered_json& s) {
       cells.push_back(
           b.contains(k) ? b[k]["events"].dump() + ", " + TimeCell(b[k]["duration_s"], "", 2) : "-");
     }
-    h << Row(Html(k), cells);
+    h << Row(HtmlText(k), cells);
   }
   if (kinds.empty()) h << "<tr><td colspan=\"99\">no collision</td></tr>";
   h << "</table>\n";
@@ -555,11 +532,12 @@ std::string TimingSection(const nlohmann::ordered_json& s, const Traces& t) {
       std::string links;
       if (v.contains("latency")) {
         for (const auto& [link, l] : v["latency"].items()) {
-          links += (links.empty() ? "" : "<br>") + Html(link) + ": " + Cell(l["p50_ms"], "", 2) +
-                   " / " + Cell(l["p99_ms"], "", 2) + " / " + Cell(l["max_ms"], "", 2);
+          links += (links.empty() ? "" : "<br>") + HtmlText(link) + ": " +
+                   Cell(l["p50_ms"], "", 2) + " / " + Cell(l["p99_ms"], "", 2) + " / " +
+                   Cell(l["max_ms"], "", 2);
         }
       }
-      h << "<tr><td>" << Html(proc) << "</td><td>"
+      h << "<tr><td>" << HtmlText(proc) << "</td><td>"
         << Cell(v.value("dropped_frames", nlohmann::ordered_json())) << "</td><td>"
         << Cell(v.value("late_frames", nlohmann::ordered_json())) << "</td><td>"
         << Cell(v.value("too_late_dropped", nlohmann::ordered_json())) << "</td><td>"
@@ -603,7 +581,8 @@ std::string FramesSection(const fs::path& root, const fs::path& report_dir, doub
   const fs::path video = root / "session.mp4";
   if (fs::exists(video)) {
     const std::string href = fs::relative(fs::absolute(video), fs::absolute(report_dir)).string();
-    h << "<p>The session's video: <a href=\"" << Html(href) << "\">" << Html(href) << "</a>.</p>\n";
+    h << "<p>The session's video: <a href=\"" << HtmlText(href) << "\">" << HtmlText(href)
+      << "</a>.</p>\n";
   } else {
     h << "<p>No video in the session folder (it was run with --no-video, or the renderer ran on "
          "another host).</p>\n";
@@ -621,7 +600,7 @@ std::string FramesSection(const fs::path& root, const fs::path& report_dir, doub
     if (bytes > 4u << 20) break;
     const std::string stem = p.stem().string();
     const long frame = std::strtol(stem.substr(stem.find('_') + 1).c_str(), nullptr, 10);
-    h << "<figure><img alt=\"" << Html(stem) << "\" src=\"data:image/png;base64,"
+    h << "<figure><img alt=\"" << HtmlText(stem) << "\" src=\"data:image/png;base64,"
       << Base64(ss.str()) << "\"><figcaption>frame " << frame << ", "
       << HumanNumber(frame / rate_hz, 1) << " s</figcaption></figure>";
   }
@@ -686,13 +665,26 @@ const char* kStyle =
 }  // namespace
 
 std::string ScriptJson(const nlohmann::json& j) {
-  std::string s = j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  const std::string s = j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   std::string out;
+  out.reserve(s.size());
   for (std::size_t i = 0; i < s.size(); ++i) {
-    if (s[i] == '<' && i + 1 < s.size() && s[i + 1] == '/')
-      out += "<\\";
-    else
+    // Only inside JSON strings can these stand; as \u escapes they read back
+    // the same and can neither end the script ("</script>"), open a comment
+    // or a script-in-comment ("<!--<script>"), nor end a line in older
+    // JavaScript (U+2028, U+2029: E2 80 A8, E2 80 A9).
+    if (s[i] == '<') {
+      out += "\\u003c";
+    } else if (s[i] == '>') {
+      out += "\\u003e";
+    } else if (s[i] == '&') {
+      out += "\\u0026";
+    } else if (s.compare(i, 3, "\xE2\x80\xA8") == 0 || s.compare(i, 3, "\xE2\x80\xA9") == 0) {
+      out += s[i + 2] == '\xA8' ? "\\u2028" : "\\u2029";
+      i += 2;
+    } else {
       out += s[i];
+    }
   }
   return out;
 }
@@ -750,10 +742,10 @@ std::string MakeReport(const std::string& session_dir, const std::string& chart_
   std::ostringstream h;
   const std::string name = data["title"].get<std::string>();
   h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>rmslab session "
-    << Html(name) << "</title>\n"
+    << HtmlText(name) << "</title>\n"
     << kStyle << "<script>\n"
     << chart_js << "\n</script>\n</head><body>\n";
-  h << "<h1>rmslab session " << Html(name) << "</h1>\n";
+  h << "<h1>rmslab session " << HtmlText(name) << "</h1>\n";
   h << "<p>Made by <code>scripts/lab report</code> from the session folder alone: its LCM log, its "
        "processes' "
        "statistics and its manifest. One self-contained file: the plots are drawn by Chart.js, "

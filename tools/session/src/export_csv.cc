@@ -13,6 +13,7 @@
 
 #include "rms/base/check.h"
 #include "rms/base/config.h"
+#include "rms/base/text.h"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_state_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
@@ -49,14 +50,7 @@ class Csv {
     RMS_CHECK(cells.size() == n_);
     for (std::size_t i = 0; i < cells.size(); ++i) {
       if (i) f_ << ',';
-      const std::string& c = cells[i];
-      if (c.find_first_of(",\"\n") != std::string::npos) {
-        f_ << '"';
-        for (char ch : c) f_ << (ch == '"' ? std::string("\"\"") : std::string(1, ch));
-        f_ << '"';
-      } else {
-        f_ << c;
-      }
+      f_ << CsvField(cells[i]);
     }
     f_ << '\n';
     ++rows_;

@@ -4,6 +4,7 @@
 #include <cstdarg>
 #include <cstdio>
 #include <string>
+#include <string_view>
 
 namespace rms {
 
@@ -20,5 +21,21 @@ std::string HumanNumber(double v, int decimals = 3);
 // written (a full disk shows only at the flush): a tool must not end as if
 // its output were there.
 void WriteWholeFile(const std::string& path, const std::string& text);
+
+// Escaping for the context a string from a message or a session folder
+// lands in (docs/security.md "Text from messages and folders"); each tested
+// with `<!--<script>`, quotes, control characters and invalid UTF-8.
+//
+// HTML text or a quoted attribute's value: & < > " ' as entities.
+std::string HtmlText(std::string_view s);
+// One CSV field (RFC 4180): in quotes, quotes doubled, when it holds a
+// comma, a quote, CR or LF; a text beginning = + - @ TAB or CR that is not
+// a number gets a leading ' (a spreadsheet then takes it as text, not as a
+// formula).
+std::string CsvField(std::string_view s);
+// Text to print on a terminal: every control character (C0 but LF and TAB,
+// and DEL, as \xNN; C1, U+0080..U+009F in UTF-8, as \u00NN), so a forged
+// name cannot clear the screen, set the window's title or move the cursor.
+std::string TerminalText(std::string_view s);
 
 }  // namespace rms

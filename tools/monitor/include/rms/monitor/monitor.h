@@ -39,6 +39,7 @@ class Monitor {
   transport::LcmInterface* lcm_;
   transport::LcmOptions options_;
   std::map<std::string, ChannelStats> channels_;
+  static constexpr std::size_t kMaxProcesses = 64;
   std::map<std::string, std::string> processes_;  // name -> its last status line
 };
 

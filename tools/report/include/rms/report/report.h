@@ -18,7 +18,8 @@ std::string MakeReport(const std::string& session_dir, const std::string& chart_
                        const std::function<void(const std::string&)>& progress = {},
                        const std::string& out_path = "");
 // JSON to embed in a <script> (the report's and the comparison's data):
-// "</" written "<\/" so it cannot end the script.
+// < > & U+2028 U+2029 written as \u escapes, so no string in it can end the
+// script, open a comment in it, or end a line.
 std::string ScriptJson(const nlohmann::json& j);
 // A page's chart script from the source tree (report_charts.js,
 // compare_charts.js), after the helpers they share (chart_page.js): the text
