@@ -1,40 +1,82 @@
 #include "rms/base/text.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sys/stat.h>
 #include <vector>
 
 #include "rms/base/check.h"
+#include "rms/base/folder_file.h"
 
 namespace rms {
 
-void WriteWholeFile(const std::string& path, const std::string& text) {
-  // A regular file (or a new one) is written beside it and renamed over it,
-  // so a failure (a full disk) leaves the old file, or none, never a part;
-  // anything else (a device, a pipe) is written directly.
-  struct stat st {};
-  const bool regular = stat(path.c_str(), &st) != 0 || S_ISREG(st.st_mode);
-  const std::string target = regular ? path + ".tmp" : path;
-  {
-    std::ofstream f(target, std::ios::binary | std::ios::trunc);
-    if (!f) throw InputError("cannot write '" + path + "': " + std::strerror(errno));
-    f << text;
-    f.close();
-    if (!f) {
-      const int err = errno ? errno : EIO;
-      if (regular) std::remove(target.c_str());
+namespace {
+
+// A stream the user named: a FIFO or a device at the path itself, or
+// anything under /dev or /proc (/dev/stdout, /dev/full, /proc/self/fd/N).
+// Written directly; anything else is a file, replaced whole.
+bool IsStream(const std::string& path, const struct stat& st) {
+  return S_ISFIFO(st.st_mode) || S_ISCHR(st.st_mode) || path.rfind("/dev/", 0) == 0 ||
+         path.rfind("/proc/", 0) == 0;
+}
+
+void WriteStream(const std::string& path, const std::string& text) {
+  // A FIFO nobody reads is refused (ENXIO), not waited on.
+  const int fd = open(path.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) {
+    throw InputError("cannot write '" + path + "': " +
+                     (errno == ENXIO ? std::string("a FIFO that nothing reads")
+                                     : std::string(std::strerror(errno))));
+  }
+  fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = write(fd, text.data() + done, text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int err = n < 0 ? errno : EIO;
+      close(fd);
       throw InputError("could not write all of '" + path + "': " + std::strerror(err));
     }
+    done += static_cast<std::size_t>(n);
   }
-  if (regular && std::rename(target.c_str(), path.c_str()) != 0) {
-    const int err = errno;
-    std::remove(target.c_str());
-    throw InputError("could not write '" + path + "': " + std::strerror(err));
+  if (close(fd) != 0)
+    throw InputError("could not write all of '" + path + "': " + std::strerror(errno));
+}
+
+}  // namespace
+
+void WriteWholeFile(const std::string& path, const std::string& text) {
+  struct stat st {};
+  if (lstat(path.c_str(), &st) == 0 && IsStream(path, st)) {
+    WriteStream(path, text);
+    return;
   }
+  // A fresh temporary file beside it (O_EXCL | O_NOFOLLOW), renamed over
+  // its name only when whole: a failure (a full disk) leaves the old file,
+  // or none, never a part, and a link planted at the name (or at a
+  // temporary name) is replaced, never written through.
+  const std::filesystem::path p(path);
+  const std::string dir = p.has_parent_path() ? p.parent_path().string() : ".";
+  OutputFolder out(dir, Links::kFollow);
+  const int fd = out.Begin(p.filename().string());
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = write(fd, text.data() + done, text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0)
+      throw InputError("could not write all of '" + path +
+                       "': " + std::strerror(n < 0 ? errno : EIO));
+    done += static_cast<std::size_t>(n);
+  }
+  out.Commit();
 }
 
 std::string Sprintf(const char* format, ...) {

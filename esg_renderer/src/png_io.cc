@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "rms/base/folder_file.h"
+
 namespace rms::esg_renderer {
 
 namespace {
@@ -70,10 +72,17 @@ std::vector<std::uint8_t> EncodePng(int width, int height, const std::uint8_t* r
 }
 
 Image ReadPng(const std::string& path) {
+  // A regular file of bounded size (docs/security.md "Session folders are
+  // untrusted"), of bounded dimensions.
+  const std::string bytes = ReadRegularFile(path, "a PNG", kMaxPngBytes);
   png_image img{};
   img.version = PNG_IMAGE_VERSION;
-  if (!png_image_begin_read_from_file(&img, path.c_str())) {
+  if (!png_image_begin_read_from_memory(&img, bytes.data(), bytes.size())) {
     throw std::runtime_error("cannot read PNG '" + path + "': " + img.message);
+  }
+  if (img.width > 8192 || img.height > 8192) {
+    png_image_free(&img);
+    throw std::runtime_error("cannot read PNG '" + path + "': larger than 8192 x 8192");
   }
   img.format = PNG_FORMAT_RGB;
   Image out;

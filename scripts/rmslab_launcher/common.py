@@ -4,10 +4,13 @@ multicast route, reading configuration (TOML, with Python's tomllib).
 docs/sessions.md "The launcher" describes what scripts/lab does; this
 package is that launcher.
 """
+import errno
 import hashlib
+import json
 import os
 import re
 import shutil
+import stat
 import subprocess
 import sys
 import tomllib
@@ -35,6 +38,52 @@ def terminal_text(text):
     character but LF and TAB as \\xNN, so a name from a message or a folder
     cannot clear the screen or set the window's title."""
     return _CONTROL.sub(lambda m: f"\\x{ord(m.group()):02x}", text)
+
+
+# Limits for each kind of a session folder's files (as rms/base/folder_file.h).
+MAX_CONFIG_BYTES = 1 << 20
+MAX_JSON_BYTES = 64 << 20
+
+
+def read_folder_file(path, limit, what=None):
+    """The bytes of a session folder's file, read as untrusted input
+    (docs/security.md "Session folders are untrusted"): no link followed, a
+    regular file only (a FIFO or a device is refused, not waited on or read
+    without end), at most `limit` bytes. LabError naming the file otherwise."""
+    what = what or os.path.basename(path)
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
+    except OSError as e:
+        why = "a link, not followed" if e.errno == errno.ELOOP else e.strerror
+        raise LabError(f"cannot read {what} '{path}': {why}", 2)
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            raise LabError(f"cannot read {what} '{path}': not a regular file (a FIFO, a device or a folder)", 2)
+        if st.st_size > limit:
+            raise LabError(f"cannot read {what} '{path}': {st.st_size} bytes, more than {limit}", 2)
+        data = os.read(fd, limit + 1)
+        while len(data) <= limit:
+            more = os.read(fd, limit + 1 - len(data))
+            if not more:
+                break
+            data += more
+        if len(data) > limit:
+            raise LabError(f"cannot read {what} '{path}': more than {limit} bytes", 2)
+        return data
+    finally:
+        os.close(fd)
+
+
+def read_folder_json(path, limit=MAX_JSON_BYTES):
+    """A session folder's JSON file (read_folder_file), or {} when it is
+    missing or not JSON; LabError when it is there but not a regular file."""
+    if not os.path.lexists(path):
+        return {}
+    try:
+        return json.loads(read_folder_file(path, limit))
+    except ValueError:
+        return {}
 
 
 def say(*parts):
@@ -66,9 +115,18 @@ def write_run_file(path, text, append=True):
 
 
 def file_sha256(path):
-    """The SHA-256 of a file, hex (as sha256sum prints it)."""
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
+    """The SHA-256 of a session folder's file, hex (as sha256sum prints it):
+    a regular file only, no link followed (a FIFO or a device is refused, not
+    waited on or hashed without end: LabError naming it)."""
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
+    except OSError as e:
+        raise LabError(f"cannot read '{path}': {'a link, not followed' if e.errno == errno.ELOOP else e.strerror}",
+                       2)
+    with os.fdopen(fd, "rb") as f:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise LabError(f"cannot read '{path}': not a regular file (a FIFO, a device or a folder)", 2)
+        h = hashlib.sha256()
         for block in iter(lambda: f.read(1 << 20), b""):
             h.update(block)
     return h.hexdigest()
@@ -116,8 +174,14 @@ def ensure_multicast_route():
         raise LabError("could not add the route (needs root or sudo). Add it by hand, then run again.", 1)
 
 
-def read_toml(path, what):
+def read_toml(path, what, folder_file=False):
+    """A TOML file, parsed. folder_file: a session folder's (read_folder_file:
+    no link, a regular file of at most 1 MiB); else one the user named."""
     try:
+        if folder_file:
+            if not os.path.lexists(path):
+                raise FileNotFoundError(path)
+            return tomllib.loads(read_folder_file(path, MAX_CONFIG_BYTES, what).decode())
         with open(path, "rb") as f:
             return tomllib.load(f)
     except FileNotFoundError:

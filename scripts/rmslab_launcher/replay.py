@@ -7,24 +7,21 @@ exit 0 only if all are identical."""
 import argparse
 import json
 import os
-import shutil
 import signal
 import subprocess
 import time
 
 from . import disk, session
-from .common import (DEFAULT_REPLAY_URL, LabError, binary, check_lcm_url, check_speed, ensure_multicast_route,
-                     install_and_build, require_built, say)
+from .common import (DEFAULT_REPLAY_URL, MAX_CONFIG_BYTES, LabError, binary, check_lcm_url, check_speed,
+                     ensure_multicast_route, install_and_build, read_folder_file, read_folder_json, require_built,
+                     say)
 from .hosts import Host
 from .supervisor import Spec, Supervisor
 
 
 def manifest(path):
-    try:
-        with open(os.path.join(path, "manifest.json")) as f:
-            return json.load(f)
-    except (OSError, ValueError):
-        return {}
+    """The recorded session's manifest, read as untrusted (read_folder_json)."""
+    return read_folder_json(os.path.join(path, "manifest.json"))
 
 
 class Replay:
@@ -51,7 +48,12 @@ class Replay:
         out = a.out or os.path.join(self.src, "replay-" + time.strftime("%Y%m%dT%H%M%SZ", time.gmtime()))
         self.out = session.make_folder(out, self.src)
         os.makedirs(os.path.join(self.out, "journal"), exist_ok=True)
-        shutil.copyfile(os.path.join(self.src, "config.toml"), os.path.join(self.out, "config.toml"))
+        # Its configuration, read as untrusted: a link, a FIFO or /dev/zero
+        # there is refused, not copied without end (docs/security.md).
+        config = read_folder_file(os.path.join(self.src, "config.toml"), MAX_CONFIG_BYTES,
+                                  "the session's configuration")
+        with open(os.path.join(self.out, "config.toml"), "wb") as f:
+            f.write(config)
         with open(os.path.join(self.out, "run", "pilot"), "w") as f:
             f.write("replay\n")
         fields = [("--pilot", "replay"), ("--lcm-url", a.lcm_url), ("--command", f"scripts/lab replay {self.src}"),
@@ -65,9 +67,10 @@ class Replay:
         if key:
             fields.append(("--message-auth", session.MESSAGE_AUTH))
         session.write_manifest(self.out, fields)
-        summary = json.load(open(os.path.join(self.src, "summary.json"))) if os.path.exists(
-            os.path.join(self.src, "summary.json")) else {}
-        self.duration = float(summary.get("duration_s", 0) or 0)
+        summary = read_folder_json(os.path.join(self.src, "summary.json"))
+        # The log plays at its recorded pace: its wall time, not its session
+        # time (a session flown at --speed 2 has half as much).
+        self.duration = float(summary.get("wall_duration_s", 0) or summary.get("duration_s", 0) or 0)
         rate = 30.0 * self.speed
         self.bytes_per_s = disk.session_bytes_per_s(rate, a.width, a.height, a.png_every, not a.no_video)
         disk.check_room(self.out, self.bytes_per_s, (self.duration or 120) / self.speed, "the replay")
@@ -157,6 +160,8 @@ class Replay:
             return 1
         say(f"replay done: {self.out} (lcmlog, frames/{'' if self.a.no_video else ', session.mp4'})")
         r = subprocess.run([binary("tools/rms_session"), "compare-esg", self.src, self.out], capture_output=True, text=True)
+        if r.returncode != 0 and r.stderr.strip():
+            say("compare-esg: " + r.stderr.strip())
         with open(os.path.join(self.out, "replay_comparison.json"), "w") as f:
             f.write(r.stdout)
         if r.returncode == 0:

@@ -29,7 +29,7 @@ import time
 import tomllib
 
 from . import sweep_cache, sweep_table
-from .common import BUILD, ROOT, LabError, binary, file_sha256, install_and_build, read_toml, say
+from .common import BUILD, ROOT, LabError, binary, file_sha256, install_and_build, read_folder_json, read_toml, say
 
 CELL = os.path.join(ROOT, "scripts", "sweep-cell")
 NETNS_LOGIN = os.path.join(ROOT, "scripts", "rmslab_launcher", "netns-login")
@@ -161,16 +161,13 @@ class Session:
         if os.path.getsize(os.path.join(self.path, "lcmlog")) == 0:
             raise LabError(f"{path}: its lcmlog is empty: nothing to re-simulate")
         self.real = os.path.realpath(self.path)
-        self.config = read_toml(os.path.join(self.path, "config.toml"), "the session's configuration")
+        self.config = read_toml(os.path.join(self.path, "config.toml"), "the session's configuration",
+                                folder_file=True)
         self.log_sha = file_sha256(os.path.join(self.path, "lcmlog"))
         self.subject = ""
-        try:
-            with open(os.path.join(self.path, "manifest.json")) as f:
-                m = json.load(f)
-            if isinstance(m, dict) and isinstance(m.get("subject"), str):
-                self.subject = m["subject"]
-        except (OSError, ValueError):
-            pass
+        m = read_folder_json(os.path.join(self.path, "manifest.json"))
+        if isinstance(m, dict) and isinstance(m.get("subject"), str):
+            self.subject = m["subject"]
 
 
 def make_cells(sessions, grid, version):

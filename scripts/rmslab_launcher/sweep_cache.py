@@ -3,12 +3,28 @@ file a cell, named by its key (the SHA-256 of the session's log, of its
 effective configuration and of the software). Written atomically under a
 unique temporary name, so sweeps sharing a cache cannot trip each other; an
 entry that cannot be read or is not a cell's result counts as missing (the
-cell runs again and the entry is written anew)."""
+cell runs again and the entry is written anew).
+
+An entry is untrusted (docs/security.md "Session folders are untrusted"):
+it is read only as a regular file of at most 16 MiB (a link, a FIFO or a
+device is refused, not followed, waited on or read without end), and it
+carries its key and the SHA-256 of its result: an entry whose key is not
+its name's or whose result does not match its checksum (edited by hand,
+or damaged) is refused, said, and made again."""
+import hashlib
 import json
 import os
 import tempfile
 
-from .common import LabError
+from .common import LabError, read_folder_file
+
+MAX_ENTRY_BYTES = 16 << 20
+ENTRY_FORMAT = "rmslab-sweep-cell-1"
+
+
+def _checksum(res):
+    """The SHA-256 of a result's canonical JSON."""
+    return hashlib.sha256(json.dumps(res, sort_keys=True, separators=(",", ":")).encode()).hexdigest()
 
 class CannotWrite(LabError):
     """An entry could not be written (a full disk, a folder taken away)."""
@@ -92,13 +108,25 @@ class Cache:
     def load(self, key):
         """The cell's cached result, or None (missing, or unusable: noted)."""
         p = self.path(key)
-        try:
-            with open(p) as f:
-                res = json.load(f)
-        except FileNotFoundError:
+        if not os.path.lexists(p):
             return None
-        except (OSError, ValueError, RecursionError) as e:
+        try:
+            entry = json.loads(read_folder_file(p, MAX_ENTRY_BYTES, "a cache entry"))
+        except LabError as e:
+            self.unreadable.append((p, str(e)))
+            return None
+        except (ValueError, RecursionError) as e:
             self.unreadable.append((p, f"cannot be read ({type(e).__name__}: {str(e)[:80]})"))
+            return None
+        if not isinstance(entry, dict) or entry.get("format") != ENTRY_FORMAT:
+            self.unreadable.append((p, "not a checksummed entry (edited, or written by an older rmslab)"))
+            return None
+        res = entry.get("result")
+        if entry.get("key") != key:
+            self.unreadable.append((p, "its key is not its name's (another cell's entry, renamed)"))
+            return None
+        if entry.get("sha256") != _checksum(res):
+            self.unreadable.append((p, "its result does not match its checksum (edited by hand, or damaged)"))
             return None
         why = valid_result(res)
         if why:
@@ -111,7 +139,8 @@ class Cache:
         try:
             os.fchmod(fd, 0o666 & ~_UMASK)
             with os.fdopen(fd, "w") as f:
-                f.write(json.dumps(res))  # (json.dump's text, by the C encoder: it does not use it)
+                entry = {"format": ENTRY_FORMAT, "key": key, "sha256": _checksum(res), "result": res}
+                f.write(json.dumps(entry))  # (json.dump's text, by the C encoder: it does not use it)
             os.replace(tmp, self.path(key))
         except OSError as e:
             try:

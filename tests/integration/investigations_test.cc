@@ -22,6 +22,7 @@
 #include <regex>
 #include <set>
 #include <sstream>
+#include <sys/stat.h>
 #include <tuple>
 
 #include "live_session.h"
@@ -476,6 +477,30 @@ TEST_F(Investigations, ARerunOrAResumedSweepRedoesNothingFinished) {
     if (spoiled < 2) std::ofstream(e.path()) << (spoiled++ == 0 ? "garbage" : "[]");
   }
   EXPECT_FALSE(Lines(again(2, 10), "its cell is run again").empty());
+  // An entry edited by hand (its result changed, still a valid result), one
+  // linked to /dev/zero and one a FIFO (docs/security.md "Session folders
+  // are untrusted"): each refused and said, promptly, its cell run again,
+  // the table the same.
+  std::vector<fs::path> entries;
+  for (const auto& e : fs::directory_iterator(cache))
+    if (e.path().extension() == ".json") entries.push_back(e.path());
+  ASSERT_GE(entries.size(), 3u);
+  {
+    auto j = nlohmann::json::parse(ReadFile(entries[0].string()));
+    ASSERT_TRUE(j.contains("result")) << j.dump();
+    j["result"]["outcome"]["docked"] = !j["result"]["outcome"]["docked"].get<bool>();
+    std::ofstream(entries[0]) << j.dump();
+  }
+  fs::remove(entries[1]);
+  fs::create_symlink("/dev/zero", entries[1]);
+  fs::remove(entries[2]);
+  ASSERT_EQ(mkfifo(entries[2].c_str(), 0644), 0);
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::string said = again(3, 9);
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(240)) << "it waited";
+  EXPECT_NE(said.find("does not match its checksum"), std::string::npos) << said;
+  EXPECT_NE(said.find("a link, not followed"), std::string::npos) << said;
+  EXPECT_NE(said.find("not a regular file"), std::string::npos) << said;
   // A wider grid runs only its new cells.
   const ScriptRun wider =
       Script({SourcePath("scripts/lab"), "sweep", *a_, *b_, "--vary", "dcp.tpob_ft=0.2,0.3,0.4,0.5",

@@ -713,7 +713,9 @@ TEST(SessionSecurity, ADiskThatFillsStopsTheSessionAndTheSummaryIsWrittenElsewhe
   fs::remove(where);
 }
 
-// Every tool exits non-zero when it cannot write its output whole.
+// Every tool exits non-zero when it cannot write its output whole; an
+// export cut by a full disk keeps none of its files (docs/sessions.md
+// "Export"), and the last export's stand as they were.
 TEST(SessionSecurity, ToolsExitNonZeroWhenTheirOutputCannotBeWritten) {
   const std::string tmp = testing::MakeTempDir("dev_full");
   LiveSession s(tmp, testing::UniqueLcmUrl(8700),
@@ -723,11 +725,105 @@ TEST(SessionSecurity, ToolsExitNonZeroWhenTheirOutputCannotBeWritten) {
   const auto sum = Script({tool, "summary", s.out(), "--out", "/dev/full"}, tmp + "/t1.log", 60);
   EXPECT_NE(sum.rc, 0) << sum.out;
   EXPECT_NE(sum.out.find("/dev/full"), std::string::npos) << sum.out;
-  fs::create_directories(tmp + "/csv");
-  fs::create_symlink("/dev/full", tmp + "/csv/dcp_telemetry.csv");
-  const auto exp = Script({tool, "export", s.out(), "--out", tmp + "/csv"}, tmp + "/t2.log", 60);
-  EXPECT_NE(exp.rc, 0) << exp.out;
-  EXPECT_NE(exp.out.find("dcp_telemetry.csv"), std::string::npos) << exp.out;
+  {
+    SmallDisk disk(tmp + "/small", 1);
+    if (!disk.mounted()) {
+      std::printf("not root: the export onto a full disk not tried\n");
+    } else {
+      // Room for about 100 KiB more: less than this export needs.
+      std::ofstream(tmp + "/small/pad") << std::string(900 * 1024, 'x');
+      std::ofstream(tmp + "/small/dcp_telemetry.csv") << "the last export's\n";
+      const auto exp =
+          Script({tool, "export", s.out(), "--out", tmp + "/small"}, tmp + "/t2.log", 60);
+      EXPECT_NE(exp.rc, 0) << exp.out;
+      EXPECT_NE(exp.out.find(".csv"), std::string::npos) << exp.out;
+      EXPECT_NE(exp.out.find("none of this export's files were kept"), std::string::npos)
+          << exp.out;
+      std::set<std::string> left;
+      for (const auto& e : fs::directory_iterator(tmp + "/small"))
+        left.insert(e.path().filename().string());
+      EXPECT_EQ(left, (std::set<std::string>{"dcp_telemetry.csv", "pad"})) << "a part left";
+      EXPECT_EQ(ReadFile(tmp + "/small/dcp_telemetry.csv"), "the last export's\n");
+    }
+  }
+  fs::remove_all(tmp);
+}
+
+// docs/security.md "Session folders are untrusted": links, FIFOs and
+// devices planted in a session's folder are refused by every tool that
+// reads it, promptly and saying which file; outputs are never written
+// through a link planted at their names; nothing is written outside.
+TEST(SessionSecurity, ToolsTreatASessionFolderAsUntrusted) {
+  const std::string tmp = testing::MakeTempDir("untrusted");
+  LiveSession s(tmp, testing::UniqueLcmUrl(8710),
+                {"--timeline", SourcePath("scripts/timelines/short.tl")});
+  ASSERT_EQ(s.Wait(120), 0) << ReadFile(s.log());
+  const std::string tool = testing::BuildPath("tools/rms_session");
+  const std::string secret = tmp + "/secret";
+  std::ofstream(secret) << "SECRET-CONTENT\n";
+  fs::create_directories(tmp + "/elsewhere");
+  auto copy = [&](const std::string& name) {
+    std::string d = tmp + "/" + name;
+    fs::copy(s.out(), d, fs::copy_options::recursive);
+    return d;
+  };
+  // Outputs at planted links: replaced, not written through.
+  {
+    const std::string d = copy("links");
+    for (const char* f : {"/report.html", "/summary.json", "/csv"}) fs::remove_all(d + f);
+    fs::create_symlink(secret, d + "/report.html");
+    fs::create_symlink(secret, d + "/summary.json");
+    fs::create_directory_symlink(tmp + "/elsewhere", d + "/csv");
+    fs::create_directories(d + "/frames");
+    fs::create_symlink(secret, d + "/frames/frame_000001.png");  // a frame linked to a secret
+    const auto rep =
+        Script({SourcePath("scripts/lab"), "report", d, "--no-build"}, tmp + "/report.log", 120);
+    EXPECT_EQ(rep.rc, 0) << rep.out;
+    EXPECT_FALSE(fs::is_symlink(d + "/report.html"));
+    EXPECT_EQ(ReadFile(d + "/report.html").find("U0VDUkVU"), std::string::npos)
+        << "the secret, base64, in the report";
+    EXPECT_NE(ReadFile(d + "/report.html").find("a link, not followed"), std::string::npos);
+    const auto sum = Script({tool, "summary", d}, tmp + "/summary.log", 60);
+    EXPECT_EQ(sum.rc, 0) << sum.out;
+    EXPECT_FALSE(fs::is_symlink(d + "/summary.json"));
+    const auto exp = Script({tool, "export", d}, tmp + "/export.log", 60);
+    EXPECT_NE(exp.rc, 0) << exp.out;
+    EXPECT_NE(exp.out.find("a link or a file, not a folder"), std::string::npos) << exp.out;
+    EXPECT_EQ(ReadFile(secret), "SECRET-CONTENT\n");
+    EXPECT_TRUE(fs::is_empty(tmp + "/elsewhere"));
+  }
+  // Inputs that are not regular files: refused at once, naming the file.
+  struct Case {
+    std::string file, kind;
+  };
+  for (const Case& c :
+       {Case{"config.toml", "fifo"}, Case{"config.toml", "zero"}, Case{"lcmlog", "fifo"},
+        Case{"manifest.json", "link"}, Case{"run/pids", "fifo"}}) {
+    SCOPED_TRACE(c.file + " as a " + c.kind);
+    const std::string d = copy("in-" + c.kind + "-" + fs::path(c.file).filename().string());
+    fs::remove(d + "/" + c.file);
+    if (c.kind == "fifo") {
+      ASSERT_EQ(mkfifo((d + "/" + c.file).c_str(), 0600), 0);
+    }
+    if (c.kind == "zero") fs::create_symlink("/dev/zero", d + "/" + c.file);
+    if (c.kind == "link") fs::create_symlink(s.out() + "/" + c.file, d + "/" + c.file);
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto sum = Script({tool, "summary", d, "--out", tmp + "/x.json"}, tmp + "/in.log", 60);
+    EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(30)) << "it waited";
+    EXPECT_NE(sum.rc, 0) << sum.out;
+    EXPECT_NE(sum.out.find(c.file), std::string::npos) << sum.out;
+    if (c.file == "config.toml") {  // a replay once copied /dev/zero without end
+      const auto rep = Script({SourcePath("scripts/lab"), "replay", d, "--no-build", "--out",
+                               d + "-replay", "--no-video", "--png-every", "0"},
+                              tmp + "/replay.log", 60);
+      EXPECT_EQ(rep.rc, 2) << rep.out;
+      EXPECT_NE(rep.out.find("config.toml"), std::string::npos) << rep.out;
+      std::error_code ec;
+      EXPECT_LT(
+          fs::exists(d + "-replay/config.toml") ? fs::file_size(d + "-replay/config.toml", ec) : 0,
+          1u << 20);
+    }
+  }
   fs::remove_all(tmp);
 }
 

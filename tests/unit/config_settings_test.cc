@@ -136,16 +136,15 @@ TEST(ReadTextFile, SaysWhyAFileCannotBeRead) {
     }
     return std::string("(read)");
   };
-  EXPECT_EQ(why(dir + "/config.toml"),
-            "cannot read the configuration file '" + dir + "/config.toml': it is a folder");
+  EXPECT_EQ(why(dir + "/config.toml"), "cannot read the configuration file '" + dir +
+                                           "/config.toml': a folder, not a regular file");
   EXPECT_EQ(why(dir + "/none.toml"), "cannot read the configuration file '" + dir +
                                          "/none.toml': No such file or directory");
   std::ofstream(dir + "/ok.toml") << "a = 1\n";
   EXPECT_EQ(ReadTextFile(dir + "/ok.toml", "x"), "a = 1\n");
-  // A device without end is refused once past the limit, not read on.
+  // A device without end is refused before it is read.
   EXPECT_EQ(why("/dev/zero"),
-            "cannot read the configuration file '/dev/zero': it is larger than 64 MiB (not a "
-            "text file of this kind?)");
+            "cannot read the configuration file '/dev/zero': a device, not a regular file");
   std::filesystem::remove_all(dir);
 }
 

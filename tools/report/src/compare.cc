@@ -10,6 +10,7 @@
 #include "rms/base/check.h"
 #include "rms/base/text.h"
 #include "rms/report/report.h"
+#include "rms/session/session_folder.h"
 #include "rms/session/session_summary.h"
 
 namespace fs = std::filesystem;
@@ -34,9 +35,11 @@ Session Load(const std::string& dir) {
   s.name = fs::absolute(dir).lexically_normal().filename().string();
   if (s.name.empty())
     s.name = fs::absolute(dir).lexically_normal().parent_path().filename().string();
-  if (std::ifstream f(fs::path(dir) / "manifest.json"); f) {
+  std::error_code ec;
+  if (fs::exists(fs::symlink_status(fs::path(dir) / "manifest.json", ec))) {
     try {
-      const auto m = nlohmann::json::parse(f);
+      const auto m =
+          nlohmann::json::parse(session::ReadSessionFile(dir, "manifest.json", kMaxJsonBytes));
       s.subject = m.value("subject", "");
       s.note = m.value("note", "");
       s.kind = m.value("kind", "live");

@@ -21,6 +21,7 @@
 #include "rms/operator_input_t.hpp"
 #include "rms/operator_state_t.hpp"
 #include "rms/process_status_t.hpp"
+#include "rms/session/session_folder.h"
 #include "rms/session/session_log.h"
 #include "rms/session/session_summary.h"
 #include "rms/session_control_t.hpp"
@@ -317,9 +318,11 @@ std::string Row(const std::string& th, const std::vector<std::string>& cells) {
 }
 
 nlohmann::ordered_json ReadManifest(const fs::path& root) {
-  if (std::ifstream mf(root / "manifest.json"); mf) {
+  std::error_code ec;
+  if (fs::exists(fs::symlink_status(root / "manifest.json", ec))) {
     try {
-      return nlohmann::ordered_json::parse(mf);
+      return nlohmann::ordered_json::parse(
+          session::ReadSessionFile(root.string(), "manifest.json", kMaxJsonBytes));
     } catch (const std::exception&) {
     }
   }
@@ -593,16 +596,20 @@ std::string FramesSection(const fs::path& root, const fs::path& report_dir, doub
   h << "<div class=\"thumbs\">";
   for (std::size_t i = 0; i < n; ++i) {
     const fs::path& p = pngs[n == 1 ? 0 : i * (pngs.size() - 1) / (n - 1)];
-    std::ifstream f(p, std::ios::binary);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    bytes += ss.str().size();
+    std::string png;
+    try {  // a frame is read only as a regular file of the folder (docs/security.md)
+      png = ReadRegularFile(p.string(), "a PNG frame", kMaxPngBytes);
+    } catch (const InputError& e) {
+      h << "<p class=\"bad\">Left out: " << HtmlText(e.what()) << "</p>";
+      continue;
+    }
+    bytes += png.size();
     if (bytes > 4u << 20) break;
     const std::string stem = p.stem().string();
     const long frame = std::strtol(stem.substr(stem.find('_') + 1).c_str(), nullptr, 10);
-    h << "<figure><img alt=\"" << HtmlText(stem) << "\" src=\"data:image/png;base64,"
-      << Base64(ss.str()) << "\"><figcaption>frame " << frame << ", "
-      << HumanNumber(frame / rate_hz, 1) << " s</figcaption></figure>";
+    h << "<figure><img alt=\"" << HtmlText(stem) << "\" src=\"data:image/png;base64," << Base64(png)
+      << "\"><figcaption>frame " << frame << ", " << HumanNumber(frame / rate_hz, 1)
+      << " s</figcaption></figure>";
   }
   h << "</div>\n";
   return h.str();
@@ -647,11 +654,10 @@ std::string ReadText(const std::string& path, const char* what) {
 }
 
 LabConfig SessionConfig(const fs::path& root) {
-  try {
-    return LoadConfig((root / "config.toml").string());
-  } catch (const std::exception&) {
-    return LoadConfig(DefaultConfigPath());
-  }
+  std::error_code ec;
+  if (!fs::exists(fs::symlink_status(root / "config.toml", ec)))
+    return LoadConfig(DefaultConfigPath());  // a session kept without its configuration
+  return session::LoadSessionConfig(root.string());
 }
 
 const char* kStyle =

@@ -63,8 +63,8 @@ class RecordedSession {
     std::call_once(summary_once_, [this] {
       const fs::path session(dir_);
       try {
-        summary_ = nlohmann::json::parse(
-            ReadTextFile((session / "summary.json").string(), "the session's summary"));
+        summary_ =
+            nlohmann::json::parse(session::ReadSessionFile(dir_, "summary.json", kMaxJsonBytes));
       } catch (const std::exception&) {
         summary_ = session::Summarize(dir_);
       }
@@ -80,16 +80,15 @@ class RecordedSession {
   const ConfigDesigns& config_designs() const {
     std::call_once(designs_once_, [this] {
       const std::string path = (fs::path(dir_) / "config.toml").string();
-      designs_ =
-          std::make_unique<const ConfigDesigns>(ReadTextFile(path, "the configuration file"), path);
+      designs_ = std::make_unique<const ConfigDesigns>(
+          session::ReadSessionFile(dir_, "config.toml", kMaxConfigBytes), path);
     });
     return *designs_;
   }
   // Its config.toml's keys.
   const std::optional<ConfigKeys>& config_keys() const {
     std::call_once(config_keys_once_, [this] {
-      config_keys_ = FlattenConfig(
-          ReadTextFile((fs::path(dir_) / "config.toml").string(), "the session's configuration"));
+      config_keys_ = FlattenConfig(session::ReadSessionFile(dir_, "config.toml", kMaxConfigBytes));
     });
     return config_keys_;
   }
@@ -135,7 +134,7 @@ std::string ReadBranch(const nlohmann::json& b, ResimOptions* parent) {
   {
     double rate = 0;
     try {
-      rate = LoadConfig((fs::path(parent->session) / "config.toml").string()).session.frame_rate_hz;
+      rate = session::LoadSessionConfig(parent->session).session.frame_rate_hz;
     } catch (const std::exception&) {
       return "";  // the prefix's own run says what is wrong with the parent
     }
@@ -365,8 +364,8 @@ void WriteNewSession(const RecordedSession& recorded, const std::string& config_
   mf.suffix = recorded.recording().suffix;
   if (fs::exists(session / "manifest.json")) {
     try {
-      const auto parent =
-          nlohmann::json::parse(std::ifstream((session / "manifest.json").string()));
+      const auto parent = nlohmann::json::parse(
+          session::ReadSessionFile(recorded.dir(), "manifest.json", kMaxJsonBytes));
       mf.subject = parent.value("subject", "");
       mf.note = parent.value("note", "");
       // Its log begins as the recorded one's did: a branch's re-simulation

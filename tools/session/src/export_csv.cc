@@ -1,5 +1,7 @@
 #include "rms/session/export_csv.h"
 
+#include <unistd.h>
+
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -13,6 +15,7 @@
 
 #include "rms/base/check.h"
 #include "rms/base/config.h"
+#include "rms/base/folder_file.h"
 #include "rms/base/text.h"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_state_t.hpp"
@@ -21,6 +24,7 @@
 #include "rms/operator_input_t.hpp"
 #include "rms/operator_state_t.hpp"
 #include "rms/process_status_t.hpp"
+#include "rms/session/session_folder.h"
 #include "rms/session/session_log.h"
 #include "rms/session/session_summary.h"
 #include "rms/session_control_t.hpp"
@@ -38,42 +42,55 @@ namespace rms::session {
 
 namespace {
 
-// One CSV file: a header row of "name [unit]" columns, then rows.
+// One CSV file: a header row of "name [unit]" columns, then rows; written
+// to a temporary file of the export's folder (OutputFolder), in blocks.
 class Csv {
  public:
-  Csv(const fs::path& path, const std::vector<std::string>& columns)
-      : path_(path), f_(path), n_(columns.size()) {
-    if (!f_) throw InputError("cannot write '" + path.string() + "'");
+  Csv(OutputFolder* folder, const std::string& name, const std::vector<std::string>& columns)
+      : folder_(folder),
+        path_(fs::path(folder->path()) / name),
+        fd_(folder->Begin(name)),
+        n_(columns.size()) {
     Row(columns);
   }
   void Row(const std::vector<std::string>& cells) {
     RMS_CHECK(cells.size() == n_);
     for (std::size_t i = 0; i < cells.size(); ++i) {
-      if (i) f_ << ',';
-      f_ << CsvField(cells[i]);
+      if (i) buf_ += ',';
+      buf_ += CsvField(cells[i]);
     }
-    f_ << '\n';
+    buf_ += '\n';
     ++rows_;
+    if (buf_.size() >= kFlushBytes) Flush();
   }
   long rows() const { return rows_ - 1; }
   const fs::path& path() const { return path_; }
-  // Flushes and closes; throws when any of it could not be written (a full
-  // disk): the export must not end as if it had.
+  // Writes what is left and closes; throws when any of it could not be
+  // written (a full disk): the export must not end as if it had.
   void Close() {
-    f_.close();
-    if (!f_) {
-      const int err = errno ? errno : EIO;
-      std::error_code ec;
-      if (fs::is_regular_file(path_, ec)) fs::remove(path_, ec);  // no partial CSV left behind
-      throw InputError("could not write all of '" + path_.string() + "' (" + std::strerror(err) +
-                       ")");
-    }
+    Flush();
+    folder_->Close(fd_);
   }
 
  private:
+  static constexpr std::size_t kFlushBytes = std::size_t{1} << 20;
+  void Flush() {
+    std::size_t done = 0;
+    while (done < buf_.size()) {
+      const ssize_t n = ::write(fd_, buf_.data() + done, buf_.size() - done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0)
+        throw InputError("could not write all of '" + path_.string() + "' (" +
+                         std::strerror(n < 0 ? errno : EIO) + ")");
+      done += static_cast<std::size_t>(n);
+    }
+    buf_.clear();
+  }
+  OutputFolder* folder_;
   fs::path path_;
-  std::ofstream f_;
+  int fd_;
   std::size_t n_;
+  std::string buf_;
   long rows_ = 0;
 };
 
@@ -396,21 +413,22 @@ std::vector<std::string> WindowKeysRow(const LogMessage& msg, const std::string&
 // The session's files, one a channel.
 struct ChannelFiles {
   Csv in, dcp, esg, tm, st, ctl, op_state, dcp_state, keys;
-  ChannelFiles(const fs::path& out, const LabConfig& config)
-      : in(out / "operator_input.csv", InputColumns(config)),
-        dcp(out / "dcp_frame.csv", DcpColumns()),
-        esg(out / "esg_frame.csv", EsgColumns()),
-        tm(out / "dcp_telemetry.csv", TelemetryColumns()),
-        st(out / "status.csv", {"log_time [us]", "session_time [s]", "send_time [us]", "process",
-                                "host", "pid", "frame", "final", "counter", "value"}),
-        ctl(out / "control.csv",
+  ChannelFiles(OutputFolder* out, const LabConfig& config)
+      : in(out, "operator_input.csv", InputColumns(config)),
+        dcp(out, "dcp_frame.csv", DcpColumns()),
+        esg(out, "esg_frame.csv", EsgColumns()),
+        tm(out, "dcp_telemetry.csv", TelemetryColumns()),
+        st(out, "status.csv",
+           {"log_time [us]", "session_time [s]", "send_time [us]", "process", "host", "pid",
+            "frame", "final", "counter", "value"}),
+        ctl(out, "control.csv",
             {"log_time [us]", "session_time [s]", "send_time [us]", "sequence", "command", "name"}),
-        op_state(out / "operator_state.csv", OperatorStateColumns()),
-        dcp_state(out / "dcp_state.csv",
+        op_state(out, "operator_state.csv", OperatorStateColumns()),
+        dcp_state(out, "dcp_state.csv",
                   {"log_time [us]", "session_time [s]", "send_time [us]", "reason", "next_frame",
                    "input_frame", "resume_pending", "resume_dcp_frame", "resume_input_frame",
                    "checkpoint [json]"}),
-        keys(out / "window_keys.csv",
+        keys(out, "window_keys.csv",
              {"log_time [us]", "session_time [s]", "send_time [us]", "sequence", "held [key codes]",
               "pressed [key codes]", "focused"}) {}
 
@@ -451,9 +469,13 @@ std::vector<std::pair<std::string, long>> ExportCsv(
     const std::string& session_dir, const std::string& out_dir,
     const std::function<void(const std::string&)>& progress, ExportRead* read) {
   const fs::path root(session_dir), out(out_dir);
-  const LabConfig config = LoadConfig((root / "config.toml").string());
-  fs::create_directories(out);
-  ChannelFiles files(out, config);
+  const LabConfig config = LoadSessionConfig(session_dir);
+  // The CSVs are written whole or not at all: a failure part way (a full
+  // disk) leaves none of this export's files, and the last export's as
+  // they were (docs/sessions.md "Export").
+  const bool inside = fs::path(out_dir).lexically_normal() == (root / "csv").lexically_normal();
+  OutputFolder folder(out_dir, inside ? Links::kRefuse : Links::kFollow);
+  ChannelFiles files(&folder, config);
   long skipped = 0, events = 0;
   SessionLog log(session_dir);  // only the session's own messages (docs/security.md)
   log.Read({}, [&](const LogMessage& msg) {
@@ -466,10 +488,15 @@ std::vector<std::pair<std::string, long>> ExportCsv(
     }
   });
   std::vector<std::pair<std::string, long>> written;
-  for (Csv* c : {&files.in, &files.dcp, &files.esg, &files.tm, &files.st, &files.ctl,
-                 &files.op_state, &files.dcp_state, &files.keys}) {
-    c->Close();
-    written.emplace_back(c->path().string(), c->rows());
+  try {
+    for (Csv* c : {&files.in, &files.dcp, &files.esg, &files.tm, &files.st, &files.ctl,
+                   &files.op_state, &files.dcp_state, &files.keys}) {
+      c->Close();
+      written.emplace_back(c->path().string(), c->rows());
+    }
+    folder.Commit();
+  } catch (const InputError& e) {
+    throw InputError(std::string(e.what()) + ": none of this export's files were kept");
   }
   if (read) *read = {events, log.unread_bytes()};
   written.emplace_back("skipped (malformed)", skipped);

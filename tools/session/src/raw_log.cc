@@ -9,6 +9,7 @@
 #include <sys/stat.h>
 
 #include "rms/base/check.h"
+#include "rms/base/folder_file.h"
 
 namespace rms::session {
 
@@ -30,8 +31,9 @@ std::uint64_t BigEndian(const std::uint8_t* p, int bytes) {
 }  // namespace
 
 RawLogReader::RawLogReader(const std::string& path) : path_(path) {
-  fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd_ < 0) throw InputError("cannot read the LCM log '" + path + "': " + std::strerror(errno));
+  // A regular file, no link followed: a FIFO or a device is refused, not
+  // waited on or read without end (docs/security.md).
+  fd_ = OpenRegularFile(path, "the LCM log", kMaxLogBytes);
   struct stat st {};
   if (::fstat(fd_, &st) == 0 && st.st_size > 0) file_size_ = static_cast<std::size_t>(st.st_size);
   capacity_ = std::min<std::size_t>(std::max<std::size_t>(file_size_, 4), kBlockBytes);

@@ -3,9 +3,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include "rms/base/check.h"
 #include "rms/sender_t.hpp"
+#include "rms/session/session_folder.h"
 #include "rms/session/session_summary.h"
 #include "rms/wire/channels.h"
 #include "rms/wire/message_io.h"
@@ -55,7 +57,10 @@ SenderCheck::SenderCheck(const std::string& dir) {
                    "checking them (a stranger's message with the session's id would be taken)\n",
                    dir.c_str());
   }
-  std::ifstream f(fs::path(dir) / "run" / "pids");
+  std::error_code ec;
+  std::istringstream f(fs::exists(fs::symlink_status(fs::path(dir) / "run" / "pids", ec))
+                           ? ReadSessionFile(dir, "run/pids", kMaxRunFileBytes)
+                           : std::string());
   std::string name;
   long pid = 0;
   while (f >> name >> pid) pids_[wire::ProcessCode(name)].insert(static_cast<std::int32_t>(pid));

@@ -34,4 +34,14 @@ std::string CreateSessionFolder(const std::string& dir) {
   return fs::absolute(root).lexically_normal().string();
 }
 
+LabConfig LoadSessionConfig(const std::string& dir) {
+  const std::string path = (fs::path(dir) / "config.toml").string();
+  return ParseConfig(ReadRegularFile(path, "the session's configuration", kMaxConfigBytes), path);
+}
+
+std::string ReadSessionFile(const std::string& dir, const std::string& name,
+                            std::uint64_t max_bytes) {
+  return ReadRegularFile((fs::path(dir) / name).string(), "the session's " + name, max_bytes);
+}
+
 }  // namespace rms::session

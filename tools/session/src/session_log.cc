@@ -8,6 +8,7 @@
 #include "rms/base/check.h"
 #include "rms/base/config.h"
 #include "rms/base/other_core.h"
+#include "rms/session/session_folder.h"
 #include "rms/session/session_summary.h"
 #include "rms/wire/channels.h"
 
@@ -23,7 +24,7 @@ namespace {
 // config: the report's rate (docs/config.md).
 double SessionFrameRate(const std::string& session_dir) {
   try {
-    return LoadConfig((fs::path(session_dir) / "config.toml").string()).session.frame_rate_hz;
+    return LoadSessionConfig(session_dir).session.frame_rate_hz;
   } catch (const std::exception&) {
     return 30.0;
   }

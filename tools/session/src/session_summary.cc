@@ -11,6 +11,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <map>
 #include <set>
+#include <sstream>
 
 #include "rms/base/check.h"
 #include "rms/base/config.h"
@@ -26,6 +27,7 @@
 #include "rms/process_status_t.hpp"
 #include "rms/sender_t.hpp"
 #include "rms/session/sender_check.h"
+#include "rms/session/session_folder.h"
 #include "rms/session/session_log.h"
 #include "rms/session_control_t.hpp"
 #include "rms/transport/lcm_interface.h"
@@ -45,11 +47,20 @@ namespace rms::session {
 
 namespace {
 
+// A run/ file of the session ("" when it has none), read as untrusted
+// (rms/session/session_folder.h).
+std::string RunFile(const fs::path& root, const std::string& name) {
+  std::error_code ec;
+  if (!fs::exists(fs::symlink_status(root / name, ec))) return "";
+  return ReadSessionFile(root.string(), name, kMaxRunFileBytes);
+}
+
 nlohmann::json ReadJson(const fs::path& p) {
-  std::ifstream f(p);
-  if (!f) return nlohmann::json::object();
+  std::error_code ec;
+  if (!fs::exists(fs::symlink_status(p, ec))) return nlohmann::json::object();
   try {
-    return nlohmann::json::parse(f);
+    return nlohmann::json::parse(
+        ReadRegularFile(p.string(), "the session's " + p.filename().string(), kMaxJsonBytes));
   } catch (const std::exception&) {
     return nlohmann::json::object();
   }
@@ -570,19 +581,15 @@ std::map<std::string, nlohmann::json> MergedStats(const fs::path& root, const St
   return stats;
 }
 
-double FrameRate(const fs::path& root) {
-  try {
-    return LoadConfig((root / "config.toml").string()).session.frame_rate_hz;
-  } catch (const std::exception&) {
-    return 30.0;
-  }
-}
+LabConfig ConfigOf(const fs::path& root);  // below
+
+double FrameRate(const fs::path& root) { return ConfigOf(root).session.frame_rate_hz; }
 
 nlohmann::ordered_json Restarts(const fs::path& root) {
   // Processes the launcher restarted after a fault (docs/sessions.md
   // "Faults"): run/restarts, one line "NAME N EXIT_CODE DOWN_AT READY_AT".
   nlohmann::ordered_json restarts = nlohmann::ordered_json::array();
-  std::ifstream f((root / "run" / "restarts").string());
+  std::istringstream f(RunFile(root, "run/restarts"));
   std::string name;
   int n = 0, rc = 0;
   double down = 0, ready = 0;
@@ -902,12 +909,11 @@ static void ForPeople(nlohmann::ordered_json* j, bool time = false) {
 namespace {
 
 // The session's configuration, or the default one when its copy is gone.
-LabConfig SessionConfig(const fs::path& root) {
-  try {
-    return LoadConfig((root / "config.toml").string());
-  } catch (const std::exception&) {
-    return LoadConfig(DefaultConfigPath());
-  }
+LabConfig ConfigOf(const fs::path& root) {
+  std::error_code ec;
+  if (!fs::exists(fs::symlink_status(root / "config.toml", ec)))
+    return LoadConfig(DefaultConfigPath());  // a session kept without its configuration
+  return LoadSessionConfig(root.string());   // one that is there and not one: said
 }
 
 // Which session, how long, the mission and who flew it.
@@ -921,7 +927,7 @@ void AddSessionFields(const fs::path& root, const LogScan& s, double wall_s,
   (*j)["duration_s"] = s.session_s;
   (*j)["wall_duration_s"] = wall_s;
   AddMission(s.final_mode, s.modes, s.telemetry, j);
-  std::ifstream pilot((root / "run" / "pilot").string());
+  std::istringstream pilot(RunFile(root, "run/pilot"));
   std::string who;
   if (pilot >> who) (*j)["pilot"] = who;
 }
@@ -992,7 +998,7 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
   SessionLog log(dir);
   SenderCheck& check = log.check();
   check.Count("dcp_frame_out_of_sequence", dcp_frames.out_of_sequence);
-  AttemptLog attempts(SessionConfig(root));
+  AttemptLog attempts(ConfigOf(root));
   const LogScan s = ScanLog(log, dcp_frames.by_frame, &attempts);
   const double rate_hz = FrameRate(root);
   const double wall_s = s.first_us >= 0 ? (s.last_us - s.first_us) * 1e-6 : 0.0;
@@ -1185,12 +1191,14 @@ nlohmann::ordered_json ProbeAddress(const std::string& url, double seconds) {
 
 SessionInfo ReadSessionInfo(const std::string& dir) {
   const fs::path p = fs::path(dir) / "manifest.json";
-  std::ifstream f(p);
-  if (!f) throw InputError("no manifest.json in " + dir + ": not a session folder");
+  std::error_code ec;
+  if (!fs::exists(fs::symlink_status(p, ec)))
+    throw InputError("no manifest.json in " + dir + ": not a session folder");
+  const std::string text = ReadSessionFile(dir, "manifest.json", kMaxJsonBytes);
   SessionInfo s;
   s.dir = dir;
   try {
-    const auto j = nlohmann::json::parse(f);
+    const auto j = nlohmann::json::parse(text);
     if (j.contains("lcm")) {  // a re-simulation's folder has none: it ran on no network
       s.lcm_url = j.at("lcm").value("url", "");
       s.channel_suffix = j.at("lcm").value("channel_suffix", "");

@@ -16,10 +16,13 @@ std::string Sprintf(const char* format, ...) __attribute__((format(printf, 1, 2)
 // 10^-decimals; "nan" and "inf" as such.
 std::string HumanNumber(double v, int decimals = 3);
 
-// Writes `text` as the whole of the file at `path` and closes it; throws
-// rms::InputError naming the file and why when any of it could not be
-// written (a full disk shows only at the flush): a tool must not end as if
-// its output were there.
+// Writes `text` as the whole of the file at `path`; throws rms::InputError
+// naming the file and why when any of it could not be written: a tool must
+// not end as if its output were there. A file is written to a fresh
+// temporary file beside it and renamed over its name, so a failure leaves
+// no part of it, and a link planted at its name is replaced, never written
+// through (rms/base/folder_file.h); a stream the user named (a FIFO, a
+// device, /dev/stdout) is written directly, a FIFO nothing reads refused.
 void WriteWholeFile(const std::string& path, const std::string& text);
 
 // Escaping for the context a string from a message or a session folder

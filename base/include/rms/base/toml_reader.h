@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "rms/base/check.h"
+#include "rms/base/folder_file.h"
 
 namespace rms {
 
@@ -193,25 +194,13 @@ class TomlReader {
 // into memory without end).
 inline constexpr std::size_t kMaxTextFileBytes = std::size_t{64} << 20;
 
-// A whole text file; an InputError "cannot read WHAT 'PATH': WHY" when it
-// can't be read or is larger than kMaxTextFileBytes.
+// A whole text file the user named (links followed, a FIFO read to its
+// end; rms/base/folder_file.h): an InputError "cannot read WHAT 'PATH': WHY"
+// when it can't be read, is a folder or a device, or is larger than
+// kMaxTextFileBytes. A file of a session folder: ReadRegularFile with
+// Links::kRefuse.
 inline std::string ReadTextFile(const std::string& path, const std::string& what) {
-  const std::string cannot = "cannot read " + what + " '" + path + "'";
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw InputError(cannot + ": it is a folder");
-  errno = 0;
-  std::ifstream f(path);
-  // (why: the open's errno, e.g. "No such file or directory", "Too many open files")
-  if (!f) throw InputError(cannot + (errno != 0 ? ": " + std::string(std::strerror(errno)) : ""));
-  std::string text;
-  char block[65536];
-  while (f.read(block, sizeof block) || f.gcount() > 0) {
-    text.append(block, static_cast<std::size_t>(f.gcount()));
-    if (text.size() > kMaxTextFileBytes)
-      throw InputError(cannot + ": it is larger than 64 MiB (not a text file of this kind?)");
-  }
-  if (f.bad()) throw InputError(cannot + ": a read error part way");
-  return text;
+  return ReadRegularFile(path, what, kMaxTextFileBytes, Links::kFollow);
 }
 
 // Parses TOML text; a syntax error is an InputError "SOURCE:LINE:COLUMN:
