@@ -217,7 +217,10 @@ class Demo:
         self.out = session.make_folder(a.out, os.path.join(ROOT, "sessions"))
         os.makedirs(os.path.join(self.out, "journal"), exist_ok=True)
         self.name = os.path.basename(self.out)
-        self.remote_run = f"/tmp/rmslab-{self.name}"
+        # On an ssh host: a folder in the remote user's home (ssh's working
+        # folder), made 0700, its name not guessable -- never a fixed /tmp
+        # name another user could make first (it holds the session's key).
+        self.remote_run = f".rmslab/run/{self.name}-{secrets.token_hex(6)}"
         run = os.path.join(self.out, "run")
         shutil.copyfile(a.config, os.path.join(self.out, "config.toml"))
         if a.timeline:

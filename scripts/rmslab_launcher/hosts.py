@@ -41,7 +41,7 @@ class Host:
                     list(argv))
         # ssh: the remote shell writes the process's pid (for signals), then
         # becomes it; its standard input is the launcher's lifeline.
-        pre = f"mkdir -p {shlex.quote(remote_run)}/journal && " if remote_run else ""
+        pre = f"umask 077 && mkdir -p {shlex.quote(remote_run)}/journal && " if remote_run else ""
         if remote_run and pid_name:
             pre += f"echo $$ >{shlex.quote(remote_run)}/{shlex.quote(pid_name)}.pid && "
         cmd = pre + "exec env " + " ".join(shlex.quote(a) for a in env_args + list(argv))
@@ -74,7 +74,8 @@ class Host:
     def copy_to(self, local_path, remote_path):
         if not self.remote:
             return
-        subprocess.run(SSH + [self.name, f"mkdir -p {shlex.quote(os.path.dirname(remote_path))}"], check=False,
+        subprocess.run(SSH + [self.name, f"umask 077 && mkdir -p {shlex.quote(os.path.dirname(remote_path))}"],
+                       check=False,
                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         if subprocess.run(["scp", "-q", "-o", "BatchMode=yes", local_path, f"{self.name}:{remote_path}"]).returncode:
             raise LabError(f"host {self.spec}: cannot copy {local_path} there", 1)

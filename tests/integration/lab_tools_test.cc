@@ -138,7 +138,7 @@ TEST_F(RecordedSession, AManifestOfAnotherLogOrAConfigurationThatIsAFolderIsRefu
   fs::create_directory(copy + "/config.toml");
   r = Script({testing::BuildPath("tools/rms_resim"), copy, "--quiet"}, copy + ".log");
   EXPECT_EQ(r.rc, 2) << r.out;
-  EXPECT_NE(r.out.find("config.toml': it is a folder"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("config.toml': a folder, not a regular file"), std::string::npos) << r.out;
   fs::remove_all(copy);
 }
 
