@@ -3,8 +3,10 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <random>
 #include <sys/stat.h>
 
@@ -83,6 +85,14 @@ std::string ReadRegularFile(const std::string& path, const std::string& what,
   }
   close(fd);
   return text;
+}
+
+Links LinksForOutput(const std::string& out, const std::string& folder) {
+  std::error_code ec;
+  const std::filesystem::path o = std::filesystem::absolute(out, ec).lexically_normal();
+  const std::filesystem::path f = std::filesystem::absolute(folder, ec).lexically_normal();
+  const auto [fi, oi] = std::mismatch(f.begin(), f.end(), o.begin(), o.end());
+  return fi == f.end() ? Links::kRefuse : Links::kFollow;
 }
 
 OutputFolder::OutputFolder(const std::string& path, Links links) : path_(path) {

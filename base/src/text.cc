@@ -28,8 +28,9 @@ bool IsStream(const std::string& path, const struct stat& st) {
 }
 
 void WriteStream(const std::string& path, const std::string& text) {
-  // A FIFO nobody reads is refused (ENXIO), not waited on.
-  const int fd = open(path.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);
+  // A FIFO nobody reads is refused (ENXIO), not waited on; a file reached
+  // through a link the user named is written from its start, as `>` does.
+  const int fd = open(path.c_str(), O_WRONLY | O_TRUNC | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0) {
     throw InputError("cannot write '" + path + "': " +
                      (errno == ENXIO ? std::string("a FIFO that nothing reads")
@@ -53,9 +54,10 @@ void WriteStream(const std::string& path, const std::string& text) {
 
 }  // namespace
 
-void WriteWholeFile(const std::string& path, const std::string& text) {
+void WriteWholeFile(const std::string& path, const std::string& text, Links links) {
   struct stat st {};
-  if (lstat(path.c_str(), &st) == 0 && IsStream(path, st)) {
+  const bool exists = lstat(path.c_str(), &st) == 0;
+  if (exists && (IsStream(path, st) || (links == Links::kFollow && S_ISLNK(st.st_mode)))) {
     WriteStream(path, text);
     return;
   }

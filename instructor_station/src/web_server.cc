@@ -144,7 +144,7 @@ struct Upload {
   Request request;
   MHD_PostProcessor* form = nullptr;
   std::size_t bytes = 0;
-  bool too_large = false;
+  bool answered = false;  // a response is queued
   ~Upload() {
     if (form) MHD_destroy_post_processor(form);
   }
@@ -319,13 +319,43 @@ Answer WebServer::Impl::Checkpoints() const {
   return a;
 }
 
+namespace {
+
+MHD_Result Queue(MHD_Connection* c, const Answer& a) {
+  MHD_Response* res = MHD_create_response_from_buffer(
+      a.body.size(), const_cast<char*>(a.body.data()), MHD_RESPMEM_MUST_COPY);
+  MHD_add_response_header(res, "Content-Type", a.content_type.c_str());
+  for (const auto& [k, v] : a.headers) MHD_add_response_header(res, k.c_str(), v.c_str());
+  const MHD_Result ok = MHD_queue_response(c, a.status, res);
+  MHD_destroy_response(res);
+  return ok;
+}
+
+Answer TooLarge() {
+  Answer a;
+  a.status = 413;
+  a.content_type = "text/plain";
+  a.body = "413: a request's body is at most 64 KiB\n";
+  return a;
+}
+
+}  // namespace
+
 // libmicrohttpd's callback: first with the header (an Upload made), then
-// with each piece of the body, then once more to answer.
+// with each piece of the body, then once more to answer. A body declared or
+// found larger than kMaxRequestBytes is answered 413 at once, the rest of
+// it not read.
 MHD_Result WebServer::Impl::OnRequest(void* cls, MHD_Connection* c, const char* url,
                                       const char* method, const char*, const char* upload,
                                       std::size_t* upload_size, void** con_cls) {
   auto* self = static_cast<Impl*>(cls);
   auto* u = static_cast<Upload*>(*con_cls);
+  auto refuse = [&] {
+    ++self->requests;
+    ++self->refused;
+    u->answered = true;
+    return Queue(c, TooLarge());
+  };
   if (!u) {
     u = new Upload;
     *con_cls = u;
@@ -334,34 +364,28 @@ MHD_Result WebServer::Impl::OnRequest(void* cls, MHD_Connection* c, const char* 
     if (const char* t = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "X-Rmslab-Token"))
       u->request.token = t;
     if (u->request.method == "POST") u->form = MHD_create_post_processor(c, 4096, TakeFormValue, u);
+    const char* n = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Content-Length");
+    if (n && std::strtoull(n, nullptr, 10) > kMaxRequestBytes) return refuse();
+    return MHD_YES;
+  }
+  if (u->answered) {  // the rest of a body refused
+    *upload_size = 0;
     return MHD_YES;
   }
   if (*upload_size > 0) {
     u->bytes += *upload_size;
-    if (u->bytes > kMaxRequestBytes) u->too_large = true;
-    if (!u->too_large && u->form) MHD_post_process(u->form, upload, *upload_size);
+    if (u->bytes > kMaxRequestBytes) {
+      *upload_size = 0;
+      return refuse();
+    }
+    if (u->form) MHD_post_process(u->form, upload, *upload_size);
     *upload_size = 0;
     return MHD_YES;
   }
   Request& req = u->request;
   MHD_get_connection_values(c, MHD_GET_ARGUMENT_KIND, TakeQueryValue, &req);
-  Answer a;
-  if (u->too_large) {
-    ++self->requests;
-    ++self->refused;
-    a.status = 413;
-    a.content_type = "text/plain";
-    a.body = "413: a request is at most 64 KiB\n";
-  } else {
-    a = self->Serve(req);
-  }
-  MHD_Response* res =
-      MHD_create_response_from_buffer(a.body.size(), a.body.data(), MHD_RESPMEM_MUST_COPY);
-  MHD_add_response_header(res, "Content-Type", a.content_type.c_str());
-  for (const auto& [k, v] : a.headers) MHD_add_response_header(res, k.c_str(), v.c_str());
-  const MHD_Result ok = MHD_queue_response(c, a.status, res);
-  MHD_destroy_response(res);
-  return ok;
+  u->answered = true;
+  return Queue(c, self->Serve(req));
 }
 
 void WebServer::Impl::OnCompleted(void*, MHD_Connection*, void** con_cls,

@@ -4,6 +4,7 @@ multicast route, reading configuration (TOML, with Python's tomllib).
 docs/sessions.md "The launcher" describes what scripts/lab does; this
 package is that launcher.
 """
+import contextlib
 import errno
 import hashlib
 import json
@@ -13,6 +14,7 @@ import shutil
 import stat
 import subprocess
 import sys
+import tempfile
 import tomllib
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -43,6 +45,29 @@ def terminal_text(text):
 # Limits for each kind of a session folder's files (as rms/base/folder_file.h).
 MAX_CONFIG_BYTES = 1 << 20
 MAX_JSON_BYTES = 64 << 20
+
+
+_UMASK = os.umask(0)
+os.umask(_UMASK)
+
+
+@contextlib.contextmanager
+def replacing(path, **kw):
+    """A file written under a unique temporary name beside path (O_EXCL, no
+    link followed), then renamed over it: a failure leaves no part, two
+    writers do not trip each other, and a link planted at path is replaced,
+    never written through (docs/security.md). Made as an ordinary file is
+    (0666 less the umask)."""
+    fd, tmp = tempfile.mkstemp(dir=os.path.dirname(os.path.abspath(path)), prefix="." + os.path.basename(path) + ".")
+    try:
+        os.fchmod(fd, 0o666 & ~_UMASK)
+        with os.fdopen(fd, "w", **kw) as f:
+            yield f
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.remove(tmp)
+        raise
 
 
 def read_folder_file(path, limit, what=None):

@@ -29,7 +29,8 @@ import time
 import tomllib
 
 from . import sweep_cache, sweep_table
-from .common import BUILD, ROOT, LabError, binary, file_sha256, install_and_build, read_folder_json, read_toml, say
+from .common import (BUILD, ROOT, LabError, binary, file_sha256, install_and_build, read_folder_json, read_toml,
+                     replacing, say)
 
 CELL = os.path.join(ROOT, "scripts", "sweep-cell")
 NETNS_LOGIN = os.path.join(ROOT, "scripts", "rmslab_launcher", "netns-login")
@@ -217,7 +218,7 @@ def check_designs(sessions, grid):
 def write_manifest(path, cells):
     """cells.tsv: INDEX, cache KEY, SESSION, KEY=VALUE... a line a cell
     (what scripts/sweep-cell MANIFEST INDEX reads)."""
-    with open(path, "w") as f:
+    with replacing(path) as f:
         for c in cells:
             f.write("\t".join([str(c["index"]), c["key"], c["session"]] +
                               [f"{k}={v}" for k, v in c["sets"]]) + "\n")
@@ -689,7 +690,7 @@ def write_slurm(sweep_dir, cells, cache_dir, rerun):
                        "paths (#SBATCH lines cannot quote them)")
     script = os.path.join(sweep_dir, "sweep.sbatch")
     manifest = os.path.join(sweep_dir, "cells.tsv")
-    with open(script, "w") as f:
+    with replacing(script) as f:
         f.write(f"""#!/bin/sh
 # A Slurm array job of {len(cells)} cells (docs/sessions.md "Sweeps"), written by scripts/lab sweep --slurm.
 #   sbatch {shlex.quote(script)}
@@ -852,7 +853,7 @@ def run_sweep(argv):
     os.makedirs(sweep_dir, exist_ok=True)
     if not a.cached_only:
         write_manifest(os.path.join(sweep_dir, "cells.tsv"), cells)
-        with open(os.path.join(sweep_dir, "sweep.json"), "w") as f:
+        with replacing(os.path.join(sweep_dir, "sweep.json")) as f:
             json.dump({"sessions": [s.path for s in sessions],
                        "vary": [{"key": k, "values": v} for k, v in a.grid],
                        "software": version, "cache": cache.folder, "cells": len(cells)}, f, indent=2)

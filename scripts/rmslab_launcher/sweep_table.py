@@ -2,12 +2,12 @@
 a cell, and sweep.html, the same table with a plot per varied key (the
 share of cells that acquired and docked, and the docking time, against the
 key's value), self-contained: Chart.js (Debian's libjs-chart.js) embedded."""
-import contextlib
 import csv
 import html
 import json
 import os
-import tempfile
+
+from .common import replacing
 
 CHART_JS = "/usr/share/javascript/chart.js/chart.min.js"
 
@@ -109,29 +109,14 @@ def write(sweep_dir, grid, rows):
     cols = header(grid)
     table = [row_values(c, res, grid) for c, res in rows]
     csv_path = os.path.join(sweep_dir, "sweep.csv")
-    with _replacing(csv_path, newline="") as f:
+    with replacing(csv_path, newline="") as f:
         w = csv.writer(f, lineterminator="\n")
         w.writerow(cols)
         w.writerows(table)
     html_path = os.path.join(sweep_dir, "sweep.html")
-    with _replacing(html_path) as f:
+    with replacing(html_path) as f:
         f.write(page(grid, cols, table, plots(grid, rows), rows))
     return csv_path, html_path
-
-
-@contextlib.contextmanager
-def _replacing(path, **kw):
-    """A file written under a unique temporary name, then renamed over path
-    (two sweeps writing the same table do not trip each other)."""
-    fd, tmp = tempfile.mkstemp(dir=os.path.dirname(path), prefix="." + os.path.basename(path) + ".")
-    try:
-        with os.fdopen(fd, "w", **kw) as f:
-            yield f
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.remove(tmp)
-        raise
 
 
 def page(grid, cols, table, plot_data, rows):

@@ -114,6 +114,12 @@ def export(argv):
     return export_mcap(a.session, a.out or os.path.join(a.session, "session.mcap"))
 
 
+def inside(path, folder):
+    """Whether path lies inside folder (lexically, as rms::LinksForOutput)."""
+    p, f = os.path.normpath(os.path.abspath(path)), os.path.normpath(os.path.abspath(folder))
+    return os.path.commonpath([p, f]) == f
+
+
 def export_mcap(session, out):
     """The log as JSON lines (rms_session export --jsonl) into the MCAP
     writer (tools/mcap/write_mcap.mjs, @mcap/core from npm)."""
@@ -127,13 +133,17 @@ def export_mcap(session, out):
     if not os.path.isdir(schemas):
         raise LabError(f"no JSON schemas in {schemas}: build first (drop --no-build)", 1)
     reader = subprocess.Popen([binary("tools/rms_session"), "export", session, "--jsonl"], stdout=subprocess.PIPE)
-    writer = subprocess.run(["node", os.path.join(mcap, "write_mcap.mjs"), "--schemas", schemas, "--out", out],
-                            stdin=reader.stdout)
+    # A link at an --out the user named outside the session is theirs to
+    # follow (/dev/stdout); inside the folder it is replaced (docs/security.md).
+    follow = [] if inside(out, session) else ["--follow-links"]
+    writer = subprocess.run(["node", os.path.join(mcap, "write_mcap.mjs"), "--schemas", schemas, "--out", out] +
+                            follow, stdin=reader.stdout)
     reader.stdout.close()
     rc = reader.wait()
     if rc != 0 or writer.returncode != 0:
-        if os.path.exists(out) and writer.returncode == 0:
-            os.remove(out)  # a partial log: not left as if whole
+        if writer.returncode == 0 and os.path.isfile(out) and not os.path.islink(out) and \
+                not os.path.abspath(out).startswith(("/dev/", "/proc/")):
+            os.remove(out)  # a partial log: not left as if whole (a stream or a link is not removed)
         why = ("the MCAP writer failed (said above)" if writer.returncode != 0 else
                f"reading the session's log failed (rms_session exit {rc})")
         raise LabError(f"the MCAP export failed: {why}; no file written", 1)

@@ -315,6 +315,20 @@ TEST(InstructorStation, StaysBoundedUnderForgedStatusesAndAnswersUnderIdleConnec
   EXPECT_LE(ej.size(), 1000u);
   EXPECT_EQ(ej[0]["seq"].get<std::int64_t>(), events - 10000) << "the last 10,000 kept";
 
+  // A body declared larger than a request may be: 413 at once.
+  {
+    const int fd = ConnectFrom("127.0.0.4", port);
+    ASSERT_GE(fd, 0);
+    const std::string head =
+        "POST /api/control?" + auth + " HTTP/1.1\r\nHost: x\r\nContent-Length: 99999999999\r\n\r\n";
+    ASSERT_EQ(send(fd, head.data(), head.size(), MSG_NOSIGNAL), static_cast<ssize_t>(head.size()));
+    pollfd p{fd, POLLIN, 0};
+    ASSERT_EQ(poll(&p, 1, 2000), 1) << "no answer within 2 s";
+    char b[64] = {};
+    ASSERT_GT(recv(fd, b, sizeof b - 1, 0), 12);
+    EXPECT_EQ(std::string(b).substr(0, 12), "HTTP/1.1 413") << b;
+    close(fd);
+  }
   // 100 idle connections from one client, 100 slow ones from another.
   std::vector<int> idle, slow;
   for (int i = 0; i < 100; ++i) {

@@ -427,6 +427,18 @@ TEST_F(RecordedSession, ALogDamagedInsideIsReadPastSaidAndNotExact) {
       Script({testing::BuildPath("tools/rms_session"), "summary", cut, "--brief"},
              *tmp_ + "/damaged_inside_brief.log");
   EXPECT_NE(brief.out.find("NOT EXACT: the log is damaged"), std::string::npos) << brief.out;
+  // Nothing but garbage: no event at all, said, exit 3.
+  {
+    std::mt19937 rng(35);  // seed 35
+    std::string garbage(200000, '\0');
+    for (char& c : garbage) c = static_cast<char>(rng() & 0xff);
+    std::ofstream(cut + "/lcmlog", std::ios::binary) << garbage;
+  }
+  const ScriptRun none =
+      Script({testing::BuildPath("tools/rms_session"), "summary", cut, "--brief"},
+             *tmp_ + "/damaged_all_brief.log");
+  EXPECT_EQ(none.rc, 3) << none.out;
+  EXPECT_NE(none.out.find("no event at all"), std::string::npos) << none.out;
 }
 
 // The record remade from journals one of which is damaged half way (the

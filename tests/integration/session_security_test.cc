@@ -791,6 +791,36 @@ TEST(SessionSecurity, ToolsTreatASessionFolderAsUntrusted) {
     EXPECT_NE(exp.out.find("a link or a file, not a folder"), std::string::npos) << exp.out;
     EXPECT_EQ(ReadFile(secret), "SECRET-CONTENT\n");
     EXPECT_TRUE(fs::is_empty(tmp + "/elsewhere"));
+    // The sweep's own files in an --out folder with links planted in it.
+    fs::create_directories(tmp + "/sweep-out");
+    for (const char* f : {"sweep.json", "cells.tsv", "sweep.csv"})
+      fs::create_symlink(secret, tmp + "/sweep-out/" + f);
+    const auto sw =
+        Script({SourcePath("scripts/lab"), "sweep", s.out(), "--vary", "dcp.tpob_ft=0.2,0.3",
+                "--out", tmp + "/sweep-out", "--cache", tmp + "/sweep-cache", "--no-build"},
+               tmp + "/sweep.log", 240);
+    EXPECT_EQ(sw.rc, 0) << sw.out;
+    EXPECT_EQ(ReadFile(secret), "SECRET-CONTENT\n") << "written through a planted link";
+    EXPECT_FALSE(fs::is_symlink(tmp + "/sweep-out/sweep.json"));
+  }
+  // An --out the user names outside the folder is theirs: a link to their
+  // standard output is followed, never replaced (as root, the MCAP export
+  // once replaced /dev/stdout itself).
+  {
+    const std::string mine = tmp + "/my-stdout";
+    fs::create_symlink("/proc/self/fd/1", mine);
+    const auto sum = Script({tool, "summary", s.out(), "--out", mine}, tmp + "/mine1.log", 60);
+    EXPECT_EQ(sum.rc, 0) << sum.out;
+    const auto rep = Script({testing::BuildPath("tools/rms_report"), s.out(), "--out", mine},
+                            tmp + "/mine2.log", 120);
+    EXPECT_EQ(rep.rc, 0) << rep.out.substr(0, 500);
+    EXPECT_NE(rep.out.find("window.RMS_REPORT"), std::string::npos) << "the report not on stdout";
+    const auto mcap = Script(
+        {SourcePath("scripts/lab"), "export", s.out(), "--mcap", "--out", mine, "--no-build"},
+        tmp + "/mine3.log", 120);
+    EXPECT_EQ(mcap.rc, 0) << mcap.out.substr(0, 500);
+    EXPECT_NE(mcap.out.find("\x89MCAP"), std::string::npos) << "the MCAP not on stdout";
+    EXPECT_TRUE(fs::is_symlink(mine)) << "the user's link replaced by a file";
   }
   // Inputs that are not regular files: refused at once, naming the file.
   struct Case {
@@ -812,6 +842,14 @@ TEST(SessionSecurity, ToolsTreatASessionFolderAsUntrusted) {
     EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(30)) << "it waited";
     EXPECT_NE(sum.rc, 0) << sum.out;
     EXPECT_NE(sum.out.find(c.file), std::string::npos) << sum.out;
+    if (c.file == "config.toml" || c.file == "manifest.json") {  // once hung on a FIFO config
+      const auto t1 = std::chrono::steady_clock::now();
+      const auto rs =
+          Script({testing::BuildPath("tools/rms_resim"), d, "--quiet"}, tmp + "/resim.log", 60);
+      EXPECT_LT(std::chrono::steady_clock::now() - t1, std::chrono::seconds(30)) << "it waited";
+      EXPECT_EQ(rs.rc, 2) << rs.out;
+      EXPECT_NE(rs.out.find(c.file), std::string::npos) << rs.out;
+    }
     if (c.file == "config.toml") {  // a replay once copied /dev/zero without end
       const auto rep = Script({SourcePath("scripts/lab"), "replay", d, "--no-build", "--out",
                                d + "-replay", "--no-video", "--png-every", "0"},

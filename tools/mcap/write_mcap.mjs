@@ -26,7 +26,7 @@
 // it) and counted. At the end, on stderr:
 //   mcap: N messages on C channels, T types -> FILE (S MB)
 import { unlinkSync } from "node:fs";
-import { open, readFile, rename, stat, unlink } from "node:fs/promises";
+import { lstat, open, readFile, rename, stat, unlink } from "node:fs/promises";
 import { basename, dirname, join, resolve } from "node:path";
 import { StringDecoder } from "node:string_decoder";
 import { parseArgs } from "node:util";
@@ -40,7 +40,7 @@ const UINT64_MAX = (1n << 64n) - 1n;
 class InputError extends Error {}
 
 function usage() {
-  return "usage: node write_mcap.mjs --schemas DIR --out FILE.mcap < session.jsonl";
+  return "usage: node write_mcap.mjs --schemas DIR --out FILE.mcap [--follow-links] < session.jsonl";
 }
 
 // The raw text of each top-level value of a JSON object, by key. `text` must
@@ -181,7 +181,12 @@ async function main() {
   let args;
   try {
     ({ values: args } = parseArgs({
-      options: { schemas: { type: "string" }, out: { type: "string" }, help: { type: "boolean", short: "h" } },
+      options: {
+        schemas: { type: "string" },
+        out: { type: "string" },
+        "follow-links": { type: "boolean" },
+        help: { type: "boolean", short: "h" },
+      },
       strict: true,
     }));
   } catch (e) {
@@ -197,10 +202,19 @@ async function main() {
     return 2;
   }
   const out = resolve(args.out);
-  const tmp = join(dirname(out), `.${basename(out)}.${process.pid}.partial`);
+  // A stream (a FIFO, a device, anything under /dev or /proc), or a link the
+  // user named with --follow-links (`--out /dev/stdout`), is written
+  // directly; anything else to a temporary file renamed over its name, so
+  // a link planted there is replaced, never written through
+  // (docs/security.md "Session folders are untrusted").
+  const st = await lstat(out).catch(() => null);
+  const direct =
+      (st && !st.isFile() && !st.isSymbolicLink() && !st.isDirectory()) ||
+      (st && st.isSymbolicLink() && args["follow-links"]) || /^\/(dev|proc)\//.test(out);
+  const tmp = direct ? out : join(dirname(out), `.${basename(out)}.${process.pid}.partial`);
   let handle;
   try {
-    handle = await open(tmp, "w");
+    handle = await open(tmp, direct ? "w" : "wx");
   } catch (e) {
     console.error(`write_mcap: cannot write ${args.out}: ${e.message}`);
     return 1;
@@ -216,7 +230,7 @@ async function main() {
   for (const sig of ["SIGINT", "SIGTERM", "SIGHUP"]) {
     process.on(sig, () => {
       try {
-        unlinkSync(tmp);
+        if (!direct) unlinkSync(tmp);
       } catch {}
       console.error(`write_mcap: ${sig} after ${lineNo} lines; no output written`);
       process.exit(128 + ({ SIGHUP: 1, SIGINT: 2, SIGTERM: 15 })[sig]);
@@ -277,18 +291,18 @@ async function main() {
     }
     await writer.end();
     await handle.close();
-    await rename(tmp, out);
+    if (!direct) await rename(tmp, out);
     ok = true;
   } catch (e) {
     console.error(`write_mcap: ${e instanceof InputError ? e.message : e.stack || e}`);
   } finally {
     if (!ok) {
       await handle.close().catch(() => {});
-      await unlink(tmp).catch(() => {});
+      if (!direct) await unlink(tmp).catch(() => {});
     }
   }
   if (!ok) return 1;
-  const bytes = (await stat(out)).size;
+  const bytes = (await stat(out)).size || 0;
   console.error(
     `mcap: ${count} messages on ${channels.size} channels, ${schemaIds.size} types -> ${args.out} (${(bytes / 1e6).toFixed(2)} MB)`,
   );

@@ -33,13 +33,13 @@ int main(int argc, char** argv) {
     std::filesystem::create_directories(out);
     rms::WriteWholeFile(out + "/compare.html", c.html);
     rms::WriteWholeFile(out + "/compare.csv", c.csv);
-    std::cout << out << "/compare.html\n" << out << "/compare.csv\n";
+    std::cout << rms::TerminalText(out + "/compare.html\n" + out + "/compare.csv\n");
     return 0;
   } catch (const rms::InputError& e) {  // a folder that is no session, a bad manifest
-    std::cerr << "rms_compare: " << e.what() << "\n";
+    std::cerr << "rms_compare: " << rms::TerminalText(e.what()) << "\n";
     return 2;
   } catch (const std::exception& e) {
-    std::cerr << "rms_compare: " << e.what() << "\n";
+    std::cerr << "rms_compare: " << rms::TerminalText(e.what()) << "\n";
     return 1;
   }
 }

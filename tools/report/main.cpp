@@ -24,13 +24,13 @@ int main(int argc, char** argv) {
     if (out.empty()) out = session + "/report.html";
     std::function<void(const std::string&)> progress;  // only to a person at a terminal
     if (isatty(STDERR_FILENO))
-      progress = [](const std::string& line) { std::cerr << line << "\n"; };
+      progress = [](const std::string& line) { std::cerr << rms::TerminalText(line) << "\n"; };
     const std::string html = rms::report::MakeReport(session, chart_js, progress, out);
-    rms::WriteWholeFile(out, html);
-    std::cout << out << "\n";
+    rms::WriteWholeFile(out, html, rms::LinksForOutput(out, session));
+    std::cout << rms::TerminalText(out) << "\n";
     return 0;
   } catch (const std::exception& e) {
-    std::cerr << "rms_report: " << e.what() << "\n";
+    std::cerr << "rms_report: " << rms::TerminalText(e.what()) << "\n";
     return 2;
   }
 }

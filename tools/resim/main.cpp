@@ -252,7 +252,9 @@ int main(int argc, char** argv) {
     const std::string new_session_verdict = rms::resim::OtherDesign(opt) && !r.out_dir.empty()
                                                 ? CheckNewSession(r.out_dir, opt.threads)
                                                 : "";
-    if (!verdict_json.empty()) rms::WriteWholeFile(verdict_json, Verdict(&r, "").dump(2) + "\n");
+    if (!verdict_json.empty())
+      rms::WriteWholeFile(verdict_json, Verdict(&r, "").dump(2) + "\n",
+                          rms::LinksForOutput(verdict_json, opt.session));
     if (!checkpoint_out.empty()) {
       if (!r.first_difference.empty()) {
         throw rms::InputError(
@@ -260,7 +262,8 @@ int main(int argc, char** argv) {
             std::to_string(opt.until_frame) + " (" + r.first_difference +
             "): a branch from there could not reproduce it; no checkpoint written");
       }
-      rms::WriteWholeFile(checkpoint_out, r.checkpoint_text);
+      rms::WriteWholeFile(checkpoint_out, r.checkpoint_text,
+                          rms::LinksForOutput(checkpoint_out, opt.session));
     }
     if (result_json) {
       std::printf("%s\n", rms::resim::JsonLine(r.cell).c_str());
@@ -271,10 +274,11 @@ int main(int argc, char** argv) {
       std::printf("the new session re-simulates: %s\n", new_session_verdict.c_str());
     return rc;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "rms_resim: %s\n", e.what());
+    std::fprintf(stderr, "rms_resim: %s\n", rms::TerminalText(e.what()).c_str());
     if (!verdict_json.empty() && !rms::resim::OtherDesign(opt) && opt.until_frame < 0) {
       try {
-        rms::WriteWholeFile(verdict_json, Verdict(nullptr, e.what()).dump(2) + "\n");
+        rms::WriteWholeFile(verdict_json, Verdict(nullptr, e.what()).dump(2) + "\n",
+                            rms::LinksForOutput(verdict_json, opt.session));
       } catch (const std::exception& w) {
         std::fprintf(stderr, "rms_resim: %s\n", w.what());
       }

@@ -44,9 +44,10 @@ Command Summary(CLI::App& app) {
   c->add_flag("--brief", o->brief, "Print a few human-readable lines instead of the JSON");
   return {c, [o] {
             const auto j = session::Summarize(o->dir);
+            const std::string out = o->out.empty() ? o->dir + "/summary.json" : o->out;
             rms::WriteWholeFile(
-                o->out.empty() ? o->dir + "/summary.json" : o->out,
-                j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+                out, j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n",
+                rms::LinksForOutput(out, o->dir));
             if (o->brief) {
               std::ostringstream brief;  // names from messages: shown, not obeyed
               session::PrintBrief(j, brief);
@@ -59,6 +60,12 @@ Command Summary(CLI::App& app) {
               std::cerr << "summary: the log is damaged inside (" << n
                         << " bytes that are no event, read past): the summary may be short "
                            "(exit 3)\n";
+              return 3;
+            }
+            if (j["log"].value("events", std::int64_t{0}) == 0 &&
+                j["log"].value("unread_bytes", std::int64_t{0}) > 0) {
+              std::cerr << "summary: the log holds no event at all, only "
+                        << j["log"]["unread_bytes"] << " bytes that are none (exit 3)\n";
               return 3;
             }
             return 0;
@@ -179,12 +186,17 @@ Command Export(CLI::App& app) {
             session::ExportRead read;
             const auto files = session::ExportCsv(o->dir, o->out.empty() ? o->dir + "/csv" : o->out,
                                                   progress, &read);
-            for (const auto& [f, n] : files) std::cout << f << ": " << n << " rows\n";
+            for (const auto& [f, n] : files)
+              std::cout << rms::TerminalText(f) << ": " << n << " rows\n";
             // What could not be read is said, never left to a count of rows.
             if (read.unread_bytes > 0)
               std::cerr << "rms_session export: the log ends in " << read.unread_bytes
                         << " bytes that are no whole event (it was cut short or damaged there): "
                            "exported up to them\n";
+            if (read.skipped_bytes > 0)
+              std::cerr << "rms_session export: THE LOG IS DAMAGED: " << read.skipped_bytes
+                        << " bytes inside it are no event (read past; what they held is not "
+                           "exported)\n";
             if (read.events == 0) {
               std::cerr << "rms_session export: " << o->dir
                         << "/lcmlog holds no message of this session: nothing was exported\n";
@@ -263,7 +275,7 @@ int main(int argc, char** argv) {
     }
     return 2;
   } catch (const std::exception& e) {
-    std::cerr << "rms_session: " << e.what() << "\n";
+    std::cerr << "rms_session: " << rms::TerminalText(e.what()) << "\n";
     return 2;
   }
 }

@@ -245,7 +245,23 @@ Traces ReadTraces(const std::string& dir, const LabConfig& config,
 // logged messages the summary left out as not the session's own.
 std::string LossesSection(const nlohmann::ordered_json& s) {
   std::ostringstream h;
-  h << "<h2>Losses and refusals</h2>\n<table><tr><th>what</th><th>frames or messages</th></tr>";
+  h << "<h2>Losses and refusals</h2>\n";
+  // Damage to the log itself first: what it held there is in no figure
+  // below (docs/sessions.md "A damaged log").
+  if (s.contains("log") && s["log"].is_object()) {
+    const auto skipped = s["log"].value("skipped_bytes", std::int64_t{0});
+    const auto unread = s["log"].value("unread_bytes", std::int64_t{0});
+    if (skipped > 0)
+      h << "<p class=\"bad\"><b>The log is damaged:</b> " << skipped << " bytes in "
+        << s["log"].value("skipped_places", std::int64_t{0})
+        << " place(s) are no event, read past; what they held is in no figure of this "
+           "report.</p>\n";
+    if (unread > 0)
+      h << "<p class=\"bad\"><b>The log ends in " << unread
+        << " bytes that are no whole event</b> (cut short, or damaged there): what they held "
+           "is in no figure of this report.</p>\n";
+  }
+  h << "<table><tr><th>what</th><th>frames or messages</th></tr>";
   auto row = [&h](const std::string& what, const nlohmann::ordered_json& n) {
     h << "<tr><td>" << HtmlText(what) << "</td><td>"
       << (n.is_number() ? n.dump() : std::string("-")) << "</td></tr>";

@@ -161,7 +161,8 @@ std::string PrefixAgrees(const Recording& rec, const ResimResult& p) {
 void CheckBranchPrefix(const fs::path& session, const Recording& rec, ResimResult* result) {
   nlohmann::json m;
   try {
-    m = nlohmann::json::parse(ReadTextFile((session / "manifest.json").string(), "the manifest"));
+    m = nlohmann::json::parse(
+        session::ReadSessionFile(session.string(), "manifest.json", kMaxJsonBytes));
   } catch (const std::exception&) {
     return;  // no manifest, or none readable: no branch to check
   }
@@ -403,7 +404,12 @@ bool OtherDesign(const ResimOptions& opt) {
 std::string EffectiveConfigText(const ResimOptions& opt) {
   const std::string base =
       opt.config_path.empty() ? (fs::path(opt.session) / "config.toml").string() : opt.config_path;
-  const std::string text = ReadTextFile(base, "the configuration file");
+  // The session's own is read as a folder's file (no link, no FIFO); one
+  // the user named with --config as theirs.
+  const std::string text =
+      opt.config_path.empty()
+          ? session::ReadSessionFile(opt.session, "config.toml", kMaxConfigBytes)
+          : ReadTextFile(base, "the configuration file");
   return opt.settings.empty() ? text : ApplyConfigSettings(text, base, opt.settings);
 }
 

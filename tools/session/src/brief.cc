@@ -70,6 +70,11 @@ void LossLines(const Json& j, std::ostream& os) {
        << "): read past them; what they held is not in this summary, whose counts may be "
           "short\n";
   }
+  if (j["log"].value("unread_bytes", 0) > 0) {
+    os << "THE LOG ENDS IN " << j["log"]["unread_bytes"]
+       << " bytes that are no whole event (cut short, or damaged there): what they held is not in "
+          "this summary\n";
+  }
   if (j["record"].value("lost", 0) > 0) {
     // Made from journals, the log holds every frame they could be read
     // for: a frame counted lost is in no readable journal and not on the

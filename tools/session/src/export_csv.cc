@@ -498,7 +498,7 @@ std::vector<std::pair<std::string, long>> ExportCsv(
   } catch (const InputError& e) {
     throw InputError(std::string(e.what()) + ": none of this export's files were kept");
   }
-  if (read) *read = {events, log.unread_bytes()};
+  if (read) *read = {events, log.unread_bytes(), log.skipped_bytes()};
   written.emplace_back("skipped (malformed)", skipped);
   written.emplace_back("not exported (not the session's own: other sessions, other senders)",
                        static_cast<long>(log.check().ignored_total()));

@@ -38,6 +38,12 @@ inline constexpr std::uint64_t kMaxRunFileBytes = std::uint64_t{1} << 20;  // ru
 inline constexpr std::uint64_t kMaxPngBytes = std::uint64_t{32} << 20;     // frames/*.png
 inline constexpr std::uint64_t kMaxLogBytes = std::uint64_t{1} << 40;      // lcmlog, journals
 
+// How to treat a link at an output path the user named (--out): followed
+// (their own: `--out /dev/stdout`) unless the path lies inside `folder`,
+// the session's, where anyone who could write the folder could have
+// planted it (the launcher names SESSION/summary.json itself).
+Links LinksForOutput(const std::string& out, const std::string& folder);
+
 // A tool's output folder (an export's csv/): opened without following a
 // link (made when missing), its files written to fresh temporary files in
 // it (O_CREAT | O_EXCL | O_NOFOLLOW, through the folder's descriptor) and

@@ -16,6 +16,8 @@ namespace rms::session {
 struct ExportRead {
   long events = 0;                // the session's own messages read
   std::int64_t unread_bytes = 0;  // at the log's end, no whole event: not exported
+  std::int64_t skipped_bytes =
+      0;  // inside it, no event: read past (docs/sessions.md "A damaged log")
 };
 
 // Returns each file written with its rows, and the count of malformed
