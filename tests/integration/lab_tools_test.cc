@@ -439,6 +439,11 @@ TEST_F(RecordedSession, ALogDamagedInsideIsReadPastSaidAndNotExact) {
              *tmp_ + "/damaged_all_brief.log");
   EXPECT_EQ(none.rc, 3) << none.out;
   EXPECT_NE(none.out.find("no event at all"), std::string::npos) << none.out;
+  // The verdict on file judged the log before: not shown as this one's.
+  EXPECT_NE(none.out.find("re-simulates: NOT KNOWN -- the verdict on file is of another log"),
+            std::string::npos)
+      << none.out;
+  EXPECT_EQ(none.out.find("re-simulates: identical"), std::string::npos) << none.out;
 }
 
 // The record remade from journals one of which is damaged half way (the

@@ -65,9 +65,16 @@ int Report(const rms::resim::ResimResult& r, bool other_design) {
 // The session's own design re-simulated, as one JSON object
 // (--verdict-json; docs/sessions.md "Does it re-simulate"): what a session's
 // summary says of it. `why` when it could not be re-simulated at all.
-nlohmann::ordered_json Verdict(const rms::resim::ResimResult* r, const std::string& why) {
+nlohmann::ordered_json Verdict(const rms::resim::ResimResult* r, const std::string& why,
+                               const std::string& session) {
   nlohmann::ordered_json v;
   v["format"] = "rmslab-resimulation-1";
+  // The log it judged, by its size: a summary of a log that changed since
+  // does not show this verdict as the log's (docs/sessions.md "Does it
+  // re-simulate").
+  std::error_code ec;
+  const auto bytes = std::filesystem::file_size(std::filesystem::path(session) / "lcmlog", ec);
+  v["log_bytes"] = ec ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(bytes);
   if (!r) {
     v["verdict"] = "cannot be re-simulated";
     v["exact"] = false;
@@ -108,9 +115,9 @@ std::string CheckNewSession(const std::string& dir, int threads) {
   nlohmann::ordered_json v;
   try {
     const rms::resim::ResimResult r = rms::resim::Resimulate(own);
-    v = Verdict(&r, "");
+    v = Verdict(&r, "", dir);
   } catch (const std::exception& e) {
-    v = Verdict(nullptr, e.what());
+    v = Verdict(nullptr, e.what(), dir);
   }
   const std::filesystem::path root(dir);
   rms::WriteWholeFile((root / "resimulation.json").string(), v.dump(2) + "\n");
@@ -253,7 +260,7 @@ int main(int argc, char** argv) {
                                                 ? CheckNewSession(r.out_dir, opt.threads)
                                                 : "";
     if (!verdict_json.empty())
-      rms::WriteWholeFile(verdict_json, Verdict(&r, "").dump(2) + "\n",
+      rms::WriteWholeFile(verdict_json, Verdict(&r, "", opt.session).dump(2) + "\n",
                           rms::LinksForOutput(verdict_json, opt.session));
     if (!checkpoint_out.empty()) {
       if (!r.first_difference.empty()) {
@@ -277,7 +284,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "rms_resim: %s\n", rms::TerminalText(e.what()).c_str());
     if (!verdict_json.empty() && !rms::resim::OtherDesign(opt) && opt.until_frame < 0) {
       try {
-        rms::WriteWholeFile(verdict_json, Verdict(nullptr, e.what()).dump(2) + "\n",
+        rms::WriteWholeFile(verdict_json, Verdict(nullptr, e.what(), opt.session).dump(2) + "\n",
                             rms::LinksForOutput(verdict_json, opt.session));
       } catch (const std::exception& w) {
         std::fprintf(stderr, "rms_resim: %s\n", w.what());

@@ -278,6 +278,9 @@ void ResimulationLine(const Json& j, std::ostream& os) {
        << (v["first_difference"].is_string() ? v["first_difference"].get<std::string>() : "?")
        << " (" << Count(v, "frames_identical") << " of " << Count(v, "frames_compared")
        << " DCP frames identical; scripts/lab resim SESSION says more)\n";
+  } else if (what == "stale") {
+    os << "re-simulates: NOT KNOWN -- the verdict on file is of another log: "
+       << v.value("why", std::string()) << "\n";
   } else {
     os << "re-simulates: NO -- it cannot be re-simulated: "
        << (v.contains("why") && v["why"].is_string() ? v["why"].get<std::string>() : what) << "\n";
