@@ -88,11 +88,24 @@ std::string ReadRegularFile(const std::string& path, const std::string& what,
 }
 
 Links LinksForOutput(const std::string& out, const std::string& folder) {
+  // Where they really are: the output's folder and the session's, links and
+  // "a/" or "a/./" resolved (weakly_canonical: what exists, resolved; the
+  // rest kept lexically), so neither a trailing slash nor a link to the
+  // folder takes an output out of it.
+  namespace fs = std::filesystem;
   std::error_code ec;
-  const std::filesystem::path o = std::filesystem::absolute(out, ec).lexically_normal();
-  const std::filesystem::path f = std::filesystem::absolute(folder, ec).lexically_normal();
-  const auto [fi, oi] = std::mismatch(f.begin(), f.end(), o.begin(), o.end());
-  return fi == f.end() ? Links::kRefuse : Links::kFollow;
+  fs::path parent = fs::absolute(out, ec).lexically_normal().parent_path();
+  const fs::path o = fs::weakly_canonical(parent, ec);
+  const fs::path f = fs::weakly_canonical(fs::absolute(folder, ec), ec);
+  auto parts = [](const fs::path& p) {
+    std::vector<std::string> v;
+    for (const auto& c : p)
+      if (!c.empty() && c != ".") v.push_back(c.string());
+    return v;
+  };
+  const auto op = parts(o), fp = parts(f);
+  const bool inside = op.size() >= fp.size() && std::equal(fp.begin(), fp.end(), op.begin());
+  return inside ? Links::kRefuse : Links::kFollow;
 }
 
 OutputFolder::OutputFolder(const std::string& path, Links links) : path_(path) {

@@ -57,7 +57,12 @@ void WriteStream(const std::string& path, const std::string& text) {
 void WriteWholeFile(const std::string& path, const std::string& text, Links links) {
   struct stat st {};
   const bool exists = lstat(path.c_str(), &st) == 0;
-  if (exists && (IsStream(path, st) || (links == Links::kFollow && S_ISLNK(st.st_mode)))) {
+  // A stream is written directly only where the user named it: a FIFO or a
+  // device planted in a session's folder (an archive unpacked as root keeps
+  // device nodes) is replaced like anything else there.
+  const bool system = path.rfind("/dev/", 0) == 0 || path.rfind("/proc/", 0) == 0;
+  if (exists &&
+      (system || (links == Links::kFollow && (IsStream(path, st) || S_ISLNK(st.st_mode))))) {
     WriteStream(path, text);
     return;
   }

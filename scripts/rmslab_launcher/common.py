@@ -100,6 +100,19 @@ def read_folder_file(path, limit, what=None):
         os.close(fd)
 
 
+def require_session_file(session, name="lcmlog", code=2):
+    """LabError unless SESSION/NAME is a regular file (no link), saying which
+    of missing or not a regular file (a link, a FIFO, a device) it is."""
+    path = os.path.join(session, name)
+    try:
+        st = os.lstat(path)
+    except OSError:
+        raise LabError(f"{session}: not a session folder (no {name})", code)
+    if not stat.S_ISREG(st.st_mode):
+        raise LabError(f"{session}: its {name} is not a regular file (a link, a FIFO or a device): refused "
+                       f"(docs/security.md \"Session folders are untrusted\")", code)
+
+
 def read_folder_json(path, limit=MAX_JSON_BYTES):
     """A session folder's JSON file (read_folder_file), or {} when it is
     missing or not JSON; LabError when it is there but not a regular file."""

@@ -14,7 +14,7 @@ import time
 from . import disk, session
 from .common import (DEFAULT_REPLAY_URL, MAX_CONFIG_BYTES, LabError, binary, check_lcm_url, check_speed,
                      ensure_multicast_route, install_and_build, read_folder_file, read_folder_json, require_built,
-                     say)
+                     require_session_file, say)
 from .hosts import Host
 from .supervisor import Spec, Supervisor
 
@@ -217,8 +217,7 @@ def run(argv):
     p.add_argument("--lcm-url", default=DEFAULT_REPLAY_URL)
     p.add_argument("--no-build", action="store_true")
     a = p.parse_args(argv)
-    if not os.path.isfile(os.path.join(a.session, "lcmlog")):
-        raise LabError("give a session folder (with an lcmlog)")
+    require_session_file(a.session)
     r = Replay(a)
     r.speed = check_speed(a.speed)
     check_lcm_url(a.lcm_url)

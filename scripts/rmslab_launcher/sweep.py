@@ -30,7 +30,7 @@ import tomllib
 
 from . import sweep_cache, sweep_table
 from .common import (BUILD, ROOT, LabError, binary, file_sha256, install_and_build, read_folder_json, read_toml,
-                     replacing, say)
+                     replacing, require_session_file, say)
 
 CELL = os.path.join(ROOT, "scripts", "sweep-cell")
 NETNS_LOGIN = os.path.join(ROOT, "scripts", "rmslab_launcher", "netns-login")
@@ -157,8 +157,7 @@ class Session:
         except UnicodeEncodeError:
             raise LabError(f"{path!r}: a session's path must be UTF-8 text (it goes into the table)")
         for f in ("lcmlog", "config.toml"):
-            if not os.path.isfile(os.path.join(self.path, f)):
-                raise LabError(f"{path}: not a session folder (no {f})")
+            require_session_file(path, f)
         if os.path.getsize(os.path.join(self.path, "lcmlog")) == 0:
             raise LabError(f"{path}: its lcmlog is empty: nothing to re-simulate")
         self.real = os.path.realpath(self.path)

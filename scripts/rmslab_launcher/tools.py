@@ -7,7 +7,7 @@ import subprocess
 import time
 
 from . import replay
-from .common import DEFAULT_URL, ROOT, LabError, binary, file_sha256, install_and_build, say
+from .common import DEFAULT_URL, ROOT, LabError, binary, file_sha256, install_and_build, require_session_file, say
 
 
 def ensure(rel, no_build=False):
@@ -103,8 +103,7 @@ def export(argv):
     p.add_argument("--mcap", action="store_true", help="one MCAP file instead of CSV")
     p.add_argument("--no-build", action="store_true")
     a = p.parse_args(argv)
-    if not os.path.isfile(os.path.join(a.session, "lcmlog")):
-        raise LabError(f"{a.session}: not a session folder (no lcmlog)", 2)
+    require_session_file(a.session)
     if a.mcap:
         refuse_record_file(a.out)
     ensure("tools/rms_session", a.no_build)
@@ -115,8 +114,10 @@ def export(argv):
 
 
 def inside(path, folder):
-    """Whether path lies inside folder (lexically, as rms::LinksForOutput)."""
-    p, f = os.path.normpath(os.path.abspath(path)), os.path.normpath(os.path.abspath(folder))
+    """Whether path lies inside folder, links and trailing slashes resolved
+    (as rms::LinksForOutput)."""
+    p = os.path.realpath(os.path.dirname(os.path.abspath(path)))
+    f = os.path.realpath(folder)
     return os.path.commonpath([p, f]) == f
 
 
@@ -179,8 +180,7 @@ def report(argv):
     p.add_argument("--out")
     p.add_argument("--no-build", action="store_true")
     a = p.parse_args(argv)
-    if not os.path.isfile(os.path.join(a.session, "lcmlog")):
-        raise LabError(f"{a.session}: not a session folder (no lcmlog)", 2)
+    require_session_file(a.session)
     if a.out and not os.path.isdir(os.path.dirname(os.path.abspath(a.out))):
         raise LabError(f"--out {a.out}: its folder does not exist", 2)
     refuse_record_file(a.out)
@@ -205,8 +205,7 @@ def compare(argv):
     p.add_argument("--no-build", action="store_true")
     a = p.parse_args(argv)
     for s in a.sessions:
-        if not os.path.isfile(os.path.join(s, "lcmlog")):
-            raise LabError(f"{s}: not a session folder (no lcmlog)", 2)
+        require_session_file(s)
     ensure("tools/rms_compare", a.no_build)
     out = a.out or os.path.join(ROOT, "sessions", "compare-" + time.strftime("%Y%m%dT%H%M%SZ", time.gmtime()))
     return subprocess.run([binary("tools/rms_compare")] + a.sessions + ["--out", out] +

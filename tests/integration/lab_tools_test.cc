@@ -427,6 +427,19 @@ TEST_F(RecordedSession, ALogDamagedInsideIsReadPastSaidAndNotExact) {
       Script({testing::BuildPath("tools/rms_session"), "summary", cut, "--brief"},
              *tmp_ + "/damaged_inside_brief.log");
   EXPECT_NE(brief.out.find("NOT EXACT: the log is damaged"), std::string::npos) << brief.out;
+  // Bytes written over in place (the log's size unchanged): the verdict on
+  // file judged the log before, and says so.
+  {
+    std::string bytes = ReadFile(cut + "/lcmlog");
+    for (std::size_t i = bytes.size() / 4; i < bytes.size() / 4 + 64; ++i) bytes[i] ^= 0x5a;
+    std::ofstream(cut + "/lcmlog", std::ios::binary) << bytes;
+  }
+  const ScriptRun over =
+      Script({testing::BuildPath("tools/rms_session"), "summary", cut, "--brief"},
+             *tmp_ + "/damaged_over_brief.log");
+  EXPECT_NE(over.out.find("re-simulates: NOT KNOWN -- the verdict on file is of another log"),
+            std::string::npos)
+      << over.out;
   // Nothing but garbage: no event at all, said, exit 3.
   {
     std::mt19937 rng(35);  // seed 35
@@ -499,8 +512,11 @@ TEST_F(RecordedSession, ADamagedJournalIsALossOfTheRecordNotNone) {
   EXPECT_EQ(r["lost"].get<long>(), 2) << r.dump(2);
   // The brief says what the record lacks, and that the re-simulation's
   // "identical" is of what it holds: not exact.
-  fs::copy_file(*dir_ + "/resimulation.json", s + "/resimulation.json",
-                fs::copy_options::overwrite_existing);
+  // (A verdict of this record, not the session's original log: that one
+  // would be shown as another log's.)
+  Script({testing::BuildPath("tools/rms_resim"), s, "--quiet", "--verdict-json",
+          s + "/resimulation.json"},
+         *tmp_ + "/damaged_journal_resim.log");
   const ScriptRun brief =
       Script({tools, "summary", s, "--brief"}, *tmp_ + "/damaged_journal_brief.log");
   EXPECT_NE(brief.out.find("the record lacks " + std::to_string(r["lost"].get<long>())),

@@ -24,6 +24,7 @@
 #include <set>
 #include <sys/mount.h>
 #include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <thread>
 
 #include "rms/dcp_frame_t.hpp"
@@ -821,6 +822,45 @@ TEST(SessionSecurity, ToolsTreatASessionFolderAsUntrusted) {
     EXPECT_EQ(mcap.rc, 0) << mcap.out.substr(0, 500);
     EXPECT_NE(mcap.out.find("\x89MCAP"), std::string::npos) << "the MCAP not on stdout";
     EXPECT_TRUE(fs::is_symlink(mine)) << "the user's link replaced by a file";
+    // A FIFO the user names that nothing reads: refused at once, not waited on.
+    ASSERT_EQ(mkfifo((tmp + "/no-reader").c_str(), 0600), 0);
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto fifo = Script({SourcePath("scripts/lab"), "export", s.out(), "--mcap", "--out",
+                              tmp + "/no-reader", "--no-build"},
+                             tmp + "/mine4.log", 60);
+    EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(30)) << "it waited";
+    EXPECT_NE(fifo.rc, 0) << fifo.out;
+    EXPECT_NE(fifo.out.find("a FIFO that nothing reads"), std::string::npos) << fifo.out;
+  }
+  // The session's folder named with a trailing slash, or through a link to
+  // it, is still the folder: a link planted at an output's name there is
+  // replaced; a device node planted there (an archive unpacked as root
+  // keeps them) is replaced, not written into.
+  {
+    const std::string d = copy("slash");
+    fs::create_directory_symlink(d, tmp + "/alias");
+    fs::remove(d + "/summary.json");
+    fs::create_symlink(secret, d + "/summary.json");
+    fs::create_symlink(secret, d + "/report.html");
+    EXPECT_EQ(Script({tool, "summary", d + "/"}, tmp + "/slash1.log", 60).rc, 0);
+    EXPECT_EQ(
+        Script({testing::BuildPath("tools/rms_report"), d + "/"}, tmp + "/slash2.log", 120).rc, 0);
+    fs::remove(d + "/summary.json");
+    fs::create_symlink(secret, d + "/summary.json");
+    EXPECT_EQ(Script({tool, "summary", tmp + "/alias", "--out", tmp + "/alias/summary.json"},
+                     tmp + "/slash3.log", 60)
+                  .rc,
+              0);
+    EXPECT_EQ(ReadFile(secret), "SECRET-CONTENT\n") << "written through a planted link";
+    EXPECT_FALSE(fs::is_symlink(d + "/summary.json"));
+    EXPECT_FALSE(fs::is_symlink(d + "/report.html"));
+    if (geteuid() == 0) {
+      fs::remove(d + "/summary.json");
+      ASSERT_EQ(mknod((d + "/summary.json").c_str(), S_IFCHR | 0600, makedev(1, 3)), 0);
+      EXPECT_EQ(Script({tool, "summary", d}, tmp + "/dev.log", 60).rc, 0);
+      EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(d + "/summary.json")))
+          << "a device node in the folder written into, not replaced";
+    }
   }
   // Inputs that are not regular files: refused at once, naming the file.
   struct Case {

@@ -25,7 +25,8 @@
 // earlier than its channel's previous one is written as it is (MCAP allows
 // it) and counted. At the end, on stderr:
 //   mcap: N messages on C channels, T types -> FILE (S MB)
-import { unlinkSync } from "node:fs";
+import { constants, unlinkSync } from "node:fs";
+import { randomBytes } from "node:crypto";
 import { lstat, open, readFile, rename, stat, unlink } from "node:fs/promises";
 import { basename, dirname, join, resolve } from "node:path";
 import { StringDecoder } from "node:string_decoder";
@@ -38,6 +39,14 @@ const TYPE_RE = /^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*$/;
 const UINT64_MAX = (1n << 64n) - 1n;
 
 class InputError extends Error {}
+
+// A path as the terminal may show it: control characters as \xNN, never
+// obeyed (docs/security.md "Text from messages and folders").
+function shown(text) {
+  // eslint-disable-next-line no-control-regex
+  return String(text).replace(/[\x00-\x08\x0b-\x1f\x7f\u0080-\u009f]/g,
+      (c) => "\\x" + c.charCodeAt(0).toString(16).padStart(2, "0"));
+}
 
 function usage() {
   return "usage: node write_mcap.mjs --schemas DIR --out FILE.mcap [--follow-links] < session.jsonl";
@@ -202,21 +211,29 @@ async function main() {
     return 2;
   }
   const out = resolve(args.out);
-  // A stream (a FIFO, a device, anything under /dev or /proc), or a link the
-  // user named with --follow-links (`--out /dev/stdout`), is written
-  // directly; anything else to a temporary file renamed over its name, so
-  // a link planted there is replaced, never written through
+  // Written directly only where the user named it (--follow-links: an --out
+  // outside the session's folder) and it is a link, a FIFO or a device, or
+  // anywhere under /dev or /proc (`--out /dev/stdout`); anything else to a
+  // temporary file renamed over its name, so a link, FIFO or device planted
+  // in a session's folder is replaced, never written through
   // (docs/security.md "Session folders are untrusted").
   const st = await lstat(out).catch(() => null);
   const direct =
-      (st && !st.isFile() && !st.isSymbolicLink() && !st.isDirectory()) ||
-      (st && st.isSymbolicLink() && args["follow-links"]) || /^\/(dev|proc)\//.test(out);
-  const tmp = direct ? out : join(dirname(out), `.${basename(out)}.${process.pid}.partial`);
+      /^\/(dev|proc)\//.test(out) ||
+      (args["follow-links"] && st !== null && !st.isFile() && !st.isDirectory());
+  const tmp = direct ? out : join(dirname(out), `.${basename(out)}.${randomBytes(6).toString("hex")}.partial`);
   let handle;
   try {
+    if (direct && (await stat(out).catch(() => null))?.isFIFO()) {
+      // A FIFO nothing reads is refused, not waited on.
+      const probe = await open(out, constants.O_WRONLY | constants.O_NONBLOCK).catch((e) => {
+        throw new Error(e.code === "ENXIO" ? "a FIFO that nothing reads" : e.message);
+      });
+      await probe.close();
+    }
     handle = await open(tmp, direct ? "w" : "wx");
   } catch (e) {
-    console.error(`write_mcap: cannot write ${args.out}: ${e.message}`);
+    console.error(`write_mcap: cannot write ${shown(args.out)}: ${e.message}`);
     return 1;
   }
   const writer = new McapWriter({ writable: new FileWritable(handle) });
@@ -304,7 +321,7 @@ async function main() {
   if (!ok) return 1;
   const bytes = (await stat(out)).size || 0;
   console.error(
-    `mcap: ${count} messages on ${channels.size} channels, ${schemaIds.size} types -> ${args.out} (${(bytes / 1e6).toFixed(2)} MB)`,
+    `mcap: ${count} messages on ${channels.size} channels, ${schemaIds.size} types -> ${shown(args.out)} (${(bytes / 1e6).toFixed(2)} MB)`,
   );
   if (backward > 0) {
     console.error(`mcap: ${backward} messages earlier than their channel's previous one (written in input order)`);

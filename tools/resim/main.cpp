@@ -23,6 +23,7 @@
 #include "rms/base/text.h"
 #include "rms/base/version.h"
 #include "rms/resim/resim.h"
+#include "rms/session/session_folder.h"
 #include "rms/session/session_summary.h"
 
 namespace {
@@ -69,12 +70,14 @@ nlohmann::ordered_json Verdict(const rms::resim::ResimResult* r, const std::stri
                                const std::string& session) {
   nlohmann::ordered_json v;
   v["format"] = "rmslab-resimulation-1";
-  // The log it judged, by its size: a summary of a log that changed since
-  // does not show this verdict as the log's (docs/sessions.md "Does it
-  // re-simulate").
-  std::error_code ec;
-  const auto bytes = std::filesystem::file_size(std::filesystem::path(session) / "lcmlog", ec);
-  v["log_bytes"] = ec ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(bytes);
+  // The log it judged, by its SHA-256: a summary of a log that changed
+  // since does not show this verdict as the log's (docs/sessions.md "Does
+  // it re-simulate").
+  try {
+    v["log_sha256"] = rms::session::SessionFileSha256(session, "lcmlog");
+  } catch (const std::exception&) {
+    v["log_sha256"] = nullptr;
+  }
   if (!r) {
     v["verdict"] = "cannot be re-simulated";
     v["exact"] = false;

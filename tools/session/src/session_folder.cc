@@ -1,9 +1,13 @@
 #include "rms/session/session_folder.h"
 
+#include <sodium.h>
+#include <unistd.h>
+
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <vector>
 
 #include "rms/base/check.h"
 
@@ -37,6 +41,34 @@ std::string CreateSessionFolder(const std::string& dir) {
 LabConfig LoadSessionConfig(const std::string& dir) {
   const std::string path = (fs::path(dir) / "config.toml").string();
   return ParseConfig(ReadRegularFile(path, "the session's configuration", kMaxConfigBytes), path);
+}
+
+std::string SessionFileSha256(const std::string& dir, const std::string& name) {
+  const std::string path = (fs::path(dir) / name).string();
+  const int fd = OpenRegularFile(path, "the session's " + name, kMaxLogBytes);
+  RMS_CHECK(sodium_init() >= 0);
+  crypto_hash_sha256_state state;
+  crypto_hash_sha256_init(&state);
+  std::vector<unsigned char> block(std::size_t{1} << 20);
+  for (;;) {
+    const ssize_t n = read(fd, block.data(), block.size());
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      const int err = errno;
+      close(fd);
+      std::string why = "cannot read the session's " + name;
+      why.append(" '").append(path).append("': ").append(std::strerror(err));
+      throw InputError(why);
+    }
+    if (n == 0) break;
+    crypto_hash_sha256_update(&state, block.data(), static_cast<unsigned long long>(n));
+  }
+  close(fd);
+  unsigned char digest[crypto_hash_sha256_BYTES];
+  crypto_hash_sha256_final(&state, digest);
+  char hex[2 * crypto_hash_sha256_BYTES + 1];
+  sodium_bin2hex(hex, sizeof hex, digest, sizeof digest);
+  return hex;
 }
 
 std::string ReadSessionFile(const std::string& dir, const std::string& name,

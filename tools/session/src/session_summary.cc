@@ -611,17 +611,21 @@ nlohmann::ordered_json Resimulation(const fs::path& root) {
   if (!v.is_object() || !v.contains("verdict") || !v["verdict"].is_string()) return nullptr;
   nlohmann::ordered_json out;
   // A verdict of another log (the log changed since it was judged: its
-  // size differs) is not this log's.
-  std::error_code ec;
-  const auto bytes = fs::file_size(root / "lcmlog", ec);
-  if (v.contains("log_bytes") && v["log_bytes"].is_number_unsigned() && !ec &&
-      v["log_bytes"].get<std::uintmax_t>() != bytes) {
-    out["verdict"] = "stale";
-    out["exact"] = false;
-    out["why"] = "resimulation.json judged a log of " + v["log_bytes"].dump() +
-                 " bytes; the log now has " + std::to_string(bytes) +
-                 ": re-simulate it again (scripts/lab resim)";
-    return out;
+  // SHA-256 differs) is not this log's.
+  if (v.contains("log_sha256") && v["log_sha256"].is_string()) {
+    std::string now;
+    try {
+      now = SessionFileSha256(root.string(), "lcmlog");
+    } catch (const std::exception&) {
+    }
+    if (now != v["log_sha256"].get<std::string>()) {
+      out["verdict"] = "stale";
+      out["exact"] = false;
+      out["why"] =
+          "resimulation.json judged another log (its SHA-256 differs from the lcmlog's now): "
+          "re-simulate it again (scripts/lab resim)";
+      return out;
+    }
   }
   for (const char* k :
        {"verdict", "exact", "frames_compared", "frames_identical", "frames_unchecked",

@@ -23,12 +23,12 @@ std::string HumanNumber(double v, int decimals = 3);
 // not end as if its output were there. A file is written to a fresh
 // temporary file beside it and renamed over its name, so a failure leaves
 // no part of it, and a link planted at its name is replaced, never written
-// through (rms/base/folder_file.h); a FIFO or a device at the path, or
-// anything under /dev or /proc, is written directly, a FIFO nothing reads
-// refused. links: Links::kFollow for a path the user named on the command
-// line (--out): a link there is followed and written through, as the
-// user meant (`--out /dev/stdout`, a link to a FIFO); Links::kRefuse (a
-// tool's own name in a session's folder) replaces it.
+// through (rms/base/folder_file.h). Anything under /dev or /proc is
+// written directly. links: Links::kFollow for a path the user named on
+// the command line outside a session's folder (LinksForOutput): a link, a
+// FIFO or a device there is written directly, as the user meant (`--out
+// /dev/stdout`), a FIFO nothing reads refused; Links::kRefuse (a name in a
+// session's folder) replaces a link, FIFO or device node planted there.
 void WriteWholeFile(const std::string& path, const std::string& text, Links links = Links::kRefuse);
 
 // Escaping for the context a string from a message or a session folder

@@ -28,6 +28,9 @@ std::string CreateSessionFolder(const std::string& dir);
 //
 // DIR/config.toml, parsed (rms::LoadConfig's errors, naming the file).
 LabConfig LoadSessionConfig(const std::string& dir);
+// The SHA-256 of DIR/NAME (a regular file, no link followed), 64 hex
+// digits: what a resimulation.json judged (its log_sha256).
+std::string SessionFileSha256(const std::string& dir, const std::string& name);
 // DIR/NAME (e.g. "manifest.json", "run/pids") as text, at most max_bytes.
 std::string ReadSessionFile(const std::string& dir, const std::string& name,
                             std::uint64_t max_bytes);
