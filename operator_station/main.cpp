@@ -43,6 +43,10 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::Range(0.01, 100.0));
   app.add_option("--frames", opt.max_frames, "Stop after this many frames");
+  app.add_option("--end-when-docked", opt.end_when_docked_s,
+                 "By hand: stop this many seconds of session time after the payload docks (a "
+                 "study's trial; docs/studies.md)")
+      ->check(CLI::Range(0.0, 600.0));
   app.add_option("--restore", opt.restore_path,
                  "Start from a checkpoint's operator inputs (with dynamics_proc --restore; "
                  "docs/sessions.md)")

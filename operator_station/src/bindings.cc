@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "rms/base/check.h"
+#include "rms/base/config.h"
 #include "rms/base/toml_reader.h"
 
 #ifndef RMSLAB_DEFAULT_BINDINGS
@@ -163,6 +164,25 @@ void ReadControl(TomlReader& top, Bindings* b) {
   if (scale != "coarse" && scale != "vernier")
     r.Fail("scale", "must be \"coarse\" or \"vernier\", got \"" + scale + "\"");
   b->initial_vernier = scale == "vernier";
+  b->cameras.clear();
+  if (r.Has("cameras")) {
+    const toml::array* a = r.Get("cameras")->as_array();
+    if (a == nullptr) r.Fail("cameras", "must be an array of camera stations (e.g. [4, 7, 8])");
+    for (const toml::node& n : *a) {
+      const std::optional<std::int64_t> v = n.value<std::int64_t>();
+      if (!n.is_integer() || !v || *v < 1 || *v > kNumCameraStations) {
+        r.Fail("cameras", "must be camera stations, whole numbers 1.." +
+                              std::to_string(kNumCameraStations) + " (e.g. [4, 7, 8])");
+      }
+      const int st = static_cast<int>(*v);
+      if (std::find(b->cameras.begin(), b->cameras.end(), st) != b->cameras.end())
+        r.Fail("cameras", "names station " + std::to_string(st) + " twice");
+      b->cameras.push_back(st);
+    }
+    if (b->cameras.empty()) r.Fail("cameras", "must name at least one station (absent: all eight)");
+  } else {
+    for (int st = 1; st <= kNumCameraStations; ++st) b->cameras.push_back(st);
+  }
   r.Finish();
 }
 

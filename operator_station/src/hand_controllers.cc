@@ -24,6 +24,13 @@ HandControllers::HandControllers(const LabConfig& config, const Bindings& bindin
   status_.mode = bindings.initial_mode;
   status_.frame = bindings.initial_frame;
   status_.vernier = bindings.initial_vernier;
+  status_.cameras = bindings.cameras;
+  if (status_.cameras.empty())
+    for (int st = 1; st <= kNumCameraStations; ++st) status_.cameras.push_back(st);
+  // A camera set without the first station starts on the set's first.
+  if (std::find(status_.cameras.begin(), status_.cameras.end(), target_.camera_station) ==
+      status_.cameras.end())
+    target_.camera_station = out_.camera_station = status_.cameras.front();
   target_.crosshairs = out_.crosshairs = true;
 }
 
@@ -147,14 +154,13 @@ void HandControllers::HandleEvents(const DeviceCommands& cmd, const dcp_telemetr
   for (const Action& a : cmd.events) {
     switch (a.kind) {
       case ActionKind::kCamera:
-        target_.camera_station = a.camera;
+        SelectCamera(a.camera);
         break;
       case ActionKind::kCameraNext:
-        target_.camera_station = target_.camera_station % kNumCameraStations + 1;
+        StepCamera(+1);
         break;
       case ActionKind::kCameraPrev:
-        target_.camera_station =
-            (target_.camera_station + kNumCameraStations - 2) % kNumCameraStations + 1;
+        StepCamera(-1);
         break;
       case ActionKind::kReset:
         out_.reset = true;
@@ -217,6 +223,26 @@ void HandControllers::HandleEvents(const DeviceCommands& cmd, const dcp_telemetr
         break;  // not events
     }
   }
+}
+
+void HandControllers::SelectCamera(int st) {
+  const auto& set = status_.cameras;
+  if (std::find(set.begin(), set.end(), st) == set.end()) {
+    status_.camera_refused = st;
+    counters_.Add(Counter::kCameraRefused);
+    spdlog::info("camera {}: not in this session's camera set", st);
+    return;
+  }
+  status_.camera_refused = 0;
+  target_.camera_station = st;
+}
+
+void HandControllers::StepCamera(int step) {
+  const auto& set = status_.cameras;
+  const auto at = std::find(set.begin(), set.end(), target_.camera_station);
+  const int n = static_cast<int>(set.size());
+  const int i = at == set.end() ? 0 : static_cast<int>(at - set.begin());
+  SelectCamera(set[static_cast<std::size_t>(((i + step) % n + n) % n)]);
 }
 
 void HandControllers::AddPress(const struct Press& p) {

@@ -70,7 +70,8 @@ std::string KeyHelp(const Bindings& b) {
 }
 
 HandSource::HandSource(const LabConfig& config, const HandOptions& o)
-    : bindings_(LoadBindings(o.bindings_path.empty() ? DefaultBindingsPath() : o.bindings_path)) {
+    : bindings_(LoadBindings(o.bindings_path.empty() ? DefaultBindingsPath() : o.bindings_path)),
+      end_when_docked_s_(o.end_when_docked_s) {
   hands_ = std::make_unique<HandControllers>(config, bindings_);
   // Each device is optional: looked for, and reported either way.
   if (isatty(STDIN_FILENO)) {
@@ -115,6 +116,11 @@ std::optional<wire::OperatorInputs> HandSource::Next(const Frame& f) {
   const wire::OperatorInputs in = hands_->Step(f.dt_s, f.telemetry);
   requests_ = {hands_->quit(), hands_->freeze_requested(), hands_->step_requests()};
   if (hands_->quit()) return std::nullopt;
+  if (end_when_docked_s_ >= 0 && f.telemetry && (f.telemetry->docked || docked_s_ > 0)) {
+    if (docked_s_ == 0) spdlog::info("docked: the session ends in {} s", end_when_docked_s_);
+    docked_s_ += f.dt_s;
+    if (docked_s_ > end_when_docked_s_) return std::nullopt;
+  }
   return in;
 }
 

@@ -69,6 +69,7 @@ std::unique_ptr<InputSource> MakeSource(const OperatorOptions& o, const LabConfi
     h.gamepad = o.gamepad;
     h.spacemouse = o.spacemouse;
     h.window = o.window_keys;
+    h.end_when_docked_s = o.end_when_docked_s;
     return std::make_unique<HandSource>(config, h);
   }
   AutopilotOptions ao;

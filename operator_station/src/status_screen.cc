@@ -242,6 +242,15 @@ void CameraLines(const StatusSnapshot& s, const LabConfig& config, Flow& flow) {
       .Field(std::string("crosshairs ") + (in.crosshairs ? "on" : "off"))
       .Field(std::string("overlay ") + (in.overlay ? "on" : "off"));
   if (s.hand) flow.Field(std::string("window guidance ") + (s.show_guidance ? "on" : "off"));
+  if (s.hand && s.hand->camera_refused != 0) {
+    std::string set;
+    for (int c : s.hand->cameras) {
+      if (!set.empty()) set += ' ';
+      set += std::to_string(c);
+    }
+    flow.Line(Sprintf("camera %d is not in this session's camera set (%s)", s.hand->camera_refused,
+                      set.c_str()));
+  }
 }
 
 void ArmLines(const StatusSnapshot& s, Flow& flow) {

@@ -14,6 +14,7 @@
   scripts/lab export SESSION [--mcap]        every channel to CSV, or the log as MCAP
   scripts/lab report SESSION                 one self-contained HTML report
   scripts/lab compare SESSION...             scorecards side by side, learning curves
+  scripts/lab study check|run|status STUDY   a study of subjects, conditions and trials (docs/studies.md)
   scripts/lab monitor [--lcm-url URL]        live decoded traffic per channel
   scripts/lab control [--session DIR] freeze|run|step [N]|checkpoint NAME|restore NAME|FILE [--run]
                       | malfunction WHAT... | repair WHAT...   e.g. malfunction joint 2 stuck
@@ -35,7 +36,7 @@ command explains itself with --help.
 import os
 import sys
 
-from . import demo, replay, sweep, tools
+from . import demo, replay, study, sweep, tools
 from .common import LabError, say
 
 
@@ -52,6 +53,8 @@ def main(argv):
             return replay.run(rest)
         if cmd == "sweep":
             return sweep.run(rest)
+        if cmd == "study":
+            return study.run(rest)
         if cmd in ("resim", "export", "report", "compare", "monitor", "control"):
             return getattr(tools, cmd)(rest)
         if cmd in ("help", "-h", "--help"):

@@ -62,6 +62,18 @@ def add_arguments(p):
                         "pixels sooner; Linux PM QoS through /dev/cpu_dma_latency, which needs root: without "
                         "it the session runs and says so); off: leave it to the system "
                         "(docs/performance.md \"Wake latency\")")
+    p.add_argument("--limit-s", type=float, metavar="S",
+                   help="end the session after S seconds of session time (a study's trial limit)")
+    p.add_argument("--end-when-docked", type=float, metavar="S",
+                   help="by hand: end the session S seconds of session time after the payload docks (a "
+                        "study's trial; the autopilot and a timeline end there already)")
+    g = p.add_argument_group("a study's trial (set by scripts/lab study run; docs/studies.md)")
+    g.add_argument("--study", default="", help="the study's name, for the manifest")
+    g.add_argument("--study-sha256", default="", help="SHA-256 of the study file")
+    g.add_argument("--condition", default="", help="the trial's condition")
+    g.add_argument("--trial", type=int, default=0, help="the trial's place in the subject's order, from 1")
+    g.add_argument("--trial-kind", default="", choices=["", "practice", "measured"])
+    g.add_argument("--trial-run", type=int, default=1, help="1, or more when a lost run is flown again")
     p.add_argument("--no-build", action="store_true")
 
 
@@ -111,6 +123,13 @@ class Demo:
         if a.png_every < 0:
             raise LabError("--png-every: 0 (none) or more")
         self.rate = frame_rate_hz(a.config)
+        if a.limit_s is not None and not 1.0 / self.rate <= a.limit_s <= 86400:
+            raise LabError(f"--limit-s {a.limit_s}: from one frame to 86400 s of session time")
+        if a.end_when_docked is not None and not (a.by_hand and 0 <= a.end_when_docked <= 600):
+            raise LabError(f"--end-when-docked {a.end_when_docked}: by hand (--by-hand), 0..600 s")
+        if a.study and (not a.condition or a.trial < 1 or not a.trial_kind or a.trial_run < 1):
+            raise LabError("--study: with --condition, --trial (1 or more), --trial-kind and --trial-run "
+                           "(scripts/lab study run gives them)")
         self.pilot = "by-hand" if a.by_hand else "timeline" if a.timeline else "autopilot"
         if a.instructor is not None and not 0 <= a.instructor <= 65535:
             raise LabError(f"--instructor {a.instructor}: a port, 0..65535 (0: any free one)")
@@ -199,6 +218,8 @@ class Demo:
         say(f"instructor's page: {url}{where}")
 
     def duration_s(self):
+        if self.a.limit_s is not None:
+            return self.a.limit_s / self.speed + 10
         if self.pilot == "timeline":
             return timeline_length_s(self.a.timeline) / self.speed + 10
         if self.pilot == "autopilot":
@@ -257,6 +278,9 @@ class Demo:
             fields.append(("--subject", a.subject))
         if a.note:
             fields.append(("--note", a.note))
+        if a.study:
+            fields += [("--study", a.study), ("--study-sha256", a.study_sha256), ("--condition", a.condition),
+                       ("--trial", str(a.trial)), ("--trial-kind", a.trial_kind), ("--trial-run", str(a.trial_run))]
         session.write_manifest(self.out, fields)
         say(f"session {self.out}")
 
@@ -341,6 +365,8 @@ class Demo:
             # restarted, it sends the DCP's last inputs until it hears the DCP ("Faults")
             extra += ["--dcp-state-file", os.path.join(self.out, "run", "dcp_state.json")]
         tty = False
+        if a.limit_s is not None:
+            extra += ["--frames", str(max(1, round(a.limit_s * self.rate)))]
         if self.pilot == "timeline":
             extra += ["--timeline", os.path.join(self.out, "timeline.tl"), "--speed", str(self.speed)]
         elif self.pilot == "autopilot":
@@ -349,6 +375,8 @@ class Demo:
                 extra.append("--autopilot-straight")
         else:
             extra += ["--manual", "--bindings", os.path.join(self.out, "bindings.toml")]
+            if a.end_when_docked is not None:
+                extra += ["--end-when-docked", repr(a.end_when_docked)]
             if a.window:
                 extra.append("--window-keys")
             if self.tty:

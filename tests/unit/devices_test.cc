@@ -148,6 +148,14 @@ TEST_F(Devices, TheBindingsFileIsReadAndBadOnesAreRefusedNamingTheKey) {
       {"v = \"vernier\"\n", "", "key 'keyboard.keys': no key is bound to vernier"},
       {"s = \"thc_x-\"", "s = \"camera_1\"", "key 'keyboard.keys': no key is bound to thc_x-"},
       {"Q = \"quit\"\n", "", "key 'keyboard.keys': no key is bound to quit"},
+      {"scale = \"coarse\"", "scale = \"coarse\"\ncameras = [4, 9]",
+       "key 'control.cameras': must be camera stations, whole numbers 1..8"},
+      {"scale = \"coarse\"", "scale = \"coarse\"\ncameras = [4, 7, 4]",
+       "key 'control.cameras': names station 4 twice"},
+      {"scale = \"coarse\"", "scale = \"coarse\"\ncameras = []",
+       "key 'control.cameras': must name at least one station"},
+      {"scale = \"coarse\"", "scale = \"coarse\"\ncameras = 4",
+       "key 'control.cameras': must be an array of camera stations"},
   };
   for (const Case& c : cases) {
     try {
@@ -441,6 +449,33 @@ TEST_F(Devices, SingleJointDrivesTheSelectedJointAtARateWithinItsLimit) {
   hc.Apply(mode, kDt, nullptr);
   EXPECT_EQ(hc.status().mode, ControlMode::kManualAugmented);
   EXPECT_EQ(hc.counters().Get(Counter::kControlModeChanges), 1);
+}
+
+// A camera set (a study's condition, docs/studies.md): the operator starts
+// on its first station, selects only its stations (a key for another is
+// refused, counted and shown), and next / previous step through it.
+TEST_F(Devices, ACameraSetLimitsTheStationsAnOperatorMaySelect) {
+  EXPECT_EQ(bindings.cameras, (std::vector<int>{1, 2, 3, 4, 5, 6, 7, 8}));
+  const Bindings b = ParseBindings(Replace(DefaultBindingsText(), "scale = \"coarse\"",
+                                           "scale = \"coarse\"\ncameras = [4, 7, 8]"),
+                                   "bindings.toml");
+  HandControllers hc(config, b);
+  EXPECT_EQ(hc.Apply({}, kDt, nullptr).camera_station, 4);
+  const auto press = [&](const std::string& action) {
+    DeviceCommands c;
+    c.events.push_back(ParseAction(action));
+    return hc.Apply(c, kDt, nullptr).camera_station;
+  };
+  EXPECT_EQ(press("camera_7"), 7);
+  EXPECT_EQ(press("camera_2"), 7) << "a station outside the set was selected";
+  EXPECT_EQ(hc.status().camera_refused, 2);
+  EXPECT_EQ(hc.counters().Get(Counter::kCameraRefused), 1);
+  EXPECT_EQ(press("camera_next"), 8);
+  EXPECT_EQ(hc.status().camera_refused, 0);
+  EXPECT_EQ(press("camera_next"), 4);
+  EXPECT_EQ(press("camera_prev"), 8);
+  EXPECT_EQ(press("camera_1"), 8);
+  EXPECT_EQ(hc.counters().Get(Counter::kCameraRefused), 2);
 }
 
 TEST_F(Devices, ThePayloadFrameIsOfferedOnlyOnceThePayloadIsHeld) {

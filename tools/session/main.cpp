@@ -11,7 +11,10 @@
 #include <vector>
 
 #include "rms/base/command_line.h"
+#include "rms/base/config.h"
+#include "rms/base/config_settings.h"
 #include "rms/base/counters.h"
+#include "rms/base/folder_file.h"
 #include "rms/base/text.h"
 #include "rms/session/brief.h"
 #include "rms/session/export_csv.h"
@@ -125,6 +128,13 @@ Command Manifest(CLI::App& app) {
                 "A branch's recorded session (scripts/lab demo --from)");
   c->add_option("--branch-frame", f.branch_frame, "... the last DCP frame of its prefix");
   c->add_option("--branch-time", f.branch_time_s, "... that frame's session time, s");
+  c->add_option("--study", f.study.name, "A study's trial (docs/studies.md): the study's name");
+  c->add_option("--study-sha256", f.study.file_sha256, "... SHA-256 of its study file");
+  c->add_option("--condition", f.study.condition, "... the trial's condition");
+  c->add_option("--trial", f.study.trial, "... the trial's place in the subject's order, from 1");
+  c->add_option("--trial-kind", f.study.kind, "... practice or measured")
+      ->check(CLI::IsMember({"practice", "measured"}));
+  c->add_option("--trial-run", f.study.run, "... this trial's run: 1, or more after a lost one");
   c->add_option("--branch-parent-log-sha256", f.branch_parent_log_sha256,
                 "... SHA-256 of the recorded session's lcmlog");
   return {c, [o] {
@@ -250,6 +260,32 @@ Command Probe(CLI::App& app) {
           }};
 }
 
+// design: a configuration with keys set over it (a study's condition,
+// docs/studies.md), checked as every process checks it, written to a file.
+Command Design(CLI::App& app) {
+  struct O {
+    std::string config, out;
+    std::vector<std::string> sets;
+  };
+  auto o = std::make_shared<O>();
+  CLI::App* c = app.add_subcommand(
+      "design",
+      "Write a configuration with KEY=VALUE settings over another, checked (docs/studies.md)");
+  c->add_option("--config", o->config, "The configuration the design starts from")->required();
+  c->add_option("--set", o->sets, "KEY=VALUE: a key set over it, as rms_resim --set; repeatable");
+  c->add_option("--out", o->out, "Where the design's configuration goes")->required();
+  return {c, [o] {
+            std::vector<rms::ConfigSetting> settings;
+            for (const std::string& s : o->sets) settings.push_back(rms::ParseConfigSetting(s));
+            const std::string base = rms::ReadRegularFile(
+                o->config, "configuration", rms::kMaxConfigBytes, rms::Links::kFollow);
+            const std::string text = rms::ApplyConfigSettings(base, o->config, settings);
+            rms::ParseConfig(text, o->out);  // refused as every process would refuse it
+            rms::WriteWholeFile(o->out, text, rms::Links::kFollow);
+            return 0;
+          }};
+}
+
 // counters: every counter a process reports, as docs/sessions.md lists them.
 Command Counters(CLI::App& app) {
   CLI::App* c =
@@ -265,9 +301,9 @@ Command Counters(CLI::App& app) {
 int main(int argc, char** argv) {
   CLI::App app{"rmslab session tools"};
   app.require_subcommand(1);
-  const std::vector<Command> commands = {Summary(app),    Record(app), Manifest(app),
-                                         CompareEsg(app), Export(app), Folder(app),
-                                         LabFile(app),    Probe(app),  Counters(app)};
+  const std::vector<Command> commands = {Summary(app),  Record(app), Manifest(app), CompareEsg(app),
+                                         Export(app),   Folder(app), LabFile(app),  Probe(app),
+                                         Counters(app), Design(app)};
   if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   try {
     for (const Command& c : commands) {

@@ -1128,6 +1128,14 @@ nlohmann::ordered_json MakeManifest(const std::string& dir, const ManifestFields
                    {"time_s", f.branch_time_s},
                    {"parent_log_sha256", f.branch_parent_log_sha256}};
   }
+  if (!f.study.name.empty()) {
+    if (f.study.condition.empty() || f.study.kind.empty() || f.study.trial < 1 || f.study.run < 1)
+      throw InputError(
+          "--study: give --condition, --trial (1 or more), --trial-kind and --trial-run");
+    j["study"] = {{"name", f.study.name},           {"file_sha256", f.study.file_sha256},
+                  {"condition", f.study.condition}, {"trial", f.study.trial},
+                  {"kind", f.study.kind},           {"run", f.study.run}};
+  }
   j["began_from"] = !f.began_from.empty()  ? f.began_from
                     : !f.branch_of.empty() ? "branch"
                     : !restore.empty()     ? "restore"

@@ -7,6 +7,7 @@
 #include <map>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "rms/operator_station/control_modes.h"
 #include "rms/wire/input_block.h"
@@ -80,6 +81,10 @@ struct Bindings {
   ControlMode initial_mode = ControlMode::kManualAugmented;
   CommandFrame initial_frame = CommandFrame::kEndEffector;
   bool initial_vernier = false;
+  // The camera stations this operator may select (1..8, distinct; the first
+  // is shown at the start): a study's condition gives a subject a camera
+  // set (docs/studies.md "Conditions"). Every station when the key is absent.
+  std::vector<int> cameras;
 
   // [conditioning]
   double deadband = 0.1;  // analog axes: this fraction of full deflection reads as 0

@@ -52,6 +52,11 @@ struct HandStatus {
   bool held_at_port =
       false;  // docked: the CAE holds the payload and the arm until the finger opens
   double sigma_min_ft = 0.0;
+  // The bindings' camera set (docs/operator.md "Bindings"), and the last
+  // station asked for outside it (0: none since the last selection that
+  // was taken), for the status screen.
+  std::vector<int> cameras;
+  int camera_refused = 0;
 };
 
 class HandControllers {
@@ -92,6 +97,11 @@ class HandControllers {
 
  private:
   void HandleEvents(const DeviceCommands& cmd, const dcp_telemetry_t* telemetry);
+  // Selects camera station `st` if the camera set has it; else refuses it
+  // (counted, shown on the status screen). step +1 / -1: the set's next or
+  // previous station from the one shown.
+  void SelectCamera(int st);
+  void StepCamera(int step);
   void AddPress(const Press& p);
   std::array<double, kNumHandAxes> CommandedRates(const DeviceCommands& cmd, double dt_s);
   void FlyManualAugmented(const std::array<double, kNumHandAxes>& rate, double dt_s);

@@ -91,6 +91,9 @@ struct HandOptions {
   bool keyboard_required = false;  // --keyboard: this terminal's keyboard or refuse
   bool gamepad = true, spacemouse = true;
   bool window = true;  // listen for the live window's keys (RMS_WINDOW_KEYS)
+  // Stop this long (session time, s) after the DCP first says docked: a
+  // study's trial ends at docking (docs/studies.md). Negative: never.
+  double end_when_docked_s = -1;
 };
 
 class HandSource : public InputSource {
@@ -118,6 +121,8 @@ class HandSource : public InputSource {
   std::vector<std::string> device_report_;
   std::string help_;
   Requests requests_;
+  double end_when_docked_s_ = -1;
+  double docked_s_ = 0;  // session time since the DCP first said docked
 };
 
 class AutopilotSource : public InputSource {

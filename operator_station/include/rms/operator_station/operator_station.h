@@ -45,6 +45,8 @@ struct OperatorOptions {
   bool hold = false;     // --hold: keep publishing after the timeline's end / docking
   double speed = 1.0;  // --speed: timeline seconds per wall-clock second (frames stay at the rate)
   std::int64_t max_frames = -1;  // --frames N: stop after N frames (-1: no limit)
+  double end_when_docked_s =
+      -1;  // --end-when-docked S: by hand, stop S s after docking (-1: never)
   std::string
       restore_path;  // --restore CHECKPOINT: start from its operator inputs (by hand, autopilot)
   std::string

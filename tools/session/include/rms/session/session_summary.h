@@ -76,6 +76,12 @@ struct ManifestFields {
   // The session's messages carry tags (wire::kMessageAuthName), its key in
   // SESSION/run/session.key; "" when they do not.
   std::string message_auth;
+  // A study's trial (scripts/lab study run; docs/studies.md "The session
+  // folders"): empty `name` when the session is none.
+  struct StudyTrial {
+    std::string name, file_sha256, condition, kind;
+    int trial = 0, run = 1;
+  } study;
 };
 nlohmann::ordered_json MakeManifest(const std::string& session_dir, const ManifestFields& f);
 // A manifest's `began_from`; for one written before that field, derived

@@ -1,0 +1,374 @@
+// Studies (docs/studies.md), as an experimenter runs them: `scripts/lab
+// study check / run / status` on study files written here, the trials real
+// sessions of the four processes over LCM. A study file refused naming its
+// key; each subject's order a balanced Latin square or a seeded shuffle;
+// trials run one after another, tagged, resumed after the run is killed, a
+// trial whose process crashed flown again and never counted; and a subject
+// played by the scripted operator at a real terminal, by hand, with the
+// condition's camera set.
+#include <signal.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <gtest/gtest.h>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "hand_session.h"
+#include "scripted_operator.h"
+#include "study_subject.h"
+#include "subprocess.h"
+
+namespace rms {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using testing::ReadFile;
+using testing::Script;
+using testing::ScriptRun;
+using testing::SourcePath;
+
+std::string Lab() { return SourcePath("scripts/lab"); }
+
+std::string WriteStudy(const std::string& dir, const std::string& name, const std::string& text) {
+  std::string path = dir + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+// A study of `n` conditions (c0, c1, ...) and `subjects` subjects (s0, ...).
+std::string StudyText(const std::string& order, int n, int subjects, int practice = 0) {
+  std::string t = "[study]\nname = \"t\"\norder = \"" + order + "\"\n";
+  if (order == "random") t += "seed = 7\n";
+  t += "practice_trials = " + std::to_string(practice) +
+       "\nmeasured_trials = 1\ntrial_limit_s = 60\n";
+  t += "subjects = [";
+  for (int i = 0; i < subjects; ++i)
+    t += (i ? ", " : "") + std::string("\"s") + std::to_string(i) + "\"";
+  t += "]\n";
+  for (int i = 0; i < n; ++i) {
+    t += "[[conditions]]\nname = \"c";
+    t += std::to_string(i);
+    t += "\"\n";
+  }
+  return t;
+}
+
+json Plan(const std::string& dir, const std::string& study) {
+  const ScriptRun r =
+      Script({Lab(), "study", "check", study, "--json", "--no-build"}, dir + "/check.log");
+  EXPECT_EQ(r.rc, 0) << r.out;
+  const auto brace = r.out.find('{');
+  return brace == std::string::npos ? json() : json::parse(r.out.substr(brace), nullptr, false);
+}
+
+// Each subject's order of conditions (indices), from the plan.
+std::vector<std::vector<int>> Orders(const json& plan, int subjects) {
+  std::vector<std::vector<int>> out;
+  for (int s = 0; s < subjects; ++s) {
+    std::vector<int> order;
+    std::string name = "s";
+    name += std::to_string(s);
+    for (const json& t : plan["subjects"][name]) {
+      const int c = std::stoi(t["condition"].get<std::string>().substr(1));
+      if (order.empty() || order.back() != c) order.push_back(c);
+    }
+    out.push_back(order);
+  }
+  return out;
+}
+
+TEST(Study, AStudyFileIsRefusedNamingTheKeyAndWhy) {
+  const std::string dir = testing::MakeTempDir("study_file");
+  const std::string good =
+      "[study]\nname = \"ok\"\norder = \"balanced-latin-square\"\nmeasured_trials = 2\n"
+      "trial_limit_s = 120\nsubjects = [\"S1\", \"S2\"]\n"
+      "[[conditions]]\nname = \"flown\"\n"
+      "[[conditions]]\nname = \"short\"\nset = { \"arm.upper_boom_ft\" = 19.9 }\ncameras = [4, 7, "
+      "8]\n";
+  ASSERT_EQ(Script({Lab(), "study", "check", WriteStudy(dir, "good.toml", good), "--no-build"},
+                   dir + "/good.log")
+                .rc,
+            0)
+      << ReadFile(dir + "/good.log");
+  struct Case {
+    std::string from, to, message;
+  };
+  const Case cases[] = {
+      {"order = \"balanced-latin-square\"", "order = \"latin\"", "key 'study.order': must be"},
+      {"order = \"balanced-latin-square\"", "order = \"random\"", "key 'study.seed': missing"},
+      {"measured_trials = 2", "measured_trials = 0",
+       "key 'study.measured_trials': must be a whole"},
+      {"trial_limit_s = 120", "trial_limt_s = 120", "key 'study.trial_limt_s': unknown key"},
+      {"\"S2\"", "\"S1\"", "key 'study.subjects[1]': 'S1' is listed twice"},
+      {"\"S2\"", "\"../x\"", "key 'study.subjects[1]': a subject's name must be"},
+      {"name = \"short\"", "name = \"flown\"", "key 'conditions[1].name': 'flown' is the name"},
+      {"19.9", "-3", "key 'conditions[1].set.arm.upper_boom_ft': must be > 0, got -3"},
+      {"19.9", "\"long\"", "key 'conditions[1].set.arm.upper_boom_ft': the key is a number"},
+      {"arm.upper_boom_ft", "arm.uper_boom_ft",
+       "key 'conditions[1].set.arm.uper_boom_ft': the "
+       "configuration has no key"},
+      {"cameras = [4, 7, 8]", "cameras = [4, 9]", "key 'conditions[1].cameras': must be distinct"},
+      {"cameras = [4, 7, 8]", "control = \"joystick\"", "key 'conditions[1].control': must be"},
+      {"[[conditions]]\nname = \"flown\"\n", "", "name = \"flown\""},  // one condition left: fine
+  };
+  for (std::size_t i = 0; i + 1 < std::size(cases); ++i) {
+    const Case& c = cases[i];
+    std::string text = good;
+    ASSERT_NE(text.find(c.from), std::string::npos) << c.from;
+    text.replace(text.find(c.from), c.from.size(), c.to);
+    const ScriptRun r =
+        Script({Lab(), "study", "check", WriteStudy(dir, "bad.toml", text), "--no-build"},
+               dir + "/bad.log");
+    EXPECT_EQ(r.rc, 2) << c.to << "\n" << r.out;
+    EXPECT_NE(r.out.find("bad.toml: " + c.message), std::string::npos) << c.to << "\n" << r.out;
+  }
+  fs::remove_all(dir);
+}
+
+// Williams's balanced Latin square: over a whole square's subjects each
+// condition comes once (n even) or twice (n odd, the square and its mirror)
+// in each place, and each condition directly follows each other as often.
+TEST(Study, OrdersAreBalancedLatinSquaresOrShufflesOfAPrintedSeed) {
+  const std::string dir = testing::MakeTempDir("study_order");
+  for (const int n : {4, 3}) {
+    const int rows = n % 2 == 0 ? n : 2 * n;
+    const json plan = Plan(
+        dir, WriteStudy(dir, "latin.toml", StudyText("balanced-latin-square", n, 2 * rows, 1)));
+    ASSERT_TRUE(plan.is_object());
+    const auto orders = Orders(plan, 2 * rows);
+    std::map<std::pair<int, int>, int> at, follows;
+    for (int s = 0; s < rows; ++s) {
+      ASSERT_EQ(std::set<int>(orders[s].begin(), orders[s].end()).size(),
+                static_cast<std::size_t>(n))
+          << "subject " << s << " does not fly every condition once";
+      for (int k = 0; k < n; ++k) ++at[{orders[s][k], k}];
+      for (int k = 0; k + 1 < n; ++k) ++follows[{orders[s][k], orders[s][k + 1]}];
+      EXPECT_EQ(orders[s + rows], orders[s]) << "the square's rows repeat for the next subjects";
+    }
+    for (const auto& [key, count] : at)
+      EXPECT_EQ(count, rows / n) << "condition " << key.first << " place " << key.second;
+    EXPECT_EQ(follows.size(), static_cast<std::size_t>(n * (n - 1)));
+    for (const auto& [key, count] : follows)
+      EXPECT_EQ(count, rows / n) << key.first << " then " << key.second;
+    // Each condition's practice trial comes before its measured one.
+    const json& s0 = plan["subjects"]["s0"];
+    ASSERT_EQ(s0.size(), static_cast<std::size_t>(2 * n));
+    for (int k = 0; k < n; ++k) {
+      EXPECT_EQ(s0[2 * k]["kind"], "practice");
+      EXPECT_EQ(s0[2 * k + 1]["kind"], "measured");
+      EXPECT_EQ(s0[2 * k]["condition"], s0[2 * k + 1]["condition"]);
+      EXPECT_EQ(s0[2 * k]["trial"], 2 * k + 1);
+    }
+  }
+  // Random: the same seed, the same orders, and the seed is printed.
+  const std::string random = WriteStudy(dir, "random.toml", StudyText("random", 4, 6));
+  std::printf("random order: seed 7 (the study file's)\n");
+  const json a = Plan(dir, random), b = Plan(dir, random);
+  EXPECT_EQ(a["subjects"], b["subjects"]);
+  EXPECT_EQ(a["seed"], 7);
+  const ScriptRun said = Script({Lab(), "study", "check", random, "--no-build"}, dir + "/said.log");
+  EXPECT_NE(said.out.find("seed 7"), std::string::npos) << said.out;
+  std::string other = StudyText("random", 4, 6);
+  other.replace(other.find("seed = 7"), 8, "seed = 8");
+  const json c = Plan(dir, WriteStudy(dir, "random8.toml", other));
+  EXPECT_NE(Orders(a, 6), Orders(c, 6)) << "seeds 7 and 8 gave the same orders";
+  std::set<std::vector<int>> distinct;
+  for (const auto& o : Orders(a, 6)) distinct.insert(o);
+  EXPECT_GT(distinct.size(), 1u) << "every subject has the same shuffle";
+  fs::remove_all(dir);
+}
+
+json Status(const std::string& dir, const std::string& study, const std::string& folder) {
+  const ScriptRun r =
+      Script({Lab(), "study", "status", study, "--dir", folder, "--json"}, dir + "/status.log");
+  EXPECT_EQ(r.rc, 0) << r.out;
+  const auto brace = r.out.find('{');
+  return brace == std::string::npos ? json() : json::parse(r.out.substr(brace), nullptr, false);
+}
+
+std::vector<json> Journal(const std::string& folder) {
+  std::vector<json> out;
+  std::ifstream f(folder + "/trials.jsonl");
+  for (std::string line; std::getline(f, line);) out.push_back(json::parse(line, nullptr, false));
+  return out;
+}
+
+int Starts(const std::string& folder, int trial) {
+  int n = 0;
+  for (const json& e : Journal(folder))
+    n += e.value("event", "") == "start" && e.value("trial", 0) == trial;
+  return n;
+}
+
+bool WaitUntil(const std::function<bool()>& done, double limit_s) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(limit_s);
+  while (std::chrono::steady_clock::now() < end) {
+    if (done()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return done();
+}
+
+// A dry run (the autopilot as a virtual subject): four trials one after
+// another, the run killed (SIGKILL) as its second begins and resumed, and
+// the DCP killed in the third; each a session tagged with its trial, the
+// killed and the crashed runs marked lost and flown again, none counted.
+TEST(Study, TrialsRunInOrderResumeAfterAKillAndALostOneIsFlownAgain) {
+  const std::string dir = testing::MakeTempDir("study_run");
+  const std::string folder = dir + "/study";
+  const std::string url = testing::UniqueLcmUrl(9500);
+  const std::string study =
+      WriteStudy(dir, "dry.toml",
+                 "[study]\nname = \"dry\"\norder = \"balanced-latin-square\"\n"
+                 "measured_trials = 2\ntrial_limit_s = 12\nsubjects = [\"A\", \"B\"]\n"
+                 "[[conditions]]\nname = \"flown\"\n"
+                 "[[conditions]]\nname = \"tpob\"\nset = { \"dcp.tpob_ft\" = 0.35 }\n");
+  const std::vector<std::string> run = {
+      Lab(),   "study",      "run",         study,       "--subject",  "A",
+      "--dir", folder,       "--pilot",     "autopilot", "--no-build", "--speed",
+      "2",     "--no-video", "--png-every", "0",         "--lcm-url",  url};
+  {
+    testing::Subprocess first(run, dir + "/first.log");
+    ASSERT_TRUE(WaitUntil([&] { return Starts(folder, 2) >= 1; }, 120))
+        << ReadFile(dir + "/first.log");
+    first.Signal(SIGKILL);
+    first.Wait(10);
+  }
+  // The killed run's trial-2 session stops by itself (its launcher is told
+  // when the study run dies); the resumed run waits for it, marks it lost
+  // and flies it again.
+  testing::Subprocess second(run, dir + "/second.log");
+  ASSERT_TRUE(WaitUntil([&] { return Starts(folder, 3) >= 1; }, 180))
+      << ReadFile(dir + "/second.log");
+  std::string pid_file;
+  ASSERT_TRUE(WaitUntil(
+      [&] {
+        for (const auto& e : fs::directory_iterator(folder + "/A"))
+          if (e.path().filename().string().rfind("03-", 0) == 0 &&
+              fs::exists(e.path() / "run/dynamics_proc.ready"))
+            pid_file = (e.path() / "run/dynamics_proc.pid").string();
+        return !pid_file.empty();
+      },
+      60));
+  const int dcp = std::stoi(ReadFile(pid_file));
+  ASSERT_EQ(kill(dcp, SIGKILL), 0);
+  ASSERT_EQ(second.Wait(300), 0) << ReadFile(dir + "/second.log");
+  const std::string log = ReadFile(dir + "/second.log");
+  EXPECT_NE(log.find("marked lost, to be flown again"), std::string::npos) << log;
+  EXPECT_NE(log.find("LOST: a process crashed and was restarted (dynamics_proc)"),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("subject A has flown every trial"), std::string::npos) << log;
+
+  const json st = Status(dir, study, folder);
+  const json& a = st["subjects"]["A"];
+  EXPECT_EQ(a["planned"], 4);
+  EXPECT_EQ(a["done"], 4);
+  EXPECT_EQ(a["lost_runs"], 2);
+  EXPECT_TRUE(a["next"].is_null());
+  EXPECT_EQ(st["subjects"]["B"]["done"], 0);
+  EXPECT_EQ(st["subjects"]["B"]["next"]["trial"], 1);
+  // Balanced Latin square of two: A flies flown, flown, tpob, tpob.
+  const std::vector<std::string> conds = {"flown", "flown", "tpob", "tpob"};
+  for (int i = 0; i < 4; ++i) {
+    const json& t = a["trials"][i];
+    EXPECT_EQ(t["condition"], conds[i]);
+    EXPECT_TRUE(t["done"].get<bool>());
+    const std::size_t runs = t["sessions"].size();
+    EXPECT_EQ(runs, i == 1 || i == 2 ? 2u : 1u) << t.dump();
+    // The run counted is the last; each run's session is tagged (a lost
+    // run's, killed before its session began, may have none).
+    for (std::size_t k = 0; k < runs; ++k) {
+      const std::string session = folder + "/" + t["sessions"][k].get<std::string>();
+      if (k + 1 < runs && !fs::exists(session + "/manifest.json")) continue;
+      const json m = json::parse(ReadFile(session + "/manifest.json"), nullptr, false);
+      ASSERT_TRUE(m.is_object()) << session;
+      EXPECT_EQ(m["subject"], "A");
+      EXPECT_EQ(m["study"]["name"], "dry");
+      EXPECT_EQ(m["study"]["condition"], conds[i]);
+      EXPECT_EQ(m["study"]["trial"], i + 1);
+      EXPECT_EQ(m["study"]["run"], static_cast<int>(k) + 1);
+      EXPECT_EQ(m["study"]["kind"], "measured");
+      // The condition's design is the session's configuration.
+      const std::string cfg = ReadFile(session + "/config.toml");
+      EXPECT_EQ(cfg.find("tpob_ft = 0.34999999999999998") != std::string::npos, conds[i] == "tpob")
+          << session;
+    }
+    const std::string counted = folder + "/" + t["sessions"][runs - 1].get<std::string>();
+    const json sum = json::parse(ReadFile(counted + "/summary.json"), nullptr, false);
+    EXPECT_TRUE(sum["resimulation"]["exact"].get<bool>()) << counted;
+    EXPECT_TRUE(sum["restarts"].empty()) << counted;
+  }
+  // Run again: nothing left to fly.
+  const ScriptRun again = Script(run, dir + "/again.log", 60);
+  EXPECT_EQ(again.rc, 0);
+  EXPECT_NE(again.out.find("has flown every trial"), std::string::npos) << again.out;
+  // A changed study file is refused for the folder its trials were flown in.
+  std::string changed = ReadFile(study);
+  changed.replace(changed.find("0.35"), 4, "0.40");
+  const ScriptRun refused =
+      Script({Lab(), "study", "run", WriteStudy(dir, "dry.toml", changed), "--subject", "B",
+              "--dir", folder, "--pilot", "autopilot", "--no-build"},
+             dir + "/refused.log", 60);
+  EXPECT_EQ(refused.rc, 2);
+  EXPECT_NE(refused.out.find("is not the study file its folder"), std::string::npos) << refused.out;
+  if (!::testing::Test::HasFailure()) fs::remove_all(dir);
+}
+
+// A subject at a terminal: the scripted operator flies each trial by hand
+// from the status screen (acquires, then quits), the study's prompt between
+// them; the second condition's camera set refuses station 1.
+TEST(Study, ASubjectFliesEachTrialByHandAtATerminal) {
+  const std::string dir = testing::MakeTempDir("study_hand");
+  const std::string folder = dir + "/study";
+  const std::string study =
+      WriteStudy(dir, "hand.toml",
+                 "[study]\nname = \"hand\"\norder = \"balanced-latin-square\"\n"
+                 "measured_trials = 1\ntrial_limit_s = 200\nsubjects = [\"P1\"]\n"
+                 "[[conditions]]\nname = \"all-cameras\"\n"
+                 "[[conditions]]\nname = \"three-cameras\"\ncameras = [4, 7, 8]\n");
+  testing::StudySubject subject(dir, study, "P1", folder, testing::UniqueLcmUrl(9520));
+  for (int trial = 1; trial <= 2; ++trial) {
+    ASSERT_TRUE(subject.StartTrial(trial, 120))
+        << "trial " << trial << "\n"
+        << subject.tmux()->Capture() << ReadFile(dir + "/study.log");
+    if (trial == 2) {
+      // The camera set: station 1 is refused, and said so on the screen.
+      subject.tmux()->Send({"1"});
+      EXPECT_TRUE(subject.WaitFor("camera 1 is not in this session's camera set (4 7 8)", 10))
+          << subject.tmux()->Capture();
+    }
+    testing::ScriptedOperator op(subject.tmux(), testing::kReactionS);
+    const testing::FlightReport r = op.Fly(/*acquire_only=*/true, 150);
+    EXPECT_TRUE(r.acquired) << "trial " << trial << ": " << r.failure << "\n"
+                            << subject.tmux()->Capture();
+    subject.tmux()->Send({"Q"});
+  }
+  ASSERT_EQ(subject.WaitExit(120), 0) << ReadFile(dir + "/study.log");
+  const std::string log = ReadFile(dir + "/study.log");
+  EXPECT_NE(log.find("subject P1: trial 1 of 2 -- condition 'all-cameras'"), std::string::npos)
+      << log;
+  EXPECT_NE(log.find("trial 2 of 2 done: acquired"), std::string::npos) << log;
+  const json st = Status(dir, study, folder);
+  EXPECT_EQ(st["subjects"]["P1"]["done"], 2);
+  const std::string second =
+      folder + "/" + st["subjects"]["P1"]["trials"][1]["sessions"][0].get<std::string>();
+  const json stats = json::parse(ReadFile(second + "/stats/operator_station.json"), nullptr, false);
+  EXPECT_EQ(stats["counters"].value("camera.refused", 0), 1) << stats.dump();
+  const json sum = json::parse(ReadFile(second + "/summary.json"), nullptr, false);
+  EXPECT_EQ(sum["pilot"], "by-hand");
+  EXPECT_TRUE(sum["acquired"].get<bool>());
+  if (!::testing::Test::HasFailure()) fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rms
