@@ -5,6 +5,7 @@
                         [--no-build] [demo options: --window --instructor --speed --lcm-url ...]
                                              that subject's next trials, one after another
   scripts/lab study status STUDY [--dir DIR] [--json]   what is done and what is left
+  scripts/lab study report STUDY [--dir DIR] [--out DIR]  one table (CSV, JSON lines) and one page
 
 A study's folder (default sessions/studies/NAME, --dir) holds the study file
 as first run, the plan, each condition's configuration and bindings, the
@@ -48,7 +49,10 @@ def run(argv):
         return run_trials(rest)
     if cmd == "status":
         return status(rest)
-    raise LabError(f"study: unknown command '{cmd}' (check, run or status; scripts/lab study --help)")
+    if cmd == "report":
+        from . import study_report
+        return study_report.run(rest)
+    raise LabError(f"study: unknown command '{cmd}' (check, run, status or report; scripts/lab study --help)")
 
 
 # ---- the study's folder ----

@@ -308,6 +308,29 @@ TEST(Study, TrialsRunInOrderResumeAfterAKillAndALostOneIsFlownAgain) {
     EXPECT_TRUE(sum["resimulation"]["exact"].get<bool>()) << counted;
     EXPECT_TRUE(sum["restarts"].empty()) << counted;
   }
+  // The report: a row an attempt of the four trials counted (the lost runs
+  // are not in it), and the statistics over them.
+  const ScriptRun rep = Script({Lab(), "study", "report", study, "--dir", folder, "--no-build"},
+                               dir + "/report.log", 120);
+  ASSERT_EQ(rep.rc, 0) << rep.out;
+  EXPECT_NE(rep.out.find("2 lost runs not counted"), std::string::npos) << rep.out;
+  {
+    std::ifstream csv(folder + "/report/study.csv");
+    std::string header, line;
+    std::getline(csv, header);
+    EXPECT_EQ(header.rfind("study,subject,condition,trial,trial_kind,run,session,result,docked", 0),
+              0u)
+        << header;
+    int rows = 0;
+    while (std::getline(csv, line)) rows += !line.empty();
+    EXPECT_EQ(rows, 4) << "one row an attempt of each trial counted";
+    const json stats = json::parse(ReadFile(folder + "/report/stats.json"), nullptr, false);
+    EXPECT_EQ(stats["trials"], 4);
+    EXPECT_EQ(stats["lost_runs"], 2);
+    EXPECT_EQ(stats["conditions"]["tpob"]["trials"], 2);
+    EXPECT_NE(ReadFile(folder + "/report/study.html").find("learning curve of A"),
+              std::string::npos);
+  }
   // Run again: nothing left to fly.
   const ScriptRun again = Script(run, dir + "/again.log", 60);
   EXPECT_EQ(again.rc, 0);
@@ -367,6 +390,61 @@ TEST(Study, ASubjectFliesEachTrialByHandAtATerminal) {
   const json sum = json::parse(ReadFile(second + "/summary.json"), nullptr, false);
   EXPECT_EQ(sum["pilot"], "by-hand");
   EXPECT_TRUE(sum["acquired"].get<bool>());
+  if (!::testing::Test::HasFailure()) fs::remove_all(dir);
+}
+
+// The statistics against a case worked by hand: three subjects each fly
+// two conditions (their measured trials' result attempts), plus rows the
+// figures must leave out (a practice trial, an attempt not the result).
+TEST(Study, TheStatisticsAgreeWithACaseWorkedByHand) {
+  const std::string dir = testing::MakeTempDir("study_stats");
+  std::ofstream(dir + "/study.csv")
+      << "study,subject,condition,trial,trial_kind,run,session,result,docked,duration_s,outcome,"
+         "task_time_s,collisions,actions\n"
+         "h,s1,c0,1,practice,1,x,1,1,300,docked,400,9,99\n"  // practice: left out
+         "h,s1,c0,2,measured,1,x,0,0,300,acquired,,7,50\n"   // not the result: left out
+         "h,s1,c0,2,measured,1,x,1,1,300,docked,100,1,40\n"
+         "h,s1,c1,3,measured,1,x,1,1,300,docked,110,2,44\n"
+         "h,s2,c0,1,measured,1,x,1,1,300,docked,90,0,38\n"
+         "h,s2,c1,2,measured,1,x,1,1,300,docked,104,3,47\n"
+         "h,s3,c0,1,measured,1,x,1,1,300,docked,120,2,41\n"
+         "h,s3,c1,2,measured,1,x,1,1,300,docked,128,4,45\n";
+  const ScriptRun r =
+      Script({"/usr/bin/env", "PYTHONPATH=" + SourcePath("scripts"),
+              fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3", "-m",
+              "rmslab_launcher.study_stats", dir + "/study.csv", dir, "--conditions", "c0,c1"},
+             dir + "/stats.log", 120);
+  ASSERT_EQ(r.rc, 0) << r.out;
+  const json s = json::parse(ReadFile(dir + "/stats.json"), nullptr, false);
+  ASSERT_TRUE(s.is_object());
+  EXPECT_EQ(s["trials"], 6);
+  // c0's task times 100, 90, 120: mean 103.333, s 15.2753, t(0.975, 2)
+  // 4.302653: 103.333 +- 37.946.
+  const json& t0 = s["conditions"]["c0"]["task_time_s"];
+  EXPECT_NEAR(t0["mean"].get<double>(), 103.3333, 1e-3);
+  EXPECT_NEAR(t0["sd"].get<double>(), 15.2753, 1e-3);
+  EXPECT_NEAR(t0["low"].get<double>(), 65.387, 1e-2);
+  EXPECT_NEAR(t0["high"].get<double>(), 141.280, 1e-2);
+  // Three of three docked: Wilson's interval 0.4385 to 1.
+  const json& d0 = s["conditions"]["c0"]["docked_rate"];
+  EXPECT_NEAR(d0["p"].get<double>(), 1.0, 1e-12);
+  EXPECT_NEAR(d0["low"].get<double>(), 0.4385, 1e-3);
+  EXPECT_NEAR(d0["high"].get<double>(), 1.0, 1e-9);
+  // Balanced: the mixed model's difference is the difference of the means,
+  // (110 + 104 + 128 - 100 - 90 - 120) / 3 = 10.667 s; each subject's own
+  // differences (10, 14, 8) are close, so its interval excludes 0.
+  const json& m = s["models"]["task_time_s"];
+  ASSERT_TRUE(m["fitted"].get<bool>()) << m.dump();
+  EXPECT_EQ(m["reference"], "c0");
+  ASSERT_EQ(m["differences"].size(), 1u);
+  EXPECT_NEAR(m["differences"][0]["estimate"].get<double>(), 10.6667, 1e-3);
+  EXPECT_GT(m["differences"][0]["low"].get<double>(), 0.0);
+  EXPECT_LT(m["differences"][0]["p"].get<double>(), 0.05);
+  // Collisions: c0 1, 0, 2 and c1 2, 3, 4: a difference of 2.
+  EXPECT_NEAR(s["models"]["collisions"]["differences"][0]["estimate"].get<double>(), 2.0, 1e-6);
+  const std::string page = ReadFile(dir + "/study.html");
+  EXPECT_NE(page.find("statsmodels MixedLM"), std::string::npos);
+  EXPECT_NE(page.find("c1 minus c0"), std::string::npos);
   if (!::testing::Test::HasFailure()) fs::remove_all(dir);
 }
 
