@@ -10,7 +10,9 @@
   scripts/lab replay SESSION [options]       scene and ESG driven from the log: frames, video
   scripts/lab resim SESSION [--config FILE] [--set KEY=VALUE]  the DCP again on the recorded inputs
   scripts/lab sweep SESSION... --vary KEY=V1,V2,... [--hosts LABFILE | --slurm]
-                                             every session under every design: one table
+                                             the same inputs under every design: one table
+  scripts/lab sweep --closed-loop --vary KEY=V1,V2,... [--runs N] [--seed S]
+                                             every design flown afresh by virtual subjects
   scripts/lab export SESSION [--mcap]        every channel to CSV, or the log as MCAP
   scripts/lab report SESSION                 one self-contained HTML report
   scripts/lab compare SESSION...             scorecards side by side, learning curves

@@ -1,5 +1,7 @@
 """scripts/lab sweep: recorded sessions re-simulated under every combination
-of configuration values (docs/sessions.md "Sweeps").
+of configuration values (docs/sessions.md "Sweeps"): the same inputs under
+another design. (--closed-loop flies each design afresh instead:
+sweep_closed.py, docs/studies.md.)
 
 On this machine the cells run in one rms_resim --cells process
 (scripts/sweep-cell --cells), --jobs cells at once on its threads; on a
@@ -819,6 +821,9 @@ def run(argv):
     [--hosts LABFILE] [--jobs N] [--slurm | --cached-only] [--cache DIR] [--retries N]:
     every session re-simulated under every combination of the varied keys;
     one table (DIR/sweep.csv, DIR/sweep.html) of what each design did."""
+    if "--closed-loop" in argv:
+        from . import sweep_closed
+        return sweep_closed.run(argv)
     try:
         return run_sweep(argv)
     except KeyboardInterrupt:

@@ -448,5 +448,52 @@ TEST(Study, TheStatisticsAgreeWithACaseWorkedByHand) {
   if (!::testing::Test::HasFailure()) fs::remove_all(dir);
 }
 
+// Designs judged by flying them: a boom far too short to fly the task fails
+// in every run, the flown arm docks in (nearly) every one; the same seed
+// gives the same flights whatever the number of threads.
+TEST(Study, AClosedLoopSweepFliesEachDesignByVirtualSubjects) {
+  const std::string dir = testing::MakeTempDir("sweep_closed");
+  std::printf("closed-loop sweep: seed 5, 12 runs a design\n");
+  const auto sweep = [&](const std::string& out, const std::string& jobs) {
+    return Script({Lab(), "sweep", "--closed-loop", "--vary", "arm.upper_boom_ft=12,20.9", "--runs",
+                   "12", "--seed", "5", "--jobs", jobs, "--out", out, "--no-build"},
+                  out + ".log", 300);
+  };
+  const ScriptRun a = sweep(dir + "/a", "1");
+  ASSERT_EQ(a.rc, 0) << a.out;
+  const json d = json::parse(ReadFile(dir + "/a/designs.json"), nullptr, false);
+  ASSERT_TRUE(d.is_object()) << a.out;
+  ASSERT_EQ(d["designs"].size(), 2u);
+  EXPECT_EQ(d["designs"][0]["arm.upper_boom_ft"], "12");  // as given
+  EXPECT_EQ(d["designs"][0]["runs"], 12);
+  EXPECT_EQ(d["designs"][0]["docked"], 0) << "a 12 ft upper boom flew the task";
+  EXPECT_GE(d["designs"][1]["docked"].get<int>(), 11) << d["designs"][1].dump();
+  EXPECT_GT(d["designs"][1]["docked_low"].get<double>(), 0.6);
+  EXPECT_LT(d["designs"][0]["docked_high"].get<double>(), 0.3);
+  EXPECT_NE(a.out.find("docked 0 of 12"), std::string::npos) << a.out;
+  // Deterministic: two threads give the same flights as one.
+  const ScriptRun b = sweep(dir + "/b", "2");
+  ASSERT_EQ(b.rc, 0) << b.out;
+  EXPECT_EQ(ReadFile(dir + "/a/flights.csv"), ReadFile(dir + "/b/flights.csv"));
+  // Each run's draws differ (a person's dispersions, not one subject 12 times).
+  std::ifstream flights(dir + "/a/flights.csv");
+  std::string line;
+  std::getline(flights, line);
+  std::set<std::string> reactions;  // column 5: reaction_s
+  while (std::getline(flights, line)) {
+    std::size_t at = 0;
+    for (int k = 0; k < 4; ++k) at = line.find(',', at) + 1;
+    reactions.insert(line.substr(at, line.find(',', at) - at));
+  }
+  EXPECT_EQ(reactions.size(), 12u) << "each design's runs draw the same 12 subjects, each its own";
+  // A design the configuration refuses is refused naming the key.
+  const ScriptRun bad = Script({Lab(), "sweep", "--closed-loop", "--vary", "arm.upper_boom_ft=-1",
+                                "--runs", "2", "--out", dir + "/bad", "--no-build"},
+                               dir + "/bad.log", 60);
+  EXPECT_EQ(bad.rc, 2);
+  EXPECT_NE(bad.out.find("arm.upper_boom_ft"), std::string::npos) << bad.out;
+  if (!::testing::Test::HasFailure()) fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace rms

@@ -5,6 +5,7 @@
 // telemetry comes back after `latency_frames` frames (one, as over LCM where
 // the station reads the telemetry before it sends the next block).
 // Deterministic; for tests and for checking a configuration before a session.
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -26,9 +27,26 @@ struct ClosedLoopResult {
   int modes_entered[4] = {0, 0, 0,
                           0};  // frame each mode was first seen (0: never, mode 1 at start)
   int held_frames = 0;         // frames the DCP held the slave arm (a collision)
+  int collision_events = 0;    // runs of frames whose command collided (their starts)
+  int docked_frame = -1;       // the frame docking was declared (-1: never)
   Counters autopilot;          // the autopilot's counters
   Counters dcp;                // what the DCP counted (clamped inputs...)
 };
+
+// A virtual subject (docs/studies.md "Designs judged by flying them"): the
+// autopilot flying with a person's dispersions -- it sees the telemetry
+// `latency_frames` frames late (a reaction time), moves at `rate_gain`
+// times its rates, and its joint commands carry a tremor of `tremor_deg`
+// (standard deviation, each frame, each joint; a seeded generator).
+struct VirtualSubject {
+  operator_station::AutopilotOptions autopilot;
+  int latency_frames = 1;
+  double rate_gain = 1.0;
+  double tremor_deg = 0.0;
+  std::uint64_t seed = 0;
+};
+ClosedLoopResult FlyVirtualSubject(const LabConfig& config, const VirtualSubject& subject,
+                                   int max_frames);
 
 // inputs: when given, receives each frame's operator inputs as the DCP
 // decoded them (for benchmarks that replay the flight).

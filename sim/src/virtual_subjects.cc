@@ -1,0 +1,56 @@
+#include "rms/sim/virtual_subjects.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <random>
+#include <thread>
+
+namespace rms::sim {
+
+std::uint64_t RunSeed(std::uint64_t seed, int run) {
+  std::uint64_t z = seed + 0x9e3779b97f4a7c15ULL * static_cast<std::uint64_t>(run + 1);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+FlightRun DrawSubject(const LabConfig& config, const Dispersions& d, std::uint64_t seed, int run) {
+  FlightRun f;
+  f.run = run;
+  f.seed = RunSeed(seed, run);
+  std::mt19937_64 rng(f.seed);
+  f.reaction_s = std::uniform_real_distribution<double>(d.reaction_lo_s, d.reaction_hi_s)(rng);
+  f.rate_gain = std::uniform_real_distribution<double>(d.gain_lo, d.gain_hi)(rng);
+  f.latency_frames =
+      std::max(1, static_cast<int>(std::lround(f.reaction_s * config.session.frame_rate_hz)));
+  return f;
+}
+
+std::vector<FlightRun> FlyRuns(const LabConfig& config, const Dispersions& d, std::uint64_t seed,
+                               int runs, double max_s, int jobs) {
+  std::vector<FlightRun> out(static_cast<std::size_t>(std::max(0, runs)));
+  const int max_frames = static_cast<int>(std::ceil(max_s * config.session.frame_rate_hz));
+  std::atomic<int> next{0};
+  auto work = [&] {
+    for (int i = next++; i < runs; i = next++) {
+      FlightRun f = DrawSubject(config, d, seed, i);
+      VirtualSubject s;
+      s.autopilot.cameras = false;
+      s.autopilot.timeout_s = max_s;
+      s.latency_frames = f.latency_frames;
+      s.rate_gain = f.rate_gain;
+      s.tremor_deg = d.tremor_deg;
+      s.seed = f.seed;
+      f.result = FlyVirtualSubject(config, s, max_frames);
+      out[static_cast<std::size_t>(i)] = std::move(f);
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int j = 1; j < std::max(1, jobs); ++j) threads.emplace_back(work);
+  work();
+  for (auto& t : threads) t.join();
+  return out;
+}
+
+}  // namespace rms::sim
