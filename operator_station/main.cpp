@@ -43,6 +43,10 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::Range(0.01, 100.0));
   app.add_option("--frames", opt.max_frames, "Stop after this many frames");
+  app.add_option("--lesson", opt.lesson_path,
+                 "Scripted events: malfunctions, repairs, freezes at a session time, on entering a "
+                 "mode or on a condition (docs/lessons.md)")
+      ->check(CLI::ExistingFile);
   app.add_option("--end-when-docked", opt.end_when_docked_s,
                  "By hand: stop this many seconds of session time after the payload docks (a "
                  "study's trial; docs/studies.md)")

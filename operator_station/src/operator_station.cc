@@ -86,6 +86,7 @@ void CheckSourceFiles(const OperatorOptions& o, const LabConfig& config) {
     (void)LoadBindings(o.bindings_path.empty() ? DefaultBindingsPath() : o.bindings_path);
   }
   if (!o.restore_path.empty()) (void)wire::ReadCheckpoint(o.restore_path);
+  if (!o.lesson_path.empty()) (void)Lesson::Load(o.lesson_path);
 }
 
 void OperatorStation::RateMeter::Tick(std::int64_t now_us) {
@@ -114,6 +115,10 @@ OperatorStation::OperatorStation(const OperatorOptions& options, const LabConfig
       follow_(config.session.frame_rate_hz),
       checkpoints_(options.checkpoint_dir) {
   telemetry_seq_.SetClock(transport::SessionFrameClock(config.session.frame_rate_hz));
+  if (!options.lesson_path.empty()) {
+    lesson_ = Lesson::Load(options.lesson_path);
+    spdlog::info("lesson {}: {} events", options.lesson_path, lesson_->events().size());
+  }
   Subscribe();
 }
 
@@ -260,11 +265,12 @@ void OperatorStation::OnWindowKeys(const void* data, int size, std::int64_t recv
     counters_.Add(Counter::kDroppedWindowKeysStale);
 }
 
-void OperatorStation::SendControl(std::int8_t command) {
+void OperatorStation::SendControl(std::int8_t command, const std::string& name) {
   session_control_t m;
   m.send_time_us = lcm_.NowUs();
   m.sequence = control_sequence_++;
   m.command = command;
+  m.name = name;
   if (!transport::PublishMessage(lcm_, wire::channels::kControl, m))
     counters_.Add(Counter::kPublishFailed);
 }
@@ -393,8 +399,28 @@ void OperatorStation::DrawScreen(std::int64_t frame, const wire::OperatorInputs&
   screen_->Draw(std::move(s));
 }
 
+// docs/lessons.md: each event once, when its trigger first holds at the
+// start of a frame (the session time of the frames published so far).
+void OperatorStation::FireLessonEvents() {
+  if (!lesson_) return;
+  const double t_s = static_cast<double>(frames_) / config_.session.frame_rate_hz;
+  for (const std::size_t i : lesson_->Due(t_s, telemetry_ ? &*telemetry_ : nullptr)) {
+    const LessonEvent& e = lesson_->events()[i];
+    spdlog::warn("lesson: event {} ({}), at {:.3f} s of session time", i + 1, e.text, t_s);
+    SendControl(e.command, e.name);
+    counters_.Add(Counter::kLessonEvents);
+    if (e.command == session_control_t::FREEZE && e.for_s > 0)
+      run_again_at_us_ = lcm_.NowUs() + static_cast<std::int64_t>(e.for_s * 1e6);
+  }
+}
+
 bool OperatorStation::RunFrozen() {
   // Frozen: no clock, no frames. The session's keys still work.
+  if (run_again_at_us_ != 0 && lcm_.NowUs() >= run_again_at_us_) {
+    run_again_at_us_ = 0;
+    spdlog::info("lesson: the freeze is over: run");
+    SendControl(session_control_t::RUN);
+  }
   source_->WhileFrozen();
   const Requests r = source_->requests();
   if (r.quit) return false;
@@ -500,6 +526,7 @@ bool OperatorStation::StepFrame(transport::StatusReporter* status) {
   f.dt_s = 1.0 / config_.session.frame_rate_hz;
   f.telemetry = telemetry_ ? &*telemetry_ : nullptr;
   f.now_us = lcm_.NowUs();
+  FireLessonEvents();
   std::optional<wire::OperatorInputs> in = source_->Next(f);
   if (source_->requests().freeze) SendControl(session_control_t::FREEZE);
   if (!in) return false;

@@ -62,6 +62,8 @@ def add_arguments(p):
                         "pixels sooner; Linux PM QoS through /dev/cpu_dma_latency, which needs root: without "
                         "it the session runs and says so); off: leave it to the system "
                         "(docs/performance.md \"Wake latency\")")
+    p.add_argument("--lesson", help="scripted events: malfunctions, repairs, freezes at a session time, on entering "
+                                    "a mode or on a condition (docs/lessons.md)")
     p.add_argument("--limit-s", type=float, metavar="S",
                    help="end the session after S seconds of session time (a study's trial limit)")
     p.add_argument("--end-when-docked", type=float, metavar="S",
@@ -94,7 +96,7 @@ class Demo:
             self.branch = Branch(a.from_)
             a.config = a.config or os.path.join(self.branch.parent, "config.toml")
         a.config = a.config or os.path.join(ROOT, "config", "rmslab.toml")
-        for f in [a.config, a.timeline, a.restore, a.lab, a.bindings]:
+        for f in [a.config, a.timeline, a.restore, a.lab, a.bindings, a.lesson]:
             if f and not os.path.exists(f):
                 raise LabError(f"no such file: {f}")
             if f and not os.path.isfile(f):
@@ -176,6 +178,8 @@ class Demo:
             op += ["--autopilot"]
         if a.restore:
             op += ["--restore", a.restore]
+        if a.lesson:
+            op += ["--lesson", a.lesson]
         dcp = [binary("dynamics_proc/dynamics_proc")] + common + (["--restore", a.restore] if a.restore else [])
         esg = [binary("esg_renderer/esg_renderer")] + common + ["--width", str(a.width), "--height", str(a.height),
                                                                  "--gl", a.gl, "--visibility", a.visibility]
@@ -246,6 +250,8 @@ class Demo:
         shutil.copyfile(a.config, os.path.join(self.out, "config.toml"))
         if a.timeline:
             shutil.copyfile(a.timeline, os.path.join(self.out, "timeline.tl"))
+        if a.lesson:
+            shutil.copyfile(a.lesson, os.path.join(self.out, "lesson.toml"))
         if a.restore:
             shutil.copyfile(a.restore, os.path.join(run, "restore.json"))
         if self.pilot == "by-hand":
@@ -365,6 +371,12 @@ class Demo:
             # restarted, it sends the DCP's last inputs until it hears the DCP ("Faults")
             extra += ["--dcp-state-file", os.path.join(self.out, "run", "dcp_state.json")]
         tty = False
+        if a.lesson:
+            if remote:
+                self.hosts["operator_station"].copy_to(os.path.join(self.out, "lesson.toml"),
+                                                       f"{self.remote_run}/lesson.toml")
+            extra += ["--lesson", f"{self.remote_run}/lesson.toml" if remote else
+                      os.path.join(self.out, "lesson.toml")]
         if a.limit_s is not None:
             extra += ["--frames", str(max(1, round(a.limit_s * self.rate)))]
         if self.pilot == "timeline":

@@ -68,6 +68,23 @@ class StudyFolder:
     def exists(self):
         return os.path.isfile(os.path.join(self.dir, "study.toml"))
 
+    def subject_dir(self, subject):
+        """A subject's sessions: trials/SUBJECT (apart from the folder's own files, whatever the name)."""
+        return os.path.join(self.dir, "trials", subject)
+
+    def in_flight(self, subject):
+        """A study run holds the subject's lock now: its started run is under way, not lost."""
+        path = os.path.join(self.subject_dir(subject), ".lock")
+        if not os.path.exists(path):
+            return False
+        with open(path, "a+") as f:
+            try:
+                fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                return True
+            fcntl.flock(f, fcntl.LOCK_UN)
+        return False
+
     def open(self, create):
         """Checks the folder's study file against this one; makes the folder
         (the conditions written and checked) when create and it is new."""
@@ -112,6 +129,15 @@ class StudyFolder:
                            f"(study.toml there): its trials were flown under that one. Only subjects may be "
                            f"added, at the end of study.subjects. Restore the file, or begin a new study "
                            f"(another study.name, or --dir)")
+        added = new_subjects[len(old_subjects):]
+        if not added:
+            # Comments or the description only: the folder keeps the file
+            # its trials began with (and its SHA-256 in their manifests).
+            if update and not getattr(self, "_said_same", False):
+                self._said_same = True
+                say(f"note: {self.study.path} differs from the study's own copy ({self.dir}/study.toml) only in "
+                    f"comments or its description: the copy is kept")
+            return
         if not update:
             return
         # Subjects added: the plan and the folder's copy follow the file.
@@ -120,7 +146,7 @@ class StudyFolder:
                        "subjects": self.study.plan()}, f, indent=1)
         with replacing(os.path.join(self.dir, "study.toml"), encoding="utf-8") as f:
             f.write(self.study.text.decode())
-        say(f"study file: subjects added ({', '.join(new_subjects[len(old_subjects):])}); the folder follows it")
+        say(f"study file: subjects added ({', '.join(added)}); the folder follows it")
 
     # ---- the journal ----
     def events(self):
@@ -178,7 +204,8 @@ def check(argv):
     if a.json:
         print(json.dumps({"study": s.name, "order": s.order, "seed": s.seed, "subjects": plan}, indent=1))
         return 0
-    say(f"study '{s.name}': {len(s.conditions)} conditions, {len(s.subjects)} subjects, {s.practice} practice "
+    say(f"study '{s.name}': {plural(len(s.conditions), 'condition')}, {plural(len(s.subjects), 'subject')}, "
+        f"{s.practice} practice "
         f"and {s.measured} measured trials a condition, at most {s.limit_s:g} s each; order {s.order}"
         + (f", seed {s.seed}" if s.seed is not None else ""))
     for c in s.conditions:
@@ -190,10 +217,15 @@ def check(argv):
     return 0
 
 
+def plural(n, word):
+    return f"{n} {word}" if n == 1 else f"{n} {word}s"
+
+
 def describe(c):
     sets = "; ".join(f"{k} = {v}" for k, v in c["set"].items()) or "the study's configuration"
     cams = " ".join(str(x) for x in c["cameras"])
-    return f"{sets}; cameras {cams}; {c['control'].replace('_', ' ')}"
+    lesson = f"; lesson {os.path.basename(c['lesson'])}" if c.get("lesson") else ""
+    return f"{sets}; cameras {cams}; {c['control'].replace('_', ' ')}{lesson}"
 
 
 def build(no_build):
@@ -204,8 +236,15 @@ def build(no_build):
 
 # ---- status ----
 def progress(folder, subject, trials):
-    """Each planned trial with its runs, and the next to fly (None: all done)."""
+    """Each planned trial with its runs, and the next to fly (None: all done).
+    A run started and not ended is lost -- unless a study run holds the
+    subject now: then it is the trial under way."""
     runs = folder.runs(subject)
+    if folder.in_flight(subject):
+        for rs in runs.values():
+            for r in rs:
+                if r["status"] == "started":
+                    r["status"] = "under way"
     rows, nxt = [], None
     for t in trials:
         rs = runs.get(t["trial"], [])
@@ -228,6 +267,8 @@ def status(argv):
     folder = StudyFolder(s, a.dir)
     if folder.exists():
         folder._same_study(update=False)
+    elif not a.json:
+        say(f"no trial of study '{s.name}' has been run in {folder.dir} (no study.toml there)")
     plan = s.plan()
     out = {"study": s.name, "folder": folder.dir, "subjects": {}}
     for subject, trials in plan.items():
@@ -300,8 +341,8 @@ class Subject:
         self.folder, self.a, self.study = folder, a, folder.study
         self.name = a.subject
         self.trials = self.study.plan()[self.name]
-        os.makedirs(os.path.join(folder.dir, self.name), exist_ok=True)
-        self.lock = open(os.path.join(folder.dir, self.name, ".lock"), "a+")
+        os.makedirs(folder.subject_dir(self.name), exist_ok=True)
+        self.lock = open(os.path.join(folder.subject_dir(self.name), ".lock"), "a+")
         try:
             fcntl.flock(self.lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
@@ -332,7 +373,7 @@ class Subject:
         runs = self.folder.runs(self.name).get(t["trial"], [])
         run_no = 1 + max([r.get("run") or 0 for r in runs] or [0])
         base = f"{t['trial']:02d}-{t['condition']}-{t['kind']}-{t['index']}"
-        session = os.path.join(self.folder.dir, self.name, base + ("" if run_no == 1 else f".run{run_no}"))
+        session = os.path.join(self.folder.subject_dir(self.name), base + ("" if run_no == 1 else f".run{run_no}"))
         if os.path.lexists(session):
             raise LabError(f"{session} exists, and the study's journal has no such run: left as it is; move it "
                            f"away to go on")
@@ -343,6 +384,8 @@ class Subject:
                f"{len(self.trials)}, {t['condition']}, {t['kind']} {t['index']} of {t['of']}",
                "--study", self.study.name, "--study-sha256", self.folder.sha256, "--condition", t["condition"],
                "--trial", str(t["trial"]), "--trial-kind", t["kind"], "--trial-run", str(run_no)]
+        if os.path.exists(os.path.join(cond, "lesson.toml")):
+            cmd += ["--lesson", os.path.join(cond, "lesson.toml")]
         if self.a.pilot == "by-hand":
             cmd += ["--by-hand", "--bindings", os.path.join(cond, "bindings.toml"),
                     "--end-when-docked", repr(DOCKED_S)]
@@ -387,6 +430,9 @@ def judge(session, rc, limit_s):
     """A trial's run: done (its outcome counted) or lost (a technical
     reason: flown again) or stopped (by the experimenter: flown again)."""
     summary = read_folder_json(os.path.join(session, "summary.json"))
+    if not os.path.isdir(session):
+        return {"status": "refused", "why": f"the session did not start (exit code {rc}; its reason is said above)",
+                "exit_code": rc}
     if rc == 130:
         return {"status": "stopped", "why": "stopped by the experimenter (Ctrl-C or a signal)", "exit_code": rc}
     if not summary:
@@ -436,6 +482,10 @@ def wait_for_launcher(session, limit_s=120):
         time.sleep(0.5)
 
 
+def dir_arg(a):
+    return f" --dir {a.dir}" if a.dir else ""
+
+
 def banner(study, subject, t, n, folder):
     cond = next(c for c in study.conditions if c["name"] == t["condition"])
     say(f"study '{study.name}', subject {subject}: trial {t['trial']} of {n} -- condition '{t['condition']}', "
@@ -449,7 +499,11 @@ def ask(prompt):
         return True
     try:
         print(f"lab: {prompt} [Enter: go on, q: stop here] ", end="", file=sys.stderr, flush=True)
-        return sys.stdin.readline().strip().lower() not in ("q", "quit") and True
+        line = sys.stdin.readline()
+        if not line:  # end of input (Ctrl-D): stop, as q does
+            print(file=sys.stderr)
+            return False
+        return line.strip().lower() not in ("q", "quit")
     except (OSError, KeyboardInterrupt):
         return False
 
@@ -470,11 +524,11 @@ def run_trials(argv):
         t = subj.next_trial()
         if t is None:
             say(f"subject {subj.name} has flown every trial of study '{study.name}' "
-                f"({len(subj.trials)} of {len(subj.trials)}); scripts/lab study status {a.study}")
+                f"({len(subj.trials)} of {len(subj.trials)}); scripts/lab study status {a.study}{dir_arg(a)}")
             return 0
         if a.trials is not None and flown >= a.trials:
             say(f"{flown} trial(s) done; next for {subj.name}: trial {t['trial']} "
-                f"(scripts/lab study run {a.study} --subject {subj.name} goes on)")
+                f"(scripts/lab study run {a.study} --subject {subj.name}{dir_arg(a)} goes on)")
             return 0
         banner(study, subj.name, t, len(subj.trials), folder)
         if not ask("the subject is ready?"):
@@ -489,12 +543,16 @@ def run_trials(argv):
         elif end["status"] == "stopped":
             say(f"trial {t['trial']} stopped part way: not counted; the same command flies it again")
             return 130
+        elif end["status"] == "refused":
+            say(f"trial {t['trial']}: the session did not start (why: above): nothing was flown or counted; "
+                f"put it right and run the same command again")
+            return end["exit_code"] or 1
         else:
             lost_in_a_row += 1
             say(f"trial {t['trial']} LOST: {end['why']}: not counted; it is flown again next")
             if lost_in_a_row >= MAX_LOST_IN_A_ROW:
-                say(f"{lost_in_a_row} runs lost in a row: stopping here (see {end['session']}/logs in "
-                    f"{folder.dir}); the same command goes on")
+                say(f"{lost_in_a_row} runs lost in a row: stopping here (see {folder.dir}/{end['session']}/logs); "
+                    f"the same command goes on")
                 return 1
             continue
         lost_in_a_row = 0

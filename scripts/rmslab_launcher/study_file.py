@@ -24,7 +24,7 @@ MAX_CONDITIONS = 26
 
 STUDY_KEYS = {"name", "description", "order", "seed", "practice_trials", "measured_trials", "trial_limit_s",
               "subjects", "config", "bindings"}
-CONDITION_KEYS = {"name", "description", "set", "cameras", "control"}
+CONDITION_KEYS = {"name", "description", "set", "cameras", "control", "lesson"}
 
 
 class StudyFile:
@@ -139,7 +139,8 @@ class StudyFile:
             self.fail(where, "must be a table")
         for k in c:
             if k not in CONDITION_KEYS:
-                self.fail(f"{where}.{k}", "unknown key (a condition has name, description, set, cameras, control)")
+                self.fail(f"{where}.{k}", "unknown key (a condition has name, description, set, cameras, control, "
+                                          "lesson)")
         name = self._name(c.get("name"), f"{where}.name", "a condition's name")
         desc = c.get("description", "")
         if not isinstance(desc, str):
@@ -166,7 +167,9 @@ class StudyFile:
         if control not in CONTROL_MODES:
             self.fail(f"{where}.control", f"must be \"manual_augmented\" or \"single_joint\" (the control mode the "
                                           f"trial starts in), got {control!r}")
-        return {"name": name, "description": desc, "set": settings, "cameras": cams, "control": control}
+        lesson = self._path(c, where, "lesson", None)
+        return {"name": name, "description": desc, "set": settings, "cameras": cams, "control": control,
+                "lesson": lesson}
 
     # ---- the designs, checked by the processes' own checks ----
     def write_condition(self, cond, folder):
@@ -194,6 +197,14 @@ class StudyFile:
         if r.returncode != 0:
             self.fail(f"conditions[{i}]", f"its bindings (the study's, with its cameras and control): "
                                           f"{_tool_error(r)}")
+        if cond["lesson"]:
+            les = os.path.join(folder, "lesson.toml")
+            with open(les, "w") as f:
+                f.write(_read_text(cond["lesson"]))
+            r = subprocess.run([binary("operator_station/operator_station"), "--check", "--autopilot", "--config",
+                                cfg, "--lesson", les, "--log-level", "warn"], capture_output=True, text=True)
+            if r.returncode != 0:
+                self.fail(f"conditions[{i}].lesson", _tool_error(r).replace(les, cond["lesson"]))
 
     def check_designs(self):
         with tempfile.TemporaryDirectory(prefix="rmslab-study-") as tmp:

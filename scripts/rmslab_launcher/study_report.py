@@ -20,7 +20,7 @@ import sys
 import tempfile
 
 from .common import ROOT, LabError, binary, read_folder_json, replacing, require_built, say
-from .study import StudyFolder, build
+from .study import StudyFolder, build, progress
 from .study_file import StudyFile
 
 STUDY_COLUMNS = ["study", "subject", "condition", "trial", "trial_kind", "run", "session", "result", "docked",
@@ -42,13 +42,17 @@ def counted_runs(folder, study):
     each subject's order; and how many runs were lost."""
     plan, out, lost = study.plan(), [], 0
     for subject, trials in plan.items():
-        runs = folder.runs(subject)
-        for t in trials:
-            rs = runs.get(t["trial"], [])
-            lost += sum(r["status"] in ("lost", "started") for r in rs)
-            done = next((r for r in rs if r["status"] == "done"), None)
-            if done:
-                out.append((subject, t, done))
+        rows, _ = progress(folder, subject, trials)
+        for t in rows:
+            lost += t["lost"]
+            done = next((r for r in t["runs"] if r["status"] == "done"), None)
+            if done is None:
+                continue
+            if not os.path.isfile(os.path.join(folder.dir, done["session"], "summary.json")):
+                say(f"{subject}'s trial {t['trial']}: its session {done['session']} is missing (or has no "
+                    f"summary.json): left out of the report")
+                continue
+            out.append((subject, t, done))
     return out, lost
 
 

@@ -81,6 +81,11 @@ def mixed_model(df, column, conditions):
     except Exception as e:  # singular matrices and the like: said, not raised
         return {"fitted": False, "why": f"the model could not be fit ({type(e).__name__}: {e})"}
     ci = fit.conf_int()
+    if not all(math.isfinite(float(v)) for v in list(ci.values.ravel()) + list(fit.pvalues.values)):
+        # A degenerate fit (every trial of a condition alike: a dry run's
+        # deterministic autopilot) has no intervals: said, not shown as figures.
+        return {"fitted": False, "why": "the model's intervals are undefined (no variation left within the "
+                                        "conditions once each subject's level is taken out)"}
     out = {"fitted": True, "reference": ref, "trials": int(len(d)), "subjects": int(d["subject"].nunique()),
            "converged": bool(getattr(fit, "converged", True)),
            "warnings": sorted({str(w.message).splitlines()[0] for w in caught}),
@@ -146,12 +151,18 @@ def page(stats, df, conditions, title):
             verdicts.append(f"<li><b>{e(what)}</b>: no model: {e(m['why'])}.</li>")
             continue
         for d in m["differences"]:
-            sure = "the interval excludes no difference" if d["low"] > 0 or d["high"] < 0 else \
-                "the interval includes no difference: not shown to differ"
+            if d["low"] > 0:
+                sure = f"higher with {e(d['condition'])}: the 95 % interval lies above 0"
+            elif d["high"] < 0:
+                sure = f"lower with {e(d['condition'])}: the 95 % interval lies below 0"
+            else:
+                sure = "not shown to differ: the 95 % interval includes 0"
             verdicts.append(
                 f"<li><b>{e(what)}</b>: {e(d['condition'])} minus {e(m['reference'])}: "
-                f"{fmt(d['estimate'], unit)} (95 % CI {fmt(d['low'])} to {fmt(d['high'])}; p = {d['p']:.3g}; "
-                f"{sure}){'' if m['converged'] else ' -- the fit did not converge'}</li>")
+                f"{fmt(d['estimate'], unit)} (95 % CI {fmt(d['low'])} to {fmt(d['high'])}; p = {d['p']:.3g}): "
+                f"{sure}{'' if m['converged'] else '. The fit did not converge: read it with care'}"
+                + (f"<br><small>the fit warned: {e('; '.join(m['warnings']))}</small>" if m["warnings"] else "")
+                + "</li>")
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>{e(title)}</title>
 <style>body{{font-family:sans-serif;margin:2em;max-width:72em}}table{{border-collapse:collapse}}
@@ -211,6 +222,14 @@ def curves(df, conditions):
     return f"<p>{legend}</p>" + "".join(figs)
 
 
+def write(path, text):
+    """Whole or not at all: a temporary file renamed over path."""
+    tmp = f"{path}.{os.getpid()}.tmp"
+    with open(tmp, "w", encoding="utf-8") as f:
+        f.write(text)
+    os.replace(tmp, path)
+
+
 def clean(v):
     """NaN and infinities (a singular fit's p-value) as null: JSON has none."""
     if isinstance(v, float) and not math.isfinite(v):
@@ -236,7 +255,9 @@ def main(argv):
         print("study_stats: needs pandas, scipy and statsmodels (Debian's python3-pandas, python3-scipy, "
               "python3-statsmodels: scripts/install-deps)", file=sys.stderr)
         return 2
-    df = pd.read_csv(a.table, keep_default_na=True)
+    # Names stay text ("01" is not "1", "NA" is a name): only an empty cell is missing.
+    df = pd.read_csv(a.table, keep_default_na=False, na_values=[""],
+                     dtype={"study": str, "subject": str, "condition": str, "trial_kind": str, "outcome": str})
     conditions = a.conditions.split(",") if a.conditions else list(dict.fromkeys(df["condition"]))
     stats = compute(df, conditions)
     stats["lost_runs"] = a.lost
@@ -245,10 +266,10 @@ def main(argv):
                                       "C(condition), first condition the reference, random intercept per "
                                       "subject; 95 % Wald intervals"}
     os.makedirs(a.out, exist_ok=True)
-    with open(os.path.join(a.out, "stats.json"), "w") as f:
-        json.dump(clean(stats), f, indent=1, allow_nan=False, default=str)
-    with open(os.path.join(a.out, "study.html"), "w", encoding="utf-8") as f:
-        f.write(page(clean(stats), df, conditions, a.title))
+    stats = clean(stats)
+    text = page(stats, df, conditions, a.title)  # made whole before anything is written
+    write(os.path.join(a.out, "stats.json"), json.dumps(stats, indent=1, allow_nan=False, default=str))
+    write(os.path.join(a.out, "study.html"), text)
     return 0
 
 

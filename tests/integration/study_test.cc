@@ -118,8 +118,12 @@ TEST(Study, AStudyFileIsRefusedNamingTheKeyAndWhy) {
        "configuration has no key"},
       {"cameras = [4, 7, 8]", "cameras = [4, 9]", "key 'conditions[1].cameras': must be distinct"},
       {"cameras = [4, 7, 8]", "control = \"joystick\"", "key 'conditions[1].control': must be"},
+      {"cameras = [4, 7, 8]", "lesson = \"nowhere.toml\"",
+       "key 'conditions[1].lesson': no such file"},
+      {"cameras = [4, 7, 8]", "lesson = \"bad_lesson.toml\"", "key 'conditions[1].lesson':"},
       {"[[conditions]]\nname = \"flown\"\n", "", "name = \"flown\""},  // one condition left: fine
   };
+  WriteStudy(dir, "bad_lesson.toml", "[[events]]\nat_s = 1\ndo = \"explode\"\n");
   for (std::size_t i = 0; i + 1 < std::size(cases); ++i) {
     const Case& c = cases[i];
     std::string text = good;
@@ -231,7 +235,9 @@ TEST(Study, TrialsRunInOrderResumeAfterAKillAndALostOneIsFlownAgain) {
                  "[study]\nname = \"dry\"\norder = \"balanced-latin-square\"\n"
                  "measured_trials = 2\ntrial_limit_s = 12\nsubjects = [\"A\", \"B\"]\n"
                  "[[conditions]]\nname = \"flown\"\n"
-                 "[[conditions]]\nname = \"tpob\"\nset = { \"dcp.tpob_ft\" = 0.35 }\n");
+                 "[[conditions]]\nname = \"tpob\"\nset = { \"dcp.tpob_ft\" = 0.35 }\n"
+                 "lesson = \"lesson.toml\"\n");
+  WriteStudy(dir, "lesson.toml", "[[events]]\nat_s = 2\ndo = \"malfunction camera 2 lost\"\n");
   const std::vector<std::string> run = {
       Lab(),   "study",      "run",         study,       "--subject",  "A",
       "--dir", folder,       "--pilot",     "autopilot", "--no-build", "--speed",
@@ -252,7 +258,7 @@ TEST(Study, TrialsRunInOrderResumeAfterAKillAndALostOneIsFlownAgain) {
   std::string pid_file;
   ASSERT_TRUE(WaitUntil(
       [&] {
-        for (const auto& e : fs::directory_iterator(folder + "/A"))
+        for (const auto& e : fs::directory_iterator(folder + "/trials/A"))
           if (e.path().filename().string().rfind("03-", 0) == 0 &&
               fs::exists(e.path() / "run/dynamics_proc.ready"))
             pid_file = (e.path() / "run/dynamics_proc.pid").string();
@@ -307,6 +313,8 @@ TEST(Study, TrialsRunInOrderResumeAfterAKillAndALostOneIsFlownAgain) {
     const json sum = json::parse(ReadFile(counted + "/summary.json"), nullptr, false);
     EXPECT_TRUE(sum["resimulation"]["exact"].get<bool>()) << counted;
     EXPECT_TRUE(sum["restarts"].empty()) << counted;
+    // The condition's lesson: its event in the tpob trials only.
+    EXPECT_EQ(sum["malfunctions"].size(), conds[i] == "tpob" ? 1u : 0u) << counted;
   }
   // The report: a row an attempt of the four trials counted (the lost runs
   // are not in it), and the statistics over them.
@@ -492,6 +500,46 @@ TEST(Study, AClosedLoopSweepFliesEachDesignByVirtualSubjects) {
                                dir + "/bad.log", 60);
   EXPECT_EQ(bad.rc, 2);
   EXPECT_NE(bad.out.find("arm.upper_boom_ft"), std::string::npos) << bad.out;
+  if (!::testing::Test::HasFailure()) fs::remove_all(dir);
+}
+
+// A lesson (docs/lessons.md) in a live session flown by the autopilot: each
+// event fires once, at its time, on entering its mode, when its condition
+// first holds; the DCP takes each; the summary lists them as the operator
+// station's commands; and the session re-simulates word for word.
+TEST(Lesson, ScriptedEventsFireInASessionAndReSimulateWordForWord) {
+  const std::string dir = testing::MakeTempDir("lesson");
+  const ScriptRun r = Script({Lab(), "demo", "--lesson", SourcePath("config/lessons/example.toml"),
+                              "--no-build", "--speed", "4", "--no-video", "--png-every", "0",
+                              "--out", dir + "/s", "--lcm-url", testing::UniqueLcmUrl(9560)},
+                             dir + "/demo.log", 300);
+  ASSERT_EQ(r.rc, 0) << r.out;
+  EXPECT_TRUE(fs::exists(dir + "/s/lesson.toml"));
+  const json sum = json::parse(ReadFile(dir + "/s/summary.json"), nullptr, false);
+  ASSERT_TRUE(sum.is_object());
+  EXPECT_TRUE(sum["docked"].get<bool>());
+  EXPECT_TRUE(sum["resimulation"]["exact"].get<bool>());
+  const json& modes = sum["mode_changes"];
+  ASSERT_EQ(modes.size(), 2u);
+  const json& m = sum["malfunctions"];
+  ASSERT_EQ(m.size(), 3u) << m.dump(1);
+  // at 15 s: camera 4 lost (taken by the DCP within a frame or a few of the
+  // station's sending it, however loaded the machine).
+  EXPECT_EQ(m[0]["injected"][0], "camera 4 lost");
+  EXPECT_GE(m[0]["time_s"].get<double>(), 15.0 - 1e-9);
+  EXPECT_LT(m[0]["time_s"].get<double>(), 16.0);
+  // on entering Mode 2: repaired.
+  EXPECT_EQ(m[1]["repaired"][0], "camera 4 lost");
+  EXPECT_GE(m[1]["time_s"].get<double>(), modes[0]["time_s"].get<double>());
+  EXPECT_LT(m[1]["time_s"].get<double>(), modes[0]["time_s"].get<double>() + 1.0);
+  // within 5 ft of the port (Mode 3): joint 6 slow.
+  EXPECT_EQ(m[2]["injected"][0], "joint 6 slow 2");
+  EXPECT_GT(m[2]["time_s"].get<double>(), modes[1]["time_s"].get<double>());
+  int from_station = 0;
+  for (const json& c : sum["control"]) from_station += c.value("process", "") == "operator_station";
+  EXPECT_EQ(from_station, 3) << sum["control"].dump(1);
+  const json stats = json::parse(ReadFile(dir + "/s/stats/operator_station.json"), nullptr, false);
+  EXPECT_EQ(stats["counters"].value("lesson.events", 0), 3);
   if (!::testing::Test::HasFailure()) fs::remove_all(dir);
 }
 

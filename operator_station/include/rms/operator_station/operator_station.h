@@ -19,6 +19,7 @@
 #include "rms/operator_station/follow_watch.h"
 #include "rms/operator_station/guidance.h"
 #include "rms/operator_station/input_sources.h"
+#include "rms/operator_station/lesson.h"
 #include "rms/operator_station/session_events.h"
 #include "rms/operator_station/status_screen.h"
 #include "rms/transport/lcm_interface.h"
@@ -45,8 +46,9 @@ struct OperatorOptions {
   bool hold = false;     // --hold: keep publishing after the timeline's end / docking
   double speed = 1.0;  // --speed: timeline seconds per wall-clock second (frames stay at the rate)
   std::int64_t max_frames = -1;  // --frames N: stop after N frames (-1: no limit)
-  double end_when_docked_s =
-      -1;  // --end-when-docked S: by hand, stop S s after docking (-1: never)
+  // --end-when-docked S: by hand, stop S s after docking (-1: never)
+  double end_when_docked_s = -1;
+  std::string lesson_path;  // --lesson FILE: scripted events (docs/lessons.md)
   std::string
       restore_path;  // --restore CHECKPOINT: start from its operator inputs (by hand, autopilot)
   std::string
@@ -106,7 +108,9 @@ class OperatorStation {
   void OnStatus(const void* data, int size, std::int64_t recv_us);
   void OnControl(const void* data, int size, std::int64_t recv_us);
   void OnWindowKeys(const void* data, int size, std::int64_t recv_us);
-  void SendControl(std::int8_t command);
+  void SendControl(std::int8_t command, const std::string& name = "");
+  // The lesson's events due this frame, sent (docs/lessons.md).
+  void FireLessonEvents();
   void ApplyRestore();
   // Drops the telemetry heard so far: after a reset or a restore nothing of
   // the frames before it is shown or flown on.
@@ -131,6 +135,8 @@ class OperatorStation {
 
   // What the DCP and the other processes say.
   std::optional<dcp_telemetry_t> telemetry_;
+  std::optional<Lesson> lesson_;
+  std::int64_t run_again_at_us_ = 0;  // a lesson's freeze for_s: when to send RUN (0: none)
   // The telemetry's frame numbers: a frame beyond the session's clock is
   // refused (dropped.far_ahead), so one forged frame far ahead cannot make
   // every real one after it stale (docs/protocol.md "Frame numbers").
