@@ -167,7 +167,7 @@ def page(stats, df, conditions, title):
 <html lang="en"><head><meta charset="utf-8"><title>{e(title)}</title>
 <style>body{{font-family:sans-serif;margin:2em;max-width:72em}}table{{border-collapse:collapse}}
 td,th{{border:1px solid #999;padding:.3em .6em;text-align:left}}figure{{display:inline-block;margin:1em}}</style>
-</head><body>
+</head><body><main>
 <h1>{e(title)}</h1>
 <p>{stats['trials']} measured trials of {len(stats['subjects'])} subjects; the unit is a trial, its result
 attempt (its last that docked, or else its last). Practice trials are in the table, not in these figures.
@@ -184,7 +184,7 @@ Student's t. Task time counts docked trials only.</p>
 <p>Each subject's task time (docked) or session time (not docked, hollow) by trial, coloured by
 condition; practice trials included.</p>
 {curves(df, conditions)}
-</body></html>
+</main></body></html>
 """
 
 

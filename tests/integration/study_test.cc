@@ -453,6 +453,14 @@ TEST(Study, TheStatisticsAgreeWithACaseWorkedByHand) {
   const std::string page = ReadFile(dir + "/study.html");
   EXPECT_NE(page.find("statsmodels MixedLM"), std::string::npos);
   EXPECT_NE(page.find("c1 minus c0"), std::string::npos);
+  EXPECT_NE(page.find("higher with c1: the 95 % interval lies above 0"), std::string::npos);
+  // The page in a real browser: its table, curves and comparisons, and
+  // axe-core's accessibility check.
+  const ScriptRun browser =
+      Script({"/usr/bin/env", "node", SourcePath("tests/browser/study_page.mjs"),
+              dir + "/study.html", "2", "3"},
+             dir + "/browser.log", 120);
+  EXPECT_EQ(browser.rc, 0) << browser.out;
   if (!::testing::Test::HasFailure()) fs::remove_all(dir);
 }
 
