@@ -8,6 +8,7 @@
 #include "rms/base/folder_file.h"
 #include "rms/base/toml_reader.h"
 #include "rms/session_control_t.hpp"
+#include "rms/wire/collision_bits.h"
 #include "rms/wire/malfunction.h"
 
 namespace rms::operator_station {
@@ -34,8 +35,11 @@ double Value(LessonQuantity q, const dcp_telemetry_t& t) {
       return t.dock_distance_ft;
     case LessonQuantity::kDockAngleDeg:
       return t.dock_angle_deg;
-    case LessonQuantity::kCollisions:
-      return t.collisions != 0 ? 1.0 : 0.0;
+    case LessonQuantity::kCollisions:  // as the summary counts them: not the essential contact
+      return wire::DetrimentalCollisions(static_cast<std::uint32_t>(t.collisions), t.finger_held,
+                                         t.held, t.master_finger > t.slave_finger) != 0
+                 ? 1.0
+                 : 0.0;
   }
   return 0.0;
 }
@@ -109,7 +113,11 @@ void ParseAction(TomlReader& r, LessonEvent* e) {
 LessonEvent ParseEvent(TomlReader& r) {
   LessonEvent e;
   const int triggers = r.Has("at_s") + r.Has("on_mode") + r.Has("when");
-  if (triggers != 1) r.Fail("at_s", "give exactly one trigger of an event: at_s, on_mode or when");
+  if (triggers != 1) {
+    throw InputError(r.source() + ": " + r.path() + ": " +
+                     (triggers == 0 ? "no trigger" : "more than one trigger") +
+                     ": give exactly one of at_s, on_mode or when (docs/lessons.md)");
+  }
   char trigger[96] = {};
   if (r.Has("at_s")) {
     e.at_s = r.Number("at_s", 0.0, 86400.0);

@@ -411,6 +411,10 @@ void OperatorStation::FireLessonEvents() {
     counters_.Add(Counter::kLessonEvents);
     if (e.command == session_control_t::FREEZE && e.for_s > 0)
       run_again_at_us_ = lcm_.NowUs() + static_cast<std::int64_t>(e.for_s * 1e6);
+    else if (e.command == session_control_t::FREEZE)
+      spdlog::warn(
+          "lesson: the session stays frozen until someone runs it (p, the instructor's Run, "
+          "scripts/lab control run)");
   }
 }
 
@@ -559,6 +563,14 @@ bool OperatorStation::StepFrame(transport::StatusReporter* status) {
 // At the end: the counters reported and written; the exit code.
 int OperatorStation::Finish(const std::string& stats_path, transport::StatusReporter* status) {
   screen_.reset();  // the terminal back, the captured log written out
+  if (lesson_ && lesson_->fired() < lesson_->events().size()) {
+    std::string never;
+    for (std::size_t i = 0; i < lesson_->events().size(); ++i)
+      if (!lesson_->was_fired(i))
+        never += "\n  event " + std::to_string(i + 1) + " (" + lesson_->events()[i].text + ")";
+    spdlog::warn("lesson: {} of {} events never fired (their triggers never held):{}",
+                 lesson_->events().size() - lesson_->fired(), lesson_->events().size(), never);
+  }
   source_->AddCounters(&counters_);
   transport::NoteTransportCounters(lcm_, &counters_);
   counters_.Set(Counter::kFramesTotal, frames_);

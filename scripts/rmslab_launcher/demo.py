@@ -127,6 +127,9 @@ class Demo:
         self.rate = frame_rate_hz(a.config)
         if a.limit_s is not None and not 1.0 / self.rate <= a.limit_s <= 86400:
             raise LabError(f"--limit-s {a.limit_s}: from one frame to 86400 s of session time")
+        if a.lesson and (a.from_ or a.restore):
+            raise LabError("--lesson with --from or --restore: a lesson's times and modes are the task's from its "
+                           "start (docs/lessons.md); start the session afresh")
         if a.end_when_docked is not None and not (a.by_hand and 0 <= a.end_when_docked <= 600):
             raise LabError(f"--end-when-docked {a.end_when_docked}: by hand (--by-hand), 0..600 s")
         if a.study and (not a.condition or a.trial < 1 or not a.trial_kind or a.trial_run < 1):

@@ -18,6 +18,9 @@ FIGURES = [("acquired_s", "time to acquire, s"), ("docked_s", "time to dock, s")
            ("collision_events", "collisions")]
 
 
+COUNTS = {"collision_events"}
+
+
 def number(v):
     try:
         return float(v) if v != "" else None
@@ -35,6 +38,8 @@ def summarize(meta, flights):
                "docked_high": hi}
         for key, _ in FIGURES:
             s = t_interval([x for x in (number(f[key]) for f in fl) if x is not None])
+            if key in COUNTS and s["low"] is not None:
+                s["low"] = max(0.0, s["low"])  # a count's interval is cut at 0
             row.update({f"{key}_n": s["n"], f"{key}_mean": s["mean"], f"{key}_low": s["low"], f"{key}_high": s["high"]})
         failures = collections.Counter(f["failure"] for f in fl if f["failure"])
         row["failures"] = "; ".join(f"{n} x {why}" for why, n in failures.most_common())

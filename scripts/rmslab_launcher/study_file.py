@@ -85,8 +85,10 @@ class StudyFile:
         if not isinstance(v, str) or not v:
             self.fail(f"{where}.{key}", "must be a file's path (relative to the study file)")
         p = os.path.normpath(os.path.join(os.path.dirname(self.path), v))
-        if not os.path.isfile(p):
+        if not os.path.exists(p):
             self.fail(f"{where}.{key}", f"no such file: {p}")
+        if not os.path.isfile(p):
+            self.fail(f"{where}.{key}", f"{p} is not a regular file (a folder, a device or a pipe)")
         return p
 
     def _read(self, doc):
@@ -330,4 +332,5 @@ def _read_text(path):
 def _tool_error(r):
     lines = [l for l in (r.stderr or r.stdout).strip().splitlines() if l.strip()]
     text = lines[-1] if lines else f"refused (exit code {r.returncode})"
+    text = re.sub(r"^\[[^\]]*\] \[[a-z_]+\] \[[a-z]+\] ", "", text)  # a process's log prefix
     return re.sub(r"^(rms_session|operator_station): ", "", text)

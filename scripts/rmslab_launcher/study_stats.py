@@ -114,6 +114,8 @@ def compute(df, conditions):
         for col, _, _, docked_only in METRICS:
             v = t[t["docked"] == 1][col] if docked_only else t[col]
             row[col] = t_interval([float(x) for x in v.dropna()])
+            if col != "task_time_s" and row[col]["low"] is not None:
+                row[col]["low"] = max(0.0, row[col]["low"])  # a count's interval is cut at 0
         out["conditions"][c] = row
     for col, _, _, docked_only in METRICS:
         d = trials[trials["docked"] == 1] if docked_only else trials

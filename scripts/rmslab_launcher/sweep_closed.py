@@ -63,17 +63,28 @@ def designs(grid):
     return [dict(zip(keys, combo)) for combo in itertools.product(*[vals for _, vals in grid])]
 
 
-def fly(a, design, jobs):
-    cmd = [binary("tools/rms_fly"), "--config", a.config, "--runs", str(a.runs), "--seed", str(a.seed),
+def fly(a, design, jobs, runs=None, max_s=None):
+    cmd = [binary("tools/rms_fly"), "--config", a.config, "--runs", str(runs or a.runs), "--seed", str(a.seed),
            "--reaction-s", a.reaction_s, "--rate-gain", a.rate_gain, "--tremor-deg", a.tremor_deg,
-           "--max-s", a.max_s, "--jobs", str(jobs)]
+           "--max-s", max_s or a.max_s, "--jobs", str(jobs)]
     for k, v in design.items():
         cmd += ["--set", f"{k}={v}"]
     r = subprocess.run(cmd, capture_output=True, text=True)
     if r.returncode != 0:
-        why = (r.stderr.strip().splitlines() or [f"exit code {r.returncode}"])[-1].removeprefix("rms_fly: ")
-        raise LabError(f"design {', '.join(f'{k}={v}' for k, v in design.items())}: {why}")
+        lines = [l for l in r.stderr.strip().splitlines() if l.strip() and not l.startswith("Run with --help")]
+        why = (lines[-1] if lines else f"exit code {r.returncode}").removeprefix("rms_fly: ")
+        about = [k for k in design if k in why]
+        raise LabError(f"design {', '.join(f'{k}={v}' for k, v in design.items())}: {why}" if about else why)
     return [json.loads(line) for line in r.stdout.splitlines() if line.strip()]
+
+
+def check_out(out):
+    """A new folder, or an empty one: a sweep never writes over another's
+    results or into a session's folder."""
+    if os.path.lexists(out) and not os.path.isdir(out):
+        raise LabError(f"--out {out}: not a folder")
+    if os.path.isdir(out) and os.listdir(out):
+        raise LabError(f"--out {out}: the folder has files already (another sweep's, a session's): give a new one")
 
 
 def run(argv):
@@ -87,8 +98,11 @@ def run(argv):
     ds = designs(a.grid)
     out = os.path.abspath(a.out or os.path.join(ROOT, "sessions",
                                                  "sweep-closed-" + time.strftime("%Y%m%dT%H%M%SZ", time.gmtime())))
+    check_out(out)
+    for d in ds:  # every design and setting checked before any is flown (one short flight each)
+        fly(a, d, 1, runs=1, max_s="1")
     os.makedirs(out, exist_ok=True)
-    say(f"sweep: {len(ds)} designs x {a.runs} closed-loop flights by virtual subjects (seed {a.seed}; reaction "
+    say(f"sweep: {len(ds)} design{'' if len(ds) == 1 else 's'} x {a.runs} closed-loop flights by virtual subjects (seed {a.seed}; reaction "
         f"{a.reaction_s} s, rate gain {a.rate_gain}, tremor {a.tremor_deg} deg), {jobs} at once")
     t0 = time.monotonic()
     keys = [k for k, _ in a.grid]

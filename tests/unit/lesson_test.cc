@@ -72,9 +72,8 @@ TEST(Lesson, ABadFileIsRefusedNamingTheKey) {
   };
   const Case cases[] = {
       {"", "key 'events': missing"},
-      {"[[events]]\ndo = \"freeze\"\n", "key 'events[0].at_s': give exactly one trigger"},
-      {"[[events]]\nat_s = 1\non_mode = 2\ndo = \"freeze\"\n",
-       "key 'events[0].at_s': give exactly"},
+      {"[[events]]\ndo = \"freeze\"\n", "events[0]: no trigger: give exactly one of"},
+      {"[[events]]\nat_s = 1\non_mode = 2\ndo = \"freeze\"\n", "events[0]: more than one trigger"},
       {"[[events]]\nat_s = -1\ndo = \"freeze\"\n", "key 'events[0].at_s': must be >= 0"},
       {"[[events]]\non_mode = 4\ndo = \"freeze\"\n", "key 'events[0].on_mode': must be <= 3"},
       {"[[events]]\nat_s = 1\ndo = \"malfunction joint 9 stuck\"\n", "key 'events[0].do':"},

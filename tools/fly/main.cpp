@@ -4,6 +4,7 @@
 // line a run on stdout (docs/studies.md "Designs judged by flying them").
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -51,6 +52,8 @@ nlohmann::json RunJson(const rms::sim::FlightRun& f, const rms::LabConfig& confi
 
 std::pair<double, double> Range(const std::string& text, const char* what) {
   const auto comma = text.find(',');
+  if (comma != std::string::npos && text.find(',', comma + 1) != std::string::npos)
+    throw rms::InputError(std::string(what) + " '" + text + "': LO,HI (two numbers) or one number");
   try {
     if (comma == std::string::npos) {
       const double v = std::stod(text);
@@ -73,7 +76,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> sets;
   int runs = 20, jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   std::uint64_t seed = 1;
-  double tremor = 0.05, max_s = 300;
+  double tremor = 0.01, max_s = 300;
   app.add_option("--config", config_path, "The configuration (docs/config.md)")->required();
   app.add_option("--set", sets, "KEY=VALUE: a design's key over it, as rms_resim --set");
   app.add_option("--runs", runs, "Flights")->capture_default_str()->check(CLI::Range(1, 100000));
@@ -82,7 +85,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--rate-gain", gain, "The subject's rates over the autopilot's: LO,HI or one")
       ->capture_default_str();
-  app.add_option("--tremor-deg", tremor, "Joint command tremor, deg (standard deviation a frame)")
+  app.add_option("--tremor-deg", tremor,
+                 "Joint command tremor, deg: its standard deviation (a Gauss-Markov wander, 1 s "
+                 "correlation time)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 5.0));
   app.add_option("--max-s", max_s, "Session time a flight may take, s")
@@ -98,11 +103,14 @@ int main(int argc, char** argv) {
         rms::ApplyConfigSettings(rms::ReadRegularFile(config_path, "configuration",
                                                       rms::kMaxConfigBytes, rms::Links::kFollow),
                                  config_path, settings);
-    const rms::LabConfig config = rms::ParseConfig(text, config_path);
+    const rms::LabConfig config =
+        rms::ParseConfig(text, settings.empty() ? config_path : config_path + " with --set");
     rms::sim::Dispersions d;
     std::tie(d.reaction_lo_s, d.reaction_hi_s) = Range(reaction, "--reaction-s");
     std::tie(d.gain_lo, d.gain_hi) = Range(gain, "--rate-gain");
     d.tremor_deg = tremor;
+    if (!std::isfinite(tremor) || !std::isfinite(max_s))
+      throw rms::InputError("--tremor-deg and --max-s must be numbers");
     if (!(0 <= d.reaction_lo_s && d.reaction_lo_s <= d.reaction_hi_s && d.reaction_hi_s <= 5))
       throw rms::InputError("--reaction-s " + reaction + ": 0 <= LO <= HI <= 5 s");
     if (!(0.1 <= d.gain_lo && d.gain_lo <= d.gain_hi && d.gain_hi <= 5))

@@ -176,6 +176,7 @@ class TomlReader {
   }
 
   const std::string& path() const { return path_; }
+  const std::string& source() const { return *source_; }
   const toml::table& table() const { return *table_; }
   bool Has(std::string_view key) const { return table_->contains(key); }
   // Marks a key as read (for free-form tables read by iterating table()).

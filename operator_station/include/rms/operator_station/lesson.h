@@ -49,6 +49,7 @@ class Lesson {
   // each once: their indices, marked fired.
   std::vector<std::size_t> Due(double t_s, const dcp_telemetry_t* telemetry);
   std::size_t fired() const;
+  bool was_fired(std::size_t i) const { return fired_[i]; }
 
  private:
   std::vector<LessonEvent> events_;
