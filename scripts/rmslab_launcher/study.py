@@ -64,6 +64,8 @@ class StudyFolder:
         self.study = study
         self.dir = os.path.abspath(folder or os.path.join(ROOT, "sessions", "studies", study.name))
         self.journal = os.path.join(self.dir, JOURNAL)
+        if os.path.lexists(self.dir) and not os.path.isdir(self.dir):
+            raise LabError(f"--dir {self.dir}: not a folder (a study's folder holds its trials)")
 
     def exists(self):
         return os.path.isfile(os.path.join(self.dir, "study.toml"))

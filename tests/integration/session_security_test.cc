@@ -440,7 +440,10 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
   // (docs/sessions.md "Re-simulation"), and the record lost nothing.
   EXPECT_EQ(sum["record"]["lost"], 0) << sum["record"].dump();
   EXPECT_EQ(sum["resimulation"]["verdict"], "identical") << sum["resimulation"].dump();
-  fs::remove_all(tmp);
+  if (::testing::Test::HasFailure())
+    std::printf("kept for a look: %s\n", tmp.c_str());
+  else
+    fs::remove_all(tmp);
 }
 
 // Two stations on one address: the second is refused at start, naming the
