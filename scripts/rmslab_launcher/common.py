@@ -170,6 +170,15 @@ def file_sha256(path):
     return h.hexdigest()
 
 
+def run_statistics(module, *args):
+    """python3 -m rmslab_launcher.MODULE ARGS... with Debian's python3, where
+    apt puts python3-pandas, -scipy and -statsmodels (another python3 first
+    on PATH, a pyenv's, has not them): its CompletedProcess, output kept."""
+    py = "/usr/bin/python3" if os.path.exists("/usr/bin/python3") else sys.executable
+    env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "scripts"))
+    return subprocess.run([py, "-m", f"rmslab_launcher.{module}", *args], capture_output=True, text=True, env=env)
+
+
 def binary(rel):
     return os.path.join(BUILD, rel)
 

@@ -23,6 +23,7 @@ import signal
 import subprocess
 import sys
 import time
+import tomllib
 
 from .common import ROOT, LabError, file_sha256, install_and_build, read_folder_json, replacing, require_built, say
 from .study_file import StudyFile
@@ -98,12 +99,16 @@ class StudyFolder:
         else:
             os.makedirs(os.path.join(self.dir, "conditions"), exist_ok=True)
             self._write_conditions()
-            with replacing(os.path.join(self.dir, "plan.json")) as f:
-                json.dump({"study": self.study.name, "order": self.study.order, "seed": self.study.seed,
-                           "subjects": self.study.plan()}, f, indent=1)
-            with replacing(os.path.join(self.dir, "study.toml"), encoding="utf-8") as f:
-                f.write(self.study.text.decode())
+            self._write_plan_and_copy()
         self.sha256 = file_sha256(os.path.join(self.dir, "study.toml"))
+
+    def _write_plan_and_copy(self):
+        """plan.json and study.toml, the study file's copy, from this file."""
+        with replacing(os.path.join(self.dir, "plan.json")) as f:
+            json.dump({"study": self.study.name, "order": self.study.order, "seed": self.study.seed,
+                       "subjects": self.study.plan()}, f, indent=1)
+        with replacing(os.path.join(self.dir, "study.toml"), encoding="utf-8") as f:
+            f.write(self.study.text.decode())
 
     def _write_conditions(self):
         for c in self.study.conditions:
@@ -113,15 +118,11 @@ class StudyFolder:
         """A study file changed after its first trial would make its trials
         incomparable: refused, unless only subjects were added at the end
         (their orders follow on; no earlier subject's changes)."""
-        first = StudyFile.__new__(StudyFile)
-        first.path = os.path.join(self.dir, "study.toml")
-        first.file = f"{self.dir}/study.toml"
-        with open(first.path, "rb") as f:
-            first.text = f.read()
-        if first.text == self.study.text:
+        with open(os.path.join(self.dir, "study.toml"), "rb") as f:
+            first = f.read()
+        if first == self.study.text:
             return
-        import tomllib
-        a, b = tomllib.loads(first.text.decode()), tomllib.loads(self.study.text.decode())
+        a, b = tomllib.loads(first.decode()), tomllib.loads(self.study.text.decode())
         old_subjects = a["study"].pop("subjects", [])
         new_subjects = b["study"].pop("subjects", [])
         a["study"].pop("description", None)
@@ -143,11 +144,7 @@ class StudyFolder:
         if not update:
             return
         # Subjects added: the plan and the folder's copy follow the file.
-        with replacing(os.path.join(self.dir, "plan.json")) as f:
-            json.dump({"study": self.study.name, "order": self.study.order, "seed": self.study.seed,
-                       "subjects": self.study.plan()}, f, indent=1)
-        with replacing(os.path.join(self.dir, "study.toml"), encoding="utf-8") as f:
-            f.write(self.study.text.decode())
+        self._write_plan_and_copy()
         say(f"study file: subjects added ({', '.join(added)}); the folder follows it")
 
     # ---- the journal ----

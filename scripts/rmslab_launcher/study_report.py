@@ -19,7 +19,7 @@ import subprocess
 import sys
 import tempfile
 
-from .common import ROOT, LabError, binary, read_folder_json, replacing, require_built, say
+from .common import LabError, binary, read_folder_json, replacing, require_built, run_statistics, say
 from .study import StudyFolder, build, progress
 from .study_file import StudyFile
 
@@ -110,12 +110,6 @@ def write_table(rows, out):
             f.write(json.dumps({c: r.get(c) for c in columns}) + "\n")
 
 
-def debian_python():
-    """Debian's python3, where apt puts python3-pandas and -statsmodels
-    (another python3 first on PATH, a pyenv's, has not them)."""
-    return "/usr/bin/python3" if os.path.exists("/usr/bin/python3") else sys.executable
-
-
 def run(argv):
     p = argparse.ArgumentParser(prog="scripts/lab study report", description="One tidy table (study.csv, "
                                 "study.jsonl) and one page (study.html: per-condition means with 95 % "
@@ -141,11 +135,9 @@ def run(argv):
     if compare_html:
         with replacing(os.path.join(out, "compare.html"), encoding="utf-8") as f:
             f.write(compare_html)
-    env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "scripts"))
-    r = subprocess.run([debian_python(), "-m", "rmslab_launcher.study_stats", os.path.join(out, "study.csv"), out,
-                        "--title", f"Study {study.name}" + (f": {study.description}" if study.description else ""),
-                        "--conditions", ",".join(c["name"] for c in study.conditions), "--lost", str(lost)],
-                       capture_output=True, text=True, env=env)
+    r = run_statistics("study_stats", os.path.join(out, "study.csv"), out,
+                       "--title", f"Study {study.name}" + (f": {study.description}" if study.description else ""),
+                       "--conditions", ",".join(c["name"] for c in study.conditions), "--lost", str(lost))
     if r.returncode != 0:
         raise LabError(f"the study's statistics failed: {(r.stderr or r.stdout).strip()}", 1)
     measured = sum(1 for x in rows if x["result"] and x["trial_kind"] == "measured")

@@ -19,10 +19,8 @@ import os
 import subprocess
 import time
 
-from .common import ROOT, LabError, binary, install_and_build, replacing, require_built, say
-from .study_file import toml_text
+from .common import ROOT, LabError, binary, install_and_build, replacing, require_built, run_statistics, say
 from .sweep import parse_vary
-from .study_report import debian_python
 
 FLIGHT_COLUMNS = ["design", "run", "seed", "reaction_s", "latency_frames", "rate_gain", "docked", "failure", "time_s",
                   "acquired_s", "cleared_s", "docked_s", "dock_distance_ft", "dock_angle_deg", "distance_margin_ft",
@@ -122,9 +120,7 @@ def run(argv):
         json.dump({"kind": "closed-loop", "config": os.path.abspath(a.config), "seed": a.seed, "runs": a.runs,
                    "reaction_s": a.reaction_s, "rate_gain": a.rate_gain, "tremor_deg": a.tremor_deg,
                    "max_s": a.max_s, "keys": keys, "designs": ds, "wall_s": wall, "jobs": jobs}, f, indent=1)
-    env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "scripts"))
-    r = subprocess.run([debian_python(), "-m", "rmslab_launcher.flight_stats", out], capture_output=True,
-                       text=True, env=env)
+    r = run_statistics("flight_stats", out)
     if r.returncode != 0:
         raise LabError(f"the sweep's statistics failed: {(r.stderr or r.stdout).strip()}", 1)
     for line in r.stdout.splitlines():
