@@ -81,6 +81,16 @@ TEST(Record, TheRecorderStoppedOnABusyMachineLosesNothingAndItReSimulates) {
     EXPECT_GT(r["published"].get<long>(), 0) << channel;
     EXPECT_EQ(r["logged"], r["published"]) << channel;
   }
+  // Each numbered stream's distinct frame numbers, which the summary holds
+  // the log against: here every number was sent once.
+  ASSERT_TRUE(record.contains("frames_by_channel")) << record.dump();
+  EXPECT_EQ(record["frames_by_channel"].size(), 4u) << record["frames_by_channel"].dump();
+  for (const auto& [channel, n] : record["frames_by_channel"].items()) {
+    long messages = 0;
+    for (const auto& jf : record["journals"]) messages += jf["by_channel"].value(channel, 0L);
+    EXPECT_EQ(n.get<long>(), messages) << channel;
+    EXPECT_EQ(s["record"]["by_channel"][channel]["published"], n) << channel;
+  }
   EXPECT_EQ(s["log"]["dcp_frames"], s["frames"]["dcp_published"]);
   EXPECT_EQ(s["log"]["operator_frames"], s["frames"]["operator_published"]);
   EXPECT_EQ(s["log"]["esg_frames"], s["frames"]["esg_published"]);

@@ -37,6 +37,7 @@
 #include "rms/transport/lcm_interface.h"
 #include "rms/wire/channels.h"
 #include "rms/wire/control_word.h"
+#include "rms/wire/frame_numbers.h"
 #include "rms/wire/message_auth.h"
 #include "rms/wire/message_io.h"
 
@@ -102,6 +103,16 @@ std::map<std::string, long> GenuineFramesLogged(
   for (const auto& [channel, pid] : publishers)
     counts[channel] = static_cast<long>(frames[channel].size());
   return counts;
+}
+
+// The ESG frames the log holds from scene_proc (`pid` of session `id`), as
+// messages: a number sent twice counted twice.
+long GenuineMessagesLogged(const std::string& log, std::int64_t id, int pid) {
+  long n = 0;
+  lcm::LogFile f(log, "r");
+  while (const lcm::LogEvent* ev = f.readNextEvent())
+    if (ev->channel == wire::channels::kEsgFrame) n += FrameFrom<esg_frame_t>(*ev, id, pid) >= 0;
+  return n;
 }
 
 // A program on the session's network: it sees every message (session id 0
@@ -304,8 +315,15 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
         0.003);  // paced: a burst would overrun the recorder's socket, and the test would test that
   }
   // DCP frames as the DCP itself, for numbers it has sent, saying otherwise:
-  // the numbers are disputed, and neither version is believed.
-  for (int i = 0; i < 30; ++i) {
+  // the numbers are disputed, and neither version is believed. Thirty in a
+  // row, each above the one before, with the DCP stopped (as a loaded
+  // machine stalls it): scene_proc follows the numbering back (`resyncs`,
+  // docs/protocol.md "Frame numbers") and sends an ESG frame number a
+  // second time, which the record counts once (docs/sessions.md "The
+  // record": `frames_by_channel`), as the log's reader does.
+  ASSERT_EQ(kill(dcp_pid, SIGSTOP), 0);
+  peer.Listen(0.1);  // what the DCP sent before it stopped
+  for (int i = 0; i < wire::SequenceTracker::kResyncAfter; ++i) {
     dcp_frame_t d = peer.last_dcp();  // well-formed words, as the DCP sends them
     d.frame = std::max<std::int64_t>(1, now - 300) + i;
     d.input_frame = d.frame + 7;
@@ -313,6 +331,8 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
     peer.Send(wire::channels::kDcpFrame, d, as_dcp);
     peer.Listen(0.003);
   }
+  peer.Listen(0.2);  // scene_proc's time to take them
+  ASSERT_EQ(kill(dcp_pid, SIGCONT), 0);
   // A docked DCP frame and its telemetry far ahead (frame 500000), as the
   // DCP itself: off the DCP's increasing run, neither believed.
   for (int i = 0; i < 3; ++i) {
@@ -439,6 +459,10 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
   // the re-simulation takes, as the summary believes, the DCP's own
   // (docs/sessions.md "Re-simulation"), and the record lost nothing.
   EXPECT_EQ(sum["record"]["lost"], 0) << sum["record"].dump();
+  EXPECT_GE(Counter(out, "scene_proc", "resyncs"), 1) << "scene_proc never followed back";
+  const auto esg_messages = GenuineMessagesLogged(s.out() + "/lcmlog", id, scene_pid);
+  EXPECT_GT(esg_messages, genuine.at(wire::channels::kEsgFrame))
+      << "no ESG frame number was sent twice: the case the record counts once is not tried";
   EXPECT_EQ(sum["resimulation"]["verdict"], "identical") << sum["resimulation"].dump();
   if (::testing::Test::HasFailure())
     std::printf("kept for a look: %s\n", tmp.c_str());

@@ -11,12 +11,21 @@
 #include <map>
 #include <memory>
 #include <queue>
+#include <set>
 #include <unordered_map>
 #include <vector>
 
 #include "rms/base/check.h"
 #include "rms/base/text.h"
+#include "rms/dcp_frame_t.hpp"
+#include "rms/dcp_telemetry_t.hpp"
+#include "rms/esg_frame_t.hpp"
+#include "rms/operator_input_t.hpp"
+#include "rms/session/session_summary.h"
 #include "rms/transport/journal.h"
+#include "rms/wire/channels.h"
+#include "rms/wire/message_auth.h"
+#include "rms/wire/message_io.h"
 
 #include "raw_log.h"
 
@@ -159,8 +168,38 @@ struct Tally {
 
 using Counts = std::unordered_map<MessageKey, std::int64_t, MessageKeyHash>;
 
+// The frame numbers the journals hold, by channel as logged, of the four
+// numbered streams (docs/sessions.md "The record": `frames_by_channel`).
+using FrameNumbers = std::map<std::string, std::set<std::int64_t>>;
+
+template <typename T>
+void AddFrameOf(const RawLogEvent& ev, FrameNumbers* frames) {
+  T m;  // a session with a key: the message's bytes, then its tag
+  if (wire::SafeDecode(ev.data, ev.size, &m) == wire::DecodeError::kNone ||
+      (ev.size > wire::kMacBytes &&
+       wire::SafeDecode(ev.data, ev.size - wire::kMacBytes, &m) == wire::DecodeError::kNone))
+    (*frames)[std::string(ev.channel)].insert(m.frame);
+}
+
+// A publisher may send one number twice (a receiver that followed a
+// sender's numbering back: docs/protocol.md "Frame numbers"), so the
+// summary holds the log's distinct numbers against these, not against the
+// journals' message counts.
+void AddFrameNumber(const RawLogEvent& ev, FrameNumbers* frames) {
+  const std::string base = BaseChannel(std::string(ev.channel));
+  if (base == wire::channels::kOperatorInput)
+    AddFrameOf<operator_input_t>(ev, frames);
+  else if (base == wire::channels::kDcpFrame)
+    AddFrameOf<dcp_frame_t>(ev, frames);
+  else if (base == wire::channels::kDcpTelemetry)
+    AddFrameOf<dcp_telemetry_t>(ev, frames);
+  else if (base == wire::channels::kEsgFrame)
+    AddFrameOf<esg_frame_t>(ev, frames);
+}
+
 // Pass one: every journal's events by message, and each one's tally.
-std::vector<Tally> CountJournals(const std::vector<JournalFile>& journals, Counts* held) {
+std::vector<Tally> CountJournals(const std::vector<JournalFile>& journals, Counts* held,
+                                 FrameNumbers* frames) {
   std::vector<Tally> tallies(journals.size());
   for (std::size_t i = 0; i < journals.size(); ++i) {
     RawLogReader r(journals[i].path.string());
@@ -169,6 +208,7 @@ std::vector<Tally> CountJournals(const std::vector<JournalFile>& journals, Count
       ++(*held)[KeyOf(ev)];
       ++tallies[i].events;
       ++tallies[i].by_channel[std::string(ev.channel)];
+      AddFrameNumber(ev, frames);
     }
     tallies[i].unread_bytes = static_cast<std::int64_t>(r.size() - r.good_end());
     tallies[i].skipped_bytes = static_cast<std::int64_t>(r.skipped_bytes());
@@ -335,7 +375,8 @@ nlohmann::ordered_json MakeRecord(const std::string& session_dir, const RecordOp
   // a re-simulation's folder): whatever lcmlog there is stays.
   if (journals.empty()) return NotMade("no journal in journal/");
   Counts held;
-  const std::vector<Tally> tallies = CountJournals(journals, &held);
+  FrameNumbers frames;
+  const std::vector<Tally> tallies = CountJournals(journals, &held, &frames);
   const Merged m = Merge(journals, tallies, wire_path, &held, root / "lcmlog");
   std::int64_t missed_total = 0;
   const auto missed = MissedByWire(journals, held, &missed_total);
@@ -348,6 +389,8 @@ nlohmann::ordered_json MakeRecord(const std::string& session_dir, const RecordOp
   const bool keep = options.keep_journals || damaged;
   nlohmann::ordered_json j =
       RecordJson(journals, tallies, m, fs::exists(wire_path), missed, missed_total, keep);
+  for (const auto& [channel, numbers] : frames)
+    j["frames_by_channel"][channel] = static_cast<std::int64_t>(numbers.size());
   WriteWholeFile((root / "record.json").string(), j.dump(2) + "\n");
   if (!keep) {
     for (const JournalFile& jf : journals) fs::remove(jf.path);

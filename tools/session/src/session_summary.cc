@@ -337,6 +337,10 @@ struct LogScan {
   std::int64_t events = 0, first_us = -1, last_us = -1, malformed = 0;
   double session_s = 0;  // the session time its operator frames reach (the last one's end)
   wire::SequenceTracker input, dcp, esg;  // frame numbers as logged
+  // The distinct numbers of the operator's and the ESG's frames, of those
+  // not refused as far ahead: what the record holds (RecordJson), where a
+  // number sent again after a resync is one frame, not a stale one.
+  std::set<std::int64_t> input_logged, esg_logged;
   double rate_hz = 30.0;
   std::set<std::int64_t> telemetry_frames;  // believed
   std::set<std::int64_t> telemetry_logged;  // of the DCP's frames, whether believed or not
@@ -427,7 +431,8 @@ void ScanFrameNumbers(const std::string& base, const LogMessage& ev,
   } else if (base == wire::channels::kOperatorInput) {
     operator_input_t m;
     if (wire::SafeDecode(ev.data, ev.size, &m) == wire::DecodeError::kNone) {
-      s->input.Accept(m.frame);
+      if (s->input.Accept(m.frame) != wire::SequenceTracker::Verdict::kFarAhead)
+        s->input_logged.insert(m.frame);
       s->session_s = std::max(s->session_s, (m.frame + 1) / s->rate_hz);
     } else {
       ++s->malformed;
@@ -444,10 +449,10 @@ void ScanFrameNumbers(const std::string& base, const LogMessage& ev,
     }
   } else if (base == wire::channels::kEsgFrame) {
     esg_frame_t m;
-    if (wire::SafeDecode(ev.data, ev.size, &m) == wire::DecodeError::kNone)
-      s->esg.Accept(m.frame);
-    else
+    if (wire::SafeDecode(ev.data, ev.size, &m) != wire::DecodeError::kNone)
       ++s->malformed;
+    else if (s->esg.Accept(m.frame) != wire::SequenceTracker::Verdict::kFarAhead)
+      s->esg_logged.insert(m.frame);
   }
 }
 
@@ -701,7 +706,13 @@ bool JournalDamaged(const nlohmann::json& record, const std::string& process) {
 // up is then a loss of the record, not none).
 std::int64_t Published(const nlohmann::json& process_stats, const nlohmann::json& record,
                        const std::string& channel, const std::string& process) {
-  const std::int64_t journaled = Journaled(record, channel);
+  // The journals' distinct frame numbers where the record counted them (a
+  // number sent twice is one frame, as the log's reader counts it), else
+  // their messages.
+  const std::int64_t journaled = record.is_object() && record.contains("frames_by_channel") &&
+                                         record["frames_by_channel"].is_object()
+                                     ? RecordCount(record, {"frames_by_channel", channel.c_str()})
+                                     : Journaled(record, channel);
   const std::int64_t counted = CounterOf(process_stats, rms::Counter::kPublished);
   if (journaled < 0) return counted;
   return JournalDamaged(record, process) ? std::max(journaled, counted) : journaled;
@@ -835,13 +846,14 @@ nlohmann::ordered_json RecordJson(const std::map<std::string, nlohmann::json>& s
   };
   const Row rows[] = {
       {wire::channels::kOperatorInput,
-       published(wire::channels::kOperatorInput, "operator_station"), s.input.received()},
+       published(wire::channels::kOperatorInput, "operator_station"),
+       static_cast<std::int64_t>(s.input_logged.size())},
       {wire::channels::kDcpFrame, published(wire::channels::kDcpFrame, "dynamics_proc"),
        s.dcp.received()},
       {wire::channels::kDcpTelemetry, published(wire::channels::kDcpTelemetry, "dynamics_proc"),
        static_cast<std::int64_t>(s.telemetry_logged.size())},
       {wire::channels::kEsgFrame, published(wire::channels::kEsgFrame, "scene_proc"),
-       s.esg.received()},
+       static_cast<std::int64_t>(s.esg_logged.size())},
   };
   nlohmann::ordered_json r;
   r["source"] = journals ? "journals" : "network";
