@@ -31,14 +31,19 @@ std::optional<wire::OperatorInputs> TimelineSource::Next(const Frame& f) {
 // ---- by hand ----
 
 // Groups two spaces apart (the status screen wraps between groups).
-std::string KeyHelp(const Bindings& b) {
-  // Keys grouped by what they do, the pairs of an axis together.
-  std::map<std::string, std::string> by_action;
+std::map<std::string, std::string> KeyHints(const Bindings& b) {
+  std::map<std::string, std::string> m;
   for (const auto& [code, a] : b.keys) {
-    std::string& k = by_action[ActionName(a)];
+    std::string& k = m[ActionName(a)];
     if (!k.empty()) k += ",";
     k += wire::KeyName(code);
   }
+  return m;
+}
+
+std::string KeyHelp(const Bindings& b) {
+  // Keys grouped by what they do, the pairs of an axis together.
+  std::map<std::string, std::string> by_action = KeyHints(b);
   std::string s = "keys:";
   auto pair = [&](const std::string& plus, const std::string& minus, const char* what) {
     if (by_action.count(plus) && by_action.count(minus)) {
@@ -129,15 +134,7 @@ void HandSource::WhileFrozen() {
   requests_ = {hands_->quit(), hands_->freeze_requested(), hands_->step_requests()};
 }
 
-std::map<std::string, std::string> HandSource::key_hints() const {
-  std::map<std::string, std::string> m;
-  for (const auto& [code, a] : bindings_.keys) {
-    std::string& k = m[ActionName(a)];
-    if (!k.empty()) k += ",";
-    k += wire::KeyName(code);
-  }
-  return m;
-}
+std::map<std::string, std::string> HandSource::key_hints() const { return KeyHints(bindings_); }
 
 void HandSource::Resume(const wire::OperatorInputs& in, bool) { hands_->SetInputs(in); }
 

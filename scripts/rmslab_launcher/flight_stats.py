@@ -7,6 +7,7 @@ t for a mean.
 """
 import collections
 import csv
+import itertools
 import json
 import os
 import sys
@@ -15,10 +16,10 @@ from .study_stats import clean, t_interval, wilson
 
 FIGURES = [("acquired_s", "time to acquire, s"), ("docked_s", "time to dock, s"),
            ("distance_margin_ft", "docking distance margin, ft"), ("angle_margin_deg", "docking angle margin, deg"),
-           ("collision_events", "collisions")]
+           ("collision_events", "collisions"), ("key_actions", "keys pressed")]
 
 
-COUNTS = {"collision_events"}
+COUNTS = {"collision_events", "key_actions"}
 
 
 def number(v):
@@ -29,13 +30,18 @@ def number(v):
 
 
 def summarize(meta, flights):
+    """A row a design and kind of subject (in the sweep's order), of the
+    flights it has (a cell without a result: fewer runs than asked)."""
     out = []
-    for i, d in enumerate(meta["designs"], 1):
-        fl = [f for f in flights if int(f["design"]) == i]
+    for (i, d), subject in itertools.product(enumerate(meta["designs"], 1),
+                                             meta.get("subjects") or ["autopilot"]):
+        fl = [f for f in flights if int(f["design"]) == i and f.get("subject", "autopilot") == subject]
+        if not fl:
+            continue
         docked = sum(f["docked"] == "True" for f in fl)
         p, lo, hi = wilson(docked, len(fl))
-        row = {"design": i, **d, "runs": len(fl), "docked": docked, "docked_rate": p, "docked_low": lo,
-               "docked_high": hi}
+        row = {"design": i, **d, "subject": subject, "runs": len(fl), "docked": docked, "docked_rate": p,
+               "docked_low": lo, "docked_high": hi}
         for key, _ in FIGURES:
             s = t_interval([x for x in (number(f[key]) for f in fl) if x is not None])
             if key in COUNTS and s["low"] is not None:
@@ -67,7 +73,7 @@ def main(argv):
         json.dump(clean({"sweep": meta, "designs": rows}), f, indent=1, allow_nan=False)
     for r in rows:
         design = ", ".join(f"{k} = {r[k]}" for k in meta["keys"])
-        print(f"design {r['design']} ({design}): docked {r['docked']} of {r['runs']} "
+        print(f"design {r['design']} ({design}), {r['subject']}: docked {r['docked']} of {r['runs']} "
               f"({100 * r['docked_rate']:.0f} %; 95 % CI {100 * r['docked_low']:.0f} to {100 * r['docked_high']:.0f} %)")
         for key, what in FIGURES:
             if r[f"{key}_n"]:

@@ -218,11 +218,12 @@ def check_designs(sessions, grid):
 
 def write_manifest(path, cells):
     """cells.tsv: INDEX, cache KEY, SESSION, KEY=VALUE... a line a cell
-    (what scripts/sweep-cell MANIFEST INDEX reads)."""
+    (what scripts/sweep-cell MANIFEST INDEX reads); a closed-loop sweep's
+    cell: INDEX, KEY and its rms_fly options (c["fields"]: sweep_closed.py)."""
     with replacing(path) as f:
         for c in cells:
-            f.write("\t".join([str(c["index"]), c["key"], c["session"]] +
-                              [f"{k}={v}" for k, v in c["sets"]]) + "\n")
+            rest = c["fields"] if "fields" in c else [c["session"]] + [f"{k}={v}" for k, v in c["sets"]]
+            f.write("\t".join([str(c["index"]), c["key"]] + rest) + "\n")
 
 
 def lab_workers(labfile, jobs):
@@ -388,6 +389,8 @@ def batch_timeout_s(todo, per_job):
     value = timeout_override()
     if value is not None:
         return value
+    if todo and "cell_s" in todo[0]:  # a closed-loop sweep's cells say their own
+        return round(BATCH_S_BASE + per_job * max(c["cell_s"] for c in todo))
     mib = 0.0
     for s in {c["session"] for c in todo}:
         with contextlib.suppress(OSError):
@@ -425,10 +428,16 @@ def parallel_command(args, joblog, todo):
     # Nothing of the user's in the command: GNU parallel reads {...} in it
     # as its replacement strings (check_parallel_paths refused braces in these).
     prefix = " ".join(f"{k}={shlex.quote(v)}" for k, v in env_build.items())
-    template = f"{prefix} {shlex.quote(cell)} --cells".strip()
+    template = f"{prefix} {shlex.quote(cell)} {cell_mode(args)}".strip()
     k = batch_size(cells, slots)
     timeout = batch_timeout_s(todo, k)
     return cmd + ["--timeout", f"{timeout:g}", "-N", str(k), template], k, timeout
+
+
+def cell_mode(args):
+    """scripts/sweep-cell's mode for the sweep's cells: --cells (re-simulations)
+    or --fly-cells (a closed-loop sweep's flights)."""
+    return getattr(args, "cell_mode", "--cells")
 
 
 def check_parallel_paths(workers):
@@ -610,7 +619,7 @@ def run_here(todo, sweep_dir, args, progress, on_result):
     errors = []
     lines = ResultLines(todo, progress, on_result, errors)
     stalled = False
-    with cells_process([CELL, "--cells", "--jobs", str(jobs)], todo, sweep_dir, errors, stop_here) as proc:
+    with cells_process([CELL, cell_mode(args), "--jobs", str(jobs)], todo, sweep_dir, errors, stop_here) as proc:
         try:
             for line in lines_within(proc.stdout, limit):
                 lines.take(line)
@@ -618,7 +627,7 @@ def run_here(todo, sweep_dir, args, progress, on_result):
         except (Stalled, subprocess.TimeoutExpired):
             stalled = True
             stop_here(proc)
-    why = "no result: its process on this machine (rms_resim --cells) "
+    why = f"no result: its process on this machine (scripts/sweep-cell {cell_mode(args)}) "
     if stalled:
         why += (f"ran past its time limit ({limit:g} s) and was stopped: no line came for that long "
                 "(a cell that stalled?)")
@@ -682,10 +691,11 @@ def stop_parallel(proc):
         raise interrupted
 
 
-def write_slurm(sweep_dir, cells, cache_dir, rerun):
+def write_slurm(sweep_dir, cells, cache_dir, rerun, cell_args=""):
     """A Slurm array job: task N runs cell N of cells.tsv and stores its
     result in the cache; `scripts/lab sweep ... --cached-only` afterwards
-    makes the table from the cache."""
+    makes the table from the cache. cell_args: scripts/sweep-cell's mode
+    before the manifest ("--fly": a closed-loop sweep's cells)."""
     if any(c.isspace() for c in sweep_dir + cache_dir + ROOT + BUILD):
         raise LabError("--slurm: the sweep's folder, the cache and the tree must have no spaces in their "
                        "paths (#SBATCH lines cannot quote them)")
@@ -702,7 +712,7 @@ def write_slurm(sweep_dir, cells, cache_dir, rerun):
 #SBATCH --cpus-per-task=1
 #SBATCH --output={os.path.join(sweep_dir, 'slurm-%A_%a.out')}
 export RMSLAB_BUILD={shlex.quote(BUILD)}
-exec {shlex.quote(CELL)} {shlex.quote(manifest)} "$SLURM_ARRAY_TASK_ID" --store {shlex.quote(cache_dir)}
+exec {shlex.quote(CELL)} {cell_args + " " if cell_args else ""}{shlex.quote(manifest)} "$SLURM_ARRAY_TASK_ID" --store {shlex.quote(cache_dir)}
 """)
     os.chmod(script, 0o755)
     return script

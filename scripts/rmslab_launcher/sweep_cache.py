@@ -59,13 +59,35 @@ def _outcome_why(o, name):
     return None
 
 
+# A closed-loop sweep's flight (rms_fly's line): each field the table reads, and its kind.
+FLIGHT_FIELDS = {"subject": lambda x: x in ("autopilot", "scripted"), "run": lambda x: type(x) is int,  # noqa: E721
+                 "docked": lambda x: type(x) is bool, "failure": lambda x: isinstance(x, str),  # noqa: E721
+                 "time_s": _number, "acquired_s": _number, "cleared_s": _number, "docked_s": _number,
+                 "collision_events": _integer, "held_frames": _integer, "key_actions": _integer}
+
+
+def _flights_why(flights):
+    if not isinstance(flights, list) or not flights:
+        return "'flights' is missing or empty"
+    for f in flights:
+        if not isinstance(f, dict):
+            return "a flight is not an object"
+        for key, ok in FLIGHT_FIELDS.items():
+            if key not in f or not ok(f[key]):
+                return f"a flight's '{key}' is missing or of the wrong kind"
+    return None
+
+
 def valid_result(res):
-    """None when res is a cell's result (rms_resim --result-json; every
-    field the table reads, of its kind), else why not."""
+    """None when res is a cell's result (rms_resim --result-json, or a
+    closed-loop cell's {"flights": [...]} from rms_fly --cells; every field
+    the table reads, of its kind), else why not."""
     if not isinstance(res, dict):
         return "not a JSON object"
     if "error" in res:
         return f"a failure ({res['error']})"
+    if "flights" in res:
+        return _flights_why(res["flights"])
     for name in ("outcome", "recorded_outcome"):
         why = _outcome_why(res.get(name), name)
         if why:

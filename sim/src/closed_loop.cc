@@ -10,7 +10,24 @@
 #include "rms/dynamics_proc/dynamics_proc.h"
 #include "rms/wire/input_block.h"
 
+#include "flight_log.h"
+
 namespace rms::sim {
+
+void ObserveFrame(const dcp_telemetry_t& tm, int frame, bool* colliding, ClosedLoopResult* r) {
+  if (tm.mode >= 1 && tm.mode <= 3 && r->modes_entered[tm.mode] == 0 && frame > 0)
+    r->modes_entered[tm.mode] = frame;
+  if (tm.collisions != 0 && !*colliding) ++r->collision_events;
+  *colliding = tm.collisions != 0;
+  if (tm.docked && !r->docked) {
+    r->docked = true;
+    r->docked_frame = frame;
+    r->dock_distance_ft = tm.dock_distance_ft;
+    r->dock_angle_deg = tm.dock_angle_deg;
+  }
+  r->held_frames += tm.held;
+  r->last = tm;
+}
 
 namespace {
 
@@ -54,18 +71,7 @@ ClosedLoopResult Fly(const LabConfig& config, const VirtualSubject& subject, int
     out.frame = f;
     out.input_frame = f;
     dcp_telemetry_t tm = dynamics_proc::MakeTelemetry(program.status(), out);
-    if (tm.mode >= 1 && tm.mode <= 3 && r.modes_entered[tm.mode] == 0 && f > 0)
-      r.modes_entered[tm.mode] = f;
-    if (tm.collisions != 0 && !colliding) ++r.collision_events;
-    colliding = tm.collisions != 0;
-    if (tm.docked && !r.docked) {
-      r.docked = true;
-      r.docked_frame = f;
-      r.dock_distance_ft = tm.dock_distance_ft;
-      r.dock_angle_deg = tm.dock_angle_deg;
-    }
-    r.held_frames += tm.held;
-    r.last = tm;
+    ObserveFrame(tm, f, &colliding, &r);
     in_flight.push_back(tm);
     while (static_cast<int>(in_flight.size()) > latency_frames) {
       seen = in_flight.front();

@@ -3,8 +3,13 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <optional>
 #include <random>
 #include <thread>
+
+#include "rms/base/check.h"
+#include "rms/operator_station/bindings.h"
+#include "rms/sim/offline_station.h"
 
 namespace rms::sim {
 
@@ -27,22 +32,60 @@ FlightRun DrawSubject(const LabConfig& config, const Dispersions& d, std::uint64
   return f;
 }
 
+const char* SubjectKindName(SubjectKind k) {
+  return k == SubjectKind::kScripted ? "scripted" : "autopilot";
+}
+
+SubjectKind SubjectKindFrom(const std::string& name) {
+  for (const SubjectKind k : {SubjectKind::kAutopilot, SubjectKind::kScripted})
+    if (name == SubjectKindName(k)) return k;
+  throw InputError("subject '" + name + "': autopilot or scripted");
+}
+
+namespace {
+
+void FlyAutopilotRun(const LabConfig& config, const Dispersions& d, double max_s, FlightRun* f) {
+  VirtualSubject s;
+  s.autopilot.cameras = false;
+  s.autopilot.timeout_s = max_s;
+  s.latency_frames = f->latency_frames;
+  s.rate_gain = f->rate_gain;
+  s.tremor_deg = d.tremor_deg;
+  s.seed = f->seed;
+  f->result = FlyVirtualSubject(config, s,
+                                static_cast<int>(std::ceil(max_s * config.session.frame_rate_hz)));
+}
+
+void FlyScriptedRun(const LabConfig& config, const operator_station::Bindings& bindings,
+                    const Dispersions& d, double max_s, FlightRun* f) {
+  ScriptedOperatorOptions o;
+  o.reaction_s = f->reaction_s;
+  o.tap_gain = f->rate_gain;
+  o.reaction_sd_s = d.reaction_sd_s;
+  o.seed = f->seed | 1;  // never 0: 0 is "no noise"
+  ScriptedFlight flight = FlyScriptedSubject(config, bindings, o, max_s);
+  f->key_actions = flight.key_actions;
+  f->result = std::move(flight.result);
+}
+
+}  // namespace
+
 std::vector<FlightRun> FlyRuns(const LabConfig& config, const Dispersions& d, std::uint64_t seed,
-                               int runs, double max_s, int jobs) {
+                               int runs, double max_s, int jobs, SubjectKind subject,
+                               int first_run) {
   std::vector<FlightRun> out(static_cast<std::size_t>(std::max(0, runs)));
-  const int max_frames = static_cast<int>(std::ceil(max_s * config.session.frame_rate_hz));
+  std::optional<operator_station::Bindings> bindings;
+  if (subject == SubjectKind::kScripted)
+    bindings = operator_station::LoadBindings(operator_station::DefaultBindingsPath());
   std::atomic<int> next{0};
   auto work = [&] {
     for (int i = next++; i < runs; i = next++) {
-      FlightRun f = DrawSubject(config, d, seed, i);
-      VirtualSubject s;
-      s.autopilot.cameras = false;
-      s.autopilot.timeout_s = max_s;
-      s.latency_frames = f.latency_frames;
-      s.rate_gain = f.rate_gain;
-      s.tremor_deg = d.tremor_deg;
-      s.seed = f.seed;
-      f.result = FlyVirtualSubject(config, s, max_frames);
+      FlightRun f = DrawSubject(config, d, seed, first_run + i);
+      f.subject = subject;
+      if (subject == SubjectKind::kScripted)
+        FlyScriptedRun(config, *bindings, d, max_s, &f);
+      else
+        FlyAutopilotRun(config, d, max_s, &f);
       out[static_cast<std::size_t>(i)] = std::move(f);
     }
   };

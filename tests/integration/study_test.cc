@@ -17,11 +17,13 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "hand_session.h"
+#include "netns_lab.h"
 #include "scripted_operator.h"
 #include "study_subject.h"
 #include "subprocess.h"
@@ -467,47 +469,198 @@ TEST(Study, TheStatisticsAgreeWithACaseWorkedByHand) {
 // Designs judged by flying them: a boom far too short to fly the task fails
 // in every run, the flown arm docks in (nearly) every one; the same seed
 // gives the same flights whatever the number of threads.
+// flights.csv's rows as maps, column name to text.
+std::vector<std::map<std::string, std::string>> ReadFlights(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::vector<std::string> head;
+  std::vector<std::map<std::string, std::string>> rows;
+  auto split = [](std::string l) {
+    if (!l.empty() && l.back() == '\r') l.pop_back();  // (Python's csv ends its lines so)
+    std::vector<std::string> v;
+    std::size_t at = 0;
+    for (std::size_t c; (c = l.find(',', at)) != std::string::npos; at = c + 1)
+      v.push_back(l.substr(at, c - at));
+    v.push_back(l.substr(at));
+    return v;
+  };
+  if (std::getline(in, line)) head = split(line);
+  while (std::getline(in, line)) {
+    const auto v = split(line);  // (no field of these holds a comma but `failure`'s, kept whole)
+    std::map<std::string, std::string> row;
+    for (std::size_t i = 0; i < head.size() && i < v.size(); ++i) row[head[i]] = v[i];
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+// A closed-loop sweep (docs/studies.md "Designs judged by flying them"): a
+// boom too short to reach the bar fails for both kinds of virtual subject,
+// every run; the recorded design docks for both; the autopilot and the
+// scripted operator (status screen and keys alone, offline) each fly;
+// the same seed gives the same flights on one thread or two.
 TEST(Study, AClosedLoopSweepFliesEachDesignByVirtualSubjects) {
   const std::string dir = testing::MakeTempDir("sweep_closed");
-  std::printf("closed-loop sweep: seed 5, 12 runs a design\n");
-  const auto sweep = [&](const std::string& out, const std::string& jobs) {
-    return Script({Lab(), "sweep", "--closed-loop", "--vary", "arm.upper_boom_ft=12,20.9", "--runs",
-                   "12", "--seed", "5", "--jobs", jobs, "--out", out, "--no-build"},
+  std::printf("closed-loop sweep: seed 5, 6 autopilot and 3 scripted runs a design\n");
+  const auto sweep = [&](const std::string& out, const std::string& jobs, const char* subjects,
+                         const char* runs, const std::string& cache = "") {
+    return Script({Lab(),
+                   "sweep",
+                   "--closed-loop",
+                   "--vary",
+                   "arm.upper_boom_ft=8,20.9",
+                   "--subjects",
+                   subjects,
+                   "--runs",
+                   runs,
+                   "--runs-per-cell",
+                   "2",
+                   "--seed",
+                   "5",
+                   "--max-s",
+                   "150",
+                   "--jobs",
+                   jobs,
+                   "--out",
+                   out,
+                   "--cache",
+                   cache.empty() ? out + "-cache" : cache,
+                   "--no-build"},
                   out + ".log", 300);
   };
-  const ScriptRun a = sweep(dir + "/a", "1");
+  const ScriptRun a = sweep(dir + "/a", "1", "autopilot", "6");
   ASSERT_EQ(a.rc, 0) << a.out;
-  const json d = json::parse(ReadFile(dir + "/a/designs.json"), nullptr, false);
-  ASSERT_TRUE(d.is_object()) << a.out;
-  ASSERT_EQ(d["designs"].size(), 2u);
-  EXPECT_EQ(d["designs"][0]["arm.upper_boom_ft"], "12");  // as given
-  EXPECT_EQ(d["designs"][0]["runs"], 12);
-  EXPECT_EQ(d["designs"][0]["docked"], 0) << "a 12 ft upper boom flew the task";
-  EXPECT_GE(d["designs"][1]["docked"].get<int>(), 11) << d["designs"][1].dump();
-  EXPECT_GT(d["designs"][1]["docked_low"].get<double>(), 0.6);
-  EXPECT_LT(d["designs"][0]["docked_high"].get<double>(), 0.3);
-  EXPECT_NE(a.out.find("docked 0 of 12"), std::string::npos) << a.out;
-  // Deterministic: two threads give the same flights as one.
-  const ScriptRun b = sweep(dir + "/b", "2");
+  const ScriptRun s = sweep(dir + "/s", "2", "scripted", "3");
+  ASSERT_EQ(s.rc, 0) << s.out;
+  for (const auto& [name, runs] : {std::pair<std::string, int>{"a", 6}, {"s", 3}}) {
+    std::string table = dir;
+    table.append("/").append(name).append("/designs.json");
+    const json d = json::parse(ReadFile(table), nullptr, false);
+    ASSERT_TRUE(d.is_object()) << name;
+    ASSERT_EQ(d["designs"].size(), 2u) << name;
+    EXPECT_EQ(d["designs"][0]["arm.upper_boom_ft"], "8");  // as given
+    EXPECT_EQ(d["designs"][0]["runs"], runs);
+    EXPECT_EQ(d["designs"][0]["docked"], 0) << name << ": an 8 ft upper boom flew the task";
+    EXPECT_EQ(d["designs"][1]["docked"].get<int>(), runs) << d["designs"][1].dump();
+    EXPECT_LT(d["designs"][0]["docked_high"].get<double>(), 0.71);
+  }
+  EXPECT_NE(a.out.find("autopilot: docked 0 of 6"), std::string::npos) << a.out;
+  EXPECT_NE(s.out.find("scripted: docked 0 of 3"), std::string::npos) << s.out;
+  EXPECT_NE(s.out.find("not docked: 3 x no acquisition by 150 s"), std::string::npos) << s.out;
+  // The scripted operator's flights: keys counted, every run its own.
+  std::set<std::string> reactions;
+  for (const auto& row : ReadFlights(dir + "/s/flights.csv")) {
+    EXPECT_EQ(row.at("subject"), "scripted");
+    EXPECT_GT(std::stoi(row.at("key_actions")), 10) << row.at("run");
+    reactions.insert(row.at("reaction_s"));
+  }
+  EXPECT_EQ(reactions.size(), 3u) << "each design's runs draw the same 3 subjects, each its own";
+  // Deterministic: two threads give the same flights as one (a cache of its own).
+  const ScriptRun b = sweep(dir + "/b", "2", "autopilot", "6");
   ASSERT_EQ(b.rc, 0) << b.out;
   EXPECT_EQ(ReadFile(dir + "/a/flights.csv"), ReadFile(dir + "/b/flights.csv"));
-  // Each run's draws differ (a person's dispersions, not one subject 12 times).
-  std::ifstream flights(dir + "/a/flights.csv");
-  std::string line;
-  std::getline(flights, line);
-  std::set<std::string> reactions;  // column 5: reaction_s
-  while (std::getline(flights, line)) {
-    std::size_t at = 0;
-    for (int k = 0; k < 4; ++k) at = line.find(',', at) + 1;
-    reactions.insert(line.substr(at, line.find(',', at) - at));
-  }
-  EXPECT_EQ(reactions.size(), 12u) << "each design's runs draw the same 12 subjects, each its own";
+  // Run again into the same cache: nothing flown, the same table.
+  const ScriptRun again = sweep(dir + "/a2", "2", "autopilot", "6", dir + "/a-cache");
+  ASSERT_EQ(again.rc, 0) << again.out;
+  EXPECT_NE(again.out.find("6 cells, 6 already in the cache"), std::string::npos) << again.out;
+  EXPECT_EQ(ReadFile(dir + "/a/flights.csv"), ReadFile(dir + "/a2/flights.csv"));
   // A design the configuration refuses is refused naming the key.
   const ScriptRun bad = Script({Lab(), "sweep", "--closed-loop", "--vary", "arm.upper_boom_ft=-1",
                                 "--runs", "2", "--out", dir + "/bad", "--no-build"},
                                dir + "/bad.log", 60);
   EXPECT_EQ(bad.rc, 2);
   EXPECT_NE(bad.out.find("arm.upper_boom_ft"), std::string::npos) << bad.out;
+  if (!::testing::Test::HasFailure()) fs::remove_all(dir);
+}
+
+// The same closed-loop sweep flown where a lab flies its sweeps
+// (docs/studies.md "Designs judged by flying them"): its cells on the lab's
+// hosts through GNU parallel (network-namespace hosts, as the replay
+// sweep's test), and as a Slurm array job whose tasks the test runs as
+// Slurm would; both tables are the one this machine flies, flight for flight.
+TEST(Study, AClosedLoopSweepFliesOnTheLabsHostsAndAsASlurmArrayJob) {
+  const std::string dir = testing::MakeTempDir("sweep_closed_hosts");
+  std::printf("closed-loop sweep: seed 9, 2 runs a design and subject\n");
+  const auto sweep = [&](const std::string& name, std::vector<std::string> more) {
+    std::vector<std::string> argv = {Lab(),
+                                     "sweep",
+                                     "--closed-loop",
+                                     "--vary",
+                                     "arm.upper_boom_ft=8,20.9",
+                                     "--runs",
+                                     "2",
+                                     "--runs-per-cell",
+                                     "1",
+                                     "--seed",
+                                     "9",
+                                     "--max-s",
+                                     "120",
+                                     "--out",
+                                     dir + "/" + name,
+                                     "--cache",
+                                     dir + "/cache-" + name,
+                                     "--no-build"};
+    argv.insert(argv.end(), more.begin(), more.end());
+    return Script(argv, dir + "/" + name + ".log", 400);
+  };
+  const ScriptRun here = sweep("here", {});
+  ASSERT_EQ(here.rc, 0) << here.out;
+  const std::string flights = ReadFile(dir + "/here/flights.csv");
+  EXPECT_EQ(ReadFlights(dir + "/here/flights.csv").size(), 8u);
+
+  testing::NetnsLab net("fl" + std::to_string(getpid() % 100000), dir, 2);
+  ASSERT_TRUE(net.ok()) << ReadFile(dir + "/netns.log");
+  const std::string lab = dir + "/lab.toml";
+  std::ofstream(lab)
+      << "[hosts]\noperator_station = \"" << net.host(1) << "\"\ndynamics_proc = \"" << net.host(2)
+      << "\"\nscene_proc = \"" << net.host(1) << "\"\nesg_renderer = \"" << net.host(2)
+      << "\"\nrecorder = \"localhost\"\n[lcm]\ngroup = \"239.255.76.69\"\nport = 7670\nttl = 1\n"
+         "[remote]\nroot = \"\"\nbuild = \"\"\n"
+         "[sweep]\nhosts = [\""
+      << net.host(1) << "\", \"" << net.host(2) << "\"]\njobs_per_host = 1\n";
+  const ScriptRun across = sweep("across", {"--hosts", lab});
+  ASSERT_EQ(across.rc, 0) << across.out;
+  EXPECT_EQ(ReadFile(dir + "/across/flights.csv"), flights);
+  // Every batch ran on one of the lab's hosts (GNU parallel's joblog).
+  std::set<std::string> hosts;
+  for (const auto& e : fs::directory_iterator(dir + "/across")) {
+    if (e.path().filename().string().rfind("joblog-", 0) != 0) continue;
+    std::istringstream jl(ReadFile(e.path().string()));
+    std::string line;
+    std::getline(jl, line);  // the header
+    while (std::getline(jl, line)) {
+      std::istringstream fields(line);
+      std::string field[7];  // Seq, Host, Starttime, JobRuntime, Send, Receive, Exitval
+      for (std::string& f : field) std::getline(fields, f, '\t');
+      hosts.insert(field[1]);
+      EXPECT_NE(field[1].find("netns-login"), std::string::npos) << line;
+      EXPECT_EQ(field[6], "0") << line;
+    }
+  }
+  EXPECT_EQ(hosts.size(), 2u) << "both hosts took cells";
+  net.Down();
+
+  ScriptRun job = sweep("slurm", {"--slurm"});
+  ASSERT_EQ(job.rc, 0) << job.out;
+  const std::string sbatch = ReadFile(dir + "/slurm/sweep.sbatch");
+  EXPECT_NE(sbatch.find("#SBATCH --array=1-8"), std::string::npos) << sbatch;
+  EXPECT_FALSE(fs::exists(dir + "/slurm/designs.csv")) << "--slurm flew the cells itself";
+  // Before the job: every cell missing, nothing flown, said.
+  ScriptRun table = sweep("slurm", {"--cached-only"});
+  EXPECT_EQ(table.rc, 1) << table.out;
+  EXPECT_NE(table.out.find("not in the cache"), std::string::npos) << table.out;
+  for (int task = 8; task >= 1; --task) {  // as Slurm runs them: any order
+    const std::string log = dir + "/task-" + std::to_string(task) + ".log";
+    testing::Subprocess t({"/bin/sh", dir + "/slurm/sweep.sbatch"}, log,
+                          {"SLURM_ARRAY_TASK_ID=" + std::to_string(task)});
+    ASSERT_EQ(t.Wait(120), 0) << ReadFile(log);
+    EXPECT_EQ(ReadFile(log).rfind(std::to_string(task) + "\t{\"flights\":[", 0), 0u)
+        << ReadFile(log);
+  }
+  table = sweep("slurm", {"--cached-only"});
+  ASSERT_EQ(table.rc, 0) << table.out;
+  EXPECT_NE(table.out.find("8 cells, 8 already in the cache"), std::string::npos) << table.out;
+  EXPECT_EQ(ReadFile(dir + "/slurm/flights.csv"), flights);
   if (!::testing::Test::HasFailure()) fs::remove_all(dir);
 }
 

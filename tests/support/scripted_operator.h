@@ -1,90 +1,45 @@
 #pragma once
-// A scripted operator that sees only what a person sees and does only what
-// a person at a terminal can do (docs/operator.md "A scripted operator"): it
-// reads the operator station's status screen through tmux, waits a
-// reaction delay after each look before it acts, and types the terminal's
-// keys -- manual augmented control, coarse and vernier increments, stop,
-// the frame key, the finger -- to acquire the payload, lift it out of the
-// bay and dock it, counting every key it presses.
-#include <array>
-#include <functional>
+// The scripted operator (rms/sim/scripted_operator.h) at a real terminal:
+// tmux, where `scripts/lab demo --by-hand` (or operator_station
+// --keyboard) runs; it waits in real time.
+#include <chrono>
 #include <string>
+#include <thread>
 #include <vector>
+
+#include "rms/sim/scripted_operator.h"
 
 #include "tmux.h"
 
 namespace rms::testing {
 
-// The status screen, read as a person reads it (operator_station's
-// status_screen.cc writes it).
-struct Screen {
-  bool valid = false;  // the station's screen is up
-  double t_s = 0.0;    // session time
-  int mode = 0;        // 1..3 (0: no telemetry shown)
-  bool acquired = false, docked = false, held = false;
-  std::string frame;  // "end effector", "orbiter", "payload"
-  bool vernier = false;
-  // Per axis x, y, z, roll, pitch, yaw: the commanded rate (signed, ft/s
-  // or deg/s) and what is still to go of the increment in flight.
-  std::array<double, 6> rate{}, to_go{};
-  bool guidance = false;
-  // The guidance offsets, signed in each axis's "+" key direction: x
-  // forward, y right, z down, roll right, pitch up, yaw right.
-  std::array<double, 6> offset{};
-  std::array<bool, 6> condition{};
-  std::array<double, 6> margin{};  // > 0: holds by
-  double close_gap = -1;           // Mode 1: where the closing finger would stop
-  bool close_ok = false;           // ... below D3Y
-  double bay_clearance = -1e9;     // Mode 2/3: > 0 clear of the bay
-  double dock_distance = 0, dock_angle = 0;
-};
-Screen ParseScreen(const std::string& text);
+using sim::FlightReport;
+using sim::ParseScreen;
+using sim::Screen;
 
-struct FlightReport {
-  bool acquired = false, docked = false;
-  double acquired_t_s = -1, docked_t_s = -1;        // session time
-  int key_actions = 0;                              // keys pressed in all
-  int key_actions_acquire = 0;                      // up to acquisition
-  double dock_distance_ft = 0, dock_angle_deg = 0;  // as the screen showed them when docked
-  std::string failure;                              // why it stopped short, if it did
-  std::vector<std::string> transcript;              // what it saw and did, line by line
+class TmuxTerminal : public sim::OperatorTerminal {
+ public:
+  explicit TmuxTerminal(Tmux* tmux) : tmux_(tmux) {}
+  std::string Capture() override { return tmux_->Capture(); }
+  void Send(const std::vector<std::string>& keys) override { tmux_->Send(keys); }
+  void Wait(double s) override {
+    if (s > 0) std::this_thread::sleep_for(std::chrono::duration<double>(s));
+  }
+
+ private:
+  Tmux* tmux_;
 };
 
 class ScriptedOperator {
  public:
-  // tmux: a terminal in which `scripts/lab demo --by-hand` (or
-  // operator_station --keyboard) is running with the default bindings.
-  explicit ScriptedOperator(Tmux* tmux, double reaction_s = 0.3);
-  // Flies from the initial state: acquires, and unless acquire_only, lifts
-  // the payload out of the bay and docks it. Gives up at `limit_s` of
-  // session time.
-  FlightReport Fly(bool acquire_only, double limit_s);
+  explicit ScriptedOperator(Tmux* tmux, double reaction_s = 0.3)
+      : terminal_(tmux), op_(&terminal_, sim::ScriptedOperatorOptions{reaction_s}) {}
+  // sim::ScriptedOperator::Fly.
+  FlightReport Fly(bool acquire_only, double limit_s) { return op_.Fly(acquire_only, limit_s); }
 
  private:
-  struct Goal {
-    int axis;      // 0..5: x, y, z, roll, pitch, yaw
-    double error;  // how far to go, in the axis's "+" direction (ft or deg)
-    double tol;    // close enough
-  };
-  Screen Look();
-  // Presses `keys` a reaction time after the last look; with pulse_s > 0,
-  // presses `then` that long after (a tap and its stop: one motion of the
-  // hand, not a second reaction).
-  void Press(const std::vector<std::string>& keys, const std::string& why, double pulse_s = 0,
-             const std::vector<std::string>& then = {});
-  // Moves each goal's axis toward its target this cycle (presses what it
-  // takes); true when every goal is within its tolerance and still.
-  bool Drive(const Screen& s, const std::vector<Goal>& goals, const std::string& why);
-  void Note(const std::string& line);
-  bool Acquire(double limit_s);
-  bool Extract(double limit_s);
-  bool Dock(double limit_s);
-  bool WaitForFrame(const std::string& frame, double limit_s);
-
-  Tmux* tmux_;
-  double reaction_s_;
-  Screen last_;
-  FlightReport report_;
+  TmuxTerminal terminal_;
+  sim::ScriptedOperator op_;
 };
 
 }  // namespace rms::testing

@@ -1,15 +1,22 @@
 // rms_fly: one design flown from the start by N virtual subjects -- the
-// autopilot with a reaction time, a rate gain and a tremor drawn for each
-// run from one seed -- in closed loop with the real DCP, no network; a JSON
-// line a run on stdout (docs/studies.md "Designs judged by flying them").
+// autopilot, or the scripted operator at an offline station, each run with
+// a reaction time, a rate gain and a noise seed drawn from one seed -- in
+// closed loop with the real DCP, no network; a JSON line a run on stdout
+// (docs/studies.md "Designs judged by flying them").
+//   rms_fly --config FILE [--set KEY=VALUE]... [--subject autopilot|scripted] [--runs N] ...
+//   rms_fly --cells FILE|- [--jobs N]   a sweep's cells (scripts/sweep-cell --fly-cells): lines
+//       "INDEX<TAB>KEY<TAB>ARG<TAB>ARG...", each ARG one of the options above; a line
+//       "INDEX<TAB>{"flights": [...]}" each (or {"error": "..."})
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <spdlog/spdlog.h>
+#include <sstream>
 #include <thread>
 
 #include "rms/base/check.h"
@@ -18,6 +25,7 @@
 #include "rms/base/config_settings.h"
 #include "rms/base/folder_file.h"
 #include "rms/base/text.h"
+#include "rms/base/version.h"
 #include "rms/sim/virtual_subjects.h"
 
 namespace {
@@ -28,7 +36,8 @@ nlohmann::json RunJson(const rms::sim::FlightRun& f, const rms::LabConfig& confi
   const auto at = [&](int frame) -> nlohmann::json {
     return frame > 0 ? nlohmann::json(frame / rate) : nlohmann::json(nullptr);
   };
-  nlohmann::json j = {{"run", f.run},
+  nlohmann::json j = {{"subject", rms::sim::SubjectKindName(f.subject)},
+                      {"run", f.run},
                       {"seed", f.seed},
                       {"reaction_s", f.reaction_s},
                       {"latency_frames", f.latency_frames},
@@ -40,7 +49,9 @@ nlohmann::json RunJson(const rms::sim::FlightRun& f, const rms::LabConfig& confi
                       {"cleared_s", at(r.modes_entered[3])},
                       {"docked_s", at(r.docked_frame)},
                       {"collision_events", r.collision_events},
-                      {"held_frames", r.held_frames}};
+                      {"held_frames", r.held_frames},
+                      {"key_actions", f.key_actions >= 0 ? nlohmann::json(f.key_actions)
+                                                         : nlohmann::json(nullptr)}};
   if (r.docked) {
     j["dock_distance_ft"] = r.dock_distance_ft;
     j["dock_angle_deg"] = r.dock_angle_deg;
@@ -65,58 +76,164 @@ std::pair<double, double> Range(const std::string& text, const char* what) {
   }
 }
 
+// One design's flights, as the options give them.
+struct FlyArgs {
+  std::string config_path, reaction = "0.2,0.5", gain = "0.8,1.2", subject = "autopilot";
+  std::vector<std::string> sets;
+  int runs = 20, first_run = 0;
+  std::uint64_t seed = 1;
+  double tremor = 0.01, reaction_sd = 0.05, max_s = 300;
+};
+
+void AddFlyOptions(CLI::App& app, FlyArgs& a) {
+  app.add_option("--config", a.config_path, "The configuration (docs/config.md)");
+  app.add_option("--set", a.sets, "KEY=VALUE: a design's key over it, as rms_resim --set");
+  app.add_option("--subject", a.subject,
+                 "Who flies: autopilot, or scripted (the scripted operator: the status screen and "
+                 "the keys alone, at an offline station)")
+      ->capture_default_str();
+  app.add_option("--runs", a.runs, "Flights")->capture_default_str()->check(CLI::Range(1, 100000));
+  app.add_option("--first-run", a.first_run,
+                 "The first run's number: runs FIRST.. FIRST+N-1, each drawn as in a sweep of them "
+                 "all (a sweep's cell)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 10000000));
+  app.add_option("--seed", a.seed, "The seed every run's draws come from")->capture_default_str();
+  app.add_option("--reaction-s", a.reaction, "Reaction time, s: LO,HI (uniform) or one value")
+      ->capture_default_str();
+  app.add_option("--rate-gain", a.gain,
+                 "The autopilot: its rates times this; the scripted operator: its timed taps held "
+                 "this times the time they need. LO,HI (uniform) or one value")
+      ->capture_default_str();
+  app.add_option("--tremor-deg", a.tremor,
+                 "The autopilot's joint command tremor, deg: its standard deviation (a "
+                 "Gauss-Markov wander, 1 s correlation time)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 5.0));
+  app.add_option("--reaction-sd-s", a.reaction_sd,
+                 "The scripted operator's: each reaction drawn about the run's, this standard "
+                 "deviation, s")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 2.0));
+  app.add_option("--max-s", a.max_s, "Session time a flight may take, s")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 3600.0));
+}
+
+// The flights, a JSON object a run. Throws rms::InputError on a bad option
+// or design.
+std::vector<nlohmann::json> Fly(const FlyArgs& a, int jobs) {
+  if (a.config_path.empty()) throw rms::InputError("--config is required");
+  std::vector<rms::ConfigSetting> settings;
+  for (const std::string& s : a.sets) settings.push_back(rms::ParseConfigSetting(s));
+  const std::string text =
+      rms::ApplyConfigSettings(rms::ReadRegularFile(a.config_path, "configuration",
+                                                    rms::kMaxConfigBytes, rms::Links::kFollow),
+                               a.config_path, settings);
+  const rms::LabConfig config =
+      rms::ParseConfig(text, settings.empty() ? a.config_path : a.config_path + " with --set");
+  rms::sim::Dispersions d;
+  std::tie(d.reaction_lo_s, d.reaction_hi_s) = Range(a.reaction, "--reaction-s");
+  std::tie(d.gain_lo, d.gain_hi) = Range(a.gain, "--rate-gain");
+  d.tremor_deg = a.tremor;
+  d.reaction_sd_s = a.reaction_sd;
+  if (!std::isfinite(a.tremor) || !std::isfinite(a.max_s) || !std::isfinite(a.reaction_sd))
+    throw rms::InputError("--tremor-deg, --reaction-sd-s and --max-s must be numbers");
+  if (!(0 <= d.reaction_lo_s && d.reaction_lo_s <= d.reaction_hi_s && d.reaction_hi_s <= 5))
+    throw rms::InputError("--reaction-s " + a.reaction + ": 0 <= LO <= HI <= 5 s");
+  if (!(0.1 <= d.gain_lo && d.gain_lo <= d.gain_hi && d.gain_hi <= 5))
+    throw rms::InputError("--rate-gain " + a.gain + ": 0.1 <= LO <= HI <= 5");
+  const rms::sim::SubjectKind kind = rms::sim::SubjectKindFrom(a.subject);
+  std::vector<nlohmann::json> out;
+  for (const auto& f :
+       rms::sim::FlyRuns(config, d, a.seed, a.runs, a.max_s, jobs, kind, a.first_run))
+    out.push_back(RunJson(f, config));
+  return out;
+}
+
+// One cell's line: "INDEX<TAB>KEY<TAB>ARG..." -> "INDEX<TAB>{"flights": [...]}".
+std::string RunCell(const std::string& line, int jobs, bool* ok) {
+  std::vector<std::string> fields;
+  std::stringstream ss(line);
+  for (std::string f; std::getline(ss, f, '\t');) fields.push_back(f);
+  *ok = false;
+  if (fields.size() < 2) return "";
+  const std::string index = fields[0];
+  nlohmann::json result;
+  try {
+    std::stol(index);
+    CLI::App app{"a cell"};
+    FlyArgs a;
+    AddFlyOptions(app, a);
+    std::vector<std::string> args(fields.begin() + 2, fields.end());
+    std::reverse(args.begin(), args.end());  // CLI11 takes them last first
+    app.parse(args);
+    result = {{"flights", Fly(a, jobs)}};
+    *ok = true;
+  } catch (const CLI::ParseError& e) {
+    result = {{"error", std::string("a cell's options: ") + e.what()}};
+  } catch (const std::exception& e) {
+    result = {{"error", rms::TerminalText(e.what())}};
+  }
+  return index + "\t" + result.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+int RunCells(std::istream& in, int jobs) {
+  int failed = 0;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty()) continue;
+    bool ok = false;
+    const std::string out = RunCell(line, jobs, &ok);
+    if (out.empty()) {
+      std::cerr << "rms_fly: --cells: a line that is no cell (INDEX<TAB>KEY<TAB>ARG...)\n";
+      ++failed;
+      continue;
+    }
+    std::cout << out << std::endl;  // each line as it is done (a sweep reads them as they come)
+    failed += !ok;
+  }
+  return failed ? 1 : 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{
       "rmslab rms_fly: a design flown closed loop from the start by N virtual subjects (the "
-      "autopilot with a reaction time, a rate gain and a tremor drawn for each run from one seed), "
-      "no network; a JSON line a run (docs/studies.md)"};
-  std::string config_path, reaction = "0.2,0.5", gain = "0.8,1.2";
-  std::vector<std::string> sets;
-  int runs = 20, jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  std::uint64_t seed = 1;
-  double tremor = 0.01, max_s = 300;
-  app.add_option("--config", config_path, "The configuration (docs/config.md)")->required();
-  app.add_option("--set", sets, "KEY=VALUE: a design's key over it, as rms_resim --set");
-  app.add_option("--runs", runs, "Flights")->capture_default_str()->check(CLI::Range(1, 100000));
-  app.add_option("--seed", seed, "The seed every run's draws come from")->capture_default_str();
-  app.add_option("--reaction-s", reaction, "Reaction time, s: LO,HI (uniform) or one value")
-      ->capture_default_str();
-  app.add_option("--rate-gain", gain, "The subject's rates over the autopilot's: LO,HI or one")
-      ->capture_default_str();
-  app.add_option("--tremor-deg", tremor,
-                 "Joint command tremor, deg: its standard deviation (a Gauss-Markov wander, 1 s "
-                 "correlation time)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 5.0));
-  app.add_option("--max-s", max_s, "Session time a flight may take, s")
-      ->capture_default_str()
-      ->check(CLI::Range(1.0, 3600.0));
+      "autopilot, or the scripted operator at an offline station, with a reaction time, a rate "
+      "gain and a noise seed drawn for each run from one seed), no network; a JSON line a run "
+      "(docs/studies.md)"};
+  app.set_version_flag("--version", rms::VersionString());
+  FlyArgs a;
+  AddFlyOptions(app, a);
+  std::string cells;
+  int jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   app.add_option("--jobs", jobs, "Flights at once (threads)")->check(CLI::Range(1, 256));
+  app.add_option("--cells", cells,
+                 "A sweep's cells, FILE or - (standard input): a line \"INDEX<TAB>KEY<TAB>ARG...\" "
+                 "each, its options; a result line each (scripts/sweep-cell --fly-cells)");
   if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
-  spdlog::set_level(spdlog::level::off);  // the autopilot's narration: each run's line says it
+  spdlog::set_level(spdlog::level::off);  // the pilots' narration: each run's line says it
+  if (app.count("--cells") > 0) {
+    for (const char* o :
+         {"--config", "--set", "--subject", "--runs", "--first-run", "--seed", "--reaction-s",
+          "--rate-gain", "--tremor-deg", "--reaction-sd-s", "--max-s"}) {
+      if (app.count(o) > 0) {
+        std::cerr << "rms_fly: --cells: each cell's options are in its line (not " << o
+                  << " beside it)\n";
+        return 2;
+      }
+    }
+    if (cells == "-") return RunCells(std::cin, jobs);
+    std::ifstream in(cells);
+    if (!in) {
+      std::cerr << "rms_fly: --cells " << cells << ": cannot be read\n";
+      return 2;
+    }
+    return RunCells(in, jobs);
+  }
   try {
-    std::vector<rms::ConfigSetting> settings;
-    for (const std::string& s : sets) settings.push_back(rms::ParseConfigSetting(s));
-    const std::string text =
-        rms::ApplyConfigSettings(rms::ReadRegularFile(config_path, "configuration",
-                                                      rms::kMaxConfigBytes, rms::Links::kFollow),
-                                 config_path, settings);
-    const rms::LabConfig config =
-        rms::ParseConfig(text, settings.empty() ? config_path : config_path + " with --set");
-    rms::sim::Dispersions d;
-    std::tie(d.reaction_lo_s, d.reaction_hi_s) = Range(reaction, "--reaction-s");
-    std::tie(d.gain_lo, d.gain_hi) = Range(gain, "--rate-gain");
-    d.tremor_deg = tremor;
-    if (!std::isfinite(tremor) || !std::isfinite(max_s))
-      throw rms::InputError("--tremor-deg and --max-s must be numbers");
-    if (!(0 <= d.reaction_lo_s && d.reaction_lo_s <= d.reaction_hi_s && d.reaction_hi_s <= 5))
-      throw rms::InputError("--reaction-s " + reaction + ": 0 <= LO <= HI <= 5 s");
-    if (!(0.1 <= d.gain_lo && d.gain_lo <= d.gain_hi && d.gain_hi <= 5))
-      throw rms::InputError("--rate-gain " + gain + ": 0.1 <= LO <= HI <= 5");
-    for (const auto& f : rms::sim::FlyRuns(config, d, seed, runs, max_s, jobs))
-      std::cout << RunJson(f, config).dump() << "\n";
+    for (const auto& j : Fly(a, jobs)) std::cout << j.dump() << "\n";
     return 0;
   } catch (const std::exception& e) {
     std::cerr << "rms_fly: " << rms::TerminalText(e.what()) << "\n";

@@ -147,5 +147,8 @@ class AutopilotSource : public InputSource {
 
 // The key map in one line: "w/s thc_x  d/a thc_y ... space stop ...".
 std::string KeyHelp(const Bindings& b);
+// Each action's keys, by the action's name ("thc_x+" -> "w"; several
+// comma-separated): the status screen's hints.
+std::map<std::string, std::string> KeyHints(const Bindings& b);
 
 }  // namespace rms::operator_station

@@ -1,0 +1,382 @@
+#include "rms/sim/scripted_operator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <regex>
+
+namespace rms::sim {
+
+namespace {
+
+constexpr const char* kAxisNames[6] = {"x", "y", "z", "roll", "pitch", "yaw"};
+// The default bindings (config/bindings.toml): each axis's "+" and "-" key.
+constexpr const char* kPlusKey[6] = {"w", "d", "f", "o", "k", "l"};
+constexpr const char* kMinusKey[6] = {"s", "a", "r", "u", "i", "j"};
+
+int AxisIndex(const std::string& name) {
+  for (int i = 0; i < 6; ++i) {
+    if (name == kAxisNames[i]) return i;
+  }
+  return -1;
+}
+
+std::string Fmt(const char* f, double a, double b = 0, double c = 0) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, f, a, b, c);
+  return buf;
+}
+
+// "1 2 3 . 5 6": the conditions that hold.
+std::string Conditions(const Screen& s) {
+  std::string c;
+  for (int i = 0; i < 6; ++i) {
+    if (i > 0) c.push_back(' ');
+    c.push_back(s.condition[i] ? static_cast<char>('1' + i) : '.');
+  }
+  return c;
+}
+
+}  // namespace
+
+Screen ParseScreen(const std::string& text) {
+  // Compiled once (a sweep parses a screen a look: thousands a flight).
+  static const std::regex kTimeRe(R"(t ([\d.]+) s  frame)");
+  static const std::regex kModeRe(R"(MODE (\d))");
+  static const std::regex kFrameRe(R"(frame: (end effector|orbiter|payload))");
+  static const std::regex kFingerStopRe(R"(the finger would stop at ([\d.]+) ft: (below|NOT))");
+  static const std::regex kClearOfBayRe(R"(clear of the bay by ([\d.]+) ft)");
+  static const std::regex kInBayRe(R"(in the bay: ([\d.]+) ft to lift it clear)");
+  static const std::regex kDockDistanceRe(R"(DOCKING distance ([\d.]+) ft)");
+  static const std::regex kDockAngleRe(R"(angle ([\d.]+) deg \(<=)");
+  Screen s;
+  s.valid = text.find("rmslab operator station") != std::string::npos;
+  if (!s.valid) return s;
+  std::smatch m;
+  if (std::regex_search(text, m, kTimeRe)) s.t_s = std::stod(m[1]);
+  if (std::regex_search(text, m, kModeRe)) s.mode = std::stoi(m[1]);
+  s.acquired = text.find("acquired YES") != std::string::npos;
+  s.docked = text.find("docked YES") != std::string::npos;
+  s.held = text.find("arm HELD") != std::string::npos;
+  if (std::regex_search(text, m, kFrameRe)) s.frame = m[1];
+  s.vernier = text.find("scale: VERNIER") != std::string::npos;
+  static const std::regex moving(
+      R"(\b(x|y|z|roll|pitch|yaw) ([+-][\d.]+) (?:ft|deg)/s(?: \(([\d.]+) (?:ft|deg) to go\))?)");
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), moving);
+       it != std::sregex_iterator(); ++it) {
+    const int a = AxisIndex((*it)[1]);
+    s.rate[a] = std::stod((*it)[2]);
+    if ((*it)[3].matched) s.to_go[a] = std::stod((*it)[3]);
+  }
+  s.guidance = text.find("GUIDANCE") != std::string::npos;
+  static const std::regex offset(R"(\b(x|y|z) (forward|back|right|left|down|up) ([\d.]+) ft)");
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), offset);
+       it != std::sregex_iterator(); ++it) {
+    const std::string w = (*it)[2];
+    const double sign = w == "forward" || w == "right" || w == "down" ? 1.0 : -1.0;
+    s.offset[AxisIndex((*it)[1])] = sign * std::stod((*it)[3]);
+  }
+  static const std::regex turn(R"(\b(roll|pitch|yaw) (right|left|up|down) ([\d.]+) deg)");
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), turn); it != std::sregex_iterator();
+       ++it) {
+    const std::string w = (*it)[2];
+    const double sign = w == "right" || w == "up" ? 1.0 : -1.0;
+    s.offset[AxisIndex((*it)[1])] = sign * std::stod((*it)[3]);
+  }
+  static const std::regex cond(R"(\[([x ])\] ([1-6]) [A-Za-z0-9 :]+?(holds|short) by ([\d.]+) ft)");
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), cond); it != std::sregex_iterator();
+       ++it) {
+    const int i = std::stoi((*it)[2]) - 1;
+    s.condition[i] = (*it)[1] == "x";
+    s.margin[i] = ((*it)[3] == "holds" ? 1.0 : -1.0) * std::stod((*it)[4]);
+  }
+  if (std::regex_search(text, m, kFingerStopRe)) {
+    s.close_gap = std::stod(m[1]);
+    s.close_ok = m[2] == "below";
+  }
+  if (std::regex_search(text, m, kClearOfBayRe)) s.bay_clearance = std::stod(m[1]);
+  if (std::regex_search(text, m, kInBayRe)) {
+    s.bay_clearance = -std::stod(m[1]);
+  }
+  if (std::regex_search(text, m, kDockDistanceRe)) s.dock_distance = std::stod(m[1]);
+  if (std::regex_search(text, m, kDockAngleRe)) s.dock_angle = std::stod(m[1]);
+  return s;
+}
+
+ScriptedOperator::ScriptedOperator(OperatorTerminal* terminal,
+                                   const ScriptedOperatorOptions& options)
+    : terminal_(terminal), options_(options), rng_(options.seed) {}
+
+double ScriptedOperator::Reaction() {
+  if (options_.seed == 0 || options_.reaction_sd_s <= 0) return options_.reaction_s;
+  std::normal_distribution<double> law(options_.reaction_s, options_.reaction_sd_s);
+  return std::max(0.05, law(rng_));
+}
+
+void ScriptedOperator::Note(const std::string& line) {
+  report_.transcript.push_back(Fmt("%6.1f s  ", last_.t_s) + line);
+}
+
+Screen ScriptedOperator::Look() {
+  last_ = ParseScreen(terminal_->Capture());
+  return last_;
+}
+
+void ScriptedOperator::Press(const std::vector<std::string>& keys, const std::string& why,
+                             double pulse_s, const std::vector<std::string>& then) {
+  // A person acts a reaction time after seeing what they act on.
+  terminal_->Wait(Reaction());
+  terminal_->Send(keys);
+  report_.key_actions += static_cast<int>(keys.size());
+  std::string k;
+  for (const auto& key : keys) k += (k.empty() ? "" : " ") + key;
+  if (pulse_s > 0) {
+    terminal_->Wait(pulse_s);
+    terminal_->Send(then);
+    report_.key_actions += static_cast<int>(then.size());
+    for (const auto& key : then) k += Fmt(" (%.2f s) ", pulse_s) + key;
+  }
+  Note("press " + k + ": " + why);
+  // And sees it take effect before looking again (a few frames).
+  terminal_->Wait(0.12);
+}
+
+bool ScriptedOperator::Drive(const Screen& s, const std::vector<Goal>& goals,
+                             const std::string& why) {
+  // Coarse for the long way, vernier for the last foot or so; changing the
+  // scale stops every motion, so it is a press of its own. (With
+  // hysteresis: coarse covers 0.9 ft and 3.4 deg while a press is on its
+  // way, vernier a tenth of that.)
+  double worst_ft = 0.0, worst_deg = 0.0;
+  bool any_moving = false;
+  for (const Goal& g : goals) {
+    any_moving = any_moving || s.rate[g.axis] != 0.0;
+    if (std::abs(g.error) <= g.tol) continue;
+    double& worst = g.axis < 3 ? worst_ft : worst_deg;
+    worst = std::max(worst, std::abs(g.error));
+  }
+  const bool done = worst_ft == 0.0 && worst_deg == 0.0;
+  const bool want_vernier =
+      s.vernier ? (worst_ft < 2.5 && worst_deg < 12.0) : (worst_ft < 1.2 && worst_deg < 5.0);
+  if (!done && want_vernier != s.vernier) {
+    Press({"v"}, s.vernier ? "coarse for the long way" : "vernier for the last of it");
+    return false;
+  }
+  // How far an axis goes while a press is on its way: the reaction, the
+  // key's way to the station, a frame, the telemetry back, the look.
+  const double latency = options_.reaction_s + 0.15;
+  std::vector<std::string> keys;
+  const Goal* pulse = nullptr;
+  double pulse_rate = 0.0;
+  for (const Goal& g : goals) {
+    const double m = s.rate[g.axis], e = g.error, left = s.to_go[g.axis];
+    const char* toward = e > 0 ? kPlusKey[g.axis] : kMinusKey[g.axis];
+    const char* against = m > 0 ? kMinusKey[g.axis] : kPlusKey[g.axis];
+    if (std::abs(e) <= g.tol) {
+      if (m != 0.0) keys.push_back(against);  // there: stop it
+      continue;
+    }
+    if (m != 0.0 && (m > 0) != (e > 0)) {
+      keys.push_back(against);  // going the wrong way: stop it, start again next time
+    } else if (m != 0.0) {
+      const double travel = std::abs(m) * latency;
+      if (std::abs(e) <= travel + 0.5 * g.tol)
+        keys.push_back(against);  // stop it in time
+      else if (left < 1.2 * travel && std::abs(e) > left + g.tol)
+        keys.push_back(toward);  // keep it going
+    } else {
+      // Still. Far: start it (and stop it when it gets there). Near: a
+      // tap and its stop, timed, one axis at a time.
+      const double rate = g.axis < 3 ? (s.vernier ? 0.2 : 2.0) : (s.vernier ? 0.8 : 8.0);
+      if (std::abs(e) > 3 * rate * latency)
+        keys.push_back(toward);
+      else if (!pulse || std::abs(e) / g.tol > std::abs(pulse->error) / pulse->tol)
+        pulse = &g, pulse_rate = rate;
+    }
+  }
+  if (!keys.empty()) {
+    Press(keys, why);
+  } else if (pulse && !any_moving) {
+    const char* toward = pulse->error > 0 ? kPlusKey[pulse->axis] : kMinusKey[pulse->axis];
+    const char* against = pulse->error > 0 ? kMinusKey[pulse->axis] : kPlusKey[pulse->axis];
+    Press({toward}, why + " (" + kAxisNames[pulse->axis] + Fmt(" %.2f, a tap)", pulse->error),
+          options_.tap_gain * std::abs(pulse->error) / pulse_rate, {against});
+  } else {
+    terminal_->Wait(0.05);
+  }
+  return done;
+}
+
+bool ScriptedOperator::WaitForFrame(const std::string& frame, double limit_s) {
+  for (int tries = 0; tries < 8 && last_.t_s < limit_s; ++tries) {
+    const Screen s = Look();
+    if (s.frame == frame) return true;
+    Press({"n"}, "the " + frame + " frame");
+    terminal_->Wait(0.15);
+  }
+  return Look().frame == frame;
+}
+
+bool ScriptedOperator::Acquire(double limit_s) {
+  enum Stage { kTurn, kHover, kDescend, kClose, kWait } stage = kTurn;
+  constexpr double kHoverFt = 3.0;
+  double closed_at = 0.0;
+  while (true) {
+    const Screen s = Look();
+    if (!s.valid || !s.guidance || s.mode == 0) {
+      terminal_->Wait(0.1);
+      continue;
+    }
+    if (s.t_s > limit_s)
+      return report_.failure = "no acquisition by " + Fmt("%.0f s", limit_s), false;
+    if (s.mode >= 2) {
+      Note("acquired");
+      return true;
+    }
+    if (s.held) {
+      Press({"Space", "s"}, "held by a collision: stop, and back off");
+      stage = kHover;
+      continue;
+    }
+    const auto& o = s.offset;
+    std::vector<Goal> goals;
+    switch (stage) {
+      case kTurn:  // turn about the grasp point until the end effector is square to the bar
+        goals = {{3, o[3], 1.0}, {4, o[4], 1.0}, {5, o[5], 1.0}};
+        break;
+      case kHover:  // to a point above the grasp, the fingers either side of the bar's line
+        goals = {{0, o[0] - kHoverFt, 0.15},
+                 {1, o[1], 0.04},
+                 {2, o[2], 0.1},
+                 {3, o[3], 1.0},
+                 {4, o[4], 1.0},
+                 {5, o[5], 1.0}};
+        break;
+      case kDescend:  // straight down onto the bar
+        goals = {{0, o[0], 0.05}, {1, o[1], 0.04}, {2, o[2], 0.1},
+                 {3, o[3], 1.0},  {4, o[4], 1.0},  {5, o[5], 1.0}};
+        break;
+      case kClose: {
+        bool ready = s.close_ok;
+        for (int i : {0, 1, 2, 4, 5}) ready = ready && s.margin[i] > 0;
+        if (!ready) {
+          Note("not ready to close (conditions " + Conditions(s) +
+               Fmt(", the finger would stop at %.3f ft)", s.close_gap) + ": align again");
+          stage = kDescend;
+          continue;
+        }
+        Press({"c"}, "every condition but the finger's holds: close the finger");
+        closed_at = s.t_s;
+        stage = kWait;
+        continue;
+      }
+      case kWait:
+        if (s.t_s - closed_at > 4.0) {
+          Press({"x"}, "closed and not acquired (conditions " + Conditions(s) + "): open it");
+          stage = kDescend;
+        } else {
+          terminal_->Wait(0.1);
+        }
+        continue;
+    }
+    static const char* kStage[] = {"turn", "to the hover point", "descend", "", ""};
+    if (Drive(s, goals, kStage[stage])) {
+      stage = static_cast<Stage>(stage + 1);
+      Note(stage == kHover     ? "square to the bar"
+           : stage == kDescend ? "over the bar"
+                               : "at the grasp");
+    }
+  }
+}
+
+bool ScriptedOperator::Extract(double limit_s) {
+  if (!WaitForFrame("orbiter", limit_s))
+    return report_.failure = "the orbiter frame would not come", false;
+  while (true) {
+    const Screen s = Look();
+    if (s.t_s > limit_s)
+      return report_.failure = "not out of the bay by " + Fmt("%.0f s", limit_s), false;
+    if (s.mode == 3 && s.bay_clearance > 2.0) {
+      Note("clear of the bay");
+      return true;
+    }
+    // Straight up (the orbiter's -z), until 3 ft clear.
+    Drive(s, {{2, -(3.0 - s.bay_clearance), 0.3}, {0, 0.0, 1.0}, {1, 0.0, 1.0}},
+          "lift it out of the bay");
+  }
+}
+
+bool ScriptedOperator::Dock(double limit_s) {
+  enum Stage { kBelow, kTurn, kAlign, kIn } stage = kBelow;
+  constexpr double kBelowFt = 12.0, kAlignFt = 1.5;
+  while (true) {
+    const Screen s = Look();
+    if (s.t_s > limit_s) return report_.failure = "not docked by " + Fmt("%.0f s", limit_s), false;
+    if (s.docked) {
+      report_.dock_distance_ft = s.dock_distance;
+      report_.dock_angle_deg = s.dock_angle;
+      Note("docked");
+      return true;
+    }
+    if (s.held) {
+      Press({"Space"}, "held by a collision: stop");
+      if (stage == kIn) {
+        Press({"s"}, "back off along the probe");
+        stage = kAlign;
+      }
+      continue;
+    }
+    const auto& o = s.offset;
+    std::vector<Goal> goals;
+    switch (stage) {
+      case kBelow:  // the probe's tip well below the port (orbiter axes: z is down)
+        goals = {{0, o[0], 0.3}, {1, o[1], 0.3}, {2, o[2] + kBelowFt, 0.5}};
+        break;
+      case kTurn:  // the probe's axis onto the port's, turning about the tip
+        goals = {{3, o[3], 1.0}, {4, o[4], 1.0}, {5, o[5], 1.0}};
+        break;
+      case kAlign:  // payload axes: y along the probe; on the port's axis, short of it
+        if (s.frame != "payload") {
+          if (!WaitForFrame("payload", limit_s))
+            return report_.failure = "the payload frame would not come", false;
+          continue;
+        }
+        goals = {{0, o[0], 0.05}, {2, o[2], 0.05}, {1, o[1] - kAlignFt, 0.3},
+                 {3, o[3], 0.8},  {4, o[4], 0.8},  {5, o[5], 0.8}};
+        break;
+      case kIn:  // in along the probe until it docks (0.25 ft, 2 deg 32 min)
+        goals = {{0, o[0], 0.05}, {2, o[2], 0.05}, {1, o[1], 0.05},
+                 {3, o[3], 0.8},  {4, o[4], 0.8},  {5, o[5], 0.8}};
+        break;
+    }
+    static const char* kStage[] = {"below the port", "turn the probe up", "onto the port's axis",
+                                   "in"};
+    if (Drive(s, goals, kStage[stage]) && stage != kIn) {
+      stage = static_cast<Stage>(stage + 1);
+      Note(stage == kTurn    ? "below the port"
+           : stage == kAlign ? "probe square to the port"
+                             : "on the axis");
+    }
+  }
+}
+
+FlightReport ScriptedOperator::Fly(bool acquire_only, double limit_s) {
+  report_ = {};
+  // The screen up, with guidance.
+  for (int i = 0; i < 200; ++i) {
+    const Screen s = Look();
+    if (s.valid && s.guidance && s.mode == 1) break;
+    terminal_->Wait(0.1);
+  }
+  Note("start");
+  report_.acquired = Acquire(limit_s);
+  report_.key_actions_acquire = report_.key_actions;
+  report_.acquired_t_s = report_.acquired ? last_.t_s : -1;
+  if (!report_.acquired || acquire_only) return report_;
+  if (!Extract(limit_s)) return report_;
+  report_.docked = Dock(limit_s);
+  report_.docked_t_s = report_.docked ? last_.t_s : -1;
+  return report_;
+}
+
+}  // namespace rms::sim
