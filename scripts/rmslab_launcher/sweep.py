@@ -742,7 +742,9 @@ def check_out(out):
 
 
 def parse_args(argv):
-    p = argparse.ArgumentParser(prog="scripts/lab sweep", description=run.__doc__)
+    p = argparse.ArgumentParser(prog="scripts/lab sweep", description=run.__doc__,
+                                epilog="scripts/lab sweep --closed-loop --help: designs flown afresh by virtual "
+                                       "subjects instead (docs/studies.md)")
     p.add_argument("sessions", nargs="+", metavar="SESSION")
     p.add_argument("--vary", action="append", default=[], metavar="KEY=V1,V2,...",
                    help="a configuration key and its values (TOML), e.g. dcp.tpob_ft=0.2,0.3")
@@ -780,7 +782,8 @@ def run_cells(a, cells, todo, sweep_dir, cache, cached):
     errors, retried, pending = [], 0, todo
 
     def on_result(cell, res):
-        why = sweep_cache.valid_result(res)
+        # (a closed-loop sweep checks each result against its cell too: sweep_closed.py)
+        why = sweep_cache.valid_result(res) or (a.check_result(cell, res) if hasattr(a, "check_result") else None)
         if why is None:
             cache.store(cell["key"], res)
             cell.pop("error", None)

@@ -125,6 +125,8 @@ class Cache:
         self.unreadable = []  # (path, why) of entries found but not usable
 
     def path(self, key):
+        if not (isinstance(key, str) and len(key) == 64 and all(c in "0123456789abcdef" for c in key)):
+            raise LabError(f"a cache key must be a SHA-256 (64 hex digits), not {key!r}")
         return os.path.join(self.folder, key + ".json")
 
     def load(self, key):

@@ -102,7 +102,11 @@ def parse_args(argv):
     try:
         a.max_s_value = float(a.max_s)
     except ValueError:
-        raise LabError(f"--max-s {a.max_s}: a number of seconds")
+        a.max_s_value = float("nan")
+    if not 1 <= a.max_s_value <= 3600:  # (rms_fly's range; nan and inf fail it)
+        raise LabError(f"--max-s {a.max_s}: a number of seconds, 1 to 3600")
+    if any(c in a.config for c in "\t\n\r"):
+        raise LabError(f"--config {a.config!r}: tabs and line breaks are not allowed in its path")
     a.grid = sweep.parse_vary(a.vary)
     a.cell_mode = "--fly-cells"  # sweep.py's runners: scripts/sweep-cell --fly-cells
     return a
@@ -119,6 +123,20 @@ def fly_options(a, runs, max_s):
             a.tremor_deg, "--reaction-sd-s", a.reaction_sd_s, "--max-s", max_s, "--runs", str(runs)]
 
 
+def check_config(a):
+    """The configuration every cell reads (again and again, wherever it
+    flies): a regular file, named by its real path (a link followed once)."""
+    real = os.path.realpath(a.config)
+    if os.path.isdir(real):
+        raise LabError(f"--config {a.config}: a folder, not a configuration file")
+    if not os.path.exists(real):
+        raise LabError(f"--config {a.config}: no such file")
+    if not os.path.isfile(real):
+        raise LabError(f"--config {a.config}: not a regular file (each cell reads it again: a FIFO or a device "
+                       "cannot be)")
+    a.config = real
+
+
 def check_design(a, design):
     """A design's configuration checked by one short flight (rms_fly here):
     a bad key or value is refused, naming it, before anything is flown."""
@@ -133,54 +151,79 @@ def check_design(a, design):
         raise LabError(f"design {', '.join(f'{k}={v}' for k, v in design.items())}: {why}" if about else why)
 
 
-def software_version():
-    """rms_fly's --version and the SHA-256 of the binary (a tree rebuilt with
-    uncommitted changes has the same --version, not the same binary)."""
-    r = subprocess.run([binary("tools/rms_fly"), "--version"], capture_output=True, text=True)
-    if r.returncode != 0 or not r.stdout.strip():
-        raise LabError(f"{binary('tools/rms_fly')} --version failed: build first (drop --no-build)", 1)
-    return f"{r.stdout.strip()} {file_sha256(binary('tools/rms_fly'))}"
+def software_id():
+    """rms_fly --software-id: its version and the SHA-256 of the binary (a
+    tree rebuilt with uncommitted changes has the same version, not the same
+    binary). Each cell names it, and rms_fly refuses to fly a cell that
+    names another."""
+    r = subprocess.run([binary("tools/rms_fly"), "--software-id"], capture_output=True, text=True)
+    if r.returncode != 0 or not r.stdout.strip() or any(c in r.stdout.strip() for c in "\t\n"):
+        raise LabError(f"{binary('tools/rms_fly')} --software-id failed: build first (drop --no-build)", 1)
+    return r.stdout.strip()
 
 
-def make_cells(a, ds, version):
+def make_cells(a, ds, software):
     """Every design x subject x chunk of runs, in order: dicts with index
     (from 1), design (from 1), subject, first, runs, fields (rms_fly's
-    options), key (the cache key: the configuration's content, the options
-    but the configuration's path, the software) and cell_s (its time limit)."""
-    config_sha, config = file_sha256(a.config), os.path.abspath(a.config)
+    options: the configuration, its SHA-256 and the software, which rms_fly
+    checks before it flies), key (the SHA-256 of the fields joined by tabs,
+    which rms_fly --cells checks too: what is cached under a key is what its
+    options fly) and cell_s (its time limit)."""
+    config_sha = file_sha256(a.config)
     cells = []
     for i, d in enumerate(ds, 1):
         for subject in a.subject_list:
             for first in range(0, a.runs, a.runs_per_cell):
                 n = min(a.runs_per_cell, a.runs - first)
-                opts = (["--subject", subject, "--first-run", str(first)] + fly_options(a, n, a.max_s) +
-                        [x for k, v in d.items() for x in ("--set", f"{k}={v}")])
-                key = hashlib.sha256(json.dumps([config_sha, opts, version]).encode()).hexdigest()
+                fields = (["--config", a.config, "--config-sha256", config_sha, "--software", software,
+                           "--subject", subject, "--first-run", str(first)] + fly_options(a, n, a.max_s) +
+                          [x for k, v in d.items() for x in ("--set", f"{k}={v}")])
+                key = hashlib.sha256("\t".join(fields).encode()).hexdigest()
                 cells.append({"index": len(cells) + 1, "design": i, "subject": subject, "first": first, "runs": n,
-                              "fields": ["--config", config] + opts, "key": key,
+                              "fields": fields, "key": key,
                               "cell_s": CELL_S_BASE + n * CELL_S_A_FLIGHT_S * a.max_s_value})
     return cells
 
 
-def check_out(a, out):
-    """A new folder, or an empty one: a sweep never writes over another's
-    results or into a session's folder. With --cached-only: the folder of
-    the Slurm job's sweep (its sweep.json, of a closed-loop sweep)."""
+def cell_result_why(cell, res):
+    """None when res holds the flights its cell flies (each run of it, by
+    its subject), else why not: a cached entry is checked against the cell
+    it stands for."""
+    flights = res.get("flights") if isinstance(res, dict) else None
+    if not isinstance(flights, list):
+        return "not a closed-loop cell's result"
+    runs = [f.get("run") for f in flights if isinstance(f, dict)]
+    if runs != list(range(cell["first"], cell["first"] + cell["runs"])):
+        return f"its runs are not the cell's ({cell['first']}..{cell['first'] + cell['runs'] - 1})"
+    if any(f.get("subject") != cell["subject"] for f in flights):
+        return f"its flights are not all the {cell['subject']}'s"
+    return None
+
+
+def manifest_text(cells):
+    return "".join("\t".join([str(c["index"]), c["key"]] + c["fields"]) + "\n" for c in cells)
+
+
+def check_out(a, out, cells):
+    """A new folder, an empty one, or this very sweep's (its cells.tsv the
+    same: the same command again, after a stop, goes on where it stopped):
+    a sweep never writes over another's results or into a session's
+    folder. With --cached-only: the folder --slurm wrote for this sweep."""
     if os.path.lexists(out) and not os.path.isdir(out):
         raise LabError(f"--out {out}: not a folder")
-    if a.cached_only:
-        meta = os.path.join(out, "sweep.json")
-        try:
-            kind = json.load(open(meta)).get("kind") if os.path.isfile(meta) else None
-        except (OSError, ValueError, AttributeError):
-            kind = None
-        if kind != "closed-loop":
-            raise LabError(f"--out {out}: --cached-only needs the folder --slurm wrote (no closed-loop sweep.json "
-                           "there)")
-        return
-    if os.path.isdir(out) and os.listdir(out):
+    try:
+        same = open(os.path.join(out, "cells.tsv")).read() == manifest_text(cells)
+    except (OSError, UnicodeDecodeError):
+        same = False
+    if a.cached_only and not same:
+        raise LabError(f"--out {out}: --cached-only needs the folder --slurm wrote for this very sweep (its "
+                       "cells.tsv is not this sweep's, or there is none): give the command --slurm printed")
+    if not same and os.path.isdir(out) and os.listdir(out):
         raise LabError(f"--out {out}: the folder has files already (another sweep's, a session's): give a new one")
     sweep.check_out(out)
+    if a.slurm and any(c.isspace() for c in out):
+        raise LabError("--slurm: the sweep's folder must have no spaces in its path (#SBATCH lines cannot "
+                       "quote it)")
 
 
 def write_slurm(a, out, cells, cache_dir):
@@ -209,8 +252,8 @@ def flight_rows(a, ds, cells, results):
         if res is None:
             missing.append(c)
             continue
-        for f in res["flights"]:
-            rows.append({"design": c["design"], **ds[c["design"] - 1], **f})
+        for f in res["flights"]:  # the design is the cell's, whatever the result says
+            rows.append({**f, "design": c["design"], **ds[c["design"] - 1]})
     return rows, missing
 
 
@@ -234,28 +277,36 @@ def write_tables(a, out, ds, rows, jobs, wall, missing):
 
 def run(argv):
     a = parse_args(argv)
-    if not os.path.isfile(a.config):
-        raise LabError(f"--config {a.config}: no such file")
+    check_config(a)
     if not a.no_build:
         install_and_build()
     require_built("tools/rms_fly")
     ds = designs(a.grid)
     out = os.path.abspath(a.out or os.path.join(ROOT, "sessions",
                                                  "sweep-closed-" + time.strftime("%Y%m%dT%H%M%SZ", time.gmtime())))
-    check_out(a, out)
+    cells = make_cells(a, ds, software_id())
+    check_out(a, out, cells)
     sweep.timeout_override()
     a.workers = sweep.lab_workers(a.hosts, a.jobs) if a.hosts else None
     sweep.check_parallel_paths(a.workers)
     for d in ds:  # every design and setting checked before any is flown (one short flight each)
         check_design(a, d)
     cache = sweep_cache.Cache(a.cache or os.path.join(ROOT, "sessions", "sweep-cache"), must_exist=a.cached_only)
-    cells = make_cells(a, ds, software_version())
+    a.check_result = cell_result_why
+    if a.slurm and any(c.isspace() for c in cache.folder + ROOT):
+        raise LabError("--slurm: the cache and the tree must have no spaces in their paths (#SBATCH lines cannot "
+                       "quote them)")
     os.makedirs(out, exist_ok=True)
     jobs = a.jobs or len(os.sched_getaffinity(0))
     if not a.cached_only:
         sweep.write_manifest(os.path.join(out, "cells.tsv"), cells)
         write_tables(a, out, ds, [], jobs, 0.0, [])  # what the sweep is, before anything is flown
     results = {c["index"]: cache.load(c["key"]) for c in cells}
+    for c in cells:  # an entry is checked against the cell it stands for
+        why = results[c["index"]] is not None and cell_result_why(c, results[c["index"]])
+        if why:
+            cache.unreadable.append((cache.path(c["key"]), f"not its cell's ({why})"))
+            results[c["index"]] = None
     for path, why in cache.unreadable:
         say(f"cache entry {path}: {why}: " + ("not used" if a.cached_only else "its cell is flown again"))
     todo = [c for c in cells if results[c["index"]] is None]
@@ -288,11 +339,15 @@ def run(argv):
         for c in todo:
             results[c["index"]] = None if "error" in c else cache.load(c["key"])
     wall = time.monotonic() - t0
+    if file_sha256(a.config) != cells[0]["fields"][3]:
+        say(f"the configuration {a.config} changed during the sweep: the cells flown after the change were "
+            "refused (their results would not be the sweep's); put it back, or make a new sweep")
     rows, missing = flight_rows(a, ds, cells, results)
     write_tables(a, out, ds, rows, jobs, wall, missing)
     for c in missing[:sweep.FAILED_SHOWN]:
-        say(f"  cell {c['index']} (design {c['design']}, {c['subject']}, runs {c['first']}..{c['first'] + c['runs'] - 1}) "
-            f"has no result: {c.get('error', 'no result')}")
+        why = c.get("error", "no result").removeprefix("no result: ")
+        say(f"  cell {c['index']} (design {c['design']}, {c['subject']}, runs {c['first']}.."
+            f"{c['first'] + c['runs'] - 1}): no result: {why}")
     if not rows:
         raise LabError("no cell has a result: no table", 1)
     r = run_statistics("flight_stats", out)
@@ -301,5 +356,6 @@ def run(argv):
     for line in r.stdout.splitlines():
         say(line)
     say(f"{len(rows)} flights in {wall:.1f} s of wall time; {out}/designs.csv (a row a design and subject), "
-        f"flights.csv (a row a flight)" + (f"; {len(missing)} cells without a result" if missing else ""))
+        f"flights.csv (a row a flight)" +
+        (f"; {len(missing)} cell{'' if len(missing) == 1 else 's'} without a result" if missing else ""))
     return 1 if missing else 0

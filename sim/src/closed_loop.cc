@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <deque>
 #include <optional>
 #include <random>
@@ -27,6 +28,16 @@ void ObserveFrame(const dcp_telemetry_t& tm, int frame, bool* colliding, ClosedL
   }
   r->held_frames += tm.held;
   r->last = tm;
+}
+
+std::string TimeUpFailure(const ClosedLoopResult& r, double max_s) {
+  char why[96];
+  std::snprintf(why, sizeof why, "%s by %.0f s",
+                r.modes_entered[2] == 0   ? "no acquisition"
+                : r.modes_entered[3] == 0 ? "not out of the bay"
+                                          : "not docked",
+                max_s);
+  return why;
 }
 
 namespace {

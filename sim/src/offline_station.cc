@@ -1,7 +1,6 @@
 #include "rms/sim/offline_station.h"
 
 #include <cmath>
-#include <cstdio>
 #include <memory>
 
 #include "rms/base/check.h"
@@ -112,15 +111,7 @@ ScriptedFlight FlyScriptedSubject(const LabConfig& config,
   try {
     flight.report = op.Fly(false, max_s);
   } catch (const FlightTimeUp&) {
-    // Where the time ran out, as the scripted operator's own limits say it.
-    const ClosedLoopResult& r = station.result();
-    char why[96];
-    std::snprintf(why, sizeof why, "%s by %.0f s",
-                  r.modes_entered[2] == 0   ? "no acquisition"
-                  : r.modes_entered[3] == 0 ? "not out of the bay"
-                                            : "not docked",
-                  max_s);
-    flight.report.failure = why;
+    flight.report.failure = TimeUpFailure(station.result(), max_s);  // where the time ran out
   }
   flight.result = station.result();
   flight.key_actions = station.key_actions();

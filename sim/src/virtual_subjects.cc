@@ -11,6 +11,8 @@
 #include "rms/operator_station/bindings.h"
 #include "rms/sim/offline_station.h"
 
+#include "flight_log.h"
+
 namespace rms::sim {
 
 std::uint64_t RunSeed(std::uint64_t seed, int run) {
@@ -54,6 +56,10 @@ void FlyAutopilotRun(const LabConfig& config, const Dispersions& d, double max_s
   s.seed = f->seed;
   f->result = FlyVirtualSubject(config, s,
                                 static_cast<int>(std::ceil(max_s * config.session.frame_rate_hz)));
+  // Out of frames: say where it had got to, as the scripted operator's
+  // flights do (the autopilot's own timeout names its phase).
+  if (!f->result.docked && f->result.failure == "frame limit")
+    f->result.failure = TimeUpFailure(f->result, max_s);
 }
 
 void FlyScriptedRun(const LabConfig& config, const operator_station::Bindings& bindings,

@@ -469,6 +469,12 @@ TEST(Study, TheStatisticsAgreeWithACaseWorkedByHand) {
 // Designs judged by flying them: a boom far too short to fly the task fails
 // in every run, the flown arm docks in (nearly) every one; the same seed
 // gives the same flights whatever the number of threads.
+std::size_t FilesIn(const std::string& dir) {
+  std::size_t n = 0;
+  for (const auto& e : fs::directory_iterator(dir)) n += e.is_regular_file();
+  return n;
+}
+
 // flights.csv's rows as maps, column name to text.
 std::vector<std::map<std::string, std::string>> ReadFlights(const std::string& path) {
   std::ifstream in(path);
@@ -661,6 +667,23 @@ TEST(Study, AClosedLoopSweepFliesOnTheLabsHostsAndAsASlurmArrayJob) {
   ASSERT_EQ(table.rc, 0) << table.out;
   EXPECT_NE(table.out.find("8 cells, 8 already in the cache"), std::string::npos) << table.out;
   EXPECT_EQ(ReadFile(dir + "/slurm/flights.csv"), flights);
+  // A cells.tsv edited by hand (design 1's 8 ft made 20.9 ft) flies nothing
+  // under the old key, and caches nothing.
+  std::string tsv = ReadFile(dir + "/slurm/cells.tsv");
+  const std::size_t at = tsv.find("arm.upper_boom_ft=8");
+  ASSERT_NE(at, std::string::npos);
+  tsv.replace(at, std::string("arm.upper_boom_ft=8").size(), "arm.upper_boom_ft=20.9");
+  std::ofstream(dir + "/slurm/cells.tsv") << tsv;
+  const std::size_t cached = FilesIn(dir + "/cache-slurm");
+  fs::remove_all(dir + "/cache-slurm");
+  fs::create_directories(dir + "/cache-slurm");
+  testing::Subprocess edited({"/bin/sh", dir + "/slurm/sweep.sbatch"}, dir + "/edited.log",
+                             {"SLURM_ARRAY_TASK_ID=1"});
+  EXPECT_NE(edited.Wait(120), 0);
+  EXPECT_NE(ReadFile(dir + "/edited.log").find("is not its options' SHA-256"), std::string::npos)
+      << ReadFile(dir + "/edited.log");
+  EXPECT_EQ(FilesIn(dir + "/cache-slurm"), 0u) << "an edited cell was cached";
+  EXPECT_EQ(cached, 8u);
   if (!::testing::Test::HasFailure()) fs::remove_all(dir);
 }
 

@@ -5,8 +5,13 @@
 // (docs/studies.md "Designs judged by flying them").
 //   rms_fly --config FILE [--set KEY=VALUE]... [--subject autopilot|scripted] [--runs N] ...
 //   rms_fly --cells FILE|- [--jobs N]   a sweep's cells (scripts/sweep-cell --fly-cells): lines
-//       "INDEX<TAB>KEY<TAB>ARG<TAB>ARG...", each ARG one of the options above; a line
-//       "INDEX<TAB>{"flights": [...]}" each (or {"error": "..."})
+//       "INDEX<TAB>KEY<TAB>ARG<TAB>ARG...", each ARG one of the options above, KEY the
+//       SHA-256 of the ARGs joined by tabs; a line "INDEX<TAB>{"flights": [...]}" each (or
+//       {"error": "..."}); exit 0, 1 when a cell had an error, 2 when a line was no cell
+//   rms_fly --software-id   what a sweep's cells name in --software: the version and the
+//       binary's SHA-256
+#include <sodium.h>
+
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
@@ -29,6 +34,27 @@
 #include "rms/sim/virtual_subjects.h"
 
 namespace {
+
+std::string Sha256Hex(const void* data, std::size_t size) {
+  RMS_CHECK(sodium_init() >= 0);
+  unsigned char digest[crypto_hash_sha256_BYTES];
+  crypto_hash_sha256(digest, static_cast<const unsigned char*>(data), size);
+  char hex[2 * crypto_hash_sha256_BYTES + 1];
+  sodium_bin2hex(hex, sizeof hex, digest, sizeof digest);
+  return hex;
+}
+
+// The version and this binary's SHA-256: a tree rebuilt with changes not
+// committed has the same version, not the same binary (docs/studies.md
+// "Where it flies": a cell's result is cached under it).
+std::string SoftwareId() {
+  static const std::string id = [] {
+    const std::string self =
+        rms::ReadRegularFile("/proc/self/exe", "this program", 1ULL << 30, rms::Links::kFollow);
+    return rms::VersionString() + " " + Sha256Hex(self.data(), self.size());
+  }();
+  return id;
+}
 
 nlohmann::json RunJson(const rms::sim::FlightRun& f, const rms::LabConfig& config) {
   const rms::sim::ClosedLoopResult& r = f.result;
@@ -83,6 +109,7 @@ struct FlyArgs {
   int runs = 20, first_run = 0;
   std::uint64_t seed = 1;
   double tremor = 0.01, reaction_sd = 0.05, max_s = 300;
+  std::string config_sha256, software;  // a sweep's cell: what it was made with, checked
 };
 
 void AddFlyOptions(CLI::App& app, FlyArgs& a) {
@@ -118,6 +145,10 @@ void AddFlyOptions(CLI::App& app, FlyArgs& a) {
   app.add_option("--max-s", a.max_s, "Session time a flight may take, s")
       ->capture_default_str()
       ->check(CLI::Range(1.0, 3600.0));
+  app.add_option("--config-sha256", a.config_sha256,
+                 "Refuse to fly unless the configuration's SHA-256 is this (a sweep's cell)");
+  app.add_option("--software", a.software,
+                 "Refuse to fly unless this is the program's --software-id (a sweep's cell)");
 }
 
 // The flights, a JSON object a run. Throws rms::InputError on a bad option
@@ -126,10 +157,16 @@ std::vector<nlohmann::json> Fly(const FlyArgs& a, int jobs) {
   if (a.config_path.empty()) throw rms::InputError("--config is required");
   std::vector<rms::ConfigSetting> settings;
   for (const std::string& s : a.sets) settings.push_back(rms::ParseConfigSetting(s));
-  const std::string text =
-      rms::ApplyConfigSettings(rms::ReadRegularFile(a.config_path, "configuration",
-                                                    rms::kMaxConfigBytes, rms::Links::kFollow),
-                               a.config_path, settings);
+  if (!a.software.empty() && a.software != SoftwareId())
+    throw rms::InputError("this rms_fly (" + SoftwareId() +
+                          ") is not the one the sweep was made with (" + a.software +
+                          "): build the same tree, or make the sweep again");
+  const std::string file = rms::ReadRegularFile(a.config_path, "configuration",
+                                                rms::kMaxConfigBytes, rms::Links::kFollow);
+  if (!a.config_sha256.empty() && Sha256Hex(file.data(), file.size()) != a.config_sha256)
+    throw rms::InputError("the configuration " + a.config_path +
+                          " changed since the sweep was made (its SHA-256 is not the sweep's)");
+  const std::string text = rms::ApplyConfigSettings(file, a.config_path, settings);
   const rms::LabConfig config =
       rms::ParseConfig(text, settings.empty() ? a.config_path : a.config_path + " with --set");
   rms::sim::Dispersions d;
@@ -151,18 +188,31 @@ std::vector<nlohmann::json> Fly(const FlyArgs& a, int jobs) {
   return out;
 }
 
-// One cell's line: "INDEX<TAB>KEY<TAB>ARG..." -> "INDEX<TAB>{"flights": [...]}".
+// One cell's line: "INDEX<TAB>KEY<TAB>ARG..." -> "INDEX<TAB>{"flights": [...]}";
+// "" for a line that is no cell (no INDEX of digits, no KEY).
 std::string RunCell(const std::string& line, int jobs, bool* ok) {
   std::vector<std::string> fields;
   std::stringstream ss(line);
   for (std::string f; std::getline(ss, f, '\t');) fields.push_back(f);
   *ok = false;
-  if (fields.size() < 2) return "";
+  if (fields.size() < 2 || fields[0].empty() || fields[0].size() > 15 ||
+      fields[0].find_first_not_of("0123456789") != std::string::npos)
+    return "";
   const std::string index = fields[0];
   nlohmann::json result;
   try {
-    std::stol(index);
+    // The key is the cell's options' hash: what is cached under it is what
+    // they fly (a cells.tsv edited by hand cannot put one design's flights
+    // under another's key).
+    std::string joined;
+    for (std::size_t i = 2; i < fields.size(); ++i) {
+      if (i > 2) joined += '\t';
+      joined += fields[i];
+    }
+    if (fields[1] != Sha256Hex(joined.data(), joined.size()))
+      throw rms::InputError("the cell's key is not its options' SHA-256 (a cells.tsv edited?)");
     CLI::App app{"a cell"};
+    app.set_help_flag();  // (--help is no cell's option)
     FlyArgs a;
     AddFlyOptions(app, a);
     std::vector<std::string> args(fields.begin() + 2, fields.end());
@@ -179,20 +229,22 @@ std::string RunCell(const std::string& line, int jobs, bool* ok) {
 }
 
 int RunCells(std::istream& in, int jobs) {
-  int failed = 0;
+  int failed = 0, not_cells = 0, n = 0;
   for (std::string line; std::getline(in, line);) {
+    ++n;
     if (line.empty()) continue;
     bool ok = false;
     const std::string out = RunCell(line, jobs, &ok);
     if (out.empty()) {
-      std::cerr << "rms_fly: --cells: a line that is no cell (INDEX<TAB>KEY<TAB>ARG...)\n";
-      ++failed;
+      std::cerr << "rms_fly: --cells: line " << n
+                << " is no cell (INDEX<TAB>KEY<TAB>ARG..., INDEX digits)\n";
+      ++not_cells;
       continue;
     }
     std::cout << out << std::endl;  // each line as it is done (a sweep reads them as they come)
     failed += !ok;
   }
-  return failed ? 1 : 0;
+  return not_cells ? 2 : failed ? 1 : 0;
 }
 
 }  // namespace
@@ -209,15 +261,22 @@ int main(int argc, char** argv) {
   std::string cells;
   int jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   app.add_option("--jobs", jobs, "Flights at once (threads)")->check(CLI::Range(1, 256));
+  bool software_id = false;
+  app.add_flag("--software-id", software_id,
+               "Print the version and this binary's SHA-256 (what a sweep's cells are made with)");
   app.add_option("--cells", cells,
                  "A sweep's cells, FILE or - (standard input): a line \"INDEX<TAB>KEY<TAB>ARG...\" "
                  "each, its options; a result line each (scripts/sweep-cell --fly-cells)");
   if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   spdlog::set_level(spdlog::level::off);  // the pilots' narration: each run's line says it
+  if (software_id) {
+    std::cout << SoftwareId() << "\n";
+    return 0;
+  }
   if (app.count("--cells") > 0) {
-    for (const char* o :
-         {"--config", "--set", "--subject", "--runs", "--first-run", "--seed", "--reaction-s",
-          "--rate-gain", "--tremor-deg", "--reaction-sd-s", "--max-s"}) {
+    for (const char* o : {"--config", "--set", "--subject", "--runs", "--first-run", "--seed",
+                          "--reaction-s", "--rate-gain", "--tremor-deg", "--reaction-sd-s",
+                          "--max-s", "--config-sha256", "--software"}) {
       if (app.count(o) > 0) {
         std::cerr << "rms_fly: --cells: each cell's options are in its line (not " << o
                   << " beside it)\n";
