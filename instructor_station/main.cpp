@@ -26,6 +26,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--view-rate", o.view_rate_hz, "Each view drawn at most this often, Hz")
       ->capture_default_str();
+  app.add_option("--lesson", o.lesson_path,
+                 "A lesson (docs/lessons.md) whose events this station fires as the session "
+                 "reaches them (the page can load one too)");
   return rms::transport::ProcessMain(
       app, argc, argv, "instructor_station", &common,
       [&](const rms::LabConfig& config, rms::transport::LcmInterface& lcm) {

@@ -14,9 +14,11 @@
 
 #include "rms/base/check.h"
 #include "rms/base/text.h"
+#include "rms/instructor_station/instructor_lesson.h"
 #include "rms/instructor_station/session_watch.h"
 #include "rms/instructor_station/station_views.h"
 #include "rms/instructor_station/web_server.h"
+#include "rms/lesson/lesson.h"
 #include "rms/session_control_t.hpp"
 #include "rms/transport/process.h"
 #include "rms/wire/channels.h"
@@ -52,6 +54,21 @@ bool Loopback(const std::string& host) {
   return host == "127.0.0.1" || host == "localhost" || host == "::1";
 }
 
+// docs/lessons.md "From the instructor's station": what is due, queued
+// for RMS_CONTROL with the page's own commands, said in the events list and
+// the log.
+void FireLesson(InstructorLesson* lesson, SessionWatch& watch, double frame_rate_hz,
+                std::int64_t now_us, ControlQueue* controls, Counters* counters) {
+  const std::optional<dcp_telemetry_t> t = watch.LatestTelemetry();
+  for (const LessonCommand& c : lesson->Due(t ? &*t : nullptr, frame_rate_hz, now_us)) {
+    controls->Push({c.command, c.name});
+    if (c.said.empty()) continue;  // a timed freeze's RUN
+    spdlog::warn("{}", c.said);
+    watch.NoteLocal("lesson", c.said);
+    counters->Add(Counter::kLessonEvents);
+  }
+}
+
 }  // namespace
 
 void TakeTokenFromEnvironment(InstructorOptions* o) {
@@ -75,6 +92,7 @@ void CheckOptions(const InstructorOptions& o) {
     if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_')
       throw InputError("--token: letters, digits, - and _ only");
   }
+  if (!o.lesson_path.empty()) (void)lesson::Lesson::Load(o.lesson_path);  // refused at start
   if (!Loopback(o.bind) && o.token.empty()) {
     // Refused rather than made up: whoever opens it beyond this host needs
     // to be given the token (docs/security.md "The instructor's page").
@@ -94,7 +112,12 @@ int RunInstructorStation(const LabConfig& config, transport::LcmInterface& lcm,
   StationViews views(config, options.view_width, options.view_height, options.view_rate_hz,
                      &counters);
   ControlQueue controls;
-  WebServer server(config, options, &watch, &views, &controls, &counters);
+  InstructorLesson lesson;
+  if (!options.lesson_path.empty()) {
+    lesson.Set(lesson::Lesson::Load(options.lesson_path), options.lesson_path);
+    spdlog::info("lesson {}: fired from this station", options.lesson_path);
+  }
+  WebServer server(config, options, &watch, &views, &controls, &lesson, &counters);
   const int port = server.Start();
   std::string host = options.bind == "0.0.0.0" || options.bind == "::" ? "localhost" : options.bind;
   if (host.find(':') != std::string::npos) host = "[" + host + "]";  // IPv6
@@ -115,6 +138,7 @@ int RunInstructorStation(const LabConfig& config, transport::LcmInterface& lcm,
       },
       [&] {
         if (auto d = watch.LatestDcpFrame()) views.Update(*d, watch.LostStations());
+        FireLesson(&lesson, watch, config.session.frame_rate_hz, lcm.NowUs(), &controls, &counters);
         for (const ControlRequest& r : controls.Drain()) {
           session_control_t m;
           m.send_time_us = lcm.NowUs();

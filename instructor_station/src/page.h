@@ -45,6 +45,9 @@ input, select { background: #222; color: #eee; border: 1px solid #555; padding: 
 <span id="munit"></span><button id="inject">Inject</button><br>
 <div id="mlist">none in force</div>
 <div id="said"></div>
+<h2>Lesson</h2>
+<label for="lessonfile">A lesson file (docs/lessons.md): </label><input type="file" id="lessonfile" accept=".toml,text/plain">
+<div id="lessonsaid"></div><ol id="lesson"></ol>
 <h2>Events</h2><div id="events"></div></div>
 <div class="pane"><h2>From above: the orbiter, the CAE and the end effector's path (nose up, starboard right)</h2>
 <canvas id="map" width="640" height="480"></canvas></div>
@@ -84,6 +87,29 @@ async function control(command, extra) {
   $("said").textContent = r.ok ? ("sent " + command + (j.name ? " " + j.name : "")) : ("refused: " + (j.error || r.status));
   $("said").className = r.ok ? "ok" : "bad";
   refreshCheckpoints();
+}
+
+// The lesson: each event and whether it fired, when (session time).
+function showLesson(l) {
+  const list = $("lesson");
+  list.innerHTML = "";
+  for (const e of (l.events || [])) {
+    const li = document.createElement("li");
+    li.textContent = e.text + (e.fired ? "  -- fired at " + fmt(e.fired_at_s, 1) + " s" : "  -- to come");
+    li.className = e.fired ? "ok" : "";
+    list.appendChild(li);
+  }
+  if (!l.loaded) $("lessonsaid").textContent = "none loaded";
+  else if (!$("lessonsaid").classList.contains("bad")) $("lessonsaid").textContent = l.source;
+}
+
+async function loadLesson(file) {
+  const body = new URLSearchParams({text: await file.text(), name: file.name});
+  const r = await fetch(q("/api/lesson"), {method: "POST", body, headers: {"X-Rmslab-Token": token}});
+  const j = await r.json().catch(() => ({}));
+  $("lessonsaid").textContent = r.ok ? j.source : ("refused: " + (j.error || r.status));
+  $("lessonsaid").className = r.ok ? "ok" : "bad";
+  if (r.ok) showLesson(j);
 }
 
 async function refreshCheckpoints() {
@@ -225,6 +251,7 @@ async function poll() {
       eventsNext = e.seq + 1;
     }
     if (ev.length) $("events").scrollTop = 1e9;
+    showLesson(await getJson("/api/lesson"));
     const p = await getJson("/api/path?since=" + pathNext);
     path = path.concat(p.points); pathNext = p.next;
     drawMap();
@@ -250,6 +277,7 @@ async function start() {
   $("checkpoint").onclick = () => control("checkpoint", {name: $("cpname").value});
   $("restore").onclick = () => control("restore", {name: $("cplist").value});
   if (map) malfunctionMenu();
+  $("lessonfile").onchange = (e) => { if (e.target.files[0]) loadLesson(e.target.files[0]); };
   refreshCheckpoints();
   poll();
 }

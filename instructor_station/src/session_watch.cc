@@ -305,6 +305,11 @@ std::optional<wire::DcpFrameData> SessionWatch::LatestDcpFrame() const {
   return dcp_;
 }
 
+std::optional<dcp_telemetry_t> SessionWatch::LatestTelemetry() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return telemetry_;
+}
+
 std::int64_t SessionWatch::events_seen() const {
   std::lock_guard<std::mutex> lock(mu_);
   return next_event_seq_;

@@ -186,6 +186,7 @@ struct WebServer::Impl {
   SessionWatch* watch;
   StationViews* views;
   ControlQueue* controls;
+  InstructorLesson* lesson;
   Counters* counters;
   MHD_Daemon* daemon = nullptr;
   std::string map_json;
@@ -204,6 +205,7 @@ struct WebServer::Impl {
   Answer Serve(const Request& req);
   Answer Route(const Request& req);
   Answer Control(const Request& req);
+  Answer LoadLesson(const Request& req);
   Answer Checkpoints() const;
   static MHD_Result OnRequest(void* cls, MHD_Connection* c, const char* url, const char* method,
                               const char* version, const char* upload, std::size_t* upload_size,
@@ -270,6 +272,10 @@ Answer WebServer::Impl::Route(const Request& req) {
     }
   } else if (req.method == "POST" && req.path == "/api/control") {
     return Control(req);
+  } else if (get && req.path == "/api/lesson") {
+    a.body = Json(lesson->Json());
+  } else if (req.method == "POST" && req.path == "/api/lesson") {
+    return LoadLesson(req);
   } else {
     ++refused;
     a.status = 404;
@@ -300,6 +306,22 @@ Answer WebServer::Impl::Control(const Request& req) {
   sent += steps;
   Answer a;
   a.body = Json(nlohmann::json{{"sent", command}, {"name", r.name}, {"times", steps}});
+  return a;
+}
+
+// docs/lessons.md "From the instructor's station": a lesson file's text
+// (form field `text`, within the request's 64 KiB) and its name (`name`,
+// for the page), checked as the operator station checks one: refused (400,
+// the key and the reason) with the lesson in force unchanged.
+Answer WebServer::Impl::LoadLesson(const Request& req) {
+  std::string name = req.param("name").substr(0, 100);
+  for (char& c : name)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';  // shown on the page
+  const std::string source = "the page's lesson" + (name.empty() ? "" : " " + name);
+  lesson->Set(lesson::Lesson::Parse(req.param("text"), source), source);
+  watch->NoteLocal("lesson", "lesson loaded: " + source);
+  Answer a;
+  a.body = Json(lesson->Json());
   return a;
 }
 
@@ -395,8 +417,10 @@ void WebServer::Impl::OnCompleted(void*, MHD_Connection*, void** con_cls,
 }
 
 WebServer::WebServer(const LabConfig& config, const InstructorOptions& options, SessionWatch* watch,
-                     StationViews* views, ControlQueue* controls, Counters* counters)
-    : impl_(new Impl{config, options, watch, views, controls, counters, nullptr, {}, {}, {}, {}}) {
+                     StationViews* views, ControlQueue* controls, InstructorLesson* lesson,
+                     Counters* counters)
+    : impl_(new Impl{
+          config, options, watch, views, controls, lesson, counters, nullptr, {}, {}, {}, {}}) {
   impl_->map_json = Json(MapJson(config));
 }
 

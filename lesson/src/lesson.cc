@@ -1,4 +1,4 @@
-#include "rms/operator_station/lesson.h"
+#include "rms/lesson/lesson.h"
 
 #include <algorithm>
 #include <cstdio>
@@ -11,7 +11,7 @@
 #include "rms/wire/collision_bits.h"
 #include "rms/wire/malfunction.h"
 
-namespace rms::operator_station {
+namespace rms::lesson {
 
 namespace {
 
@@ -206,4 +206,4 @@ std::size_t Lesson::fired() const {
   return static_cast<std::size_t>(std::count(fired_.begin(), fired_.end(), true));
 }
 
-}  // namespace rms::operator_station
+}  // namespace rms::lesson

@@ -86,7 +86,7 @@ void CheckSourceFiles(const OperatorOptions& o, const LabConfig& config) {
     (void)LoadBindings(o.bindings_path.empty() ? DefaultBindingsPath() : o.bindings_path);
   }
   if (!o.restore_path.empty()) (void)wire::ReadCheckpoint(o.restore_path);
-  if (!o.lesson_path.empty()) (void)Lesson::Load(o.lesson_path);
+  if (!o.lesson_path.empty()) (void)lesson::Lesson::Load(o.lesson_path);
 }
 
 void OperatorStation::RateMeter::Tick(std::int64_t now_us) {
@@ -116,7 +116,7 @@ OperatorStation::OperatorStation(const OperatorOptions& options, const LabConfig
       checkpoints_(options.checkpoint_dir) {
   telemetry_seq_.SetClock(transport::SessionFrameClock(config.session.frame_rate_hz));
   if (!options.lesson_path.empty()) {
-    lesson_ = Lesson::Load(options.lesson_path);
+    lesson_ = lesson::Lesson::Load(options.lesson_path);
     spdlog::info("lesson {}: {} events", options.lesson_path, lesson_->events().size());
   }
   Subscribe();
@@ -405,7 +405,7 @@ void OperatorStation::FireLessonEvents() {
   if (!lesson_) return;
   const double t_s = static_cast<double>(frames_) / config_.session.frame_rate_hz;
   for (const std::size_t i : lesson_->Due(t_s, telemetry_ ? &*telemetry_ : nullptr)) {
-    const LessonEvent& e = lesson_->events()[i];
+    const lesson::LessonEvent& e = lesson_->events()[i];
     spdlog::warn("lesson: event {} ({}), at {:.3f} s of session time", i + 1, e.text, t_s);
     SendControl(e.command, e.name);
     counters_.Add(Counter::kLessonEvents);

@@ -64,6 +64,9 @@ def add_arguments(p):
                         "(docs/performance.md \"Wake latency\")")
     p.add_argument("--lesson", help="scripted events: malfunctions, repairs, freezes at a session time, on entering "
                                     "a mode or on a condition (docs/lessons.md)")
+    p.add_argument("--instructor-lesson", metavar="FILE",
+                   help="a lesson the instructor's station fires (with --instructor; its page can load one "
+                        "too: docs/lessons.md \"From the instructor's station\")")
     p.add_argument("--limit-s", type=float, metavar="S",
                    help="end the session after S seconds of session time (a study's trial limit)")
     p.add_argument("--end-when-docked", type=float, metavar="S",
@@ -96,7 +99,7 @@ class Demo:
             self.branch = Branch(a.from_)
             a.config = a.config or os.path.join(self.branch.parent, "config.toml")
         a.config = a.config or os.path.join(ROOT, "config", "rmslab.toml")
-        for f in [a.config, a.timeline, a.restore, a.lab, a.bindings, a.lesson]:
+        for f in [a.config, a.timeline, a.restore, a.lab, a.bindings, a.lesson, a.instructor_lesson]:
             if f and not os.path.exists(f):
                 raise LabError(f"no such file: {f}")
             if f and not os.path.isfile(f):
@@ -127,6 +130,11 @@ class Demo:
         self.rate = frame_rate_hz(a.config)
         if a.limit_s is not None and not 1.0 / self.rate <= a.limit_s <= 86400:
             raise LabError(f"--limit-s {a.limit_s}: from one frame to 86400 s of session time")
+        if a.instructor_lesson and a.instructor is None:
+            raise LabError("--instructor-lesson: the instructor's station fires it: give --instructor too")
+        if a.instructor_lesson and (a.from_ or a.restore):
+            raise LabError("--instructor-lesson with --from or --restore: a lesson's times and modes are the "
+                           "task's from its start (docs/lessons.md); start the session afresh")
         if a.lesson and (a.from_ or a.restore):
             raise LabError("--lesson with --from or --restore: a lesson's times and modes are the task's from its "
                            "start (docs/lessons.md); start the session afresh")
@@ -190,7 +198,8 @@ class Demo:
                   ("scene_proc", [binary("scene_proc/scene_proc")] + common), ("esg_renderer", esg)]
         if a.instructor is not None:
             checks.append(("instructor_station", [binary("instructor_station/instructor_station")] + common +
-                           self.instructor_args() + ["--token", "x" * 16]))
+                           self.instructor_args() + ["--token", "x" * 16] +
+                           (["--lesson", a.instructor_lesson] if a.instructor_lesson else [])))
         session.precheck(checks)
 
     def instructor_args(self):
@@ -215,6 +224,8 @@ class Demo:
         url_file = os.path.join(self.out, "run", "instructor.url")
         extra = self.instructor_args() + ["--url-file", url_file,
                                           "--checkpoint-dir", os.path.join(self.out, "checkpoints")]
+        if self.a.instructor_lesson:
+            extra += ["--lesson", os.path.join(self.out, "instructor_lesson.toml")]
         self.sup.add(self.spec("instructor_station", extra, env=self.instructor_env()))
         err = self.sup.wait_ready(["instructor_station"])
         if err:
@@ -255,6 +266,8 @@ class Demo:
             shutil.copyfile(a.timeline, os.path.join(self.out, "timeline.tl"))
         if a.lesson:
             shutil.copyfile(a.lesson, os.path.join(self.out, "lesson.toml"))
+        if a.instructor_lesson:
+            shutil.copyfile(a.instructor_lesson, os.path.join(self.out, "instructor_lesson.toml"))
         if a.restore:
             shutil.copyfile(a.restore, os.path.join(run, "restore.json"))
         if self.pilot == "by-hand":

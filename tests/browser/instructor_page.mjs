@@ -202,7 +202,26 @@ try {
     return v && v.lit > first.lit / 4 ? v : null;
   }, 20);
   console.log("ok repaired from the page: the joint follows and the view is back");
-  // 7. Text from the session's messages is shown as text, never run.
+  // 7. A lesson loaded from a file on the page (docs/lessons.md "From the
+  // instructor's station"): a bad one refused naming its key, a good one
+  // listed and fired (at_s 0: at once, as its time has passed).
+  const fs = await import("node:fs");
+  const os = await import("node:os");
+  const path = await import("node:path");
+  const dir = fs.mkdtempSync(path.join(os.tmpdir(), "rmslab-lesson-"));
+  const badLesson = path.join(dir, "bad.toml"), goodLesson = path.join(dir, "lesson.toml");
+  fs.writeFileSync(badLesson, "[[events]]\nat_s = 0\ndo = \"malfunction joint 9 stuck\"\n");
+  fs.writeFileSync(goodLesson, "[[events]]\nat_s = 0\ndo = \"malfunction camera 7 lost\"\n");
+  await (await page.$("#lessonfile")).uploadFile(badLesson);
+  await until("a bad lesson refused naming its key", async () =>
+      /refused: .*events\[0\]\.do/.test(await page.$eval("#lessonsaid", (e) => e.textContent)), 10);
+  await (await page.$("#lessonfile")).uploadFile(goodLesson);
+  await until("the lesson's event listed as fired", async () =>
+      /camera 7 lost.*fired at/.test(await page.$eval("#lesson", (e) => e.innerText)), 20);
+  await until("the DCP took it", async () => ((await status()).malfunctions || []).includes("camera 7 lost"), 10);
+  fs.rmSync(dir, {recursive: true});
+  console.log("ok a lesson loaded on the page: a bad one refused naming its key, a good one fired");
+  // 8. Text from the session's messages is shown as text, never run.
   const forged = await page.evaluate(() => ({
     element: document.getElementById("forged") !== null,
     title: document.title,

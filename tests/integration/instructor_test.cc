@@ -146,12 +146,14 @@ TEST(InstructorStation,
   EXPECT_EQ(freezes, 1) << summary["control"].dump();
   EXPECT_EQ(runs, 1) << summary["control"].dump();
   EXPECT_EQ(resets, 1) << summary["control"].dump();
-  EXPECT_EQ(malfunctions, 2) << summary["control"].dump();
+  EXPECT_EQ(malfunctions, 3) << summary["control"].dump();  // the page's 2, the lesson's 1
   EXPECT_EQ(repairs, 1) << summary["control"].dump();
   // The malfunctions as the DCP took them, with their times and frames: the
-  // joint stuck, the camera lost, both repaired at once.
+  // joint stuck, the camera lost, both repaired at once; then the page's
+  // lesson's camera 7.
   const auto& mf = summary["malfunctions"];
-  ASSERT_EQ(mf.size(), 3u) << mf.dump();
+  ASSERT_EQ(mf.size(), 4u) << mf.dump();
+  EXPECT_EQ(mf[3]["injected"][0], "camera 7 lost") << mf.dump();
   EXPECT_NE(mf[0]["injected"][0].get<std::string>().find(" stuck"), std::string::npos) << mf.dump();
   EXPECT_EQ(mf[1]["injected"][0], "camera 1 lost") << mf.dump();
   EXPECT_EQ(mf[2]["repaired"].size(), 2u) << mf.dump();
@@ -161,14 +163,15 @@ TEST(InstructorStation,
     EXPECT_GT(mf[i]["dcp_frame"].get<std::int64_t>(), mf[i - 1]["dcp_frame"].get<std::int64_t>());
   }
   const auto dcp = nlohmann::json::parse(ReadFile(out + "/stats/dynamics_proc.json"));
-  EXPECT_EQ(dcp["counters"].value("control.malfunctions", 0), 2);
+  EXPECT_EQ(dcp["counters"].value("control.malfunctions", 0), 3);
   EXPECT_EQ(dcp["counters"].value("control.repairs", 0), 1);
   // The reset began a second attempt, and the autopilot flew it to the dock.
   EXPECT_EQ(summary["attempts"].size(), 2u) << summary["attempts"].dump();
   const auto stats = nlohmann::json::parse(ReadFile(out + "/stats/instructor_station.json"));
   EXPECT_GT(stats["counters"].value("views.rendered", 0), 10);
-  EXPECT_EQ(stats["counters"].value("http.refused", 0), 6);
+  EXPECT_EQ(stats["counters"].value("http.refused", 0), 7);  // 6 here, the page's bad lesson
   EXPECT_EQ(stats["counters"].value("control.sent", 0), 6);
+  EXPECT_EQ(stats["counters"].value("lesson.events", 0), 1);
   const auto op = nlohmann::json::parse(ReadFile(out + "/stats/operator_station.json"));
   EXPECT_EQ(op["counters"].value("control.resets", 0), 1);
   EXPECT_GE(op["counters"].value("arm.not_following", 0), 1);
@@ -185,6 +188,110 @@ TEST(InstructorStation,
       tmp + "/resim.log");
   EXPECT_EQ(resim.rc, 0) << resim.out;
   EXPECT_NE(resim.out.find("identical, word for word"), std::string::npos) << resim.out;
+}
+
+// docs/lessons.md "From the instructor's station": a lesson given at start
+// (--instructor-lesson) fires from the instructor's station -- a camera
+// lost at 3 s, repaired on entering Mode 2 -- and one loaded on the page
+// afterwards (POST /api/lesson) fires when its condition holds; a bad one
+// is refused naming its key and changes nothing. The DCP takes each, the
+// summary lists them as the instructor's, and the session re-simulates
+// word for word.
+TEST(InstructorStation, ALessonAtStartAndOneLoadedOnThePageFireAndReSimulate) {
+  const std::string tmp = testing::MakeTempDir("instructor_lesson");
+  const std::string out = tmp + "/session";
+  std::ofstream(tmp + "/a.toml") << "[[events]]\nat_s = 3\ndo = \"malfunction camera 4 lost\"\n"
+                                    "[[events]]\non_mode = 2\ndo = \"repair camera 4\"\n";
+  // Refused at start: a lesson without --instructor, and a bad one.
+  const auto alone =
+      testing::Script({SourcePath("scripts/lab"), "demo", "--no-build", "--instructor-lesson",
+                       tmp + "/a.toml", "--out", tmp + "/alone"},
+                      tmp + "/alone.log", 60);
+  EXPECT_EQ(alone.rc, 2) << alone.out;
+  EXPECT_NE(alone.out.find("give --instructor too"), std::string::npos) << alone.out;
+  std::ofstream(tmp + "/bad.toml") << "[[events]]\nat_s = 3\ndo = \"malfunction joint 9 stuck\"\n";
+  const auto bad_file = testing::Script(
+      {SourcePath("scripts/lab"), "demo", "--no-build", "--instructor", "0", "--instructor-lesson",
+       tmp + "/bad.toml", "--out", tmp + "/bad", "--lcm-url", testing::UniqueLcmUrl(8670)},
+      tmp + "/bad.log", 90);
+  EXPECT_NE(bad_file.rc, 0) << bad_file.out;
+  EXPECT_NE(bad_file.out.find("'events[0].do'"), std::string::npos) << bad_file.out;
+  EXPECT_FALSE(fs::exists(tmp + "/bad/lcmlog")) << "a bad lesson's session ran";
+
+  Subprocess lab({SourcePath("scripts/lab"),
+                  "demo",
+                  "--no-build",
+                  "--out",
+                  out,
+                  "--lcm-url",
+                  testing::UniqueLcmUrl(8680),
+                  "--instructor",
+                  "0",
+                  "--instructor-lesson",
+                  tmp + "/a.toml",
+                  "--speed",
+                  "2",
+                  "--no-video",
+                  "--png-every",
+                  "0",
+                  "--width",
+                  "320",
+                  "--height",
+                  "240"},
+                 tmp + "/lab.log", {std::string("RMSLAB_BUILD=") + RMSLAB_BUILD_DIR});
+  ASSERT_TRUE(testing::WaitForFile(out + "/run/instructor.url", 90)) << ReadFile(tmp + "/lab.log");
+  int port = 0;
+  std::string token;
+  SplitUrl(ReadFile(out + "/run/instructor.url"), &port, &token);
+  httplib::Client web("127.0.0.1", port);
+  web.set_read_timeout(30, 0);
+  const std::string auth = "?token=" + token;
+  // Both of the first lesson's events fire (the second on entering Mode 2).
+  nlohmann::json lesson;
+  for (int i = 0; i < 1200; ++i) {
+    const auto r = web.Get("/api/lesson" + auth);
+    ASSERT_TRUE(r);
+    lesson = nlohmann::json::parse(r->body);
+    if (lesson["events"].size() == 2 && lesson["events"][1]["fired"].get<bool>()) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  ASSERT_TRUE(lesson["loaded"].get<bool>()) << lesson.dump();
+  ASSERT_TRUE(lesson["events"][1]["fired"].get<bool>()) << lesson.dump();
+  EXPECT_GE(lesson["events"][0]["fired_at_s"].get<double>(), 3.0);
+  // On the page: a bad lesson refused naming its key, the one in force kept...
+  const auto refused =
+      web.Post("/api/lesson" + auth, "name=b.toml&text=%5B%5Bevents%5D%5D%0Aat_s+%3D+1%0A",
+               "application/x-www-form-urlencoded");
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->status, 400);
+  EXPECT_NE(refused->body.find("'events[0].do': missing"), std::string::npos) << refused->body;
+  EXPECT_EQ(nlohmann::json::parse(web.Get("/api/lesson" + auth)->body)["source"],
+            out + "/instructor_lesson.toml");
+  // ... and a good one taken, fired when the payload is within 5 ft of the port.
+  const auto taken = web.Post("/api/lesson" + auth,
+                              "name=near.toml&text=%5B%5Bevents%5D%5D%0Awhen+%3D+%22dock_distance_"
+                              "ft+%3C+5%22%0Ado+%3D+%22malfunction+joint+6+slow+2%22%0A",
+                              "application/x-www-form-urlencoded");
+  ASSERT_TRUE(taken);
+  EXPECT_EQ(taken->status, 200) << taken->body;
+  EXPECT_NE(taken->body.find("near.toml"), std::string::npos) << taken->body;
+  ASSERT_EQ(lab.Wait(300), 0) << ReadFile(tmp + "/lab.log");
+  EXPECT_TRUE(fs::exists(out + "/instructor_lesson.toml"));
+
+  const auto summary = nlohmann::json::parse(ReadFile(out + "/summary.json"));
+  EXPECT_TRUE(summary["docked"].get<bool>());
+  int from_instructor = 0;
+  for (const auto& c : summary["control"]) from_instructor += c["process"] == "instructor_station";
+  EXPECT_EQ(from_instructor, 3) << summary["control"].dump(1);
+  const auto& mf = summary["malfunctions"];
+  ASSERT_EQ(mf.size(), 3u) << mf.dump(1);
+  EXPECT_EQ(mf[0]["injected"][0], "camera 4 lost");
+  EXPECT_EQ(mf[1]["repaired"][0], "camera 4 lost");
+  EXPECT_EQ(mf[2]["injected"][0], "joint 6 slow 2");
+  const auto stats = nlohmann::json::parse(ReadFile(out + "/stats/instructor_station.json"));
+  EXPECT_EQ(stats["counters"].value("lesson.events", 0), 3);
+  EXPECT_TRUE(summary["resimulation"]["exact"].get<bool>()) << summary["resimulation"].dump();
+  fs::remove_all(tmp);
 }
 
 // The station's resident memory, kB (Linux /proc).

@@ -1,6 +1,6 @@
 // A lesson's file (docs/lessons.md): refused naming the key, and each event
 // fired once, when its trigger first holds.
-#include "rms/operator_station/lesson.h"
+#include "rms/lesson/lesson.h"
 
 #include <gtest/gtest.h>
 #include <string>
@@ -8,7 +8,7 @@
 #include "rms/base/check.h"
 #include "rms/session_control_t.hpp"
 
-namespace rms::operator_station {
+namespace rms::lesson {
 namespace {
 
 const char* kLesson = R"(
@@ -100,4 +100,4 @@ TEST(Lesson, ABadFileIsRefusedNamingTheKey) {
 }
 
 }  // namespace
-}  // namespace rms::operator_station
+}  // namespace rms::lesson

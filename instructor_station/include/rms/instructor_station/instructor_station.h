@@ -3,7 +3,8 @@
 // (docs/instructor.md): joins the session over LCM, serves a web page with
 // live views of any camera station, the session's status and events, and
 // its controls (freeze, run, step, reset, checkpoint, restore, sent as
-// RMS_CONTROL commands so the log records them).
+// RMS_CONTROL commands so the log records them), and a lesson's scripted
+// events (instructor_lesson.h).
 #include <string>
 
 #include "rms/base/config.h"
@@ -20,6 +21,7 @@ struct InstructorOptions {
   int view_width = 512;        // --view-width: the views' size, pixels
   int view_height = 384;       // --view-height
   double view_rate_hz = 15.0;  // --view-rate: each view drawn at most this often
+  std::string lesson_path;     // --lesson FILE: a lesson fired from the start (docs/lessons.md)
 };
 
 // --token's default: RMSLAB_INSTRUCTOR_TOKEN (how the launcher passes it,

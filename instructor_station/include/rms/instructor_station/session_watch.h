@@ -59,6 +59,8 @@ class SessionWatch {
 
   // The latest DCP frame (what the views are drawn from), if any yet.
   std::optional<wire::DcpFrameData> LatestDcpFrame() const;
+  // The latest telemetry believed (in sequence, within the session's clock).
+  std::optional<dcp_telemetry_t> LatestTelemetry() const;
   // Mode, collisions, acquisition conditions with margins, docking, the
   // processes' rates, latencies and losses (docs/instructor.md "/api/status").
   nlohmann::json StatusJson() const;

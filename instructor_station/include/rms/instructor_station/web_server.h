@@ -14,6 +14,7 @@
 
 #include "rms/base/config.h"
 #include "rms/base/counters.h"
+#include "rms/instructor_station/instructor_lesson.h"
 #include "rms/instructor_station/instructor_station.h"
 #include "rms/instructor_station/session_watch.h"
 #include "rms/instructor_station/station_views.h"
@@ -44,7 +45,8 @@ nlohmann::json MapJson(const LabConfig& config);
 class WebServer {
  public:
   WebServer(const LabConfig& config, const InstructorOptions& options, SessionWatch* watch,
-            StationViews* views, ControlQueue* controls, Counters* counters);
+            StationViews* views, ControlQueue* controls, InstructorLesson* lesson,
+            Counters* counters);
   ~WebServer();
   WebServer(const WebServer&) = delete;
   WebServer& operator=(const WebServer&) = delete;

@@ -13,7 +13,7 @@
 
 #include "rms/dcp_telemetry_t.hpp"
 
-namespace rms::operator_station {
+namespace rms::lesson {
 
 // A quantity of the DCP's telemetry a condition may test (docs/lessons.md
 // "Conditions"): its name, and the mode in which it means something.
@@ -57,4 +57,4 @@ class Lesson {
   int last_mode_ = 0;
 };
 
-}  // namespace rms::operator_station
+}  // namespace rms::lesson

@@ -15,11 +15,11 @@
 #include "rms/base/config.h"
 #include "rms/base/counters.h"
 #include "rms/dcp_telemetry_t.hpp"
+#include "rms/lesson/lesson.h"
 #include "rms/operator_input_t.hpp"
 #include "rms/operator_station/follow_watch.h"
 #include "rms/operator_station/guidance.h"
 #include "rms/operator_station/input_sources.h"
-#include "rms/operator_station/lesson.h"
 #include "rms/operator_station/session_events.h"
 #include "rms/operator_station/status_screen.h"
 #include "rms/transport/lcm_interface.h"
@@ -135,7 +135,7 @@ class OperatorStation {
 
   // What the DCP and the other processes say.
   std::optional<dcp_telemetry_t> telemetry_;
-  std::optional<Lesson> lesson_;
+  std::optional<lesson::Lesson> lesson_;
   std::int64_t run_again_at_us_ = 0;  // a lesson's freeze for_s: when to send RUN (0: none)
   // The telemetry's frame numbers: a frame beyond the session's clock is
   // refused (dropped.far_ahead), so one forged frame far ahead cannot make
