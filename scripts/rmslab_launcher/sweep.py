@@ -627,7 +627,8 @@ def run_here(todo, sweep_dir, args, progress, on_result):
         except (Stalled, subprocess.TimeoutExpired):
             stalled = True
             stop_here(proc)
-    why = f"no result: its process on this machine (scripts/sweep-cell {cell_mode(args)}) "
+    tool = "rms_fly" if cell_mode(args) == "--fly-cells" else "rms_resim"
+    why = f"no result: its process on this machine ({tool} --cells) "
     if stalled:
         why += (f"ran past its time limit ({limit:g} s) and was stopped: no line came for that long "
                 "(a cell that stalled?)")

@@ -58,12 +58,23 @@ TEST(MultiHost, ASessionRunsAcrossNamespaceHosts) {
   EXPECT_NE(m["lcm"]["url"].get<std::string>().find("ttl=1"), std::string::npos);
   const auto s = nlohmann::json::parse(ReadFile(dir + "/session/summary.json"));
   EXPECT_TRUE(s["docked"].get<bool>());
-  // Every frame crossed from host to host: published, received, rendered.
+  // Every frame crossed from host to host: published, received, rendered --
+  // or, on a loaded machine, counted as too late to act on where it
+  // arrived (never lost on the way: no host's link loses here).
   const int published = s["frames"]["operator_published"];
   EXPECT_GT(published, 1000);
-  EXPECT_EQ(s["frames"]["dcp_published"], published);
-  EXPECT_EQ(s["frames"]["esg_published"], published);
-  EXPECT_EQ(s["frames"]["rendered"].get<int>() + s["frames"]["superseded"].get<int>(), published);
+  const auto& tm = s["timing"];
+  const int dcp_late = tm["dynamics_proc"]["too_late_dropped"],
+            scene_late = tm["scene_proc"]["too_late_dropped"],
+            esg_late = tm["esg_renderer"]["too_late_dropped"];
+  EXPECT_EQ(s["frames"]["dcp_published"].get<int>() + dcp_late, published) << tm.dump();
+  EXPECT_EQ(s["frames"]["esg_published"].get<int>() + scene_late,
+            s["frames"]["dcp_published"].get<int>())
+      << tm.dump();
+  EXPECT_EQ(s["frames"]["rendered"].get<int>() + s["frames"]["superseded"].get<int>() + esg_late,
+            s["frames"]["esg_published"].get<int>())
+      << tm.dump();
+  EXPECT_LE(dcp_late + scene_late + esg_late, published / 100) << tm.dump();
   EXPECT_EQ(s["timing"]["dynamics_proc"]["dropped_frames"], 0);
   EXPECT_EQ(s["log"]["final_status_from"].size(), 4u);
   EXPECT_NE(ReadFile(dir + "/lab.log").find("hosts checked"), std::string::npos);
@@ -138,10 +149,15 @@ TEST(MultiHost, OverALossyLinkEveryGapIsCountedAndTheAutopilotStillDocks) {
               static_cast<double>(dcp_sent - scene_sent), 2.0)
       << "scene_proc's counters: " << scene.dump();
   EXPECT_GT(dups, 0);
-  // The ESG drew every frame the scene sent: the picture stays on the last
-  // good frame through a gap.
-  EXPECT_EQ(s["frames"]["rendered"].get<long>() + s["frames"]["superseded"].get<long>(),
-            scene_sent);
+  // The ESG drew every frame the scene sent (the picture stays on the last
+  // good frame through a gap), or counted it: superseded, or too late to
+  // draw on a loaded machine. (Its own count of missing frames holds the
+  // DCP frames the scene never had: an ESG frame is numbered as its DCP frame.)
+  const auto& esg = s["timing"]["esg_renderer"];
+  EXPECT_EQ(s["frames"]["rendered"].get<long>() + s["frames"]["superseded"].get<long>() +
+                esg["too_late_dropped"].get<long>(),
+            scene_sent)
+      << esg.dump();
   // Losses on the wire are the wire's: the record holds every frame sent,
   // and the DCP's answers to the inputs that reached it re-simulate.
   EXPECT_EQ(s["record"]["lost"], 0) << s["record"].dump();
