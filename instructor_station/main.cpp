@@ -29,6 +29,9 @@ int main(int argc, char** argv) {
   app.add_option("--lesson", o.lesson_path,
                  "A lesson (docs/lessons.md) whose events this station fires as the session "
                  "reaches them (the page can load one too)");
+  app.add_option("--lesson-state", o.lesson_state_path,
+                 "Keep the lesson in force and what it fired here; a restarted station carries on "
+                 "from it");
   return rms::transport::ProcessMain(
       app, argc, argv, "instructor_station", &common,
       [&](const rms::LabConfig& config, rms::transport::LcmInterface& lcm) {

@@ -1,17 +1,75 @@
 #include "rms/instructor_station/instructor_lesson.h"
 
 #include <algorithm>
+#include <filesystem>
+#include <spdlog/spdlog.h>
 
+#include "rms/base/check.h"
+#include "rms/base/folder_file.h"
 #include "rms/base/text.h"
 #include "rms/session_control_t.hpp"
 
 namespace rms::instructor_station {
 
-void InstructorLesson::Set(lesson::Lesson lesson, const std::string& source) {
+InstructorLesson::InstructorLesson(std::string state_path) : state_path_(std::move(state_path)) {}
+
+bool InstructorLesson::Restore() {
+  if (state_path_.empty() || !std::filesystem::exists(state_path_)) return false;
+  const std::string what = "the instructor's lesson state " + state_path_;
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(ReadRegularFile(state_path_, what, 64 << 20, Links::kRefuse));
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(what + ": not JSON (" + e.what() + ")");
+  }
+  if (!j.is_object() || !j.contains("text") || !j["text"].is_string() ||
+      !j.value("fired_at_s", nlohmann::json()).is_array())
+    throw InputError(what + ": not a lesson state");
+  lesson::Lesson l = lesson::Lesson::Parse(j["text"].get<std::string>(), j.value("source", ""));
+  std::vector<double> fired_at(l.events().size(), -1.0);
+  const auto& fired = j["fired_at_s"];
+  for (std::size_t i = 0; i < fired.size() && i < fired_at.size(); ++i) {
+    if (!fired[i].is_number()) continue;
+    fired_at[i] = fired[i].get<double>();
+    l.MarkFired(i);
+  }
   std::lock_guard<std::mutex> lock(mu_);
-  fired_at_s_.assign(lesson.events().size(), -1.0);
-  lesson_ = std::move(lesson);
+  fired_at_s_ = std::move(fired_at);
+  text_ = j["text"].get<std::string>();
+  source_ = j.value("source", "");
+  loaded_ = j.value("loaded", nlohmann::json::array());
+  lesson_ = std::move(l);
+  return true;
+}
+
+void InstructorLesson::Load(std::string_view toml, const std::string& source, double session_s) {
+  lesson::Lesson l = lesson::Lesson::Parse(toml, source);  // InputError: nothing changes
+  std::lock_guard<std::mutex> lock(mu_);
+  fired_at_s_.assign(l.events().size(), -1.0);
+  lesson_ = std::move(l);
   source_ = source;
+  text_ = std::string(toml);
+  loaded_.push_back({{"session_s", session_s}, {"source", source}, {"text", text_}});
+  Save();
+}
+
+void InstructorLesson::CancelTimedRuns() {
+  std::lock_guard<std::mutex> lock(mu_);
+  run_at_us_.clear();
+}
+
+void InstructorLesson::Save() {
+  if (state_path_.empty() || !lesson_) return;
+  nlohmann::json fired = nlohmann::json::array();
+  for (const double t : fired_at_s_) fired.push_back(t >= 0 ? nlohmann::json(t) : nullptr);
+  const nlohmann::json j = {
+      {"source", source_}, {"text", text_}, {"fired_at_s", fired}, {"loaded", loaded_}};
+  try {
+    WriteWholeFile(state_path_, j.dump(1) + "\n");
+  } catch (
+      const std::exception& e) {  // (a full disk: the lesson goes on; a restart would not know)
+    spdlog::error("lesson: cannot keep its state in {}: {}", state_path_, e.what());
+  }
 }
 
 std::vector<LessonCommand> InstructorLesson::Due(const dcp_telemetry_t* telemetry,
@@ -28,15 +86,18 @@ std::vector<LessonCommand> InstructorLesson::Due(const dcp_telemetry_t* telemetr
   // Session time as the operator station counts it: the frames published,
   // up to and with the one this telemetry answers.
   const double t_s = static_cast<double>(telemetry->input_frame + 1) / frame_rate_hz;
+  bool fired = false;
   for (const std::size_t i : lesson_->Due(t_s, telemetry)) {
     const lesson::LessonEvent& e = lesson_->events()[i];
     fired_at_s_[i] = t_s;
-    out.push_back(
-        {e.command, e.name,
-         Sprintf("lesson: event %zu (%s), at %.3f s of session time", i + 1, e.text.c_str(), t_s)});
+    fired = true;
+    out.push_back({e.command, e.name,
+                   Sprintf("lesson %s: event %zu (%s), at %.3f s of session time", source_.c_str(),
+                           i + 1, e.text.c_str(), t_s)});
     if (e.command == session_control_t::FREEZE && e.for_s > 0)
       run_at_us_.push_back(now_us + static_cast<std::int64_t>(e.for_s * 1e6));
   }
+  if (fired) Save();
   return out;
 }
 

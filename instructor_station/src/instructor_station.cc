@@ -13,6 +13,7 @@
 #include <spdlog/spdlog.h>
 
 #include "rms/base/check.h"
+#include "rms/base/folder_file.h"
 #include "rms/base/text.h"
 #include "rms/instructor_station/instructor_lesson.h"
 #include "rms/instructor_station/session_watch.h"
@@ -112,9 +113,14 @@ int RunInstructorStation(const LabConfig& config, transport::LcmInterface& lcm,
   StationViews views(config, options.view_width, options.view_height, options.view_rate_hz,
                      &counters);
   ControlQueue controls;
-  InstructorLesson lesson;
-  if (!options.lesson_path.empty()) {
-    lesson.Set(lesson::Lesson::Load(options.lesson_path), options.lesson_path);
+  // docs/lessons.md "From the instructor's station": a station restarted
+  // after a crash carries on with the lesson in force, fired events fired.
+  InstructorLesson lesson(options.lesson_state_path);
+  if (lesson.Restore()) {
+    spdlog::warn("lesson: carried on from {}", options.lesson_state_path);
+  } else if (!options.lesson_path.empty()) {
+    lesson.Load(ReadRegularFile(options.lesson_path, "lesson", kMaxConfigBytes, Links::kFollow),
+                options.lesson_path, 0.0);
     spdlog::info("lesson {}: fired from this station", options.lesson_path);
   }
   WebServer server(config, options, &watch, &views, &controls, &lesson, &counters);

@@ -107,7 +107,8 @@ async function loadLesson(file) {
   const body = new URLSearchParams({text: await file.text(), name: file.name});
   const r = await fetch(q("/api/lesson"), {method: "POST", body, headers: {"X-Rmslab-Token": token}});
   const j = await r.json().catch(() => ({}));
-  $("lessonsaid").textContent = r.ok ? j.source : ("refused: " + (j.error || r.status));
+  $("lessonsaid").textContent = r.ok ? j.source :
+    ("refused: " + (j.error || (r.status === 413 ? "a lesson file is at most 64 KiB" : r.status)));
   $("lessonsaid").className = r.ok ? "ok" : "bad";
   if (r.ok) showLesson(j);
 }

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <map>
+#include <spdlog/spdlog.h>
 #include <sys/socket.h>
 
 #include "rms/base/check.h"
@@ -302,6 +303,10 @@ Answer WebServer::Impl::Control(const Request& req) {
   if (r.command == session_control_t::REPAIR) r.name = wire::RepairText(wire::ParseRepair(what));
   const int steps =
       r.command == session_control_t::STEP ? static_cast<int>(IntParam(req, "n", 1, 1, 300)) : 1;
+  // A freeze or run by hand: the instructor's to run again, not a lesson's
+  // timed freeze's (docs/lessons.md "From the instructor's station").
+  if (r.command == session_control_t::FREEZE || r.command == session_control_t::RUN)
+    lesson->CancelTimedRuns();
   for (int i = 0; i < steps; ++i) controls->Push(r);
   sent += steps;
   Answer a;
@@ -317,8 +322,20 @@ Answer WebServer::Impl::LoadLesson(const Request& req) {
   std::string name = req.param("name").substr(0, 100);
   for (char& c : name)
     if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';  // shown on the page
-  const std::string source = "the page's lesson" + (name.empty() ? "" : " " + name);
-  lesson->Set(lesson::Lesson::Parse(req.param("text"), source), source);
+  std::string source = "the page's lesson";
+  if (!name.empty()) source.append(" ").append(name);
+  if (!req.has_param("text"))
+    throw InputError("form field 'text' missing: the lesson file's TOML (docs/lessons.md)");
+  const auto t = watch->LatestTelemetry();
+  const double session_s =
+      t ? static_cast<double>(t->input_frame + 1) / config.session.frame_rate_hz : 0.0;
+  try {
+    lesson->Load(req.param("text"), source, session_s);
+  } catch (const InputError& e) {
+    spdlog::warn("lesson from the page refused: {}", e.what());
+    throw;
+  }
+  spdlog::info("lesson loaded from the page: {}", source);
   watch->NoteLocal("lesson", "lesson loaded: " + source);
   Answer a;
   a.body = Json(lesson->Json());

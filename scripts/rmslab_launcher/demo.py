@@ -223,7 +223,8 @@ class Demo:
     def start_instructor(self):
         url_file = os.path.join(self.out, "run", "instructor.url")
         extra = self.instructor_args() + ["--url-file", url_file,
-                                          "--checkpoint-dir", os.path.join(self.out, "checkpoints")]
+                                          "--checkpoint-dir", os.path.join(self.out, "checkpoints"),
+                                          "--lesson-state", os.path.join(self.out, "run", "instructor_lesson.json")]
         if self.a.instructor_lesson:
             extra += ["--lesson", os.path.join(self.out, "instructor_lesson.toml")]
         self.sup.add(self.spec("instructor_station", extra, env=self.instructor_env()))

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "rms/dcp_telemetry_t.hpp"
@@ -28,10 +29,23 @@ struct LessonCommand {
 
 class InstructorLesson {
  public:
-  // Replaces the lesson (what the old one had not fired is dropped; a
-  // timed freeze's RUN still due is kept). `source`: where it came from,
-  // for the page ("lesson.toml", "the page: my_lesson.toml").
-  void Set(lesson::Lesson lesson, const std::string& source);
+  // The state file (--lesson-state; the launcher's
+  // run/instructor_lesson.json): the lesson in force -- its text, source
+  // and which events fired -- and every lesson loaded, written whole after
+  // each change, so a station restarted after a crash carries on with the
+  // same lesson and fires none of its events again. "" : none kept.
+  explicit InstructorLesson(std::string state_path = "");
+  // Restores the state file's lesson, if there is one: true when it did.
+  // Throws rms::InputError when it cannot be read as one.
+  bool Restore();
+  // Replaces the lesson with the one `toml` holds (what the old one had not
+  // fired is dropped; a timed freeze's RUN still due is kept). `source`:
+  // where it came from, for the page. Throws rms::InputError naming the
+  // source and the key; the lesson in force is then unchanged.
+  void Load(std::string_view toml, const std::string& source, double session_s);
+  // A freeze or a run the instructor sent by hand: the timed freeze's RUN
+  // still due is dropped (the session is the instructor's to run again).
+  void CancelTimedRuns();
   // The commands due: each event whose trigger first holds at this
   // telemetry (session time: the operator frame it answers, over the frame
   // rate), and the RUN of a timed freeze whose wall time (now_us) came.
@@ -41,11 +55,15 @@ class InstructorLesson {
   nlohmann::json Json() const;
 
  private:
+  void Save();  // mu_ held
+
   mutable std::mutex mu_;
+  std::string state_path_;
   std::optional<lesson::Lesson> lesson_;
-  std::string source_;
-  std::vector<double> fired_at_s_;       // -1: not yet
-  std::vector<std::int64_t> run_at_us_;  // timed freezes' RUNs still due
+  std::string source_, text_;
+  nlohmann::json loaded_ = nlohmann::json::array();  // every lesson loaded: when, source, text
+  std::vector<double> fired_at_s_;                   // -1: not yet
+  std::vector<std::int64_t> run_at_us_;              // timed freezes' RUNs still due
 };
 
 }  // namespace rms::instructor_station

@@ -17,11 +17,12 @@ struct InstructorOptions {
   int port = 8080;                 // --port N (0: any free port)
   std::string token;     // --token T (or RMSLAB_INSTRUCTOR_TOKEN; default random): every request
   std::string url_file;  // --url-file FILE: the page's URL written there once serving
-  std::string checkpoint_dir;  // --checkpoint-dir DIR: the session's checkpoints (listed)
-  int view_width = 512;        // --view-width: the views' size, pixels
-  int view_height = 384;       // --view-height
-  double view_rate_hz = 15.0;  // --view-rate: each view drawn at most this often
-  std::string lesson_path;     // --lesson FILE: a lesson fired from the start (docs/lessons.md)
+  std::string checkpoint_dir;     // --checkpoint-dir DIR: the session's checkpoints (listed)
+  int view_width = 512;           // --view-width: the views' size, pixels
+  int view_height = 384;          // --view-height
+  double view_rate_hz = 15.0;     // --view-rate: each view drawn at most this often
+  std::string lesson_path;        // --lesson FILE: a lesson fired from the start (docs/lessons.md)
+  std::string lesson_state_path;  // --lesson-state FILE: kept there; a restart carries on from it
 };
 
 // --token's default: RMSLAB_INSTRUCTOR_TOKEN (how the launcher passes it,

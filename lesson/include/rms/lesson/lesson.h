@@ -50,6 +50,9 @@ class Lesson {
   std::vector<std::size_t> Due(double t_s, const dcp_telemetry_t* telemetry);
   std::size_t fired() const;
   bool was_fired(std::size_t i) const { return fired_[i]; }
+  // Event i counted as fired (a station restarted that had fired it): it
+  // is never due again.
+  void MarkFired(std::size_t i) { fired_.at(i) = true; }
 
  private:
   std::vector<LessonEvent> events_;
