@@ -99,11 +99,14 @@ function showLesson(l) {
     li.className = e.fired ? "ok" : "";
     list.appendChild(li);
   }
-  if (!l.loaded) $("lessonsaid").textContent = "none loaded";
-  else if (!$("lessonsaid").classList.contains("bad")) $("lessonsaid").textContent = l.source;
+  // (what the last load said stays until the next load: a refusal is not
+  // overwritten by the next poll)
+  if (!lessonSaid) $("lessonsaid").textContent = l.loaded ? l.source : "none loaded";
 }
 
+let lessonSaid = false;
 async function loadLesson(file) {
+  lessonSaid = true;
   const body = new URLSearchParams({text: await file.text(), name: file.name});
   const r = await fetch(q("/api/lesson"), {method: "POST", body, headers: {"X-Rmslab-Token": token}});
   const j = await r.json().catch(() => ({}));

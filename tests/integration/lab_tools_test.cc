@@ -240,26 +240,41 @@ bool IsDcpFrameOrTelemetry(const std::string& channel) {
   return channel.rfind("RMS_DCP_FRAME", 0) == 0 || channel.rfind("RMS_DCP_TELEMETRY", 0) == 0;
 }
 
-// The first of the log's periodic states, from the third on, whose DCP
-// frames [n - margin, n + margin] the log holds every one of (the recording
-// was made on a loaded machine: a frame the session itself lost next to a
-// stretch the test cuts would join the stretch); -1 when none does.
-std::int64_t WholePeriodicState(const std::string& log, std::int64_t margin) {
-  std::set<std::int64_t> dcp;
+// The first of the log's periodic states, from the third on, around which
+// the recording is whole for `margin` DCP frames either side: every DCP
+// frame there, each answering the operator frame of its number (less one
+// constant), and every one of those operator frames logged. (The recording
+// was made on a loaded machine: a frame the session itself lost, or an
+// input the DCP dropped as too late, next to a stretch the test cuts would
+// change what the stretch is.) -1 when none is.
+std::int64_t WholePeriodicState(const std::string& dir, std::int64_t margin) {
+  const int tag = testing::SessionTagsMessages(dir) ? wire::kMacBytes : 0;
+  std::map<std::int64_t, std::int64_t> answered;  // DCP frame -> the operator frame it answered
+  std::set<std::int64_t> inputs;
   {
-    lcm::LogFile in(log, "r");
+    lcm::LogFile in(dir + "/lcmlog", "r");
     while (const lcm::LogEvent* ev = in.readNextEvent()) {
+      dcp_frame_t d;
       std::int64_t f = -1;
       if (ev->channel.rfind("RMS_DCP_FRAME", 0) == 0 &&
-          wire::ReadFrameNumber(ev->data, static_cast<int>(ev->datalen), &f))
-        dcp.insert(f);
+          wire::SafeDecode(ev->data, static_cast<int>(ev->datalen) - tag, &d) ==
+              wire::DecodeError::kNone)
+        answered[d.frame] = d.input_frame;
+      else if (ev->channel.rfind("RMS_OPERATOR_INPUT", 0) == 0 &&
+               wire::ReadFrameNumber(ev->data, static_cast<int>(ev->datalen), &f))
+        inputs.insert(f);
     }
   }
-  const std::vector<std::int64_t> periodic = PeriodicStateFrames(log);
+  const std::vector<std::int64_t> periodic = PeriodicStateFrames(dir + "/lcmlog");
   for (std::size_t k = 2; k < periodic.size(); ++k) {
     const std::int64_t n = periodic[k];
-    bool whole = true;
-    for (std::int64_t f = n - margin; f <= n + margin && whole; ++f) whole = dcp.count(f) > 0;
+    const auto at_n = answered.find(n);
+    bool whole = at_n != answered.end();
+    const std::int64_t offset = whole ? at_n->second - n : 0;
+    for (std::int64_t f = n - margin; f <= n + margin && whole; ++f) {
+      const auto it = answered.find(f);
+      whole = it != answered.end() && it->second - f == offset && inputs.count(it->second) > 0;
+    }
     if (whole) return n;
   }
   return -1;
@@ -309,7 +324,7 @@ TEST_F(RecordedSession, FramesLostFromEverySourceAreNamedAndTheRestCheckedWordFo
 // unchecked), or, where inputs after the state are lost too, is one
 // stretch from the first lost frame on -- never two that overlap.
 TEST_F(RecordedSession, AStateLoggedAmongLostFramesIsGoneOnFromAndTheStretchIsOne) {
-  const std::int64_t n = WholePeriodicState(*dir_ + "/lcmlog", 120);
+  const std::int64_t n = WholePeriodicState(*dir_, 120);
   ASSERT_GT(n, 0) << "no periodic state with 120 whole DCP frames either side in the recording";
   const std::int64_t lost_from = n - 100, lost_to = n + 100;
   for (const bool after_too : {false, true}) {
