@@ -21,7 +21,7 @@
 //      it flies), the operator station's autopilot reports it (its report is
 //      in the event list), and the page's Repair puts it right; a lost
 //      camera station's view goes black but for "NO VIDEO".
-import puppeteer from "puppeteer-core";
+import {launchChromium, pageErrors} from "./chromium.mjs";
 
 const url = process.argv[2];
 const station = process.argv[3] || "1";
@@ -79,15 +79,10 @@ async function dcpFrame(page) {
 
 const eventsText = (page) => page.evaluate(() => document.getElementById("events").innerText);
 
-const browser = await puppeteer.launch({
-  executablePath: process.env.RMSLAB_CHROMIUM || "/usr/bin/chromium",
-  headless: true,
-  args: ["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage"],
-});
+const browser = await launchChromium();
 try {
   const page = await browser.newPage();
-  const errors = [];
-  page.on("pageerror", (e) => errors.push(String(e)));
+  const errors = pageErrors(page);
   await page.goto(url, {waitUntil: "load", timeout: 30000});
   // 1. The views load.
   await until("the operator's view loads", async () => ((await viewPixels(page, "view0")) || {}).loads >= 2, 30);

@@ -3,17 +3,14 @@
 // Opens the page in the system's Chromium (puppeteer-core), picks STATION
 // (default 7), waits until the session's time passes AT_SESSION_S (default
 // 0) and both views have loaded, and saves a screenshot of the page.
-import puppeteer from "puppeteer-core";
+import {launchChromium} from "./chromium.mjs";
 
 const [url, out, station = "7", at = "0"] = process.argv.slice(2);
 if (!url || !out) {
   console.error("usage: node screenshot.mjs URL OUT.png [STATION] [AT_SESSION_S]");
   process.exit(2);
 }
-const browser = await puppeteer.launch({
-  executablePath: process.env.RMSLAB_CHROMIUM || "/usr/bin/chromium",
-  headless: true,
-  args: ["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage"],
+const browser = await launchChromium({
   defaultViewport: {width: 1600, height: 1000},
 });
 try {

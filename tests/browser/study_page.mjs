@@ -11,7 +11,7 @@
 // axe-core finds no accessibility violation at all.
 import {readFileSync} from "node:fs";
 import {createRequire} from "node:module";
-import puppeteer from "puppeteer-core";
+import {launchChromium, pageErrors} from "./chromium.mjs";
 
 const [file, conditions, subjects] = process.argv.slice(2);
 if (!file || !conditions || !subjects) {
@@ -26,16 +26,10 @@ function fail(why) {
 }
 const axeSource = readFileSync(createRequire(import.meta.url).resolve("axe-core/axe.min.js"), "utf8");
 
-const browser = await puppeteer.launch({
-  executablePath: process.env.RMSLAB_CHROMIUM || "/usr/bin/chromium",
-  headless: true,
-  args: ["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage"],
-});
+const browser = await launchChromium();
 try {
   const page = await browser.newPage();
-  const errors = [];
-  page.on("pageerror", (e) => errors.push(String(e)));
-  page.on("console", (m) => { if (m.type() === "error") errors.push(m.text()); });
+  const errors = pageErrors(page, {consoleErrors: true});
   await page.goto("file://" + file, {waitUntil: "load", timeout: 30000});
   result.title = await page.title();
   result.rows = await page.$$eval("table tbody tr", (r) => r.length);
