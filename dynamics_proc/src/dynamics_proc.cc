@@ -5,6 +5,7 @@
 #include <spdlog/spdlog.h>
 
 #include "rms/base/check.h"
+#include "rms/control_answer_t.hpp"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/operator_input_t.hpp"
@@ -157,6 +158,17 @@ void DynamicsProc::WriteStateFile() {
   state_written_us_ = lcm_->NowUs();
 }
 
+// Every command this process acts on is answered, done or refused with the
+// reason, on RMS_CONTROL_ANSWER (docs/protocol.md): the sender, and the
+// log, know what took effect.
+void DynamicsProc::Answer(const session_control_t& m, std::int8_t outcome,
+                          const std::string& text) {
+  const control_answer_t a = wire::MakeControlAnswer(m, outcome, next_frame_, text);
+  counters_.Add(transport::PublishMessage(*lcm_, wire::channels::kControlAnswer, a)
+                    ? Counter::kPublished
+                    : Counter::kPublishFailed);
+}
+
 void DynamicsProc::OnControl(const void* data, int size) {
   session_control_t m;
   if (wire::SafeDecode(data, size, &m) != wire::DecodeError::kNone) {
@@ -177,6 +189,9 @@ void DynamicsProc::OnControl(const void* data, int size) {
                    wire::CheckpointRateLimit::kPerSecond);
     }
     counters_.Add(Counter::kControlRateLimited);
+    Answer(m, control_answer_t::REFUSED,
+           "more than " + std::to_string(wire::CheckpointRateLimit::kPerSecond) +
+               " checkpoints or restores a second: try again");
     return;
   }
   try {
@@ -185,14 +200,21 @@ void DynamicsProc::OnControl(const void* data, int size) {
       counters_.Add(Counter::kControlCheckpoints);
       spdlog::info("checkpoint: DCP frame {} saved as {}", next_frame_ - 1,
                    checkpoints_.PathOf(m.name));
+      Answer(m, control_answer_t::DONE,
+             "saved DCP frame " + std::to_string(next_frame_ - 1) + " as " + m.name);
     } else {
       Restore(checkpoints_.Read(m.name), checkpoints_.PathOf(m.name));
       counters_.Add(Counter::kControlRestores);
       PublishState(dcp_state_t::RESTORE);
+      Answer(m, control_answer_t::DONE,
+             "restored " + m.name + ": Mode " + std::to_string(dcp_.status().mode) +
+                 (dcp_.status().acquired ? ", acquired" : "") +
+                 (dcp_.status().docked ? ", docked" : ""));
     }
   } catch (const InputError& e) {
     counters_.Add(Counter::kControlRefused);
     spdlog::error("{}", e.what());
+    Answer(m, control_answer_t::REFUSED, e.what());
   }
 }
 
@@ -209,16 +231,20 @@ void DynamicsProc::OnMalfunction(const session_control_t& m) {
                    wire::CheckpointRateLimit::kPerSecond);
     }
     counters_.Add(Counter::kControlRateLimited);
+    Answer(m, control_answer_t::REFUSED,
+           "more than " + std::to_string(wire::CheckpointRateLimit::kPerSecond) +
+               " malfunctions a second: try again");
     return;
   }
   const char* from = wire::ProcessCodeName(m.sender.process);
+  std::string done;
   try {
     if (m.command == session_control_t::MALFUNCTION) {
       const wire::Malfunction f = wire::ParseMalfunction(m.name);
       dcp_.Inject(f);
       counters_.Add(Counter::kControlMalfunctions);
-      spdlog::warn("malfunction from {}: {}, from DCP frame {}", from, wire::MalfunctionText(f),
-                   next_frame_);
+      done = wire::MalfunctionText(f) + ", from DCP frame " + std::to_string(next_frame_);
+      spdlog::warn("malfunction from {}: {}", from, done);
     } else {
       const wire::Repair r = wire::ParseRepair(m.name);
       const std::size_t before = dcp_.malfunctions().active().size();
@@ -228,15 +254,19 @@ void DynamicsProc::OnMalfunction(const session_control_t& m) {
                          "' is in force");
       }
       counters_.Add(Counter::kControlRepairs);
-      spdlog::info("repair from {}: {}, from DCP frame {}", from, wire::RepairText(r), next_frame_);
+      done = wire::RepairText(r) + ", from DCP frame " + std::to_string(next_frame_);
+      spdlog::info("repair from {}: {}", from, done);
+      done.insert(0, "repaired ");
     }
   } catch (const InputError& e) {
     counters_.Add(Counter::kControlRefused);
     spdlog::error("{} from {} refused: {}", wire::ControlCommandName(m.command), from, e.what());
+    Answer(m, control_answer_t::REFUSED, e.what());
     return;
   }
   PublishState(dcp_state_t::MALFUNCTION);
   WriteStateFile();
+  Answer(m, control_answer_t::DONE, done);
 }
 
 void DynamicsProc::EnableLiveChecks(double frame_rate_hz) {

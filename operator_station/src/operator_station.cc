@@ -12,6 +12,7 @@
 #include "rms/base/check.h"
 #include "rms/base/text.h"
 #include "rms/base/toml_reader.h"
+#include "rms/control_answer_t.hpp"
 #include "rms/operator_state_t.hpp"
 #include "rms/operator_station/telemetry_check.h"
 #include "rms/process_status_t.hpp"
@@ -218,35 +219,61 @@ void OperatorStation::OnControl(const void* data, int size, std::int64_t) {
     counters_.Add(Counter::kDroppedControlMalformed);
     return;
   }
+  const std::string at = " at operator frame " + std::to_string(builder_.next_frame());
   switch (m.command) {
     case session_control_t::FREEZE:
       if (!frozen_) spdlog::info("FROZEN: the session holds its frame");
+      Answer(m, control_answer_t::DONE, (frozen_ ? "already frozen" : "frozen") + at);
       frozen_ = true;
       counters_.Add(Counter::kControlFreezes);
       break;
     case session_control_t::RUN:
       if (frozen_) spdlog::info("running again");
+      Answer(m, control_answer_t::DONE, (frozen_ ? "running again" : "already running") + at);
       frozen_ = false;
       counters_.Add(Counter::kControlRuns);
       steps_pending_ = 0;
       break;
     case session_control_t::STEP:
-      if (frozen_) ++steps_pending_;
       counters_.Add(Counter::kControlSteps);
+      if (!frozen_) {
+        Answer(m, control_answer_t::REFUSED, "not frozen: a step is one frame of a frozen session");
+        break;
+      }
+      ++steps_pending_;
+      Answer(m, control_answer_t::DONE, "one frame more" + at);
       break;
     case session_control_t::RESET:
       reset_pending_ = true;
       counters_.Add(Counter::kControlResets);
+      Answer(m, control_answer_t::DONE,
+             "the reset button pressed for one frame" + at + (frozen_ ? " (when it runs)" : ""));
       break;
     case session_control_t::RESTORE:
-      if (checkpoint_rate_.Allow(lcm_.NowUs()))
-        restored_from_ = m.name;
-      else
+      // docs/sessions.md "Freeze, run, step, checkpoint": a restore freezes
+      // the session, from whichever client; run resumes it. One refused
+      // changes nothing.
+      if (!checkpoint_rate_.Allow(lcm_.NowUs())) {
         counters_.Add(Counter::kControlRateLimited);
+        Answer(m, control_answer_t::REFUSED,
+               "more than " + std::to_string(wire::CheckpointRateLimit::kPerSecond) +
+                   " checkpoints or restores a second: try again");
+        break;
+      }
+      restore_command_ = m;  // taken, and the session frozen, before the next frame
       break;
     default:
       break;
   }
+}
+
+// Every command this station acts on is answered (RMS_CONTROL_ANSWER;
+// docs/protocol.md).
+void OperatorStation::Answer(const session_control_t& m, std::int8_t outcome,
+                             const std::string& text) {
+  const control_answer_t a = wire::MakeControlAnswer(m, outcome, builder_.next_frame(), text);
+  if (!transport::PublishMessage(lcm_, wire::channels::kControlAnswer, a))
+    counters_.Add(Counter::kPublishFailed);
 }
 
 void OperatorStation::OnWindowKeys(const void* data, int size, std::int64_t recv_us) {
@@ -288,18 +315,29 @@ void OperatorStation::ForgetTelemetry(std::int64_t fresh_from_input_frame) {
 void OperatorStation::ApplyRestore() {
   // Carry on from the checkpoint's inputs, so the first frame after it
   // commands the arm where the DCP now has it.
+  const session_control_t m = *restore_command_;
+  restore_command_.reset();
   try {
-    const wire::Checkpoint c = checkpoints_.Read(*restored_from_);
+    const wire::Checkpoint c = checkpoints_.Read(m.name);
     source_->Resume(c.inputs, true);
     ForgetTelemetry(builder_.next_frame());
     spdlog::info("RESTORED the checkpoint {}: carrying on from its inputs",
-                 checkpoints_.PathOf(*restored_from_));
+                 checkpoints_.PathOf(m.name));
     counters_.Add(Counter::kControlRestores);
+    // One frame from the checkpoint's inputs, so every display -- the
+    // operator's, the ESG's, the instructor's -- shows the restored pose;
+    // then frozen (docs/sessions.md "Freeze, run, step, checkpoint").
+    if (!frozen_) spdlog::info("FROZEN for a restore");
+    frozen_ = true;
+    steps_pending_ = 1;
+    Answer(m, control_answer_t::DONE,
+           "frozen after one frame from the inputs of " + m.name +
+               " (every display shows the restored pose): run resumes");
   } catch (const InputError& e) {
     counters_.Add(Counter::kControlRefused);
     spdlog::error("{}", e.what());
+    Answer(m, control_answer_t::REFUSED, std::string(e.what()) + " (nothing changed)");
   }
-  restored_from_.reset();
 }
 
 std::optional<Guidance> OperatorStation::CurrentGuidance() const {
@@ -614,7 +652,7 @@ int OperatorStation::Run(const std::string& stats_path, const std::string& ready
     if (options_.max_frames >= 0 && frames_ >= options_.max_frames) break;
     if (lcm_.HandleSubscriptions(0) < 0) counters_.Add(Counter::kTransportErrors);
     transport::NoteTransportCounters(lcm_, &counters_);
-    if (restored_from_) ApplyRestore();
+    if (restore_command_) ApplyRestore();
     WriteClockFileOnChange();
     if (frozen_ && steps_pending_ == 0) {
       if (!RunFrozen()) break;

@@ -15,7 +15,7 @@ from . import disk
 from .common import LabError, binary, say
 
 CHANNELS = ["RMS_OPERATOR_INPUT", "RMS_OPERATOR_STATE", "RMS_WINDOW_KEYS", "RMS_DCP_FRAME", "RMS_DCP_TELEMETRY", "RMS_DCP_STATE",
-            "RMS_ESG_FRAME", "RMS_STATUS", "RMS_CONTROL"]
+            "RMS_ESG_FRAME", "RMS_STATUS", "RMS_CONTROL", "RMS_CONTROL_ANSWER"]
 
 
 def new_session_id():

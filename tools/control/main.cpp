@@ -1,17 +1,21 @@
 // rms_control: commands to a running session on RMS_CONTROL
 // (docs/sessions.md "Freeze, run, step, checkpoint"; docs/security.md "The
 // control channel"):
-//   rms_control --session DIR freeze | run | step [N] | checkpoint NAME | restore NAME|FILE [--run]
+//   rms_control --session DIR freeze | run | step [N] | reset | checkpoint NAME
+//               | restore NAME|FILE [--run]
 //               | malfunction WHAT... | repair WHAT...
 // Every command carries the session's id (from DIR/manifest.json, or
 // --session-id): the session's processes take no other. A checkpoint is a
 // name in the session's checkpoints folder, never a path; restore of a file
 // from elsewhere copies it into that folder first. restore freezes the
-// session first (so no frame is in flight), restores the DCP's state and the
+// session (so no frame is in flight), restores the DCP's state and the
 // operator station's inputs, and leaves the session frozen unless --run.
+// Each command is confirmed by the answer of the process that acts on it
+// (RMS_CONTROL_ANSWER), or its refusal said with the reason.
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -22,6 +26,7 @@
 
 #include "rms/base/check.h"
 #include "rms/base/command_line.h"
+#include "rms/control_answer_t.hpp"
 #include "rms/process_status_t.hpp"
 #include "rms/sender_t.hpp"
 #include "rms/session/session_summary.h"
@@ -82,22 +87,33 @@ std::string RestoreName(const std::string& what, const std::string& folder) {
 namespace {
 
 // The session's control channel as this tool uses it: commands out, and
-// the DCP's own counts in (from its status reports, once a second), so what
-// a checkpoint or restore did is confirmed rather than assumed.
+// the answers of the processes that act on them in (RMS_CONTROL_ANSWER,
+// docs/protocol.md), so what a command did is confirmed, or its refusal
+// said with the reason, rather than assumed. Status reports say whether
+// anyone is there to answer.
 class ControlLink {
  public:
+  struct Heard {
+    std::int8_t outcome = 0;  // control_answer_t::DONE or REFUSED
+    std::string text;
+  };
+
   ControlLink(const rms::transport::LcmOptions& options, std::int64_t session_id,
               const std::optional<rms::wire::SessionKey>& key)
-      : lcm_(options) {
-    lcm_.SetSender(
-        {session_id, rms::sender_t::PROCESS_CONTROL, static_cast<std::int32_t>(getpid())});
+      : lcm_(options), pid_(static_cast<std::int32_t>(getpid())) {
+    lcm_.SetSender({session_id, rms::sender_t::PROCESS_CONTROL, pid_});
     if (key) lcm_.SetKey(*key);
     lcm_.Subscribe(rms::wire::channels::kStatus, [this](const void* d, int n, std::int64_t) {
       rms::process_status_t st;
       if (rms::wire::SafeDecode(d, n, &st) != rms::wire::DecodeError::kNone) return;
-      auto& counts = counts_[st.process];
-      for (int i = 0; i < st.num_counters; ++i) counts[st.counter_names[i]] = st.counter_values[i];
       ++reports_[st.process];
+    });
+    lcm_.Subscribe(rms::wire::channels::kControlAnswer, [this](const void* d, int n, std::int64_t) {
+      rms::control_answer_t a;
+      if (rms::wire::SafeDecode(d, n, &a) != rms::wire::DecodeError::kNone) return;
+      if (a.command_process != rms::sender_t::PROCESS_CONTROL || a.command_pid != pid_) return;
+      answers_[{a.command_sequence, rms::wire::ProcessCodeName(a.sender.process)}] = {a.outcome,
+                                                                                      a.text};
     });
   }
   // Journals what it sends in the session's journal/ (rms/transport/journal.h);
@@ -112,7 +128,8 @@ class ControlLink {
                    e.what());
     }
   }
-  void Send(std::int8_t command, const std::string& name = "") {
+  // Sends a command; its sequence (with this tool's pid, its id).
+  std::int64_t Send(std::int8_t command, const std::string& name = "") {
     rms::session_control_t m;
     m.send_time_us = lcm_.NowUs();
     m.sequence = sequence_++;
@@ -120,6 +137,7 @@ class ControlLink {
     m.name = name;
     if (!rms::transport::PublishMessage(lcm_, rms::wire::channels::kControl, m))
       throw std::runtime_error("cannot publish");
+    return m.sequence;
   }
   // Handles messages until done() or `seconds` pass; done()'s last answer.
   bool ListenUntil(double seconds, const std::function<bool()>& done) {
@@ -127,27 +145,25 @@ class ControlLink {
     while (std::chrono::steady_clock::now() < end && !done()) lcm_.HandleSubscriptions(50);
     return done();
   }
-  // Waits (up to 2.5 s: they report once a second) for a first report of
-  // `process`'s counts; false if none came (nobody there to answer).
-  bool WaitForCounts(const std::string& process = "dynamics_proc") {
-    return ListenUntil(2.5, [&] { return reports(process) > 0; });
+  // Waits (up to 2.5 s: they report once a second) for a first status
+  // report of `process`; false if none came (nobody there to answer).
+  bool WaitForProcess(const std::string& process) {
+    return ListenUntil(2.5, [&] { return reports_.count(process) > 0; });
   }
-  std::int64_t Count(rms::Counter counter, const std::string& process = "dynamics_proc") const {
-    const auto p = counts_.find(process);
-    if (p == counts_.end()) return 0;
-    const auto it = p->second.find(std::string(rms::CounterName(counter)));
-    return it == p->second.end() ? 0 : it->second;
-  }
-  int reports(const std::string& process = "dynamics_proc") const {
-    const auto it = reports_.find(process);
-    return it == reports_.end() ? 0 : it->second;
+  // `process`'s answer to command `sequence`, waiting up to `seconds`.
+  std::optional<Heard> Answer(std::int64_t sequence, const std::string& process, double seconds) {
+    ListenUntil(seconds, [&] { return answers_.count({sequence, process}) > 0; });
+    const auto it = answers_.find({sequence, process});
+    if (it == answers_.end()) return std::nullopt;
+    return it->second;
   }
 
  private:
   rms::transport::UdpLcm lcm_;
+  std::int32_t pid_;
   std::int64_t sequence_ = 0;
-  std::map<std::string, std::map<std::string, std::int64_t>> counts_;  // by process
   std::map<std::string, int> reports_;
+  std::map<std::pair<std::int64_t, std::string>, Heard> answers_;
 };
 
 void SayWhereSent(const rms::transport::LcmOptions& options, std::int64_t id);
@@ -164,32 +180,37 @@ int NobodyThere(const rms::transport::LcmOptions& options, std::int64_t id, cons
   return 1;
 }
 
-// FREEZE, RUN, STEP: confirmed by the operator station's counts (it is the
-// session's clock).
-int Clock(ControlLink& link, std::int8_t command, int steps,
-          const rms::transport::LcmOptions& options, std::int64_t id) {
-  const rms::Counter what = command == rms::session_control_t::FREEZE
-                                ? rms::Counter::kControlFreezes
-                            : command == rms::session_control_t::RUN ? rms::Counter::kControlRuns
-                                                                     : rms::Counter::kControlSteps;
-  if (!link.WaitForCounts("operator_station")) return NobodyThere(options, id, "operator station");
-  const std::int64_t before = link.Count(what, "operator_station");
-  for (int i = 0; i < steps; ++i) link.Send(command);
-  SayWhereSent(options, id);
-  const int seen = link.reports("operator_station");
-  const bool done = link.ListenUntil(3.0, [&] {
-    return link.reports("operator_station") > seen &&
-           link.Count(what, "operator_station") >= before + steps;
-  });
-  if (!done) {
-    std::fprintf(
-        stderr,
-        "rms_control: the operator station did not confirm the command within 3 s (see the "
-        "session's logs/operator_station.log)\n");
+// A command's answer from `process`, said: 0 done, 1 refused or none
+// within 3 s.
+int Said(ControlLink& link, std::int64_t sequence, const char* process, const char* what) {
+  const std::optional<ControlLink::Heard> h = link.Answer(sequence, process, 3.0);
+  if (!h) {
+    std::fprintf(stderr,
+                 "rms_control: %s: no answer from %s within 3 s (see its log in the "
+                 "session's logs/)\n",
+                 what, process);
     return 1;
   }
-  std::printf("done (the operator station confirms)\n");
+  if (h->outcome != rms::control_answer_t::DONE) {
+    std::fprintf(stderr, "rms_control: %s refused by %s: %s\n", what, process, h->text.c_str());
+    return 1;
+  }
+  std::printf("%s: %s (%s)\n", what, h->text.c_str(), process);
   return 0;
+}
+
+// FREEZE, RUN, STEP, RESET: answered by the operator station (it is the
+// session's clock, and presses the reset button).
+int Clock(ControlLink& link, std::int8_t command, int steps,
+          const rms::transport::LcmOptions& options, std::int64_t id) {
+  if (!link.WaitForProcess("operator_station")) return NobodyThere(options, id, "operator station");
+  std::vector<std::int64_t> sent;
+  for (int i = 0; i < steps; ++i) sent.push_back(link.Send(command));
+  SayWhereSent(options, id);
+  int rc = 0;
+  for (std::int64_t q : sent)
+    rc = std::max(rc, Said(link, q, "operator_station", rms::wire::ControlCommandName(command)));
+  return rc;
 }
 
 void SayWhereSent(const rms::transport::LcmOptions& options, std::int64_t id) {
@@ -199,122 +220,43 @@ void SayWhereSent(const rms::transport::LcmOptions& options, std::int64_t id) {
       id ? rms::wire::FormatSessionId(id).c_str() : "none (only processes of no session take it)");
 }
 
-// CHECKPOINT, confirmed when there is a session folder: the DCP writes the
-// file within a frame or two, or its counts say it refused.
+// CHECKPOINT: answered by the DCP.
 int Checkpoint(ControlLink& link, const std::string& name, const std::string& folder,
                const rms::transport::LcmOptions& options, std::int64_t id) {
-  if (!link.WaitForCounts()) return NobodyThere(options, id, "dynamics_proc");
-  const std::int64_t saved0 = link.Count(rms::Counter::kControlCheckpoints);
-  auto refusals = [&link] {
-    return link.Count(rms::Counter::kControlRefused) +
-           link.Count(rms::Counter::kControlRateLimited);
-  };
-  const std::int64_t refused0 = refusals();
-  link.Send(rms::session_control_t::CHECKPOINT, name);
+  if (!link.WaitForProcess("dynamics_proc")) return NobodyThere(options, id, "dynamics_proc");
+  const std::int64_t q = link.Send(rms::session_control_t::CHECKPOINT, name);
   SayWhereSent(options, id);
-  if (folder.empty()) {  // no folder to look in: the DCP's counts say
-    const int seen0 = link.reports();
-    link.ListenUntil(3.0, [&] {
-      return link.reports() > seen0 &&
-             link.Count(rms::Counter::kControlCheckpoints) + refusals() > saved0 + refused0;
-    });
-    if (link.Count(rms::Counter::kControlCheckpoints) > saved0) {
-      std::printf("saved %s (dynamics_proc confirms)\n", name.c_str());
-      return 0;
-    }
-    std::fprintf(stderr, "rms_control: dynamics_proc did not save checkpoint %s (%s)\n",
-                 name.c_str(), refusals() > refused0 ? "refused" : "no word from it within 3 s");
-    return 1;
-  }
-  const fs::path p = fs::path(folder) / name;
-  const int seen = link.reports();
-  link.ListenUntil(
-      3.0, [&] { return fs::exists(p) || (link.reports() > seen && refusals() > refused0); });
-  if (!fs::exists(p) && refusals() > refused0) {
-    std::fprintf(stderr,
-                 "rms_control: dynamics_proc refused checkpoint %s (see the session's "
-                 "logs/dynamics_proc.log)\n",
-                 name.c_str());
-    return 1;
-  }
-  if (!fs::exists(p)) {
-    std::fprintf(
-        stderr,
-        "rms_control: %s did not appear within 3 s (see the session's logs/dynamics_proc.log)\n",
-        p.c_str());
-    return 1;
-  }
-  std::printf("saved %s\n", p.c_str());
-  return 0;
+  const int rc = Said(link, q, "dynamics_proc", "checkpoint");
+  if (rc == 0 && !folder.empty()) std::printf("saved %s\n", (fs::path(folder) / name).c_str());
+  return rc;
 }
 
-// FREEZE, RESTORE (and RUN with --run), confirmed by the DCP's counts.
+// RESTORE (which freezes the session), and RUN with --run: answered by the
+// DCP (its state) and the operator station (its inputs, and the freeze).
 int Restore(ControlLink& link, const std::string& name, bool then_run,
             const rms::transport::LcmOptions& options, std::int64_t id) {
-  auto pause = [] { std::this_thread::sleep_for(std::chrono::milliseconds(300)); };
-  if (!link.WaitForCounts()) return NobodyThere(options, id, "dynamics_proc");
-  const std::int64_t restores0 = link.Count(rms::Counter::kControlRestores),
-                     refused0 = link.Count(rms::Counter::kControlRefused),
-                     limited0 = link.Count(rms::Counter::kControlRateLimited);
-  link.Send(rms::session_control_t::FREEZE);
-  pause();  // the last frames through the pipeline
-  link.Send(rms::session_control_t::RESTORE, name);
-  if (then_run) {
-    pause();
-    link.Send(rms::session_control_t::RUN);
-  }
+  if (!link.WaitForProcess("dynamics_proc")) return NobodyThere(options, id, "dynamics_proc");
+  // Frozen first, and the last frames through the pipeline, so the DCP
+  // restores with no frame in flight (docs/sessions.md).
+  if (Said(link, link.Send(rms::session_control_t::FREEZE), "operator_station", "freeze") != 0)
+    return 1;
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const std::int64_t q = link.Send(rms::session_control_t::RESTORE, name);
   SayWhereSent(options, id);
-  const int seen = link.reports();
-  link.ListenUntil(3.0, [&] {
-    return link.reports() > seen && (link.Count(rms::Counter::kControlRestores) > restores0 ||
-                                     link.Count(rms::Counter::kControlRefused) > refused0 ||
-                                     link.Count(rms::Counter::kControlRateLimited) > limited0);
-  });
-  if (link.Count(rms::Counter::kControlRestores) > restores0) {
-    std::printf("restored from %s (dynamics_proc confirms)%s\n", name.c_str(),
-                then_run ? "" : "; frozen: run resumes");
-    return 0;
-  }
-  std::fprintf(stderr,
-               "rms_control: dynamics_proc did not restore %s (%s; see the session's "
-               "logs/dynamics_proc.log)\n",
-               name.c_str(),
-               link.Count(rms::Counter::kControlRateLimited) > limited0
-                   ? "too many checkpoint commands a second: try again"
-               : link.Count(rms::Counter::kControlRefused) > refused0
-                   ? "refused"
-                   : "no word from it within 3 s");
-  return 1;
+  int rc = Said(link, q, "dynamics_proc", "restore");
+  rc = std::max(rc, Said(link, q, "operator_station", "restore"));
+  if (rc == 0 && then_run)
+    rc = Said(link, link.Send(rms::session_control_t::RUN), "operator_station", "run");
+  return rc;
 }
 
-// MALFUNCTION and REPAIR (docs/sessions.md "Malfunctions"), confirmed by
-// the DCP's counts.
+// MALFUNCTION and REPAIR (docs/sessions.md "Malfunctions"): answered by the DCP.
 int Malfunction(ControlLink& link, std::int8_t command, const std::string& text,
                 const rms::transport::LcmOptions& options, std::int64_t id) {
-  if (!link.WaitForCounts()) return NobodyThere(options, id, "dynamics_proc");
-  const rms::Counter taken = command == rms::session_control_t::MALFUNCTION
-                                 ? rms::Counter::kControlMalfunctions
-                                 : rms::Counter::kControlRepairs;
-  auto refusals = [&link] {
-    return link.Count(rms::Counter::kControlRefused) +
-           link.Count(rms::Counter::kControlRateLimited);
-  };
-  const std::int64_t taken0 = link.Count(taken), refused0 = refusals();
-  link.Send(command, text);
+  if (!link.WaitForProcess("dynamics_proc")) return NobodyThere(options, id, "dynamics_proc");
+  const std::int64_t q = link.Send(command, text);
   SayWhereSent(options, id);
-  const int seen = link.reports();
-  link.ListenUntil(3.0, [&] {
-    return link.reports() > seen && link.Count(taken) + refusals() > taken0 + refused0;
-  });
-  if (link.Count(taken) > taken0) {
-    std::printf("%s: %s (dynamics_proc confirms)\n",
-                command == rms::session_control_t::MALFUNCTION ? "malfunction" : "repaired",
-                text.c_str());
-    return 0;
-  }
-  std::fprintf(stderr, "rms_control: dynamics_proc did not take '%s' (%s; see its log)\n",
-               text.c_str(), refusals() > refused0 ? "refused" : "no word from it within 3 s");
-  return 1;
+  return Said(link, q, "dynamics_proc", rms::wire::ControlCommandName(command));
 }
 
 // The words after the subcommand, as one text.
@@ -352,6 +294,8 @@ int main(int argc, char** argv) {
   bool then_run = false;
   auto* freeze = app.add_subcommand("freeze", "Freeze the session: every process holds its frame");
   auto* run = app.add_subcommand("run", "Run a frozen session again");
+  auto* reset = app.add_subcommand(
+      "reset", "Press the reset button for one frame: back to Mode 1, a new attempt");
   auto* step = app.add_subcommand("step", "While frozen: N more frames (default 1)");
   step->add_option("n", steps, "Frames")->check(CLI::Range(1, 100000));
   auto* checkpoint = app.add_subcommand(
@@ -423,6 +367,7 @@ int main(int argc, char** argv) {
     if (restore->parsed()) return Restore(link, name, then_run, lcm_options, id);
     if (freeze->parsed()) return Clock(link, rms::session_control_t::FREEZE, 1, lcm_options, id);
     if (run->parsed()) return Clock(link, rms::session_control_t::RUN, 1, lcm_options, id);
+    if (reset->parsed()) return Clock(link, rms::session_control_t::RESET, 1, lcm_options, id);
     return Clock(link, rms::session_control_t::STEP, steps, lcm_options, id);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rms_control: %s\n", e.what());

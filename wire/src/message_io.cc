@@ -2,6 +2,7 @@
 
 #include <cstdio>
 
+#include "rms/control_answer_t.hpp"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_state_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
@@ -28,6 +29,7 @@ bool IsRmslabFingerprint(std::int64_t fp) {
       operator_input_t::getHash(), dcp_frame_t::getHash(),      esg_frame_t::getHash(),
       process_status_t::getHash(), dcp_telemetry_t::getHash(),  session_control_t::getHash(),
       window_keys_t::getHash(),    operator_state_t::getHash(), dcp_state_t::getHash(),
+      control_answer_t::getHash(),
   };
   for (std::int64_t t : kTypes) {
     if (t == fp) return true;
@@ -82,6 +84,24 @@ const char* ControlCommandName(std::int8_t command) {
       "?", "freeze", "run", "step", "checkpoint", "restore", "reset", "malfunction", "repair"};
   static_assert(session_control_t::REPAIR == 8, "kNames follows session_control_t's commands");
   return command >= 1 && command <= 8 ? kNames[command] : "?";
+}
+
+control_answer_t MakeControlAnswer(const session_control_t& command, std::int8_t outcome,
+                                   std::int64_t frame, std::string text) {
+  control_answer_t a{};
+  a.command_process = command.sender.process;
+  a.command_pid = command.sender.pid;
+  a.command_sequence = command.sequence;
+  a.command = command.command;
+  a.outcome = outcome;
+  a.frame = frame;
+  if (text.size() > static_cast<std::size_t>(control_answer_t::MAX_TEXT_BYTES)) {
+    std::size_t n = control_answer_t::MAX_TEXT_BYTES;
+    while (n > 0 && (static_cast<unsigned char>(text[n]) & 0xC0) == 0x80) --n;  // a continuation
+    text.resize(n);
+  }
+  a.text = std::move(text);
+  return a;
 }
 
 const char* ProcessCodeName(std::int8_t process) {

@@ -460,6 +460,61 @@ std::string MalfunctionsSection(const nlohmann::ordered_json& s) {
   return h.str();
 }
 
+// docs/sessions.md "Freeze, run, step, checkpoint": each command, who sent
+// it, and what the processes that acted on it answered.
+std::string ControlSection(const nlohmann::ordered_json& s) {
+  const auto& list = s["control"];
+  if (!list.is_array() || list.empty()) return "";
+  std::ostringstream h;
+  h << "<h2>Session control</h2>\n<p>Each command as sent, and each answer of the processes that "
+       "acted on it (RMS_CONTROL_ANSWER): done, or refused with the reason.</p>\n"
+       "<table><tr><th>time, s</th><th>from</th><th>command</th><th>answers</th></tr>";
+  for (const auto& c : list) {
+    std::string answers;
+    if (c.contains("answers")) {
+      for (const auto& a : c["answers"]) {
+        const bool done = a["outcome"] == "done";
+        answers += std::string(answers.empty() ? "" : "<br>") + "<span class=\"" +
+                   (done ? "ok" : "bad") + "\">" + (done ? "done" : "REFUSED") + "</span> (" +
+                   HtmlText(a["process"].get<std::string>()) +
+                   "): " + HtmlText(a["text"].get<std::string>());
+      }
+    }
+    h << "<tr><td>" << TimeCell(c["time_s"], "", 2) << "</td><td>" << Cell(c["process"])
+      << "</td><td>" << Cell(c["command"])
+      << (c.contains("name") ? " " + HtmlText(c["name"].get<std::string>()) : "") << "</td><td>"
+      << (answers.empty() ? "none" : answers) << "</td></tr>";
+  }
+  h << "</table>\n";
+  return h.str();
+}
+
+// docs/instructor.md "Marks": the instructor's marks and notes, from
+// SESSION/instructor_marks.jsonl (untrusted: each line a JSON object, its
+// text shown as text; at most 1000).
+std::string MarksSection(const fs::path& root) {
+  std::error_code ec;
+  if (!fs::is_regular_file(fs::symlink_status(root / "instructor_marks.jsonl", ec))) return "";
+  std::ifstream in(root / "instructor_marks.jsonl");
+  if (!in) return "";
+  std::ostringstream h;
+  int n = 0;
+  std::string line;
+  while (n < 1000 && std::getline(in, line)) {
+    if (line.size() > 4096) continue;
+    const auto m = nlohmann::ordered_json::parse(line, nullptr, false);
+    if (!m.is_object() || !m.contains("session_s") || !m["session_s"].is_number() ||
+        !m.contains("text") || !m["text"].is_string())
+      continue;
+    if (n++ == 0)
+      h << "<h2>The instructor's marks</h2>\n<table><tr><th>time, s</th><th>note</th></tr>";
+    h << "<tr><td>" << TimeCell(m["session_s"], "", 1) << "</td><td>"
+      << HtmlText(m["text"].get<std::string>()) << "</td></tr>";
+  }
+  if (n) h << "</table>\n";
+  return h.str();
+}
+
 std::string ScorecardSection(const nlohmann::ordered_json& s) {
   const auto& attempts = s["attempts"];
   if (attempts.empty()) return "";
@@ -773,7 +828,7 @@ std::string MakeReport(const std::string& session_dir, const std::string& chart_
        "statistics and its manifest. One self-contained file: the plots are drawn by Chart.js, "
        "embedded.</p>\n";
   h << SessionSection(manifest, s) << TolerancesSection(config) << AttemptsSection(s)
-    << MalfunctionsSection(s) << ScorecardSection(s);
+    << MalfunctionsSection(s) << ControlSection(s) << MarksSection(root) << ScorecardSection(s);
   h << "<h2>Plots</h2>\n<div id=\"rms-charts\"></div>\n";
   h << "<script>\nwindow.RMS_REPORT = " << ScriptJson(data) << ";\n</script>\n<script>\n"
     << charts << "\n</script>\n";

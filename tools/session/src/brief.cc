@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "rms/base/text.h"
 
@@ -187,7 +188,34 @@ void SessionLines(const Json& j, std::ostream& os) {
     for (const auto& c : j["control"]) ++n[c["command"].get<std::string>()];
     os << "session control sent:";
     for (const auto& [what, k] : n) os << " " << what << " " << k;
+    // Each command's outcome, as the processes that acted on it answered
+    // (RMS_CONTROL_ANSWER): the refusals named.
+    int done = 0, unanswered = 0;
+    std::vector<std::string> refused;
+    for (const auto& c : j["control"]) {
+      const Json& answers = c.contains("answers") ? c["answers"] : Json::array();
+      bool no = false;
+      std::string why;
+      for (const auto& a : answers) {
+        if (a["outcome"] == "refused" && !no) {
+          no = true;
+          why = c["command"].get<std::string>();
+          if (c.contains("name")) why.append(" ").append(c["name"].get<std::string>());
+          why.append(": ").append(a["text"].get<std::string>());
+        }
+      }
+      if (no)
+        refused.push_back(why);
+      else if (answers.empty())
+        ++unanswered;
+      else
+        ++done;
+    }
+    os << "; done " << done << ", refused " << refused.size();
+    if (unanswered) os << ", unanswered " << unanswered;
     os << "\n";
+    for (std::size_t i = 0; i < refused.size() && i < 5; ++i)
+      os << "  refused: " << refused[i] << "\n";
   }
   if (j.contains("malfunctions") && !j["malfunctions"].empty()) {
     // docs/sessions.md "Malfunctions": as the DCP took them, at session time.

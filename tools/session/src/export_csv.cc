@@ -17,6 +17,7 @@
 #include "rms/base/config.h"
 #include "rms/base/folder_file.h"
 #include "rms/base/text.h"
+#include "rms/control_answer_t.hpp"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_state_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
@@ -412,7 +413,7 @@ std::vector<std::string> WindowKeysRow(const LogMessage& msg, const std::string&
 
 // The session's files, one a channel.
 struct ChannelFiles {
-  Csv in, dcp, esg, tm, st, ctl, op_state, dcp_state, keys;
+  Csv in, dcp, esg, tm, st, ctl, answer, op_state, dcp_state, keys;
   ChannelFiles(OutputFolder* out, const LabConfig& config)
       : in(out, "operator_input.csv", InputColumns(config)),
         dcp(out, "dcp_frame.csv", DcpColumns()),
@@ -422,7 +423,11 @@ struct ChannelFiles {
            {"log_time [us]", "session_time [s]", "send_time [us]", "process", "host", "pid",
             "frame", "final", "counter", "value"}),
         ctl(out, "control.csv",
-            {"log_time [us]", "session_time [s]", "send_time [us]", "sequence", "command", "name"}),
+            {"log_time [us]", "session_time [s]", "send_time [us]", "process", "pid", "sequence",
+             "command", "name"}),
+        answer(out, "control_answer.csv",
+               {"log_time [us]", "session_time [s]", "send_time [us]", "process", "command_process",
+                "command_pid", "command_sequence", "command", "outcome", "frame", "text"}),
         op_state(out, "operator_state.csv", OperatorStateColumns()),
         dcp_state(out, "dcp_state.csv",
                   {"log_time [us]", "session_time [s]", "send_time [us]", "reason", "next_frame",
@@ -451,8 +456,14 @@ struct ChannelFiles {
       }
     } else if (base == wire::channels::kControl) {
       const auto m = Decoded<session_control_t>(msg);
-      ctl.Row(
-          {t, st_s, I(m.send_time_us), I(m.sequence), wire::ControlCommandName(m.command), m.name});
+      ctl.Row({t, st_s, I(m.send_time_us), wire::ProcessCodeName(m.sender.process), I(m.sender.pid),
+               I(m.sequence), wire::ControlCommandName(m.command), m.name});
+    } else if (base == wire::channels::kControlAnswer) {
+      const auto m = Decoded<control_answer_t>(msg);
+      answer.Row({t, st_s, I(m.send_time_us), wire::ProcessCodeName(m.sender.process),
+                  wire::ProcessCodeName(m.command_process), I(m.command_pid), I(m.command_sequence),
+                  wire::ControlCommandName(m.command),
+                  m.outcome == control_answer_t::DONE ? "done" : "refused", I(m.frame), m.text});
     } else if (base == wire::channels::kOperatorState) {
       op_state.Row(OperatorStateRow(msg, t, config.session.frame_rate_hz));
     } else if (base == wire::channels::kDcpState) {

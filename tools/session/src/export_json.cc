@@ -3,6 +3,7 @@
 #include <ostream>
 #include <type_traits>
 
+#include "rms/control_answer_t.hpp"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_state_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
@@ -80,6 +81,8 @@ long ExportJsonLines(const std::string& session_dir, std::ostream& out, long* ma
       ok = Line<process_status_t>(log, ev, "rms.process_status_t", out);
     else if (b == wire::channels::kControl)
       ok = Line<session_control_t>(log, ev, "rms.session_control_t", out);
+    else if (b == wire::channels::kControlAnswer)
+      ok = Line<control_answer_t>(log, ev, "rms.control_answer_t", out);
     else if (b == wire::channels::kWindowKeys)
       ok = Line<window_keys_t>(log, ev, "rms.window_keys_t", out);
     else

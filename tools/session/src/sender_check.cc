@@ -29,6 +29,8 @@ bool Publishes(std::string_view base, std::int8_t process) {
   }
   if (base == wire::channels::kEsgFrame) return process == S::PROCESS_SCENE;
   if (base == wire::channels::kWindowKeys) return process == S::PROCESS_ESG;
+  if (base == wire::channels::kControlAnswer)
+    return process == S::PROCESS_OPERATOR_STATION || process == S::PROCESS_DYNAMICS;
   if (base == wire::channels::kControl) {
     return process == S::PROCESS_CONTROL || process == S::PROCESS_OPERATOR_STATION ||
            process == S::PROCESS_INSTRUCTOR;

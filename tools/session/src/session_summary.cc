@@ -12,12 +12,14 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include "rms/base/check.h"
 #include "rms/base/config.h"
 #include "rms/base/counters.h"
 #include "rms/base/text.h"
 #include "rms/base/version.h"
+#include "rms/control_answer_t.hpp"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_state_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
@@ -350,8 +352,12 @@ struct LogScan {
   HandControlLog hand;
   StatusRuns status;
   nlohmann::ordered_json control = nlohmann::ordered_json::array();
+  // Each command's place in `control`, by its id (sender process, pid,
+  // sequence): where its answers go (RMS_CONTROL_ANSWER).
+  std::map<std::tuple<int, std::int32_t, std::int64_t>, std::size_t> control_index;
   AttemptLog* attempts = nullptr;
   std::string last_restore_name;
+  std::int64_t answers_unmatched = 0;
   // docs/sessions.md "Malfunctions": each change of the malfunctions in
   // force, as the DCP's logged states show it, and those in force now.
   nlohmann::ordered_json malfunctions = nlohmann::ordered_json::array();
@@ -398,7 +404,8 @@ void ScanStatus(const LogMessage& ev, LogScan* s) {
 }
 
 // Session control as sent (RMS_CONTROL; docs/sessions.md "Freeze, run, step,
-// checkpoint"): what acted is in the processes' control.* counters.
+// checkpoint"), each with the answers of the processes that acted on it
+// (ScanAnswer).
 void ScanControl(const LogMessage& ev, LogScan* s) {
   session_control_t m;
   if (wire::SafeDecode(ev.data, ev.size, &m) != wire::DecodeError::kNone) {
@@ -412,10 +419,35 @@ void ScanControl(const LogMessage& ev, LogScan* s) {
                               {"wall_s", (ev.log_us - s->first_us) * 1e-6},
                               {"command", what},
                               {"process", wire::ProcessCodeName(m.sender.process)},
-                              {"pid", m.sender.pid}};
+                              {"pid", m.sender.pid},
+                              {"sequence", m.sequence}};
   if (!m.name.empty()) e["name"] = m.name;
+  e["answers"] = nlohmann::ordered_json::array();
   if (m.command == session_control_t::RESTORE) s->last_restore_name = m.name;
+  s->control_index[{m.sender.process, m.sender.pid, m.sequence}] = s->control.size();
   s->control.push_back(e);
+}
+
+// RMS_CONTROL_ANSWER: a process's answer to a command (docs/protocol.md),
+// put with the command it answers; one whose command is not in the log is
+// counted (control_answers_unmatched) and kept out.
+void ScanAnswer(const LogMessage& ev, LogScan* s) {
+  control_answer_t m;
+  if (wire::SafeDecode(ev.data, ev.size, &m) != wire::DecodeError::kNone) {
+    ++s->malformed;
+    return;
+  }
+  const auto it = s->control_index.find({m.command_process, m.command_pid, m.command_sequence});
+  if (it == s->control_index.end()) {
+    ++s->answers_unmatched;
+    return;
+  }
+  s->control[it->second]["answers"].push_back(
+      {{"process", wire::ProcessCodeName(m.sender.process)},
+       {"outcome", m.outcome == control_answer_t::DONE ? "done" : "refused"},
+       {"frame", m.frame},
+       {"text", m.text},
+       {"wall_s", (ev.log_us - s->first_us) * 1e-6}});
 }
 
 void ScanFrameNumbers(const std::string& base, const LogMessage& ev,
@@ -527,6 +559,8 @@ LogScan ScanLog(SessionLog& log, const std::map<std::int64_t, DcpFrameRecord>& d
       ScanStatus(ev, &s);
     else if (ev.base == wire::channels::kControl)
       ScanControl(ev, &s);
+    else if (ev.base == wire::channels::kControlAnswer)
+      ScanAnswer(ev, &s);
     else if (ev.base == wire::channels::kDcpState)
       ScanState(ev, &s);
     else
@@ -1043,6 +1077,7 @@ nlohmann::ordered_json Summarize(const std::string& dir) {
   j["totals"] = std::move(a["totals"]);
   j["mode_changes"] = s.telemetry.mode_changes;
   j["control"] = s.control;
+  j["control_answers_unmatched"] = s.answers_unmatched;
   j["malfunctions"] = s.malfunctions;
   AddResult(&j);
   j["by_hand"] = s.hand.Json();

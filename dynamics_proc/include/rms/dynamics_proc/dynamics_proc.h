@@ -96,6 +96,8 @@ class DynamicsProc {
  private:
   void Report(const DcpStatus& status, std::int64_t frame);
   void OnMalfunction(const session_control_t& m);
+  // Publishes the answer to `m` (RMS_CONTROL_ANSWER; docs/protocol.md).
+  void Answer(const session_control_t& m, std::int8_t outcome, const std::string& text);
   const LabConfig& config_;
   transport::LcmInterface* lcm_;
   DynamicCollisionProgram dcp_;

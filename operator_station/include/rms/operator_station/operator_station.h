@@ -22,6 +22,7 @@
 #include "rms/operator_station/input_sources.h"
 #include "rms/operator_station/session_events.h"
 #include "rms/operator_station/status_screen.h"
+#include "rms/session_control_t.hpp"
 #include "rms/transport/lcm_interface.h"
 #include "rms/transport/process.h"
 #include "rms/wire/checkpoint.h"
@@ -109,6 +110,8 @@ class OperatorStation {
   void OnControl(const void* data, int size, std::int64_t recv_us);
   void OnWindowKeys(const void* data, int size, std::int64_t recv_us);
   void SendControl(std::int8_t command, const std::string& name = "");
+  // Publishes the answer to `m` (RMS_CONTROL_ANSWER; docs/protocol.md).
+  void Answer(const session_control_t& m, std::int8_t outcome, const std::string& text);
   // The lesson's events due this frame, sent (docs/lessons.md).
   void FireLessonEvents();
   void ApplyRestore();
@@ -158,8 +161,8 @@ class OperatorStation {
   int steps_pending_ = 0;
   bool clock_written_frozen_ = false;  // what the clock file says (none: running)
   std::int64_t clock_written_frame_ = -1;
-  bool reset_pending_ = false;                // RMS_CONTROL RESET: the next frame's reset button
-  std::optional<std::string> restored_from_;  // a checkpoint name (CheckpointFolder)
+  bool reset_pending_ = false;  // RMS_CONTROL RESET: the next frame's reset button
+  std::optional<session_control_t> restore_command_;  // RESTORE: its name a checkpoint's
   wire::CheckpointFolder checkpoints_;
   wire::CheckpointRateLimit checkpoint_rate_;
   std::int64_t control_sequence_ = 0;

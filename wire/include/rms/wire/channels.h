@@ -18,5 +18,7 @@ inline constexpr const char* kOperatorState =
 inline constexpr const char* kWindowKeys =
     "RMS_WINDOW_KEYS";  // esg_renderer (window) -> operator_station
 inline constexpr const char* kDcpState = "RMS_DCP_STATE";  // dynamics_proc -> log (re-simulation)
+inline constexpr const char* kControlAnswer =
+    "RMS_CONTROL_ANSWER";  // operator_station, dynamics_proc -> rms_control, instructor, log
 
 }  // namespace rms::wire::channels

@@ -13,7 +13,9 @@
 #include <vector>
 
 #include "rms/base/counters.h"
+#include "rms/control_answer_t.hpp"
 #include "rms/lcm_limits.h"
+#include "rms/session_control_t.hpp"
 
 namespace rms::wire {
 
@@ -98,6 +100,14 @@ const char* ControlCommandName(std::int8_t command);
 const char* ProcessCodeName(std::int8_t process);
 // sender_t::PROCESS_* for a process name ("operator_station", ...); PROCESS_TOOL otherwise.
 std::int8_t ProcessCode(std::string_view name);
+
+// The answer to `command` (docs/protocol.md "RMS_CONTROL_ANSWER"): its id
+// (the command's sender and sequence), the outcome (control_answer_t::DONE
+// or REFUSED), the frame from which it holds and the text, cut to
+// control_answer_t::MAX_TEXT_BYTES on a UTF-8 character's boundary. The
+// answerer stamps its own sender as it publishes.
+control_answer_t MakeControlAnswer(const session_control_t& command, std::int8_t outcome,
+                                   std::int64_t frame, std::string text);
 
 // Decodes a raw message of type Msg. Its size limit and the bounds of its
 // counts and strings come from the type (lcmtypes/*.lcm's MAX_* constants,
