@@ -32,6 +32,15 @@ int main(int argc, char** argv) {
   app.add_option("--lesson-state", o.lesson_state_path,
                  "Keep the lesson in force and what it fired here; a restarted station carries on "
                  "from it");
+  app.add_option("--session-dir", o.session_dir,
+                 "The session's folder: its log so far is read at start (a restarted station "
+                 "recovers its history)");
+  app.add_option("--marks-file", o.marks_path,
+                 "The instructor's marks and notes, kept here (JSON lines; the launcher's "
+                 "SESSION/instructor_marks.jsonl)");
+  app.add_flag("--debrief", o.debrief,
+               "A debrief of the recorded session in --session-dir: scrub through it, place marks; "
+               "nothing is sent");
   return rms::transport::ProcessMain(
       app, argc, argv, "instructor_station", &common,
       [&](const rms::LabConfig& config, rms::transport::LcmInterface& lcm) {

@@ -70,6 +70,15 @@ void FireLesson(InstructorLesson* lesson, SessionWatch& watch, double frame_rate
   }
 }
 
+// The debrief's scrubbing: one past view asked for, drawn a wait, from the
+// frames kept (the camera drive run up over the 3 s before it).
+void DrawPastView(const SessionWatch& watch, StationViews& views) {
+  const auto asked = views.PendingPast();
+  if (!asked) return;
+  const SessionWatch::PastFrames past = watch.HistoryAt(asked->second, 90);
+  views.DrawPast(asked->first, asked->second, past.frames, past.lost_stations);
+}
+
 }  // namespace
 
 void TakeTokenFromEnvironment(InstructorOptions* o) {
@@ -94,6 +103,8 @@ void CheckOptions(const InstructorOptions& o) {
       throw InputError("--token: letters, digits, - and _ only");
   }
   if (!o.lesson_path.empty()) (void)lesson::Lesson::Load(o.lesson_path);  // refused at start
+  if (o.debrief && o.session_dir.empty())
+    throw InputError("--debrief: give the recorded session with --session-dir DIR");
   if (!Loopback(o.bind) && o.token.empty()) {
     // Refused rather than made up: whoever opens it beyond this host needs
     // to be given the token (docs/security.md "The instructor's page").
@@ -109,7 +120,21 @@ int RunInstructorStation(const LabConfig& config, transport::LcmInterface& lcm,
   CheckOptions(options);
   if (options.token.empty()) options.token = NewToken();
   Counters counters;
-  SessionWatch watch(config, &lcm, &counters);
+  SessionWatch watch(config, &lcm, &counters, !options.debrief);
+  if (!options.marks_path.empty()) watch.SetMarksFile(options.marks_path);
+  // docs/instructor.md "A restarted station", "Debrief": the session's log
+  // so far, through the same handlers as live traffic (which waits
+  // meanwhile in the socket: what both hold counts once).
+  if (!options.session_dir.empty()) {
+    try {
+      const std::int64_t n = watch.ReadLog(options.session_dir);
+      spdlog::info("read {} messages of the session's log{}", n,
+                   watch.restarted() ? ": a restart, its history recovered" : "");
+    } catch (const InputError& e) {
+      if (options.debrief) throw;
+      spdlog::warn("the session's log not read ({}): the history begins now", e.what());
+    }
+  }
   StationViews views(config, options.view_width, options.view_height, options.view_rate_hz,
                      &counters);
   ControlQueue controls;
@@ -135,7 +160,6 @@ int RunInstructorStation(const LabConfig& config, transport::LcmInterface& lcm,
   spdlog::info("instructor's page: {} (its token: {})", page,
                options.url_file.empty() ? "given with --token" : "in " + options.url_file);
   if (!ready_path.empty()) transport::WriteReadyFile(ready_path);
-  std::int64_t sequence = 0;
   transport::RunNodeLoop(
       lcm, "instructor_station", counters, {},
       [&] {
@@ -144,13 +168,17 @@ int RunInstructorStation(const LabConfig& config, transport::LcmInterface& lcm,
       },
       [&] {
         if (auto d = watch.LatestDcpFrame()) views.Update(*d, watch.LostStations());
-        FireLesson(&lesson, watch, config.session.frame_rate_hz, lcm.NowUs(), &controls, &counters);
-        for (const ControlRequest& r : controls.Drain()) {
+        DrawPastView(watch, views);
+        if (!options.debrief)
+          FireLesson(&lesson, watch, config.session.frame_rate_hz, lcm.NowUs(), &controls,
+                     &counters);
+        for (const ControlRequest& r : controls.Drain(transport::WallTimeUs())) {
           session_control_t m;
           m.send_time_us = lcm.NowUs();
-          m.sequence = sequence++;
+          m.sequence = r.id;
           m.command = r.command;
           m.name = r.name;
+          watch.NoteCommand(r.id, r.command, r.name);
           counters.Add(transport::PublishMessage(lcm, wire::channels::kControl, m)
                            ? Counter::kPublished
                            : Counter::kPublishFailed);

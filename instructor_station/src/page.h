@@ -1,106 +1,210 @@
 #pragma once
 // The instructor's page (docs/instructor.md): one self-contained HTML file,
-// no outside scripts. It polls /api/status, /api/events and /api/path,
-// reloads each view's image as soon as the last one arrived, and sends the
-// controls to /api/control with the token from its own URL.
+// no outside scripts. It polls /api/status, /api/events, /api/path and
+// /api/plot; fetches each view's next image as soon as the last one was
+// shown (the last stays until the next has arrived); sends the controls to
+// /api/control and follows each command's answer (/api/command); and in a
+// debrief (or when scrubbed back) asks for past frames' views.
 namespace rms::instructor_station {
 
 inline constexpr const char* kPageHtml = R"PAGE(<!doctype html>
 <html lang="en"><head><meta charset="utf-8">
+<meta name="viewport" content="width=device-width, initial-scale=1">
 <title>rmslab instructor station</title>
 <style>
-body { font: 14px system-ui, sans-serif; margin: 0; background: #111; color: #ddd; }
-header { padding: 6px 12px; background: #222; display: flex; gap: 18px; align-items: baseline; flex-wrap: wrap; }
-header b { font-size: 16px; }
-main { display: grid; grid-template-columns: 1fr 1fr 440px; gap: 10px; padding: 10px; }
-.pane { background: #1b1b1b; border: 1px solid #333; padding: 6px; }
-.pane h2 { font-size: 13px; margin: 0 0 6px 0; color: #aaa; font-weight: 600; }
-img.view { width: 100%; image-rendering: auto; background: #000; aspect-ratio: 4 / 3; display: block; }
+* { box-sizing: border-box; }
+html, body { height: 100%; }
+body { font: 13px system-ui, sans-serif; margin: 0; background: #111; color: #ddd; display: flex; flex-direction: column; }
+header { padding: 4px 8px; background: #222; display: flex; gap: 4px 14px; align-items: center; flex-wrap: wrap; flex: none; }
+h1 { font-size: 14px; margin: 0; }
+#banner { font-weight: 700; padding: 2px 10px; border-radius: 3px; background: #2f5f2f; color: #fff; }
+#banner.frozen { background: #24528a; } #banner.ended { background: #555; } #banner.lost { background: #8a2424; }
+#banner.debrief { background: #5a3d7a; } #banner.waiting { background: #444; }
+#note { color: #eb4; }
+#timeline { display: flex; gap: 6px; align-items: center; flex-wrap: wrap; padding: 3px 8px; background: #1a1a1a; flex: none; }
+#scrub { flex: 1 1 260px; min-width: 160px; }
+main { flex: 1 1 auto; min-height: 0; display: grid; grid-template-columns: minmax(0, 34fr) minmax(0, 36fr) minmax(0, 30fr); gap: 6px; padding: 6px; }
+.col { min-height: 0; overflow-y: auto; display: flex; flex-direction: column; gap: 6px; }
+.pane { background: #1b1b1b; border: 1px solid #333; padding: 4px 6px; }
+h2 { font-size: 12px; margin: 0 0 3px 0; color: #bbb; font-weight: 600; }
+img.view { width: 100%; background: #000; aspect-ratio: 4 / 3; display: block; object-fit: contain; }
 canvas { width: 100%; background: #050505; display: block; }
 table { border-collapse: collapse; width: 100%; font-size: 12px; }
-td, th { padding: 2px 4px; vertical-align: top; border-bottom: 1px solid #2a2a2a; text-align: left; }
-.ok { color: #6c6; } .bad { color: #e66; } .warn { color: #eb4; }
-#events { height: 260px; overflow-y: auto; font: 12px monospace; white-space: pre-wrap; }
-button { background: #333; color: #eee; border: 1px solid #555; padding: 4px 10px; margin: 2px; cursor: pointer; }
-button:hover { background: #444; }
-input, select { background: #222; color: #eee; border: 1px solid #555; padding: 3px; }
+td, th { padding: 1px 4px; vertical-align: top; border-bottom: 1px solid #2a2a2a; text-align: left; }
+.ok { color: #7d7; } .bad { color: #f77; } .warn { color: #eb4; }
+td.bad, span.bad { font-weight: 700; }
+#events { max-height: 200px; overflow-y: auto; font: 12px monospace; white-space: pre-wrap; }
+#events div.past { color: #999; }
+#events div.after { opacity: 0.45; }
+button { background: #333; color: #eee; border: 1px solid #666; padding: 3px 9px; margin: 1px; cursor: pointer; font: inherit; }
+button:hover { background: #444; } button:disabled { opacity: 0.5; cursor: default; }
+input, select { background: #222; color: #eee; border: 1px solid #666; padding: 2px; font: inherit; max-width: 100%; }
 #said { font: 12px monospace; min-height: 1.2em; }
+.chips span { display: inline-block; margin: 1px 4px 1px 0; padding: 0 4px; border: 1px solid #444; }
+.bars { display: grid; grid-template-columns: 2.6em 1fr 3.2em 2.6em 1fr 3.2em; gap: 1px 4px; align-items: center; font-size: 12px; }
+.bar { height: 8px; background: #2a2a2a; position: relative; }
+.bar i { position: absolute; top: 0; bottom: 0; background: #6af; }
+#warnings div { color: #f77; font-weight: 700; }
+details summary { cursor: pointer; color: #bbb; font-size: 12px; }
+.sr { position: absolute; width: 1px; height: 1px; overflow: hidden; clip: rect(0 0 0 0); }
+@media (max-width: 900px) {
+  body { display: block; height: auto; }
+  main { display: block; }
+  .col { overflow: visible; margin-bottom: 6px; }
+  #events { max-height: 260px; }
+  body { font-size: 15px; }
+  table, .bars, #events, #said { font-size: 14px; }
+}
 </style></head>
 <body>
-<header><b>rmslab instructor station</b>
+<header>
+<h1>rmslab instructor</h1>
+<span id="banner" class="waiting">CONNECTING</span>
 <span id="clock">t -- s</span><span id="mode">no telemetry yet</span>
-<span id="flags"></span><span id="collisions"></span><span id="conn"></span></header>
+<span id="flags"></span><span id="note"></span>
+<div id="announce" class="sr" role="status" aria-live="polite"></div>
+</header>
+<nav id="timeline" aria-label="the session's timeline">
+<label for="scrub">Session time</label>
+<input type="range" id="scrub" min="0" max="0" step="1" value="0">
+<span id="cursor">live</span>
+<button id="live" aria-label="Back to live">Live</button>
+<label for="marktext" class="sr">A note for a mark at the cursor</label>
+<input id="marktext" placeholder="note for a mark" size="18" maxlength="500">
+<button id="mark">Mark</button>
+<span id="branch"></span>
+</nav>
 <main>
-<div class="pane"><h2>The operator's view <span id="opstation"></span></h2>
-<img class="view" id="view0" alt="the operator's view"></div>
-<div class="pane"><h2>Station <select id="station"></select> <span id="viewframe"></span></h2>
-<img class="view" id="view1" alt="a camera station's view"></div>
-<div class="pane"><h2>Controls</h2>
+<div class="col">
+<div class="pane"><h2>The operator's view <span id="opstation"></span> <span id="frame0"></span></h2>
+<img class="view" id="view0" alt="the operator's view, as the trainee sees it"></div>
+<div class="pane"><h2><label for="station">Station</label> <select id="station"></select> <span id="frame1"></span></h2>
+<img class="view" id="view1" alt="the chosen camera station's view"></div>
+</div>
+<div class="col">
+<div class="pane"><h2>The trainee</h2>
+<div id="trainee">no operator state yet</div>
+<div class="bars" id="hands" aria-label="the hand controllers' inputs"></div>
+<div id="guidance"></div>
+<div id="warnings" aria-live="polite"></div></div>
+<div class="pane"><h2>Joints (as they are; commanded): a failed part in red</h2><table id="joints"></table></div>
+<div class="pane"><h2>Acquisition and docking</h2><div class="chips" id="acq"></div></div>
+<div class="pane"><h2>Distance to the goal and the acquisition margins, ft, against session time</h2>
+<canvas id="plot" width="640" height="160" role="img" aria-label="plot of the distance to the goal and the margins against session time"></canvas></div>
+<div class="pane"><h2>From above (nose up, starboard right): the end effector's path</h2>
+<canvas id="map" width="640" height="230" role="img" aria-label="map of the orbiter, the CAE and the end effector's path"></canvas></div>
+</div>
+<div class="col">
+<div class="pane" id="controls"><h2>Controls</h2>
 <button id="freeze">Freeze</button><button id="run">Run</button><button id="step">Step</button>
 <button id="reset">Reset</button><br>
-<input id="cpname" placeholder="checkpoint name" size="16"><button id="checkpoint">Checkpoint</button><br>
-<select id="cplist"></select><button id="restore">Restore</button>
+<label for="cpname" class="sr">Checkpoint name</label><input id="cpname" placeholder="checkpoint name" size="14"><button id="checkpoint">Checkpoint</button><br>
+<label for="cplist" class="sr">Checkpoint to restore</label><select id="cplist"></select><button id="restore">Restore</button>
 <h2>Malfunctions</h2>
-<select id="mkind"></select><select id="mtarget"></select><input id="mvalue" size="6">
-<span id="munit"></span><button id="inject">Inject</button><br>
+<label for="mkind" class="sr">Malfunction kind</label><select id="mkind"></select>
+<label for="mtarget" class="sr">Joint or camera station</label><select id="mtarget"></select>
+<label for="mvalue" class="sr">Value</label><input id="mvalue" size="5">
+<span id="munit"></span><button id="inject">Inject</button>
 <div id="mlist">none in force</div>
-<div id="said"></div>
+<div id="said" role="status" aria-live="polite"></div>
 <h2>Lesson</h2>
 <label for="lessonfile">A lesson file (docs/lessons.md): </label><input type="file" id="lessonfile" accept=".toml,text/plain">
-<div id="lessonsaid"></div><ol id="lesson"></ol>
-<h2>Events</h2><div id="events"></div></div>
-<div class="pane"><h2>From above: the orbiter, the CAE and the end effector's path (nose up, starboard right)</h2>
-<canvas id="map" width="640" height="480"></canvas></div>
-<div class="pane"><h2>Acquisition and docking</h2><table id="acq"></table></div>
-<div class="pane"><h2>Processes: rates, latency, losses</h2><table id="procs"></table></div>
+<div id="lessonsaid"></div><ol id="lesson"></ol></div>
+<div class="pane"><h2>Scorecard (live)</h2><table id="score"></table></div>
+<div class="pane"><h2>Events</h2><div id="events" tabindex="0" aria-label="the session's events"></div></div>
+<div class="pane"><details><summary>Processes: rates, latency, losses</summary><table id="procs"></table></details></div>
+</div>
 </main>
 <script>
 "use strict";
 const token = new URLSearchParams(location.search).get("token") || "";
 const q = (p) => p + (p.includes("?") ? "&" : "?") + "token=" + encodeURIComponent(token);
 const $ = (id) => document.getElementById(id);
-const fmt = (x, n) => (x === null || x === undefined) ? "--" : Number(x).toFixed(n);
-let map = null, path = [], pathNext = 0, eventsNext = 0, lastStatus = null, instance = null;
+const fmt = (x, n) => (x === null || x === undefined || Number.isNaN(x)) ? "--" : Number(x).toFixed(n);
+let map = null, path = [], pathNext = 0, eventsNext = 0, plot = [], plotNext = 0, instance = null;
+let lastStatus = null, events = [], marks = [], failures = 0, debrief = false;
+// The cursor: null is live; else a DCP frame (the scrubbed time).
+let cursorFrame = null;
 // Text from the session's messages (process, host and counter names) is
 // never markup.
 const esc = (t) => String(t).replace(/[&<>"']/g, (c) => ({"&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;", "'": "&#39;"})[c]);
+const announce = (t) => { $("announce").textContent = t; };
 
 async function getJson(p) {
   const r = await fetch(q(p), {headers: {"X-Rmslab-Token": token}, cache: "no-store"});
-  if (!r.ok) throw new Error(p + ": " + r.status);
+  if (!r.ok) throw new Error(p.split("?")[0] + ": " + r.status);
   return r.json();
 }
 
-// Each view: the next image is asked for as soon as the last one arrived.
-function liveView(img, viewOf) {
+// Each view: the next image is asked for as soon as the last one is shown;
+// the last stays until the next has arrived (no broken image between).
+function liveView(img, label, viewOf) {
   let n = 0;
-  const next = () => { img.src = q("/api/view?v=" + viewOf() + "&n=" + (n++)); };
-  img.onload = () => { img.dataset.loads = String(Number(img.dataset.loads || 0) + 1); setTimeout(next, 30); };
-  img.onerror = () => setTimeout(next, 300);
+  const next = async () => {
+    const past = cursorFrame !== null;
+    const u = "/api/view?v=" + viewOf() + (past ? "&frame=" + cursorFrame : "") + "&n=" + (n++);
+    try {
+      const r = await fetch(q(u), {headers: {"X-Rmslab-Token": token}, cache: "no-store"});
+      if (r.status === 200) {
+        const blob = await r.blob();
+        const url = URL.createObjectURL(blob);
+        await new Promise((ok) => { img.onload = ok; img.onerror = ok; img.src = url; });
+        if (img.dataset.url) URL.revokeObjectURL(img.dataset.url);
+        img.dataset.url = url;
+        img.dataset.frame = r.headers.get("X-Rmslab-Frame") || "";
+        img.dataset.loads = String(Number(img.dataset.loads || 0) + 1);
+        label.textContent = "frame " + img.dataset.frame + (past ? " (past)" : "");
+        setTimeout(next, past ? 250 : 30);
+        return;
+      }
+    } catch (e) {}
+    setTimeout(next, 250);
+  };
   next();
 }
 
+// A command and its outcome: the processes that act on it answer done or
+// refused (RMS_CONTROL_ANSWER); the page says which, never just "sent".
 async function control(command, extra) {
   const body = new URLSearchParams(Object.assign({command}, extra || {}));
-  const r = await fetch(q("/api/control"), {method: "POST", body, headers: {"X-Rmslab-Token": token}});
-  const j = await r.json().catch(() => ({}));
-  $("said").textContent = r.ok ? ("sent " + command + (j.name ? " " + j.name : "")) : ("refused: " + (j.error || r.status));
-  $("said").className = r.ok ? "ok" : "bad";
-  refreshCheckpoints();
+  const said = $("said");
+  let r, j;
+  try {
+    r = await fetch(q("/api/control"), {method: "POST", body, headers: {"X-Rmslab-Token": token}});
+    j = await r.json().catch(() => ({}));
+  } catch (e) { said.textContent = command + ": not sent, no connection"; said.className = "bad"; return; }
+  if (!r.ok) { said.textContent = command + " refused: " + (j.error || r.status); said.className = "bad"; announce(said.textContent); return; }
+  const what = command + (j.name ? " " + j.name : "");
+  said.textContent = what + ": waiting for the answer"; said.className = "warn";
+  const end = Date.now() + 8000;
+  while (Date.now() < end) {
+    await new Promise((ok) => setTimeout(ok, 200));
+    const c = await getJson("/api/command?id=" + j.id).catch(() => null);
+    if (!c || c.state === "pending") continue;
+    const texts = c.answers.map((a) => a.process + ": " + a.text).join("; ");
+    said.textContent = what + ": " + (c.state === "done" ? "DONE, " : c.state === "refused" ? "REFUSED, " : "no answer within 3 s from " + c.expected.join(", ")) + texts;
+    said.className = c.state === "done" ? "ok" : "bad";
+    said.dataset.state = c.state;
+    announce(said.textContent);
+    refreshCheckpoints();
+    return;
+  }
+  said.textContent = what + ": no answer"; said.className = "bad"; said.dataset.state = "unanswered";
 }
 
-// The lesson: each event and whether it fired, when (session time).
 function showLesson(l) {
   const list = $("lesson");
-  list.innerHTML = "";
-  for (const e of (l.events || [])) {
-    const li = document.createElement("li");
-    li.textContent = e.text + (e.fired ? "  -- fired at " + fmt(e.fired_at_s, 1) + " s" : "  -- to come");
-    li.className = e.fired ? "ok" : "";
-    list.appendChild(li);
+  const key = JSON.stringify(l.events || []);
+  if (list.dataset.shown !== key) {
+    list.dataset.shown = key;
+    list.innerHTML = "";
+    for (const e of (l.events || [])) {
+      const li = document.createElement("li");
+      li.textContent = e.text + (e.fired ? "  -- fired at " + fmt(e.fired_at_s, 1) + " s" : "  -- to come");
+      li.className = e.fired ? "ok" : "";
+      list.appendChild(li);
+    }
   }
-  // (what the last load said stays until the next load: a refusal is not
-  // overwritten by the next poll)
   if (!lessonSaid) $("lessonsaid").textContent = l.loaded ? l.source : "none loaded";
 }
 
@@ -113,6 +217,7 @@ async function loadLesson(file) {
   $("lessonsaid").textContent = r.ok ? j.source :
     ("refused: " + (j.error || (r.status === 413 ? "a lesson file is at most 64 KiB" : r.status)));
   $("lessonsaid").className = r.ok ? "ok" : "bad";
+  announce($("lessonsaid").textContent);
   if (r.ok) showLesson(j);
 }
 
@@ -153,7 +258,6 @@ function malfunctionMenu() {
   };
 }
 
-// What a malfunction in force is repaired as: "joint 2 stuck" -> "joint 2".
 const repairOf = (t) => t.startsWith("joint") || t.startsWith("camera") ? t.split(" ").slice(0, 2).join(" ") : t.split(" ")[0];
 
 function showMalfunctions(list) {
@@ -163,7 +267,7 @@ function showMalfunctions(list) {
   div.innerHTML = list.length ? "" : "none in force";
   for (const t of list) {
     const row = document.createElement("div"), b = document.createElement("button");
-    b.textContent = "Repair"; b.onclick = () => control("repair", {name: repairOf(t)});
+    b.textContent = "Repair"; b.setAttribute("aria-label", "Repair " + t); b.onclick = () => control("repair", {name: repairOf(t)});
     row.className = "bad"; row.appendChild(document.createTextNode(t + " ")); row.appendChild(b);
     div.appendChild(row);
   }
@@ -172,6 +276,9 @@ function showMalfunctions(list) {
     b.onclick = () => control("repair", {name: "all"}); div.appendChild(b);
   }
 }
+
+const rate = () => (lastStatus && lastStatus.frame_rate_hz) || 30;
+const frameTime = (f) => f / rate();
 
 function drawMap() {
   const c = $("map"), g = c.getContext("2d");
@@ -182,7 +289,6 @@ function drawMap() {
   for (const p of path) { xs.push(p[1]); ys.push(p[2]); }
   const x0 = Math.min(...xs) - 3, x1 = Math.max(...xs) + 3, y0 = Math.min(...ys) - 3, y1 = Math.max(...ys) + 3;
   const s = Math.min(c.height / (x1 - x0), c.width / (y1 - y0));
-  // Seen from above (R: x aft, y starboard, z up): the nose up the page, starboard right.
   const P = (x, y) => [c.width / 2 + (y - (y0 + y1) / 2) * s, c.height / 2 + (x - (x0 + x1) / 2) * s];
   for (const o of map.outlines) {
     g.beginPath();
@@ -191,48 +297,124 @@ function drawMap() {
     g.strokeStyle = o.group === "cae" ? "#c9a" : "#789";
     g.stroke();
   }
+  const until = cursorFrame === null ? Infinity : frameTime(cursorFrame);
+  const shown = path.filter((p) => p[0] <= until + 1e-9);
   g.beginPath();
-  path.forEach((p, i) => { const [u, v] = P(p[1], p[2]); i ? g.lineTo(u, v) : g.moveTo(u, v); });
+  shown.forEach((p, i) => { const [u, v] = P(p[1], p[2]); i ? g.lineTo(u, v) : g.moveTo(u, v); });
   g.strokeStyle = "#fc3"; g.stroke();
-  if (path.length) {
-    const p = path[path.length - 1], [u, v] = P(p[1], p[2]);
+  if (shown.length) {
+    const p = shown[shown.length - 1], [u, v] = P(p[1], p[2]);
     g.fillStyle = "#f63"; g.beginPath(); g.arc(u, v, 4, 0, 7); g.fill();
   }
 }
 
-function showStatus(s) {
-  lastStatus = s;
-  if (instance !== null && s.instance !== instance) {
-    // The station restarted: its events and path begin again.
-    eventsNext = 0; pathNext = 0; path = [];
-    $("events").textContent = "";
+// The plot: the distance to the goal (white) and the six margins (colours)
+// against session time; events as ticks (mode changes, collisions,
+// malfunctions, commands, marks); the cursor as a line.
+const marginColours = ["#6af", "#7d7", "#eb4", "#f7a", "#a8f", "#4dd"];
+function drawPlot() {
+  const c = $("plot"), g = c.getContext("2d");
+  g.clearRect(0, 0, c.width, c.height);
+  if (!plot.length) return;
+  const t0 = plot[0][0], t1 = Math.max(plot[plot.length - 1][0], t0 + 1);
+  let lo = -0.5, hi = 2;
+  for (const p of plot) {
+    if (p[3] !== null) hi = Math.max(hi, Math.min(p[3], 60));
+    for (const m of p[4]) if (m !== null) { lo = Math.max(Math.min(lo, m), -5); hi = Math.max(hi, Math.min(m, 60)); }
   }
-  instance = s.instance;
-  const d = s.dcp;
-  $("opstation").textContent = s.camera_station ? "(station " + s.camera_station + ")" : "";
-  if (d) {
-    $("clock").textContent = "t " + fmt(d.session_s, 1) + " s  frame " + d.frame;
-    $("mode").textContent = "MODE " + d.mode;
-    $("flags").innerHTML = (d.acquired ? "<span class=ok>ACQUIRED</span> " : "not acquired ") +
-      (d.docked ? "<span class=ok>DOCKED</span> " : "") + (d.held ? "<span class=bad>HELD</span>" : "");
-    $("collisions").innerHTML = d.collisions ? "<span class=bad>collision: " + esc(d.collisions) + "</span>" : "no collision";
-    let rows = "<tr><th>condition</th><th>holds</th><th>margin ft</th></tr>";
-    for (const c of d.acquisition_conditions)
-      rows += d.mode === 1
-        ? "<tr><td>" + esc(c.name) + "</td><td class=" + (c.holds ? "ok>yes" : "bad>no") + "</td><td>" + fmt(c.margin_ft, 3) + "</td></tr>"
-        : "<tr><td>" + esc(c.name) + "</td><td colspan=2>(Mode 1 only: acquired)</td></tr>";
-    rows += "<tr><td>docking distance</td><td></td><td>" + fmt(d.dock_distance_ft, 3) + " (&le; " + fmt(d.dock_distance_limit_ft, 2) + ")</td></tr>";
-    rows += "<tr><td>docking angle, deg</td><td></td><td>" + fmt(d.dock_angle_deg, 2) + " (&le; " + fmt(d.dock_angle_limit_deg, 2) + ")</td></tr>";
-    rows += "<tr><td>clear of the bay, ft</td><td></td><td>" + fmt(d.bay_clearance_ft, 2) + "</td></tr>";
-    // Each joint as commanded and as it is: a failed joint shows here.
-    (map ? map.joints : []).forEach((n, i) => {
-      const off = Math.abs(d.master_angles_deg[i] - d.slave_angles_deg[i]) > 0.5;
-      rows += "<tr><td>joint " + (i + 1) + " " + esc(n) + ", deg</td><td></td><td" + (off ? " class=bad" : "") + ">" +
-        fmt(d.slave_angles_deg[i], 1) + " (commanded " + fmt(d.master_angles_deg[i], 1) + ")</td></tr>";
+  const X = (t) => 30 + (t - t0) / (t1 - t0) * (c.width - 36), Y = (v) => c.height - 14 - (v - lo) / (hi - lo) * (c.height - 22);
+  g.strokeStyle = "#444"; g.beginPath(); g.moveTo(30, Y(0)); g.lineTo(c.width, Y(0)); g.stroke();
+  g.fillStyle = "#aaa"; g.font = "11px sans-serif";
+  g.fillText(fmt(hi, 0), 2, 12); g.fillText("0", 2, Y(0) + 4); g.fillText(fmt(t0, 0) + " s", 30, c.height - 2); g.fillText(fmt(t1, 0) + " s", c.width - 40, c.height - 2);
+  const line = (get, colour) => {
+    g.strokeStyle = colour; g.beginPath(); let on = false;
+    for (const p of plot) { const v = get(p); if (v === null || p[2] !== 1 && get !== goal) { on = false; continue; } const [u, w] = [X(p[0]), Y(Math.max(lo, Math.min(hi, v)))]; on ? g.lineTo(u, w) : g.moveTo(u, w); on = true; }
+    g.stroke();
+  };
+  const goal = (p) => p[3];
+  for (let i = 0; i < 6; ++i) line((p) => p[4][i], marginColours[i]);
+  g.lineWidth = 2; line(goal, "#fff"); g.lineWidth = 1;
+  const tick = {mode: "#fff", collision: "#f55", malfunction: "#f90", control: "#6af", mark: "#ff0", acquired: "#7d7", docked: "#7d7"};
+  for (const e of events) {
+    const col = tick[e.kind]; if (!col || e.session_s < t0) continue;
+    g.strokeStyle = col; g.beginPath(); g.moveTo(X(e.session_s), 0); g.lineTo(X(e.session_s), 8); g.stroke();
+  }
+  for (const m of marks) { g.fillStyle = "#ff0"; g.fillRect(X(m.session_s) - 2, 0, 4, 10); }
+  if (cursorFrame !== null) { g.strokeStyle = "#ff0"; g.beginPath(); g.moveTo(X(frameTime(cursorFrame)), 0); g.lineTo(X(frameTime(cursorFrame)), c.height); g.stroke(); }
+}
+
+function showBanner(s) {
+  const st = s.session || {}, b = $("banner");
+  let text = st.state || "WAITING", cls = "";
+  if (st.state === "FROZEN") { text = "FROZEN since " + new Date(st.frozen_wall_us / 1000).toLocaleTimeString() + " (t " + fmt(st.frozen_session_s, 1) + " s)"; cls = "frozen"; }
+  else if (st.state === "SESSION ENDED") { text = "SESSION ENDED: " + (st.ended_how || ""); cls = "ended"; }
+  else if (st.state === "DEBRIEF") { text = "DEBRIEF of a recorded session" + (st.ended_how ? ": " + st.ended_how : ""); cls = "debrief"; }
+  else if (st.state === "WAITING") cls = "waiting";
+  if (b.textContent !== text) { b.textContent = text; announce(text); }
+  b.className = cls;
+  debrief = !!st.debrief;
+  $("note").textContent = st.restarted ? "STATION RESTARTED: its history recovered from the session's log" : "";
+  for (const id of ["freeze", "run", "step", "reset", "checkpoint", "restore", "inject"]) $(id).disabled = debrief || st.ended;
+}
+
+function showTrainee(s) {
+  const o = s.operator;
+  if (!o) { $("trainee").textContent = "no operator state yet"; }
+  else {
+    $("trainee").innerHTML = "<b>" + esc(o.source) + "</b>" + (o.source !== "by hand" ? "" : ": " + esc(o.control_mode) +
+      (o.control_mode === "manual augmented" ? ", frame " + esc(o.command_frame) : "") +
+      (o.joint ? ", joint " + esc(o.joint) : "") + ", " + (o.vernier ? "vernier" : "coarse") +
+      ", " + o.key_actions + " key presses");
+    const names = ["x", "roll", "y", "pitch", "z", "yaw"], order = [0, 3, 1, 4, 2, 5];
+    let h = "";
+    order.map((k) => o.hand_rate[k]).forEach((v, i) => {
+      const f = Math.max(-1, Math.min(1, v || 0));
+      h += "<span>" + names[i] + "</span><div class=bar><i style='left:" + (50 + Math.min(0, f) * 50) + "%;width:" + Math.abs(f) * 50 + "%'></i></div><span>" + fmt(v, 2) + "</span>";
     });
-    rows += "<tr><td>finger lever</td><td></td><td>" + fmt(d.slave_finger, 2) + " (commanded " + fmt(d.master_finger, 2) + ")</td></tr>";
-    $("acq").innerHTML = rows;
+    $("hands").innerHTML = h;
+    const gd = o.guidance;
+    $("guidance").innerHTML = gd ? "to " + esc(gd.target) + ": " + fmt(gd.distance_ft, 2) + " ft, " + fmt(gd.angle_deg, 1) +
+      " deg (offset " + gd.offset_ft.map((v) => fmt(v, 2)).join(", ") + " ft)" : "no guidance";
   }
+  const w = s.warnings || [];
+  $("warnings").innerHTML = w.map((t) => "<div>" + esc(t) + "</div>").join("");
+}
+
+function showJoints(d, mal) {
+  if (!d || !map) return;
+  const stuck = (i) => mal.some((t) => t.startsWith("joint " + (i + 1) + " "));
+  let rows = "<tr><th>joint</th><th>deg</th><th>commanded</th></tr>";
+  map.joints.forEach((n, i) => {
+    const bad = Math.abs(d.master_angles_deg[i] - d.slave_angles_deg[i]) > 0.5 || stuck(i);
+    rows += "<tr><td>" + (i + 1) + " " + esc(n) + "</td><td" + (bad ? " class=bad" : "") + ">" + fmt(d.slave_angles_deg[i], 1) +
+      "</td><td>" + fmt(d.master_angles_deg[i], 1) + "</td></tr>";
+  });
+  const finger = mal.some((t) => t.startsWith("finger")) || Math.abs(d.master_finger - d.slave_finger) > 0.02;
+  rows += "<tr id=fingerrow><td>finger lever</td><td" + (finger ? " class=bad" : "") + ">" + fmt(d.slave_finger, 2) + "</td><td>" + fmt(d.master_finger, 2) + "</td></tr>";
+  $("joints").innerHTML = rows;
+}
+
+function showAcquisition(d) {
+  if (!d) return;
+  let h = "";
+  if (d.mode === 1) for (const c of d.acquisition_conditions)
+    h += "<span class=" + (c.holds ? "ok" : "bad") + ">" + esc(c.name) + " " + fmt(c.margin_ft, 2) + "</span>";
+  h += "<span>dock " + fmt(d.dock_distance_ft, 2) + " ft (&le; " + fmt(d.dock_distance_limit_ft, 2) + "), " + fmt(d.dock_angle_deg, 1) + " deg (&le; " + fmt(d.dock_angle_limit_deg, 1) + ")</span>";
+  h += "<span>clear of the bay " + fmt(d.bay_clearance_ft, 2) + " ft</span>";
+  $("acq").innerHTML = h;
+}
+
+function showScore(c) {
+  if (!c) return;
+  const rows = [["attempt", c.attempts], ["session time", fmt(c.session_s, 1) + " s"],
+    ["Mode 1 / 2 / 3", c.mode_s.map((v) => fmt(v, 1)).join(" / ") + " s"], ["collisions", c.collisions + " (" + fmt(c.collision_s, 1) + " s)"],
+    ["holds", c.holds], ["malfunctions", c.malfunctions], ["acquired at", c.acquired_at_s === null ? "--" : fmt(c.acquired_at_s, 1) + " s"],
+    ["docked at", c.docked_at_s === null ? "--" : fmt(c.docked_at_s, 1) + " s"], ["closest to the port", fmt(c.closest_to_port_ft, 2) + " ft"],
+    ["key presses", c.key_actions]];
+  $("score").innerHTML = rows.map((r) => "<tr><td>" + r[0] + "</td><td>" + esc(r[1]) + "</td></tr>").join("");
+}
+
+function showProcesses(s) {
   let rows = "<tr><th>process</th><th>state</th><th>Hz</th><th>latency p50/p99 ms</th><th>dropped</th></tr>";
   for (const [name, p] of Object.entries(s.processes)) {
     const lat = Object.entries(p.latency).map(([k, v]) => esc(k) + " " + fmt(v.p50_ms, 1) + "/" + fmt(v.p99_ms, 1)).join("<br>");
@@ -240,30 +422,113 @@ function showStatus(s) {
       "</td><td>" + fmt(p.rate_hz, 1) + "</td><td>" + lat + "</td><td>" + fmt(p.dropped, 0) + "</td></tr>";
   }
   $("procs").innerHTML = rows;
+}
+
+function showStatus(s) {
+  if (instance !== null && s.instance !== instance) {
+    // The station restarted: it read its history again from the session's
+    // log; the lists are read again from the start.
+    eventsNext = 0; pathNext = 0; path = []; plotNext = 0; plot = []; events = [];
+    $("events").textContent = "";
+    announce("the instructor's station restarted: its history read again");
+  }
+  instance = s.instance;
+  lastStatus = s;
+  showBanner(s);
+  const d = s.dcp;
+  $("opstation").textContent = s.camera_station ? "(station " + s.camera_station + ")" : "";
+  if (d) {
+    $("clock").textContent = "t " + fmt(d.session_s, 1) + " s, frame " + d.frame;
+    $("mode").textContent = "MODE " + d.mode;
+    $("flags").innerHTML = (d.acquired ? "<span class=ok>ACQUIRED</span> " : "") +
+      (d.docked ? "<span class=ok>DOCKED</span> " : "") + (d.held ? "<span class=bad>HELD</span> " : "") +
+      (d.collisions ? "<span class=bad>COLLISION " + esc(d.collisions) + "</span>" : "");
+  }
+  showTrainee(s);
+  showJoints(d, s.malfunctions || []);
+  showAcquisition(d);
+  showScore(s.scorecard);
+  showProcesses(s);
   showMalfunctions(s.malfunctions || []);
+  const h = s.history, sc = $("scrub");
+  if (h) { sc.min = String(h.first_frame); sc.max = String(h.last_frame); if (cursorFrame === null) sc.value = sc.max; }
+}
+
+function showEvents(ev) {
+  for (const e of ev) {
+    events.push(e);
+    const line = document.createElement("div");
+    line.textContent = fmt(e.session_s, 1).padStart(7) + " s  " + e.text;
+    line.dataset.kind = e.kind; line.dataset.t = String(e.session_s);
+    if (e.kind === "answer" && / REFUSED, /.test(e.text)) line.className = "bad";
+    $("events").appendChild(line);
+    eventsNext = e.seq + 1;
+    if (e.kind === "station" || e.kind === "failure" || e.kind === "malfunction") announce(e.text);
+  }
+  if (ev.length && cursorFrame === null) $("events").scrollTop = 1e9;
+}
+
+// The events under the cursor: those after it dimmed; the nearest before it in view.
+function markCursorEvents() {
+  const lines = $("events").children;
+  if (cursorFrame === null) { for (const l of lines) l.className = l.className.replace(/\s*after/, ""); return; }
+  const t = frameTime(cursorFrame);
+  let last = null;
+  for (const l of lines) {
+    const after = Number(l.dataset.t) > t + 1e-9;
+    l.classList.toggle("after", after);
+    if (!after) last = l;
+  }
+  if (last) last.scrollIntoView({block: "nearest"});
 }
 
 async function poll() {
   try {
     showStatus(await getJson("/api/status"));
-    const ev = await getJson("/api/events?since=" + eventsNext);
-    for (const e of ev) {
-      const line = document.createElement("div");
-      line.textContent = fmt(e.session_s, 1).padStart(7) + " s  " + e.text;
-      line.dataset.kind = e.kind;
-      $("events").appendChild(line);
-      eventsNext = e.seq + 1;
-    }
-    if (ev.length) $("events").scrollTop = 1e9;
+    showEvents(await getJson("/api/events?since=" + eventsNext));
     showLesson(await getJson("/api/lesson"));
     const p = await getJson("/api/path?since=" + pathNext);
     path = path.concat(p.points); pathNext = p.next;
-    drawMap();
-    $("conn").textContent = "";
+    const pl = await getJson("/api/plot?since=" + plotNext);
+    plot = plot.concat(pl.points); plotNext = pl.next;
+    if (plot.length > 20000) plot = plot.slice(-20000);
+    marks = await getJson("/api/marks");
+    drawMap(); drawPlot(); markCursorEvents();
+    failures = 0;
   } catch (e) {
-    $("conn").innerHTML = "<span class=bad>" + esc(e.message) + "</span>";
+    // The station is gone or unreachable: said, and tried again.
+    ++failures;
+    const ended = lastStatus && lastStatus.session && lastStatus.session.ended;
+    const b = $("banner");
+    const text = ended ? "SESSION ENDED: " + (lastStatus.session.ended_how || "") + " -- the station has closed (for a debrief: scripts/lab debrief SESSION)"
+                       : "CONNECTION LOST to the instructor's station (" + e.message + "): retrying, attempt " + failures;
+    if (b.textContent !== text) { b.textContent = text; announce(text); }
+    b.className = ended ? "ended" : "lost";
   }
-  setTimeout(poll, 250);
+  setTimeout(poll, failures ? Math.min(5000, 500 * failures) : 250);
+}
+
+function scrubTo(frame) {
+  cursorFrame = frame;
+  $("cursor").textContent = frame === null ? "live" : "t " + fmt(frameTime(frame), 1) + " s (frame " + frame + ")";
+  // Initial conditions from this instant: a new session branched from it
+  // (docs/sessions.md "Branching"), its pose the one the views show.
+  const dir = lastStatus && lastStatus.session && lastStatus.session.session_dir;
+  $("branch").textContent = frame !== null && dir ? "start a session from here: scripts/lab demo --from " + dir + "@f" + frame : "";
+  drawMap(); drawPlot(); markCursorEvents();
+}
+
+async function placeMark() {
+  const text = $("marktext").value.trim();
+  if (!text) { $("said").textContent = "a mark needs a note"; $("said").className = "bad"; return; }
+  const f = cursorFrame !== null ? cursorFrame : Number($("scrub").max);
+  const body = new URLSearchParams({text, t: String(frameTime(f))});
+  const r = await fetch(q("/api/mark"), {method: "POST", body, headers: {"X-Rmslab-Token": token}});
+  const j = await r.json().catch(() => ({}));
+  $("said").textContent = r.ok ? "marked at " + fmt(j.session_s, 1) + " s: " + j.text : "mark refused: " + (j.error || r.status);
+  $("said").className = r.ok ? "ok" : "bad";
+  announce($("said").textContent);
+  if (r.ok) $("marktext").value = "";
 }
 
 async function start() {
@@ -272,14 +537,17 @@ async function start() {
   (map ? map.stations : ["1", "2", "3", "4", "5", "6", "7", "8"]).forEach((n, i) => {
     const o = document.createElement("option"); o.value = String(i + 1); o.textContent = (i + 1) + " " + n; sel.appendChild(o);
   });
-  liveView($("view0"), () => 0);
-  liveView($("view1"), () => sel.value);
+  liveView($("view0"), $("frame0"), () => 0);
+  liveView($("view1"), $("frame1"), () => sel.value);
   $("freeze").onclick = () => control("freeze");
   $("run").onclick = () => control("run");
   $("step").onclick = () => control("step");
   $("reset").onclick = () => control("reset");
   $("checkpoint").onclick = () => control("checkpoint", {name: $("cpname").value});
   $("restore").onclick = () => control("restore", {name: $("cplist").value});
+  $("scrub").oninput = (e) => scrubTo(Number(e.target.value) >= Number(e.target.max) && !debrief ? null : Number(e.target.value));
+  $("live").onclick = () => { $("scrub").value = $("scrub").max; scrubTo(null); };
+  $("mark").onclick = placeMark;
   if (map) malfunctionMenu();
   $("lessonfile").onchange = (e) => { if (e.target.files[0]) loadLesson(e.target.files[0]); };
   refreshCheckpoints();

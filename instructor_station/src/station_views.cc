@@ -57,20 +57,75 @@ void StationViews::Update(const wire::DcpFrameData& dcp, std::uint32_t lost_stat
     // every frame, watched or not, as scene_proc's does.
     if (v != kOperatorView && !watched[v]) continue;
     if (stepped_frame_[v] != dcp.frame) {
-      wire::DcpFrameData d = dcp;
-      if (v != kOperatorView) {
-        d.control.camera_station = v;  // the station at its default aim, widest
-        d.camera_pan_deg = d.camera_tilt_deg = d.camera_zoom = 0.0;
-        d.control.no_video = (lost_stations >> (v - 1)) & 1u;  // a lost station: no picture
-      }
-      content_[v] = programs_[v]->Step(d, frame_count, nullptr);
+      content_[v] = programs_[v]->Step(AsStation(dcp, v, lost_stations), frame_count, nullptr);
       stepped_frame_[v] = dcp.frame;
     }
     if (due[v]) Draw(v, content_[v], dcp.frame);
   }
 }
 
+// View v's DCP frame: the operator's as it is; a station at its default
+// aim, widest, black when it is lost.
+wire::DcpFrameData StationViews::AsStation(wire::DcpFrameData d, int v,
+                                           std::uint32_t lost_stations) {
+  if (v != kOperatorView) {
+    d.control.camera_station = v;
+    d.camera_pan_deg = d.camera_tilt_deg = d.camera_zoom = 0.0;
+    d.control.no_video = (lost_stations >> (v - 1)) & 1u;
+  }
+  return d;
+}
+
 void StationViews::Draw(int view, const wire::EsgFrameData& e, std::int64_t frame) {
+  ViewImage img = Render(e, frame);
+  std::lock_guard<std::mutex> lock(mu_);
+  images_[view] = std::move(img);
+  drawn_at_[view] = Clock::now();
+}
+
+void StationViews::RequestPast(int view, std::int64_t frame) {
+  if (view < 0 || view >= kNumViews) throw std::out_of_range("view");
+  std::lock_guard<std::mutex> lock(mu_);
+  past_asked_[view] = frame;
+}
+
+ViewImage StationViews::Past(int view, std::int64_t frame) const {
+  std::lock_guard<std::mutex> lock(mu_);
+  const ViewImage& img = past_.at(static_cast<std::size_t>(view));
+  if (past_asked_[view] == frame && img.png.size() > 1 && img.frame >= 0) return img;
+  return {};
+}
+
+std::optional<std::pair<int, std::int64_t>> StationViews::PendingPast() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  for (int v = 0; v < kNumViews; ++v) {
+    if (past_asked_[v] >= 0 && (past_[v].png.empty() || past_[v].frame != past_asked_[v]))
+      return std::make_pair(v, past_asked_[v]);
+  }
+  return std::nullopt;
+}
+
+void StationViews::DrawPast(int view, std::int64_t asked_frame,
+                            const std::vector<wire::DcpFrameData>& frames,
+                            std::uint32_t lost_stations) {
+  ViewImage img;
+  if (!frames.empty()) {
+    // A program of its own, run up over the lead-in as the live one ran.
+    scene_proc::VisualSceneProgram program(config_);
+    wire::EsgFrameData e;
+    for (const wire::DcpFrameData& d : frames)
+      e = program.Step(AsStation(d, view, lost_stations),
+                       static_cast<std::uint32_t>(d.frame & 0xFFFFFF), nullptr);
+    img = Render(e, frames.back().frame);
+  }
+  std::lock_guard<std::mutex> lock(mu_);
+  if (past_asked_[view] != asked_frame) return;  // asked for another meanwhile
+  img.frame = asked_frame;                       // what was asked (the nearest kept drawn)
+  if (img.png.empty()) img.png = {0};            // nothing kept: answered, not drawn again
+  past_[view] = std::move(img);
+}
+
+ViewImage StationViews::Render(const wire::EsgFrameData& e, std::int64_t frame) {
   // Through the words, as the ESG receives them (the same rounding).
   const wire::EsgFrameData f = wire::UnpackEsgWords(wire::PackEsgWords(e, nullptr));
   renderer_->Render(f);
@@ -81,9 +136,7 @@ void StationViews::Draw(int view, const wire::EsgFrameData& e, std::int64_t fram
   img.frame = frame;
   img.png = esg_renderer::EncodePng(width_, height_, rgba.data());
   counters_->Add(Counter::kViewsRendered);
-  std::lock_guard<std::mutex> lock(mu_);
-  images_[view] = std::move(img);
-  drawn_at_[view] = Clock::now();
+  return img;
 }
 
 }  // namespace rms::instructor_station

@@ -5,6 +5,7 @@
 
 #include <arpa/inet.h>
 #include <atomic>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <map>
@@ -23,15 +24,21 @@
 
 namespace rms::instructor_station {
 
-void ControlQueue::Push(ControlRequest r) {
+std::int64_t ControlQueue::Push(ControlRequest r) {
   std::lock_guard<std::mutex> lock(mu_);
+  r.id = next_id_++;
   queue_.push_back(std::move(r));
+  return queue_.back().id;
 }
 
-std::vector<ControlRequest> ControlQueue::Drain() {
+std::vector<ControlRequest> ControlQueue::Drain(std::int64_t now_us) {
   std::lock_guard<std::mutex> lock(mu_);
   std::vector<ControlRequest> out;
-  out.swap(queue_);
+  // In order: one not yet due holds back those after it.
+  std::size_t n = 0;
+  while (n < queue_.size() && queue_[n].not_before_us <= now_us) ++n;
+  out.assign(queue_.begin(), queue_.begin() + static_cast<std::ptrdiff_t>(n));
+  queue_.erase(queue_.begin(), queue_.begin() + static_cast<std::ptrdiff_t>(n));
   return out;
 }
 
@@ -206,6 +213,8 @@ struct WebServer::Impl {
   Answer Serve(const Request& req);
   Answer Route(const Request& req);
   Answer Control(const Request& req);
+  Answer PastView(const Request& req, int view);
+  Answer Mark(const Request& req);
   Answer LoadLesson(const Request& req);
   Answer Checkpoints() const;
   static MHD_Result OnRequest(void* cls, MHD_Connection* c, const char* url, const char* method,
@@ -260,6 +269,7 @@ Answer WebServer::Impl::Route(const Request& req) {
     return Checkpoints();
   } else if (get && req.path == "/api/view") {
     const int v = static_cast<int>(IntParam(req, "v", 0, 0, kNumViews - 1));
+    if (req.has_param("frame")) return PastView(req, v);
     views->Request(v);
     const ViewImage img = views->Latest(v);
     a.headers = {{"Cache-Control", "no-store"}, {"X-Rmslab-Frame", std::to_string(img.frame)}};
@@ -273,6 +283,17 @@ Answer WebServer::Impl::Route(const Request& req) {
     }
   } else if (req.method == "POST" && req.path == "/api/control") {
     return Control(req);
+  } else if (get && req.path == "/api/command") {
+    const std::int64_t id = IntParam(req, "id", 0, 0, std::int64_t{1} << 40);
+    a.body = Json(watch->CommandJson(id));
+  } else if (get && req.path == "/api/plot") {
+    const auto since =
+        static_cast<std::size_t>(IntParam(req, "since", 0, 0, std::int64_t{1} << 40));
+    a.body = Json(watch->PlotJson(since));
+  } else if (get && req.path == "/api/marks") {
+    a.body = Json(watch->MarksJson());
+  } else if (req.method == "POST" && req.path == "/api/mark") {
+    return Mark(req);
   } else if (get && req.path == "/api/lesson") {
     a.body = Json(lesson->Json());
   } else if (req.method == "POST" && req.path == "/api/lesson") {
@@ -287,6 +308,13 @@ Answer WebServer::Impl::Route(const Request& req) {
 }
 
 Answer WebServer::Impl::Control(const Request& req) {
+  if (options.debrief) {
+    Answer a;
+    a.status = 409;
+    a.body = Json(nlohmann::json{{"error", "a debrief of a recorded session: nothing to control"}});
+    ++refused;
+    return a;
+  }
   const std::string command = req.param("command");
   ControlRequest r;
   r.command = CommandCode(command);
@@ -307,10 +335,69 @@ Answer WebServer::Impl::Control(const Request& req) {
   // timed freeze's (docs/lessons.md "From the instructor's station").
   if (r.command == session_control_t::FREEZE || r.command == session_control_t::RUN)
     lesson->CancelTimedRuns();
-  for (int i = 0; i < steps; ++i) controls->Push(r);
+  // docs/sessions.md "Freeze, run, step, checkpoint": a restore freezes the
+  // session first and lets the last frames through, as scripts/lab control
+  // does, so the DCP restores with no frame in flight.
+  if (r.command == session_control_t::RESTORE) {
+    controls->Push({session_control_t::FREEZE, "", -1, 0});
+    r.not_before_us = transport::WallTimeUs() + 300'000;
+  }
+  std::int64_t id = -1;
+  for (int i = 0; i < steps; ++i) id = controls->Push(r);
   sent += steps;
+  // Its outcome comes as the processes answer: GET /api/command?id=ID.
   Answer a;
-  a.body = Json(nlohmann::json{{"sent", command}, {"name", r.name}, {"times", steps}});
+  a.body =
+      Json(nlohmann::json{{"id", id}, {"command", command}, {"name", r.name}, {"times", steps}});
+  return a;
+}
+
+// GET /api/view?v=V&frame=F: view V at DCP frame F (the nearest kept at or
+// before it), drawn on the LCM thread: 503 until it is (ask again).
+Answer WebServer::Impl::PastView(const Request& req, int v) {
+  const std::int64_t frame = IntParam(req, "frame", 0, 0, std::int64_t{1} << 48);
+  Answer a;
+  a.headers = {{"Cache-Control", "no-store"}};
+  if (watch->HistoryRange().first < 0) {
+    a.status = 404;
+    a.content_type = "text/plain";
+    a.body = "no DCP frame kept yet\n";
+    return a;
+  }
+  views->RequestPast(v, frame);
+  const ViewImage img = views->Past(v, frame);
+  if (img.png.empty()) {
+    a.status = 503;
+    a.content_type = "text/plain";
+    a.body = "not drawn yet\n";
+    return a;
+  }
+  a.headers.emplace_back("X-Rmslab-Frame", std::to_string(img.frame));
+  a.content_type = "image/png";
+  a.body.assign(reinterpret_cast<const char*>(img.png.data()), img.png.size());
+  return a;
+}
+
+// POST /api/mark: form fields `text` (1..500 bytes) and `t` (session time,
+// s; default: the newest frame's).
+Answer WebServer::Impl::Mark(const Request& req) {
+  std::string text = req.param("text");
+  if (text.empty() || text.size() > 500)
+    throw InputError("form field 'text': a note of 1..500 bytes");
+  for (char& c : text)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = ' ';
+  double t_s = 0.0;
+  if (req.has_param("t")) {
+    const std::string v = req.param("t");
+    char* end = nullptr;
+    t_s = std::strtod(v.c_str(), &end);
+    if (v.empty() || !end || *end != '\0' || !std::isfinite(t_s) || t_s < 0 || t_s > 1e7)
+      throw InputError("parameter t='" + v.substr(0, 32) + "': a session time, s, 0..1e7");
+  } else if (const auto d = watch->LatestDcpFrame()) {
+    t_s = static_cast<double>(d->frame) / config.session.frame_rate_hz;
+  }
+  Answer a;
+  a.body = Json(watch->AddMark(t_s, text));
   return a;
 }
 

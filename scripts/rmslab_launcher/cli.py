@@ -15,10 +15,11 @@
                                              every design flown afresh by virtual subjects
   scripts/lab export SESSION [--mcap]        every channel to CSV, or the log as MCAP
   scripts/lab report SESSION                 one self-contained HTML report
+  scripts/lab debrief SESSION [--port N]     the instructor's page over a recorded session: scrub, mark
   scripts/lab compare SESSION...             scorecards side by side, learning curves
   scripts/lab study check|run|status STUDY   a study of subjects, conditions and trials (docs/studies.md)
   scripts/lab monitor [--lcm-url URL]        live decoded traffic per channel
-  scripts/lab control [--session DIR] freeze|run|step [N]|checkpoint NAME|restore NAME|FILE [--run]
+  scripts/lab control [--session DIR] freeze|run|step [N]|reset|checkpoint NAME|restore NAME|FILE [--run]
                       | malfunction WHAT... | repair WHAT...   e.g. malfunction joint 2 stuck
 
 demo: installs what is missing, builds, checks every file the session will
@@ -57,7 +58,7 @@ def main(argv):
             return sweep.run(rest)
         if cmd == "study":
             return study.run(rest)
-        if cmd in ("resim", "export", "report", "compare", "monitor", "control"):
+        if cmd in ("resim", "export", "report", "compare", "monitor", "control", "debrief"):
             return getattr(tools, cmd)(rest)
         if cmd in ("help", "-h", "--help"):
             print(__doc__.split("\n", 2)[2])

@@ -225,6 +225,10 @@ class Demo:
         extra = self.instructor_args() + ["--url-file", url_file,
                                           "--checkpoint-dir", os.path.join(self.out, "checkpoints"),
                                           "--lesson-state", os.path.join(self.out, "run", "instructor_lesson.json")]
+        if not self.hosts["instructor_station"].remote:
+            # a restarted station reads its history back from the log
+            extra += ["--session-dir", self.out,
+                      "--marks-file", os.path.join(self.out, "instructor_marks.jsonl")]
         if self.a.instructor_lesson:
             extra += ["--lesson", os.path.join(self.out, "instructor_lesson.toml")]
         self.sup.add(self.spec("instructor_station", extra, env=self.instructor_env()))
@@ -510,8 +514,12 @@ class Demo:
         self.sup.stop(["operator_station"])
         if self.interrupted is None and self.sup.fatal is None:
             time.sleep(0.5)  # the last frames through the pipeline
-        self.sup.stop(["esg_renderer", "scene_proc", "dynamics_proc"] +
-                      (["instructor_station"] if self.a.instructor is not None else []))
+        self.sup.stop(["esg_renderer", "scene_proc", "dynamics_proc"])
+        if self.a.instructor is not None:
+            # Open pages poll once more and show the session ended, with how
+            # (docs/instructor.md "The banner").
+            time.sleep(1.0)
+            self.sup.stop(["instructor_station"])
         time.sleep(0.3)
         self.sup.stop(["lcm-logger"])
         self.sup.record_exit_codes()

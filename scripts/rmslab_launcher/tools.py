@@ -188,6 +188,68 @@ def report(argv):
     return subprocess.run([binary("tools/rms_report"), a.session] + (["--out", a.out] if a.out else [])).returncode
 
 
+def debrief(argv):
+    """scripts/lab debrief SESSION [--port N] [--bind ADDRESS] [--for SECONDS]:
+    the instructor's page over a recorded session (docs/instructor.md
+    "Debrief"): scrub through it -- any station's view at any session time,
+    drawn from the log's DCP frames, the plots and events under the cursor
+    -- and place marks and notes on its timeline, kept in
+    SESSION/instructor_marks.jsonl and shown in the report. Nothing is sent
+    to any session. Runs until Ctrl-C (or --for SECONDS)."""
+    p = argparse.ArgumentParser(prog="scripts/lab debrief", description=debrief.__doc__)
+    p.add_argument("session")
+    p.add_argument("--port", type=int, default=8080, help="the page's port (0: any free one)")
+    p.add_argument("--bind", default="127.0.0.1", help="the address to serve on (beyond loopback the token "
+                   "crosses the network in clear: docs/security.md)")
+    p.add_argument("--for", dest="for_s", type=float, help="stop after this many seconds")
+    p.add_argument("--no-build", action="store_true")
+    a = p.parse_args(argv)
+    require_session_file(a.session)
+    require_session_file(a.session, "config.toml")
+    if not 0 <= a.port <= 65535:
+        raise LabError(f"--port {a.port}: 0..65535 (0: any free one)", 2)
+    if a.for_s is not None and not 0 < a.for_s <= 86400:
+        raise LabError(f"--for {a.for_s}: 0..86400 s", 2)
+    ensure("instructor_station/instructor_station", a.no_build)
+    import secrets
+    import signal
+    import tempfile
+    token = secrets.token_hex(16)
+    with tempfile.TemporaryDirectory(prefix="rmslab-debrief-") as tmp:
+        url_file = os.path.join(tmp, "debrief.url")
+        argv = [binary("instructor_station/instructor_station"), "--debrief", "--session-dir", a.session,
+                "--config", os.path.join(a.session, "config.toml"), "--lcm-url", "memq://",
+                "--bind", a.bind, "--port", str(a.port), "--url-file", url_file,
+                "--marks-file", os.path.join(a.session, "instructor_marks.jsonl"),
+                "--checkpoint-dir", os.path.join(a.session, "checkpoints")]
+        proc = subprocess.Popen(argv, env=dict(os.environ, RMSLAB_INSTRUCTOR_TOKEN=token))
+        try:
+            end = time.monotonic() + 60
+            while not os.path.exists(url_file):
+                if proc.poll() is not None:
+                    raise LabError(f"the debrief's station stopped (exit {proc.returncode}): see above", 1)
+                if time.monotonic() > end:
+                    raise LabError("the debrief's station did not start within 60 s", 1)
+                time.sleep(0.1)
+            say(f"debrief of {a.session}: {open(url_file).read().strip()}")
+            say("Ctrl-C stops it" if a.for_s is None else f"for {a.for_s:g} s")
+            try:
+                proc.wait(timeout=a.for_s)
+            except subprocess.TimeoutExpired:
+                pass
+        except KeyboardInterrupt:
+            pass
+        finally:
+            if proc.poll() is None:
+                proc.send_signal(signal.SIGINT)
+                try:
+                    proc.wait(timeout=10)
+                except subprocess.TimeoutExpired:
+                    proc.kill()
+                    proc.wait()
+    return 0 if proc.returncode in (0, -signal.SIGINT, 130) else proc.returncode
+
+
 def compare(argv):
     """scripts/lab compare SESSION... [--out DIR]: the scorecard of each
     session side by side, and each subject's learning curve across the
@@ -240,7 +302,7 @@ def running_sessions():
 
 
 def control(argv):
-    """scripts/lab control [--session DIR] freeze | run | step [N] | checkpoint NAME | restore NAME|FILE [--run]
+    """scripts/lab control [--session DIR] freeze | run | step [N] | reset | checkpoint NAME | restore NAME|FILE [--run]
                     | malfunction WHAT... | repair WHAT...:
     commands to a running session (docs/sessions.md "Freeze, run, step,
     checkpoint" and "Malfunctions"). WHAT is 'joint N stuck', 'joint N drift

@@ -105,8 +105,17 @@ try {
   result.view_changed_after_frames = (await dcpFrame(page)) - f0;
   console.log("ok station " + station + "'s image changed (" + moved.loads + " images loaded)");
   // 3. Freeze, then run.
+  const bannerText = () => page.$eval("#banner", (e) => e.textContent);
+  await until("the banner says RUNNING", async () => (await bannerText()) === "RUNNING", 20);
   await page.click("#freeze");
   await until("the freeze is in the event list", async () => /freeze \(from instructor_station\)/.test(await eventsText(page)), 10);
+  await until("the freeze answered done", async () =>
+      /freeze: DONE, operator_station: frozen at operator frame/.test(await page.$eval("#said", (e) => e.textContent)), 10);
+  result.frozen_banner = await until("the banner says FROZEN since", async () => {
+    const t = await bannerText();
+    return /^FROZEN since .* \(t [0-9.]+ s\)$/.test(t) ? t : null;
+  }, 10);
+  console.log("ok the banner: " + result.frozen_banner);
   await sleep(700);  // frames in flight through the pipeline
   const a = await dcpFrame(page);
   await sleep(1500);
@@ -114,9 +123,26 @@ try {
   result.frozen_frames = [a, b];
   if (a === null || a !== b) fail("frozen, the DCP's frame still moves (" + a + " -> " + b + ")");
   console.log("ok frozen: the DCP's frame holds at " + a);
+  // A checkpoint over an existing name is refused by the DCP, and said so.
+  const cp = "page-" + Date.now();
+  const said = () => page.$eval("#said", (e) => [e.dataset.state, e.textContent]);
+  for (let i = 0; i < 2; ++i) {
+    await page.$eval("#cpname", (e) => { e.value = ""; });
+    await page.type("#cpname", cp);
+    await page.click("#checkpoint");
+    const want = i === 0 ? "done" : "refused";
+    result["checkpoint_" + i] = await until("the checkpoint " + want, async () => {
+      const [st, text] = await said();
+      return st === want && text.startsWith("checkpoint " + cp) ? text : null;
+    }, 10);
+    await sleep(600);  // at most 2 checkpoints a second
+  }
+  if (!/REFUSED, dynamics_proc: .*exists already/.test(result.checkpoint_1)) fail("the refusal does not say why: " + result.checkpoint_1);
+  console.log("ok a checkpoint over an existing name: " + result.checkpoint_1);
   await page.click("#run");
   await until("the session runs again", async () => (await dcpFrame(page)) > b, 10);
-  console.log("ok run: the DCP's frame moves on");
+  await until("the banner says RUNNING again", async () => (await bannerText()) === "RUNNING", 10);
+  console.log("ok run: the DCP's frame moves on, the banner says RUNNING");
   // 4. Reset.
   const modeNow = () => page.evaluate(async () => {
     const token = new URLSearchParams(location.search).get("token");
@@ -162,8 +188,9 @@ try {
   await page.click("#inject");
   await until("the malfunction is in the event list", async () =>
       new RegExp("MALFUNCTION: joint " + joint + " stuck").test(await eventsText(page)), 10);
-  await until("the autopilot reports the joint not following", async () =>
-      /operator_station reports a joint or the finger NOT FOLLOWING/.test(await eventsText(page)), 20);
+  await until("the autopilot reports the joint, by name, not following", async () =>
+      new RegExp("operator_station reports [^\\n]*joint " + joint + " [a-z ]+[^\\n]*NOT FOLLOWING").test(await eventsText(page)), 20);
+  await until("the joint in red", async () => page.$eval("#joints", (t, j) => t.rows[j].cells[1].className === "bad", joint), 10);
   const s1 = (await status()).dcp;
   await sleep(1500);
   const s2 = (await status()).dcp;
@@ -206,7 +233,10 @@ try {
   const dir = fs.mkdtempSync(path.join(os.tmpdir(), "rmslab-lesson-"));
   const badLesson = path.join(dir, "bad.toml"), goodLesson = path.join(dir, "lesson.toml");
   fs.writeFileSync(badLesson, "[[events]]\nat_s = 0\ndo = \"malfunction joint 9 stuck\"\n");
-  fs.writeFileSync(goodLesson, "[[events]]\nat_s = 0\ndo = \"malfunction camera 7 lost\"\n");
+  // The second event waits for its condition: the payload within 40 ft of
+  // the CAE's port (Mode 3).
+  fs.writeFileSync(goodLesson, "[[events]]\nat_s = 0\ndo = \"malfunction camera 7 lost\"\n\n" +
+                   "[[events]]\nwhen = \"dock_distance_ft < 40\"\ndo = \"malfunction camera 6 lost\"\n");
   await (await page.$("#lessonfile")).uploadFile(badLesson);
   await until("a bad lesson refused naming its key", async () =>
       /refused: .*events\[0\]\.do/.test(await page.$eval("#lessonsaid", (e) => e.textContent)), 10);
@@ -216,15 +246,36 @@ try {
   await until("the DCP took it", async () => ((await status()).malfunctions || []).includes("camera 7 lost"), 10);
   fs.rmSync(dir, {recursive: true});
   console.log("ok a lesson loaded on the page: a bad one refused naming its key, a good one fired");
+  const cond = await until("the lesson's conditional event fires at its condition", async () => {
+    const s = await status();
+    return (s.malfunctions || []).includes("camera 6 lost") && s.dcp ? s.dcp : null;
+  }, 120);
+  result.conditional = {mode: cond.mode, dock_distance_ft: cond.dock_distance_ft};
+  if (cond.mode !== 3 || !(cond.dock_distance_ft < 40)) fail("the conditional event fired outside its condition: " + JSON.stringify(result.conditional));
+  console.log("ok the lesson's conditional malfunction fired in Mode 3, " + cond.dock_distance_ft.toFixed(1) + " ft from the port");
+  // The page's audit, live.
+  const {createRequire} = await import("node:module");
+  await page.evaluate(fs.readFileSync(createRequire(import.meta.url).resolve("axe-core/axe.min.js"), "utf8"));
+  const axe = await page.evaluate(async () => (await window.axe.run()).violations.map((v) => ({id: v.id, impact: v.impact})));
+  result.axe = axe;
+  const serious = axe.filter((v) => v.impact === "serious" || v.impact === "critical");
+  if (serious.length) fail("axe-core, live: " + serious.map((v) => v.id + " (" + v.impact + ")").join(", "));
+  console.log("ok axe-core, live: no serious or critical violation");
   // 8. Text from the session's messages is shown as text, never run.
   const forged = await page.evaluate(() => ({
     element: document.getElementById("forged") !== null,
     title: document.title,
-    shown: document.getElementById("procs").innerText.includes("<img id=forged"),
+    shown: document.getElementById("procs").textContent.includes("<img id=forged"),
   }));
   result.forged = forged;
   if (forged.element || forged.title === "pwned") fail("a forged process name became markup");
   if (forged.shown) console.log("ok a forged process name is shown as text");
+  // The session's end: the banner says so, with how, and stays.
+  result.ended = await until("the banner says SESSION ENDED", async () => {
+    const t = await bannerText();
+    return /^SESSION ENDED: DOCKED/.test(t) ? t : null;
+  }, 150);
+  console.log("ok the banner: " + result.ended);
   if (errors.length) fail("the page's scripts failed: " + errors.join("; "));
   result.ok = true;
   console.log(JSON.stringify(result));

@@ -18,6 +18,7 @@
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <nlohmann/json.hpp>
@@ -87,7 +88,7 @@ TEST(InstructorStation,
   Subprocess browser(
       {"/usr/bin/env", "node", SourcePath("tests/browser/instructor_page.mjs"), url, "1"},
       tmp + "/browser.log");
-  EXPECT_EQ(browser.Wait(180), 0) << ReadFile(tmp + "/browser.log");
+  EXPECT_EQ(browser.Wait(240), 0) << ReadFile(tmp + "/browser.log");
   EXPECT_NE(ReadFile(tmp + "/browser.log").find("ok a forged process name is shown as text"),
             std::string::npos)
       << ReadFile(tmp + "/browser.log");
@@ -146,14 +147,26 @@ TEST(InstructorStation,
   EXPECT_EQ(freezes, 1) << summary["control"].dump();
   EXPECT_EQ(runs, 1) << summary["control"].dump();
   EXPECT_EQ(resets, 1) << summary["control"].dump();
-  EXPECT_EQ(malfunctions, 3) << summary["control"].dump();  // the page's 2, the lesson's 1
+  EXPECT_EQ(malfunctions, 4) << summary["control"].dump();  // the page's 2, the lesson's 2
   EXPECT_EQ(repairs, 1) << summary["control"].dump();
+  // Every command answered; the page's second checkpoint of one name
+  // refused by the DCP, with the reason.
+  int refused_checkpoints = 0;
+  for (const auto& c : summary["control"]) {
+    EXPECT_FALSE(c["answers"].empty()) << c.dump();
+    if (c["command"] == "checkpoint" && !c["answers"].empty() &&
+        c["answers"][0]["outcome"] == "refused" &&
+        c["answers"][0]["text"].get<std::string>().find("exists already") != std::string::npos)
+      ++refused_checkpoints;
+  }
+  EXPECT_EQ(refused_checkpoints, 1) << summary["control"].dump();
   // The malfunctions as the DCP took them, with their times and frames: the
   // joint stuck, the camera lost, both repaired at once; then the page's
-  // lesson's camera 7.
+  // lesson's camera 7, and its camera 6 at its condition.
   const auto& mf = summary["malfunctions"];
-  ASSERT_EQ(mf.size(), 4u) << mf.dump();
+  ASSERT_EQ(mf.size(), 5u) << mf.dump();
   EXPECT_EQ(mf[3]["injected"][0], "camera 7 lost") << mf.dump();
+  EXPECT_EQ(mf[4]["injected"][0], "camera 6 lost") << mf.dump();
   EXPECT_NE(mf[0]["injected"][0].get<std::string>().find(" stuck"), std::string::npos) << mf.dump();
   EXPECT_EQ(mf[1]["injected"][0], "camera 1 lost") << mf.dump();
   EXPECT_EQ(mf[2]["repaired"].size(), 2u) << mf.dump();
@@ -163,15 +176,15 @@ TEST(InstructorStation,
     EXPECT_GT(mf[i]["dcp_frame"].get<std::int64_t>(), mf[i - 1]["dcp_frame"].get<std::int64_t>());
   }
   const auto dcp = nlohmann::json::parse(ReadFile(out + "/stats/dynamics_proc.json"));
-  EXPECT_EQ(dcp["counters"].value("control.malfunctions", 0), 3);
+  EXPECT_EQ(dcp["counters"].value("control.malfunctions", 0), 4);
   EXPECT_EQ(dcp["counters"].value("control.repairs", 0), 1);
   // The reset began a second attempt, and the autopilot flew it to the dock.
   EXPECT_EQ(summary["attempts"].size(), 2u) << summary["attempts"].dump();
   const auto stats = nlohmann::json::parse(ReadFile(out + "/stats/instructor_station.json"));
   EXPECT_GT(stats["counters"].value("views.rendered", 0), 10);
   EXPECT_EQ(stats["counters"].value("http.refused", 0), 7);  // 6 here, the page's bad lesson
-  EXPECT_EQ(stats["counters"].value("control.sent", 0), 6);
-  EXPECT_EQ(stats["counters"].value("lesson.events", 0), 1);
+  EXPECT_EQ(stats["counters"].value("control.sent", 0), 8);  // with the two checkpoints
+  EXPECT_EQ(stats["counters"].value("lesson.events", 0), 2);
   const auto op = nlohmann::json::parse(ReadFile(out + "/stats/operator_station.json"));
   EXPECT_EQ(op["counters"].value("control.resets", 0), 1);
   EXPECT_GE(op["counters"].value("arm.not_following", 0), 1);
@@ -188,6 +201,169 @@ TEST(InstructorStation,
       tmp + "/resim.log");
   EXPECT_EQ(resim.rc, 0) << resim.out;
   EXPECT_NE(resim.out.find("identical, word for word"), std::string::npos) << resim.out;
+}
+
+// The PNG's width and height, from its IHDR (0, 0: not a PNG).
+std::pair<int, int> PngSize(const std::string& path) {
+  const std::string b = ReadFile(path);
+  if (b.size() < 24 || b.compare(1, 3, "PNG") != 0) return {0, 0};
+  auto be32 = [&](std::size_t i) {
+    return (static_cast<unsigned char>(b[i]) << 24) | (static_cast<unsigned char>(b[i + 1]) << 16) |
+           (static_cast<unsigned char>(b[i + 2]) << 8) | static_cast<unsigned char>(b[i + 3]);
+  };
+  return {static_cast<int>(be32(16)), static_cast<int>(be32(20))};
+}
+
+// docs/instructor.md "The banner", "Commands and their answers", "A
+// restarted station", "Debrief": `scripts/lab control` freezes, restores
+// and resets the session, each confirmed by the process that acted (a
+// restore of a missing checkpoint refused with the reason); the page's
+// state follows (FROZEN, RUNNING); the station killed mid-session is
+// restarted by the launcher and reads its history back from the session's
+// log; after the session, `scripts/lab debrief` serves the page over the
+// record, which a browser scrubs through and marks (tests/browser/
+// instructor_debrief.mjs: layout at 1280x800 and 390 px, axe-core); the
+// mark is kept in the session's folder and shown in the report, and the
+// summary and the report give every command's answers.
+TEST(InstructorStation, ARestartedStationRecoversItsHistoryAndADebriefScrubsAndMarksTheSession) {
+  const std::string tmp = testing::MakeTempDir("instructor-debrief");
+  const std::string out = tmp + "/session";
+  Subprocess lab({SourcePath("scripts/lab"), "demo", "--no-build", "--out", out, "--lcm-url",
+                  testing::UniqueLcmUrl(8700), "--instructor", "0", "--no-video", "--png-every",
+                  "0", "--width", "320", "--height", "240"},
+                 tmp + "/lab.log", {std::string("RMSLAB_BUILD=") + RMSLAB_BUILD_DIR});
+  ASSERT_TRUE(testing::WaitForFile(out + "/run/instructor.url", 90)) << ReadFile(tmp + "/lab.log");
+  ASSERT_TRUE(testing::WaitForFile(out + "/run/operator_station.ready", 30));
+  int port = 0;
+  std::string token;
+  SplitUrl(ReadFile(out + "/run/instructor.url"), &port, &token);
+  httplib::Client web("127.0.0.1", port);
+  web.set_read_timeout(5);
+  auto status = [&] {
+    const auto r = web.Get("/api/status?token=" + token);
+    return r && r->status == 200 ? nlohmann::json::parse(r->body) : nlohmann::json::object();
+  };
+  auto until = [](const std::function<bool()>& ok, double seconds) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    while (std::chrono::steady_clock::now() < end) {
+      if (ok()) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    }
+    return ok();
+  };
+  auto state = [&] {
+    const auto s = status();
+    return s.contains("session") ? s["session"].value("state", "") : std::string();
+  };
+  ASSERT_TRUE(until([&] { return state() == "RUNNING"; }, 30)) << status().dump();
+  auto control = [&](std::vector<std::string> words) {
+    std::vector<std::string> argv = {SourcePath("scripts/lab"), "control", "--session", out};
+    argv.insert(argv.end(), words.begin(), words.end());
+    return testing::Script(argv, tmp + "/control.log", 60);
+  };
+  // Each command confirmed by the process that acted on it, or refused with the reason.
+  const auto freeze = control({"freeze"});
+  EXPECT_EQ(freeze.rc, 0) << freeze.out;
+  EXPECT_NE(freeze.out.find("freeze: frozen at operator frame"), std::string::npos) << freeze.out;
+  EXPECT_TRUE(until([&] { return state() == "FROZEN"; }, 10)) << status().dump();
+  const auto missing = control({"restore", "nothere"});
+  EXPECT_EQ(missing.rc, 1) << missing.out;
+  EXPECT_NE(missing.out.find("restore refused by dynamics_proc: cannot read checkpoint"),
+            std::string::npos)
+      << missing.out;
+  const auto saved = control({"checkpoint", "here"});
+  EXPECT_EQ(saved.rc, 0) << saved.out;
+  const auto restored = control({"restore", "here"});
+  EXPECT_EQ(restored.rc, 0) << restored.out;
+  EXPECT_NE(restored.out.find("frozen after one frame from the inputs of here.json"),
+            std::string::npos)
+      << restored.out;
+  EXPECT_EQ(state(), "FROZEN");
+  const auto run = control({"run"});
+  EXPECT_EQ(run.rc, 0) << run.out;
+  EXPECT_TRUE(until([&] { return state() == "RUNNING"; }, 10)) << status().dump();
+  const auto reset = control({"reset"});
+  EXPECT_EQ(reset.rc, 0) << reset.out;
+  EXPECT_NE(reset.out.find("reset: the reset button pressed for one frame"), std::string::npos)
+      << reset.out;
+
+  // The station killed: the launcher restarts it, and it reads its history
+  // back from the session's log.
+  const std::string before = status().value("instance", "");
+  const int pid = std::stoi(ReadFile(out + "/run/instructor_station.pid"));
+  ASSERT_EQ(kill(pid, SIGKILL), 0);
+  ASSERT_TRUE(until(
+      [&] {
+        const auto s = status();
+        return s.contains("instance") && s["instance"] != before;
+      },
+      30))
+      << ReadFile(tmp + "/lab.log");
+  const auto s = status();
+  EXPECT_TRUE(s["session"]["restarted"].get<bool>()) << s.dump();
+  // ... and the page, in a browser, says so.
+  std::string page_url = ReadFile(out + "/run/instructor.url");
+  while (!page_url.empty() && std::isspace(static_cast<unsigned char>(page_url.back())))
+    page_url.pop_back();
+  Subprocess banner({"/usr/bin/env", "node", SourcePath("tests/browser/instructor_banner.mjs"),
+                     page_url,
+                     "^RUNNING \\| STATION RESTARTED: its history recovered", "30"},
+                    tmp + "/banner.log");
+  EXPECT_EQ(banner.Wait(60), 0) << ReadFile(tmp + "/banner.log");
+  const auto events = web.Get("/api/events?token=" + token);
+  ASSERT_TRUE(events && events->status == 200);
+  for (const char* said :
+       {"freeze (from rms_control)", "REFUSED, cannot read checkpoint 'nothere.json'",
+        "reset (from rms_control)", "STATION RESTARTED: its history recovered"})
+    EXPECT_NE(events->body.find(said), std::string::npos) << said << "\n" << events->body;
+  ASSERT_EQ(lab.Wait(240), 0) << ReadFile(tmp + "/lab.log");
+
+  // Every command in the summary with its answers.
+  const auto summary = nlohmann::json::parse(ReadFile(out + "/summary.json"));
+  int refused = 0;
+  for (const auto& c : summary["control"]) {
+    EXPECT_FALSE(c["answers"].empty()) << c.dump();
+    for (const auto& a : c["answers"]) refused += a["outcome"] == "refused";
+  }
+  EXPECT_EQ(refused, 2) << summary["control"].dump();  // the missing checkpoint, by both
+  EXPECT_EQ(summary["control_answers_unmatched"], 0);
+
+  // The debrief, in a browser.
+  Subprocess debrief(
+      {SourcePath("scripts/lab"), "debrief", out, "--no-build", "--port", "0", "--for", "200"},
+      tmp + "/debrief.log");
+  std::string url;
+  ASSERT_TRUE(until(
+      [&] {
+        const std::string log = ReadFile(tmp + "/debrief.log");
+        const auto at = log.find("debrief of ");
+        if (at == std::string::npos) return false;
+        const auto http = log.find("http://", at);
+        const auto end = log.find('\n', http);
+        if (http == std::string::npos || end == std::string::npos) return false;
+        url = log.substr(http, end - http);
+        return true;
+      },
+      60))
+      << ReadFile(tmp + "/debrief.log");
+  Subprocess browser(
+      {"/usr/bin/env", "node", SourcePath("tests/browser/instructor_debrief.mjs"), url, tmp},
+      tmp + "/browser.log");
+  EXPECT_EQ(browser.Wait(180), 0) << ReadFile(tmp + "/browser.log");
+  EXPECT_EQ(PngSize(tmp + "/instructor-1280x800.png"), std::make_pair(1280, 800));
+  EXPECT_EQ(PngSize(tmp + "/instructor-390x844.png").first, 390);
+  const std::string marks = ReadFile(out + "/instructor_marks.jsonl");
+  EXPECT_NE(marks.find("debrief mark"), std::string::npos) << marks;
+  debrief.Signal(SIGINT);
+  EXPECT_EQ(debrief.Wait(30), 0) << ReadFile(tmp + "/debrief.log");
+  const testing::ScriptRun report = testing::Script(
+      {SourcePath("scripts/lab"), "report", out, "--no-build"}, tmp + "/report.log");
+  EXPECT_EQ(report.rc, 0) << report.out;
+  const std::string html = ReadFile(out + "/report.html");
+  EXPECT_NE(html.find("<h2>The instructor's marks</h2>"), std::string::npos);
+  EXPECT_NE(html.find("debrief mark"), std::string::npos);
+  EXPECT_NE(html.find("<h2>Session control</h2>"), std::string::npos);
+  EXPECT_NE(html.find("cannot read checkpoint"), std::string::npos);
 }
 
 // docs/lessons.md "From the instructor's station": a lesson given at start

@@ -32,11 +32,13 @@ double SessionFrameRate(const std::string& session_dir) {
 
 }  // namespace
 
-SessionLog::SessionLog(const std::string& session_dir, double frame_rate_hz)
+SessionLog::SessionLog(const std::string& session_dir, double frame_rate_hz,
+                       const std::string& log_name)
     : dir_(session_dir),
-      log_path_((fs::path(session_dir) / "lcmlog").string()),
+      log_path_((fs::path(session_dir) / log_name).string()),
       rate_hz_(frame_rate_hz) {
-  if (!fs::exists(log_path_)) throw InputError(session_dir + ": not a session folder (no lcmlog)");
+  if (!fs::exists(log_path_))
+    throw InputError(session_dir + ": not a session folder (no " + log_name + ")");
   if (fs::exists(fs::path(session_dir) / "manifest.json")) {
     suffix_ = ReadSessionInfo(session_dir).channel_suffix;
     check_ = SenderCheck(session_dir);

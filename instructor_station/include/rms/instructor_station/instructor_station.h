@@ -23,6 +23,10 @@ struct InstructorOptions {
   double view_rate_hz = 15.0;     // --view-rate: each view drawn at most this often
   std::string lesson_path;        // --lesson FILE: a lesson fired from the start (docs/lessons.md)
   std::string lesson_state_path;  // --lesson-state FILE: kept there; a restart carries on from it
+  std::string session_dir;  // --session-dir DIR: its log read at start (a restart recovers its
+                            // history; a debrief shows the whole session)
+  std::string marks_path;   // --marks-file FILE: the instructor's marks (JSON lines), kept there
+  bool debrief = false;     // --debrief: a recorded session, nothing live (needs --session-dir)
 };
 
 // --token's default: RMSLAB_INSTRUCTOR_TOKEN (how the launcher passes it,

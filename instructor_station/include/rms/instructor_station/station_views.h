@@ -50,6 +50,18 @@ class StationViews {
   // its view shows no picture, as the ESG would.
   void Update(const wire::DcpFrameData& dcp, std::uint32_t lost_stations = 0);
 
+  // A past frame's view (docs/instructor.md "Debrief"): from any thread,
+  // `view` at DCP frame `frame` is asked for; Past gives it once drawn
+  // (frame -1 until then: the page keeps its last image and asks again).
+  void RequestPast(int view, std::int64_t frame);
+  ViewImage Past(int view, std::int64_t frame) const;
+  // On the LCM thread: the oldest past view asked for and not drawn, if any.
+  std::optional<std::pair<int, std::int64_t>> PendingPast() const;
+  // Draws it from `frames` (the lead-in, the frame itself last: the camera
+  // drive's run-up, as it ran live) with the stations lost then.
+  void DrawPast(int view, std::int64_t asked_frame, const std::vector<wire::DcpFrameData>& frames,
+                std::uint32_t lost_stations);
+
  private:
   static std::array<std::int64_t, kNumViews> MinusOnes() {
     std::array<std::int64_t, kNumViews> a{};
@@ -57,6 +69,8 @@ class StationViews {
     return a;
   }
   void Draw(int view, const wire::EsgFrameData& e, std::int64_t frame);
+  ViewImage Render(const wire::EsgFrameData& e, std::int64_t frame);
+  static wire::DcpFrameData AsStation(wire::DcpFrameData d, int view, std::uint32_t lost_stations);
 
   const LabConfig& config_;
   int width_, height_;
@@ -73,6 +87,9 @@ class StationViews {
   std::array<std::chrono::steady_clock::time_point, kNumViews> watched_{};
   std::array<ViewImage, kNumViews> images_;
   std::array<std::chrono::steady_clock::time_point, kNumViews> drawn_at_{};
+  // Past views: for each view, the frame last asked for and its image.
+  std::array<std::int64_t, kNumViews> past_asked_ = MinusOnes();
+  std::array<ViewImage, kNumViews> past_;
 };
 
 }  // namespace rms::instructor_station

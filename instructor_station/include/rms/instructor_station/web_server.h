@@ -24,17 +24,23 @@ namespace rms::instructor_station {
 // A command for RMS_CONTROL (session_control_t), from a web request to the
 // LCM thread.
 struct ControlRequest {
-  std::int8_t command = 0;  // session_control_t::FREEZE ...
-  std::string name;         // CHECKPOINT, RESTORE: the checkpoint's name
+  std::int8_t command = 0;         // session_control_t::FREEZE ...
+  std::string name;                // CHECKPOINT, RESTORE: the checkpoint's name
+  std::int64_t id = -1;            // its sequence on the wire (Push gives it)
+  std::int64_t not_before_us = 0;  // sent no sooner (wall clock; 0: at once)
 };
 
 class ControlQueue {
  public:
-  void Push(ControlRequest r);
-  std::vector<ControlRequest> Drain();
+  // Queues `r` and gives its id: its session_control_t.sequence, so its
+  // answers can be told (RMS_CONTROL_ANSWER).
+  std::int64_t Push(ControlRequest r);
+  // The requests due by `now_us`, in order.
+  std::vector<ControlRequest> Drain(std::int64_t now_us);
 
  private:
   std::mutex mu_;
+  std::int64_t next_id_ = 0;
   std::vector<ControlRequest> queue_;
 };
 

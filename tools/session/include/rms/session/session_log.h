@@ -46,7 +46,10 @@ class SessionLog {
   // The same with the session's frame rate already known (its config.toml
   // read by the caller): not read again. kNoSessionTime: a reader that
   // needs no session time (every session_time_s is NaN).
-  SessionLog(const std::string& session_dir, double frame_rate_hz);
+  // `log_name`: another log of the session's folder than lcmlog (a running
+  // session's wire.lcmlog, the network's record so far).
+  SessionLog(const std::string& session_dir, double frame_rate_hz,
+             const std::string& log_name = "lcmlog");
   static constexpr double kNoSessionTime = std::numeric_limits<double>::quiet_NaN();
 
   // Every message of the session's own on `channels` (base names; empty:
