@@ -250,8 +250,10 @@ void DynamicsProc::OnMalfunction(const session_control_t& m) {
       const std::size_t before = dcp_.malfunctions().active().size();
       dcp_.Repair(r);
       if (dcp_.malfunctions().active().size() == before) {
-        throw InputError("nothing to repair: no malfunction of '" + wire::RepairText(r) +
-                         "' is in force");
+        throw InputError(wire::RepairText(r) == "all"
+                             ? std::string("nothing to repair: no malfunction is in force")
+                             : "nothing to repair: no malfunction of '" + wire::RepairText(r) +
+                                   "' is in force");
       }
       counters_.Add(Counter::kControlRepairs);
       done = wire::RepairText(r) + ", from DCP frame " + std::to_string(next_frame_);

@@ -33,7 +33,10 @@ table { border-collapse: collapse; width: 100%; font-size: 12px; }
 td, th { padding: 1px 4px; vertical-align: top; border-bottom: 1px solid #2a2a2a; text-align: left; }
 .ok { color: #7d7; } .bad { color: #f77; } .warn { color: #eb4; }
 td.bad, span.bad { font-weight: 700; }
-#events { max-height: 200px; overflow-y: auto; font: 12px monospace; white-space: pre-wrap; }
+#events { max-height: 200px; overflow-y: auto; font: 12px monospace; white-space: pre-wrap; overflow-wrap: anywhere; }
+.nowtag { display: none; color: #eb4; font-weight: 400; }
+body.scrubbing .nowtag { display: inline; }
+.scroll-x { overflow-x: auto; }
 #events div.past { color: #999; }
 #events div.after { opacity: 0.45; }
 button { background: #333; color: #eee; border: 1px solid #666; padding: 3px 9px; margin: 1px; cursor: pointer; font: inherit; }
@@ -49,6 +52,7 @@ details summary { cursor: pointer; color: #bbb; font-size: 12px; }
 .sr { position: absolute; width: 1px; height: 1px; overflow: hidden; clip: rect(0 0 0 0); }
 @media (max-width: 900px) {
   body { display: block; height: auto; }
+  header { position: sticky; top: 0; z-index: 2; }
   main { display: block; }
   .col { overflow: visible; margin-bottom: 6px; }
   #events { max-height: 260px; }
@@ -82,13 +86,13 @@ details summary { cursor: pointer; color: #bbb; font-size: 12px; }
 <img class="view" id="view1" alt="the chosen camera station's view"></div>
 </div>
 <div class="col">
-<div class="pane"><h2>The trainee</h2>
+<div class="pane"><h2>The trainee <span class="nowtag">(now, not at the cursor)</span></h2>
 <div id="trainee">no operator state yet</div>
 <div class="bars" id="hands" aria-label="the hand controllers' inputs"></div>
 <div id="guidance"></div>
 <div id="warnings" aria-live="polite"></div></div>
-<div class="pane"><h2>Joints (as they are; commanded): a failed part in red</h2><table id="joints"></table></div>
-<div class="pane"><h2>Acquisition and docking</h2><div class="chips" id="acq"></div></div>
+<div class="pane"><h2>Joints (as they are; commanded): a failed part in red <span class="nowtag">(now)</span></h2><table id="joints"></table></div>
+<div class="pane"><h2>Acquisition and docking <span class="nowtag">(now)</span></h2><div class="chips" id="acq"></div></div>
 <div class="pane"><h2>Distance to the goal and the acquisition margins, ft, against session time</h2>
 <canvas id="plot" width="640" height="160" role="img" aria-label="plot of the distance to the goal and the margins against session time"></canvas></div>
 <div class="pane"><h2>From above (nose up, starboard right): the end effector's path</h2>
@@ -110,9 +114,9 @@ details summary { cursor: pointer; color: #bbb; font-size: 12px; }
 <h2>Lesson</h2>
 <label for="lessonfile">A lesson file (docs/lessons.md): </label><input type="file" id="lessonfile" accept=".toml,text/plain">
 <div id="lessonsaid"></div><ol id="lesson"></ol></div>
-<div class="pane"><h2>Scorecard (live)</h2><table id="score"></table></div>
+<div class="pane"><h2>Scorecard (live) <span class="nowtag">(now)</span></h2><table id="score"></table></div>
 <div class="pane"><h2>Events</h2><div id="events" tabindex="0" aria-label="the session's events"></div></div>
-<div class="pane"><details><summary>Processes: rates, latency, losses</summary><table id="procs"></table></details></div>
+<div class="pane"><details><summary>Processes: rates, latency, losses</summary><div class="scroll-x"><table id="procs"></table></div></details></div>
 </div>
 </main>
 <script>
@@ -172,10 +176,10 @@ async function control(command, extra) {
   try {
     r = await fetch(q("/api/control"), {method: "POST", body, headers: {"X-Rmslab-Token": token}});
     j = await r.json().catch(() => ({}));
-  } catch (e) { said.textContent = command + ": not sent, no connection"; said.className = "bad"; return; }
-  if (!r.ok) { said.textContent = command + " refused: " + (j.error || r.status); said.className = "bad"; announce(said.textContent); return; }
+  } catch (e) { said.textContent = command + ": not sent, no connection"; said.className = "bad"; said.dataset.state = "unsent"; return; }
+  if (!r.ok) { said.textContent = command + " refused: " + (j.error || r.status); said.className = "bad"; said.dataset.state = "refused"; announce(said.textContent); return; }
   const what = command + (j.name ? " " + j.name : "");
-  said.textContent = what + ": waiting for the answer"; said.className = "warn";
+  said.textContent = what + ": waiting for the answer"; said.className = "warn"; said.dataset.state = "pending";
   const end = Date.now() + 8000;
   while (Date.now() < end) {
     await new Promise((ok) => setTimeout(ok, 200));
@@ -354,7 +358,8 @@ function showBanner(s) {
   b.className = cls;
   debrief = !!st.debrief;
   $("note").textContent = st.restarted ? "STATION RESTARTED: its history recovered from the session's log" : "";
-  for (const id of ["freeze", "run", "step", "reset", "checkpoint", "restore", "inject"]) $(id).disabled = debrief || st.ended;
+  for (const id of ["freeze", "run", "step", "reset", "checkpoint", "restore", "inject", "cpname", "cplist",
+                    "mkind", "mtarget", "mvalue", "lessonfile"]) $(id).disabled = debrief || st.ended;
 }
 
 function showTrainee(s) {
@@ -436,7 +441,7 @@ function showStatus(s) {
   lastStatus = s;
   showBanner(s);
   const d = s.dcp;
-  $("opstation").textContent = s.camera_station ? "(station " + s.camera_station + ")" : "";
+  $("opstation").textContent = cursorFrame !== null ? "(at the cursor)" : s.camera_station ? "(station " + s.camera_station + ")" : "";
   if (d) {
     $("clock").textContent = "t " + fmt(d.session_s, 1) + " s, frame " + d.frame;
     $("mode").textContent = "MODE " + d.mode;
@@ -500,7 +505,7 @@ async function poll() {
     ++failures;
     const ended = lastStatus && lastStatus.session && lastStatus.session.ended;
     const b = $("banner");
-    const text = ended ? "SESSION ENDED: " + (lastStatus.session.ended_how || "") + " -- the station has closed (for a debrief: scripts/lab debrief SESSION)"
+    const text = ended ? "SESSION ENDED: " + (lastStatus.session.ended_how || "") + " -- the station has closed (for a debrief: scripts/lab debrief " + (lastStatus.session.session_dir || "SESSION") + ")"
                        : "CONNECTION LOST to the instructor's station (" + e.message + "): retrying, attempt " + failures;
     if (b.textContent !== text) { b.textContent = text; announce(text); }
     b.className = ended ? "ended" : "lost";
@@ -510,6 +515,7 @@ async function poll() {
 
 function scrubTo(frame) {
   cursorFrame = frame;
+  document.body.classList.toggle("scrubbing", frame !== null);
   $("cursor").textContent = frame === null ? "live" : "t " + fmt(frameTime(frame), 1) + " s (frame " + frame + ")";
   // Initial conditions from this instant: a new session branched from it
   // (docs/sessions.md "Branching"), its pose the one the views show.
@@ -543,7 +549,10 @@ async function start() {
   $("run").onclick = () => control("run");
   $("step").onclick = () => control("step");
   $("reset").onclick = () => control("reset");
-  $("checkpoint").onclick = () => control("checkpoint", {name: $("cpname").value});
+  $("checkpoint").onclick = () => {
+    if (!$("cpname").value.trim()) { $("said").textContent = "checkpoint: give it a name"; $("said").className = "bad"; $("said").dataset.state = "refused"; return; }
+    control("checkpoint", {name: $("cpname").value});
+  };
   $("restore").onclick = () => control("restore", {name: $("cplist").value});
   $("scrub").oninput = (e) => scrubTo(Number(e.target.value) >= Number(e.target.max) && !debrief ? null : Number(e.target.value));
   $("live").onclick = () => { $("scrub").value = $("scrub").max; scrubTo(null); };

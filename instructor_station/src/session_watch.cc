@@ -410,7 +410,9 @@ void SessionWatch::AddEvent(const std::string& kind, const std::string& text) {
   Event e;
   e.seq = next_event_seq_++;
   e.wall_us = Now();
-  e.session_s = dcp_ ? static_cast<double>(dcp_->frame) / config_.session.frame_rate_hz : 0.0;
+  e.session_s = reading_log_ && std::isfinite(log_session_s_) ? log_session_s_
+                : dcp_ ? static_cast<double>(dcp_->frame) / config_.session.frame_rate_hz
+                       : 0.0;
   e.kind = kind;
   e.text = text;
   events_.push_back(std::move(e));
@@ -841,23 +843,83 @@ std::int64_t SessionWatch::ReadLog(const std::string& session_dir) {
     reading_log_ = true;
     session_dir_ = std::filesystem::absolute(session_dir).string();
   }
-  for (const std::string& name : names) ReadLogFile(session_dir, name, &n);
+  for (const std::string& name : names) ReadLogFile(session_dir, name, {}, &n);
+  // What the network's recorder missed (a burst of commands, a stall) is in
+  // the processes' own journals: their commands and answers are read from
+  // them too, each once (by its id), at its session time.
+  std::int64_t from_journals = 0;
+  if (names.front() != "lcmlog") {
+    std::error_code ec;
+    std::vector<std::string> journals;
+    for (const auto& e :
+         std::filesystem::directory_iterator(std::filesystem::path(session_dir) / "journal", ec)) {
+      const std::string f = e.path().filename().string();
+      if (e.is_regular_file(ec) && !e.is_symlink(ec) && f.size() > 7 &&
+          f.compare(f.size() - 7, 7, ".lcmlog") == 0)
+        journals.push_back("journal/" + f);
+    }
+    std::sort(journals.begin(), journals.end());
+    const std::int64_t events_before = events_seen();
+    for (const std::string& j : journals) {
+      std::int64_t taken = 0;
+      try {
+        ReadLogFile(session_dir, j, {wire::channels::kControl, wire::channels::kControlAnswer},
+                    &taken);
+      } catch (const InputError& e) {
+        spdlog::warn("journal {} not read: {}", j, e.what());
+      }
+    }
+    from_journals = events_seen() - events_before;
+  }
   std::lock_guard<std::mutex> lock(mu_);
   reading_log_ = false;
-  if (restarted_)
+  log_times_.clear();
+  if (restarted_) {
     AddEvent("station", "STATION RESTARTED: its history recovered from the session's log (" +
-                            std::to_string(n) + " messages)");
+                            std::to_string(n) + " messages; " + std::to_string(from_journals) +
+                            " events only the processes' journals held)");
+  }
+  SortEvents();
   return n;
 }
 
+// The events in session-time order (what a log and journals read at start
+// gave out of order), numbered again: done before anyone has read them.
+void SessionWatch::SortEvents() {
+  std::stable_sort(events_.begin(), events_.end(),
+                   [](const Event& a, const Event& b) { return a.session_s < b.session_s; });
+  std::int64_t seq = next_event_seq_ - static_cast<std::int64_t>(events_.size());
+  for (Event& e : events_) e.seq = seq++;
+}
+
+// The session time at recorder time `log_us`, from the network log's
+// messages read (a journal's own messages carry no operator frames).
+double SessionWatch::LogSessionTime(std::int64_t log_us) const {
+  if (log_times_.empty()) return 0.0;
+  auto it = std::upper_bound(
+      log_times_.begin(), log_times_.end(), log_us,
+      [](std::int64_t t, const std::pair<std::int64_t, double>& p) { return t < p.first; });
+  if (it == log_times_.begin()) return it->second;
+  return std::prev(it)->second;
+}
+
 void SessionWatch::ReadLogFile(const std::string& session_dir, const std::string& name,
+                               std::initializer_list<std::string_view> channels,
                                std::int64_t* taken) {
   session::SessionLog log(session_dir, config_.session.frame_rate_hz, name);
+  const bool journal = name.rfind("journal/", 0) == 0;
   std::int64_t& n = *taken;
-  log.Read({}, [&](const session::LogMessage& m) {
+  log.Read(channels, [&](const session::LogMessage& m) {
     {
       std::lock_guard<std::mutex> lock(mu_);
       log_now_us_ = m.log_us;
+      if (journal) {
+        log_session_s_ = LogSessionTime(m.log_us);
+      } else {
+        log_session_s_ = m.session_time_s;
+        if (log_times_.empty() || log_times_.back().second != m.session_time_s)
+          log_times_.emplace_back(m.log_us, m.session_time_s);
+      }
     }
     ++n;
     const std::string_view b = m.base;
@@ -885,6 +947,14 @@ bool SessionWatch::restarted() const {
   return restarted_;
 }
 
+namespace {
+std::string MarkEventText(double session_s, const std::string& text) {
+  char at[32];
+  std::snprintf(at, sizeof at, "%.1f s", session_s);
+  return std::string("MARK at ") + at + ": " + text;
+}
+}  // namespace
+
 void SessionWatch::SetMarksFile(const std::string& path) {
   std::lock_guard<std::mutex> lock(mu_);
   marks_path_ = path;
@@ -897,14 +967,38 @@ void SessionWatch::SetMarksFile(const std::string& path) {
   while (std::getline(in, line) && marks_.size() < kMaxMarks) {
     if (line.size() > kMaxMarkLineBytes) continue;
     const nlohmann::json m = nlohmann::json::parse(line, nullptr, false);
-    if (m.is_object() && m.contains("session_s") && m["session_s"].is_number() &&
-        m.contains("text") && m["text"].is_string())
-      marks_.push_back(m);
+    if (!m.is_object() || !m.contains("session_s") || !m["session_s"].is_number() ||
+        !m.contains("text") || !m["text"].is_string())
+      continue;
+    const double t = m["session_s"].get<double>();
+    const std::string text = m["text"].get<std::string>();
+    if (!(t >= 0 && t <= kMaxMarkSessionS) || text.empty() || text.size() > kMaxMarkTextBytes)
+      continue;  // not a mark the page could have placed
+    marks_.push_back(m);
+    Event e;
+    e.seq = next_event_seq_++;
+    e.wall_us = m.value("wall_us", std::int64_t{0});
+    e.session_s = t;
+    e.kind = "mark";
+    e.text = MarkEventText(t, text);
+    events_.push_back(std::move(e));
+    if (events_.size() > kMaxEvents) events_.pop_front();
   }
+  SortEvents();
 }
 
 nlohmann::json SessionWatch::AddMark(double session_s, const std::string& text) {
   std::lock_guard<std::mutex> lock(mu_);
+  if (text.find_first_not_of(" \t") == std::string::npos)
+    throw InputError("form field 'text': a note, not only spaces");
+  const double newest =
+      dcp_ ? static_cast<double>(dcp_->frame) / config_.session.frame_rate_hz : 0.0;
+  if (session_s > newest + 1.0) {
+    char why[160];
+    std::snprintf(why, sizeof why, "parameter t=%.1f: beyond the session's newest frame (%.1f s)",
+                  session_s, newest);
+    throw InputError(why);
+  }
   if (marks_.size() >= kMaxMarks)
     throw InputError("at most " + std::to_string(kMaxMarks) + " marks a session");
   nlohmann::json m = {{"session_s", session_s}, {"wall_us", Now()}, {"text", text}};
@@ -919,13 +1013,20 @@ nlohmann::json SessionWatch::AddMark(double session_s, const std::string& text) 
     const int err = errno;
     if (fd >= 0) close(fd);
     if (!ok)
-      throw InputError("cannot keep the mark in " + marks_path_ + ": " + std::strerror(err) +
+      throw InputError("cannot keep the mark in " + marks_path_ + ": " +
+                       (err == ELOOP ? std::string("it is a link, refused (docs/security.md)")
+                                     : std::string(std::strerror(err))) +
                        " (nothing marked)");
   }
   marks_.push_back(m);
-  char at[32];
-  std::snprintf(at, sizeof at, "%.1f s", session_s);
-  AddEvent("mark", std::string("MARK at ") + at + ": " + text);
+  Event e;
+  e.seq = next_event_seq_++;
+  e.wall_us = Now();
+  e.session_s = session_s;
+  e.kind = "mark";
+  e.text = MarkEventText(session_s, text);
+  events_.push_back(std::move(e));
+  if (events_.size() > kMaxEvents) events_.pop_front();
   return m;
 }
 

@@ -86,29 +86,34 @@ void StationViews::Draw(int view, const wire::EsgFrameData& e, std::int64_t fram
 void StationViews::RequestPast(int view, std::int64_t frame) {
   if (view < 0 || view >= kNumViews) throw std::out_of_range("view");
   std::lock_guard<std::mutex> lock(mu_);
-  past_asked_[view] = frame;
+  for (const PastImage& p : past_)
+    if (p.view == view && p.asked == frame) return;  // drawn
+  const auto key = std::make_pair(view, frame);
+  if (std::find(past_asked_.begin(), past_asked_.end(), key) != past_asked_.end()) return;
+  past_asked_.push_back(key);
+  // A viewer dragging the slider asks for many: only the newest few wait.
+  while (past_asked_.size() > kNumViews * 2) past_asked_.pop_front();
 }
 
 ViewImage StationViews::Past(int view, std::int64_t frame) const {
   std::lock_guard<std::mutex> lock(mu_);
-  const ViewImage& img = past_.at(static_cast<std::size_t>(view));
-  if (past_asked_[view] == frame && img.png.size() > 1 && img.frame >= 0) return img;
+  for (const PastImage& p : past_)
+    if (p.view == view && p.asked == frame) return p.image;
   return {};
 }
 
 std::optional<std::pair<int, std::int64_t>> StationViews::PendingPast() const {
   std::lock_guard<std::mutex> lock(mu_);
-  for (int v = 0; v < kNumViews; ++v) {
-    if (past_asked_[v] >= 0 && (past_[v].png.empty() || past_[v].frame != past_asked_[v]))
-      return std::make_pair(v, past_asked_[v]);
-  }
-  return std::nullopt;
+  if (past_asked_.empty()) return std::nullopt;
+  return past_asked_.back();  // the newest first: what a viewer waits for now
 }
 
 void StationViews::DrawPast(int view, std::int64_t asked_frame,
                             const std::vector<wire::DcpFrameData>& frames,
                             std::uint32_t lost_stations) {
-  ViewImage img;
+  PastImage p;
+  p.view = view;
+  p.asked = asked_frame;
   if (!frames.empty()) {
     // A program of its own, run up over the lead-in as the live one ran.
     scene_proc::VisualSceneProgram program(config_);
@@ -116,13 +121,14 @@ void StationViews::DrawPast(int view, std::int64_t asked_frame,
     for (const wire::DcpFrameData& d : frames)
       e = program.Step(AsStation(d, view, lost_stations),
                        static_cast<std::uint32_t>(d.frame & 0xFFFFFF), nullptr);
-    img = Render(e, frames.back().frame);
+    p.image = Render(e, frames.back().frame);
   }
   std::lock_guard<std::mutex> lock(mu_);
-  if (past_asked_[view] != asked_frame) return;  // asked for another meanwhile
-  img.frame = asked_frame;                       // what was asked (the nearest kept drawn)
-  if (img.png.empty()) img.png = {0};            // nothing kept: answered, not drawn again
-  past_[view] = std::move(img);
+  const auto key = std::make_pair(view, asked_frame);
+  past_asked_.erase(std::remove(past_asked_.begin(), past_asked_.end(), key), past_asked_.end());
+  if (p.image.png.empty()) return;  // nothing kept to draw it from
+  past_.push_back(std::move(p));
+  while (past_.size() > kPastCached) past_.pop_front();
 }
 
 ViewImage StationViews::Render(const wire::EsgFrameData& e, std::int64_t frame) {

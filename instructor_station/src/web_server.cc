@@ -284,6 +284,7 @@ Answer WebServer::Impl::Route(const Request& req) {
   } else if (req.method == "POST" && req.path == "/api/control") {
     return Control(req);
   } else if (get && req.path == "/api/command") {
+    if (!req.has_param("id")) throw InputError("parameter id: the id /api/control answered");
     const std::int64_t id = IntParam(req, "id", 0, 0, std::int64_t{1} << 40);
     a.body = Json(watch->CommandJson(id));
   } else if (get && req.path == "/api/plot") {
@@ -329,8 +330,11 @@ Answer WebServer::Impl::Control(const Request& req) {
   if (r.command == session_control_t::MALFUNCTION)
     r.name = wire::MalfunctionText(wire::ParseMalfunction(what));
   if (r.command == session_control_t::REPAIR) r.name = wire::RepairText(wire::ParseRepair(what));
-  const int steps =
-      r.command == session_control_t::STEP ? static_cast<int>(IntParam(req, "n", 1, 1, 300)) : 1;
+  // A step's count goes in its name: one command, one answer.
+  if (r.command == session_control_t::STEP) {
+    const std::int64_t n = IntParam(req, "n", 1, 1, session_control_t::MAX_STEPS);
+    if (n > 1) r.name = std::to_string(n);
+  }
   // A freeze or run by hand: the instructor's to run again, not a lesson's
   // timed freeze's (docs/lessons.md "From the instructor's station").
   if (r.command == session_control_t::FREEZE || r.command == session_control_t::RUN)
@@ -342,13 +346,11 @@ Answer WebServer::Impl::Control(const Request& req) {
     controls->Push({session_control_t::FREEZE, "", -1, 0});
     r.not_before_us = transport::WallTimeUs() + 300'000;
   }
-  std::int64_t id = -1;
-  for (int i = 0; i < steps; ++i) id = controls->Push(r);
-  sent += steps;
+  const std::int64_t id = controls->Push(r);
+  ++sent;
   // Its outcome comes as the processes answer: GET /api/command?id=ID.
   Answer a;
-  a.body =
-      Json(nlohmann::json{{"id", id}, {"command", command}, {"name", r.name}, {"times", steps}});
+  a.body = Json(nlohmann::json{{"id", id}, {"command", command}, {"name", r.name}});
   return a;
 }
 
@@ -364,8 +366,8 @@ Answer WebServer::Impl::PastView(const Request& req, int v) {
     a.body = "no DCP frame kept yet\n";
     return a;
   }
-  views->RequestPast(v, frame);
   const ViewImage img = views->Past(v, frame);
+  if (img.png.empty()) views->RequestPast(v, frame);
   if (img.png.empty()) {
     a.status = 503;
     a.content_type = "text/plain";
@@ -382,8 +384,9 @@ Answer WebServer::Impl::PastView(const Request& req, int v) {
 // s; default: the newest frame's).
 Answer WebServer::Impl::Mark(const Request& req) {
   std::string text = req.param("text");
-  if (text.empty() || text.size() > 500)
-    throw InputError("form field 'text': a note of 1..500 bytes");
+  if (text.empty() || text.size() > SessionWatch::kMaxMarkTextBytes)
+    throw InputError("form field 'text': a note of 1.." +
+                     std::to_string(SessionWatch::kMaxMarkTextBytes) + " bytes");
   for (char& c : text)
     if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = ' ';
   double t_s = 0.0;
@@ -391,7 +394,8 @@ Answer WebServer::Impl::Mark(const Request& req) {
     const std::string v = req.param("t");
     char* end = nullptr;
     t_s = std::strtod(v.c_str(), &end);
-    if (v.empty() || !end || *end != '\0' || !std::isfinite(t_s) || t_s < 0 || t_s > 1e7)
+    if (v.empty() || !end || *end != '\0' || !std::isfinite(t_s) || t_s < 0 ||
+        t_s > SessionWatch::kMaxMarkSessionS)
       throw InputError("parameter t='" + v.substr(0, 32) + "': a session time, s, 0..1e7");
   } else if (const auto d = watch->LatestDcpFrame()) {
     t_s = static_cast<double>(d->frame) / config.session.frame_rate_hz;
@@ -406,6 +410,13 @@ Answer WebServer::Impl::Mark(const Request& req) {
 // for the page), checked as the operator station checks one: refused (400,
 // the key and the reason) with the lesson in force unchanged.
 Answer WebServer::Impl::LoadLesson(const Request& req) {
+  if (options.debrief) {
+    Answer a;
+    a.status = 409;
+    a.body = Json(nlohmann::json{{"error", "a debrief of a recorded session: no lesson can fire"}});
+    ++refused;
+    return a;
+  }
   std::string name = req.param("name").substr(0, 100);
   for (char& c : name)
     if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';  // shown on the page

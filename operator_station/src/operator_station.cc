@@ -210,6 +210,25 @@ void OperatorStation::OnStatus(const void* data, int size, std::int64_t recv_us)
   }
 }
 
+namespace {
+
+constexpr int kMaxSteps = session_control_t::MAX_STEPS;
+
+// A STEP's count (docs/protocol.md "RMS_CONTROL"): empty is 1; 0 when it
+// is no number of frames 1..kMaxSteps.
+int StepCount(const std::string& name) {
+  if (name.empty()) return 1;
+  if (name.size() > 6) return 0;
+  int n = 0;
+  for (char c : name) {
+    if (c < '0' || c > '9') return 0;
+    n = n * 10 + (c - '0');
+  }
+  return n >= 1 && n <= kMaxSteps ? n : 0;
+}
+
+}  // namespace
+
 // RMS_CONTROL: freeze, run, step; a restored checkpoint (docs/sessions.md).
 // The station is the session's clock: frozen, it stops its source and
 // publishes nothing, so every process holds its frame and nothing is lost.
@@ -234,15 +253,26 @@ void OperatorStation::OnControl(const void* data, int size, std::int64_t) {
       counters_.Add(Counter::kControlRuns);
       steps_pending_ = 0;
       break;
-    case session_control_t::STEP:
+    case session_control_t::STEP: {
       counters_.Add(Counter::kControlSteps);
-      if (!frozen_) {
-        Answer(m, control_answer_t::REFUSED, "not frozen: a step is one frame of a frozen session");
-        break;
+      // `name`: how many frames, 1..kMaxSteps (empty: one).
+      const int n = StepCount(m.name);
+      if (n == 0) {
+        Answer(m, control_answer_t::REFUSED,
+               "'" + m.name.substr(0, 32) + "' is not a number of frames, 1.." +
+                   std::to_string(kMaxSteps));
+      } else if (!frozen_) {
+        Answer(m, control_answer_t::REFUSED, "not frozen: a step is frames of a frozen session");
+      } else {
+        Answer(m, control_answer_t::DONE,
+               (n == 1 ? std::string("one frame") : std::to_string(n) + " frames") +
+                   ", operator frames " + std::to_string(builder_.next_frame() + steps_pending_) +
+                   " to " + std::to_string(builder_.next_frame() + steps_pending_ + n - 1) +
+                   "; then frozen again");
+        steps_pending_ += n;
       }
-      ++steps_pending_;
-      Answer(m, control_answer_t::DONE, "one frame more" + at);
       break;
+    }
     case session_control_t::RESET:
       reset_pending_ = true;
       counters_.Add(Counter::kControlResets);

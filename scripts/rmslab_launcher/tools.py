@@ -223,6 +223,12 @@ def debrief(argv):
                 "--marks-file", os.path.join(a.session, "instructor_marks.jsonl"),
                 "--checkpoint-dir", os.path.join(a.session, "checkpoints")]
         proc = subprocess.Popen(argv, env=dict(os.environ, RMSLAB_INSTRUCTOR_TOKEN=token))
+
+        def stop_on(signum, _frame):
+            raise KeyboardInterrupt  # SIGTERM, SIGHUP: stopped as by Ctrl-C, the station with it
+
+        for sig in (signal.SIGTERM, signal.SIGHUP):
+            signal.signal(sig, stop_on)
         try:
             end = time.monotonic() + 60
             while not os.path.exists(url_file):

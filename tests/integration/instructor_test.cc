@@ -266,6 +266,10 @@ TEST(InstructorStation, ARestartedStationRecoversItsHistoryAndADebriefScrubsAndM
   EXPECT_EQ(freeze.rc, 0) << freeze.out;
   EXPECT_NE(freeze.out.find("freeze: frozen at operator frame"), std::string::npos) << freeze.out;
   EXPECT_TRUE(until([&] { return state() == "FROZEN"; }, 10)) << status().dump();
+  // Steps: one command and one answer however many frames.
+  const auto steps = control({"step", "30"});
+  EXPECT_EQ(steps.rc, 0) << steps.out;
+  EXPECT_NE(steps.out.find("step: 30 frames, operator frames "), std::string::npos) << steps.out;
   const auto missing = control({"restore", "nothere"});
   EXPECT_EQ(missing.rc, 1) << missing.out;
   EXPECT_NE(missing.out.find("restore refused by dynamics_proc: cannot read checkpoint"),
@@ -282,6 +286,10 @@ TEST(InstructorStation, ARestartedStationRecoversItsHistoryAndADebriefScrubsAndM
   const auto run = control({"run"});
   EXPECT_EQ(run.rc, 0) << run.out;
   EXPECT_TRUE(until([&] { return state() == "RUNNING"; }, 10)) << status().dump();
+  const auto running_step = control({"step"});
+  EXPECT_EQ(running_step.rc, 1) << running_step.out;
+  EXPECT_NE(running_step.out.find("refused by operator_station: not frozen"), std::string::npos)
+      << running_step.out;
   const auto reset = control({"reset"});
   EXPECT_EQ(reset.rc, 0) << reset.out;
   EXPECT_NE(reset.out.find("reset: the reset button pressed for one frame"), std::string::npos)
@@ -306,8 +314,7 @@ TEST(InstructorStation, ARestartedStationRecoversItsHistoryAndADebriefScrubsAndM
   while (!page_url.empty() && std::isspace(static_cast<unsigned char>(page_url.back())))
     page_url.pop_back();
   Subprocess banner({"/usr/bin/env", "node", SourcePath("tests/browser/instructor_banner.mjs"),
-                     page_url,
-                     "^RUNNING \\| STATION RESTARTED: its history recovered", "30"},
+                     page_url, "^RUNNING \\| STATION RESTARTED: its history recovered", "30"},
                     tmp + "/banner.log");
   EXPECT_EQ(banner.Wait(60), 0) << ReadFile(tmp + "/banner.log");
   const auto events = web.Get("/api/events?token=" + token);
@@ -325,7 +332,7 @@ TEST(InstructorStation, ARestartedStationRecoversItsHistoryAndADebriefScrubsAndM
     EXPECT_FALSE(c["answers"].empty()) << c.dump();
     for (const auto& a : c["answers"]) refused += a["outcome"] == "refused";
   }
-  EXPECT_EQ(refused, 2) << summary["control"].dump();  // the missing checkpoint, by both
+  EXPECT_EQ(refused, 3) << summary["control"].dump();  // the missing checkpoint by both, a step
   EXPECT_EQ(summary["control_answers_unmatched"], 0);
 
   // The debrief, in a browser.

@@ -204,13 +204,10 @@ int Said(ControlLink& link, std::int64_t sequence, const char* process, const ch
 int Clock(ControlLink& link, std::int8_t command, int steps,
           const rms::transport::LcmOptions& options, std::int64_t id) {
   if (!link.WaitForProcess("operator_station")) return NobodyThere(options, id, "operator station");
-  std::vector<std::int64_t> sent;
-  for (int i = 0; i < steps; ++i) sent.push_back(link.Send(command));
+  // One command, a step's count in its name (docs/protocol.md "RMS_CONTROL").
+  const std::int64_t q = link.Send(command, steps > 1 ? std::to_string(steps) : "");
   SayWhereSent(options, id);
-  int rc = 0;
-  for (std::int64_t q : sent)
-    rc = std::max(rc, Said(link, q, "operator_station", rms::wire::ControlCommandName(command)));
-  return rc;
+  return Said(link, q, "operator_station", rms::wire::ControlCommandName(command));
 }
 
 void SayWhereSent(const rms::transport::LcmOptions& options, std::int64_t id) {
@@ -297,7 +294,8 @@ int main(int argc, char** argv) {
   auto* reset = app.add_subcommand(
       "reset", "Press the reset button for one frame: back to Mode 1, a new attempt");
   auto* step = app.add_subcommand("step", "While frozen: N more frames (default 1)");
-  step->add_option("n", steps, "Frames")->check(CLI::Range(1, 100000));
+  step->add_option("n", steps, "Frames")
+      ->check(CLI::Range(1, static_cast<int>(rms::session_control_t::MAX_STEPS)));
   auto* checkpoint = app.add_subcommand(
       "checkpoint", "dynamics_proc saves its state as NAME in the session's checkpoints folder");
   checkpoint->add_option("name", what, "Checkpoint name (letters, digits, _ - .; .json is added)")

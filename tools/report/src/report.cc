@@ -496,22 +496,27 @@ std::string MarksSection(const fs::path& root) {
   std::error_code ec;
   if (!fs::is_regular_file(fs::symlink_status(root / "instructor_marks.jsonl", ec))) return "";
   std::ifstream in(root / "instructor_marks.jsonl");
-  if (!in) return "";
-  std::ostringstream h;
-  int n = 0;
+  std::vector<std::pair<double, std::string>> marks;  // session time, note
   std::string line;
-  while (n < 1000 && std::getline(in, line)) {
+  while (marks.size() < 1000 && std::getline(in, line)) {
     if (line.size() > 4096) continue;
     const auto m = nlohmann::ordered_json::parse(line, nullptr, false);
     if (!m.is_object() || !m.contains("session_s") || !m["session_s"].is_number() ||
         !m.contains("text") || !m["text"].is_string())
       continue;
-    if (n++ == 0)
-      h << "<h2>The instructor's marks</h2>\n<table><tr><th>time, s</th><th>note</th></tr>";
-    h << "<tr><td>" << TimeCell(m["session_s"], "", 1) << "</td><td>"
-      << HtmlText(m["text"].get<std::string>()) << "</td></tr>";
+    const double t = m["session_s"].get<double>();
+    if (!(t >= 0 && t <= 1e7)) continue;
+    marks.emplace_back(t, m["text"].get<std::string>().substr(0, 500));
   }
-  if (n) h << "</table>\n";
+  if (marks.empty()) return "";
+  std::stable_sort(marks.begin(), marks.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::ostringstream h;
+  h << "<h2>The instructor's marks</h2>\n<table><tr><th>time, s</th><th>note</th></tr>";
+  for (const auto& [t, text] : marks)
+    h << "<tr><td>" << TimeCell(nlohmann::ordered_json(t), "", 1) << "</td><td>" << HtmlText(text)
+      << "</td></tr>";
+  h << "</table>\n";
   return h.str();
 }
 

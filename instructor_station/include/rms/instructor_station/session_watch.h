@@ -16,12 +16,14 @@
 // refused, as the operator station refuses them.
 #include <cstdint>
 #include <deque>
+#include <initializer_list>
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
 #include <string>
+#include <string_view>
 #include <tuple>
 #include <vector>
 
@@ -98,6 +100,8 @@ class SessionWatch {
   static constexpr std::size_t kMaxCommands = 200;
   static constexpr std::size_t kMaxMarks = 1000;
   static constexpr std::size_t kMaxMarkLineBytes = 4096;
+  static constexpr std::size_t kMaxMarkTextBytes = 500;
+  static constexpr double kMaxMarkSessionS = 1e7;
   // Each answer: at most this many events or points (the page asks again from where it ended).
   static constexpr int kMaxEventsAnswer = 1000;
   static constexpr std::size_t kMaxPathAnswer = 5000;
@@ -186,7 +190,10 @@ class SessionWatch {
   nlohmann::json WarningsJson() const;                              // mu_ held
   nlohmann::json StateJson() const;                                 // mu_ held
   std::int64_t Now() const;  // the wall clock, or the log's time while reading it
-  void ReadLogFile(const std::string& session_dir, const std::string& name, std::int64_t* taken);
+  void ReadLogFile(const std::string& session_dir, const std::string& name,
+                   std::initializer_list<std::string_view> channels, std::int64_t* taken);
+  void SortEvents();                                 // mu_ held
+  double LogSessionTime(std::int64_t log_us) const;  // mu_ held
 
   const LabConfig& config_;
   transport::LcmInterface* lcm_;
@@ -246,6 +253,10 @@ class SessionWatch {
   } score_;
   bool reading_log_ = false;
   std::int64_t log_now_us_ = 0;
+  double log_session_s_ = 0.0;  // the session time of the log message being read
+  // (recorder time, session time) at each change, of the network log read:
+  // the session time of a journal's messages.
+  std::vector<std::pair<std::int64_t, double>> log_times_;
   bool restarted_ = false;
   bool debrief_ = false;
   std::string marks_path_;

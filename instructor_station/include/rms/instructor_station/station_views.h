@@ -10,6 +10,7 @@
 #include <array>
 #include <chrono>
 #include <cstdint>
+#include <deque>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -51,11 +52,15 @@ class StationViews {
   void Update(const wire::DcpFrameData& dcp, std::uint32_t lost_stations = 0);
 
   // A past frame's view (docs/instructor.md "Debrief"): from any thread,
-  // `view` at DCP frame `frame` is asked for; Past gives it once drawn
-  // (frame -1 until then: the page keeps its last image and asks again).
+  // `view` at DCP frame `frame` is asked for; Past gives it once drawn (its
+  // `frame` the one drawn: the nearest kept at or before the one asked),
+  // else an empty image (the page keeps its last one and asks again). The
+  // last kPastCached drawn are kept, so viewers at different instants do
+  // not draw each other's away.
+  static constexpr std::size_t kPastCached = 32;
   void RequestPast(int view, std::int64_t frame);
   ViewImage Past(int view, std::int64_t frame) const;
-  // On the LCM thread: the oldest past view asked for and not drawn, if any.
+  // On the LCM thread: a past view asked for and not drawn, if any.
   std::optional<std::pair<int, std::int64_t>> PendingPast() const;
   // Draws it from `frames` (the lead-in, the frame itself last: the camera
   // drive's run-up, as it ran live) with the stations lost then.
@@ -87,9 +92,15 @@ class StationViews {
   std::array<std::chrono::steady_clock::time_point, kNumViews> watched_{};
   std::array<ViewImage, kNumViews> images_;
   std::array<std::chrono::steady_clock::time_point, kNumViews> drawn_at_{};
-  // Past views: for each view, the frame last asked for and its image.
-  std::array<std::int64_t, kNumViews> past_asked_ = MinusOnes();
-  std::array<ViewImage, kNumViews> past_;
+  // Past views: those asked for and not drawn (oldest first), and the last
+  // kPastCached drawn, each by the view and the frame asked for.
+  struct PastImage {
+    int view = 0;
+    std::int64_t asked = 0;
+    ViewImage image;
+  };
+  std::deque<std::pair<int, std::int64_t>> past_asked_;
+  std::deque<PastImage> past_;
 };
 
 }  // namespace rms::instructor_station
