@@ -351,18 +351,21 @@ class Subject:
     def settle_unended(self):
         """A run the journal started and never ended: the study was stopped
         during it (killed, the machine down). Its session, still stopping,
-        is waited for; then it is marked lost, to be flown again."""
-        for trial, runs in self.folder.runs(self.name).items():
-            for r in runs:
-                if r["status"] != "started":
-                    continue
-                session = r.get("session") or ""
-                wait_for_launcher(session)
-                self.folder.append({"event": "end", "subject": self.name, "trial": trial, "run": r["run"],
-                                    "session": session, "status": "lost",
-                                    "why": "the study run stopped during it (no end recorded)"})
-                say(f"trial {trial} (run {r['run']}) was under way when the study run stopped: marked lost, "
-                    f"to be flown again")
+        is waited for (its launcher holds the trial lock until it exits);
+        then it is marked lost, to be flown again."""
+        unended = [(trial, r) for trial, runs in self.folder.runs(self.name).items() for r in runs
+                   if r["status"] == "started"]
+        if unended:
+            wait_for_trial_lock(self.trial_lock_path())
+        for trial, r in unended:
+            self.folder.append({"event": "end", "subject": self.name, "trial": trial, "run": r["run"],
+                                "session": r.get("session") or "", "status": "lost",
+                                "why": "the study run stopped during it (no end recorded)"})
+            say(f"trial {trial} (run {r['run']}) was under way when the study run stopped: marked lost, "
+                f"to be flown again")
+
+    def trial_lock_path(self):
+        return os.path.join(self.folder.subject_dir(self.name), ".trial.lock")
 
     def next_trial(self):
         return progress(self.folder, self.name, self.trials)[1]
@@ -392,7 +395,7 @@ class Subject:
         self.folder.append({"event": "start", "subject": self.name, "trial": t["trial"], "run": run_no,
                             "session": os.path.relpath(session, self.folder.dir), "condition": t["condition"],
                             "kind": t["kind"], "pilot": self.a.pilot})
-        rc = run_child(cmd)
+        rc = run_child(cmd, self.trial_lock_path())
         end = judge(session, rc, self.study.limit_s)
         end.update({"event": "end", "subject": self.name, "trial": t["trial"], "run": run_no,
                     "session": os.path.relpath(session, self.folder.dir)})
@@ -400,17 +403,40 @@ class Subject:
         return end
 
 
-def run_child(cmd):
+def run_child(cmd, trial_lock):
     """The trial's session in the foreground: a Ctrl-C, a closed terminal or
     a kill of this run reaches it (it stops as a session stops, its record
-    whole), and this run waits for it."""
+    whole), and this run waits for it. The session's launcher inherits the
+    trial lock and holds it until it exits, even if this run is killed: a
+    resumed run waits on it (wait_for_trial_lock) before it flies again on
+    the same address."""
+    parent = os.getpid()
+
     def child_setup():
         import ctypes
         ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
+        if os.getppid() != parent:  # this run died before prctl took
+            os.kill(os.getpid(), signal.SIGTERM)
+    lock_fd = os.open(trial_lock, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o600)
+    try:
+        fcntl.flock(lock_fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        os.close(lock_fd)
+        raise LabError(f"the session of an earlier trial still holds {trial_lock}: wait for it to stop, "
+                       f"then run the same command again", 1)
+    try:
+        return wait_child(lambda: subprocess.Popen(cmd, preexec_fn=child_setup, pass_fds=(lock_fd,)))
+    finally:
+        os.close(lock_fd)
+
+
+def wait_child(start):
+    """Starts the child (start()) and waits for it, passing on the signals
+    this run is sent."""
     stopped, signalled = [], []
     old = {s: signal.signal(s, lambda n, f: stopped.append(n)) for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
     try:
-        proc = subprocess.Popen(cmd, preexec_fn=child_setup)
+        proc = start()
         while True:
             try:
                 rc = proc.wait(timeout=0.2)
@@ -460,25 +486,27 @@ def judge(session, rc, limit_s):
             "duration_s": summary.get("duration_s")}
 
 
-def wait_for_launcher(session, limit_s=120):
-    pid_file = os.path.join(session, "run", "launcher.pid")
+def wait_for_trial_lock(path, limit_s=120):
+    """Waits until no launcher of an earlier run holds the trial lock (it
+    stops when the run that started it dies: PR_SET_PDEATHSIG)."""
+    fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o600)
     try:
-        pid = int(open(pid_file).read().strip() or 0)
-    except (OSError, ValueError):
-        return
-    end = time.time() + limit_s
-    said = False
-    while pid > 0 and time.time() < end:
-        try:
-            os.kill(pid, 0)
-        except ProcessLookupError:
-            return
-        except PermissionError:
-            pass
-        if not said:
-            say(f"waiting for the session of the run that was under way to stop ({session})")
-            said = True
-        time.sleep(0.5)
+        end = time.time() + limit_s
+        said = False
+        while True:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                return
+            except OSError:
+                if time.time() >= end:
+                    raise LabError(f"the session of the run that was under way has not stopped in {limit_s} s "
+                                   f"(it holds {path}): stop it, then run the same command again", 1)
+            if not said:
+                say("waiting for the session of the run that was under way to stop")
+                said = True
+            time.sleep(0.2)
+    finally:
+        os.close(fd)
 
 
 def dir_arg(a):
