@@ -213,6 +213,7 @@ struct WebServer::Impl {
   Answer Serve(const Request& req);
   Answer Route(const Request& req);
   Answer Control(const Request& req);
+  Answer RefusedInDebrief(const char* why);
   Answer PastView(const Request& req, int view);
   Answer Mark(const Request& req);
   Answer LoadLesson(const Request& req);
@@ -308,14 +309,18 @@ Answer WebServer::Impl::Route(const Request& req) {
   return a;
 }
 
+// A debrief replays a recorded session: a command or a lesson is refused
+// (409, counted as refused) with why.
+Answer WebServer::Impl::RefusedInDebrief(const char* why) {
+  Answer a;
+  a.status = 409;
+  a.body = Json(nlohmann::json{{"error", std::string("a debrief of a recorded session: ") + why}});
+  ++refused;
+  return a;
+}
+
 Answer WebServer::Impl::Control(const Request& req) {
-  if (options.debrief) {
-    Answer a;
-    a.status = 409;
-    a.body = Json(nlohmann::json{{"error", "a debrief of a recorded session: nothing to control"}});
-    ++refused;
-    return a;
-  }
+  if (options.debrief) return RefusedInDebrief("nothing to control");
   const std::string command = req.param("command");
   ControlRequest r;
   r.command = CommandCode(command);
@@ -410,13 +415,7 @@ Answer WebServer::Impl::Mark(const Request& req) {
 // for the page), checked as the operator station checks one: refused (400,
 // the key and the reason) with the lesson in force unchanged.
 Answer WebServer::Impl::LoadLesson(const Request& req) {
-  if (options.debrief) {
-    Answer a;
-    a.status = 409;
-    a.body = Json(nlohmann::json{{"error", "a debrief of a recorded session: no lesson can fire"}});
-    ++refused;
-    return a;
-  }
+  if (options.debrief) return RefusedInDebrief("no lesson can fire");
   std::string name = req.param("name").substr(0, 100);
   for (char& c : name)
     if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';  // shown on the page

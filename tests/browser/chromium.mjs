@@ -20,3 +20,26 @@ export function pageErrors(page, {consoleErrors = false} = {}) {
   if (consoleErrors) page.on("console", (m) => { if (m.type() === "error") errors.push(m.text()); });
   return errors;
 }
+
+export const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+// A browser test's way out: fail(why) prints "FAIL why" and what the test
+// had measured (result, as JSON) and exits 1; until(what, fn, seconds)
+// polls fn every 0.2 s until it gives a truthy value, else fails naming what.
+export function reporter(result) {
+  const fail = (why) => {
+    console.log("FAIL " + why);
+    console.log(JSON.stringify(result));
+    process.exit(1);
+  };
+  const until = async (what, fn, seconds) => {
+    const end = Date.now() + seconds * 1000;
+    for (;;) {
+      const v = await fn();
+      if (v) return v;
+      if (Date.now() > end) fail(what + " (not within " + seconds + " s)");
+      await sleep(200);
+    }
+  };
+  return {fail, until};
+}

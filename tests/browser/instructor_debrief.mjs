@@ -22,7 +22,7 @@
 //      smallest text is 12 px or more; a screenshot is written.
 import {createRequire} from "node:module";
 import {readFileSync} from "node:fs";
-import {launchChromium, pageErrors} from "./chromium.mjs";
+import {launchChromium, pageErrors, reporter, sleep} from "./chromium.mjs";
 
 const url = process.argv[2], shots = process.argv[3];
 if (!url || !shots) {
@@ -31,21 +31,7 @@ if (!url || !shots) {
 }
 const axeSource = readFileSync(createRequire(import.meta.url).resolve("axe-core/axe.min.js"), "utf8");
 const result = {};
-const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
-function fail(why) {
-  console.log("FAIL " + why);
-  console.log(JSON.stringify(result));
-  process.exit(1);
-}
-async function until(what, fn, seconds) {
-  const end = Date.now() + seconds * 1000;
-  for (;;) {
-    const v = await fn();
-    if (v) return v;
-    if (Date.now() > end) fail(what + " (not within " + seconds + " s)");
-    await sleep(200);
-  }
-}
+const {fail, until} = reporter(result);
 
 // What is on screen at this size: the page's scroll extent and each key
 // element's box.

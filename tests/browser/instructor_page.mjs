@@ -21,7 +21,7 @@
 //      it flies), the operator station's autopilot reports it (its report is
 //      in the event list), and the page's Repair puts it right; a lost
 //      camera station's view goes black but for "NO VIDEO".
-import {launchChromium, pageErrors} from "./chromium.mjs";
+import {launchChromium, pageErrors, reporter, sleep} from "./chromium.mjs";
 
 const url = process.argv[2];
 const station = process.argv[3] || "1";
@@ -30,23 +30,9 @@ if (!url) {
   process.exit(2);
 }
 const result = {};
-const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+const {fail, until} = reporter(result);
 
-function fail(why) {
-  console.log("FAIL " + why);
-  console.log(JSON.stringify(result));
-  process.exit(1);
-}
 
-async function until(what, fn, seconds) {
-  const end = Date.now() + seconds * 1000;
-  for (;;) {
-    const v = await fn();
-    if (v) return v;
-    if (Date.now() > end) fail(what + " (not within " + seconds + " s)");
-    await sleep(200);
-  }
-}
 
 // The displayed image's pixels, hashed, and the frame it showed.
 async function viewPixels(page, id) {

@@ -11,7 +11,7 @@
 // axe-core finds no accessibility violation at all.
 import {readFileSync} from "node:fs";
 import {createRequire} from "node:module";
-import {launchChromium, pageErrors} from "./chromium.mjs";
+import {launchChromium, pageErrors, reporter} from "./chromium.mjs";
 
 const [file, conditions, subjects] = process.argv.slice(2);
 if (!file || !conditions || !subjects) {
@@ -19,11 +19,7 @@ if (!file || !conditions || !subjects) {
   process.exit(2);
 }
 const result = {};
-function fail(why) {
-  console.log("FAIL " + why);
-  console.log(JSON.stringify(result));
-  process.exit(1);
-}
+const {fail} = reporter(result);
 const axeSource = readFileSync(createRequire(import.meta.url).resolve("axe-core/axe.min.js"), "utf8");
 
 const browser = await launchChromium();
