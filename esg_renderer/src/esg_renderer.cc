@@ -52,7 +52,8 @@ void EsgRenderer::OnOperatorState(const void* data, int size) {
   }
   bool finite = std::isfinite(m.distance_ft) && std::isfinite(m.angle_deg) &&
                 std::isfinite(m.bay_clearance_ft) && std::isfinite(m.close_gap_ft) &&
-                std::isfinite(m.dock_distance_ft) && std::isfinite(m.dock_angle_deg);
+                std::isfinite(m.dock_distance_ft) && std::isfinite(m.dock_angle_deg) &&
+                std::isfinite(m.turn_clearance_ft);
   for (int i = 0; i < 3; ++i)
     finite = finite && std::isfinite(m.offset_ft[i]) && std::isfinite(m.rotation_deg[i]);
   for (int i = 0; i < 6; ++i) finite = finite && std::isfinite(m.margin_ft[i]);

@@ -300,10 +300,11 @@ void DrawGuidance(std::uint8_t* rgba, int w, int h, const operator_state_t& st) 
   char b[96];
   std::snprintf(b, sizeof b, "%s  %s FRAME  %s", st.target == 1 ? "TO THE GRASP" : "TO THE PORT",
                 kFrames[frame],
-                st.control_mode == 1 ? "SINGLE JOINT"
-                : st.vernier         ? "VERNIER"
-                : st.control_mode    ? "COARSE"
-                                     : "");
+                st.control_mode == 1                          ? "SINGLE JOINT"
+                : st.scale == operator_state_t::SCALE_VERNIER ? "VERNIER"
+                : st.scale == operator_state_t::SCALE_FINE    ? "FINE"
+                : st.control_mode                             ? "COARSE"
+                                                              : "");
   L.push_back(b);
   L.push_back(Offset("X", st.offset_ft[0], "FWD", "BACK", "") + "  " +
               Offset("Y", st.offset_ft[1], "RIGHT", "LEFT", "") + "  " +
@@ -311,6 +312,17 @@ void DrawGuidance(std::uint8_t* rgba, int w, int h, const operator_state_t& st) 
   L.push_back(Offset("ROLL", st.rotation_deg[0], "R", "L", "") + "  " +
               Offset("PITCH", st.rotation_deg[1], "UP", "DN", "") + "  " +
               Offset("YAW", st.rotation_deg[2], "R", "L", " DEG"));
+  static const char* kNext[6] = {"X", "Y", "Z", "ROLL", "PITCH", "YAW"};
+  if (st.next_axis >= 0 && st.next_axis < 6) {
+    std::snprintf(b, sizeof b, "NEXT: %s", kNext[st.next_axis]);
+    std::string n = b;
+    if (st.automatic & operator_state_t::AUTO_SQUARE_UP) n += "  SQUARING UP";
+    for (int i = 0; i < 6; ++i)
+      if (st.automatic & (1 << i)) n += std::string("  NULLING ") + kNext[i];
+    L.push_back(n);
+  }
+  if (st.automatic & operator_state_t::AUTO_UNWIND) L.push_back("UNWINDING THE WRIST");
+  if (st.joints_near_limit) L.push_back("WARNING: WRIST NEAR ITS LIMIT (B UNWINDS IT)");
   if (st.mode == 1) {
     std::string c = "ACQ";
     for (int i = 0; i < 6; ++i) {
@@ -320,8 +332,13 @@ void DrawGuidance(std::uint8_t* rgba, int w, int h, const operator_state_t& st) 
     }
     L.push_back(c);
     if (st.close_gap_ft > 0) {
+      // close_ok: closing now acquires (every other condition holds too).
+      bool others = true;
+      for (int i : {0, 1, 2, 4, 5}) others = others && st.conditions[i];
       std::snprintf(b, sizeof b, "CLOSED, THE FINGER WOULD STOP AT %.2f FT: %s", st.close_gap_ft,
-                    st.close_ok ? "ACQUIRES" : "NOT BELOW D3Y");
+                    st.close_ok ? "CLOSING ACQUIRES"
+                    : !others   ? "OTHER CONDITIONS SHORT"
+                                : "NOT BELOW D3Y");
       L.push_back(b);
     }
   } else if (st.mode == 2) {
@@ -330,6 +347,10 @@ void DrawGuidance(std::uint8_t* rgba, int w, int h, const operator_state_t& st) 
   } else {
     std::snprintf(b, sizeof b, "DOCK: %.2f FT  %.2f DEG", st.dock_distance_ft, st.dock_angle_deg);
     L.push_back(b);
+    std::snprintf(b, sizeof b, "SILL: %+.2f FT NOW  %+.2f FT OVER THE TURN", st.bay_clearance_ft,
+                  st.turn_clearance_ft);
+    L.push_back(b);
+    if (st.clearance_warning) L.push_back("CLEARANCE WARNING: GO UP BEFORE TURNING");
   }
   std::size_t longest = 0;
   for (const auto& l : L) longest = std::max(longest, l.size());

@@ -368,7 +368,7 @@ function showTrainee(s) {
   else {
     $("trainee").innerHTML = "<b>" + esc(o.source) + "</b>" + (o.source !== "by hand" ? "" : ": " + esc(o.control_mode) +
       (o.control_mode === "manual augmented" ? ", frame " + esc(o.command_frame) : "") +
-      (o.joint ? ", joint " + esc(o.joint) : "") + ", " + (o.vernier ? "vernier" : "coarse") +
+      (o.joint ? ", joint " + esc(o.joint) : "") + ", " + esc(o.scale) +
       ", " + o.key_actions + " key presses");
     const names = ["x", "roll", "y", "pitch", "z", "yaw"], order = [0, 3, 1, 4, 2, 5];
     let h = "";

@@ -640,13 +640,20 @@ nlohmann::json SessionWatch::OperatorJson() const {
   if (!operator_) return nullptr;
   const operator_state_t& m = *operator_;
   nlohmann::json limits = nlohmann::json::array();
-  for (int j = 0; j < wire::kNumJoints; ++j)
+  nlohmann::json near = nlohmann::json::array();
+  for (int j = 0; j < wire::kNumJoints; ++j) {
     if ((m.joint_limits >> j) & 1) limits.push_back(wire::JointName(j + 1));
+    if ((m.joints_near_limit >> j) & 1) near.push_back(wire::JointName(j + 1));
+  }
   nlohmann::json j = {{"frame", m.frame},
                       {"source", SourceName(m.source)},
                       {"control_mode", ControlModeName(m.control_mode)},
                       {"command_frame", CommandFrameName(m.command_frame)},
-                      {"vernier", static_cast<bool>(m.vernier)},
+                      {"scale", m.scale == operator_state_t::SCALE_FINE      ? "fine"
+                                : m.scale == operator_state_t::SCALE_VERNIER ? "vernier"
+                                                                             : "coarse"},
+                      {"joints_near_limit", near},
+                      {"automatic", m.automatic},
                       {"joint", m.control_mode == 1 ? wire::JointName(m.joint + 1) : ""},
                       {"hand_rate", Array(m.hand_rate, 6)},
                       {"joints_at_limit", limits},
@@ -663,7 +670,10 @@ nlohmann::json SessionWatch::OperatorJson() const {
                      {"angle_deg", m.angle_deg},
                      {"margins_ft", margins},
                      {"close_gap_ft", m.close_gap_ft},
-                     {"close_ok", static_cast<bool>(m.close_ok)}};
+                     {"close_ok", static_cast<bool>(m.close_ok)},
+                     {"bay_clearance_ft", m.bay_clearance_ft},
+                     {"turn_clearance_ft", m.turn_clearance_ft},
+                     {"clearance_warning", static_cast<bool>(m.clearance_warning)}};
   } else {
     j["guidance"] = nullptr;
   }
@@ -687,6 +697,15 @@ nlohmann::json SessionWatch::WarningsJson() const {
                     " at its limit");
     if (operator_->singular) w.push_back("near a singular pose: some direction is damped");
     if (operator_->rate_limited) w.push_back("hand-controller rates limited");
+    for (int j = 0; j < wire::kNumJoints; ++j)
+      if ((operator_->joints_near_limit >> j) & 1)
+        w.push_back(std::string("joint ") + std::to_string(j + 1) + " " + wire::JointName(j + 1) +
+                    " near its limit (the trainee is warned; unwind is the way out)");
+    if (operator_->guidance_valid && operator_->clearance_warning)
+      w.push_back(
+          fmt::format("CLEARANCE: the payload {:.2f} ft above the orbiter's sill line over "
+                      "the turn (margin {:.0f} ft)",
+                      operator_->turn_clearance_ft, operator_state_t::CLEARANCE_MARGIN_FT));
   }
   for (const std::string& t : malfunctions_) w.push_back("MALFUNCTION in force: " + t);
   if (dcp_ && dcp_->control.no_video) w.push_back("NO VIDEO on the operator's monitor");

@@ -39,6 +39,8 @@ constexpr Named kNamedActions[] = {
     {"mode", ActionKind::kMode},
     {"frame", ActionKind::kFrame},
     {"vernier", ActionKind::kVernier},
+    {"square_up", ActionKind::kSquareUp},
+    {"unwind", ActionKind::kUnwind},
     {"joint_next", ActionKind::kJointNext},
     {"joint_prev", ActionKind::kJointPrev},
     {"quit", ActionKind::kQuit},
@@ -59,6 +61,10 @@ Action ParseAction(std::string_view t) {
   if (t.size() == 8 && t.substr(0, 7) == "camera_" && t[7] >= '1' && t[7] <= '8') {
     a.kind = ActionKind::kCamera;
     a.camera = t[7] - '0';
+    return a;
+  }
+  if (t.substr(0, 5) == "null_" && (a.index = HandAxisIndex(t.substr(5))) >= 0) {
+    a.kind = ActionKind::kNull;
     return a;
   }
   if (!t.empty() && (t.back() == '+' || t.back() == '-')) {
@@ -85,8 +91,8 @@ Action ParseAction(std::string_view t) {
       "unknown action \"" + std::string(t) +
       "\" (thc_x, thc_y, thc_z, rhc_roll, rhc_pitch, rhc_yaw, finger, shoulder_height, camera_pan, "
       "camera_tilt, camera_zoom with + or -; camera_1..camera_8, camera_next, camera_prev, reset, "
-      "overlay, crosshairs, guidance, stop, mode, frame, vernier, joint_next, joint_prev, quit, "
-      "freeze, step)");
+      "overlay, crosshairs, guidance, stop, mode, frame, vernier, null_ and an axis (null_thc_x .. "
+      "null_rhc_yaw), square_up, unwind, joint_next, joint_prev, quit, freeze, step)");
 }
 
 std::string ActionName(const Action& a) {
@@ -98,6 +104,8 @@ std::string ActionName(const Action& a) {
       return std::string(kAnalogInputNames[a.index]) + sign;
     case ActionKind::kCamera:
       return "camera_" + std::to_string(a.camera);
+    case ActionKind::kNull:
+      return "null_" + std::string(kHandAxisNames[a.index]);
     default:
       break;
   }
@@ -161,9 +169,9 @@ void ReadControl(TomlReader& top, Bindings* b) {
   }
   b->initial_frame = *f;
   const std::string scale = r.String("scale");
-  if (scale != "coarse" && scale != "vernier")
-    r.Fail("scale", "must be \"coarse\" or \"vernier\", got \"" + scale + "\"");
-  b->initial_vernier = scale == "vernier";
+  const auto sc = ParseRateScale(scale);
+  if (!sc) r.Fail("scale", "must be \"coarse\", \"vernier\" or \"fine\", got \"" + scale + "\"");
+  b->initial_scale = *sc;
   b->cameras.clear();
   if (r.Has("cameras")) {
     const toml::array* a = r.Get("cameras")->as_array();
@@ -216,6 +224,9 @@ void ReadKeyboard(TomlReader& top, Bindings* b) {
     h.vernier_deg = s.Positive("vernier_deg", 180.0);
     h.joint_coarse_deg = s.Positive("joint_coarse_deg", 180.0);
     h.joint_vernier_deg = s.Positive("joint_vernier_deg", 180.0);
+    if (s.Has("fine_ft")) h.fine_ft = s.Positive("fine_ft", 100.0);
+    if (s.Has("fine_deg")) h.fine_deg = s.Positive("fine_deg", 180.0);
+    if (s.Has("joint_fine_deg")) h.joint_fine_deg = s.Positive("joint_fine_deg", 180.0);
     s.Finish();
   }
   {

@@ -24,6 +24,30 @@ std::string_view CommandFrameName(CommandFrame f) {
   return "?";
 }
 
+std::string_view RateScaleName(RateScale s) {
+  switch (s) {
+    case RateScale::kCoarse:
+      return "coarse";
+    case RateScale::kVernier:
+      return "vernier";
+    case RateScale::kFine:
+      return "fine";
+  }
+  return "?";
+}
+
+RateScale NextRateScale(RateScale s) {
+  return s == RateScale::kCoarse    ? RateScale::kVernier
+         : s == RateScale::kVernier ? RateScale::kFine
+                                    : RateScale::kCoarse;
+}
+
+std::optional<RateScale> ParseRateScale(std::string_view s) {
+  for (RateScale r : {RateScale::kCoarse, RateScale::kVernier, RateScale::kFine})
+    if (s == RateScaleName(r)) return r;
+  return std::nullopt;
+}
+
 std::optional<ControlMode> ParseControlMode(std::string_view s) {
   if (s == "single_joint") return ControlMode::kSingleJoint;
   if (s == "manual_augmented") return ControlMode::kManualAugmented;

@@ -41,7 +41,7 @@ std::string RecoveredText(int part) {
 
 }  // namespace
 
-std::vector<FollowWatch::Change> FollowWatch::Observe(const dcp_telemetry_t& t) {
+std::vector<FollowWatch::Change> FollowWatch::Observe(const dcp_telemetry_t& t, bool commanding) {
   std::vector<Change> changes;
   // Held by a collision, or captured at the dock: the arm is meant to stay.
   const bool captured = t.docked && !t.released;
@@ -55,7 +55,7 @@ std::vector<FollowWatch::Change> FollowWatch::Observe(const dcp_telemetry_t& t) 
     const bool was = (failing_ >> p) & 1u;
     bool off = false, back = false;
     if (p == kArm) {
-      off = t.held && at_command && !captured;
+      off = t.held && at_command && !captured && !commanding;
       back = !t.held;
     } else if (p < kFinger) {
       const double d = std::abs(t.master_angles_deg[p] - t.slave_angles_deg[p]);

@@ -60,6 +60,10 @@ GuidanceGeometry MakeGuidanceGeometry(const LabConfig& c) {
   }
   g.fixed_finger_face_Y2_ft =
       c.end_effector.palm_half_width_ft - c.end_effector.finger_thickness_ft;
+  g.body_radius_ft = 0.5 * c.payload.diameter_ft;
+  g.body_half_length_ft = 0.5 * c.payload.length_ft;
+  g.probe_root_radius_ft = 0.5 * c.payload.probe_diameter_ft;
+  g.probe_tip_radius_ft = 0.6 * g.probe_root_radius_ft;  // docs/scene.md: the drawn probe
   return g;
 }
 
@@ -95,7 +99,70 @@ Eigen::Vector3d PointOfResolution(const GuidanceGeometry& g, const ArmState& s) 
   return s.X_RS2.inverse() * (s.X_RP * g.p_PoT_P);
 }
 
-Guidance ComputeGuidance(const GuidanceGeometry& g, const ArmState& s, CommandFrame f) {
+namespace {
+
+// The lowest point of a circle (centre c, radius r, normal a; unit) in z.
+double CircleLowestZ(const Eigen::Vector3d& c, double r, const Eigen::Vector3d& a) {
+  return c.z() - r * std::sqrt(std::max(0.0, 1.0 - a.z() * a.z()));
+}
+
+// The axis to fly next: the largest turn beyond kTurnTolDeg; then, of the
+// translations beyond kMoveTolFt, the two across the approach line (the
+// axis most along approach_F goes last) by size, then the one along it.
+int NextAxis(const Guidance& out, const Eigen::Vector3d& approach_F) {
+  constexpr double kTurnTolDeg = 0.5, kMoveTolFt = 0.05;
+  int best = -1;
+  for (int i = 0; i < 3; ++i) {
+    if (std::abs(out.rotation_deg[i]) > kTurnTolDeg &&
+        (best < 0 || std::abs(out.rotation_deg[i]) > std::abs(out.rotation_deg[best - 3])))
+      best = 3 + i;
+  }
+  if (best >= 0) return best;
+  int along = 0;
+  approach_F.cwiseAbs().maxCoeff(&along);
+  for (int i = 0; i < 3; ++i) {
+    if (i == along || std::abs(out.offset_ft[i]) <= kMoveTolFt) continue;
+    if (best < 0 || std::abs(out.offset_ft[i]) > std::abs(out.offset_ft[best])) best = i;
+  }
+  if (best >= 0) return best;
+  return std::abs(out.offset_ft[along]) > kMoveTolFt ? along : -1;
+}
+
+}  // namespace
+
+double PayloadLowestZ(const GuidanceGeometry& g, const Eigen::Isometry3d& X_RP) {
+  const Eigen::Vector3d y = X_RP.linear().col(1);
+  const Eigen::Vector3d o = X_RP.translation();
+  const Eigen::Vector3d root = o + g.body_half_length_ft * y, tip = X_RP * g.p_PoT_P;
+  return std::min({CircleLowestZ(o - g.body_half_length_ft * y, g.body_radius_ft, y),
+                   CircleLowestZ(root, g.body_radius_ft, y),
+                   CircleLowestZ(tip, g.probe_tip_radius_ft, y)});
+}
+
+double TurnClearance(const GuidanceGeometry& g, const Eigen::Isometry3d& X_RP,
+                     const Eigen::Vector3d& p_R, const Eigen::Vector3d& phi_R) {
+  const double angle = phi_R.norm();
+  const int n = std::max(1, static_cast<int>(std::ceil(angle * 180.0 / M_PI)));
+  double least = PayloadLowestZ(g, X_RP);
+  for (int k = 1; k <= n && angle > 0; ++k) {
+    const Eigen::AngleAxisd turn(angle * k / n, phi_R / angle);
+    Eigen::Isometry3d X = X_RP;
+    X.linear() = turn.toRotationMatrix() * X_RP.linear();
+    X.translation() = p_R + turn * (X_RP.translation() - p_R);
+    least = std::min(least, PayloadLowestZ(g, X));
+  }
+  return least;
+}
+
+bool WouldAcquire(const dcp_telemetry_t& t, const Guidance& g, double d3y_ft) {
+  if (t.mode != 1 || g.close_gap_ft <= 0 || g.close_gap_ft >= d3y_ft) return false;
+  for (int i : {0, 1, 2, 4, 5})  // all but 4, the finger's own (docs/collision.md)
+    if (!t.acquisition_conditions[i]) return false;
+  return true;
+}
+
+Guidance ComputeGuidance(const GuidanceGeometry& g, const ArmState& s, CommandFrame f,
+                         const Eigen::Vector3d* turn_F_deg) {
   Guidance out;
   out.frame = f;
   const Eigen::Matrix3d R_RF = CommandAxes(g, f, s);
@@ -135,6 +202,20 @@ Guidance ComputeGuidance(const GuidanceGeometry& g, const ArmState& s, CommandFr
   out.rotation_deg = R_RF.transpose() * phi_R * (180.0 / M_PI);
   out.distance_ft = d_R.norm();
   out.angle_deg = phi_R.norm() * 180.0 / M_PI;
+  if (s.mode >= 2) {
+    const Eigen::Vector3d turn_R =
+        turn_F_deg ? Eigen::Vector3d(R_RF * *turn_F_deg * (M_PI / 180.0)) : phi_R;
+    out.turn_clearance_ft = TurnClearance(g, s.X_RP, s.X_RP * g.p_PoT_P, turn_R);
+    out.clearance_warning = s.mode == 3 && out.turn_clearance_ft < kClearanceMarginFt;
+  }
+  const Eigen::Vector3d approach_R =
+      s.mode == 1 ? Eigen::Vector3d(g.X_RS2_grasp.linear().col(0)) : g.y_port_R;
+  out.next_axis = NextAxis(out, R_RF.transpose() * approach_R);
+  if (out.leave_bay && out.leave_bay_ft.norm() > 1e-9) {
+    int up = 0;
+    out.leave_bay_ft.cwiseAbs().maxCoeff(&up);
+    out.next_axis = up;
+  }
   return out;
 }
 

@@ -10,8 +10,39 @@ namespace rms::operator_station {
 
 namespace {
 constexpr double kDeg = M_PI / 180.0;
+// An automatic motion (docs/operator.md "Nulling an axis, squaring up,
+// unwinding") flies at error / kNullTimeS, at most the scale's full rate,
+// and has arrived within kNullTolFt / kNullTolDeg.
+constexpr double kNullTimeS = 0.4;
+constexpr double kNullTolFt = 0.005;
+constexpr double kNullTolDeg = 0.02;
+// The commanded motion's reference waits while the arm lags it by more
+// than this (a joint at its rate, a singular pose), so a press moves the
+// distance asked.
+constexpr double kLagFt = 0.25;
+constexpr double kLagDeg = 1.0;
+// Given up after this long without headway (a joint at its limit, the end
+// of the reach).
+constexpr double kBlockedS = 1.5;
+
+constexpr const char* kAxisWords[kNumHandAxes] = {"x", "y", "z", "roll", "pitch", "yaw"};
+
+double AxisError(const Guidance& g, int i) {
+  return i < 3 ? g.offset_ft[i] : g.rotation_deg[i - 3];
+}
 
 }  // namespace
+
+std::optional<Eigen::Vector3d> TurnInFlight(const HandStatus& h, const Guidance& g) {
+  if (h.automatic & kAutoSquareUp) return std::nullopt;
+  Eigen::Vector3d turn = Eigen::Vector3d::Zero();
+  for (int i = 0; i < 3; ++i) {
+    turn[i] = h.pending[kRhcRoll + i];
+    if (h.automatic & (1u << (kRhcRoll + i))) turn[i] = g.rotation_deg[i];
+  }
+  if (turn.isZero()) return std::nullopt;
+  return turn;
+}
 
 HandControllers::HandControllers(const LabConfig& config, const Bindings& bindings)
     : config_(config),
@@ -23,7 +54,7 @@ HandControllers::HandControllers(const LabConfig& config, const Bindings& bindin
   for (int i = 0; i < 6; ++i) limits_.rate_deg_s[i] = bindings.max_rate[i];
   status_.mode = bindings.initial_mode;
   status_.frame = bindings.initial_frame;
-  status_.vernier = bindings.initial_vernier;
+  status_.scale = bindings.initial_scale;
   status_.cameras = bindings.cameras;
   if (status_.cameras.empty())
     for (int st = 1; st <= kNumCameraStations; ++st) status_.cameras.push_back(st);
@@ -110,7 +141,7 @@ void HandControllers::Announce(const char* what) {
     s += ", " + std::string(CommandFrameName(status_.frame)) + " frame";
   else
     s += " (" + std::string(kAnalogInputNames[status_.joint]) + ")";
-  s += status_.vernier ? ", vernier" : ", coarse";
+  s += ", " + std::string(RateScaleName(status_.scale));
   spdlog::info("{}: {}", what, s);
 }
 
@@ -130,23 +161,35 @@ void HandControllers::FollowHeldArm(const dcp_telemetry_t& tm) {
 void HandControllers::StopMotion() {
   status_.pending = {};
   status_.rate = {};
+  status_.automatic = 0;
   for (int i = kFinger; i < kNumAnalogInputs; ++i) target_.value[i] = out_.value[i];
 }
 
 double HandControllers::Increment(int axis) const {
   const HandIncrements& k = b_.increments;
-  if (status_.mode == ControlMode::kSingleJoint)
-    return status_.vernier ? k.joint_vernier_deg : k.joint_coarse_deg;
-  if (axis < 3) return status_.vernier ? k.vernier_ft : k.coarse_ft;
-  return status_.vernier ? k.vernier_deg : k.coarse_deg;
+  const RateScale sc = status_.scale;
+  if (status_.mode == ControlMode::kSingleJoint) {
+    return sc == RateScale::kCoarse    ? k.joint_coarse_deg
+           : sc == RateScale::kVernier ? k.joint_vernier_deg
+                                       : k.joint_fine_deg;
+  }
+  if (axis < 3) {
+    return sc == RateScale::kCoarse    ? k.coarse_ft
+           : sc == RateScale::kVernier ? k.vernier_ft
+                                       : k.fine_ft;
+  }
+  return sc == RateScale::kCoarse    ? k.coarse_deg
+         : sc == RateScale::kVernier ? k.vernier_deg
+                                     : k.fine_deg;
 }
 
 double HandControllers::FullRate(int axis) const {
   const HandRates& r = b_.rates;
+  const bool coarse = status_.scale == RateScale::kCoarse;  // fine flies at vernier's rates
   if (status_.mode == ControlMode::kSingleJoint)
-    return status_.vernier ? r.joint_vernier_deg_s : r.joint_coarse_deg_s;
-  if (axis < 3) return status_.vernier ? r.vernier_ft_s : r.coarse_ft_s;
-  return status_.vernier ? r.vernier_deg_s : r.coarse_deg_s;
+    return coarse ? r.joint_coarse_deg_s : r.joint_vernier_deg_s;
+  if (axis < 3) return coarse ? r.coarse_ft_s : r.vernier_ft_s;
+  return coarse ? r.coarse_deg_s : r.vernier_deg_s;
 }
 
 void HandControllers::HandleEvents(const DeviceCommands& cmd, const dcp_telemetry_t* tm) {
@@ -199,9 +242,14 @@ void HandControllers::HandleEvents(const DeviceCommands& cmd, const dcp_telemetr
       }
       case ActionKind::kVernier:
         StopMotion();
-        status_.vernier = !status_.vernier;
+        status_.scale = NextRateScale(status_.scale);
         counters_.Add(Counter::kControlScaleChanges);
         Announce("rate scale");
+        break;
+      case ActionKind::kNull:
+      case ActionKind::kSquareUp:
+      case ActionKind::kUnwind:
+        StartAutomatic(a);
         break;
       case ActionKind::kJointNext:
       case ActionKind::kJointPrev:
@@ -222,6 +270,151 @@ void HandControllers::HandleEvents(const DeviceCommands& cmd, const dcp_telemetr
       case ActionKind::kInput:
         break;  // not events
     }
+  }
+}
+
+void HandControllers::StartAutomatic(const Action& a) {
+  if (a.kind == ActionKind::kUnwind) {
+    // docs/operator.md "Nulling an axis, squaring up, unwinding": in either
+    // control mode; every other motion stops.
+    StopMotion();
+    status_.automatic = kAutoUnwind;
+    counters_.Add(Counter::kControlUnwinds);
+    spdlog::info("unwind: the wrist's pitch, yaw and roll to the middle of their travel");
+    return;
+  }
+  if (status_.mode == ControlMode::kSingleJoint) {
+    counters_.Add(Counter::kSingleJointPressesIgnored);
+    spdlog::info("{}: manual augmented only (m)", ActionName(a));
+    return;
+  }
+  status_.automatic &= ~kAutoUnwind;
+  if (a.kind == ActionKind::kSquareUp) {
+    for (int i = kRhcRoll; i <= kRhcYaw; ++i) {
+      status_.pending[i] = 0.0;
+      status_.automatic &= ~(1u << i);
+    }
+    status_.automatic |= kAutoSquareUp;
+    counters_.Add(Counter::kControlSquareUps);
+    spdlog::info("square up: the whole turn the guidance shows, in one rotation");
+  } else {
+    status_.pending[a.index] = 0.0;
+    if (a.index >= kRhcRoll) status_.automatic &= ~kAutoSquareUp;
+    status_.automatic |= 1u << a.index;
+    counters_.Add(Counter::kControlNulls);
+    spdlog::info("null {}: flying it to the guidance's 0", kAxisWords[a.index]);
+  }
+  auto_best_.fill(1e30);
+  auto_stalled_s_.fill(0.0);
+}
+
+void HandControllers::TakeAxis(int i) {
+  status_.automatic &= ~(1u << i);
+  if (i >= kRhcRoll) status_.automatic &= ~kAutoSquareUp;
+  status_.automatic &= ~kAutoUnwind;
+}
+
+ArmState HandControllers::CommandedArmState() const {
+  JointAngles q{};
+  for (int i = 0; i < 6; ++i) q[i] = target_.value[i];
+  ArmState s;
+  s.mode = dcp_mode_;
+  s.X_RS2 = ForwardPose(config_.arm, q, target_.value[kShoulderHeight]);
+  if (X_S2P_) {
+    s.X_RP = s.X_RS2 * *X_S2P_;
+  } else {
+    s.mode = 1;
+    s.X_RP = X_RP_;
+  }
+  return s;
+}
+
+CommandFrame HandControllers::FlownFrame() const {
+  return status_.frame == CommandFrame::kPayload && !X_S2P_ ? CommandFrame::kEndEffector
+                                                            : status_.frame;
+}
+
+void HandControllers::AutomaticRates(std::array<double, kNumHandAxes>* rate, double dt_s) {
+  std::uint32_t& a = status_.automatic;
+  if ((a & ~kAutoUnwind) == 0) return;
+  const Guidance g = ComputeGuidance(geometry_, CommandedArmState(), FlownFrame());
+  // Each automatic motion's error (index 6: the square-up's whole angle);
+  // one that has arrived ends, one without headway for kBlockedS is given up.
+  for (int k = 0; k <= kNumHandAxes; ++k) {
+    const std::uint32_t bit = k < kNumHandAxes ? 1u << k : kAutoSquareUp;
+    if (!(a & bit)) continue;
+    const double e = k < kNumHandAxes ? AxisError(g, k) : g.angle_deg;
+    const bool linear = k < 3;
+    const std::string what = k < kNumHandAxes ? std::string("null ") + kAxisWords[k] : "square up";
+    if (std::abs(e) <= (linear ? kNullTolFt : kNullTolDeg)) {
+      a &= ~bit;
+      spdlog::info("{}: there ({:.3f} {})", what, std::abs(e), linear ? "ft" : "deg");
+      continue;
+    }
+    auto_stalled_s_[k] = std::abs(e) < auto_best_[k] - 1e-4 ? 0.0 : auto_stalled_s_[k] + dt_s;
+    auto_best_[k] = std::min(auto_best_[k], std::abs(e));
+    if (auto_stalled_s_[k] > kBlockedS) {
+      a &= ~bit;
+      counters_.Add(Counter::kIncrementsBlocked);
+      spdlog::warn(
+          "{}: the arm cannot move that way (a joint at its limit, the end of its reach): "
+          "stopped {:.3f} {} short",
+          what, std::abs(e), linear ? "ft" : "deg");
+      continue;
+    }
+    if (k < kNumHandAxes) {
+      const double full = FullRate(k);
+      (*rate)[k] += std::clamp(e / kNullTimeS, -full, full);
+    } else {
+      const double w = std::min(FullRate(kRhcRoll), g.angle_deg / kNullTimeS);
+      for (int i = 0; i < 3; ++i) (*rate)[kRhcRoll + i] += g.rotation_deg[i] / g.angle_deg * w;
+    }
+  }
+}
+
+void HandControllers::FlyUnwind(double dt_s) {
+  JointAngles q{}, goal{}, rate{};
+  for (int i = 0; i < 6; ++i) {
+    q[i] = goal[i] = target_.value[i];
+    rate[i] = b_.max_rate[i];
+  }
+  for (int i = 3; i < 6; ++i) goal[i] = 0.5 * (limits_.min_deg[i] + limits_.max_deg[i]);
+  const bool there = StepJointsToward(&q, goal, rate, dt_s);
+  for (int i = 0; i < 6; ++i) target_.value[i] = q[i];
+  X_ref_.reset();
+  status_.achieved = {};
+  status_.singular = false;
+  status_.rate_limited = false;
+  if (there) {
+    status_.automatic &= ~kAutoUnwind;
+    spdlog::info("unwind: there (wrist pitch {:+.1f}, yaw {:+.1f}, roll {:+.1f} deg)", q[3], q[4],
+                 q[5]);
+  }
+  ReportLimits(0);
+}
+
+void HandControllers::ReportNearLimits() {
+  status_.near_limit = 0;
+  for (int i = 3; i < 6; ++i) {  // the wrist's joints (docs/operator.md "Joint limits")
+    const double q = target_.value[i];
+    const bool near =
+        q < limits_.min_deg[i] + kNearLimitDeg || q > limits_.max_deg[i] - kNearLimitDeg;
+    const std::uint32_t bit = 1u << i;
+    if (near) status_.near_limit |= bit;
+    if (near && !(near_reported_ & bit)) {
+      counters_.Add(Counter::kJointNearLimit);
+      spdlog::warn(
+          "{} at {:+.1f} deg, within {:.0f} deg of its limit (travel {:+.1f} .. {:+.1f}): "
+          "the unwind key flies the wrist back to the middle of its travel",
+          kAnalogInputNames[i], q, kNearLimitDeg, limits_.min_deg[i], limits_.max_deg[i]);
+    }
+    // Reported again only after it has been well clear (2 deg of hysteresis).
+    const bool clear =
+        q > limits_.min_deg[i] + kNearLimitDeg + 2 && q < limits_.max_deg[i] - kNearLimitDeg - 2;
+    if (near)
+      near_reported_ |= bit;
+    else if (clear)
+      near_reported_ &= ~bit;
   }
 }
 
@@ -254,6 +447,7 @@ void HandControllers::AddPress(const struct Press& p) {
   // direction the axis is still moving is merged into that motion (it
   // never runs on more than one increment from now); one the other way
   // stops it.
+  TakeAxis(p.index);
   double& pending = status_.pending[p.index];
   const double inc = Increment(p.index);
   if (pending * p.sign > 0)
@@ -271,6 +465,7 @@ std::array<double, kNumHandAxes> HandControllers::CommandedRates(const DeviceCom
     const double full = FullRate(i);
     if (cmd.hand[i] == 0.0) hand_suppressed_[i] = false;  // let go since the stop: it acts again
     double r = hand_suppressed_[i] ? 0.0 : std::clamp(cmd.hand[i], -1.0, 1.0) * full;
+    if (r != 0.0) TakeAxis(i);
     const double pending = status_.pending[i];
     if (pending != 0.0) r += std::copysign(std::min(full, std::abs(pending) / dt_s), pending);
     rate[i] = std::clamp(r, -full, full);
@@ -286,25 +481,30 @@ void HandControllers::FlyManualAugmented(const std::array<double, kNumHandAxes>&
   JointAngles q{};
   for (int i = 0; i < 6; ++i) q[i] = target_.value[i];
   const double h = target_.value[kShoulderHeight];
-  ArmState s;
-  s.mode = dcp_mode_;
-  s.X_RS2 = ForwardPose(config_.arm, q, h);
-  if (X_S2P_)
-    s.X_RP = s.X_RS2 * *X_S2P_;
-  else
-    s.mode = 1;
-  const CommandFrame frame = status_.frame == CommandFrame::kPayload && !X_S2P_
-                                 ? CommandFrame::kEndEffector
-                                 : status_.frame;
-  const Eigen::Matrix3d R_RF = CommandAxes(geometry_, frame, s);
+  const ArmState s = CommandedArmState();
+  const Eigen::Matrix3d R_RF = CommandAxes(geometry_, FlownFrame(), s);
   const Eigen::Vector3d por = PointOfResolution(geometry_, s);
-  const Eigen::Vector3d v_R = R_RF * Eigen::Vector3d(rate[kThcX], rate[kThcY], rate[kThcZ]);
-  const Eigen::Vector3d w_R =
-      R_RF * Eigen::Vector3d(rate[kRhcRoll], rate[kRhcPitch], rate[kRhcYaw]) * kDeg;
   // The motion is flown closed loop on a reference pose that moves exactly
   // as commanded (about the point of resolution), so the rate's first-order
   // steps and the elbow's self-motion do not drift; released, nothing moves.
-  if (v_R.squaredNorm() == 0.0 && w_R.squaredNorm() == 0.0) {
+  // The reference waits while the arm lags it (a joint at its rate, a
+  // singular pose): what it moves is what the arm will have moved.
+  // (Only while an increment is counted off: what flies by itself aims at
+  // the guidance's 0 afresh every frame and needs no count.)
+  double advance = 1.0;
+  const bool counting = std::any_of(status_.pending.begin(), status_.pending.end(),
+                                    [](double p) { return p != 0.0; });
+  if (X_ref_ && counting) {
+    const double lag_ft = (*X_ref_ * por - s.X_RS2 * por).norm();
+    const double lag_rad = RotationVector(X_ref_->linear() * s.X_RS2.linear().transpose()).norm();
+    if (lag_ft > kLagFt || lag_rad > kLagDeg * kDeg) advance = 0.0;
+  }
+  const Eigen::Vector3d v_R =
+      advance * (R_RF * Eigen::Vector3d(rate[kThcX], rate[kThcY], rate[kThcZ]));
+  const Eigen::Vector3d w_R =
+      advance * (R_RF * Eigen::Vector3d(rate[kRhcRoll], rate[kRhcPitch], rate[kRhcYaw]) * kDeg);
+  const bool commanded = std::any_of(rate.begin(), rate.end(), [](double r) { return r != 0.0; });
+  if (!commanded) {
     X_ref_.reset();
   } else {
     if (!X_ref_) X_ref_ = s.X_RS2;
@@ -335,20 +535,23 @@ void HandControllers::FlyManualAugmented(const std::array<double, kNumHandAxes>&
   for (int i = 0; i < 6; ++i) target_.value[i] = r.q_deg[i];
   const Eigen::Vector3d v_done = R_RF.transpose() * r.achieved.head<3>();
   const Eigen::Vector3d w_done = R_RF.transpose() * r.achieved.tail<3>() / kDeg;
-  ConsumePending({v_done.x(), v_done.y(), v_done.z(), w_done.x(), w_done.y(), w_done.z()}, dt_s);
+  status_.achieved = {v_done.x(), v_done.y(), v_done.z(), w_done.x(), w_done.y(), w_done.z()};
+  // The increments are taken off as the reference advances.
+  std::array<double, kNumHandAxes> moved{};
+  for (int i = 0; i < kNumHandAxes; ++i) moved[i] = advance * rate[i];
+  ConsumePending(moved, dt_s);
   status_.singular = r.singular;
-  status_.rate_limited = r.rate_limited;
+  status_.rate_limited = r.rate_limited || advance == 0.0;
   status_.sigma_min_ft = r.sigma_min_ft;
   ReportLimits(r.at_limit);
 }
 
 void HandControllers::ConsumePending(const std::array<double, kNumHandAxes>& achieved,
                                      double dt_s) {
-  // An increment is done when the arm has moved it (not when it was asked
-  // for): near a singular pose the first of it may go slowly. One that
-  // makes no headway for kBlockedS (a joint at its limit, the arm at the
-  // end of its reach) is given up, and said so.
-  constexpr double kBlockedS = 1.5;
+  // An increment is done when the motion flown has moved it (not when it
+  // was asked for): near a singular pose the first of it may go slowly. One
+  // that makes no headway for kBlockedS (a joint at its limit, the arm at
+  // the end of its reach) is given up, and said so.
   for (int i = 0; i < kNumHandAxes; ++i) {
     double& pending = status_.pending[i];
     if (pending == 0.0) {
@@ -384,7 +587,8 @@ void HandControllers::FlySingleJoint(double rate_deg_s, double dt_s) {
     at_limit = 1u << j;
   }
   status_.rate_limited = std::abs(rate) < std::abs(rate_deg_s);
-  ConsumePending({(q - target_.value[j]) / dt_s, 0, 0, 0, 0, 0}, dt_s);
+  status_.achieved = {(q - target_.value[j]) / dt_s, 0, 0, 0, 0, 0};
+  ConsumePending(status_.achieved, dt_s);
   target_.value[j] = q;
   status_.singular = false;
   ReportLimits(at_limit);
@@ -454,9 +658,9 @@ wire::OperatorInputs HandControllers::Apply(const DeviceCommands& cmd, double dt
       Announce("command frame");
     }
     dcp_mode_ = tm->mode;
+    X_RP_ = TelemetryPose(tm->p_RoPo_R_ft, tm->R_RP);
     if (tm->mode >= 2)
-      X_S2P_ = TelemetryPose(tm->p_RoA_R_ft, tm->R_RS2).inverse() *
-               TelemetryPose(tm->p_RoPo_R_ft, tm->R_RP);
+      X_S2P_ = TelemetryPose(tm->p_RoA_R_ft, tm->R_RS2).inverse() * X_RP_;
     else
       X_S2P_.reset();
     // The DCP holds the arm (the command collides): carry on from the pose
@@ -472,15 +676,20 @@ wire::OperatorInputs HandControllers::Apply(const DeviceCommands& cmd, double dt
     // later); the finger and the other inputs are.
     status_.pending = {};
     status_.rate = {};
+    status_.automatic = 0;
   } else {
     for (const struct Press& p : cmd.hand_presses) AddPress(p);
-    const auto rate = CommandedRates(cmd, dt_s);
+    auto rate = CommandedRates(cmd, dt_s);
+    if (status_.mode == ControlMode::kManualAugmented) AutomaticRates(&rate, dt_s);
     status_.rate = rate;
-    if (status_.mode == ControlMode::kManualAugmented)
+    if (status_.automatic & kAutoUnwind)
+      FlyUnwind(dt_s);
+    else if (status_.mode == ControlMode::kManualAugmented)
       FlyManualAugmented(rate, dt_s);
     else
       FlySingleJoint(rate[kThcX], dt_s);
   }
+  ReportNearLimits();
   DirectInputs(cmd, dt_s);
   for (int i = 0; i < 6; ++i) out_.value[i] = target_.value[i];
   out_.camera_station = target_.camera_station;

@@ -177,7 +177,14 @@ void OperatorStation::OnTelemetry(const void* data, int size, std::int64_t recv_
   telemetry_rate_.Tick(recv_us);
   input_to_dcp_ms_ = (recv_us - m.input_send_time_us) / 1000.0;
   events_.Observe(m);
-  for (const FollowWatch::Change& c : follow_.Observe(m)) {
+  bool commanding = false;
+  if (const HandControllers* h = source_->hand()) {
+    const HandStatus& st = h->status();
+    commanding = st.automatic != 0;
+    for (int i = 0; i < kNumHandAxes; ++i)
+      commanding = commanding || st.rate[i] != 0.0 || st.pending[i] != 0.0;
+  }
+  for (const FollowWatch::Change& c : follow_.Observe(m, commanding)) {
     if (c.failing) {
       counters_.Add(Counter::kNotFollowing);
       spdlog::warn("{}", c.text);
@@ -373,9 +380,31 @@ void OperatorStation::ApplyRestore() {
 std::optional<Guidance> OperatorStation::CurrentGuidance() const {
   if (!telemetry_) return std::nullopt;
   const ArmState s = ArmStateFrom(*telemetry_);
-  CommandFrame f = source_->hand() ? source_->hand()->status().frame : CommandFrame::kEndEffector;
+  const HandControllers* hand = source_->hand();
+  CommandFrame f = hand ? hand->status().frame : CommandFrame::kEndEffector;
   if (f == CommandFrame::kPayload && s.mode == 1) f = CommandFrame::kEndEffector;
-  return ComputeGuidance(geometry_, s, f);
+  const Guidance g = ComputeGuidance(geometry_, s, f);
+  if (!hand || s.mode == 1) return g;
+  // The clearance over the turn in flight, where one is (else the whole turn's).
+  const auto turn = TurnInFlight(hand->status(), g);
+  return turn ? ComputeGuidance(geometry_, s, f, &*turn) : g;
+}
+
+// docs/operator.md "Clearance in Mode 3": said once each time the payload
+// goes, or the turn in flight would take it, under the margin.
+void OperatorStation::WatchClearance() {
+  const auto g = CurrentGuidance();
+  const bool warn = g && g->clearance_warning;
+  if (warn && !clearance_warned_) {
+    counters_.Add(Counter::kClearanceWarnings);
+    spdlog::warn(
+        "CLEARANCE: over the {} the payload comes within {:.2f} ft of the orbiter's sill line "
+        "(margin {:.0f} ft): go up (orbiter frame, r) before turning",
+        source_->hand() && TurnInFlight(source_->hand()->status(), *g) ? "turn in flight"
+                                                                       : "turn the guidance shows",
+        g->turn_clearance_ft, kClearanceMarginFt);
+  }
+  clearance_warned_ = warn;
 }
 
 void OperatorStation::PublishState(std::int64_t frame, const wire::OperatorInputs& in) {
@@ -387,7 +416,16 @@ void OperatorStation::PublishState(std::int64_t frame, const wire::OperatorInput
     const HandStatus& s = h->status();
     m.control_mode = static_cast<std::int8_t>(s.mode);
     m.command_frame = static_cast<std::int8_t>(s.frame);
-    m.vernier = s.vernier;
+    static_assert(static_cast<int>(RateScale::kCoarse) == operator_state_t::SCALE_COARSE &&
+                  static_cast<int>(RateScale::kVernier) == operator_state_t::SCALE_VERNIER &&
+                  static_cast<int>(RateScale::kFine) == operator_state_t::SCALE_FINE);
+    static_assert(kAutoSquareUp == operator_state_t::AUTO_SQUARE_UP &&
+                  kAutoUnwind == operator_state_t::AUTO_UNWIND);
+    static_assert(kNearLimitDeg == operator_state_t::NEAR_LIMIT_DEG);
+    m.scale = static_cast<std::int8_t>(s.scale);
+    for (int i = 0; i < 6; ++i) m.achieved_rate[i] = s.achieved[i];
+    m.automatic = static_cast<std::int16_t>(s.automatic);
+    m.joints_near_limit = static_cast<std::int8_t>(s.near_limit);
     m.joint = static_cast<std::int8_t>(s.joint);
     for (int i = 0; i < 6; ++i) m.hand_rate[i] = s.rate[i];
     m.joint_limits = static_cast<std::int8_t>(s.at_limit);
@@ -423,8 +461,12 @@ void OperatorStation::PublishState(std::int64_t frame, const wire::OperatorInput
       m.margin_ft[i] = t.acquisition_margin_ft[i];
     }
     m.close_gap_ft = g->close_gap_ft;
-    m.close_ok = g->close_gap_ft > 0 && g->close_gap_ft < config_.dcp.d3y_ft;
+    m.close_ok = WouldAcquire(t, *g, config_.dcp.d3y_ft);
     m.bay_clearance_ft = t.bay_clearance_ft;
+    static_assert(kClearanceMarginFt == operator_state_t::CLEARANCE_MARGIN_FT);
+    m.next_axis = static_cast<std::int8_t>(g->next_axis);
+    m.turn_clearance_ft = std::isnan(g->turn_clearance_ft) ? 0.0 : g->turn_clearance_ft;
+    m.clearance_warning = g->clearance_warning;
     m.dock_distance_ft = t.dock_distance_ft;
     m.dock_angle_deg = t.dock_angle_deg;
   }
@@ -621,6 +663,7 @@ bool OperatorStation::StepFrame(transport::StatusReporter* status) {
   else
     counters_.Add(Counter::kPublishFailed);
   PublishState(block.frame, *in);
+  WatchClearance();
   publish_rate_.Tick(lcm_.NowUs());
   ++frames_;
   status->Tick(block.frame, counters_);

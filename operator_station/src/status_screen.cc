@@ -59,6 +59,13 @@ class Flow {
   int width_;
 };
 
+// "above the orbiter's sill line by 3.20 ft" / "BELOW the orbiter's sill
+// line by 1.54 ft" (the bay's top: docs/operator.md "Clearance in Mode 3").
+std::string SillText(double ft) {
+  return ft >= 0 ? Sprintf("above the orbiter's sill line by %.2f ft", ft)
+                 : Sprintf("BELOW the orbiter's sill line by %.2f ft", -ft);
+}
+
 // "short by 12.345 ft" / "holds by 0.050 ft": a margin as an unsigned distance.
 std::string Margin(double m) {
   return m >= 0 ? Sprintf("holds by %.3f ft", m) : Sprintf("short by %.3f ft", -m);
@@ -85,6 +92,36 @@ void OffsetFields(const StatusSnapshot& s, const Eigen::Vector3d& d_ft, Flow& fl
     flow.Field(Sprintf("%s %s %.2f ft", kAxis[i], kWord[i][d >= 0 ? 0 : 1], std::abs(d)) +
                KeyHint(s, action));
   }
+}
+
+// What to fly next, one axis at a time, and the keys that fly it by itself:
+// "next: roll left 12.0 deg (u; U nulls it)   h squares up (one turn)".
+void NextLine(const StatusSnapshot& s, Flow& flow) {
+  const Guidance& g = *s.guidance;
+  static const char* kName[6] = {"x", "y", "z", "roll", "pitch", "yaw"};
+  static const char* kWord[6][2] = {{"forward", "back"}, {"right", "left"}, {"down", "up"},
+                                    {"right", "left"},   {"up", "down"},    {"right", "left"}};
+  const int a = g.next_axis;
+  if (a < 0) {
+    flow.Line(" next: nothing -- at the target");
+    return;
+  }
+  const double e =
+      a < 3 ? (g.leave_bay && g.leave_bay_ft.norm() > 1e-9 ? g.leave_bay_ft[a] : g.offset_ft[a])
+            : g.rotation_deg[a - 3];
+  const std::string move = std::string(kHandAxisNames[a]) + (e >= 0 ? "+" : "-");
+  std::string hint = KeyHint(s, move);
+  const std::string null_key = KeyHint(s, "null_" + std::string(kHandAxisNames[a]));
+  if (!null_key.empty() && !(g.leave_bay && g.leave_bay_ft.norm() > 1e-9))
+    hint = hint.substr(0, hint.size() - 1) + "; " + null_key.substr(2, null_key.size() - 3) +
+           " flies it to 0)";
+  flow.Line(Sprintf(" next: %s %s %.*f %s", kName[a], kWord[a][e >= 0 ? 0 : 1], a < 3 ? 2 : 1,
+                    std::abs(e), a < 3 ? "ft" : "deg") +
+            hint);
+  const std::string square = KeyHint(s, "square_up");
+  if (g.angle_deg > 0.5 && !square.empty())
+    flow.Field(Sprintf("%s squares up the whole %.1f deg turn at once",
+                       square.substr(2, square.size() - 3).c_str(), g.angle_deg));
 }
 
 void GuidanceLines(const StatusSnapshot& s, Flow& flow) {
@@ -118,6 +155,7 @@ void GuidanceLines(const StatusSnapshot& s, Flow& flow) {
                KeyHint(s, action));
   }
   flow.Field(Sprintf("angle %.1f deg", g.angle_deg));
+  NextLine(s, flow);
 }
 
 void ControlLines(const StatusSnapshot& s, Flow& flow) {
@@ -127,7 +165,9 @@ void ControlLines(const StatusSnapshot& s, Flow& flow) {
     flow.Field("frame: " + std::string(CommandFrameName(h.frame)));
   else
     flow.Field(Sprintf("joint: %s", std::string(kAnalogInputNames[h.joint]).c_str()));
-  flow.Field(std::string("scale: ") + (h.vernier ? "VERNIER" : "COARSE"));
+  std::string scale(RateScaleName(h.scale));
+  std::transform(scale.begin(), scale.end(), scale.begin(), ::toupper);
+  flow.Field("scale: " + scale);
   // What each axis does: "moving x +2.00 ft/s (1.20 ft to go)".
   static const char* kAxis[6] = {"x", "y", "z", "roll", "pitch", "yaw"};
   static const char* kUnit[6] = {"ft", "ft", "ft", "deg", "deg", "deg"};
@@ -139,10 +179,32 @@ void ControlLines(const StatusSnapshot& s, Flow& flow) {
                             h.rate[i], joint ? "deg" : kUnit[i]);
     if (h.pending[i] != 0.0)
       m += Sprintf(" (%.2f %s to go)", std::abs(h.pending[i]), joint ? "deg" : kUnit[i]);
+    if (h.automatic & (1u << i)) m += " (to 0)";
+    // What the arm does of it, where that is less (a joint at its rate, a
+    // singular pose): the real rate.
+    if (std::abs(h.achieved[i]) < 0.95 * std::abs(h.rate[i]))
+      m += Sprintf(" [arm %+.2f]", h.achieved[i]);
     flow.Field(moving ? m.substr(1) : m);
     moving = true;
   }
+  if (h.automatic & kAutoSquareUp) flow.Field("SQUARING UP (one turn)");
+  if (h.automatic & kAutoUnwind) {
+    flow.Field("UNWINDING the wrist to the middle of its travel");
+    moving = true;
+  }
   if (!moving) flow.Field("still");
+  if (h.near_limit) {
+    std::string j;
+    for (int i = 0; i < 6; ++i) {
+      if (h.near_limit & (1u << i))
+        j += std::string(j.empty() ? "" : ", ") + std::string(kAnalogInputNames[i]) +
+             Sprintf(" %+.1f", s.inputs.value[i]);
+    }
+    const std::string unwind = KeyHint(s, "unwind");
+    flow.Field(Sprintf("WRIST NEAR ITS LIMIT (within %.0f deg): ", kNearLimitDeg) + j +
+               (unwind.empty() ? std::string()
+                               : "; " + unwind.substr(2, unwind.size() - 3) + " unwinds it"));
+  }
   if (h.at_limit) {
     std::string j;
     for (int i = 0; i < 6; ++i) {
@@ -213,6 +275,17 @@ void ConditionLines(const StatusSnapshot& s, const LabConfig& config, int width,
           "closed, the finger would stop at %.3f ft: %s", g,
           g < config.dcp.d3y_ft ? "below D3Y" : "NOT below D3Y (the BAR nearer the fixed finger)"));
     }
+    // Closing now acquires only where every other condition holds too.
+    std::string short_of;
+    for (int i : {0, 1, 2, 4, 5})
+      if (!t.acquisition_conditions[i])
+        short_of += (short_of.empty() ? "" : " ") + std::to_string(i + 1);
+    if (s.guidance && WouldAcquire(t, *s.guidance, config.dcp.d3y_ft))
+      flow.Line("  CLOSING THE FINGER NOW ACQUIRES" + KeyHint(s, "finger+"));
+    else if (s.guidance && s.guidance->close_gap_ft > 0)
+      flow.Line("  closing now would not acquire" +
+                (short_of.empty() ? std::string(": the finger would not stop below D3Y")
+                                  : ": conditions " + short_of + " short"));
   } else if (t.mode == 2) {
     flow.Line("ACQUISITION: acquired; the payload is held")
         .Field(t.bay_clearance_ft > 0
@@ -220,7 +293,18 @@ void ConditionLines(const StatusSnapshot& s, const LabConfig& config, int width,
                    : Sprintf("in the bay: %.2f ft to lift it clear", -t.bay_clearance_ft));
   } else {
     flow.Line("ACQUISITION: acquired; the payload is held, out of the bay")
-        .Field(Sprintf("clear of the bay by %.2f ft", t.bay_clearance_ft));
+        .Field("payload " + SillText(t.bay_clearance_ft));
+    if (s.guidance && !std::isnan(s.guidance->turn_clearance_ft)) {
+      const Guidance& g = *s.guidance;
+      const bool in_flight = s.hand && TurnInFlight(*s.hand, g);
+      flow.Field(std::string(in_flight ? "over the turn in flight: " : "over the turn shown: ") +
+                 SillText(g.turn_clearance_ft));
+      if (g.clearance_warning)
+        flow.Line(
+            Sprintf("CLEARANCE WARNING: under %.0f ft above the orbiter's sill line; go up "
+                    "(orbiter frame) before turning",
+                    kClearanceMarginFt));
+    }
   }
   flow.Line(Sprintf("DOCKING distance %.3f ft (<= %.2f)", t.dock_distance_ft,
                     config.dcp.dock_distance_ft))

@@ -59,14 +59,32 @@ Screen ParseScreen(const std::string& text) {
   s.docked = text.find("docked YES") != std::string::npos;
   s.held = text.find("arm HELD") != std::string::npos;
   if (std::regex_search(text, m, kFrameRe)) s.frame = m[1];
-  s.vernier = text.find("scale: VERNIER") != std::string::npos;
+  static const std::regex kScaleRe(R"(scale: (COARSE|VERNIER|FINE))");
+  if (std::regex_search(text, m, kScaleRe)) s.scale = m[1];
+  s.vernier = s.scale == "VERNIER" || s.scale == "FINE";
+  static const std::regex kAngleRe(R"(angle ([\d.]+) deg(?! \())");
+  if (std::regex_search(text, m, kAngleRe)) s.angle = std::stod(m[1]);
+  s.squaring = text.find("SQUARING UP") != std::string::npos;
+  s.unwinding = text.find("UNWINDING") != std::string::npos;
+  s.near_limit = text.find("WRIST NEAR ITS LIMIT") != std::string::npos;
+  s.would_acquire = text.find("CLOSING THE FINGER NOW ACQUIRES") != std::string::npos;
+  s.clearance_warning = text.find("CLEARANCE WARNING") != std::string::npos;
+  static const std::regex kTurnClearRe(
+      R"(over the turn (?:in flight|shown): (above|BELOW) the orbiter's sill line by ([\d.]+) ft)");
+  if (std::regex_search(text, m, kTurnClearRe))
+    s.turn_clearance = (m[1] == "above" ? 1.0 : -1.0) * std::stod(m[2]);
+  static const std::regex kSillRe(
+      R"(payload (above|BELOW) the orbiter's sill line by ([\d.]+) ft)");
+  if (std::regex_search(text, m, kSillRe))
+    s.bay_clearance = (m[1] == "above" ? 1.0 : -1.0) * std::stod(m[2]);
   static const std::regex moving(
-      R"(\b(x|y|z|roll|pitch|yaw) ([+-][\d.]+) (?:ft|deg)/s(?: \(([\d.]+) (?:ft|deg) to go\))?)");
+      R"(\b(x|y|z|roll|pitch|yaw) ([+-][\d.]+) (?:ft|deg)/s(?: \(([\d.]+) (?:ft|deg) to go\))?( \(to 0\))?)");
   for (auto it = std::sregex_iterator(text.begin(), text.end(), moving);
        it != std::sregex_iterator(); ++it) {
     const int a = AxisIndex((*it)[1]);
     s.rate[a] = std::stod((*it)[2]);
     if ((*it)[3].matched) s.to_go[a] = std::stod((*it)[3]);
+    s.nulling[a] = (*it)[4].matched;
   }
   s.guidance = text.find("GUIDANCE") != std::string::npos;
   static const std::regex offset(R"(\b(x|y|z) (forward|back|right|left|down|up) ([\d.]+) ft)");
@@ -141,6 +159,50 @@ void ScriptedOperator::Press(const std::vector<std::string>& keys, const std::st
   terminal_->Wait(0.12);
 }
 
+bool ScriptedOperator::SetScale(const std::string& scale, double limit_s) {
+  for (int tries = 0; tries < 4 && last_.t_s < limit_s; ++tries) {
+    if (Look().scale == scale) return true;
+    Press({"v"}, "the scale key, for " + scale);
+  }
+  return Look().scale == scale;
+}
+
+bool ScriptedOperator::FlyAutomatic(const std::vector<std::string>& keys, const std::string& why,
+                                    double limit_s) {
+  // What flies by itself slows as it arrives: coarse is never too fast.
+  if (last_.scale != "COARSE") SetScale("COARSE", limit_s);
+  Press(keys, why);
+  double quiet_since = -1;
+  while (true) {
+    const Screen s = Look();
+    if (s.t_s > limit_s) return false;
+    if (s.held || s.docked) return true;
+    if (s.mode == 1 && s.near_limit && !s.unwinding && unwinds_ < 2 &&
+        (s.squaring || s.angle > 1.0)) {
+      // The way out the screen names: unwind, then square up again.
+      ++unwinds_;
+      Press({"b"}, "the wrist nears its limit: unwind it");
+      continue;
+    }
+    if (s.unwinding) {
+      quiet_since = -1;
+      terminal_->Wait(0.2);
+      continue;
+    }
+    if (!s.automatic()) {
+      // Seen still twice (what was pressed may not have shown yet).
+      if (quiet_since < 0) {
+        quiet_since = s.t_s;
+      } else if (s.t_s - quiet_since > 0.2) {
+        return true;
+      }
+    } else {
+      quiet_since = -1;
+    }
+    terminal_->Wait(0.2);
+  }
+}
+
 bool ScriptedOperator::Drive(const Screen& s, const std::vector<Goal>& goals,
                              const std::string& why) {
   // Coarse for the long way, vernier for the last foot or so; changing the
@@ -158,8 +220,8 @@ bool ScriptedOperator::Drive(const Screen& s, const std::vector<Goal>& goals,
   const bool done = worst_ft == 0.0 && worst_deg == 0.0;
   const bool want_vernier =
       s.vernier ? (worst_ft < 2.5 && worst_deg < 12.0) : (worst_ft < 1.2 && worst_deg < 5.0);
-  if (!done && want_vernier != s.vernier) {
-    Press({"v"}, s.vernier ? "coarse for the long way" : "vernier for the last of it");
+  if (!done && (want_vernier ? s.scale != "VERNIER" : s.scale != "COARSE")) {
+    Press({"v"}, want_vernier ? "vernier for the last of it" : "the scale key, for coarse");
     return false;
   }
   // How far an axis goes while a press is on its way: the reaction, the
@@ -218,9 +280,12 @@ bool ScriptedOperator::WaitForFrame(const std::string& frame, double limit_s) {
 }
 
 bool ScriptedOperator::Acquire(double limit_s) {
-  enum Stage { kTurn, kHover, kDescend, kClose, kWait } stage = kTurn;
+  // docs/operator.md "How to fly the task by hand": square up in one turn
+  // (h), back to 3 ft above the grasp if nearer, y and z to 0 (shift-d,
+  // shift-f), down to the grasp (shift-w), close when the screen says
+  // closing acquires.
   constexpr double kHoverFt = 3.0;
-  double closed_at = 0.0;
+  int retries = 0;
   while (true) {
     const Screen s = Look();
     if (!s.valid || !s.guidance || s.mode == 0) {
@@ -235,57 +300,46 @@ bool ScriptedOperator::Acquire(double limit_s) {
     }
     if (s.held) {
       Press({"Space", "s"}, "held by a collision: stop, and back off");
-      stage = kHover;
       continue;
     }
     const auto& o = s.offset;
-    std::vector<Goal> goals;
-    switch (stage) {
-      case kTurn:  // turn about the grasp point until the end effector is square to the bar
-        goals = {{3, o[3], 1.0}, {4, o[4], 1.0}, {5, o[5], 1.0}};
-        break;
-      case kHover:  // to a point above the grasp, the fingers either side of the bar's line
-        goals = {{0, o[0] - kHoverFt, 0.15},
-                 {1, o[1], 0.04},
-                 {2, o[2], 0.1},
-                 {3, o[3], 1.0},
-                 {4, o[4], 1.0},
-                 {5, o[5], 1.0}};
-        break;
-      case kDescend:  // straight down onto the bar
-        goals = {{0, o[0], 0.05}, {1, o[1], 0.04}, {2, o[2], 0.1},
-                 {3, o[3], 1.0},  {4, o[4], 1.0},  {5, o[5], 1.0}};
-        break;
-      case kClose: {
-        bool ready = s.close_ok;
-        for (int i : {0, 1, 2, 4, 5}) ready = ready && s.margin[i] > 0;
-        if (!ready) {
-          Note("not ready to close (conditions " + Conditions(s) +
-               Fmt(", the finger would stop at %.3f ft)", s.close_gap) + ": align again");
-          stage = kDescend;
-          continue;
-        }
-        Press({"c"}, "every condition but the finger's holds: close the finger");
-        closed_at = s.t_s;
-        stage = kWait;
-        continue;
-      }
-      case kWait:
-        if (s.t_s - closed_at > 4.0) {
-          Press({"x"}, "closed and not acquired (conditions " + Conditions(s) + "): open it");
-          stage = kDescend;
-        } else {
-          terminal_->Wait(0.1);
-        }
-        continue;
+    if (s.angle > 0.5) {
+      FlyAutomatic({"h"}, Fmt("square up: the whole %.1f deg turn at once", s.angle), limit_s);
+      continue;
     }
-    static const char* kStage[] = {"turn", "to the hover point", "descend", "", ""};
-    if (Drive(s, goals, kStage[stage])) {
-      stage = static_cast<Stage>(stage + 1);
-      Note(stage == kHover     ? "square to the bar"
-           : stage == kDescend ? "over the bar"
-                               : "at the grasp");
+    if (o[0] < kHoverFt - 0.5 && (std::abs(o[1]) > 0.02 || std::abs(o[2]) > 0.02)) {
+      if (s.scale == "FINE") SetScale("COARSE", limit_s);
+      Drive(s, {{0, o[0] - kHoverFt, 0.3}}, "back to 3 ft above the grasp before moving across");
+      continue;
     }
+    if (s.rate[0] != 0.0) {  // an increment of x still on its way: stop it first
+      Press({"Space"}, "over the bar: stop");
+      continue;
+    }
+    if (std::abs(o[1]) > 0.02 || std::abs(o[2]) > 0.02) {
+      FlyAutomatic({"D", "F"}, "over the bar: y and z to 0", limit_s);
+      continue;
+    }
+    if (std::abs(o[0]) > 0.02) {
+      FlyAutomatic({"W"}, "descend: x to 0", limit_s);
+      continue;
+    }
+    if (!s.would_acquire) {
+      if (++retries > 3)
+        return report_.failure =
+                   "at the grasp, and closing would not acquire (conditions " + Conditions(s) + ")",
+               false;
+      FlyAutomatic(
+          {"h", "D", "F", "W"},
+          "closing would not acquire yet (conditions " + Conditions(s) + "): every axis to 0 again",
+          limit_s);
+      continue;
+    }
+    Press({"c"}, "the screen says closing the finger now acquires: close it");
+    const double closed_at = Look().t_s;
+    while (Look().mode < 2 && last_.t_s - closed_at < 4.0) terminal_->Wait(0.1);
+    if (last_.mode < 2)
+      Press({"x"}, "closed and not acquired (conditions " + Conditions(last_) + "): open it");
   }
 }
 
@@ -307,8 +361,12 @@ bool ScriptedOperator::Extract(double limit_s) {
 }
 
 bool ScriptedOperator::Dock(double limit_s) {
+  // Under the port (orbiter frame: x and y to 0, z to kBelowFt below it,
+  // higher while the turn's clearance over the sill line is short), the
+  // probe turned up in one rotation (h), then in the payload frame onto
+  // the port's axis (x, z to 0) and in (y to 0).
   enum Stage { kBelow, kTurn, kAlign, kIn } stage = kBelow;
-  constexpr double kBelowFt = 12.0, kAlignFt = 1.5;
+  constexpr double kBelowFt = 12.0, kClearanceFt = 2.5;
   while (true) {
     const Screen s = Look();
     if (s.t_s > limit_s) return report_.failure = "not docked by " + Fmt("%.0f s", limit_s), false;
@@ -321,41 +379,51 @@ bool ScriptedOperator::Dock(double limit_s) {
     if (s.held) {
       Press({"Space"}, "held by a collision: stop");
       if (stage == kIn) {
-        Press({"s"}, "back off along the probe");
+        Press({"a"}, "back off along the probe");
         stage = kAlign;
       }
       continue;
     }
     const auto& o = s.offset;
-    std::vector<Goal> goals;
     switch (stage) {
-      case kBelow:  // the probe's tip well below the port (orbiter axes: z is down)
-        goals = {{0, o[0], 0.3}, {1, o[1], 0.3}, {2, o[2] + kBelowFt, 0.5}};
-        break;
-      case kTurn:  // the probe's axis onto the port's, turning about the tip
-        goals = {{3, o[3], 1.0}, {4, o[4], 1.0}, {5, o[5], 1.0}};
-        break;
-      case kAlign:  // payload axes: y along the probe; on the port's axis, short of it
-        if (s.frame != "payload") {
-          if (!WaitForFrame("payload", limit_s))
-            return report_.failure = "the payload frame would not come", false;
+      case kBelow: {
+        if (std::abs(o[0]) > 0.3 || std::abs(o[1]) > 0.3) {
+          FlyAutomatic({"W", "D"}, "under the port: x and y to 0", limit_s);
           continue;
         }
-        goals = {{0, o[0], 0.05}, {2, o[2], 0.05}, {1, o[1] - kAlignFt, 0.3},
-                 {3, o[3], 0.8},  {4, o[4], 0.8},  {5, o[5], 0.8}};
-        break;
-      case kIn:  // in along the probe until it docks (0.25 ft, 2 deg 32 min)
-        goals = {{0, o[0], 0.05}, {2, o[2], 0.05}, {1, o[1], 0.05},
-                 {3, o[3], 0.8},  {4, o[4], 0.8},  {5, o[5], 0.8}};
-        break;
-    }
-    static const char* kStage[] = {"below the port", "turn the probe up", "onto the port's axis",
-                                   "in"};
-    if (Drive(s, goals, kStage[stage]) && stage != kIn) {
-      stage = static_cast<Stage>(stage + 1);
-      Note(stage == kTurn    ? "below the port"
-           : stage == kAlign ? "probe square to the port"
-                             : "on the axis");
+        // Low enough to turn under the CAE, high enough that the turn keeps
+        // the payload above the sill line (the screen's "over the turn shown").
+        const double below = s.turn_clearance < kClearanceFt
+                                 ? -o[2] - (kClearanceFt + 0.5 - s.turn_clearance)
+                                 : std::min(kBelowFt, -o[2]);
+        if (Drive(s, {{2, o[2] + below, 0.5}}, Fmt("%.1f ft below the port", below))) {
+          Note(Fmt("below the port (the turn keeps the payload %.2f ft above the sill line)",
+                   s.turn_clearance));
+          stage = kTurn;
+        }
+        continue;
+      }
+      case kTurn:
+        if (s.angle > 0.5) {
+          FlyAutomatic({"h"}, Fmt("turn the probe up: the whole %.1f deg at once", s.angle),
+                       limit_s);
+          continue;
+        }
+        if (!WaitForFrame("payload", limit_s))
+          return report_.failure = "the payload frame would not come", false;
+        stage = kAlign;
+        continue;
+      case kAlign:
+        if (std::abs(o[0]) > 0.03 || std::abs(o[2]) > 0.03 || s.angle > 0.5) {
+          FlyAutomatic({"h", "W", "F"}, "onto the port's axis: x and z to 0", limit_s);
+          continue;
+        }
+        stage = kIn;
+        continue;
+      case kIn:
+        FlyAutomatic({"D"}, "in along the probe: y to 0", limit_s);
+        if (!Look().docked) stage = kAlign;
+        continue;
     }
   }
 }

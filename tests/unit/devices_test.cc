@@ -145,7 +145,11 @@ TEST_F(Devices, TheBindingsFileIsReadAndBadOnesAreRefusedNamingTheKey) {
       {"[spacemouse.buttons]", "[spacemouse.buttons]\nextra = 1", "key 'spacemouse.buttons.extra'"},
       {"Q = \"quit\"", "Q = \"quit\"\nq = \"stop\"\n\" \" = \"stop\"",
        "key 'keyboard.keys. ': is not a key"},
-      {"v = \"vernier\"\n", "", "key 'keyboard.keys': no key is bound to vernier"},
+      {"v = \"vernier\"", "", "key 'keyboard.keys': no key is bound to vernier"},
+      {"h = \"square_up\"", "h = \"null_thc_w\"",
+       "key 'keyboard.keys.h': unknown action \"null_thc_w\""},
+      {"scale = \"coarse\"", "scale = \"finer\"",
+       "key 'control.scale': must be \"coarse\", \"vernier\" or \"fine\""},
       {"s = \"thc_x-\"", "s = \"camera_1\"", "key 'keyboard.keys': no key is bound to thc_x-"},
       {"Q = \"quit\"\n", "", "key 'keyboard.keys': no key is bound to quit"},
       {"scale = \"coarse\"", "scale = \"coarse\"\ncameras = [4, 9]",
@@ -275,9 +279,16 @@ TEST_F(Devices, ATerminalPressIsOneIncrementMergedNeverQueuedAndStopHaltsIt) {
   // Vernier: a tenth of the rate, a finer increment.
   typed.keys = {'v', 'w'};
   hc.Step(kDt, &t);
-  EXPECT_TRUE(hc.status().vernier);
+  EXPECT_EQ(hc.status().scale, RateScale::kVernier);
   EXPECT_DOUBLE_EQ(hc.status().rate[kThcX], bindings.rates.vernier_ft_s);
   EXPECT_EQ(hc.counters().Get(Counter::kControlScaleChanges), 1);
+  // Fine: vernier's rate, an increment of 0.05 ft.
+  typed.keys = {'v', 'w'};
+  hc.Step(kDt, &t);
+  EXPECT_EQ(hc.status().scale, RateScale::kFine);
+  EXPECT_DOUBLE_EQ(hc.status().rate[kThcX], bindings.rates.vernier_ft_s);
+  EXPECT_NEAR(hc.status().pending[kThcX],
+              bindings.increments.fine_ft - bindings.rates.vernier_ft_s * kDt, 1e-9);
 }
 
 // The keys of one frame act in the order they came: a press then a key that
@@ -295,12 +306,12 @@ TEST_F(Devices, OneFramesKeysActInTheOrderTheyCame) {
   ASSERT_GT(hc.status().rate[kThcX], 0.0);
   typed.keys = {'s', 'v'};  // stop the axis, then vernier
   hc.Step(kDt, &t);
-  EXPECT_TRUE(hc.status().vernier);
+  EXPECT_EQ(hc.status().scale, RateScale::kVernier);
   EXPECT_EQ(hc.status().pending[kThcX], 0.0);
   EXPECT_EQ(hc.status().rate[kThcX], 0.0);
-  typed.keys = {'v', 'd'};  // coarse again, then right: it moves
+  typed.keys = {'v', 'd'};  // fine, then right: it moves
   hc.Step(kDt, &t);
-  EXPECT_FALSE(hc.status().vernier);
+  EXPECT_EQ(hc.status().scale, RateScale::kFine);
   EXPECT_GT(hc.status().rate[kThcY], 0.0);
 }
 
@@ -753,6 +764,114 @@ TEST_F(Devices, TheStatusScreenShowsGuidanceMarginsAndFollowsTheWidth) {
   EXPECT_NE(tiny.find("to go 3.44 ft"), std::string::npos) << tiny;
   std::istringstream is(tiny);
   for (std::string l; std::getline(is, l);) EXPECT_LE(static_cast<int>(l.size()), 40) << l;
+}
+
+}  // namespace
+}  // namespace rms::operator_station
+
+namespace rms::operator_station {
+namespace {
+
+// docs/operator.md "Nulling an axis, squaring up, unwinding": shift-d
+// flies y to the guidance's 0 and stops; h squares the whole turn up in
+// one rotation; b brings the wrist to the middle of its travel; each is
+// counted, and a key of the axis takes it back.
+TEST_F(Devices, NullKeysSquareUpAndUnwindFlyToTheirZeroAndStop) {
+  HandControllers hc(config, bindings);
+  TypedKeys typed;
+  hc.AddDevice(std::make_unique<KeyboardDevice>(bindings, typed.Source()));
+  wire::OperatorInputs in = MidPose();
+  hc.SetInputs(in);
+  auto guidance = [&](const wire::OperatorInputs& now) {
+    ArmState s;
+    s.X_RS2 = X_RS2(now);
+    s.X_RP = arm::MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft);
+    return ComputeGuidance(geometry, s, CommandFrame::kEndEffector);
+  };
+  auto fly = [&](std::vector<int> keys, int frames) {
+    typed.keys = std::deque<int>(keys.begin(), keys.end());
+    for (int k = 0; k < frames; ++k) {
+      const dcp_telemetry_t t = Telemetry(in, 1);
+      in = hc.Step(kDt, &t);
+      typed.keys.clear();
+    }
+  };
+  ASSERT_GT(std::abs(guidance(in).offset_ft[1]), 0.5);
+  fly({'D'}, 1);
+  EXPECT_EQ(hc.status().automatic, 1u << kThcY);
+  fly({}, 900);
+  EXPECT_LT(std::abs(guidance(in).offset_ft[1]), 0.01);
+  EXPECT_EQ(hc.status().automatic, 0u);  // there: it stopped by itself
+  EXPECT_EQ(hc.counters().Get(Counter::kControlNulls), 1);
+
+  ASSERT_GT(guidance(in).angle_deg, 5.0);
+  fly({'h'}, 1);
+  EXPECT_EQ(hc.status().automatic, kAutoSquareUp);
+  fly({}, 1200);
+  EXPECT_LT(guidance(in).angle_deg, 0.05);
+  EXPECT_EQ(hc.status().automatic, 0u);
+  // A rotation key takes the square-up back at once.
+  fly({'b'}, 1);
+  EXPECT_EQ(hc.status().automatic, kAutoUnwind);
+  fly({}, 900);
+  for (int j = 3; j < 6; ++j) EXPECT_NEAR(in.value[j], 0.0, 1e-6) << j;
+  EXPECT_EQ(hc.counters().Get(Counter::kControlUnwinds), 1);
+  fly({'h'}, 1);
+  fly({'u'}, 1);
+  EXPECT_EQ(hc.status().automatic & kAutoSquareUp, 0u);
+}
+
+// A wrist joint within 10 deg of a limit is warned of (once), with the
+// way out.
+TEST_F(Devices, AWristNearItsLimitIsWarnedOf) {
+  HandControllers hc(config, bindings);
+  wire::OperatorInputs in = MidPose();
+  in.value[5] = config.inputs[5].max - 5.0;
+  hc.SetInputs(in);
+  for (int k = 0; k < 3; ++k) {
+    const dcp_telemetry_t t = Telemetry(in, 1);
+    hc.Apply({}, kDt, &t);
+  }
+  EXPECT_EQ(hc.status().near_limit, 1u << 5);
+  EXPECT_EQ(hc.counters().Get(Counter::kJointNearLimit), 1);
+}
+
+// Closing acquires only where every other condition holds too: a finger
+// that would stop below D3Y 2.8 ft above the bar does not.
+TEST_F(Devices, WouldAcquireOnlyWhereEveryOtherConditionHolds) {
+  dcp_telemetry_t t = Telemetry(MidPose(), 1);
+  Guidance g;
+  g.close_gap_ft = 0.5 * config.dcp.d3y_ft;
+  for (auto& c : t.acquisition_conditions) c = 1;
+  EXPECT_TRUE(WouldAcquire(t, g, config.dcp.d3y_ft));
+  t.acquisition_conditions[4] = false;  // condition 5: the palm not within TPOB of the bar
+  EXPECT_FALSE(WouldAcquire(t, g, config.dcp.d3y_ft));
+  t.acquisition_conditions[4] = true;
+  g.close_gap_ft = 1.5 * config.dcp.d3y_ft;
+  EXPECT_FALSE(WouldAcquire(t, g, config.dcp.d3y_ft));
+}
+
+// docs/operator.md "Clearance in Mode 3": a payload level 20 ft above the
+// sill line, turned 90 deg about its probe's tip until it hangs below it,
+// drops its far end by its length and probe: the clearance over the turn
+// is the hanging payload's, computed in closed form here.
+TEST_F(Devices, TheClearanceOverATurnIsTheLowestThePayloadGoes) {
+  Eigen::Isometry3d X_RP = Eigen::Isometry3d::Identity();  // y_P along X_R, level
+  X_RP.linear() << 0, -1, 0, 1, 0, 0, 0, 0, 1;
+  X_RP.translation() = Eigen::Vector3d(30, 0, 20);
+  const double r = geometry.body_radius_ft;
+  EXPECT_NEAR(PayloadLowestZ(geometry, X_RP), 20 - r, 1e-9);
+  const Eigen::Vector3d tip = X_RP * geometry.p_PoT_P;
+  // Probe up: 90 deg about Y_R turns y_P (-X_R) to +Z_R, about the tip; the
+  // body's far end ends D = probe + body length below the tip (its end
+  // circle then level: no radius below its centre).
+  const Eigen::Vector3d phi(0, M_PI / 2, 0);
+  const double D = geometry.p_PoT_P.y() + geometry.body_half_length_ft;
+  const double least = TurnClearance(geometry, X_RP, tip, phi);
+  EXPECT_NEAR(least, tip.z() - std::hypot(D, r), 0.05);
+  EXPECT_LT(least, 20 - r - 5.0);
+  // No turn: the clearance now.
+  EXPECT_NEAR(TurnClearance(geometry, X_RP, tip, Eigen::Vector3d::Zero()), 20 - r, 1e-9);
 }
 
 }  // namespace

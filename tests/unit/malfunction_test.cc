@@ -401,6 +401,12 @@ TEST(FollowWatch, HeldThoughCommandedWhereItIsIsAFailureOfTheArm) {
   t.held = true;
   t.master_angles_deg[0] += 3.0;
   for (int k = 0; k < 60; ++k) EXPECT_TRUE(w.Observe(t).empty());
+  // Held where it is commanded while the operator flies into the contact
+  // (the hand controllers carry on from the held pose each frame): the
+  // operator's own collision, never "something moves it on its own".
+  t = Following();
+  t.held = true;
+  for (int k = 0; k < 60; ++k) EXPECT_TRUE(w.Observe(t, /*commanding=*/true).empty());
 }
 
 TEST(FollowWatch, CollisionHoldsTheDockAndTheFingerOnTheBarAreNoFailure) {

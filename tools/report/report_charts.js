@@ -264,8 +264,8 @@
     const sec = section('Operator inputs', 300);
     if (!V || !V.length || !T.length) return note(sec, 'no hand-controller inputs (autopilot or timeline)');
     const names = arr(inp.names).length ? inp.names : ['x', 'y', 'z', 'roll', 'pitch', 'yaw'];
-    const o = timeOptions('hand controller, ' + (inp.unit || 'fraction of full rate (-1..1)'));
-    Object.assign(o.scales.y, { suggestedMin: -1, suggestedMax: 1 });
+    const o = timeOptions('hand controller, ' + (inp.unit || 'commanded rate: x, y, z ft/s; roll, pitch, yaw deg/s'));
+    Object.assign(o.scales.y, { suggestedMin: -2, suggestedMax: 2 });
     timeChart(sec.canvas, { type: 'line', data: { datasets: columnLines(V, names) }, options: o });
   }
 

@@ -812,7 +812,7 @@ std::string MakeReport(const std::string& session_dir, const std::string& chart_
   data["series"]["inputs"] =
       t.by_hand ? nlohmann::json{{"names", {"x", "y", "z", "roll", "pitch", "yaw"}},
                                  {"values", t.inputs},
-                                 {"unit", "fraction of full rate (-1..1)"}}
+                                 {"unit", "commanded rate: x, y, z ft/s; roll, pitch, yaw deg/s"}}
                 : nlohmann::json(nullptr);
   data["geometry"] = Geometry(config);
   data["events"] = t.events;

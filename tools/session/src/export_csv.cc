@@ -336,11 +336,14 @@ std::vector<std::string> TelemetryRow(const LogMessage& msg, const std::string& 
 }
 
 std::vector<std::string> OperatorStateColumns() {
-  std::vector<std::string> cols = {"log_time [us]",  "session_time [s]", "frame",
-                                   "send_time [us]", "source",           "control_mode",
-                                   "command_frame",  "vernier",          "joint"};
+  std::vector<std::string> cols = {
+      "log_time [us]", "session_time [s]", "frame", "send_time [us]", "source",
+      "control_mode",  "command_frame",    "scale", "joint"};
   for (const char* a : {"x", "y", "z", "roll", "pitch", "yaw"})
     cols.push_back(std::string("hand_rate_") + a + " [1]");
+  for (const char* a : {"x", "y", "z", "roll", "pitch", "yaw"})
+    cols.push_back(std::string("achieved_rate_") + a + " [1]");
+  Add(&cols, {"automatic [bits]", "joints_near_limit [bits]"});
   Add(&cols,
       {"joint_limits [bits]", "singular", "sigma_min [ft]", "guidance_valid", "mode", "target"});
   for (const auto& c : Vec3Columns("offset", "ft")) cols.push_back(c);
@@ -349,7 +352,8 @@ std::vector<std::string> OperatorStateColumns() {
   for (int i = 1; i <= 6; ++i) cols.push_back("condition_" + std::to_string(i));
   for (int i = 1; i <= 6; ++i) cols.push_back("margin_" + std::to_string(i) + " [ft]");
   Add(&cols, {"close_gap [ft]", "close_ok", "bay_clearance [ft]", "dock_distance [ft]",
-              "dock_angle [deg]", "show_guidance", "key_actions", "rate_limited", "devices"});
+              "dock_angle [deg]", "next_axis", "turn_clearance [ft]", "clearance_warning",
+              "show_guidance", "key_actions", "rate_limited", "devices"});
   return cols;
 }
 
@@ -363,9 +367,11 @@ std::vector<std::string> OperatorStateRow(const LogMessage& msg, const std::stri
                                   I(m.source),
                                   I(m.control_mode),
                                   I(m.command_frame),
-                                  B(m.vernier),
+                                  I(m.scale),
                                   I(m.joint)};
   for (double r : m.hand_rate) row.push_back(N(r));
+  for (double r : m.achieved_rate) row.push_back(N(r));
+  Add(&row, {I(m.automatic), I(m.joints_near_limit)});
   Add(&row, {I(m.joint_limits), B(m.singular), N(m.sigma_min_ft), B(m.guidance_valid), I(m.mode),
              I(m.target)});
   for (double v : m.offset_ft) row.push_back(N(v));
@@ -376,9 +382,9 @@ std::vector<std::string> OperatorStateRow(const LogMessage& msg, const std::stri
   std::string devices;
   for (int i = 0; i < m.num_devices; ++i)
     devices += (i ? "; " : "") + m.device_names[i] + " " + I(m.device_actions[i]);
-  Add(&row,
-      {N(m.close_gap_ft), B(m.close_ok), N(m.bay_clearance_ft), N(m.dock_distance_ft),
-       N(m.dock_angle_deg), B(m.show_guidance), I(m.key_actions), B(m.rate_limited), devices});
+  Add(&row, {N(m.close_gap_ft), B(m.close_ok), N(m.bay_clearance_ft), N(m.dock_distance_ft),
+             N(m.dock_angle_deg), I(m.next_axis), N(m.turn_clearance_ft), B(m.clearance_warning),
+             B(m.show_guidance), I(m.key_actions), B(m.rate_limited), devices});
   return row;
 }
 

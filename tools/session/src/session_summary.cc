@@ -96,10 +96,12 @@ class HandControlLog {
   void Observe(const operator_state_t& m, double t_s) {
     if (m.source != operator_state_t::SOURCE_BY_HAND) return;
     seen_ = true;
-    const int key = m.control_mode * 100 + m.command_frame * 10 + m.vernier;
+    const int key = m.control_mode * 100 + m.command_frame * 10 + m.scale;
     if (key != last_key_) {
       static const char* kModes[3] = {"?", "single joint", "manual augmented"};
       static const char* kFrames[4] = {"?", "end effector", "orbiter", "payload"};
+      static const char* kScales[4] = {"?", "coarse", "vernier",
+                                       "fine"};  // operator_state_t SCALE_*
       changes_.push_back(
           {{"time_s", t_s},
            {"frame", m.frame},
@@ -107,7 +109,7 @@ class HandControlLog {
             kModes[m.control_mode >= 1 && m.control_mode <= 2 ? m.control_mode : 0]},
            {"command_frame",
             kFrames[m.command_frame >= 1 && m.command_frame <= 3 ? m.command_frame : 0]},
-           {"scale", m.vernier ? "vernier" : "coarse"}});
+           {"scale", kScales[m.scale >= 1 && m.scale <= 3 ? m.scale : 0]}});
       last_key_ = key;
     }
     key_actions_ = std::max<std::int64_t>(key_actions_, m.key_actions);

@@ -29,7 +29,10 @@ enum class ActionKind {
   kStop,        // every commanded motion stops at once
   kMode,        // the next control mode (single joint <-> manual augmented)
   kFrame,       // the next command frame (end effector, orbiter, payload once held)
-  kVernier,     // coarse <-> vernier rates
+  kVernier,     // the next rate scale: coarse, vernier, fine, coarse ...
+  kNull,        // fly hand-controller axis `index` to its guidance's 0, and stop there
+  kSquareUp,    // fly the whole turn the guidance shows, in one rotation, and stop
+  kUnwind,      // fly the wrist's three joints to the middle of their travel
   kJointNext,   // single joint: the next joint (wrist roll wraps to shoulder yaw)
   kJointPrev,
   kQuit,    // stop the station (keyboards only)
@@ -38,13 +41,14 @@ enum class ActionKind {
 };
 struct Action {
   ActionKind kind = ActionKind::kQuit;
-  int index = -1;     // kHand: the HandAxis; kInput: the analog input (kFinger .. kCameraZoom)
+  int index = -1;  // kHand, kNull: the HandAxis; kInput: the analog input (kFinger .. kCameraZoom)
   double sign = 1.0;  // kHand, kInput: +1 or -1
   int camera = 0;     // kCamera: 1..8
 };
 // "thc_x+", "rhc_yaw-", "finger+", "camera_pan-", "camera_3", "camera_next",
 // "camera_prev", "reset", "overlay", "crosshairs", "guidance", "stop", "mode",
-// "frame", "vernier", "joint_next", "joint_prev", "quit", "freeze", "step".
+// "frame", "vernier", "null_thc_x" .. "null_rhc_yaw", "square_up", "unwind",
+// "joint_next", "joint_prev", "quit", "freeze", "step".
 // Throws rms::InputError naming the text.
 Action ParseAction(std::string_view text);
 // The inverse, for help lines and logs.
@@ -58,8 +62,8 @@ struct AxisBinding {
   double sign = 1.0;  // "-thc_x": deflection the other way
 };
 
-// The hand controllers' full-scale rates, coarse and vernier
-// (docs/operator.md "Rates").
+// The hand controllers' full-scale rates, coarse and vernier (the fine
+// scale flies at vernier's; docs/operator.md "Rates").
 struct HandRates {
   double coarse_ft_s = 0, coarse_deg_s = 0;  // manual augmented: translation, rotation
   double vernier_ft_s = 0, vernier_deg_s = 0;
@@ -72,6 +76,8 @@ struct HandIncrements {
   double coarse_ft = 0, coarse_deg = 0;
   double vernier_ft = 0, vernier_deg = 0;
   double joint_coarse_deg = 0, joint_vernier_deg = 0;
+  // The fine scale's (optional keys; defaults 0.05 ft, 0.2 deg, 0.1 deg).
+  double fine_ft = 0.05, fine_deg = 0.2, joint_fine_deg = 0.1;
 };
 
 struct Bindings {
@@ -80,7 +86,7 @@ struct Bindings {
   // [control]: how a by-hand session starts.
   ControlMode initial_mode = ControlMode::kManualAugmented;
   CommandFrame initial_frame = CommandFrame::kEndEffector;
-  bool initial_vernier = false;
+  RateScale initial_scale = RateScale::kCoarse;
   // The camera stations this operator may select (1..8, distinct; the first
   // is shown at the start): a study's condition gives a subject a camera
   // set (docs/studies.md "Conditions"). Every station when the key is absent.

@@ -19,6 +19,14 @@ enum class CommandFrame : int {
   kPayload = 3,  // the payload's axes x_P, y_P (toward the probe), z_P (toward the bar); once held
 };
 
+// The hand controllers' rate scales (docs/operator.md "Rates: coarse,
+// vernier and fine"): the full-scale rates and a terminal press's increment.
+enum class RateScale : int {
+  kCoarse = 1,   // the long way: 2 ft/s, 8 deg/s; a press 5 ft, 20 deg
+  kVernier = 2,  // a tenth
+  kFine = 3,     // the last hundredths: vernier's rates, a press 0.05 ft, 0.2 deg
+};
+
 // The hand controllers' six axes: the translational controller's (THC) x,
 // y, z and the rotational one's (RHC) roll, pitch, yaw about the command
 // frame's x, y, z.
@@ -28,10 +36,14 @@ inline constexpr std::string_view kHandAxisNames[kNumHandAxes] = {
 
 std::string_view ControlModeName(ControlMode m);    // "single joint", "manual augmented"
 std::string_view CommandFrameName(CommandFrame f);  // "end effector", "orbiter", "payload"
+std::string_view RateScaleName(RateScale s);        // "coarse", "vernier", "fine"
+// The next scale of the scale key: coarse, vernier, fine, coarse...
+RateScale NextRateScale(RateScale s);
 // From the bindings file's words: "single_joint", "manual_augmented";
 // "end_effector", "orbiter", "payload".
 std::optional<ControlMode> ParseControlMode(std::string_view s);
 std::optional<CommandFrame> ParseCommandFrame(std::string_view s);
-int HandAxisIndex(std::string_view name);  // -1 when none
+std::optional<RateScale> ParseRateScale(std::string_view s);  // "coarse", "vernier", "fine"
+int HandAxisIndex(std::string_view name);                     // -1 when none
 
 }  // namespace rms::operator_station

@@ -43,7 +43,10 @@ class FollowWatch {
     bool failing = false;
     std::string text;
   };
-  std::vector<Change> Observe(const dcp_telemetry_t& t);
+  // commanding: the operator's hand controllers command a motion now (a
+  // held arm is then the operator's own collision, not "something moving
+  // it on its own").
+  std::vector<Change> Observe(const dcp_telemetry_t& t, bool commanding = false);
   // Bit p: part p does not follow.
   std::uint32_t failing() const { return failing_; }
   // After a reset or a restore: nothing carried over.

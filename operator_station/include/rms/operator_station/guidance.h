@@ -7,6 +7,7 @@
 // controller that reduces an offset is the one the offset names.
 #include <Eigen/Geometry>
 #include <array>
+#include <limits>
 
 #include "rms/base/config.h"
 #include "rms/dcp_telemetry_t.hpp"
@@ -27,6 +28,10 @@ struct GuidanceGeometry {
   Eigen::Vector3d y_port_R = Eigen::Vector3d::UnitZ();   // the port's axis (into the CAE)
   std::array<Eigen::Vector3d, 8> bar_P;                  // the BAR's corners, payload frame
   double fixed_finger_face_Y2_ft = 0.0;  // face b of EFF HEX 2 (the fixed finger's inside), Y2
+  // The payload as drawn (docs/scene.md): a cylinder along y_P and the
+  // probe, a frustum from its root (the body's +y end) to its tip; ft.
+  double body_radius_ft = 0.0, body_half_length_ft = 0.0;
+  double probe_root_radius_ft = 0.0, probe_tip_radius_ft = 0.0;
 };
 GuidanceGeometry MakeGuidanceGeometry(const LabConfig& config);
 
@@ -69,12 +74,39 @@ struct Guidance {
   // b to the BAR's far side along Y2): condition 4 needs it below D3Y. -1
   // when the BAR is not between the fingers' planes.
   double close_gap_ft = -1.0;
+  // The axis to fly next, one at a time (0..5: x, y, z, roll, pitch, yaw;
+  // -1: at the target): the largest turn first, then across the approach
+  // line, then along it (docs/operator.md "Guidance").
+  int next_axis = -1;
+  // Modes 2 and 3: the least height of the payload above the orbiter's
+  // sill line over the rest of the turn (ComputeGuidance's turn_F_deg; the
+  // whole turn shown when none is given); NaN in Mode 1.
+  double turn_clearance_ft = std::numeric_limits<double>::quiet_NaN();
+  bool clearance_warning = false;  // Mode 3: it is under kClearanceMarginFt
 };
 // In Mode 1: to the grasp. In Modes 2 and 3: from the probe's tip to the
 // port's centre, and the turn that brings the probe's axis onto the port's
 // (roll about the port's axis is free: 0); in Mode 2 also the way up out of
 // the bay, which comes first.
 inline constexpr double kLeaveBayMarginFt = 2.0;
-Guidance ComputeGuidance(const GuidanceGeometry& g, const ArmState& s, CommandFrame f);
+// Mode 3: a warning when the payload is, or a turn would take it, nearer
+// the sill line than this (docs/operator.md "Clearance in Mode 3").
+inline constexpr double kClearanceMarginFt = 2.0;
+// turn_F_deg: the turn in flight (command axes, deg; about the point of
+// resolution) for the clearance; null: the guidance's own turn.
+Guidance ComputeGuidance(const GuidanceGeometry& g, const ArmState& s, CommandFrame f,
+                         const Eigen::Vector3d* turn_F_deg = nullptr);
+
+// The payload's lowest point above the sill line (the bay's top face c,
+// z_R = 0), the payload at X_RP.
+double PayloadLowestZ(const GuidanceGeometry& g, const Eigen::Isometry3d& X_RP);
+// The least of it over a turn phi_R (a rotation vector, rad, in R) about
+// the point p_R, sampled every degree.
+double TurnClearance(const GuidanceGeometry& g, const Eigen::Isometry3d& X_RP,
+                     const Eigen::Vector3d& p_R, const Eigen::Vector3d& phi_R);
+
+// Mode 1: closing the finger now acquires -- it would stop on the BAR
+// below D3Y and conditions 1, 2, 3, 5 and 6 hold (the telemetry's).
+bool WouldAcquire(const dcp_telemetry_t& t, const Guidance& g, double d3y_ft);
 
 }  // namespace rms::operator_station

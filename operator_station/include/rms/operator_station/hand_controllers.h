@@ -37,16 +37,27 @@
 
 namespace rms::operator_station {
 
+// What flies by itself (HandStatus::automatic; docs/operator.md "Nulling
+// an axis, squaring up, unwinding"): bit i (HandAxis) that axis flown to
+// its guidance's 0; and these two.
+inline constexpr std::uint32_t kAutoSquareUp = 64;  // the whole turn, in one rotation
+inline constexpr std::uint32_t kAutoUnwind = 128;   // the wrist to the middle of its travel
+// A joint this near a limit of its travel is warned of.
+inline constexpr double kNearLimitDeg = 10.0;
+
 // What the hand controllers did this frame (the status screen, the
 // operator state message).
 struct HandStatus {
   ControlMode mode = ControlMode::kManualAugmented;
   CommandFrame frame = CommandFrame::kEndEffector;
-  bool vernier = false;
-  int joint = 0;                               // single joint: which
-  std::array<double, kNumHandAxes> rate{};     // commanded: ft/s, deg/s (single joint: [0] deg/s)
-  std::array<double, kNumHandAxes> pending{};  // a terminal's increments still to fly: ft, deg
-  std::uint32_t at_limit = 0;                  // joints held at a limit
+  RateScale scale = RateScale::kCoarse;
+  int joint = 0;                                // single joint: which
+  std::array<double, kNumHandAxes> rate{};      // commanded: ft/s, deg/s (single joint: [0] deg/s)
+  std::array<double, kNumHandAxes> achieved{};  // what the arm did of it this frame
+  std::array<double, kNumHandAxes> pending{};   // a terminal's increments still to fly: ft, deg
+  std::uint32_t automatic = 0;                  // kAuto* and bit i: axis i nulled
+  std::uint32_t at_limit = 0;                   // joints held at a limit
+  std::uint32_t near_limit = 0;                 // joints within kNearLimitDeg of a limit
   bool singular = false;
   bool rate_limited = false;  // slower than commanded: a joint at its rate
   bool held_at_port =
@@ -58,6 +69,12 @@ struct HandStatus {
   std::vector<int> cameras;
   int camera_refused = 0;
 };
+
+// The turn in flight (command axes, deg) for the clearance over it
+// (docs/operator.md "Clearance in Mode 3"): the rotation increments still
+// to go and the nulled rotation axes' guidance; nothing when neither (the
+// guidance's whole turn is then the one judged, as for a square-up).
+std::optional<Eigen::Vector3d> TurnInFlight(const HandStatus& h, const Guidance& g);
 
 class HandControllers {
  public:
@@ -105,9 +122,26 @@ class HandControllers {
   void AddPress(const Press& p);
   std::array<double, kNumHandAxes> CommandedRates(const DeviceCommands& cmd, double dt_s);
   void FlyManualAugmented(const std::array<double, kNumHandAxes>& rate, double dt_s);
+  // The arm as commanded now (the angles sent, the payload held as the
+  // telemetry last showed it), for guidance flown by itself.
+  ArmState CommandedArmState() const;
+  // The automatic motions' rates this frame (nulled axes, the square-up),
+  // added to `rate`; an automatic motion that has arrived ends, said so.
+  void AutomaticRates(std::array<double, kNumHandAxes>* rate, double dt_s);
+  void StartAutomatic(const Action& a);
+  // The command frame flown: the payload's falls back to the end
+  // effector's until a payload is held.
+  CommandFrame FlownFrame() const;
+  // The unwind: the wrist's joints toward the middle of their travel.
+  void FlyUnwind(double dt_s);
+  // A person takes axis i (a press, a stick, a held key): what flies it by
+  // itself stops.
+  void TakeAxis(int i);
+  void ReportNearLimits();
   void FlySingleJoint(double rate_deg_s, double dt_s);
-  // Takes what the arm did (ft/s, deg/s, command axes) off the increments in progress.
-  void ConsumePending(const std::array<double, kNumHandAxes>& achieved, double dt_s);
+  // Takes what the motion flown did (ft/s, deg/s, command axes: the
+  // reference's advance) off the increments in progress.
+  void ConsumePending(const std::array<double, kNumHandAxes>& done, double dt_s);
   void ReportLimits(std::uint32_t at_limit);
   void DirectInputs(const DeviceCommands& cmd, double dt_s);
   void StopMotion();
@@ -135,6 +169,12 @@ class HandControllers {
   // in System Two (from the telemetry).
   int dcp_mode_ = 1;
   std::optional<Eigen::Isometry3d> X_S2P_;
+  Eigen::Isometry3d X_RP_ = Eigen::Isometry3d::Identity();  // the payload, as last shown
+  std::uint32_t near_reported_ = 0;
+  // Each automatic motion's least error so far and how long it has made no
+  // headway (index 6: the square-up).
+  std::array<double, kNumHandAxes + 1> auto_best_{};
+  std::array<double, kNumHandAxes + 1> auto_stalled_s_{};
   // Manual augmented: the pose the commanded motion has reached, flown to
   // closed loop while a motion is commanded (none while still).
   std::optional<Eigen::Isometry3d> X_ref_;

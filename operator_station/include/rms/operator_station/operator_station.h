@@ -122,6 +122,7 @@ class OperatorStation {
   void PublishState(std::int64_t frame, const wire::OperatorInputs& in);
   void DrawScreen(std::int64_t frame, const wire::OperatorInputs& in, bool frozen);
   std::optional<Guidance> CurrentGuidance() const;
+  void WatchClearance();
 
   const OperatorOptions& options_;
   const LabConfig& config_;
@@ -135,6 +136,7 @@ class OperatorStation {
   std::unique_ptr<StatusScreen> screen_;
   TelemetryEvents events_;
   FollowWatch follow_;
+  bool clearance_warned_ = false;
 
   // What the DCP and the other processes say.
   std::optional<dcp_telemetry_t> telemetry_;

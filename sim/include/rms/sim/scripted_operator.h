@@ -27,8 +27,9 @@ struct Screen {
   double t_s = 0.0;    // session time
   int mode = 0;        // 1..3 (0: no telemetry shown)
   bool acquired = false, docked = false, held = false;
-  std::string frame;  // "end effector", "orbiter", "payload"
-  bool vernier = false;
+  std::string frame;     // "end effector", "orbiter", "payload"
+  std::string scale;     // "COARSE", "VERNIER", "FINE"
+  bool vernier = false;  // not coarse (vernier or fine: the same rates)
   // Per axis x, y, z, roll, pitch, yaw: the commanded rate (signed, ft/s
   // or deg/s) and what is still to go of the increment in flight.
   std::array<double, 6> rate{}, to_go{};
@@ -40,7 +41,20 @@ struct Screen {
   std::array<double, 6> margin{};  // > 0: holds by
   double close_gap = -1;           // Mode 1: where the closing finger would stop
   bool close_ok = false;           // ... below D3Y
-  double bay_clearance = -1e9;     // Mode 2/3: > 0 clear of the bay
+  bool would_acquire = false;      // "CLOSING THE FINGER NOW ACQUIRES"
+  double angle = 0;                // the guidance's whole turn, deg
+  // What flies by itself: each axis nulled ("(to 0)"), the square-up, the unwind.
+  std::array<bool, 6> nulling{};
+  bool squaring = false, unwinding = false;
+  bool near_limit = false;      // "WRIST NEAR ITS LIMIT"
+  double turn_clearance = 1e9;  // Mode 3: above the sill line over the turn, ft
+  bool clearance_warning = false;
+  bool automatic() const {
+    bool any = squaring || unwinding;
+    for (bool n : nulling) any = any || n;
+    return any;
+  }
+  double bay_clearance = -1e9;  // Mode 2/3: > 0 clear of the bay
   double dock_distance = 0, dock_angle = 0;
 };
 Screen ParseScreen(const std::string& text);
@@ -112,6 +126,13 @@ class ScriptedOperator {
   bool Extract(double limit_s);
   bool Dock(double limit_s);
   bool WaitForFrame(const std::string& frame, double limit_s);
+  // Presses `keys` (null keys, the square-up) and watches until nothing
+  // flies by itself; unwinds and squares up again if the wrist nears its
+  // limit on the way. False when the limit comes first.
+  bool FlyAutomatic(const std::vector<std::string>& keys, const std::string& why, double limit_s);
+  // Presses the scale key until the screen shows `scale`.
+  bool SetScale(const std::string& scale, double limit_s);
+  int unwinds_ = 0;
 
   OperatorTerminal* terminal_;
   ScriptedOperatorOptions options_;
