@@ -24,6 +24,9 @@ constexpr double kLagDeg = 1.0;
 // Given up after this long without headway (a joint at its limit, the end
 // of the reach).
 constexpr double kBlockedS = 1.5;
+// A reference the arm has not kept up with for this long starts again from
+// the arm (what it had counted beyond the arm given back to the press).
+constexpr double kRebaseS = 0.3;
 
 constexpr const char* kAxisWords[kNumHandAxes] = {"x", "y", "z", "roll", "pitch", "yaw"};
 
@@ -448,6 +451,8 @@ void HandControllers::AddPress(const struct Press& p) {
   // never runs on more than one increment from now); one the other way
   // stops it.
   TakeAxis(p.index);
+  pending_best_[p.index] = 1e30;  // a press: its headway counted afresh
+  stalled_s_[p.index] = 0.0;
   double& pending = status_.pending[p.index];
   const double inc = Increment(p.index);
   if (pending * p.sign > 0)
@@ -495,9 +500,25 @@ void HandControllers::FlyManualAugmented(const std::array<double, kNumHandAxes>&
   const bool counting = std::any_of(status_.pending.begin(), status_.pending.end(),
                                     [](double p) { return p != 0.0; });
   if (X_ref_ && counting) {
-    const double lag_ft = (*X_ref_ * por - s.X_RS2 * por).norm();
-    const double lag_rad = RotationVector(X_ref_->linear() * s.X_RS2.linear().transpose()).norm();
-    if (lag_ft > kLagFt || lag_rad > kLagDeg * kDeg) advance = 0.0;
+    const Eigen::Vector3d lag_R = *X_ref_ * por - s.X_RS2 * por;
+    const Eigen::Vector3d turn_R = RotationVector(X_ref_->linear() * s.X_RS2.linear().transpose());
+    if (lag_R.norm() > kLagFt || turn_R.norm() > kLagDeg * kDeg) advance = 0.0;
+    waited_s_ = advance == 0.0 ? waited_s_ + dt_s : 0.0;
+    if (waited_s_ > kRebaseS) {
+      // The arm cannot reach the reference (it moves, but not that way):
+      // start the reference again from where the arm is, and give the
+      // presses back what it had counted beyond the arm.
+      const Eigen::Vector3d lag_F = R_RF.transpose() * lag_R;
+      const Eigen::Vector3d turn_F = R_RF.transpose() * turn_R / kDeg;
+      for (int i = 0; i < kNumHandAxes; ++i) {
+        double& p = status_.pending[i];
+        const double back = i < 3 ? lag_F[i] : turn_F[i - 3];
+        if (p * back > 0) p += back;
+      }
+      X_ref_ = s.X_RS2;
+      waited_s_ = 0.0;
+      advance = 1.0;
+    }
   }
   const Eigen::Vector3d v_R =
       advance * (R_RF * Eigen::Vector3d(rate[kThcX], rate[kThcY], rate[kThcZ]));
@@ -539,11 +560,37 @@ void HandControllers::FlyManualAugmented(const std::array<double, kNumHandAxes>&
   // The increments are taken off as the reference advances.
   std::array<double, kNumHandAxes> moved{};
   for (int i = 0; i < kNumHandAxes; ++i) moved[i] = advance * rate[i];
+  const std::array<double, kNumHandAxes> before = status_.pending;
   ConsumePending(moved, dt_s);
+  if (counting && X_ref_) FinishPresses(before, ForwardPose(config_.arm, r.q_deg, h), por, R_RF);
   status_.singular = r.singular;
   status_.rate_limited = r.rate_limited || advance == 0.0;
   status_.sigma_min_ft = r.sigma_min_ft;
   ReportLimits(r.at_limit);
+}
+
+// The reference has flown the presses' whole distance: what the arm still
+// lags it by along the axes pressed is given back to them, from where the
+// arm is, so a press ends where it was asked to even where the arm could
+// not keep up (the straight arm).
+void HandControllers::FinishPresses(const std::array<double, kNumHandAxes>& before,
+                                    const Eigen::Isometry3d& X_RS2_next, const Eigen::Vector3d& por,
+                                    const Eigen::Matrix3d& R_RF) {
+  if (std::any_of(status_.pending.begin(), status_.pending.end(),
+                  [](double p) { return p != 0.0; }))
+    return;
+  const Eigen::Vector3d lag_F = R_RF.transpose() * (*X_ref_ * por - X_RS2_next * por);
+  const Eigen::Vector3d turn_F =
+      R_RF.transpose() * RotationVector(X_ref_->linear() * X_RS2_next.linear().transpose()) / kDeg;
+  bool again = false;
+  for (int i = 0; i < kNumHandAxes; ++i) {
+    const double back = i < 3 ? lag_F[i] : turn_F[i - 3];
+    if (before[i] * back > 0 && std::abs(back) > (i < 3 ? kNullTolFt : kNullTolDeg)) {
+      status_.pending[i] = back;
+      again = true;
+    }
+  }
+  if (again) X_ref_ = X_RS2_next;
 }
 
 void HandControllers::ConsumePending(const std::array<double, kNumHandAxes>& achieved,
@@ -556,12 +603,19 @@ void HandControllers::ConsumePending(const std::array<double, kNumHandAxes>& ach
     double& pending = status_.pending[i];
     if (pending == 0.0) {
       stalled_s_[i] = 0.0;
+      pending_best_[i] = 1e30;
       continue;
     }
     const double along = std::copysign(1.0, pending) * achieved[i];  // > 0: toward completing it
     if (along > 0) pending -= std::copysign(std::min(std::abs(pending), along * dt_s), pending);
     if (std::abs(pending) < 1e-3 * Increment(i)) pending = 0.0;  // done, to a thousandth
-    stalled_s_[i] = along < 0.05 * FullRate(i) ? stalled_s_[i] + dt_s : 0.0;
+    // No headway: what is left of it has not shrunk (by 1e-4) for kBlockedS.
+    if (std::abs(pending) < pending_best_[i] - 1e-4) {
+      pending_best_[i] = std::abs(pending);
+      stalled_s_[i] = 0.0;
+    } else {
+      stalled_s_[i] += dt_s;
+    }
     if (stalled_s_[i] > kBlockedS) {
       pending = 0.0;
       stalled_s_[i] = 0.0;

@@ -27,7 +27,7 @@ int KeyCode(const std::string& name) {
 }  // namespace
 
 OfflineStation::OfflineStation(const LabConfig& config, const operator_station::Bindings& bindings,
-                               double max_s, int width, int height)
+                               double max_s, int width, int height, bool window_keys)
     : config_(config),
       bindings_(bindings),
       hands_(config, bindings_),
@@ -37,6 +37,12 @@ OfflineStation::OfflineStation(const LabConfig& config, const operator_station::
       max_s_(max_s),
       width_(width),
       height_(height) {
+  if (window_keys) {
+    auto w = std::make_unique<operator_station::WindowKeyboardDevice>(bindings_);
+    window_ = w.get();
+    hands_.AddDevice(std::move(w));
+    return;
+  }
   hands_.AddDevice(std::make_unique<operator_station::KeyboardDevice>(
       bindings_,
       [this] {
@@ -46,7 +52,18 @@ OfflineStation::OfflineStation(const LabConfig& config, const operator_station::
       "the offline station"));
 }
 
+void OfflineStation::Release(const std::vector<std::string>& keys) {
+  for (const std::string& k : keys) window_held_.erase(KeyCode(k));
+}
+
 void OfflineStation::Send(const std::vector<std::string>& keys) {
+  if (window_) {
+    for (const std::string& k : keys) {
+      window_pressed_.push_back(KeyCode(k));
+      window_held_.insert(KeyCode(k));
+    }
+    return;
+  }
   if (next_key_ >= pending_keys_.size()) pending_keys_.clear(), next_key_ = 0;
   for (const std::string& k : keys) pending_keys_.push_back(KeyCode(k));
 }
@@ -62,6 +79,18 @@ void OfflineStation::Wait(double s) {
 }
 
 void OfflineStation::StepFrame() {
+  if (window_) {
+    // The window's message this frame (it sends at every change and every
+    // 100 ms while a key is held; every frame here).
+    const auto now_us = static_cast<std::int64_t>(std::llround(frames_ * 1e6 / rate_hz_));
+    operator_station::WindowKeyboardDevice::Message m;
+    m.sequence = window_sequence_++;
+    m.held.assign(window_held_.begin(), window_held_.end());
+    m.pressed = window_pressed_;
+    window_pressed_.clear();
+    window_->Receive(m, now_us);
+    window_->SetNow(now_us);
+  }
   const wire::OperatorInputs in = hands_.Step(1.0 / rate_hz_, telemetry_ ? &*telemetry_ : nullptr);
   const auto words = wire::EncodeInputs(in, config_.inputs, &result_.dcp);
   const wire::OperatorInputs decoded = wire::DecodeInputs(words, config_.inputs, &result_.dcp);
@@ -104,13 +133,15 @@ std::string OfflineStation::Capture() {
 
 ScriptedFlight FlyScriptedSubject(const LabConfig& config,
                                   const operator_station::Bindings& bindings,
-                                  const ScriptedOperatorOptions& options, double max_s) {
-  OfflineStation station(config, bindings, max_s);
+                                  const ScriptedOperatorOptions& options, double max_s,
+                                  bool window_keys) {
+  OfflineStation station(config, bindings, max_s, 132, 50, window_keys);
   ScriptedOperator op(&station, options);
   ScriptedFlight flight;
   try {
     flight.report = op.Fly(false, max_s);
   } catch (const FlightTimeUp&) {
+    flight.report = op.report();  // what it saw and did, up to there
     flight.report.failure = TimeUpFailure(station.result(), max_s);  // where the time ran out
   }
   flight.result = station.result();

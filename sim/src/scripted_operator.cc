@@ -14,6 +14,12 @@ constexpr const char* kAxisNames[6] = {"x", "y", "z", "roll", "pitch", "yaw"};
 constexpr const char* kPlusKey[6] = {"w", "d", "f", "o", "k", "l"};
 constexpr const char* kMinusKey[6] = {"s", "a", "r", "u", "i", "j"};
 
+bool IsMotionKey(const std::string& k) {
+  for (int i = 0; i < 6; ++i)
+    if (k == kPlusKey[i] || k == kMinusKey[i]) return true;
+  return false;
+}
+
 int AxisIndex(const std::string& name) {
   for (int i = 0; i < 6; ++i) {
     if (name == kAxisNames[i]) return i;
@@ -140,14 +146,47 @@ Screen ScriptedOperator::Look() {
   return last_;
 }
 
+void ScriptedOperator::ReleaseHeld(const std::vector<std::string>& keys) {
+  // A person lets go a reaction time after seeing it get there.
+  terminal_->Wait(Reaction());
+  terminal_->Release(keys);
+  for (const auto& k : keys) held_.erase(std::remove(held_.begin(), held_.end(), k), held_.end());
+  std::string t;
+  for (const auto& k : keys) t += (t.empty() ? "" : " ") + k;
+  Note("let go of " + t);
+}
+
 void ScriptedOperator::Press(const std::vector<std::string>& keys, const std::string& why,
-                             double pulse_s, const std::vector<std::string>& then) {
+                             double pulse_s, const std::vector<std::string>& then, bool hold) {
   // A person acts a reaction time after seeing what they act on.
   terminal_->Wait(Reaction());
   terminal_->Send(keys);
   report_.key_actions += static_cast<int>(keys.size());
   std::string k;
   for (const auto& key : keys) k += (k.empty() ? "" : " ") + key;
+  if (terminal_->HoldsKeys()) {
+    // A window's keys: a motion key is held -- for the tap's time, until
+    // Drive lets go (hold), or as long as a terminal's increment flies --
+    // and every other key let go after a few frames. Space lets go of all.
+    std::vector<std::string> motion, other;
+    for (const auto& key : keys) (IsMotionKey(key) ? motion : other).push_back(key);
+    if (std::find(keys.begin(), keys.end(), "Space") != keys.end()) {
+      terminal_->Release(held_);
+      held_.clear();
+    }
+    if (!motion.empty() && hold) {
+      held_.insert(held_.end(), motion.begin(), motion.end());
+    } else if (!motion.empty()) {
+      const double held_s = pulse_s > 0 ? pulse_s : 2.5;
+      terminal_->Wait(held_s);
+      terminal_->Release(motion);
+      k += Fmt(" (held %.2f s)", held_s);
+    }
+    Note("press " + k + ": " + why);
+    terminal_->Wait(0.12);
+    terminal_->Release(other);
+    return;
+  }
   if (pulse_s > 0) {
     terminal_->Wait(pulse_s);
     terminal_->Send(then);
@@ -169,6 +208,8 @@ bool ScriptedOperator::SetScale(const std::string& scale, double limit_s) {
 
 bool ScriptedOperator::FlyAutomatic(const std::vector<std::string>& keys, const std::string& why,
                                     double limit_s) {
+  // A window's key still held from Drive is let go of first.
+  if (!held_.empty()) ReleaseHeld(std::vector<std::string>(held_));
   // What flies by itself slows as it arrives: coarse is never too fast.
   if (last_.scale != "COARSE") SetScale("COARSE", limit_s);
   Press(keys, why);
@@ -227,24 +268,32 @@ bool ScriptedOperator::Drive(const Screen& s, const std::vector<Goal>& goals,
   // How far an axis goes while a press is on its way: the reaction, the
   // key's way to the station, a frame, the telemetry back, the look.
   const double latency = options_.reaction_s + 0.15;
-  std::vector<std::string> keys;
+  // A terminal stops an axis with a press the other way; a window by
+  // letting go of the key held (and a held key keeps going by itself).
+  const bool window = terminal_->HoldsKeys();
+  std::vector<std::string> keys, release;
+  auto stop = [&](int axis, double m) {
+    if (window)
+      release.push_back(m > 0 ? kPlusKey[axis] : kMinusKey[axis]);
+    else
+      keys.push_back(m > 0 ? kMinusKey[axis] : kPlusKey[axis]);
+  };
   const Goal* pulse = nullptr;
   double pulse_rate = 0.0;
   for (const Goal& g : goals) {
     const double m = s.rate[g.axis], e = g.error, left = s.to_go[g.axis];
     const char* toward = e > 0 ? kPlusKey[g.axis] : kMinusKey[g.axis];
-    const char* against = m > 0 ? kMinusKey[g.axis] : kPlusKey[g.axis];
     if (std::abs(e) <= g.tol) {
-      if (m != 0.0) keys.push_back(against);  // there: stop it
+      if (m != 0.0) stop(g.axis, m);  // there: stop it
       continue;
     }
     if (m != 0.0 && (m > 0) != (e > 0)) {
-      keys.push_back(against);  // going the wrong way: stop it, start again next time
+      stop(g.axis, m);  // going the wrong way: stop it, start again next time
     } else if (m != 0.0) {
       const double travel = std::abs(m) * latency;
       if (std::abs(e) <= travel + 0.5 * g.tol)
-        keys.push_back(against);  // stop it in time
-      else if (left < 1.2 * travel && std::abs(e) > left + g.tol)
+        stop(g.axis, m);  // stop it in time
+      else if (!window && left < 1.2 * travel && std::abs(e) > left + g.tol)
         keys.push_back(toward);  // keep it going
     } else {
       // Still. Far: start it (and stop it when it gets there). Near: a
@@ -256,8 +305,11 @@ bool ScriptedOperator::Drive(const Screen& s, const std::vector<Goal>& goals,
         pulse = &g, pulse_rate = rate;
     }
   }
+  if (!release.empty()) ReleaseHeld(release);
   if (!keys.empty()) {
-    Press(keys, why);
+    Press(keys, why, 0, {}, /*hold=*/true);
+  } else if (!release.empty()) {
+    terminal_->Wait(0.12);
   } else if (pulse && !any_moving) {
     const char* toward = pulse->error > 0 ? kPlusKey[pulse->axis] : kMinusKey[pulse->axis];
     const char* against = pulse->error > 0 ? kMinusKey[pulse->axis] : kPlusKey[pulse->axis];

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <SDL2/SDL.h>
+#include <algorithm>
 #include <cstdlib>
 #include <deque>
 #include <fstream>
@@ -872,6 +873,127 @@ TEST_F(Devices, TheClearanceOverATurnIsTheLowestThePayloadGoes) {
   EXPECT_LT(least, 20 - r - 5.0);
   // No turn: the clearance now.
   EXPECT_NEAR(TurnClearance(geometry, X_RP, tip, Eigen::Vector3d::Zero()), 20 - r, 1e-9);
+}
+
+}  // namespace
+}  // namespace rms::operator_station
+
+namespace rms::operator_station {
+namespace {
+
+// docs/operator.md "Guidance", "Clearance in Mode 3": each message's
+// condition, and only then -- what to fly next with its keys, whether
+// closing acquires, the wrist's limit, the arm's real rate, the clearance.
+TEST_F(Devices, TheStatusScreenSaysWhatToFlyNextAndWarnsOnlyWhereItHolds) {
+  StatusSnapshot s;
+  s.source = "by hand";
+  s.inputs = wire::InitialInputs(config.inputs);
+  s.inputs.value[5] = 172.0;
+  dcp_telemetry_t t{};
+  t.mode = 1;
+  for (auto& c : t.acquisition_conditions) c = 1;
+  t.acquisition_conditions[4] = 0;  // condition 5 short
+  s.telemetry = t;
+  Guidance g;
+  g.rotation_deg = {-12.0, 30.0, 0.0};
+  g.angle_deg = 32.3;
+  g.next_axis = kRhcPitch;
+  g.close_gap_ft = 0.5 * config.dcp.d3y_ft;
+  s.guidance = g;
+  HandStatus h;
+  h.near_limit = 1u << 5;
+  h.automatic = kAutoSquareUp;
+  h.rate[kThcX] = 2.0;
+  h.achieved[kThcX] = 0.8;
+  s.hand = h;
+  for (const auto& [code, a] : bindings.keys) s.keys[ActionName(a)] = wire::KeyName(code);
+  auto shows = [&](const char* want) {
+    return RenderStatusScreen(s, config, 132, 60).find(want) != std::string::npos;
+  };
+  EXPECT_TRUE(shows("next: pitch up 30.0 deg (k; K flies it to 0)"));
+  EXPECT_TRUE(shows("h squares up the whole 32.3 deg turn at once"));
+  EXPECT_TRUE(shows("closing now would not acquire: conditions 5 short"));
+  EXPECT_FALSE(shows("CLOSING THE FINGER NOW ACQUIRES"));
+  EXPECT_TRUE(shows("WRIST NEAR ITS LIMIT (within 10 deg): wrist_roll +172.0; b unwinds it"));
+  EXPECT_TRUE(shows("SQUARING UP"));
+  EXPECT_TRUE(shows("moving x +2.00 ft/s [arm +0.80]"));
+  EXPECT_FALSE(shows("CLEARANCE"));
+  s.telemetry->acquisition_conditions[4] = 1;
+  s.hand->near_limit = 0;
+  s.hand->achieved[kThcX] = 2.0;
+  EXPECT_TRUE(shows("CLOSING THE FINGER NOW ACQUIRES (c)"));
+  EXPECT_FALSE(shows("WRIST NEAR"));
+  EXPECT_FALSE(shows("[arm"));
+  // Mode 3: the payload high now, but the turn shown takes it under the sill line.
+  s.telemetry->mode = 3;
+  s.telemetry->bay_clearance_ft = 14.2;
+  s.guidance->turn_clearance_ft = -3.1;
+  s.guidance->clearance_warning = true;
+  s.hand->automatic = 0;
+  EXPECT_TRUE(shows("payload above the orbiter's sill line by 14.20 ft"));
+  EXPECT_TRUE(shows("over the turn shown: BELOW the orbiter's sill line by 3.10 ft"));
+  EXPECT_TRUE(shows("CLEARANCE WARNING"));
+  EXPECT_FALSE(shows("clear of the bay by"));
+  s.guidance->turn_clearance_ft = 6.0;
+  s.guidance->clearance_warning = false;
+  EXPECT_FALSE(shows("CLEARANCE WARNING"));
+}
+
+// The clearance warning is Mode 3's, and computed: a payload held level
+// just above the sill line under a turn that swings it down warns; the
+// same turn 40 ft up does not.
+TEST_F(Devices, ModeThreeWarnsWhereTheTurnShownTakesThePayloadUnderTheMargin) {
+  ArmState s;
+  s.mode = 3;
+  s.X_RP.linear() << 0, -1, 0, 1, 0, 0, 0, 0, 1;  // y_P along -X_R: the probe level
+  s.X_RP.translation() = Eigen::Vector3d(30, 0, 8);
+  s.X_RS2 = s.X_RP;
+  const Guidance low = ComputeGuidance(geometry, s, CommandFrame::kOrbiter);
+  ASSERT_GT(low.angle_deg, 45.0);  // the probe level, the port's axis not
+  EXPECT_TRUE(low.clearance_warning) << low.turn_clearance_ft;
+  s.X_RP.translation().z() = 48;
+  s.X_RS2 = s.X_RP;
+  const Guidance high = ComputeGuidance(geometry, s, CommandFrame::kOrbiter);
+  EXPECT_FALSE(high.clearance_warning) << high.turn_clearance_ft;
+  EXPECT_GT(high.turn_clearance_ft, kClearanceMarginFt);
+}
+
+}  // namespace
+}  // namespace rms::operator_station
+
+namespace rms::operator_station {
+namespace {
+
+// docs/operator.md "Rates": a press moves the distance asked whatever the
+// pose -- from the straight (stowed) arm, a singular pose, too, where a
+// motion goes slowly at first.
+TEST_F(Devices, APressMovesTheDistanceAskedFromTheStraightArm) {
+  for (const int key : {'a', 'd', 's', 'f'}) {
+    HandControllers hc(config, bindings);
+    TypedKeys typed;
+    hc.AddDevice(std::make_unique<KeyboardDevice>(bindings, typed.Source()));
+    wire::OperatorInputs in = wire::InitialInputs(config.inputs);
+    hc.SetInputs(in);
+    const Eigen::Isometry3d X0 = X_RS2(in);
+    typed.keys = {key};
+    int frames = 0;
+    for (; frames < 30 * 30; ++frames) {
+      const dcp_telemetry_t t = Telemetry(in, 1);
+      in = hc.Step(kDt, &t);
+      const auto& p = hc.status().pending;
+      if (frames > 0 && std::all_of(p.begin(), p.end(), [](double v) { return v == 0.0; })) break;
+    }
+    // The grasp point's motion, in the end effector's axes at the start.
+    const Eigen::Matrix3d R_RF = X0.linear() * geometry.R_S2H;
+    const Eigen::Vector3d d_F =
+        R_RF.transpose() * (X_RS2(in) * geometry.p_S2oG_S2 - X0 * geometry.p_S2oG_S2);
+    const int axis = key == 'a' || key == 'd' ? 1 : key == 's' ? 0 : 2;
+    const double sign = key == 'a' || key == 's' ? -1.0 : 1.0;
+    std::printf("key %c: %.3f ft along its axis in %.1f s (asked %.1f)\n", key, d_F[axis],
+                frames * kDt, sign * bindings.increments.coarse_ft);
+    EXPECT_NEAR(d_F[axis], sign * bindings.increments.coarse_ft, 0.1) << static_cast<char>(key);
+    EXPECT_EQ(hc.counters().Get(Counter::kIncrementsBlocked), 0) << static_cast<char>(key);
+  }
 }
 
 }  // namespace

@@ -142,6 +142,9 @@ class HandControllers {
   // Takes what the motion flown did (ft/s, deg/s, command axes: the
   // reference's advance) off the increments in progress.
   void ConsumePending(const std::array<double, kNumHandAxes>& done, double dt_s);
+  void FinishPresses(const std::array<double, kNumHandAxes>& before,
+                     const Eigen::Isometry3d& X_RS2_next, const Eigen::Vector3d& por,
+                     const Eigen::Matrix3d& R_RF);
   void ReportLimits(std::uint32_t at_limit);
   void DirectInputs(const DeviceCommands& cmd, double dt_s);
   void StopMotion();
@@ -164,6 +167,9 @@ class HandControllers {
   std::array<bool, kNumAnalogInputs> clamping_{};
   std::uint32_t limit_reported_ = 0;
   std::array<double, kNumHandAxes> stalled_s_{};  // how long each increment has made no headway
+  std::array<double, kNumHandAxes> pending_best_ = {
+      1e30, 1e30, 1e30, 1e30, 1e30, 1e30};  // the least left of each increment so far
+  double waited_s_ = 0.0;                   // how long the reference has waited for the arm
   HandStatus status_;
   // The DCP's state the frames need: the mode and, once held, the payload
   // in System Two (from the telemetry).

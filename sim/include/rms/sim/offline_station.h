@@ -9,6 +9,7 @@
 // operator flies it as a virtual subject.
 #include <cstdint>
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -33,13 +34,17 @@ class OfflineStation : public OperatorTerminal {
  public:
   // max_s: the session time Wait may reach before it throws FlightTimeUp.
   // width x height: the terminal's size (the status screen follows it).
+  // window_keys: the keys are the live window's (held until released,
+  // RMS_WINDOW_KEYS' device), not a terminal's.
   OfflineStation(const LabConfig& config, const operator_station::Bindings& bindings, double max_s,
-                 int width = 132, int height = 50);
+                 int width = 132, int height = 50, bool window_keys = false);
   std::string Capture() override;
   // Keys by tmux's names (one character, "Space", "Enter"); an unknown name
   // throws rms::InputError. Each is read by the station's next frame.
   void Send(const std::vector<std::string>& keys) override;
   void Wait(double s) override;
+  bool HoldsKeys() const override { return window_ != nullptr; }
+  void Release(const std::vector<std::string>& keys) override;
 
   // What the DCP's telemetry said, frame by frame (docked, times, margins,
   // collisions): the truth the screen showed.
@@ -58,6 +63,12 @@ class OfflineStation : public OperatorTerminal {
   double rate_hz_, max_s_;
   int width_, height_;
   std::vector<int> pending_keys_;  // typed, for the keyboard's next poll
+  // The window's keyboard, when the keys are a window's: held keys and
+  // those that went down since the last message.
+  operator_station::WindowKeyboardDevice* window_ = nullptr;
+  std::set<int> window_held_;
+  std::vector<int> window_pressed_;
+  std::int64_t window_sequence_ = 0;
   std::size_t next_key_ = 0;
   std::int64_t frames_ = 0;
   double waited_s_ = 0.0;  // the session time the waits asked for
@@ -77,6 +88,7 @@ struct ScriptedFlight {
 };
 ScriptedFlight FlyScriptedSubject(const LabConfig& config,
                                   const operator_station::Bindings& bindings,
-                                  const ScriptedOperatorOptions& options, double max_s);
+                                  const ScriptedOperatorOptions& options, double max_s,
+                                  bool window_keys = false);
 
 }  // namespace rms::sim

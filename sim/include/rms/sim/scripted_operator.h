@@ -81,6 +81,10 @@ class OperatorTerminal {
   // Lets `s` seconds pass: the wall clock's at a live terminal, session
   // time at an offline station.
   virtual void Wait(double s) = 0;
+  // A live window's keyboard (docs/operator.md "The live window's keys"):
+  // Send puts keys down, and they stay held until Release.
+  virtual bool HoldsKeys() const { return false; }
+  virtual void Release(const std::vector<std::string>& keys) { (void)keys; }
 };
 
 // A person's dispersions (docs/studies.md "Designs judged by flying
@@ -104,6 +108,8 @@ class ScriptedOperator {
   // the payload out of the bay and docks it. Gives up at `limit_s` of
   // session time.
   FlightReport Fly(bool acquire_only, double limit_s);
+  // What it has seen and done so far (a flight cut short keeps it).
+  const FlightReport& report() const { return report_; }
 
  private:
   struct Goal {
@@ -116,8 +122,11 @@ class ScriptedOperator {
   // Presses `keys` a reaction time after the last look; with pulse_s > 0,
   // presses `then` that long after (a tap and its stop: one motion of the
   // hand, not a second reaction).
+  // At a window (OperatorTerminal::HoldsKeys) a motion key is held for
+  // pulse_s, or until let go (hold: Drive lets go of it), or as long as a
+  // terminal's increment would fly; `then` is not needed there.
   void Press(const std::vector<std::string>& keys, const std::string& why, double pulse_s = 0,
-             const std::vector<std::string>& then = {});
+             const std::vector<std::string>& then = {}, bool hold = false);
   // Moves each goal's axis toward its target this cycle (presses what it
   // takes); true when every goal is within its tolerance and still.
   bool Drive(const Screen& s, const std::vector<Goal>& goals, const std::string& why);
@@ -133,6 +142,9 @@ class ScriptedOperator {
   // Presses the scale key until the screen shows `scale`.
   bool SetScale(const std::string& scale, double limit_s);
   int unwinds_ = 0;
+  // A window's keys: the motion keys held now.
+  std::vector<std::string> held_;
+  void ReleaseHeld(const std::vector<std::string>& keys);
 
   OperatorTerminal* terminal_;
   ScriptedOperatorOptions options_;
