@@ -30,7 +30,12 @@ constexpr double kRebaseS = 0.3;
 
 constexpr const char* kAxisWords[kNumHandAxes] = {"x", "y", "z", "roll", "pitch", "yaw"};
 
+// Mode 2, the payload still in the bay: the way out comes first, so a
+// translation's 0 is the way up out of the bay's, and there is no turn.
+bool InTheBay(const Guidance& g) { return g.leave_bay && g.leave_bay_ft.norm() > 1e-9; }
+
 double AxisError(const Guidance& g, int i) {
+  if (InTheBay(g)) return i < 3 ? g.leave_bay_ft[i] : 0.0;
   return i < 3 ? g.offset_ft[i] : g.rotation_deg[i - 3];
 }
 
@@ -282,6 +287,8 @@ void HandControllers::StartAutomatic(const Action& a) {
     // control mode; every other motion stops.
     StopMotion();
     status_.automatic = kAutoUnwind;
+    auto_best_.fill(1e30);
+    auto_stalled_s_.fill(0.0);
     counters_.Add(Counter::kControlUnwinds);
     spdlog::info("unwind: the wrist's pitch, yaw and roll to the middle of their travel");
     return;
@@ -309,6 +316,7 @@ void HandControllers::StartAutomatic(const Action& a) {
   }
   auto_best_.fill(1e30);
   auto_stalled_s_.fill(0.0);
+  auto_in_bay_ = InTheBay(ComputeGuidance(geometry_, CommandedArmState(), FlownFrame()));
 }
 
 void HandControllers::TakeAxis(int i) {
@@ -325,6 +333,7 @@ ArmState HandControllers::CommandedArmState() const {
   s.X_RS2 = ForwardPose(config_.arm, q, target_.value[kShoulderHeight]);
   if (X_S2P_) {
     s.X_RP = s.X_RS2 * *X_S2P_;
+    s.bay_clearance_ft = PayloadLowestZ(geometry_, s.X_RP);  // as commanded, for the way out
   } else {
     s.mode = 1;
     s.X_RP = X_RP_;
@@ -341,11 +350,24 @@ void HandControllers::AutomaticRates(std::array<double, kNumHandAxes>* rate, dou
   std::uint32_t& a = status_.automatic;
   if ((a & ~kAutoUnwind) == 0) return;
   const Guidance g = ComputeGuidance(geometry_, CommandedArmState(), FlownFrame());
+  if (auto_in_bay_ && !InTheBay(g)) {
+    // Nulls begun in the bay flew the way out's 0: out, they are there
+    // (the port's 0 is another press).
+    a &= ~0x3fu;
+    auto_in_bay_ = false;
+    spdlog::info("null: out of the bay ({:.0f} ft clear): there", kLeaveBayMarginFt);
+  }
   // Each automatic motion's error (index 6: the square-up's whole angle);
   // one that has arrived ends, one without headway for kBlockedS is given up.
   for (int k = 0; k <= kNumHandAxes; ++k) {
     const std::uint32_t bit = k < kNumHandAxes ? 1u << k : kAutoSquareUp;
     if (!(a & bit)) continue;
+    if (k == kNumHandAxes && InTheBay(g)) {
+      a &= ~bit;
+      counters_.Add(Counter::kIncrementsBlocked);
+      spdlog::warn("square up: the payload is still in the bay; lift it out first");
+      continue;
+    }
     const double e = k < kNumHandAxes ? AxisError(g, k) : g.angle_deg;
     const bool linear = k < 3;
     const std::string what = k < kNumHandAxes ? std::string("null ") + kAxisWords[k] : "square up";
@@ -360,9 +382,9 @@ void HandControllers::AutomaticRates(std::array<double, kNumHandAxes>* rate, dou
       a &= ~bit;
       counters_.Add(Counter::kIncrementsBlocked);
       spdlog::warn(
-          "{}: the arm cannot move that way (a joint at its limit, the end of its reach): "
-          "stopped {:.3f} {} short",
-          what, std::abs(e), linear ? "ft" : "deg");
+          "{}: no headway for {:.1f} s (a joint at its limit or its rate, the end of the reach, "
+          "or a contact): stopped {:.3f} {} short",
+          what, kBlockedS, std::abs(e), linear ? "ft" : "deg");
       continue;
     }
     if (k < kNumHandAxes) {
@@ -383,6 +405,19 @@ void HandControllers::FlyUnwind(double dt_s) {
   }
   for (int i = 3; i < 6; ++i) goal[i] = 0.5 * (limits_.min_deg[i] + limits_.max_deg[i]);
   const bool there = StepJointsToward(&q, goal, rate, dt_s);
+  // No headway (held by a contact: the hand controllers carry on from the
+  // pose the DCP holds) for kBlockedS: given up, and said so.
+  double left = 0.0;
+  for (int i = 3; i < 6; ++i) left += std::abs(goal[i] - q[i]);
+  auto_stalled_s_[kNumHandAxes] =
+      left < auto_best_[kNumHandAxes] - 1e-3 ? 0.0 : auto_stalled_s_[kNumHandAxes] + dt_s;
+  auto_best_[kNumHandAxes] = std::min(auto_best_[kNumHandAxes], left);
+  if (!there && auto_stalled_s_[kNumHandAxes] > kBlockedS) {
+    status_.automatic &= ~kAutoUnwind;
+    counters_.Add(Counter::kIncrementsBlocked);
+    spdlog::warn("unwind: no headway for {:.1f} s (a contact holds the arm?): stopped", kBlockedS);
+    return;
+  }
   for (int i = 0; i < 6; ++i) target_.value[i] = q[i];
   X_ref_.reset();
   status_.achieved = {};
@@ -455,8 +490,10 @@ void HandControllers::AddPress(const struct Press& p) {
   stalled_s_[p.index] = 0.0;
   double& pending = status_.pending[p.index];
   const double inc = Increment(p.index);
+  // "From now" is from where the arm is: the reference may be ahead of it
+  // by what it has counted and the arm not yet flown (lag_F_).
   if (pending * p.sign > 0)
-    pending = p.sign * std::max(std::abs(pending), inc);
+    pending = p.sign * std::max(std::abs(pending), inc - std::max(0.0, p.sign * lag_F_[p.index]));
   else if (pending * p.sign < 0)
     pending = 0.0;
   else
@@ -496,26 +533,29 @@ void HandControllers::FlyManualAugmented(const std::array<double, kNumHandAxes>&
   // singular pose): what it moves is what the arm will have moved.
   // (Only while an increment is counted off: what flies by itself aims at
   // the guidance's 0 afresh every frame and needs no count.)
+  lag_F_ = {};
   double advance = 1.0;
   const bool counting = std::any_of(status_.pending.begin(), status_.pending.end(),
                                     [](double p) { return p != 0.0; });
   if (X_ref_ && counting) {
     const Eigen::Vector3d lag_R = *X_ref_ * por - s.X_RS2 * por;
     const Eigen::Vector3d turn_R = RotationVector(X_ref_->linear() * s.X_RS2.linear().transpose());
+    const Eigen::Vector3d lag_F = R_RF.transpose() * lag_R;
+    const Eigen::Vector3d turn_F = R_RF.transpose() * turn_R / kDeg;
+    lag_F_ = {lag_F.x(), lag_F.y(), lag_F.z(), turn_F.x(), turn_F.y(), turn_F.z()};
     if (lag_R.norm() > kLagFt || turn_R.norm() > kLagDeg * kDeg) advance = 0.0;
     waited_s_ = advance == 0.0 ? waited_s_ + dt_s : 0.0;
     if (waited_s_ > kRebaseS) {
       // The arm cannot reach the reference (it moves, but not that way):
       // start the reference again from where the arm is, and give the
       // presses back what it had counted beyond the arm.
-      const Eigen::Vector3d lag_F = R_RF.transpose() * lag_R;
-      const Eigen::Vector3d turn_F = R_RF.transpose() * turn_R / kDeg;
       for (int i = 0; i < kNumHandAxes; ++i) {
         double& p = status_.pending[i];
         const double back = i < 3 ? lag_F[i] : turn_F[i - 3];
         if (p * back > 0) p += back;
       }
       X_ref_ = s.X_RS2;
+      lag_F_ = {};
       waited_s_ = 0.0;
       advance = 1.0;
     }

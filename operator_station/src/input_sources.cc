@@ -63,10 +63,30 @@ std::string KeyHelp(const Bindings& b) {
   pair("camera_pan+", "camera_pan-", "pan");
   pair("camera_tilt+", "camera_tilt-", "tilt");
   pair("camera_zoom+", "camera_zoom-", "zoom");
-  for (const char* one : {"stop", "vernier", "mode", "frame", "joint_next", "joint_prev",
-                          "crosshairs", "guidance", "overlay", "reset", "freeze", "step", "quit"}) {
+  std::string nulls;  // shift and an axis's keys: "W,S/D,A/F,R/... null"
+  for (const char* axis : {"thc_x", "thc_y", "thc_z", "rhc_pitch", "rhc_yaw", "rhc_roll"}) {
+    const std::string n = "null_" + std::string(axis);
+    if (by_action.count(n)) nulls += (nulls.empty() ? "" : "/") + by_action[n];
+  }
+  if (!nulls.empty()) s += "  " + nulls + " fly the axis to 0";
+  static const std::pair<const char*, const char*> kOnes[] = {{"square_up", "square up"},
+                                                              {"unwind", "unwind wrist"},
+                                                              {"stop", "stop"},
+                                                              {"vernier", "scale"},
+                                                              {"mode", "mode"},
+                                                              {"frame", "frame"},
+                                                              {"joint_next", "joint_next"},
+                                                              {"joint_prev", "joint_prev"},
+                                                              {"crosshairs", "crosshairs"},
+                                                              {"guidance", "guidance"},
+                                                              {"overlay", "overlay"},
+                                                              {"reset", "reset"},
+                                                              {"freeze", "freeze"},
+                                                              {"step", "step"},
+                                                              {"quit", "quit"}};
+  for (const auto& [one, what] : kOnes) {
     if (by_action.count(one)) {
-      s += "  " + by_action[one] + " " + one;
+      s += "  " + by_action[one] + " " + what;
       by_action.erase(one);
     }
   }

@@ -398,11 +398,12 @@ void OperatorStation::WatchClearance() {
   if (warn && !clearance_warned_) {
     counters_.Add(Counter::kClearanceWarnings);
     spdlog::warn(
-        "CLEARANCE: over the {} the payload comes within {:.2f} ft of the orbiter's sill line "
+        "CLEARANCE: over the {} the payload goes {:.2f} ft {} the orbiter's sill line "
         "(margin {:.0f} ft): go up (orbiter frame, r) before turning",
         source_->hand() && TurnInFlight(source_->hand()->status(), *g) ? "turn in flight"
                                                                        : "turn the guidance shows",
-        g->turn_clearance_ft, kClearanceMarginFt);
+        std::abs(g->turn_clearance_ft), g->turn_clearance_ft >= 0 ? "above" : "BELOW",
+        kClearanceMarginFt);
   }
   clearance_warned_ = warn;
 }

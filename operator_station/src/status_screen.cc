@@ -102,24 +102,27 @@ void NextLine(const StatusSnapshot& s, Flow& flow) {
   static const char* kWord[6][2] = {{"forward", "back"}, {"right", "left"}, {"down", "up"},
                                     {"right", "left"},   {"up", "down"},    {"right", "left"}};
   const int a = g.next_axis;
+  if (s.telemetry && s.telemetry->docked) {
+    flow.Line(" next: nothing -- docked");
+    return;
+  }
   if (a < 0) {
     flow.Line(" next: nothing -- at the target");
     return;
   }
-  const double e =
-      a < 3 ? (g.leave_bay && g.leave_bay_ft.norm() > 1e-9 ? g.leave_bay_ft[a] : g.offset_ft[a])
-            : g.rotation_deg[a - 3];
+  const bool in_bay = g.leave_bay && g.leave_bay_ft.norm() > 1e-9;
+  const double e = a < 3 ? (in_bay ? g.leave_bay_ft[a] : g.offset_ft[a]) : g.rotation_deg[a - 3];
   const std::string move = std::string(kHandAxisNames[a]) + (e >= 0 ? "+" : "-");
   std::string hint = KeyHint(s, move);
   const std::string null_key = KeyHint(s, "null_" + std::string(kHandAxisNames[a]));
-  if (!null_key.empty() && !(g.leave_bay && g.leave_bay_ft.norm() > 1e-9))
+  if (!null_key.empty())  // in the bay, the way out's 0
     hint = hint.substr(0, hint.size() - 1) + "; " + null_key.substr(2, null_key.size() - 3) +
            " flies it to 0)";
   flow.Line(Sprintf(" next: %s %s %.*f %s", kName[a], kWord[a][e >= 0 ? 0 : 1], a < 3 ? 2 : 1,
                     std::abs(e), a < 3 ? "ft" : "deg") +
             hint);
   const std::string square = KeyHint(s, "square_up");
-  if (g.angle_deg > 0.5 && !square.empty())
+  if (g.angle_deg > 0.5 && !square.empty() && !in_bay)
     flow.Field(Sprintf("%s squares up the whole %.1f deg turn at once",
                        square.substr(2, square.size() - 3).c_str(), g.angle_deg));
 }

@@ -44,6 +44,14 @@ TEST(ScriptedOperator, AcquiresThePayloadByHandReadingOnlyTheStatusScreen) {
   // the control mode it flew in.
   EXPECT_EQ(summary["by_hand"]["key_actions"].get<int>(), r.key_actions + 1);
   EXPECT_EQ(summary["by_hand"]["control_changes"][0]["control_mode"], "manual augmented");
+  // Flown with the square-up and null keys (docs/operator.md "Nulling an
+  // axis, squaring up, unwinding"), counted, and the session re-simulates
+  // word for word: what flew by itself is in the record as inputs.
+  const nlohmann::json stats =
+      nlohmann::json::parse(testing::ReadFile(session.out + "/stats/operator_station.json"));
+  EXPECT_GE(stats["counters"].value("control.square_ups", 0), 1) << stats.dump();
+  EXPECT_GE(stats["counters"].value("control.nulls", 0), 3) << stats.dump();
+  EXPECT_TRUE(summary["resimulation"]["exact"].get<bool>()) << summary["resimulation"].dump();
 }
 
 }  // namespace

@@ -998,3 +998,44 @@ TEST_F(Devices, APressMovesTheDistanceAskedFromTheStraightArm) {
 
 }  // namespace
 }  // namespace rms::operator_station
+
+namespace rms::operator_station {
+namespace {
+
+// Mode 2, the payload in the bay: a null key flies the way out's 0 (up
+// until the payload is 2 ft clear), not the port's; the square-up waits.
+TEST_F(Devices, InTheBayANullFliesTheWayOutAndTheSquareUpWaits) {
+  HandControllers hc(config, bindings);
+  TypedKeys typed;
+  hc.AddDevice(std::make_unique<KeyboardDevice>(bindings, typed.Source()));
+  wire::OperatorInputs in = MidPose();
+  hc.SetInputs(in);
+  auto lowest = [&](const wire::OperatorInputs& now) {
+    return PayloadLowestZ(geometry, X_RS2(now) * mission::PlanGeometry(config).X_S2P);
+  };
+  // Lower the pose until the payload is in the bay.
+  for (int k = 0; k < 200 && lowest(in) > 0.5; ++k) {
+    typed.keys = {'f'};
+    const dcp_telemetry_t t = Telemetry(in, 2);
+    in = hc.Step(kDt, &t);
+  }
+  typed.keys = {' ', 'n'};  // stop; the orbiter frame
+  for (int k = 0; k < 5; ++k) {
+    const dcp_telemetry_t t = Telemetry(in, 2);
+    in = hc.Step(kDt, &t);
+    typed.keys.clear();
+  }
+  ASSERT_LT(lowest(in), kLeaveBayMarginFt - 0.5);
+  typed.keys = {'h', 'R'};
+  for (int k = 0; k < 900 && (k < 2 || hc.status().automatic != 0); ++k) {
+    const dcp_telemetry_t t = Telemetry(in, 2);
+    in = hc.Step(kDt, &t);
+    typed.keys.clear();
+  }
+  EXPECT_EQ(hc.status().automatic, 0u);
+  EXPECT_NEAR(lowest(in), kLeaveBayMarginFt, 0.05);              // out, and no further
+  EXPECT_GE(hc.counters().Get(Counter::kIncrementsBlocked), 1);  // the square-up: not in the bay
+}
+
+}  // namespace
+}  // namespace rms::operator_station

@@ -169,7 +169,10 @@ class HandControllers {
   std::array<double, kNumHandAxes> stalled_s_{};  // how long each increment has made no headway
   std::array<double, kNumHandAxes> pending_best_ = {
       1e30, 1e30, 1e30, 1e30, 1e30, 1e30};  // the least left of each increment so far
-  double waited_s_ = 0.0;                   // how long the reference has waited for the arm
+  double waited_s_ = 0.0;
+  bool auto_in_bay_ = false;  // the nulls in flight began with the payload in the bay
+  // The reference ahead of the arm (command axes: ft, deg), this frame.
+  std::array<double, kNumHandAxes> lag_F_{};  // how long the reference has waited for the arm
   HandStatus status_;
   // The DCP's state the frames need: the mode and, once held, the payload
   // in System Two (from the telemetry).
