@@ -166,6 +166,19 @@ void HandControllers::FollowHeldArm(const dcp_telemetry_t& tm) {
   X_ref_.reset();
 }
 
+// The DCP holds the arm (the command collides): a terminal's presses in
+// flight end there, said so -- flown on, they would count their distance
+// into the contact.
+void HandControllers::CutPressesShort() {
+  for (int i = 0; i < kNumHandAxes; ++i) {
+    if (status_.pending[i] == 0.0) continue;
+    spdlog::warn("{}: press cut short by a collision, {:.2f} {} of it not flown", kAxisWords[i],
+                 std::abs(status_.pending[i]), i < 3 ? "ft" : "deg");
+    status_.pending[i] = 0.0;
+    counters_.Add(Counter::kIncrementsBlocked);
+  }
+}
+
 void HandControllers::StopMotion() {
   status_.pending = {};
   status_.rate = {};
@@ -763,6 +776,7 @@ wire::OperatorInputs HandControllers::Apply(const DeviceCommands& cmd, double dt
     // opens: nothing the hand controllers do moves it meanwhile.
     status_.held_at_port = tm->docked && !tm->released;
     if ((tm->held && tm->slave_collisions == 0) || status_.held_at_port) FollowHeldArm(*tm);
+    if (tm->held && !status_.held_at_port) CutPressesShort();
   }
   HandleEvents(cmd, tm);
   if (status_.held_at_port) {

@@ -1039,3 +1039,28 @@ TEST_F(Devices, InTheBayANullFliesTheWayOutAndTheSquareUpWaits) {
 
 }  // namespace
 }  // namespace rms::operator_station
+
+namespace rms::operator_station {
+namespace {
+
+// A terminal's press flown into a collision ends when the DCP holds the
+// arm, said and counted -- not flown on into the contact.
+TEST_F(Devices, APressIntoACollisionIsCutShortThere) {
+  HandControllers hc(config, bindings);
+  TypedKeys typed;
+  hc.AddDevice(std::make_unique<KeyboardDevice>(bindings, typed.Source()));
+  wire::OperatorInputs in = MidPose();
+  hc.SetInputs(in);
+  typed.keys = {'w'};
+  dcp_telemetry_t t = Telemetry(in, 1);
+  in = hc.Step(kDt, &t);
+  ASSERT_GT(hc.status().pending[kThcX], 1.0);
+  t = Telemetry(in, 1);
+  t.held = true;  // the command collides: the DCP holds the slave where it was
+  in = hc.Step(kDt, &t);
+  EXPECT_EQ(hc.status().pending[kThcX], 0.0);
+  EXPECT_EQ(hc.counters().Get(Counter::kIncrementsBlocked), 1);
+}
+
+}  // namespace
+}  // namespace rms::operator_station

@@ -153,6 +153,7 @@ class HandControllers {
   // The DCP holds the arm (a collision, or docked at the port): carry on
   // from the pose it holds.
   void FollowHeldArm(const dcp_telemetry_t& tm);
+  void CutPressesShort();
   void Announce(const char* what);
   double Increment(int axis) const;
   double FullRate(int axis) const;
