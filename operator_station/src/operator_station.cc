@@ -392,8 +392,7 @@ std::optional<Guidance> OperatorStation::CurrentGuidance() const {
 
 // docs/operator.md "Clearance in Mode 3": said once each time the payload
 // goes, or the turn in flight would take it, under the margin.
-void OperatorStation::WatchClearance() {
-  const auto g = CurrentGuidance();
+void OperatorStation::WatchClearance(const std::optional<Guidance>& g) {
   const bool warn = g && g->clearance_warning;
   if (warn && !clearance_warned_) {
     counters_.Add(Counter::kClearanceWarnings);
@@ -408,7 +407,7 @@ void OperatorStation::WatchClearance() {
   clearance_warned_ = warn;
 }
 
-void OperatorStation::PublishState(std::int64_t frame, const wire::OperatorInputs& in) {
+void OperatorStation::PublishState(std::int64_t frame, const std::optional<Guidance>& g) {
   operator_state_t m{};
   m.frame = frame;
   m.send_time_us = lcm_.NowUs();
@@ -445,7 +444,7 @@ void OperatorStation::PublishState(std::int64_t frame, const wire::OperatorInput
       m.device_actions.push_back(static_cast<std::int32_t>(h->device_actions()[i]));
     }
   }
-  if (const auto g = CurrentGuidance()) {
+  if (g) {
     const dcp_telemetry_t& t = *telemetry_;
     m.guidance_valid = true;
     m.mode = t.mode;
@@ -471,7 +470,6 @@ void OperatorStation::PublishState(std::int64_t frame, const wire::OperatorInput
     m.dock_distance_ft = t.dock_distance_ft;
     m.dock_angle_deg = t.dock_angle_deg;
   }
-  (void)in;
   if (!transport::PublishMessage(lcm_, wire::channels::kOperatorState, m))
     counters_.Add(Counter::kPublishFailed);
 }
@@ -663,8 +661,9 @@ bool OperatorStation::StepFrame(transport::StatusReporter* status) {
     counters_.Add(Counter::kPublished);
   else
     counters_.Add(Counter::kPublishFailed);
-  PublishState(block.frame, *in);
-  WatchClearance();
+  const std::optional<Guidance> guidance = CurrentGuidance();  // once a frame
+  PublishState(block.frame, guidance);
+  WatchClearance(guidance);
   publish_rate_.Tick(lcm_.NowUs());
   ++frames_;
   status->Tick(block.frame, counters_);

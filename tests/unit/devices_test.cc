@@ -767,12 +767,6 @@ TEST_F(Devices, TheStatusScreenShowsGuidanceMarginsAndFollowsTheWidth) {
   for (std::string l; std::getline(is, l);) EXPECT_LE(static_cast<int>(l.size()), 40) << l;
 }
 
-}  // namespace
-}  // namespace rms::operator_station
-
-namespace rms::operator_station {
-namespace {
-
 // docs/operator.md "Nulling an axis, squaring up, unwinding": shift-d
 // flies y to the guidance's 0 and stops; h squares the whole turn up in
 // one rotation; b brings the wrist to the middle of its travel; each is
@@ -875,12 +869,6 @@ TEST_F(Devices, TheClearanceOverATurnIsTheLowestThePayloadGoes) {
   EXPECT_NEAR(TurnClearance(geometry, X_RP, tip, Eigen::Vector3d::Zero()), 20 - r, 1e-9);
 }
 
-}  // namespace
-}  // namespace rms::operator_station
-
-namespace rms::operator_station {
-namespace {
-
 // docs/operator.md "Guidance", "Clearance in Mode 3": each message's
 // condition, and only then -- what to fly next with its keys, whether
 // closing acquires, the wrist's limit, the arm's real rate, the clearance.
@@ -958,12 +946,6 @@ TEST_F(Devices, ModeThreeWarnsWhereTheTurnShownTakesThePayloadUnderTheMargin) {
   EXPECT_GT(high.turn_clearance_ft, kClearanceMarginFt);
 }
 
-}  // namespace
-}  // namespace rms::operator_station
-
-namespace rms::operator_station {
-namespace {
-
 // docs/operator.md "Rates": a press moves the distance asked whatever the
 // pose -- from the straight (stowed) arm, a singular pose, too, where a
 // motion goes slowly at first.
@@ -995,12 +977,6 @@ TEST_F(Devices, APressMovesTheDistanceAskedFromTheStraightArm) {
     EXPECT_EQ(hc.counters().Get(Counter::kIncrementsBlocked), 0) << static_cast<char>(key);
   }
 }
-
-}  // namespace
-}  // namespace rms::operator_station
-
-namespace rms::operator_station {
-namespace {
 
 // Mode 2, the payload in the bay: a null key flies the way out's 0 (up
 // until the payload is 2 ft clear), not the port's; the square-up waits.
@@ -1036,12 +1012,6 @@ TEST_F(Devices, InTheBayANullFliesTheWayOutAndTheSquareUpWaits) {
   EXPECT_NEAR(lowest(in), kLeaveBayMarginFt, 0.05);              // out, and no further
   EXPECT_GE(hc.counters().Get(Counter::kIncrementsBlocked), 1);  // the square-up: not in the bay
 }
-
-}  // namespace
-}  // namespace rms::operator_station
-
-namespace rms::operator_station {
-namespace {
 
 // A terminal's press flown into a collision ends when the DCP holds the
 // arm, said and counted -- not flown on into the contact.

@@ -119,10 +119,10 @@ class OperatorStation {
   // the frames before it is shown or flown on.
   void ForgetTelemetry(std::int64_t fresh_from_input_frame);
   bool RunFrozen();  // false: quit
-  void PublishState(std::int64_t frame, const wire::OperatorInputs& in);
+  void PublishState(std::int64_t frame, const std::optional<Guidance>& guidance);
   void DrawScreen(std::int64_t frame, const wire::OperatorInputs& in, bool frozen);
   std::optional<Guidance> CurrentGuidance() const;
-  void WatchClearance();
+  void WatchClearance(const std::optional<Guidance>& guidance);
 
   const OperatorOptions& options_;
   const LabConfig& config_;
