@@ -322,7 +322,10 @@ void DrawGuidance(std::uint8_t* rgba, int w, int h, const operator_state_t& st) 
     L.push_back(n);
   }
   if (st.automatic & operator_state_t::AUTO_UNWIND) L.push_back("UNWINDING THE WRIST");
-  if (st.joints_near_limit) L.push_back("WARNING: WRIST NEAR ITS LIMIT: UNWIND IT");
+  if (st.automatic & operator_state_t::AUTO_STOW) L.push_back("STOWING THE ARM");
+  if (st.joints_near_limit)
+    L.push_back(st.mode == 1 ? "WARNING: WRIST NEAR ITS LIMIT: UNWIND IT OR STOW THE ARM"
+                             : "WARNING: WRIST NEAR ITS LIMIT: UNWIND IT");
   if (st.mode == 1) {
     std::string c = "ACQ";
     for (int i = 0; i < 6; ++i) {

@@ -41,6 +41,7 @@ constexpr Named kNamedActions[] = {
     {"vernier", ActionKind::kVernier},
     {"square_up", ActionKind::kSquareUp},
     {"unwind", ActionKind::kUnwind},
+    {"stow", ActionKind::kStow},
     {"joint_next", ActionKind::kJointNext},
     {"joint_prev", ActionKind::kJointPrev},
     {"quit", ActionKind::kQuit},
@@ -92,7 +93,7 @@ Action ParseAction(std::string_view t) {
       "\" (thc_x, thc_y, thc_z, rhc_roll, rhc_pitch, rhc_yaw, finger, shoulder_height, camera_pan, "
       "camera_tilt, camera_zoom with + or -; camera_1..camera_8, camera_next, camera_prev, reset, "
       "overlay, crosshairs, guidance, stop, mode, frame, vernier, null_ and an axis (null_thc_x .. "
-      "null_rhc_yaw), square_up, unwind, joint_next, joint_prev, quit, freeze, step)");
+      "null_rhc_yaw), square_up, unwind, stow, joint_next, joint_prev, quit, freeze, step)");
 }
 
 std::string ActionName(const Action& a) {

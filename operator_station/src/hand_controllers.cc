@@ -270,6 +270,7 @@ void HandControllers::HandleEvents(const DeviceCommands& cmd, const dcp_telemetr
       case ActionKind::kNull:
       case ActionKind::kSquareUp:
       case ActionKind::kUnwind:
+      case ActionKind::kStow:
         StartAutomatic(a);
         break;
       case ActionKind::kJointNext:
@@ -295,15 +296,24 @@ void HandControllers::HandleEvents(const DeviceCommands& cmd, const dcp_telemetr
 }
 
 void HandControllers::StartAutomatic(const Action& a) {
-  if (a.kind == ActionKind::kUnwind) {
+  if (a.kind == ActionKind::kStow && (dcp_mode_ != 1 || X_S2P_)) {
+    // With the payload held the arm's way back would carry it through the
+    // bay's sill and the orbiter (docs/operator.md "Stowing the arm").
+    counters_.Add(Counter::kIncrementsBlocked);
+    spdlog::warn("stow: only in Mode 1, the payload left in the bay (reset first)");
+    return;
+  }
+  if (a.kind == ActionKind::kUnwind || a.kind == ActionKind::kStow) {
     // docs/operator.md "Nulling an axis, squaring up, unwinding": in either
     // control mode; every other motion stops.
+    const bool stow = a.kind == ActionKind::kStow;
     StopMotion();
-    status_.automatic = kAutoUnwind;
+    status_.automatic = stow ? kAutoStow : kAutoUnwind;
     auto_best_.fill(1e30);
     auto_stalled_s_.fill(0.0);
-    counters_.Add(Counter::kControlUnwinds);
-    spdlog::info("unwind: the wrist's pitch, yaw and roll to the middle of their travel");
+    counters_.Add(stow ? Counter::kControlStows : Counter::kControlUnwinds);
+    spdlog::info(stow ? "stow: every joint back to where the session started it"
+                      : "unwind: the wrist's pitch, yaw and roll to the middle of their travel");
     return;
   }
   if (status_.mode == ControlMode::kSingleJoint) {
@@ -311,7 +321,7 @@ void HandControllers::StartAutomatic(const Action& a) {
     spdlog::info("{}: manual augmented only (m)", ActionName(a));
     return;
   }
-  status_.automatic &= ~kAutoUnwind;
+  status_.automatic &= ~(kAutoUnwind | kAutoStow);
   if (a.kind == ActionKind::kSquareUp) {
     for (int i = kRhcRoll; i <= kRhcYaw; ++i) {
       status_.pending[i] = 0.0;
@@ -335,7 +345,7 @@ void HandControllers::StartAutomatic(const Action& a) {
 void HandControllers::TakeAxis(int i) {
   status_.automatic &= ~(1u << i);
   if (i >= kRhcRoll) status_.automatic &= ~kAutoSquareUp;
-  status_.automatic &= ~kAutoUnwind;
+  status_.automatic &= ~(kAutoUnwind | kAutoStow);
 }
 
 ArmState HandControllers::CommandedArmState() const {
@@ -361,7 +371,7 @@ CommandFrame HandControllers::FlownFrame() const {
 
 void HandControllers::AutomaticRates(std::array<double, kNumHandAxes>* rate, double dt_s) {
   std::uint32_t& a = status_.automatic;
-  if ((a & ~kAutoUnwind) == 0) return;
+  if ((a & ~(kAutoUnwind | kAutoStow)) == 0) return;
   const Guidance g = ComputeGuidance(geometry_, CommandedArmState(), FlownFrame());
   if (auto_in_bay_ && !InTheBay(g)) {
     // Nulls begun in the bay flew the way out's 0: out, they are there
@@ -410,25 +420,30 @@ void HandControllers::AutomaticRates(std::array<double, kNumHandAxes>* rate, dou
   }
 }
 
-void HandControllers::FlyUnwind(double dt_s) {
+void HandControllers::FlyJoints(std::uint32_t bit, double dt_s) {
+  const bool stow = bit == kAutoStow;
+  const char* what = stow ? "stow" : "unwind";
   JointAngles q{}, goal{}, rate{};
   for (int i = 0; i < 6; ++i) {
     q[i] = goal[i] = target_.value[i];
     rate[i] = b_.max_rate[i];
+    if (stow) goal[i] = config_.inputs[i].initial;  // where the session started it
   }
-  for (int i = 3; i < 6; ++i) goal[i] = 0.5 * (limits_.min_deg[i] + limits_.max_deg[i]);
+  if (!stow)
+    for (int i = 3; i < 6; ++i) goal[i] = 0.5 * (limits_.min_deg[i] + limits_.max_deg[i]);
   const bool there = StepJointsToward(&q, goal, rate, dt_s);
   // No headway (held by a contact: the hand controllers carry on from the
   // pose the DCP holds) for kBlockedS: given up, and said so.
   double left = 0.0;
-  for (int i = 3; i < 6; ++i) left += std::abs(goal[i] - q[i]);
+  for (int i = 0; i < 6; ++i) left += std::abs(goal[i] - q[i]);
   auto_stalled_s_[kNumHandAxes] =
       left < auto_best_[kNumHandAxes] - 1e-3 ? 0.0 : auto_stalled_s_[kNumHandAxes] + dt_s;
   auto_best_[kNumHandAxes] = std::min(auto_best_[kNumHandAxes], left);
   if (!there && auto_stalled_s_[kNumHandAxes] > kBlockedS) {
-    status_.automatic &= ~kAutoUnwind;
+    status_.automatic &= ~bit;
     counters_.Add(Counter::kIncrementsBlocked);
-    spdlog::warn("unwind: no headway for {:.1f} s (a contact holds the arm?): stopped", kBlockedS);
+    spdlog::warn("{}: no headway for {:.1f} s (a contact holds the arm?): stopped", what,
+                 kBlockedS);
     return;
   }
   for (int i = 0; i < 6; ++i) target_.value[i] = q[i];
@@ -437,8 +452,8 @@ void HandControllers::FlyUnwind(double dt_s) {
   status_.singular = false;
   status_.rate_limited = false;
   if (there) {
-    status_.automatic &= ~kAutoUnwind;
-    spdlog::info("unwind: there (wrist pitch {:+.1f}, yaw {:+.1f}, roll {:+.1f} deg)", q[3], q[4],
+    status_.automatic &= ~bit;
+    spdlog::info("{}: there (wrist pitch {:+.1f}, yaw {:+.1f}, roll {:+.1f} deg)", what, q[3], q[4],
                  q[5]);
   }
   ReportLimits(0);
@@ -731,6 +746,9 @@ void HandControllers::DirectInputs(const DeviceCommands& cmd, double dt_s) {
       t = o;
     else
       t = o + p.sign * b_.key_step[p.index];
+    // A press asks for a step, not a place: it moves to the end of the
+    // range at most, which is no command out of range (nothing clamped).
+    t = std::clamp(t, cal[p.index].min, cal[p.index].max);
   }
   for (int i = kFinger; i < kNumAnalogInputs; ++i) {
     const double lim = b_.max_rate[i] * dt_s;
@@ -790,8 +808,8 @@ wire::OperatorInputs HandControllers::Apply(const DeviceCommands& cmd, double dt
     auto rate = CommandedRates(cmd, dt_s);
     if (status_.mode == ControlMode::kManualAugmented) AutomaticRates(&rate, dt_s);
     status_.rate = rate;
-    if (status_.automatic & kAutoUnwind)
-      FlyUnwind(dt_s);
+    if (status_.automatic & (kAutoUnwind | kAutoStow))
+      FlyJoints(status_.automatic & (kAutoUnwind | kAutoStow), dt_s);
     else if (status_.mode == ControlMode::kManualAugmented)
       FlyManualAugmented(rate, dt_s);
     else

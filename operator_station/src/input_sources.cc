@@ -71,6 +71,7 @@ std::string KeyHelp(const Bindings& b) {
   if (!nulls.empty()) s += "  " + nulls + " fly the axis to 0";
   static const std::pair<const char*, const char*> kOnes[] = {{"square_up", "square up"},
                                                               {"unwind", "unwind wrist"},
+                                                              {"stow", "stow the arm"},
                                                               {"stop", "stop"},
                                                               {"vernier", "scale"},
                                                               {"mode", "mode"},

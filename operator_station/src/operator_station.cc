@@ -416,11 +416,16 @@ void OperatorStation::PublishState(std::int64_t frame, const std::optional<Guida
     const HandStatus& s = h->status();
     m.control_mode = static_cast<std::int8_t>(s.mode);
     m.command_frame = static_cast<std::int8_t>(s.frame);
+    static_assert(static_cast<int>(ControlMode::kSingleJoint) ==
+                      operator_state_t::CONTROL_SINGLE_JOINT &&
+                  static_cast<int>(ControlMode::kManualAugmented) ==
+                      operator_state_t::CONTROL_MANUAL_AUGMENTED);
     static_assert(static_cast<int>(RateScale::kCoarse) == operator_state_t::SCALE_COARSE &&
                   static_cast<int>(RateScale::kVernier) == operator_state_t::SCALE_VERNIER &&
                   static_cast<int>(RateScale::kFine) == operator_state_t::SCALE_FINE);
     static_assert(kAutoSquareUp == operator_state_t::AUTO_SQUARE_UP &&
-                  kAutoUnwind == operator_state_t::AUTO_UNWIND);
+                  kAutoUnwind == operator_state_t::AUTO_UNWIND &&
+                  kAutoStow == operator_state_t::AUTO_STOW);
     static_assert(kNearLimitDeg == operator_state_t::NEAR_LIMIT_DEG);
     m.scale = static_cast<std::int8_t>(s.scale);
     for (int i = 0; i < 6; ++i) m.achieved_rate[i] = s.achieved[i];

@@ -195,6 +195,10 @@ void ControlLines(const StatusSnapshot& s, Flow& flow) {
     flow.Field("UNWINDING the wrist to the middle of its travel");
     moving = true;
   }
+  if (h.automatic & kAutoStow) {
+    flow.Field("STOWING the arm: every joint back to its start");
+    moving = true;
+  }
   if (!moving) flow.Field("still");
   if (h.near_limit) {
     std::string j;
@@ -203,10 +207,14 @@ void ControlLines(const StatusSnapshot& s, Flow& flow) {
         j += std::string(j.empty() ? "" : ", ") + std::string(kAnalogInputNames[i]) +
              Sprintf(" %+.1f", s.inputs.value[i]);
     }
-    const std::string unwind = KeyHint(s, "unwind");
-    flow.Field(Sprintf("WRIST NEAR ITS LIMIT (within %.0f deg): ", kNearLimitDeg) + j +
-               (unwind.empty() ? std::string()
-                               : "; " + unwind.substr(2, unwind.size() - 3) + " unwinds it"));
+    // The ways out: the unwind, and in Mode 1 the stow (where the wrist
+    // comes back to its limit after an unwind: docs/operator.md "Stowing").
+    const std::string unwind = KeyHint(s, "unwind"), stow = KeyHint(s, "stow");
+    std::string out =
+        unwind.empty() ? "" : "; " + unwind.substr(2, unwind.size() - 3) + " unwinds it";
+    if (!stow.empty() && s.telemetry && s.telemetry->mode == 1)
+      out += (out.empty() ? "; " : ", ") + stow.substr(2, stow.size() - 3) + " stows the arm";
+    flow.Field(Sprintf("WRIST NEAR ITS LIMIT (within %.0f deg): ", kNearLimitDeg) + j + out);
   }
   if (h.at_limit) {
     std::string j;

@@ -9,6 +9,7 @@
 #include "rms/operator_station/input_sources.h"
 #include "rms/operator_station/status_screen.h"
 #include "rms/wire/input_block.h"
+#include "rms/wire/key_codes.h"
 
 #include "flight_log.h"
 
@@ -16,12 +17,15 @@ namespace rms::sim {
 
 namespace {
 
-// A key by tmux's send-keys name, as a terminal sends it.
+// A key by tmux's send-keys name, as the keyboard devices read it (a
+// character, or a key code of wire/key_codes.h).
 int KeyCode(const std::string& name) {
   if (name.size() == 1) return static_cast<unsigned char>(name[0]);
   if (name == "Space") return ' ';
   if (name == "Enter") return '\r';
-  throw InputError("the offline station has no key '" + name + "' (one character, Space or Enter)");
+  if (name == "BSpace") return wire::kKeyBackspace;
+  throw InputError("the offline station has no key '" + name +
+                   "' (one character, Space, Enter or BSpace)");
 }
 
 }  // namespace
@@ -134,12 +138,13 @@ std::string OfflineStation::Capture() {
 ScriptedFlight FlyScriptedSubject(const LabConfig& config,
                                   const operator_station::Bindings& bindings,
                                   const ScriptedOperatorOptions& options, double max_s,
-                                  bool window_keys) {
+                                  bool window_keys, bool again_after_reset) {
   OfflineStation station(config, bindings, max_s, 132, 50, window_keys);
   ScriptedOperator op(&station, options);
   ScriptedFlight flight;
   try {
     flight.report = op.Fly(false, max_s);
+    if (again_after_reset && flight.report.docked) flight.report = op.FlyAgainAfterReset(max_s);
   } catch (const FlightTimeUp&) {
     flight.report = op.report();  // what it saw and did, up to there
     flight.report.failure = TimeUpFailure(station.result(), max_s);  // where the time ran out

@@ -72,6 +72,7 @@ Screen ParseScreen(const std::string& text) {
   if (std::regex_search(text, m, kAngleRe)) s.angle = std::stod(m[1]);
   s.squaring = text.find("SQUARING UP") != std::string::npos;
   s.unwinding = text.find("UNWINDING") != std::string::npos;
+  s.stowing = text.find("STOWING") != std::string::npos;
   s.near_limit = text.find("WRIST NEAR ITS LIMIT") != std::string::npos;
   s.would_acquire = text.find("CLOSING THE FINGER NOW ACQUIRES") != std::string::npos;
   s.clearance_warning = text.find("CLEARANCE WARNING") != std::string::npos;
@@ -218,14 +219,23 @@ bool ScriptedOperator::FlyAutomatic(const std::vector<std::string>& keys, const 
     const Screen s = Look();
     if (s.t_s > limit_s) return false;
     if (s.held || s.docked) return true;
-    if (s.mode == 1 && s.near_limit && !s.unwinding && unwinds_ < 2 &&
+    if (s.mode == 1 && s.near_limit && !s.unwinding && !s.stowing &&
         (s.squaring || s.angle > 1.0)) {
-      // The way out the screen names: unwind, then square up again.
-      ++unwinds_;
-      Press({"b"}, "the wrist nears its limit: unwind it");
-      continue;
+      // The ways out the screen names: unwind, then square up again; where
+      // the wrist comes back to its limit after that, stow the arm and
+      // start again from where the session started it.
+      if (unwinds_ == 0 || (stowed_ && unwinds_ < 2)) {
+        ++unwinds_;
+        Press({"b"}, "the wrist nears its limit: unwind it");
+        continue;
+      }
+      if (!stowed_) {
+        stowed_ = true;
+        Press({"z"}, "the wrist is back at its limit after the unwind: stow the arm");
+        continue;
+      }
     }
-    if (s.unwinding) {
+    if (s.unwinding || s.stowing) {
       quiet_since = -1;
       terminal_->Wait(0.2);
       continue;
@@ -480,8 +490,26 @@ bool ScriptedOperator::Dock(double limit_s) {
   }
 }
 
+FlightReport ScriptedOperator::FlyAgainAfterReset(double limit_s) {
+  Press({"BSpace"}, "reset: a new attempt from where the arm is");
+  for (int i = 0; i < 100; ++i) {
+    const Screen s = Look();
+    if (s.mode == 1 && !s.docked && !s.acquired) break;
+    terminal_->Wait(0.1);
+  }
+  // The finger is still closed from the docking: open it for the new grasp.
+  Press({"x"}, "open the finger for the new attempt");
+  FlightReport r = Fly(false, limit_s);
+  r.key_actions += 2;  // the reset and the finger
+  r.key_actions_acquire += 2;
+  report_ = r;
+  return r;
+}
+
 FlightReport ScriptedOperator::Fly(bool acquire_only, double limit_s) {
   report_ = {};
+  unwinds_ = 0;
+  stowed_ = false;
   // The screen up, with guidance.
   for (int i = 0; i < 200; ++i) {
     const Screen s = Look();

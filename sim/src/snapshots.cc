@@ -28,7 +28,7 @@ operator_state_t StateOf(const LabConfig& config, const OfflineSession& s,
       operator_station::ComputeGuidance(operator_station::MakeGuidanceGeometry(config), arm, frame);
   operator_state_t m{};
   m.source = operator_state_t::SOURCE_BY_HAND;
-  m.control_mode = 2;
+  m.control_mode = operator_state_t::CONTROL_MANUAL_AUGMENTED;
   m.command_frame = static_cast<std::int8_t>(frame);
   m.guidance_valid = true;
   m.show_guidance = true;

@@ -539,6 +539,17 @@ TEST_F(Devices, OutOfRangeCommandsAreClampedAndReportedOnce) {
   const double held = in.value[kFinger];
   EXPECT_LT(held, 0.5);
   EXPECT_DOUBLE_EQ(h2.Apply({}, kDt, nullptr).value[kFinger], held);
+  // From part-way, a press either way runs to the end of the range: a step
+  // asked for, never a command out of range (nothing clamped, nothing said).
+  DeviceCommands open;
+  open.input_presses.push_back({kFinger, -1.0});
+  in = h2.Apply(open, kDt, nullptr);
+  for (int i = 0; i < 60; ++i) in = h2.Apply({}, kDt, nullptr);
+  EXPECT_DOUBLE_EQ(in.value[kFinger], config.inputs[kFinger].min);
+  in = h2.Apply(press, kDt, nullptr);
+  for (int i = 0; i < 90; ++i) in = h2.Apply({}, kDt, nullptr);
+  EXPECT_DOUBLE_EQ(in.value[kFinger], config.inputs[kFinger].max);
+  EXPECT_EQ(h2.counters().Get(Counter::kClampedFinger), 0);
 }
 
 TEST_F(Devices, DeadbandZeroesSmallDeflectionsAndKeepsFullScale) {
@@ -816,6 +827,53 @@ TEST_F(Devices, NullKeysSquareUpAndUnwindFlyToTheirZeroAndStop) {
   EXPECT_EQ(hc.status().automatic & kAutoSquareUp, 0u);
 }
 
+// docs/operator.md "Stowing the arm": in Mode 1, z flies every joint back
+// to where the session started it, all arriving together, and stops
+// there, counted; holding the payload it is refused, counted, and nothing
+// moves.
+TEST_F(Devices, StowFliesEveryJointToItsStartInModeOneOnly) {
+  HandControllers hc(config, bindings);
+  TypedKeys typed;
+  hc.AddDevice(std::make_unique<KeyboardDevice>(bindings, typed.Source()));
+  wire::OperatorInputs in = MidPose();
+  hc.SetInputs(in);
+  auto fly = [&](std::vector<int> keys, int frames, int mode) {
+    typed.keys = std::deque<int>(keys.begin(), keys.end());
+    for (int k = 0; k < frames; ++k) {
+      const dcp_telemetry_t t = Telemetry(in, mode);
+      in = hc.Step(kDt, &t);
+      typed.keys.clear();
+    }
+  };
+  fly({'z'}, 1, 2);  // the payload held: refused
+  EXPECT_EQ(hc.status().automatic, 0u);
+  EXPECT_EQ(hc.counters().Get(Counter::kIncrementsBlocked), 1);
+  EXPECT_EQ(hc.counters().Get(Counter::kControlStows), 0);
+  for (int j = 0; j < 6; ++j) EXPECT_EQ(in.value[j], MidPose().value[j]) << j;
+  fly({'z'}, 1, 1);
+  EXPECT_EQ(hc.status().automatic, kAutoStow);
+  EXPECT_EQ(hc.counters().Get(Counter::kControlStows), 1);
+  // Halfway, every joint is halfway: they arrive together.
+  double longest_deg = 0.0;
+  int longest = 0;
+  for (int j = 0; j < 6; ++j) {
+    const double d = std::abs(config.inputs[j].initial - MidPose().value[j]);
+    if (d / bindings.max_rate[j] > longest_deg / bindings.max_rate[longest]) {
+      longest_deg = d;
+      longest = j;
+    }
+  }
+  const int half = static_cast<int>(0.5 * longest_deg / bindings.max_rate[longest] / kDt);
+  fly({}, half, 1);
+  for (int j = 0; j < 6; ++j) {
+    const double start = MidPose().value[j], end = config.inputs[j].initial;
+    EXPECT_NEAR((in.value[j] - start) / (end - start), 0.5, 0.05) << j;
+  }
+  fly({}, 2 * half + 30, 1);
+  for (int j = 0; j < 6; ++j) EXPECT_NEAR(in.value[j], config.inputs[j].initial, 1e-6) << j;
+  EXPECT_EQ(hc.status().automatic, 0u);
+}
+
 // A wrist joint within 10 deg of a limit is warned of (once), with the
 // way out.
 TEST_F(Devices, AWristNearItsLimitIsWarnedOf) {
@@ -902,8 +960,13 @@ TEST_F(Devices, TheStatusScreenSaysWhatToFlyNextAndWarnsOnlyWhereItHolds) {
   EXPECT_TRUE(shows("h squares up the whole 32.3 deg turn at once"));
   EXPECT_TRUE(shows("closing now would not acquire: conditions 5 short"));
   EXPECT_FALSE(shows("CLOSING THE FINGER NOW ACQUIRES"));
-  EXPECT_TRUE(shows("WRIST NEAR ITS LIMIT (within 10 deg): wrist_roll +172.0; b unwinds it"));
+  EXPECT_TRUE(shows(
+      "WRIST NEAR ITS LIMIT (within 10 deg): wrist_roll +172.0; b unwinds it, z stows the arm"));
   EXPECT_TRUE(shows("SQUARING UP"));
+  s.telemetry->mode = 2;  // the payload held: no stow
+  EXPECT_TRUE(shows("wrist_roll +172.0; b unwinds it"));
+  EXPECT_FALSE(shows("stows the arm"));
+  s.telemetry->mode = 1;
   EXPECT_TRUE(shows("moving x +2.00 ft/s [arm +0.80]"));
   EXPECT_FALSE(shows("CLEARANCE"));
   s.telemetry->acquisition_conditions[4] = 1;

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <gtest/gtest.h>
 #include <stdexcept>
+#include <vector>
 
 #include "rms/base/check.h"
 #include "rms/base/config.h"
@@ -45,18 +46,22 @@ TEST(ScriptedSubject, DocksOfflineFromTheStatusScreenAndKeysAlone) {
 // docs/operator.md "A scripted operator": from the start and three awkward
 // attitudes of the wrist (one of the whole arm too) the operator squares up
 // with the square-up key, unwinds the wrist where the screen warns of its
-// limit, acquires within the budget -- 50 key actions at a terminal, 30 at
-// the live window (held keys) -- and docks.
+// limit (and stows the arm where it warns again after that: a second
+// attempt after a reset from Mode 3), acquires within the budget -- 50 key actions at a terminal,
+// 30 at the live window (held keys) -- and docks.
 TEST(ScriptedSubject, SquaresUpFromAwkwardAttitudesAndDocksWithinTheBudget) {
   struct Attitude {
     const char* name;
     double q_deg[6];
+    bool after_reset = false;  // a second attempt, after a reset from Mode 3
   };
   const Attitude attitudes[] = {
       {"the start (the stowed arm)", {NAN, NAN, NAN, NAN, NAN, NAN}},
       {"wrist pitched up, yawed and rolled", {0.06, 0.16, -0.31, 90.0, -60.0, 150.0}},
       {"wrist pitched down, yawed the other way", {0.06, 0.16, -0.31, -100.0, 80.0, -120.0}},
       {"arm raised, wrist rolled near its limit", {20.0, 30.0, -60.0, 40.0, 100.0, 172.0}},
+      // A reset from Mode 3 leaves the arm over the CAE, where it docked.
+      {"where the arm docked, after a reset", {NAN, NAN, NAN, NAN, NAN, NAN}, true},
   };
   for (const Attitude& a : attitudes) {
     LabConfig c = LoadConfig(DefaultConfigPath());
@@ -67,19 +72,21 @@ TEST(ScriptedSubject, SquaresUpFromAwkwardAttitudesAndDocksWithinTheBudget) {
     // A terminal's keys (budget 50 to acquire), then the live window's
     // held keys (budget 30).
     for (const bool window : {false, true}) {
-      const ScriptedFlight f = FlyScriptedSubject(c, DefaultBindings(), o, 400, window);
+      const ScriptedFlight f = FlyScriptedSubject(c, DefaultBindings(), o,
+                                                  a.after_reset ? 700 : 400, window, a.after_reset);
       std::printf(
-          "%s, %s: acquired at %.1f s with %d keys, docked %d at %.1f s with %ld keys, "
+          "%s, %s: acquired at %.1f s with %d keys, docked %d at %.1f s with %d keys, "
           "%d collision events\n",
           a.name, window ? "window" : "terminal", f.report.acquired_t_s,
-          f.report.key_actions_acquire, f.result.docked,
-          f.result.docked_frame / c.session.frame_rate_hz, f.key_actions,
+          f.report.key_actions_acquire, f.report.docked, f.report.docked_t_s, f.report.key_actions,
           f.result.collision_events);
       for (const auto& line : f.report.transcript) std::printf("  %s\n", line.c_str());
       ASSERT_TRUE(f.result.docked) << a.name << ": " << f.result.failure << f.report.failure;
+      ASSERT_TRUE(f.report.docked) << a.name << ": " << f.report.failure;  // this attempt
       EXPECT_LE(f.report.key_actions_acquire, window ? 30 : 50) << a.name;
       EXPECT_LE(f.result.dock_distance_ft, c.dcp.dock_distance_ft) << a.name;
-      EXPECT_EQ(f.key_actions, f.report.key_actions) << a.name;  // the station counted them too
+      if (!a.after_reset)  // the station counted them too (after a reset: both attempts')
+        EXPECT_EQ(f.key_actions, f.report.key_actions) << a.name;
     }
   }
 }

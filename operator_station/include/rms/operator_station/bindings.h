@@ -33,6 +33,7 @@ enum class ActionKind {
   kNull,        // fly hand-controller axis `index` to its guidance's 0, and stop there
   kSquareUp,    // fly the whole turn the guidance shows, in one rotation, and stop
   kUnwind,      // fly the wrist's three joints to the middle of their travel
+  kStow,        // Mode 1: fly every joint back to where the session started it
   kJointNext,   // single joint: the next joint (wrist roll wraps to shoulder yaw)
   kJointPrev,
   kQuit,    // stop the station (keyboards only)
@@ -48,7 +49,7 @@ struct Action {
 // "thc_x+", "rhc_yaw-", "finger+", "camera_pan-", "camera_3", "camera_next",
 // "camera_prev", "reset", "overlay", "crosshairs", "guidance", "stop", "mode",
 // "frame", "vernier", "null_thc_x" .. "null_rhc_yaw", "square_up", "unwind",
-// "joint_next", "joint_prev", "quit", "freeze", "step".
+// "stow", "joint_next", "joint_prev", "quit", "freeze", "step".
 // Throws rms::InputError naming the text.
 Action ParseAction(std::string_view text);
 // The inverse, for help lines and logs.

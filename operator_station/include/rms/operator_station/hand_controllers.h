@@ -39,9 +39,10 @@ namespace rms::operator_station {
 
 // What flies by itself (HandStatus::automatic; docs/operator.md "Nulling
 // an axis, squaring up, unwinding"): bit i (HandAxis) that axis flown to
-// its guidance's 0; and these two.
+// its guidance's 0; and these three.
 inline constexpr std::uint32_t kAutoSquareUp = 64;  // the whole turn, in one rotation
 inline constexpr std::uint32_t kAutoUnwind = 128;   // the wrist to the middle of its travel
+inline constexpr std::uint32_t kAutoStow = 256;     // every joint to its start (Mode 1)
 // A joint this near a limit of its travel is warned of.
 inline constexpr double kNearLimitDeg = 10.0;
 
@@ -132,8 +133,10 @@ class HandControllers {
   // The command frame flown: the payload's falls back to the end
   // effector's until a payload is held.
   CommandFrame FlownFrame() const;
-  // The unwind: the wrist's joints toward the middle of their travel.
-  void FlyUnwind(double dt_s);
+  // The unwind (the wrist's joints toward the middle of their travel) or
+  // the stow (every joint toward where the session started it): flown in
+  // the joints, all arriving together; `bit` is kAutoUnwind or kAutoStow.
+  void FlyJoints(std::uint32_t bit, double dt_s);
   // A person takes axis i (a press, a stick, a held key): what flies it by
   // itself stops.
   void TakeAxis(int i);

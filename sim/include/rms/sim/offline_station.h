@@ -80,7 +80,9 @@ class OfflineStation : public OperatorTerminal {
 
 // The scripted operator flying one design at an offline station from the
 // start, at most max_s of session time: the DCP's verdicts (result) and the
-// operator's own report (keys, transcript).
+// operator's own report (keys, transcript). With again_after_reset, once
+// docked it resets and flies a second attempt from where the arm docked;
+// the report is that attempt's (the result and key_actions the session's).
 struct ScriptedFlight {
   ClosedLoopResult result;
   FlightReport report;
@@ -89,6 +91,6 @@ struct ScriptedFlight {
 ScriptedFlight FlyScriptedSubject(const LabConfig& config,
                                   const operator_station::Bindings& bindings,
                                   const ScriptedOperatorOptions& options, double max_s,
-                                  bool window_keys = false);
+                                  bool window_keys = false, bool again_after_reset = false);
 
 }  // namespace rms::sim

@@ -45,12 +45,12 @@ struct Screen {
   double angle = 0;                // the guidance's whole turn, deg
   // What flies by itself: each axis nulled ("(to 0)"), the square-up, the unwind.
   std::array<bool, 6> nulling{};
-  bool squaring = false, unwinding = false;
+  bool squaring = false, unwinding = false, stowing = false;
   bool near_limit = false;      // "WRIST NEAR ITS LIMIT"
   double turn_clearance = 1e9;  // Mode 3: above the sill line over the turn, ft
   bool clearance_warning = false;
   bool automatic() const {
-    bool any = squaring || unwinding;
+    bool any = squaring || unwinding || stowing;
     for (bool n : nulling) any = any || n;
     return any;
   }
@@ -108,6 +108,11 @@ class ScriptedOperator {
   // the payload out of the bay and docks it. Gives up at `limit_s` of
   // session time.
   FlightReport Fly(bool acquire_only, double limit_s);
+  // After a flight that docked: presses reset (a new attempt: Mode 1, the
+  // payload back in the bay, the arm where it docked), opens the finger and
+  // flies again from there; the report is the new attempt's, those two
+  // presses counted.
+  FlightReport FlyAgainAfterReset(double limit_s);
   // What it has seen and done so far (a flight cut short keeps it).
   const FlightReport& report() const { return report_; }
 
@@ -137,11 +142,13 @@ class ScriptedOperator {
   bool WaitForFrame(const std::string& frame, double limit_s);
   // Presses `keys` (null keys, the square-up) and watches until nothing
   // flies by itself; unwinds and squares up again if the wrist nears its
-  // limit on the way. False when the limit comes first.
+  // limit on the way, and stows the arm if it comes back there after an
+  // unwind. False when the limit comes first.
   bool FlyAutomatic(const std::vector<std::string>& keys, const std::string& why, double limit_s);
   // Presses the scale key until the screen shows `scale`.
   bool SetScale(const std::string& scale, double limit_s);
   int unwinds_ = 0;
+  bool stowed_ = false;
   // A window's keys: the motion keys held now.
   std::vector<std::string> held_;
   void ReleaseHeld(const std::vector<std::string>& keys);
