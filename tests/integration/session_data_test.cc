@@ -436,7 +436,21 @@ TEST_F(HandFlownSession, ItsReportShowsEveryAttemptThePathAndTheTimeline) {
   ASSERT_GT(goal.size(), 10u);
   for (const auto& g : goal) ASSERT_GE(g.get<double>(), 0.0) << "a signed distance";
   ASSERT_EQ(d["series"]["p_ft"].size(), goal.size());
-  EXPECT_TRUE(d["series"]["inputs"].is_object()) << "by hand: the inputs are plotted";
+  // By hand the inputs are plotted as the rates commanded, each column with
+  // its unit: the terminal's coarse presses fly at the full 2 ft/s (not a
+  // deflection of -1..1), no faster.
+  const auto& inputs = d["series"]["inputs"];
+  ASSERT_TRUE(inputs.is_object()) << "by hand: the inputs are plotted";
+  ASSERT_EQ(inputs["names"].size(), inputs["units"].size());
+  ASSERT_EQ(inputs["names"].size(), 7u) << inputs["names"].dump();
+  for (int k = 0; k < 7; ++k)
+    EXPECT_EQ(inputs["units"][k], k < 3 ? "ft/s" : "deg/s") << inputs["names"][k];
+  double fastest_ft_s = 0.0;
+  for (const auto& row : inputs["values"])
+    for (int k = 0; k < 3; ++k)
+      fastest_ft_s = std::max(fastest_ft_s, std::abs(row[k].get<double>()));
+  EXPECT_GT(fastest_ft_s, 1.0) << "the presses' 2 ft/s plotted as a deflection";
+  EXPECT_LE(fastest_ft_s, 2.0 + 1e-9);
   std::set<std::string> kinds;
   for (const auto& e : d["events"]) kinds.insert(e["kind"].get<std::string>());
   for (const char* k : {"reset", "restore", "freeze", "restart"})

@@ -258,15 +258,27 @@
       { type: 'line', data: { datasets: columnLines(J, names) }, options: timeOptions('joint angle, deg') });
   }
 
+  // The hand controllers' commanded rates: x, y, z on the left axis in
+  // ft/s, roll, pitch, yaw (and the single joint's rate) on the right in
+  // deg/s, each column's unit as the data names it; a column never moved
+  // is left out.
   function inputChart() {
     const inp = S.inputs;
     const V = inp && arr(inp.values);
     const sec = section('Operator inputs', 300);
     if (!V || !V.length || !T.length) return note(sec, 'no hand-controller inputs (autopilot or timeline)');
     const names = arr(inp.names).length ? inp.names : ['x', 'y', 'z', 'roll', 'pitch', 'yaw'];
-    const o = timeOptions('hand controller, ' + (inp.unit || 'commanded rate: x, y, z ft/s; roll, pitch, yaw deg/s'));
-    Object.assign(o.scales.y, { suggestedMin: -2, suggestedMax: 2 });
-    timeChart(sec.canvas, { type: 'line', data: { datasets: columnLines(V, names) }, options: o });
+    const units = arr(inp.units);
+    const unit = (k) => units[k] || (k < 3 ? 'ft/s' : 'deg/s');
+    const moved = (k) => V.some((row) => Array.isArray(row) && num(row[k]) && row[k] !== 0);
+    const ds = columnLines(V, names.map((n, k) => n + ', ' + unit(k)))
+      .map((d, k) => Object.assign(d, { yAxisID: unit(k) === 'ft/s' ? 'y' : 'y1' }))
+      .filter((d, k) => moved(k));
+    if (!ds.length) return note(sec, 'the hand controllers commanded no motion');
+    const o = timeOptions('commanded rate, ft/s (x, y, z)');
+    o.scales.y1 = { position: 'right', grid: { drawOnChartArea: false },
+      title: titled('commanded rate, deg/s (roll, pitch, yaw, single joint)') };
+    timeChart(sec.canvas, { type: 'line', data: { datasets: ds }, options: o });
   }
 
   function goalChart() {

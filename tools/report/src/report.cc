@@ -84,7 +84,10 @@ struct TraceReader {
   std::int64_t frozen_us = 0;
   double frozen_at_s = 0;
   std::map<std::string, int> status_pid;
-  std::array<double, 6> hand{};
+  // What the hand controllers command (operator_state_t hand_rate): x, y, z
+  // ft/s, roll, pitch, yaw deg/s; in single joint the joint's rate, deg/s,
+  // is a seventh column (hand_rate[0] there), the six others 0.
+  std::array<double, 7> hand{};
 
   void Event(double t_s, const char* kind, const std::string& text, double duration_s = -1) {
     nlohmann::json e = {{"t_s", t_s}, {"kind", kind}, {"text", text}};
@@ -197,7 +200,11 @@ struct TraceReader {
   void OperatorState(const operator_state_t& m) {
     if (m.source != operator_state_t::SOURCE_BY_HAND) return;
     t.by_hand = true;
-    for (int i = 0; i < 6; ++i) hand[i] = m.hand_rate[i];
+    hand = {};
+    if (m.control_mode == operator_state_t::CONTROL_SINGLE_JOINT)
+      hand[6] = m.hand_rate[0];
+    else
+      for (int i = 0; i < 6; ++i) hand[i] = m.hand_rate[i];
   }
 };
 
@@ -810,10 +817,11 @@ std::string MakeReport(const std::string& session_dir, const std::string& chart_
       {"distance_to_goal_ft", t.goal_ft},
       {"dock_angle_deg", t.dock_angle_deg}};
   data["series"]["inputs"] =
-      t.by_hand ? nlohmann::json{{"names", {"x", "y", "z", "roll", "pitch", "yaw"}},
-                                 {"values", t.inputs},
-                                 {"unit", "commanded rate: x, y, z ft/s; roll, pitch, yaw deg/s"}}
-                : nlohmann::json(nullptr);
+      t.by_hand
+          ? nlohmann::json{{"names", {"x", "y", "z", "roll", "pitch", "yaw", "single joint"}},
+                           {"units", {"ft/s", "ft/s", "ft/s", "deg/s", "deg/s", "deg/s", "deg/s"}},
+                           {"values", t.inputs}}
+          : nlohmann::json(nullptr);
   data["geometry"] = Geometry(config);
   data["events"] = t.events;
   data["attempts"] = nlohmann::json::array();

@@ -339,10 +339,13 @@ std::vector<std::string> OperatorStateColumns() {
   std::vector<std::string> cols = {
       "log_time [us]", "session_time [s]", "frame", "send_time [us]", "source",
       "control_mode",  "command_frame",    "scale", "joint"};
-  for (const char* a : {"x", "y", "z", "roll", "pitch", "yaw"})
-    cols.push_back(std::string("hand_rate_") + a + " [1]");
-  for (const char* a : {"x", "y", "z", "roll", "pitch", "yaw"})
-    cols.push_back(std::string("achieved_rate_") + a + " [1]");
+  // x, y, z ft/s; roll, pitch, yaw deg/s (single joint: x is the joint's
+  // rate, deg/s; docs/sessions.md "CSV").
+  for (const char* kind : {"hand_rate_", "achieved_rate_"}) {
+    for (const char* a : {"x", "y", "z"}) cols.push_back(std::string(kind) + a + " [ft/s]");
+    for (const char* a : {"roll", "pitch", "yaw"})
+      cols.push_back(std::string(kind) + a + " [deg/s]");
+  }
   Add(&cols, {"automatic [bits]", "joints_near_limit [bits]"});
   Add(&cols,
       {"joint_limits [bits]", "singular", "sigma_min [ft]", "guidance_valid", "mode", "target"});
