@@ -53,6 +53,7 @@ def main():
     by = {}
     for ch, blob in events(os.path.join(sys.argv[1], "lcmlog")):
         by.setdefault(ch, []).append(blob)
+
     def channel(prefix):
         out = []
         for ch, blobs in by.items():
@@ -63,7 +64,8 @@ def main():
     for b in pick(inputs):
         put("fuzz_operator_input", b)
     if len(inputs) > 3:  # a sequence: next, stale, duplicate
-        put("fuzz_operator_input", inputs[10] + b"\xff\xfe" + inputs[11] + b"\xff\xfe" + inputs[5] + b"\xff\xfe" + inputs[11])
+        sep = b"\xff\xfe"
+        put("fuzz_operator_input", inputs[10] + sep + inputs[11] + sep + inputs[5] + sep + inputs[11])
     for b in pick(channel("RMS_DCP_FRAME")):
         put("fuzz_dcp_frame", b)
     for b in pick(channel("RMS_ESG_FRAME")):

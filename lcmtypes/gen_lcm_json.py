@@ -360,6 +360,7 @@ def load(lcm_dir):
         for m in s.members:
             if m.type_name not in PRIMITIVES and m.type_name not in types:
                 raise LcmError(f"{s.path}:{m.line}: {s.name}.{m.name}: unknown type {m.type_name}")
+
     # No type may contain itself (lcm-gen would reject it too).
     def check(name, stack):
         if name in stack:
@@ -450,7 +451,7 @@ def member_code(m):
         return [f'  j["{m.name}"] = {elem.format("m." + m.name)};']
     lines = ["  {"]
     depth = len(m.dims)
-    lines.append(f"    nlohmann::ordered_json a0 = nlohmann::ordered_json::array();")
+    lines.append("    nlohmann::ordered_json a0 = nlohmann::ordered_json::array();")
     src = f"m.{m.name}"
     indent = "    "
     for k in range(depth):

@@ -192,8 +192,8 @@ class Demo:
         if a.lesson:
             op += ["--lesson", a.lesson]
         dcp = [binary("dynamics_proc/dynamics_proc")] + common + (["--restore", a.restore] if a.restore else [])
-        esg = [binary("esg_renderer/esg_renderer")] + common + ["--width", str(a.width), "--height", str(a.height),
-                                                                 "--gl", a.gl, "--visibility", a.visibility]
+        esg = [binary("esg_renderer/esg_renderer")] + common + [
+            "--width", str(a.width), "--height", str(a.height), "--gl", a.gl, "--visibility", a.visibility]
         checks = [("operator_station", op), ("dynamics_proc", dcp),
                   ("scene_proc", [binary("scene_proc/scene_proc")] + common), ("esg_renderer", esg)]
         if a.instructor is not None:
@@ -334,9 +334,12 @@ class Demo:
         log = os.path.join(self.out, "logs", f"{name}.log")
         if h.remote:
             # Ready once this run has said so: the log keeps the earlier runs' lines.
-            ready_fn = lambda c: open(log, errors="replace").read().count("] ready: ") > c.n  # noqa: E731
+            def ready_fn(c):
+                with open(log, errors="replace") as f:
+                    return f.read().count("] ready: ") > c.n
         else:
-            ready_fn = lambda c: os.path.exists(ready)  # noqa: E731
+            def ready_fn(c):
+                return os.path.exists(ready)
             if os.path.exists(ready):
                 os.remove(ready)
         if h.remote:  # the key where that host's process reads it
@@ -353,11 +356,14 @@ class Demo:
 
     def recorder_spec(self):
         chans = f"RMS_({'|'.join(c[4:] for c in session.CHANNELS)}){self.a.channel_suffix}"
+
         def argv(n):
             return ["lcm-logger", f"--lcm-url={self.url}", "--force", "--quiet", f"--channel={chans}",
                     os.path.join(self.out, session.WIRE_LOG if n == 0 else f"{session.WIRE_LOG}.{n}")]
+
         def ready(c):
             return os.path.exists(argv(c.n)[-1])
+
         def may_restart():
             free = disk.free_bytes(self.out)
             if free < disk.stop_threshold(self.bytes_per_s):
@@ -458,8 +464,8 @@ class Demo:
         time.sleep(0.2)
         flying = {"timeline": f"the timeline {os.path.basename(self.a.timeline or '')}",
                   "autopilot": "the autopilot",
-                  "by-hand": "you, by hand " + ("(the status screen follows; Q quits)" if self.tty else
-                                               "from the live window (Q in the window quits)")}[self.pilot]
+                  "by-hand": "you, by hand " + ("(the status screen follows; Q quits)" if self.tty
+                                                else "from the live window (Q in the window quits)")}[self.pilot]
         lab_hosts = {str(h) for h in self.hosts.values()} != {"localhost"}
         where = f"the lab's hosts ({os.path.basename(self.a.lab)})" if lab_hosts else "this host"
         suffix = f" (channel suffix {self.a.channel_suffix})" if self.a.channel_suffix else ""
@@ -546,8 +552,8 @@ class Demo:
             say("interrupted: session stopped")
         else:
             say("done; summary:")
-        for l in lines:
-            say("  " + l)
+        for line in lines:
+            say("  " + line)
         for n in self.notes:
             say("note: " + n)
         own = where == os.path.join(self.out, "summary.json")

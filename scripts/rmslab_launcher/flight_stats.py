@@ -74,7 +74,8 @@ def main(argv):
     for r in rows:
         design = ", ".join(f"{k} = {r[k]}" for k in meta["keys"])
         print(f"design {r['design']} ({design}), {r['subject']}: docked {r['docked']} of {r['runs']} "
-              f"({100 * r['docked_rate']:.0f} %; 95 % CI {100 * r['docked_low']:.0f} to {100 * r['docked_high']:.0f} %)")
+              f"({100 * r['docked_rate']:.0f} %; "
+              f"95 % CI {100 * r['docked_low']:.0f} to {100 * r['docked_high']:.0f} %)")
         for key, what in FIGURES:
             if r[f"{key}_n"]:
                 print(f"    {what}: {fmt(r[f'{key}_mean'])} (95 % CI {fmt(r[f'{key}_low'])} to "

@@ -105,7 +105,8 @@ def check_hosts(url, remote_build, hosts):
                 continue
             if h.run(["ip", "route", "get", "239.255.76.67"], stdout=subprocess.DEVNULL,
                      stderr=subprocess.DEVNULL).returncode:
-                problems.append(f"host {h}: no route for multicast in the namespace (ip route add 224.0.0.0/4 dev IFACE)")
+                problems.append(f"host {h}: no route for multicast in the namespace "
+                                "(ip route add 224.0.0.0/4 dev IFACE)")
         elif h.kind == "ssh":
             if subprocess.run(SSH + [h.name, "true"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).returncode:
                 problems.append(f"host {h}: cannot reach it by ssh without a password")

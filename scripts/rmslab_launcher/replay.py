@@ -114,8 +114,8 @@ class Replay:
         time.sleep(0.2)
         player = ["lcm-logplayer", "-s", str(self.speed), "-e", f"^RMS_DCP_FRAME{self.suffix}$", "-l", a.lcm_url,
                   os.path.join(self.src, "lcmlog")]
-        self.sup.add(Spec("lcm-logplayer", Host("localhost"), player, os.path.join(self.out, "logs", "lcm-logplayer.log"),
-                          pilot=True, lifeline=False))
+        self.sup.add(Spec("lcm-logplayer", Host("localhost"), player,
+                          os.path.join(self.out, "logs", "lcm-logplayer.log"), pilot=True, lifeline=False))
         start = time.time()
         next_say = start + 2
         while not self.sup.pilot_done and self.interrupted is None and self.sup.fatal is None:
@@ -140,9 +140,9 @@ class Replay:
 
     def finish(self):
         lines, summary_path = session.summarize(self.out, os.path.basename(self.out))
-        for l in lines:
-            if l.startswith(("video:", "renderer:", "the record lost")):
-                say(l)
+        for line in lines:
+            if line.startswith(("video:", "renderer:", "the record lost")):
+                say(line)
         if self.sup.fatal:
             say(self.sup.fatal[0])
             return self.sup.fatal[1]
@@ -153,13 +153,15 @@ class Replay:
         if player.exit_code not in (0, None):
             say(f"lcm-logplayer failed: {open(player.spec.log_path, errors='replace').read().strip()}")
             return 1
-        bad = [n for n in ("esg_renderer", "scene_proc", "lcm-logger") if self.sup.children[n].exit_code not in (0, None)]
+        bad = [n for n in ("esg_renderer", "scene_proc", "lcm-logger")
+               if self.sup.children[n].exit_code not in (0, None)]
         for n in bad:
             say(f"{n} exited with {self.sup.children[n].exit_code} (see {self.sup.children[n].spec.log_path})")
         if bad:
             return 1
         say(f"replay done: {self.out} (lcmlog, frames/{'' if self.a.no_video else ', session.mp4'})")
-        r = subprocess.run([binary("tools/rms_session"), "compare-esg", self.src, self.out], capture_output=True, text=True)
+        r = subprocess.run([binary("tools/rms_session"), "compare-esg", self.src, self.out],
+                           capture_output=True, text=True)
         if r.returncode != 0 and r.stderr.strip():
             say("compare-esg: " + r.stderr.strip())
         with open(os.path.join(self.out, "replay_comparison.json"), "w") as f:

@@ -14,8 +14,8 @@ import time
 from . import disk
 from .common import LabError, binary, say
 
-CHANNELS = ["RMS_OPERATOR_INPUT", "RMS_OPERATOR_STATE", "RMS_WINDOW_KEYS", "RMS_DCP_FRAME", "RMS_DCP_TELEMETRY", "RMS_DCP_STATE",
-            "RMS_ESG_FRAME", "RMS_STATUS", "RMS_CONTROL", "RMS_CONTROL_ANSWER"]
+CHANNELS = ["RMS_OPERATOR_INPUT", "RMS_OPERATOR_STATE", "RMS_WINDOW_KEYS", "RMS_DCP_FRAME", "RMS_DCP_TELEMETRY",
+            "RMS_DCP_STATE", "RMS_ESG_FRAME", "RMS_STATUS", "RMS_CONTROL", "RMS_CONTROL_ANSWER"]
 
 
 def new_session_id():
@@ -103,7 +103,7 @@ def precheck(checks):
                 # "[time] [process] [level] message" -> "message"
                 parts = line.split("] ", 3)
                 lines.append(parts[-1] if len(parts) == 4 and line.startswith("[") else line)
-            raise LabError(f"{name} refuses to start:\n" + "\n".join("  " + l for l in lines if l.strip()))
+            raise LabError(f"{name} refuses to start:\n" + "\n".join("  " + line for line in lines if line.strip()))
 
 
 def probe_network(host, url, suffix, share):
@@ -332,8 +332,8 @@ def resimulate(out):
 def verdict_of(lines, resimulates):
     """The brief's "re-simulates:" line taken out of `lines` (said last), or
     one saying why there is none."""
-    said = [l for l in lines if l.startswith("re-simulates:")]
-    rest = [l for l in lines if not l.startswith("re-simulates:")]
+    said = [line for line in lines if line.startswith("re-simulates:")]
+    rest = [line for line in lines if not line.startswith("re-simulates:")]
     if said:
         return rest, said[-1]
     if resimulates is None:

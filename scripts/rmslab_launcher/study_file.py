@@ -330,7 +330,7 @@ def _read_text(path):
 
 
 def _tool_error(r):
-    lines = [l for l in (r.stderr or r.stdout).strip().splitlines() if l.strip()]
+    lines = [line for line in (r.stderr or r.stdout).strip().splitlines() if line.strip()]
     text = lines[-1] if lines else f"refused (exit code {r.returncode})"
     text = re.sub(r"^\[[^\]]*\] \[[a-z_]+\] \[[a-z]+\] ", "", text)  # a process's log prefix
     return re.sub(r"^(rms_session|operator_station): ", "", text)

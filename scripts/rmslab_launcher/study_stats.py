@@ -136,9 +136,9 @@ def page(stats, df, conditions, title):
     for c in conditions:
         s = stats["conditions"][c]
         r = s["docked_rate"]
-        cells = [e(c), str(s["trials"]),
-                 "-" if r["p"] is None else f"{s['docked']} of {s['trials']} ({100 * r['p']:.0f} %; "
-                                             f"{100 * r['low']:.0f} to {100 * r['high']:.0f} %)"]
+        share = "-" if r["p"] is None else (
+            f"{s['docked']} of {s['trials']} ({100 * r['p']:.0f} %; {100 * r['low']:.0f} to {100 * r['high']:.0f} %)")
+        cells = [e(c), str(s["trials"]), share]
         for col, _, unit, _ in METRICS:
             m = s[col]
             cells.append("-" if m["mean"] is None else fmt(m["mean"], unit) + (

@@ -53,7 +53,7 @@ def log_tail(path, lines=12):
     except OSError:
         return []
     # The log's error lines first, else its last lines.
-    errors = [l for l in text if "[error]" in l or "rror" in l.split("]")[-1][:60]]
+    errors = [line for line in text if "[error]" in line or "rror" in line.split("]")[-1][:60]]
     return (errors or text)[-lines:]
 
 
@@ -209,13 +209,13 @@ class Supervisor:
             time.sleep(0.05)
         lines = [f"{', '.join(pending)} not ready within {timeout_s:.0f} s; the log{'s' if len(pending) > 1 else ''}:"]
         for n in pending:
-            lines += [f"  {n}: {l}" for l in log_tail(self.children[n].spec.log_path, 6)]
+            lines += [f"  {n}: {line}" for line in log_tail(self.children[n].spec.log_path, 6)]
         return "\n".join(lines)
 
     def _exited_at_start(self, c, rc):
         what = "with a usage or configuration error" if rc == 2 else f"with code {rc}"
         lines = [f"{c.spec.name} exited at start {what}; its log ({c.spec.log_path}):"]
-        lines += ["  " + l for l in log_tail(c.spec.log_path)]
+        lines += ["  " + line for line in log_tail(c.spec.log_path)]
         return "\n".join(lines)
 
     def _became_ready(self, c):
@@ -248,7 +248,7 @@ class Supervisor:
             pass
         try:
             with open(c.spec.log_path, errors="replace") as f:
-                said = [l for l in f if "] cpu wake latency: " in l]
+                said = [line for line in f if "] cpu wake latency: " in line]
         except OSError:
             return None
         if not said:
@@ -305,7 +305,8 @@ class Supervisor:
         if rc == 2 or not c.spec.restart or rc == 0:
             c.exit_code = rc
             why = "a usage or configuration error" if rc == 2 else f"code {rc}"
-            msg = f"{name} ended mid-session ({why}); its log:\n" + "\n".join("  " + l for l in log_tail(c.spec.log_path))
+            tail = "\n".join("  " + line for line in log_tail(c.spec.log_path))
+            msg = f"{name} ended mid-session ({why}); its log:\n" + tail
             self.fatal = (msg, 2 if rc == 2 else 1)
             return
         c.restart_times = [t for t in c.restart_times if now - t < RESTART_WINDOW_S] + [now]
@@ -313,7 +314,7 @@ class Supervisor:
             c.exit_code = rc
             self.fatal = (f"{name} keeps failing ({MAX_RESTARTS} restarts within {RESTART_WINDOW_S:.0f} s, the last "
                           f"with code {rc}): stopping the session; its log:\n" +
-                          "\n".join("  " + l for l in log_tail(c.spec.log_path)), 1)
+                          "\n".join("  " + line for line in log_tail(c.spec.log_path)), 1)
             return
         c.n += 1
         c.last_rc = rc if rc >= 0 else 128 - rc

@@ -713,7 +713,8 @@ def write_slurm(sweep_dir, cells, cache_dir, rerun, cell_args=""):
 #SBATCH --cpus-per-task=1
 #SBATCH --output={os.path.join(sweep_dir, 'slurm-%A_%a.out')}
 export RMSLAB_BUILD={shlex.quote(BUILD)}
-exec {shlex.quote(CELL)} {cell_args + " " if cell_args else ""}{shlex.quote(manifest)} "$SLURM_ARRAY_TASK_ID" --store {shlex.quote(cache_dir)}
+exec {shlex.quote(CELL)} {cell_args + " " if cell_args else ""}{shlex.quote(manifest)} \\
+  "$SLURM_ARRAY_TASK_ID" --store {shlex.quote(cache_dir)}
 """)
     os.chmod(script, 0o755)
     return script

@@ -26,6 +26,7 @@ def _checksum(res):
     """The SHA-256 of a result's canonical JSON."""
     return hashlib.sha256(json.dumps(res, sort_keys=True, separators=(",", ":")).encode()).hexdigest()
 
+
 class CannotWrite(LabError):
     """An entry could not be written (a full disk, a folder taken away)."""
 
@@ -35,6 +36,7 @@ class CannotWrite(LabError):
 # lab's users is readable by them.
 _UMASK = os.umask(0)
 os.umask(_UMASK)
+
 
 def _number(x):
     return (isinstance(x, (int, float)) and not isinstance(x, bool)) or x is None

@@ -145,7 +145,8 @@ def check_design(a, design):
         cmd += ["--set", f"{k}={v}"]
     r = subprocess.run(cmd, capture_output=True, text=True)
     if r.returncode != 0:
-        lines = [l for l in r.stderr.strip().splitlines() if l.strip() and not l.startswith("Run with --help")]
+        lines = [line for line in r.stderr.strip().splitlines()
+                 if line.strip() and not line.startswith("Run with --help")]
         why = (lines[-1] if lines else f"exit code {r.returncode}").removeprefix("rms_fly: ")
         about = [k for k in design if k in why]
         raise LabError(f"design {', '.join(f'{k}={v}' for k, v in design.items())}: {why}" if about else why)
@@ -270,9 +271,23 @@ def write_tables(a, out, ds, rows, jobs, wall, missing):
                    "subjects": a.subject_list, "reaction_s": a.reaction_s, "rate_gain": a.rate_gain,
                    "tremor_deg": a.tremor_deg, "reaction_sd_s": a.reaction_sd_s, "max_s": a.max_s,
                    "runs_per_cell": a.runs_per_cell, "keys": keys, "designs": ds, "wall_s": wall, "jobs": jobs,
-                   "hosts": a.hosts, "missing_cells": [{k: c[k] for k in ("index", "design", "subject", "first",
-                                                                           "runs", "error") if k in c}
-                                                       for c in missing]}, f, indent=1)
+                   "hosts": a.hosts,
+                   "missing_cells": [{k: c[k] for k in ("index", "design", "subject", "first", "runs", "error")
+                                      if k in c} for c in missing]}, f, indent=1)
+
+
+def cached_results(a, cells, cache):
+    """Each cell's result from the cache (None where it has none, or one not
+    its cell's: said), and the cells still to fly."""
+    results = {c["index"]: cache.load(c["key"]) for c in cells}
+    for c in cells:  # an entry is checked against the cell it stands for
+        why = results[c["index"]] is not None and cell_result_why(c, results[c["index"]])
+        if why:
+            cache.unreadable.append((cache.path(c["key"]), f"not its cell's ({why})"))
+            results[c["index"]] = None
+    for path, why in cache.unreadable:
+        say(f"cache entry {path}: {why}: " + ("not used" if a.cached_only else "its cell is flown again"))
+    return results, [c for c in cells if results[c["index"]] is None]
 
 
 def run(argv):
@@ -282,8 +297,8 @@ def run(argv):
         install_and_build()
     require_built("tools/rms_fly")
     ds = designs(a.grid)
-    out = os.path.abspath(a.out or os.path.join(ROOT, "sessions",
-                                                 "sweep-closed-" + time.strftime("%Y%m%dT%H%M%SZ", time.gmtime())))
+    stamp = time.strftime("%Y%m%dT%H%M%SZ", time.gmtime())
+    out = os.path.abspath(a.out or os.path.join(ROOT, "sessions", "sweep-closed-" + stamp))
     cells = make_cells(a, ds, software_id())
     check_out(a, out, cells)
     sweep.timeout_override()
@@ -301,15 +316,7 @@ def run(argv):
     if not a.cached_only:
         sweep.write_manifest(os.path.join(out, "cells.tsv"), cells)
         write_tables(a, out, ds, [], jobs, 0.0, [])  # what the sweep is, before anything is flown
-    results = {c["index"]: cache.load(c["key"]) for c in cells}
-    for c in cells:  # an entry is checked against the cell it stands for
-        why = results[c["index"]] is not None and cell_result_why(c, results[c["index"]])
-        if why:
-            cache.unreadable.append((cache.path(c["key"]), f"not its cell's ({why})"))
-            results[c["index"]] = None
-    for path, why in cache.unreadable:
-        say(f"cache entry {path}: {why}: " + ("not used" if a.cached_only else "its cell is flown again"))
-    todo = [c for c in cells if results[c["index"]] is None]
+    results, todo = cached_results(a, cells, cache)
     cached = len(cells) - len(todo)
     where = (f"on the hosts of {a.hosts}" if a.hosts else "as a Slurm array job" if a.slurm else
              "from the cache" if a.cached_only else f"{jobs} at once")

@@ -174,7 +174,8 @@ if (typeof Chart !== 'undefined') plots.forEach((p, i) => {
       {label: 'docked at (s; mean of the cells that docked)', data: p.points.map(q => q.docked_at), yAxisID: 'time',
        borderDash: [4, 4]}]},
     options: {animation: false, plugins: {title: {display: true, text: p.key}},
-      scales: {share: {type: 'linear', min: 0, max: 1, position: 'left', title: {display: true, text: 'share of cells'}},
+      scales: {share: {type: 'linear', min: 0, max: 1, position: 'left',
+                       title: {display: true, text: 'share of cells'}},
                time: {type: 'linear', position: 'right', title: {display: true, text: 's'}},
                x: {title: {display: true, text: p.key}}}}
   });

@@ -29,7 +29,7 @@ TOOLS = [
     "ps", "pkill", "timeout", "jq", "python3", "flock", "parallel",  # parallel: scripts/lab sweep
     "bash", "sudo",  # scripts/lab (python3 installed first where missing), root where the user is not
     "debootstrap", "chroot",  # scripts/fresh-bookworm
-    "clang-format", "clang-tidy", "run-clang-tidy",  # scripts/lint
+    "clang-format", "clang-tidy", "run-clang-tidy", "pycodestyle", "pytest-3",  # scripts/lint
 ]
 
 

@@ -37,7 +37,7 @@ def diagram_links(doc):
     links its parent (the node it hangs from, or the left of '──'), and
     what '(+ ...)' names; 'X = a + b (+ c, privately)' links a, b and c."""
     block = doc[doc.index("## Libraries"):]
-    lines = [l for l in block.split("\n\n")[2].splitlines() if l.startswith("    ")]
+    lines = [line for line in block.split("\n\n")[2].splitlines() if line.startswith("    ")]
     links, stack = {}, []  # stack: (column, name)
 
     def add(item, parent):
