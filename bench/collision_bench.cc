@@ -294,69 +294,78 @@ std::pair<Agreement, Agreement> MeasureAgreement(long agreement_pairs, std::uint
   return {boxes, general};
 }
 
-// Every method on the same 4096 pairs of each set, cycled.
-void RegisterTimings(const Sets& sets) {
-  using rms::dynamics_proc::Collide;
-  auto cycle = [](benchmark::State& st, auto&& f) {
-    std::size_t i = 0;
-    for (auto _ : st) benchmark::DoNotOptimize(f(i++ & 4095));
-  };
+// A method timed on 4096 pairs, cycled: f(i) for i = 0..4095, again and again.
+template <class F>
+void Cycle(benchmark::State& st, F&& f) {
+  std::size_t i = 0;
+  for (auto _ : st) benchmark::DoNotOptimize(f(i++ & 4095));
+}
+
+// The DCP's Collide on a set's pairs with these options.
+template <class Pairs>
+void RegisterDcp(const char* name, const Pairs& pairs, rms::dynamics_proc::CollideOptions o) {
+  benchmark::RegisterBenchmark(name, [&pairs, o](benchmark::State& st) {
+    Cycle(st, [&](std::size_t i) {
+      return rms::dynamics_proc::Collide(pairs[i].first, pairs[i].second, o).verdict;
+    });
+  });
+}
+
+// Boxes: the DCP with and without its rejections, and every peer.
+void RegisterBoxTimings(const Sets& sets) {
   const rms::dynamics_proc::CollideOptions verdict_only = VerdictOnly();
   rms::dynamics_proc::CollideOptions report_only = verdict_only;
   report_only.sphere_reject = false;
   report_only.aabb_reject = false;
   rms::dynamics_proc::CollideOptions spheres_only = verdict_only;
   spheres_only.aabb_reject = false;
-  auto dcp = [&](const char* name, const auto& pairs, rms::dynamics_proc::CollideOptions o) {
-    benchmark::RegisterBenchmark(name, [&pairs, o, cycle](benchmark::State& st) {
-      cycle(st, [&](std::size_t i) { return Collide(pairs[i].first, pairs[i].second, o).verdict; });
+  RegisterDcp("boxes/DCP, verdict", sets.hex_boxes, verdict_only);
+  RegisterDcp("boxes/DCP, verdict, no bounding-volume rejection", sets.hex_boxes, report_only);
+  RegisterDcp("boxes/DCP, verdict, spheres but no box rejection", sets.hex_boxes, spheres_only);
+  RegisterDcp("boxes/DCP, verdict and separating plane", sets.hex_boxes, {});
+  benchmark::RegisterBenchmark("boxes/separating axes, 15 (double)", [&sets](benchmark::State& st) {
+    Cycle(st, [&](std::size_t i) {
+      return rms::bench::SatBoxesIntersect(sets.boxes[i].first, sets.boxes[i].second);
     });
-  };
-  // Boxes.
-  dcp("boxes/DCP, verdict", sets.hex_boxes, verdict_only);
-  dcp("boxes/DCP, verdict, no bounding-volume rejection", sets.hex_boxes, report_only);
-  dcp("boxes/DCP, verdict, spheres but no box rejection", sets.hex_boxes, spheres_only);
-  dcp("boxes/DCP, verdict and separating plane", sets.hex_boxes, {});
-  benchmark::RegisterBenchmark(
-      "boxes/separating axes, 15 (double)", [&sets, cycle](benchmark::State& st) {
-        cycle(st, [&](std::size_t i) {
-          return rms::bench::SatBoxesIntersect(sets.boxes[i].first, sets.boxes[i].second);
-        });
-      });
-  benchmark::RegisterBenchmark("boxes/ODE dBoxTouchesBox", [&sets, cycle](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) {
+  });
+  benchmark::RegisterBenchmark("boxes/ODE dBoxTouchesBox", [&sets](benchmark::State& st) {
+    Cycle(st, [&](std::size_t i) {
       return rms::bench::OdeBoxesTouch(sets.boxes[i].first, sets.boxes[i].second);
     });
   });
   benchmark::RegisterBenchmark(
-      "boxes/FCL collide() on boxes (computes a contact)", [&sets, cycle](benchmark::State& st) {
-        cycle(st, [&](std::size_t i) { return sets.fcl_boxes[i]->Collide(); });
+      "boxes/FCL collide() on boxes (computes a contact)", [&sets](benchmark::State& st) {
+        Cycle(st, [&](std::size_t i) { return sets.fcl_boxes[i]->Collide(); });
       });
-  benchmark::RegisterBenchmark("boxes/libccd MPR", [&sets, cycle](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) {
+  benchmark::RegisterBenchmark("boxes/libccd MPR", [&sets](benchmark::State& st) {
+    Cycle(st, [&](std::size_t i) {
       return rms::bench::CcdMprBoxes(sets.boxes[i].first, sets.boxes[i].second);
     });
   });
-  benchmark::RegisterBenchmark("boxes/exact (CGAL)", [&sets, cycle](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) {
+  benchmark::RegisterBenchmark("boxes/exact (CGAL)", [&sets](benchmark::State& st) {
+    Cycle(st, [&](std::size_t i) {
       return rms::reference::ExactHullsIntersect(sets.hulls_boxes[i].first,
                                                  sets.hulls_boxes[i].second);
     });
   });
-  // Dense pairs: bounding spheres overlapping, half colliding.
-  dcp("dense boxes/DCP, verdict", sets.hex_dense_boxes, verdict_only);
-  dcp("dense boxes/DCP, verdict and separating plane", sets.hex_dense_boxes, {});
+}
+
+// Dense pairs: bounding spheres overlapping, half colliding; the widest
+// edge axis; the mission's own pairs.
+void RegisterDenseTimings(const Sets& sets) {
+  const rms::dynamics_proc::CollideOptions verdict_only = VerdictOnly();
+  RegisterDcp("dense boxes/DCP, verdict", sets.hex_dense_boxes, verdict_only);
+  RegisterDcp("dense boxes/DCP, verdict and separating plane", sets.hex_dense_boxes, {});
   benchmark::RegisterBenchmark("dense boxes/separating axes, 15 (double)",
-                               [&sets, cycle](benchmark::State& st) {
-                                 cycle(st, [&](std::size_t i) {
+                               [&sets](benchmark::State& st) {
+                                 Cycle(st, [&](std::size_t i) {
                                    return rms::bench::SatBoxesIntersect(sets.dense_boxes[i].first,
                                                                         sets.dense_boxes[i].second);
                                  });
                                });
   benchmark::RegisterBenchmark(
-      "dense boxes/FCL collide() on boxes (computes a contact)",
-      [&sets, cycle](benchmark::State& st) {
-        cycle(st, [&](std::size_t i) { return sets.fcl_dense_boxes[i]->Collide(); });
+      "dense boxes/FCL collide() on boxes (computes a contact)", [&sets](benchmark::State& st) {
+        Cycle(st, [&](std::size_t i) { return sets.fcl_dense_boxes[i]->Collide(); });
       });
   // Step 4's last resort on the dense box pairs no face separates and no
   // edge pierces: the widest edge axis, skipping axes and all 144 (their
@@ -375,53 +384,63 @@ void RegisterTimings(const Sets& sets) {
           }
         });
   }
-  dcp("dense general/DCP, verdict", sets.hex_dense_general, verdict_only);
-  dcp("dense general/DCP, verdict and separating plane", sets.hex_dense_general, {});
+  RegisterDcp("dense general/DCP, verdict", sets.hex_dense_general, verdict_only);
+  RegisterDcp("dense general/DCP, verdict and separating plane", sets.hex_dense_general, {});
   benchmark::RegisterBenchmark(
-      "dense general/FCL collide() on convex (GJK/EPA)", [&sets, cycle](benchmark::State& st) {
-        cycle(st, [&](std::size_t i) { return sets.fcl_dense_general[i]->Collide(); });
+      "dense general/FCL collide() on convex (GJK/EPA)", [&sets](benchmark::State& st) {
+        Cycle(st, [&](std::size_t i) { return sets.fcl_dense_general[i]->Collide(); });
       });
   // The mission's Mode 1 pairs.
   if (sets.hex_mission_boxes.size() == 4096 && sets.hex_mission_general.size() == 4096) {
-    dcp("mission boxes/DCP, verdict", sets.hex_mission_boxes, verdict_only);
-    dcp("mission boxes/DCP, verdict and separating plane", sets.hex_mission_boxes, {});
+    RegisterDcp("mission boxes/DCP, verdict", sets.hex_mission_boxes, verdict_only);
+    RegisterDcp("mission boxes/DCP, verdict and separating plane", sets.hex_mission_boxes, {});
     benchmark::RegisterBenchmark("mission boxes/separating axes, 15 (double)",
-                                 [&sets, cycle](benchmark::State& st) {
-                                   cycle(st, [&](std::size_t i) {
+                                 [&sets](benchmark::State& st) {
+                                   Cycle(st, [&](std::size_t i) {
                                      return rms::bench::SatBoxesIntersect(
                                          sets.mission_boxes[i].first, sets.mission_boxes[i].second);
                                    });
                                  });
     benchmark::RegisterBenchmark(
-        "mission boxes/FCL collide() on boxes (computes a contact)",
-        [&sets, cycle](benchmark::State& st) {
-          cycle(st, [&](std::size_t i) { return sets.fcl_mission_boxes[i]->Collide(); });
+        "mission boxes/FCL collide() on boxes (computes a contact)", [&sets](benchmark::State& st) {
+          Cycle(st, [&](std::size_t i) { return sets.fcl_mission_boxes[i]->Collide(); });
         });
-    dcp("mission general/DCP, verdict", sets.hex_mission_general, verdict_only);
-    dcp("mission general/DCP, verdict and separating plane", sets.hex_mission_general, {});
+    RegisterDcp("mission general/DCP, verdict", sets.hex_mission_general, verdict_only);
+    RegisterDcp("mission general/DCP, verdict and separating plane", sets.hex_mission_general, {});
     benchmark::RegisterBenchmark(
-        "mission general/FCL collide() on convex (GJK/EPA)", [&sets, cycle](benchmark::State& st) {
-          cycle(st, [&](std::size_t i) { return sets.fcl_mission_general[i]->Collide(); });
+        "mission general/FCL collide() on convex (GJK/EPA)", [&sets](benchmark::State& st) {
+          Cycle(st, [&](std::size_t i) { return sets.fcl_mission_general[i]->Collide(); });
         });
   }
-  // General hexahedra.
-  dcp("general/DCP, verdict", sets.hex_general, verdict_only);
-  dcp("general/DCP, verdict and separating plane", sets.hex_general, {});
-  benchmark::RegisterBenchmark("general/libccd MPR", [&sets, cycle](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) {
+}
+
+// General hexahedra.
+void RegisterGeneralTimings(const Sets& sets) {
+  const rms::dynamics_proc::CollideOptions verdict_only = VerdictOnly();
+  RegisterDcp("general/DCP, verdict", sets.hex_general, verdict_only);
+  RegisterDcp("general/DCP, verdict and separating plane", sets.hex_general, {});
+  benchmark::RegisterBenchmark("general/libccd MPR", [&sets](benchmark::State& st) {
+    Cycle(st, [&](std::size_t i) {
       return rms::bench::CcdMprHulls(sets.hulls_general[i].first, sets.hulls_general[i].second);
     });
   });
   benchmark::RegisterBenchmark(
-      "general/FCL collide() on convex (GJK/EPA)", [&sets, cycle](benchmark::State& st) {
-        cycle(st, [&](std::size_t i) { return sets.fcl_general[i]->Collide(); });
+      "general/FCL collide() on convex (GJK/EPA)", [&sets](benchmark::State& st) {
+        Cycle(st, [&](std::size_t i) { return sets.fcl_general[i]->Collide(); });
       });
-  benchmark::RegisterBenchmark("general/exact (CGAL)", [&sets, cycle](benchmark::State& st) {
-    cycle(st, [&](std::size_t i) {
+  benchmark::RegisterBenchmark("general/exact (CGAL)", [&sets](benchmark::State& st) {
+    Cycle(st, [&](std::size_t i) {
       return rms::reference::ExactHullsIntersect(sets.hulls_general[i].first,
                                                  sets.hulls_general[i].second);
     });
   });
+}
+
+// Every method on the same 4096 pairs of each set, cycled.
+void RegisterTimings(const Sets& sets) {
+  RegisterBoxTimings(sets);
+  RegisterDenseTimings(sets);
+  RegisterGeneralTimings(sets);
 }
 
 // A set's rows (names under `prefix`), each against the set's DCP verdict

@@ -205,6 +205,91 @@ class Peer {
   std::int64_t sequence_ = 0;
 };
 
+// What each process counted of the attack of
+// ForgedControlTelemetryStatusAndFramesChangeNothingAndAreReported: `files`
+// the checkpoints folder's regular files after it.
+void ExpectEveryProcessCountedWhatItRefused(const std::string& out, std::size_t files) {
+  EXPECT_GE(Counter(out, "dynamics_proc", "control.rate_limited"), 250);
+  EXPECT_GE(Counter(out, "dynamics_proc", "control.refused"),
+            5);  // the paths, the link, the file, the device
+  EXPECT_GE(Counter(out, "operator_station", "control.refused"), 3);
+  EXPECT_GE(Counter(out, "dynamics_proc", "dropped.other_session"), 2);
+  EXPECT_GE(Counter(out, "dynamics_proc", "dropped.far_ahead"), 1);
+  // The outsider's: every one counted and dropped, by the process it was for.
+  EXPECT_GE(Counter(out, "dynamics_proc", "dropped.bad_mac"), 2 * 5 + 1);
+  EXPECT_GE(Counter(out, "operator_station", "dropped.bad_mac"), 2 * 5 + 2 * 30);
+  EXPECT_EQ(Counter(out, "dynamics_proc", "control.malfunctions"), 0);
+  EXPECT_EQ(Counter(out, "operator_station", "control.freezes"), 0) << "a forged FREEZE was taken";
+  // The telemetry from a pid not the DCP's, while the DCP sends: an impostor.
+  EXPECT_GE(Counter(out, "operator_station", "dropped.other_sender"), 85);
+  EXPECT_EQ(Counter(out, "dynamics_proc", "control.checkpoints"), static_cast<long>(files) - 1);
+}
+
+struct SessionPids {
+  int op = 0, dcp = 0, scene = 0;
+};
+
+// The summary after that attack: the real flight, and what it left out.
+void ExpectTheSummaryTellsTheRealFlight(const std::string& out, std::int64_t id,
+                                        std::int64_t stranger_id, SessionPids pids) {
+  const nlohmann::json sum = ReadJson(out + "/summary.json");
+  ASSERT_TRUE(sum.contains("docked")) << out;
+  std::printf("ignored: %s\ndocking: %s\n", sum["ignored"].dump().c_str(),
+              sum["docking"].dump().c_str());
+  EXPECT_TRUE(sum["docked"].get<bool>());
+  EXPECT_GT(sum["docking"]["distance_ft"].get<double>(), 0.05)
+      << "the forged docking distance was believed";
+  EXPECT_FALSE(sum["docking"]["after_restore"].get<bool>()) << "every restore was refused";
+  EXPECT_EQ(sum["mode_changes"].size(), 2u) << sum["mode_changes"].dump();
+  EXPECT_GE(Reason(sum, "other_session"), 90 + 1);
+  EXPECT_GE(Reason(sum, "not_the_sessions_process"), 90 + 1);
+  EXPECT_GE(Reason(sum, "telemetry_contradicts_its_dcp_frame") + Reason(sum, "repeated_frame"), 90);
+  EXPECT_GE(Reason(sum, "implausible_status"), 1);
+  EXPECT_GE(Reason(sum, "bad_mac"), 2 * 5 + 1 + 2 * 30);
+  EXPECT_TRUE(sum["ignored"]["macs_checked"].get<bool>());
+  // No outsider's command is in the summary's list of those sent.
+  for (const auto& c : sum["control"]) {
+    EXPECT_NE(c.value("name", ""), "joint 2 stuck") << sum["control"].dump();
+    EXPECT_NE(c.value("name", ""), "outsider.json") << sum["control"].dump();
+  }
+  EXPECT_GE(Reason(sum, "disputed_dcp_frame"), 25);
+  EXPECT_GE(Reason(sum, "dcp_frame_out_of_sequence"), 3);
+  // The record's losses are the recorder's own, neither made up nor hidden
+  // by the forgeries: each channel's loss is its publisher's count less the
+  // distinct frames the log holds from the real process (a loaded machine's
+  // recorder may lose a few; each is reported).
+  const int op_pid = pids.op, dcp_pid = pids.dcp, scene_pid = pids.scene;
+  const std::pair<const char*, int> publishers[] = {{wire::channels::kOperatorInput, op_pid},
+                                                    {wire::channels::kDcpFrame, dcp_pid},
+                                                    {wire::channels::kDcpTelemetry, dcp_pid},
+                                                    {wire::channels::kEsgFrame, scene_pid}};
+  const auto genuine = GenuineFramesLogged(out + "/lcmlog", id, publishers);
+  for (const auto& [ch, r] : sum["record"]["by_channel"].items()) {
+    ASSERT_TRUE(genuine.count(ch)) << ch;
+    const long expected = std::max<long>(0, r["published"].get<long>() - genuine.at(ch));
+    EXPECT_EQ(r["lost"].get<long>(), expected) << ch << ": " << r.dump();
+  }
+  bool listed = false;
+  for (const auto& o : sum["ignored"]["other_sessions"])
+    listed |= o.get<std::string>() == wire::FormatSessionId(stranger_id);
+  EXPECT_TRUE(listed) << "the stranger's session is not listed";
+  const auto& fr = sum["frames"];
+  EXPECT_GE(fr["rendered"].get<long>(), 0);
+  EXPECT_LE(fr["rendered"].get<long>(), fr["esg_published"].get<long>());
+  EXPECT_LT(fr["dcp_published"].get<long>(), 100000);
+  EXPECT_GE(fr["refused"]["far_ahead"].get<long>(), 1);
+  EXPECT_GE(fr["refused"]["other_sender"].get<long>(), 85);
+  // Forged telemetry and frames in the record do not stop it re-simulating:
+  // the re-simulation takes, as the summary believes, the DCP's own
+  // (docs/sessions.md "Re-simulation"), and the record lost nothing.
+  EXPECT_EQ(sum["record"]["lost"], 0) << sum["record"].dump();
+  EXPECT_GE(Counter(out, "scene_proc", "resyncs"), 1) << "scene_proc never followed back";
+  const auto esg_messages = GenuineMessagesLogged(out + "/lcmlog", id, scene_pid);
+  EXPECT_GT(esg_messages, genuine.at(wire::channels::kEsgFrame))
+      << "no ESG frame number was sent twice: the case the record counts once is not tried";
+  EXPECT_EQ(sum["resimulation"]["verdict"], "identical") << sum["resimulation"].dump();
+}
+
 // Control commands reach for the filesystem, forged telemetry and status
 // try to rewrite the summary, and an input from the far future tries to
 // lock the DCP, all while the autopilot flies: the session docks, nothing
@@ -392,78 +477,8 @@ TEST(SessionSecurity, ForgedControlTelemetryStatusAndFramesChangeNothingAndAreRe
   std::printf("checkpoints folder: %zu files after 300 requests in a flood\n", files);
   EXPECT_LE(files, 2u + 8u);
   const std::string out = s.out();
-  EXPECT_GE(Counter(out, "dynamics_proc", "control.rate_limited"), 250);
-  EXPECT_GE(Counter(out, "dynamics_proc", "control.refused"),
-            5);  // the paths, the link, the file, the device
-  EXPECT_GE(Counter(out, "operator_station", "control.refused"), 3);
-  EXPECT_GE(Counter(out, "dynamics_proc", "dropped.other_session"), 2);
-  EXPECT_GE(Counter(out, "dynamics_proc", "dropped.far_ahead"), 1);
-  // The outsider's: every one counted and dropped, by the process it was for.
-  EXPECT_GE(Counter(out, "dynamics_proc", "dropped.bad_mac"), 2 * 5 + 1);
-  EXPECT_GE(Counter(out, "operator_station", "dropped.bad_mac"), 2 * 5 + 2 * 30);
-  EXPECT_EQ(Counter(out, "dynamics_proc", "control.malfunctions"), 0);
-  EXPECT_EQ(Counter(out, "operator_station", "control.freezes"), 0) << "a forged FREEZE was taken";
-  // The telemetry from a pid not the DCP's, while the DCP sends: an impostor.
-  EXPECT_GE(Counter(out, "operator_station", "dropped.other_sender"), 85);
-  EXPECT_EQ(Counter(out, "dynamics_proc", "control.checkpoints"), static_cast<long>(files) - 1);
-
-  // The summary: the real flight, and what it left out.
-  const nlohmann::json sum = ReadJson(out + "/summary.json");
-  ASSERT_TRUE(sum.contains("docked")) << ReadFile(s.log());
-  std::printf("ignored: %s\ndocking: %s\n", sum["ignored"].dump().c_str(),
-              sum["docking"].dump().c_str());
-  EXPECT_TRUE(sum["docked"].get<bool>());
-  EXPECT_GT(sum["docking"]["distance_ft"].get<double>(), 0.05)
-      << "the forged docking distance was believed";
-  EXPECT_FALSE(sum["docking"]["after_restore"].get<bool>()) << "every restore was refused";
-  EXPECT_EQ(sum["mode_changes"].size(), 2u) << sum["mode_changes"].dump();
-  EXPECT_GE(Reason(sum, "other_session"), 90 + 1);
-  EXPECT_GE(Reason(sum, "not_the_sessions_process"), 90 + 1);
-  EXPECT_GE(Reason(sum, "telemetry_contradicts_its_dcp_frame") + Reason(sum, "repeated_frame"), 90);
-  EXPECT_GE(Reason(sum, "implausible_status"), 1);
-  EXPECT_GE(Reason(sum, "bad_mac"), 2 * 5 + 1 + 2 * 30);
-  EXPECT_TRUE(sum["ignored"]["macs_checked"].get<bool>());
-  // No outsider's command is in the summary's list of those sent.
-  for (const auto& c : sum["control"]) {
-    EXPECT_NE(c.value("name", ""), "joint 2 stuck") << sum["control"].dump();
-    EXPECT_NE(c.value("name", ""), "outsider.json") << sum["control"].dump();
-  }
-  EXPECT_GE(Reason(sum, "disputed_dcp_frame"), 25);
-  EXPECT_GE(Reason(sum, "dcp_frame_out_of_sequence"), 3);
-  // The record's losses are the recorder's own, neither made up nor hidden
-  // by the forgeries: each channel's loss is its publisher's count less the
-  // distinct frames the log holds from the real process (a loaded machine's
-  // recorder may lose a few; each is reported).
-  const int scene_pid = s.pid("scene_proc");
-  const std::pair<const char*, int> publishers[] = {{wire::channels::kOperatorInput, op_pid},
-                                                    {wire::channels::kDcpFrame, dcp_pid},
-                                                    {wire::channels::kDcpTelemetry, dcp_pid},
-                                                    {wire::channels::kEsgFrame, scene_pid}};
-  const auto genuine = GenuineFramesLogged(s.out() + "/lcmlog", id, publishers);
-  for (const auto& [ch, r] : sum["record"]["by_channel"].items()) {
-    ASSERT_TRUE(genuine.count(ch)) << ch;
-    const long expected = std::max<long>(0, r["published"].get<long>() - genuine.at(ch));
-    EXPECT_EQ(r["lost"].get<long>(), expected) << ch << ": " << r.dump();
-  }
-  bool listed = false;
-  for (const auto& o : sum["ignored"]["other_sessions"])
-    listed |= o.get<std::string>() == wire::FormatSessionId(stranger_id);
-  EXPECT_TRUE(listed) << "the stranger's session is not listed";
-  const auto& fr = sum["frames"];
-  EXPECT_GE(fr["rendered"].get<long>(), 0);
-  EXPECT_LE(fr["rendered"].get<long>(), fr["esg_published"].get<long>());
-  EXPECT_LT(fr["dcp_published"].get<long>(), 100000);
-  EXPECT_GE(fr["refused"]["far_ahead"].get<long>(), 1);
-  EXPECT_GE(fr["refused"]["other_sender"].get<long>(), 85);
-  // Forged telemetry and frames in the record do not stop it re-simulating:
-  // the re-simulation takes, as the summary believes, the DCP's own
-  // (docs/sessions.md "Re-simulation"), and the record lost nothing.
-  EXPECT_EQ(sum["record"]["lost"], 0) << sum["record"].dump();
-  EXPECT_GE(Counter(out, "scene_proc", "resyncs"), 1) << "scene_proc never followed back";
-  const auto esg_messages = GenuineMessagesLogged(s.out() + "/lcmlog", id, scene_pid);
-  EXPECT_GT(esg_messages, genuine.at(wire::channels::kEsgFrame))
-      << "no ESG frame number was sent twice: the case the record counts once is not tried";
-  EXPECT_EQ(sum["resimulation"]["verdict"], "identical") << sum["resimulation"].dump();
+  ExpectEveryProcessCountedWhatItRefused(out, files);
+  ExpectTheSummaryTellsTheRealFlight(out, id, stranger_id, {op_pid, dcp_pid, s.pid("scene_proc")});
   if (::testing::Test::HasFailure())
     std::printf("kept for a look: %s\n", tmp.c_str());
   else

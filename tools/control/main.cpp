@@ -263,6 +263,35 @@ std::string Joined(const std::vector<std::string>& words) {
   return out;
 }
 
+// The session a command goes to: its id, checkpoints folder and key, from
+// its folder or from the options (the LCM URL and suffix set in *lcm).
+struct Target {
+  std::int64_t id = 0;
+  std::string checkpoints;  // empty without --session
+  std::optional<rms::wire::SessionKey> key;
+};
+Target ResolveTarget(const std::string& session_dir, const std::string& session_id,
+                     const std::string& key_file, rms::transport::LcmOptions* lcm) {
+  Target t;
+  t.id = session_id.empty() ? 0 : rms::transport::ParseSessionId(session_id, "--session-id");
+  if (!session_dir.empty()) {
+    const rms::session::SessionInfo s = rms::session::ReadSessionInfo(session_dir);
+    if (s.lcm_url.empty())
+      throw rms::InputError(session_dir +
+                            " ran on no network (a re-simulation): nothing to control");
+    lcm->url = s.lcm_url;
+    lcm->channel_suffix = s.channel_suffix;
+    t.id = s.session_id;
+    t.checkpoints = (fs::path(session_dir) / "checkpoints").string();
+  }
+  // The session's messages carry tags: its processes drop a command
+  // without the key's (docs/security.md "Authenticated messages").
+  t.key = !session_dir.empty() ? rms::session::ReadSessionKey(session_dir)
+          : !key_file.empty()  ? std::optional(rms::wire::ReadSessionKeyFile(key_file))
+                               : rms::wire::SessionKeyFromEnv();
+  return t;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -319,25 +348,9 @@ int main(int argc, char** argv) {
   repair->add_option("what", words, "What to repair, e.g. joint 2")->required();
   if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   try {
-    std::string folder;
-    std::int64_t id =
-        session_id.empty() ? 0 : rms::transport::ParseSessionId(session_id, "--session-id");
-    if (!session_dir.empty()) {
-      const rms::session::SessionInfo s = rms::session::ReadSessionInfo(session_dir);
-      if (s.lcm_url.empty())
-        throw rms::InputError(session_dir +
-                              " ran on no network (a re-simulation): nothing to control");
-      lcm_options.url = s.lcm_url;
-      lcm_options.channel_suffix = s.channel_suffix;
-      id = s.session_id;
-      folder = (fs::path(session_dir) / "checkpoints").string();
-    }
-    // The session's messages carry tags: its processes drop a command
-    // without the key's (docs/security.md "Authenticated messages").
-    const std::optional<rms::wire::SessionKey> key =
-        !session_dir.empty() ? rms::session::ReadSessionKey(session_dir)
-        : !key_file.empty()  ? std::optional(rms::wire::ReadSessionKeyFile(key_file))
-                             : rms::wire::SessionKeyFromEnv();
+    const Target target = ResolveTarget(session_dir, session_id, key_file, &lcm_options);
+    const std::string& folder = target.checkpoints;
+    const std::int64_t id = target.id;
     std::string name;
     if (checkpoint->parsed()) {
       name = CheckpointName(what);
@@ -352,7 +365,7 @@ int main(int argc, char** argv) {
     if (malfunction->parsed())
       name = rms::wire::MalfunctionText(rms::wire::ParseMalfunction(Joined(words)));
     if (repair->parsed()) name = rms::wire::RepairText(rms::wire::ParseRepair(Joined(words)));
-    ControlLink link(lcm_options, id, key);
+    ControlLink link(lcm_options, id, target.key);
     // A running session's record has the command from this tool's own
     // journal too (docs/sessions.md "The record").
     if (!session_dir.empty() && fs::is_directory(fs::path(session_dir) / "journal"))

@@ -135,167 +135,192 @@ int Usage(const char* what) {
   return rms::kUsageExitCode;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{
-      "rmslab rms_resim: run the DCP again on a session's recorded operator inputs, as fast as it "
-      "can. "
-      "With the session's own configuration, exits 0 only if every output is identical, word for "
-      "word; "
-      "with --config, writes a new session with the outcome and a comparison."};
+// The command line's values.
+struct Args {
   rms::resim::ResimOptions opt;
-  bool quiet = false, result_json = false, check_only = false;
+  bool quiet = false, result_json = false, check_only = false, verbose = false;
   std::vector<std::string> sets;
+  std::string cells, verdict_json, checkpoint_out, threads = "auto";
+  int jobs = 1;
+};
+
+void AddOptions(CLI::App& app, Args& a) {
   app.set_version_flag("--version", rms::VersionString());
-  std::string cells;
-  app.add_option("session", opt.session, "Session folder (required but with --cells)")
+  app.add_option("session", a.opt.session, "Session folder (required but with --cells)")
       ->check(CLI::ExistingDirectory);
-  app.add_option("--cells", cells,
+  app.add_option("--cells", a.cells,
                  "A sweep's batch: each line of FILE ('-': standard input) "
                  "INDEX<TAB>KEY<TAB>SESSION<TAB>KEY=VALUE..., re-simulated as --set ... "
                  "--discard --result-json would; a line 'INDEX<TAB>JSON' each on stdout")
       ->type_name("FILE");
-  int jobs = 1;
-  app.add_option("--jobs", jobs,
+  app.add_option("--jobs", a.jobs,
                  "With --cells: cells at once, each on its own thread (a sweep on this machine "
                  "gives its cores)")
       ->check(CLI::Range(1, 256))
       ->capture_default_str();
-  app.add_option("--config", opt.config_path, "Another configuration (a different design)")
+  app.add_option("--config", a.opt.config_path, "Another configuration (a different design)")
       ->check(CLI::ExistingFile);
-  app.add_option("--out", opt.out_dir,
+  app.add_option("--out", a.opt.out_dir,
                  "With --config: the new session folder (default SESSION-resim)");
-  app.add_option("--set", sets,
+  app.add_option("--set", a.sets,
                  "KEY=VALUE: a configuration key set over the session's config (or --config's), "
                  "e.g. dcp.tpob_ft=0.4; repeatable (another design)")
       ->type_name("KEY=VALUE");
-  app.add_flag("--discard", opt.discard,
+  app.add_flag("--discard", a.opt.discard,
                "Another design: no session written, its result made in memory (what remains is "
                "the output; no --out)");
-  app.add_flag("--result-json", result_json,
+  app.add_flag("--result-json", a.result_json,
                "Another design: print only its result, one JSON line on stdout (a sweep's cell: "
                "outcome, recorded outcome, scorecard changes, first divergence)");
-  app.add_flag("--check", check_only,
+  app.add_flag("--check", a.check_only,
                "Only check the design (the configuration with its --set keys) and exit: 0 if "
                "it is valid");
-  std::string verdict_json;
-  app.add_option("--verdict-json", verdict_json,
+  app.add_option("--verdict-json", a.verdict_json,
                  "The session's own design: also write what it came to here, as JSON, whatever "
                  "it came to (identical, differs, cannot be re-simulated: docs/sessions.md \"Does "
                  "it re-simulate\"); scripts/lab writes SESSION/resimulation.json so")
       ->type_name("FILE");
-  std::string checkpoint_out;
   app.add_option(
-         "--until", opt.until_frame,
+         "--until", a.opt.until_frame,
          "Only up to this DCP frame, word for word (the session's own design); with "
          "--checkpoint-out, the DCP's state there: a branch point (scripts/lab demo --from)")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--checkpoint-out", checkpoint_out,
+  app.add_option("--checkpoint-out", a.checkpoint_out,
                  "With --until: write the DCP's state after that frame here, as a checkpoint "
                  "(only when the frames up to it are identical)");
-  std::string threads = "auto";
-  app.add_option("--threads", threads,
+  app.add_option("--threads", a.threads,
                  "The session's own design: its log read and its DCP run in two shares at once, "
                  "one on another core: auto (when that core comes in time), 1 (one thread) or 2 "
                  "(always two); the same result each way (docs/sessions.md \"Re-simulation\"); "
                  "--verbose runs on one")
       ->check(CLI::IsMember({"auto", "1", "2"}))
       ->capture_default_str();
-  app.add_flag("--quiet", quiet, "No progress lines (they go only to a terminal anyway)");
-  bool verbose = false;
-  app.add_flag("--verbose", verbose,
+  app.add_flag("--quiet", a.quiet, "No progress lines (they go only to a terminal anyway)");
+  app.add_flag("--verbose", a.verbose,
                "Also the DCP's own log lines (mode changes, collisions) as it re-flies");
+}
+
+// --cells: a sweep's batch, each cell's result a line.
+int RunCellBatch(const CLI::App& app, const Args& a) {
+  const rms::resim::ResimOptions& opt = a.opt;
+  if (!opt.session.empty() || !a.sets.empty() || !opt.config_path.empty() || a.check_only ||
+      !opt.out_dir.empty() || opt.discard || a.result_json || opt.until_frame >= 0 ||
+      !a.checkpoint_out.empty() || app.count("--threads") > 0)
+    return Usage(
+        "--cells: the sessions and keys are in its lines, each cell's result is its line "
+        "(no SESSION, --set, --config, --out, --discard, --result-json, --check, --until, "
+        "--checkpoint-out or --threads beside it)");
+  if (a.cells.empty()) return Usage("--cells: a FILE, or - for standard input");
+  spdlog::set_default_logger(spdlog::stderr_color_mt("rms_resim"));
+  if (a.cells == "-") return rms::resim::RunCells(std::cin, a.jobs);
+  std::ifstream in(a.cells);
+  if (!in || std::filesystem::is_directory(a.cells)) {
+    std::fprintf(stderr, "rms_resim: --cells %s: cannot be read\n", a.cells.c_str());
+    return 2;
+  }
+  return rms::resim::RunCells(in, a.jobs);
+}
+
+// The options that go together with others, refused with the reason.
+void CheckCombinations(const Args& a) {
+  const bool other = rms::resim::OtherDesign(a.opt);
+  if (a.result_json && !other)
+    throw rms::InputError("--result-json needs another design (--config or --set)");
+  if (a.opt.discard && !other)
+    throw rms::InputError("--discard needs another design (--config or --set)");
+  if (a.opt.discard && !a.opt.out_dir.empty())
+    throw rms::InputError("--discard writes no session: --out has no place beside it");
+  if (!a.checkpoint_out.empty() && a.opt.until_frame < 0)
+    throw rms::InputError("--checkpoint-out needs --until FRAME");
+  if (!a.verdict_json.empty() && (other || a.opt.until_frame >= 0))
+    throw rms::InputError(
+        "--verdict-json is for the session's own design, to its end (no "
+        "--config, --set or --until)");
+}
+
+// One session re-simulated: what it came to, written where asked; the exit code.
+int RunSession(const Args& a) {
+  const rms::resim::ResimOptions& opt = a.opt;
+  const rms::resim::ResimResult r = rms::resim::Resimulate(opt);
+  const bool other = rms::resim::OtherDesign(opt);
+  const std::string new_session_verdict =
+      other && !r.out_dir.empty() ? CheckNewSession(r.out_dir, opt.threads) : "";
+  if (!a.verdict_json.empty())
+    rms::WriteWholeFile(a.verdict_json, Verdict(&r, "", opt.session).dump(2) + "\n",
+                        rms::LinksForOutput(a.verdict_json, opt.session));
+  if (!a.checkpoint_out.empty()) {
+    if (!r.first_difference.empty()) {
+      throw rms::InputError("the session does not re-simulate word for word up to DCP frame " +
+                            std::to_string(opt.until_frame) + " (" + r.first_difference +
+                            "): a branch from there could not reproduce it; no checkpoint written");
+    }
+    rms::WriteWholeFile(a.checkpoint_out, r.checkpoint_text,
+                        rms::LinksForOutput(a.checkpoint_out, opt.session));
+  }
+  if (a.result_json) {
+    std::printf("%s\n", rms::resim::JsonLine(r.cell).c_str());
+    return 0;
+  }
+  const int rc = Report(r, other);
+  if (!new_session_verdict.empty())
+    std::printf("the new session re-simulates: %s\n", new_session_verdict.c_str());
+  return rc;
+}
+
+// A session that could not be re-simulated: said, and written where asked.
+int Refused(const Args& a, const std::exception& e) {
+  const rms::resim::ResimOptions& opt = a.opt;
+  std::fprintf(stderr, "rms_resim: %s\n", rms::TerminalText(e.what()).c_str());
+  if (!a.verdict_json.empty() && !rms::resim::OtherDesign(opt) && opt.until_frame < 0) {
+    try {
+      rms::WriteWholeFile(a.verdict_json, Verdict(nullptr, e.what(), opt.session).dump(2) + "\n",
+                          rms::LinksForOutput(a.verdict_json, opt.session));
+    } catch (const std::exception& w) {
+      std::fprintf(stderr, "rms_resim: %s\n", w.what());
+    }
+  }
+  // A sweep's cell says why it has no result, on its one line.
+  if (a.result_json)
+    std::printf("%s\n", rms::resim::JsonLine(nlohmann::json{{"error", e.what()}}).c_str());
+  return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "rmslab rms_resim: run the DCP again on a session's recorded operator inputs, as fast as it "
+      "can. With the session's own configuration, exits 0 only if every output is identical, "
+      "word for word; with --config, writes a new session with the outcome and a comparison."};
+  Args a;
+  AddOptions(app, a);
   if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
-  opt.threads = threads == "auto" ? 0 : std::stoi(threads);
+  rms::resim::ResimOptions& opt = a.opt;
+  opt.threads = a.threads == "auto" ? 0 : std::stoi(a.threads);
   // The DCP's own lines in the order one run makes them (two halves would
   // interleave theirs, and a half not kept would have said its own).
-  if (verbose) opt.threads = 1;
+  if (a.verbose) opt.threads = 1;
   // The re-flown DCP's log lines only when asked for: the result is the output.
-  spdlog::set_level(verbose ? spdlog::level::info : spdlog::level::warn);
+  spdlog::set_level(a.verbose ? spdlog::level::info : spdlog::level::warn);
   // With --result-json stdout is the result alone: log lines go to stderr.
-  if (result_json) spdlog::set_default_logger(spdlog::stderr_color_mt("rms_resim"));
-  if (!quiet && isatty(STDERR_FILENO)) {  // progress only to a person at a terminal
+  if (a.result_json) spdlog::set_default_logger(spdlog::stderr_color_mt("rms_resim"));
+  if (!a.quiet && isatty(STDERR_FILENO)) {  // progress only to a person at a terminal
     opt.progress = [](double f, const std::string& line) {
       std::fprintf(stderr, "resim: %3.0f%% %s\n", 100 * f, line.c_str());
     };
   }
-  if (app.count("--cells") > 0) {
-    if (!opt.session.empty() || !sets.empty() || !opt.config_path.empty() || check_only ||
-        !opt.out_dir.empty() || opt.discard || result_json || opt.until_frame >= 0 ||
-        !checkpoint_out.empty() || app.count("--threads") > 0)
-      return Usage(
-          "--cells: the sessions and keys are in its lines, each cell's result is its line "
-          "(no SESSION, --set, --config, --out, --discard, --result-json, --check, --until, "
-          "--checkpoint-out or --threads beside it)");
-    if (cells.empty()) return Usage("--cells: a FILE, or - for standard input");
-    spdlog::set_default_logger(spdlog::stderr_color_mt("rms_resim"));
-    if (cells == "-") return rms::resim::RunCells(std::cin, jobs);
-    std::ifstream in(cells);
-    if (!in || std::filesystem::is_directory(cells)) {
-      std::fprintf(stderr, "rms_resim: --cells %s: cannot be read\n", cells.c_str());
-      return 2;
-    }
-    return rms::resim::RunCells(in, jobs);
-  }
+  if (app.count("--cells") > 0) return RunCellBatch(app, a);
   if (opt.session.empty()) return Usage("session is required (or --cells)");
   if (app.count("--jobs") > 0) return Usage("--jobs: only with --cells (cells at once)");
   try {
-    for (const std::string& s : sets) opt.settings.push_back(rms::ParseConfigSetting(s));
-    if (check_only) {
+    for (const std::string& s : a.sets) opt.settings.push_back(rms::ParseConfigSetting(s));
+    if (a.check_only) {
       rms::ParseConfig(rms::resim::EffectiveConfigText(opt), rms::resim::ConfigSource(opt));
       return 0;
     }
-    if (result_json && !rms::resim::OtherDesign(opt))
-      throw rms::InputError("--result-json needs another design (--config or --set)");
-    if (opt.discard && !rms::resim::OtherDesign(opt))
-      throw rms::InputError("--discard needs another design (--config or --set)");
-    if (opt.discard && !opt.out_dir.empty())
-      throw rms::InputError("--discard writes no session: --out has no place beside it");
-    if (!checkpoint_out.empty() && opt.until_frame < 0)
-      throw rms::InputError("--checkpoint-out needs --until FRAME");
-    if (!verdict_json.empty() && (rms::resim::OtherDesign(opt) || opt.until_frame >= 0))
-      throw rms::InputError(
-          "--verdict-json is for the session's own design, to its end (no "
-          "--config, --set or --until)");
-    const rms::resim::ResimResult r = rms::resim::Resimulate(opt);
-    const std::string new_session_verdict = rms::resim::OtherDesign(opt) && !r.out_dir.empty()
-                                                ? CheckNewSession(r.out_dir, opt.threads)
-                                                : "";
-    if (!verdict_json.empty())
-      rms::WriteWholeFile(verdict_json, Verdict(&r, "", opt.session).dump(2) + "\n",
-                          rms::LinksForOutput(verdict_json, opt.session));
-    if (!checkpoint_out.empty()) {
-      if (!r.first_difference.empty()) {
-        throw rms::InputError(
-            "the session does not re-simulate word for word up to DCP frame " +
-            std::to_string(opt.until_frame) + " (" + r.first_difference +
-            "): a branch from there could not reproduce it; no checkpoint written");
-      }
-      rms::WriteWholeFile(checkpoint_out, r.checkpoint_text,
-                          rms::LinksForOutput(checkpoint_out, opt.session));
-    }
-    if (result_json) {
-      std::printf("%s\n", rms::resim::JsonLine(r.cell).c_str());
-      return 0;
-    }
-    const int rc = Report(r, rms::resim::OtherDesign(opt));
-    if (!new_session_verdict.empty())
-      std::printf("the new session re-simulates: %s\n", new_session_verdict.c_str());
-    return rc;
+    CheckCombinations(a);
+    return RunSession(a);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "rms_resim: %s\n", rms::TerminalText(e.what()).c_str());
-    if (!verdict_json.empty() && !rms::resim::OtherDesign(opt) && opt.until_frame < 0) {
-      try {
-        rms::WriteWholeFile(verdict_json, Verdict(nullptr, e.what(), opt.session).dump(2) + "\n",
-                            rms::LinksForOutput(verdict_json, opt.session));
-      } catch (const std::exception& w) {
-        std::fprintf(stderr, "rms_resim: %s\n", w.what());
-      }
-    }
-    // A sweep's cell says why it has no result, on its one line.
-    if (result_json)
-      std::printf("%s\n", rms::resim::JsonLine(nlohmann::json{{"error", e.what()}}).c_str());
-    return 2;
+    return Refused(a, e);
   }
 }

@@ -419,6 +419,77 @@ std::shared_ptr<const RecordedSession> ReadRecordedSession(const std::string& di
   return std::make_shared<const RecordedSession>(dir, session::SessionLog(dir));
 }
 
+namespace {
+
+// A re-simulation that fails leaves no half-made session behind (it would
+// refuse the next try): the folder it made goes, or, in a folder given
+// that was there, what it wrote (docs/sessions.md "Re-simulation").
+constexpr const char* kNewSessionFiles[] = {
+    "lcmlog",          "config.toml",   "manifest.json", "summary.json",
+    "comparison.json", "comparison.md", "run/pilot",     "stats/dynamics_proc.json"};
+struct NewSession {
+  fs::path dir;
+  bool made_folder = false, done = false;
+  std::vector<bool> was_there;         // each of kNewSessionFiles, before: never removed
+  std::vector<bool> folder_was_there;  // each of kSessionSubfolders, before
+  void Claim(fs::path target) {
+    dir = std::move(target);
+    made_folder = !fs::exists(dir);
+    for (const char* f : kNewSessionFiles) was_there.push_back(fs::exists(dir / f));
+    for (const char* f : session::kSessionSubfolders)
+      folder_was_there.push_back(fs::exists(dir / f));
+  }
+  ~NewSession() {
+    if (dir.empty() || done) return;
+    std::error_code ec;
+    if (made_folder) {
+      fs::remove_all(dir, ec);
+      return;
+    }
+    for (size_t i = 0; i < was_there.size(); ++i)
+      if (!was_there[i]) fs::remove(dir / kNewSessionFiles[i], ec);
+    // The folders it made, when empty (fs::remove leaves one that is not).
+    for (size_t i = 0; i < folder_was_there.size(); ++i)
+      if (!folder_was_there[i]) fs::remove(dir / session::kSessionSubfolders[i], ec);
+  }
+};
+
+// What the log lacks or holds damaged, and the frames it cannot check,
+// said in the result's notes.
+void NoteWhatTheLogLacks(const RecordedSession& recorded, bool other_design, ResimResult* result) {
+  const Recording& rec = recorded.recording();
+  const Plan& plan = recorded.plan();
+  if (recorded.unread_bytes() > 0) {
+    result->log_note = "the log ends in " + std::to_string(recorded.unread_bytes()) +
+                       " bytes that are no whole event (it was cut short or damaged there): "
+                       "re-simulated up to them";
+  }
+  if (recorded.skipped_bytes() > 0) {
+    result->log_note += std::string(result->log_note.empty() ? "" : "; ") +
+                        "the log is damaged: " + std::to_string(recorded.skipped_bytes()) +
+                        " bytes inside it are no event (read past): what they held was not "
+                        "checked";
+  }
+  result->note = plan.note;
+  NoteUnchecked(rec, plan, result);
+  if (plan.filled_in > 0) {
+    result->filled_in = static_cast<long>(plan.filled_in);
+    AddNote(std::to_string(plan.filled_in) + " DCP frame(s) between " +
+                std::to_string(plan.first_filled_in) + " and " +
+                std::to_string(plan.last_filled_in) +
+                " are not in the log: made again from the logged inputs they answered, with "
+                "nothing to check them against",
+            &result->note);
+  }
+  // Another design is judged against the recorded outcome: a log cut short
+  // (or changed) since the session's summary was made holds less than it,
+  // and the difference is the log's, not the design's.
+  if (other_design) AddNote(LogShorterThanSummary(recorded.summary(), rec), &result->note);
+  result->skipped = static_cast<long>(plan.first);
+}
+
+}  // namespace
+
 ResimResult Resimulate(const ResimOptions& opt) {
   const auto t0 = Clock::now();
   const fs::path session(opt.session);
@@ -468,69 +539,10 @@ ResimResult Resimulate(const ResimOptions& opt) {
   const auto t_read = Clock::now();
 
   ResimResult result;
-  if (recorded->unread_bytes() > 0) {
-    result.log_note = "the log ends in " + std::to_string(recorded->unread_bytes()) +
-                      " bytes that are no whole event (it was cut short or damaged there): "
-                      "re-simulated up to them";
-  }
-  if (recorded->skipped_bytes() > 0) {
-    result.log_note += std::string(result.log_note.empty() ? "" : "; ") +
-                       "the log is damaged: " + std::to_string(recorded->skipped_bytes()) +
-                       " bytes inside it are no event (read past): what they held was not "
-                       "checked";
-  }
-  result.note = plan.note;
-  NoteUnchecked(rec, plan, &result);
-  if (plan.filled_in > 0) {
-    result.filled_in = static_cast<long>(plan.filled_in);
-    AddNote(std::to_string(plan.filled_in) + " DCP frame(s) between " +
-                std::to_string(plan.first_filled_in) + " and " +
-                std::to_string(plan.last_filled_in) +
-                " are not in the log: made again from the logged inputs they answered, with "
-                "nothing to check them against",
-            &result.note);
-  }
-  // Another design is judged against the recorded outcome: a log cut short
-  // (or changed) since the session's summary was made holds less than it,
-  // and the difference is the log's, not the design's.
-  if (other_design) {
-    AddNote(LogShorterThanSummary(recorded->summary(), rec), &result.note);
-  }
-  result.skipped = static_cast<long>(plan.first);
+  NoteWhatTheLogLacks(*recorded, other_design, &result);
   // Another design discarded (a sweep's cell) is made in memory: no session written.
   const bool written = other_design && !opt.discard;
-  // A re-simulation that fails leaves no half-made session behind (it would
-  // refuse the next try): the folder it made goes, or, in a folder given
-  // that was there, what it wrote (docs/sessions.md "Re-simulation").
-  static constexpr const char* kFiles[] = {
-      "lcmlog",          "config.toml",   "manifest.json", "summary.json",
-      "comparison.json", "comparison.md", "run/pilot",     "stats/dynamics_proc.json"};
-  struct NewSession {
-    fs::path dir;
-    bool made_folder = false, done = false;
-    std::vector<bool> was_there;         // each of kFiles, before: never removed
-    std::vector<bool> folder_was_there;  // each of kSessionSubfolders, before
-    void Claim(fs::path target) {
-      dir = std::move(target);
-      made_folder = !fs::exists(dir);
-      for (const char* f : kFiles) was_there.push_back(fs::exists(dir / f));
-      for (const char* f : session::kSessionSubfolders)
-        folder_was_there.push_back(fs::exists(dir / f));
-    }
-    ~NewSession() {
-      if (dir.empty() || done) return;
-      std::error_code ec;
-      if (made_folder) {
-        fs::remove_all(dir, ec);
-        return;
-      }
-      for (size_t i = 0; i < was_there.size(); ++i)
-        if (!was_there[i]) fs::remove(dir / kFiles[i], ec);
-      // The folders it made, when empty (fs::remove leaves one that is not).
-      for (size_t i = 0; i < folder_was_there.size(); ++i)
-        if (!folder_was_there[i]) fs::remove(dir / session::kSessionSubfolders[i], ec);
-    }
-  } new_session;
+  NewSession new_session;
   std::string out_log;
   if (written) {
     // Claimed before the folder is opened, so that a folder made and then
