@@ -345,6 +345,9 @@ void HandControllers::StartAutomatic(const Action& a) {
 void HandControllers::TakeAxis(int i) {
   status_.automatic &= ~(1u << i);
   if (i >= kRhcRoll) status_.automatic &= ~kAutoSquareUp;
+  if (status_.automatic & (kAutoUnwind | kAutoStow))
+    spdlog::info("{}: stopped by a hand-controller key, where it is",
+                 status_.automatic & kAutoStow ? "stow" : "unwind");
   status_.automatic &= ~(kAutoUnwind | kAutoStow);
 }
 
@@ -453,8 +456,12 @@ void HandControllers::FlyJoints(std::uint32_t bit, double dt_s) {
   status_.rate_limited = false;
   if (there) {
     status_.automatic &= ~bit;
-    spdlog::info("{}: there (wrist pitch {:+.1f}, yaw {:+.1f}, roll {:+.1f} deg)", what, q[3], q[4],
-                 q[5]);
+    if (stow)
+      spdlog::info("stow: there (joints {:+.1f} {:+.1f} {:+.1f} {:+.1f} {:+.1f} {:+.1f} deg)", q[0],
+                   q[1], q[2], q[3], q[4], q[5]);
+    else
+      spdlog::info("unwind: there (wrist pitch {:+.1f}, yaw {:+.1f}, roll {:+.1f} deg)", q[3], q[4],
+                   q[5]);
   }
   ReportLimits(0);
 }

@@ -208,12 +208,17 @@ void ControlLines(const StatusSnapshot& s, Flow& flow) {
              Sprintf(" %+.1f", s.inputs.value[i]);
     }
     // The ways out: the unwind, and in Mode 1 the stow (where the wrist
-    // comes back to its limit after an unwind: docs/operator.md "Stowing").
-    const std::string unwind = KeyHint(s, "unwind"), stow = KeyHint(s, "stow");
-    std::string out =
-        unwind.empty() ? "" : "; " + unwind.substr(2, unwind.size() - 3) + " unwinds it";
+    // comes back to its limit after an unwind: docs/operator.md "Nulling an
+    // axis, squaring up, unwinding"), in either control mode (so not
+    // KeyHint, which names no hand-controller key in single joint).
+    const auto key = [&](const char* action) {
+      const auto it = s.keys.find(action);
+      return it == s.keys.end() ? std::string() : it->second;
+    };
+    const std::string unwind = key("unwind"), stow = key("stow");
+    std::string out = unwind.empty() ? "" : "; " + unwind + " unwinds it";
     if (!stow.empty() && s.telemetry && s.telemetry->mode == 1)
-      out += (out.empty() ? "; " : ", ") + stow.substr(2, stow.size() - 3) + " stows the arm";
+      out += (out.empty() ? "; " : ", ") + stow + " stows the arm";
     flow.Field(Sprintf("WRIST NEAR ITS LIMIT (within %.0f deg): ", kNearLimitDeg) + j + out);
   }
   if (h.at_limit) {

@@ -967,6 +967,9 @@ TEST_F(Devices, TheStatusScreenSaysWhatToFlyNextAndWarnsOnlyWhereItHolds) {
   EXPECT_TRUE(shows("wrist_roll +172.0; b unwinds it"));
   EXPECT_FALSE(shows("stows the arm"));
   s.telemetry->mode = 1;
+  s.hand->mode = ControlMode::kSingleJoint;  // both work in either control mode
+  EXPECT_TRUE(shows("wrist_roll +172.0; b unwinds it, z stows the arm"));
+  s.hand->mode = ControlMode::kManualAugmented;
   EXPECT_TRUE(shows("moving x +2.00 ft/s [arm +0.80]"));
   EXPECT_FALSE(shows("CLEARANCE"));
   s.telemetry->acquisition_conditions[4] = 1;

@@ -340,9 +340,10 @@ std::vector<std::string> OperatorStateColumns() {
       "log_time [us]", "session_time [s]", "frame", "send_time [us]", "source",
       "control_mode",  "command_frame",    "scale", "joint"};
   // x, y, z ft/s; roll, pitch, yaw deg/s (single joint: x is the joint's
-  // rate, deg/s; docs/sessions.md "CSV").
+  // rate, deg/s; docs/sessions.md "Export").
   for (const char* kind : {"hand_rate_", "achieved_rate_"}) {
-    for (const char* a : {"x", "y", "z"}) cols.push_back(std::string(kind) + a + " [ft/s]");
+    cols.push_back(std::string(kind) + "x [ft/s; single joint: deg/s]");
+    for (const char* a : {"y", "z"}) cols.push_back(std::string(kind) + a + " [ft/s]");
     for (const char* a : {"roll", "pitch", "yaw"})
       cols.push_back(std::string(kind) + a + " [deg/s]");
   }
