@@ -11,10 +11,16 @@ rmslab_sudo() {
   if [ "$(id -u)" -eq 0 ]; then "$@"; elif command -v sudo >/dev/null; then sudo "$@"; else return 1; fi
 }
 
-# Configures the project in $RMSLAB_BUILD (Release), once.
+# Configures the project in $RMSLAB_BUILD (Release), once; with
+# RMSLAB_WERROR=ON in the environment (.ci/run) warnings are errors, the
+# tree configured again if it was made without.
 rmslab_configure() {
   if [ ! -f "$RMSLAB_BUILD/build.ninja" ] && [ ! -f "$RMSLAB_BUILD/Makefile" ]; then
-    cmake -S "$RMSLAB_ROOT" -B "$RMSLAB_BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+    cmake -S "$RMSLAB_ROOT" -B "$RMSLAB_BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release \
+      ${RMSLAB_WERROR:+-DRMSLAB_WERROR=$RMSLAB_WERROR} >/dev/null
+  elif [ -n "${RMSLAB_WERROR:-}" ] &&
+       ! grep -qx "RMSLAB_WERROR:BOOL=$RMSLAB_WERROR" "$RMSLAB_BUILD/CMakeCache.txt"; then
+    cmake -S "$RMSLAB_ROOT" -B "$RMSLAB_BUILD" -DRMSLAB_WERROR="$RMSLAB_WERROR" >/dev/null
   fi
 }
 

@@ -185,7 +185,7 @@ void DrawCrosshairs(std::uint8_t* rgba, int w, int h, const wire::EsgFrameData& 
       const int tick = h / 60;
       DrawLine(rgba, w, h, static_cast<int>(x) - tick, static_cast<int>(y),
                static_cast<int>(x) + tick, static_cast<int>(y), green, t);
-      char label[8];
+      char label[12];  // any int
       std::snprintf(label, sizeof label, "%d", k / 2);
       DrawText(rgba, w, h, static_cast<int>(x) + tick + 2 * s, static_cast<int>(y) - 3 * s, label,
                green, s);

@@ -198,8 +198,9 @@ def install_and_build():
     """scripts/install-deps, then configure (once) and build, Release."""
     subprocess.run([os.path.join(ROOT, "scripts", "install-deps")], check=True)
     if not (os.path.exists(os.path.join(BUILD, "build.ninja")) or os.path.exists(os.path.join(BUILD, "Makefile"))):
-        subprocess.run(["cmake", "-S", ROOT, "-B", BUILD, "-G", "Ninja", "-DCMAKE_BUILD_TYPE=Release"],
-                       check=True, stdout=subprocess.DEVNULL)
+        werror = os.environ.get("RMSLAB_WERROR")  # as scripts/lib.sh's rmslab_configure
+        subprocess.run(["cmake", "-S", ROOT, "-B", BUILD, "-G", "Ninja", "-DCMAKE_BUILD_TYPE=Release"] +
+                       ([f"-DRMSLAB_WERROR={werror}"] if werror else []), check=True, stdout=subprocess.DEVNULL)
     subprocess.run(["cmake", "--build", BUILD, "--parallel", str(os.cpu_count() or 2)], check=True,
                    stdout=subprocess.DEVNULL)
 

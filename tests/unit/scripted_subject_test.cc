@@ -85,8 +85,9 @@ TEST(ScriptedSubject, SquaresUpFromAwkwardAttitudesAndDocksWithinTheBudget) {
       ASSERT_TRUE(f.report.docked) << a.name << ": " << f.report.failure;  // this attempt
       EXPECT_LE(f.report.key_actions_acquire, window ? 30 : 50) << a.name;
       EXPECT_LE(f.result.dock_distance_ft, c.dcp.dock_distance_ft) << a.name;
-      if (!a.after_reset)  // the station counted them too (after a reset: both attempts')
+      if (!a.after_reset) {  // the station counted them too (after a reset: both attempts')
         EXPECT_EQ(f.key_actions, f.report.key_actions) << a.name;
+      }
     }
   }
 }
