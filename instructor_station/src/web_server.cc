@@ -18,6 +18,7 @@
 #include "rms/session_control_t.hpp"
 #include "rms/transport/lcm_interface.h"
 #include "rms/wire/checkpoint.h"
+#include "rms/wire/frame_numbers.h"
 #include "rms/wire/malfunction.h"
 
 #include "page.h"
@@ -362,7 +363,7 @@ Answer WebServer::Impl::Control(const Request& req) {
 // GET /api/view?v=V&frame=F: view V at DCP frame F (the nearest kept at or
 // before it), drawn on the LCM thread: 503 until it is (ask again).
 Answer WebServer::Impl::PastView(const Request& req, int v) {
-  const std::int64_t frame = IntParam(req, "frame", 0, 0, std::int64_t{1} << 48);
+  const std::int64_t frame = IntParam(req, "frame", 0, 0, wire::kMaxFrameNumber);
   Answer a;
   a.headers = {{"Cache-Control", "no-store"}};
   if (watch->HistoryRange().first < 0) {

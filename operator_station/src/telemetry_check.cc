@@ -4,15 +4,17 @@
 #include <initializer_list>
 
 #include "rms/wire/collision_bits.h"
+#include "rms/wire/frame_numbers.h"
 
 namespace rms::operator_station {
 
 std::optional<Counter> TelemetryProblem(const dcp_telemetry_t& m) {
-  constexpr std::int64_t kMaxFrame = std::int64_t{1} << 48, kMaxTimeUs = std::int64_t{1} << 62;
-  if (m.frame < 0 || m.input_frame < 0 || m.frame >= kMaxFrame || m.input_frame >= kMaxFrame)
+  using wire::kMaxFrameNumber, wire::kMaxSendTimeUs;  // docs/protocol.md "Frame numbers"
+  if (m.frame < 0 || m.input_frame < 0 || m.frame >= kMaxFrameNumber ||
+      m.input_frame >= kMaxFrameNumber)
     return Counter::kDroppedTelemetryFrame;
-  if (m.send_time_us < 0 || m.send_time_us >= kMaxTimeUs || m.input_send_time_us < 0 ||
-      m.input_send_time_us >= kMaxTimeUs)
+  if (m.send_time_us < 0 || m.send_time_us >= kMaxSendTimeUs || m.input_send_time_us < 0 ||
+      m.input_send_time_us >= kMaxSendTimeUs)
     return Counter::kDroppedTelemetryTime;
   if (m.mode < 1 || m.mode > 3) return Counter::kDroppedTelemetryMode;
   const std::uint32_t defined = (1u << wire::collision_bits::kCount) - 1;

@@ -6,6 +6,13 @@
 
 namespace rms::wire {
 
+// What no real sender produces (docs/protocol.md "Frame numbers", its
+// dropped counters bad_frame, bad_time): a frame number of 2^48 or more (at
+// 1 kHz, 8,900 years of frames) or a send time outside [0, 2^62) us. Every
+// receiver drops such a message before any arithmetic on it.
+inline constexpr std::int64_t kMaxFrameNumber = std::int64_t{1} << 48;
+inline constexpr std::int64_t kMaxSendTimeUs = std::int64_t{1} << 62;
+
 // The frame numbers a session's clock allows (docs/protocol.md "Frame
 // numbers"): every sender numbers its frames from the session's epoch, so by
 // now_us none can have gone past (now_us - epoch_us) x max_rate_hz, plus a

@@ -82,15 +82,15 @@ auto ReceiveFrame(const void* data, int size, SequenceTracker* seq, Counters* co
     return std::nullopt;
   }
   // Frame numbers and send times a real sender cannot produce (negative, or
-  // beyond 2^48 frames, times outside [0, 2^62) us): dropped before any arithmetic on them.
-  constexpr std::int64_t kMaxFrame = std::int64_t{1} << 48, kMaxTimeUs = std::int64_t{1} << 62;
-  if (msg.frame < 0 || msg.frame >= kMaxFrame) {
+  // beyond kMaxFrameNumber, times outside [0, kMaxSendTimeUs)): dropped
+  // before any arithmetic on them.
+  if (msg.frame < 0 || msg.frame >= kMaxFrameNumber) {
     counters->Add(Counter::kDroppedBadFrame);
     return std::nullopt;
   }
-  bool times_ok = msg.send_time_us >= 0 && msg.send_time_us < kMaxTimeUs;
+  bool times_ok = msg.send_time_us >= 0 && msg.send_time_us < kMaxSendTimeUs;
   if constexpr (requires { msg.input_send_time_us; }) {
-    times_ok = times_ok && msg.input_send_time_us >= 0 && msg.input_send_time_us < kMaxTimeUs;
+    times_ok = times_ok && msg.input_send_time_us >= 0 && msg.input_send_time_us < kMaxSendTimeUs;
   }
   if (!times_ok) {
     counters->Add(Counter::kDroppedBadTime);
