@@ -37,7 +37,7 @@ constexpr double kDt = 1.0 / 30;
 constexpr double kDeg = M_PI / 180.0;
 
 class Devices : public ::testing::Test {
- protected:
+ public:  // (FlyKeys uses Telemetry)
   LabConfig config = LoadConfig(DefaultConfigPath());
   Bindings bindings = LoadBindings(DefaultBindingsPath());
   GuidanceGeometry geometry = MakeGuidanceGeometry(config);
@@ -105,6 +105,18 @@ struct TypedKeys {
     };
   }
 };
+
+// `frames` frames of the station from *in, `keys` typed on the first, each
+// against the telemetry the DCP would send of Mode `mode` for its inputs.
+void FlyKeys(const Devices& d, HandControllers& hc, TypedKeys& typed, wire::OperatorInputs* in,
+             const std::vector<int>& keys, int frames, int mode) {
+  typed.keys = std::deque<int>(keys.begin(), keys.end());
+  for (int k = 0; k < frames; ++k) {
+    const dcp_telemetry_t t = d.Telemetry(*in, mode);
+    *in = hc.Step(kDt, &t);
+    typed.keys.clear();
+  }
+}
 
 TEST_F(Devices, TheBindingsFileIsReadAndBadOnesAreRefusedNamingTheKey) {
   EXPECT_EQ(bindings.keys.at('w').kind, ActionKind::kHand);
@@ -794,13 +806,8 @@ TEST_F(Devices, NullKeysSquareUpAndUnwindFlyToTheirZeroAndStop) {
     s.X_RP = arm::MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft);
     return ComputeGuidance(geometry, s, CommandFrame::kEndEffector);
   };
-  auto fly = [&](std::vector<int> keys, int frames) {
-    typed.keys = std::deque<int>(keys.begin(), keys.end());
-    for (int k = 0; k < frames; ++k) {
-      const dcp_telemetry_t t = Telemetry(in, 1);
-      in = hc.Step(kDt, &t);
-      typed.keys.clear();
-    }
+  auto fly = [&](const std::vector<int>& keys, int frames) {
+    FlyKeys(*this, hc, typed, &in, keys, frames, 1);
   };
   ASSERT_GT(std::abs(guidance(in).offset_ft[1]), 0.5);
   fly({'D'}, 1);
@@ -837,13 +844,8 @@ TEST_F(Devices, StowFliesEveryJointToItsStartInModeOneOnly) {
   hc.AddDevice(std::make_unique<KeyboardDevice>(bindings, typed.Source()));
   wire::OperatorInputs in = MidPose();
   hc.SetInputs(in);
-  auto fly = [&](std::vector<int> keys, int frames, int mode) {
-    typed.keys = std::deque<int>(keys.begin(), keys.end());
-    for (int k = 0; k < frames; ++k) {
-      const dcp_telemetry_t t = Telemetry(in, mode);
-      in = hc.Step(kDt, &t);
-      typed.keys.clear();
-    }
+  auto fly = [&](const std::vector<int>& keys, int frames, int mode) {
+    FlyKeys(*this, hc, typed, &in, keys, frames, mode);
   };
   fly({'z'}, 1, 2);  // the payload held: refused
   EXPECT_EQ(hc.status().automatic, 0u);
