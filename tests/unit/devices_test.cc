@@ -37,7 +37,7 @@ constexpr double kDt = 1.0 / 30;
 constexpr double kDeg = M_PI / 180.0;
 
 class Devices : public ::testing::Test {
- public:  // (FlyKeys uses Telemetry)
+ public:  // (KeyedStation uses MidPose and Telemetry)
   LabConfig config = LoadConfig(DefaultConfigPath());
   Bindings bindings = LoadBindings(DefaultBindingsPath());
   GuidanceGeometry geometry = MakeGuidanceGeometry(config);
@@ -106,17 +106,28 @@ struct TypedKeys {
   }
 };
 
-// `frames` frames of the station from *in, `keys` typed on the first, each
-// against the telemetry the DCP would send of Mode `mode` for its inputs.
-void FlyKeys(const Devices& d, HandControllers& hc, TypedKeys& typed, wire::OperatorInputs* in,
-             const std::vector<int>& keys, int frames, int mode) {
-  typed.keys = std::deque<int>(keys.begin(), keys.end());
-  for (int k = 0; k < frames; ++k) {
-    const dcp_telemetry_t t = d.Telemetry(*in, mode);
-    *in = hc.Step(kDt, &t);
-    typed.keys.clear();
+// A station at Devices::MidPose flown by keys the test types.
+struct KeyedStation {
+  explicit KeyedStation(const Devices& devices) : d(devices), hc(d.config, d.bindings) {
+    hc.AddDevice(std::make_unique<KeyboardDevice>(d.bindings, typed.Source()));
+    in = d.MidPose();
+    hc.SetInputs(in);
   }
-}
+  // `frames` frames, `keys` typed on the first, each against the telemetry
+  // the DCP would send of Mode `mode` for the station's inputs.
+  void Fly(const std::vector<int>& keys, int frames, int mode) {
+    typed.keys = std::deque<int>(keys.begin(), keys.end());
+    for (int k = 0; k < frames; ++k) {
+      const dcp_telemetry_t t = d.Telemetry(in, mode);
+      in = hc.Step(kDt, &t);
+      typed.keys.clear();
+    }
+  }
+  const Devices& d;
+  TypedKeys typed;
+  HandControllers hc;
+  wire::OperatorInputs in;
+};
 
 TEST_F(Devices, TheBindingsFileIsReadAndBadOnesAreRefusedNamingTheKey) {
   EXPECT_EQ(bindings.keys.at('w').kind, ActionKind::kHand);
@@ -795,20 +806,16 @@ TEST_F(Devices, TheStatusScreenShowsGuidanceMarginsAndFollowsTheWidth) {
 // one rotation; b brings the wrist to the middle of its travel; each is
 // counted, and a key of the axis takes it back.
 TEST_F(Devices, NullKeysSquareUpAndUnwindFlyToTheirZeroAndStop) {
-  HandControllers hc(config, bindings);
-  TypedKeys typed;
-  hc.AddDevice(std::make_unique<KeyboardDevice>(bindings, typed.Source()));
-  wire::OperatorInputs in = MidPose();
-  hc.SetInputs(in);
+  KeyedStation station(*this);
+  HandControllers& hc = station.hc;
+  wire::OperatorInputs& in = station.in;
   auto guidance = [&](const wire::OperatorInputs& now) {
     ArmState s;
     s.X_RS2 = X_RS2(now);
     s.X_RP = arm::MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft);
     return ComputeGuidance(geometry, s, CommandFrame::kEndEffector);
   };
-  auto fly = [&](const std::vector<int>& keys, int frames) {
-    FlyKeys(*this, hc, typed, &in, keys, frames, 1);
-  };
+  auto fly = [&](const std::vector<int>& keys, int frames) { station.Fly(keys, frames, 1); };
   ASSERT_GT(std::abs(guidance(in).offset_ft[1]), 0.5);
   fly({'D'}, 1);
   EXPECT_EQ(hc.status().automatic, 1u << kThcY);
@@ -839,20 +846,15 @@ TEST_F(Devices, NullKeysSquareUpAndUnwindFlyToTheirZeroAndStop) {
 // there, counted; holding the payload it is refused, counted, and nothing
 // moves.
 TEST_F(Devices, StowFliesEveryJointToItsStartInModeOneOnly) {
-  HandControllers hc(config, bindings);
-  TypedKeys typed;
-  hc.AddDevice(std::make_unique<KeyboardDevice>(bindings, typed.Source()));
-  wire::OperatorInputs in = MidPose();
-  hc.SetInputs(in);
-  auto fly = [&](const std::vector<int>& keys, int frames, int mode) {
-    FlyKeys(*this, hc, typed, &in, keys, frames, mode);
-  };
-  fly({'z'}, 1, 2);  // the payload held: refused
+  KeyedStation station(*this);
+  HandControllers& hc = station.hc;
+  wire::OperatorInputs& in = station.in;
+  station.Fly({'z'}, 1, 2);  // the payload held: refused
   EXPECT_EQ(hc.status().automatic, 0u);
   EXPECT_EQ(hc.counters().Get(Counter::kIncrementsBlocked), 1);
   EXPECT_EQ(hc.counters().Get(Counter::kControlStows), 0);
   for (int j = 0; j < 6; ++j) EXPECT_EQ(in.value[j], MidPose().value[j]) << j;
-  fly({'z'}, 1, 1);
+  station.Fly({'z'}, 1, 1);
   EXPECT_EQ(hc.status().automatic, kAutoStow);
   EXPECT_EQ(hc.counters().Get(Counter::kControlStows), 1);
   // Halfway, every joint is halfway: they arrive together.
@@ -866,12 +868,12 @@ TEST_F(Devices, StowFliesEveryJointToItsStartInModeOneOnly) {
     }
   }
   const int half = static_cast<int>(0.5 * longest_deg / bindings.max_rate[longest] / kDt);
-  fly({}, half, 1);
+  station.Fly({}, half, 1);
   for (int j = 0; j < 6; ++j) {
     const double start = MidPose().value[j], end = config.inputs[j].initial;
     EXPECT_NEAR((in.value[j] - start) / (end - start), 0.5, 0.05) << j;
   }
-  fly({}, 2 * half + 30, 1);
+  station.Fly({}, 2 * half + 30, 1);
   for (int j = 0; j < 6; ++j) EXPECT_NEAR(in.value[j], config.inputs[j].initial, 1e-6) << j;
   EXPECT_EQ(hc.status().automatic, 0u);
 }
@@ -1049,11 +1051,10 @@ TEST_F(Devices, APressMovesTheDistanceAskedFromTheStraightArm) {
 // Mode 2, the payload in the bay: a null key flies the way out's 0 (up
 // until the payload is 2 ft clear), not the port's; the square-up waits.
 TEST_F(Devices, InTheBayANullFliesTheWayOutAndTheSquareUpWaits) {
-  HandControllers hc(config, bindings);
-  TypedKeys typed;
-  hc.AddDevice(std::make_unique<KeyboardDevice>(bindings, typed.Source()));
-  wire::OperatorInputs in = MidPose();
-  hc.SetInputs(in);
+  KeyedStation station(*this);
+  HandControllers& hc = station.hc;
+  TypedKeys& typed = station.typed;
+  wire::OperatorInputs& in = station.in;
   auto lowest = [&](const wire::OperatorInputs& now) {
     return PayloadLowestZ(geometry, X_RS2(now) * mission::PlanGeometry(config).X_S2P);
   };
@@ -1084,11 +1085,10 @@ TEST_F(Devices, InTheBayANullFliesTheWayOutAndTheSquareUpWaits) {
 // A terminal's press flown into a collision ends when the DCP holds the
 // arm, said and counted -- not flown on into the contact.
 TEST_F(Devices, APressIntoACollisionIsCutShortThere) {
-  HandControllers hc(config, bindings);
-  TypedKeys typed;
-  hc.AddDevice(std::make_unique<KeyboardDevice>(bindings, typed.Source()));
-  wire::OperatorInputs in = MidPose();
-  hc.SetInputs(in);
+  KeyedStation station(*this);
+  HandControllers& hc = station.hc;
+  TypedKeys& typed = station.typed;
+  wire::OperatorInputs& in = station.in;
   typed.keys = {'w'};
   dcp_telemetry_t t = Telemetry(in, 1);
   in = hc.Step(kDt, &t);
