@@ -72,12 +72,18 @@ std::string Margin(double m) {
 }
 
 // The key that moves `action`, for hints: "(w)", or "" when unbound.
+// The keys bound to an action ("h"), in any control mode; "" if none.
+std::string KeysOf(const StatusSnapshot& s, const std::string& action) {
+  const auto it = s.keys.find(action);
+  return it == s.keys.end() ? "" : it->second;
+}
+
 std::string KeyHint(const StatusSnapshot& s, const std::string& action) {
   // In single joint control the hand-controller keys drive a joint: no hint.
   if (s.hand && s.hand->mode == ControlMode::kSingleJoint && action.rfind("finger", 0) != 0)
     return "";
-  const auto it = s.keys.find(action);
-  return it == s.keys.end() ? "" : " (" + it->second + ")";
+  const std::string keys = KeysOf(s, action);
+  return keys.empty() ? "" : " (" + keys + ")";
 }
 
 // "x forward 3.25 ft (w)   y left 0.50 ft (a)   z down 1.00 ft (f)": each
@@ -211,11 +217,7 @@ void ControlLines(const StatusSnapshot& s, Flow& flow) {
     // comes back to its limit after an unwind: docs/operator.md "Nulling an
     // axis, squaring up, unwinding"), in either control mode (so not
     // KeyHint, which names no hand-controller key in single joint).
-    const auto key = [&](const char* action) {
-      const auto it = s.keys.find(action);
-      return it == s.keys.end() ? std::string() : it->second;
-    };
-    const std::string unwind = key("unwind"), stow = key("stow");
+    const std::string unwind = KeysOf(s, "unwind"), stow = KeysOf(s, "stow");
     std::string out = unwind.empty() ? "" : "; " + unwind + " unwinds it";
     if (!stow.empty() && s.telemetry && s.telemetry->mode == 1)
       out += (out.empty() ? "; " : ", ") + stow + " stows the arm";
