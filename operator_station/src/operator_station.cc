@@ -53,6 +53,11 @@ void SleepUntilNs(std::int64_t t_ns) {
 
 bool Restarted() { return transport::RestartedByLauncher(); }
 
+// A RESTORE waits at most this long for dynamics_proc's answer (within
+// rms_control's 3 s for the station's own), and at most this many wait.
+constexpr std::int64_t kRestoreWaitUs = 2'500'000;
+constexpr std::size_t kMaxRestoresWaiting = 8;
+
 }  // namespace
 
 std::unique_ptr<InputSource> MakeSource(const OperatorOptions& o, const LabConfig& config) {
@@ -130,6 +135,8 @@ void OperatorStation::Subscribe() {
                  [this](const void* d, int n, std::int64_t t) { OnStatus(d, n, t); });
   lcm_.Subscribe(wire::channels::kControl,
                  [this](const void* d, int n, std::int64_t t) { OnControl(d, n, t); });
+  lcm_.Subscribe(wire::channels::kControlAnswer,
+                 [this](const void* d, int n, std::int64_t t) { OnControlAnswer(d, n, t); });
   if (source_->window_keyboard()) {
     lcm_.Subscribe(wire::channels::kWindowKeys,
                    [this](const void* d, int n, std::int64_t t) { OnWindowKeys(d, n, t); });
@@ -288,16 +295,17 @@ void OperatorStation::OnControl(const void* data, int size, std::int64_t) {
       break;
     case session_control_t::RESTORE:
       // docs/sessions.md "Freeze, run, step, checkpoint": a restore freezes
-      // the session, from whichever client; run resumes it. One refused
-      // changes nothing.
-      if (!checkpoint_rate_.Allow(lcm_.NowUs())) {
+      // the session, from whichever client; run resumes it. It is taken
+      // only when dynamics_proc has restored its state, so one the DCP
+      // refuses changes nothing. The station holds its frame meanwhile.
+      if (restores_waiting_.size() >= kMaxRestoresWaiting) {
         counters_.Add(Counter::kControlRateLimited);
         Answer(m, control_answer_t::REFUSED,
-               "more than " + std::to_string(wire::CheckpointRateLimit::kPerSecond) +
-                   " checkpoints or restores a second: try again");
+               "more than " + std::to_string(kMaxRestoresWaiting) +
+                   " restores waiting for dynamics_proc's answer: try again");
         break;
       }
-      restore_command_ = m;  // taken, and the session frozen, before the next frame
+      restores_waiting_.push_back({m, lcm_.NowUs()});
       break;
     default:
       break;
@@ -349,11 +357,69 @@ void OperatorStation::ForgetTelemetry(std::int64_t fresh_from_input_frame) {
   follow_.Forget();
 }
 
-void OperatorStation::ApplyRestore() {
+namespace {
+
+// `a` answers `m` (the command's id: docs/protocol.md "RMS_CONTROL_ANSWER").
+bool Answers(const control_answer_t& a, const session_control_t& m) {
+  return a.command == m.command && a.command_process == m.sender.process &&
+         a.command_pid == m.sender.pid && a.command_sequence == m.sequence;
+}
+
+}  // namespace
+
+// dynamics_proc's answers to RESTORE: what the station waits for.
+void OperatorStation::OnControlAnswer(const void* data, int size, std::int64_t) {
+  control_answer_t a;
+  if (wire::SafeDecode(data, size, &a) != wire::DecodeError::kNone) {
+    counters_.Add(Counter::kDroppedAnswerMalformed);
+    return;
+  }
+  if (a.sender.process != sender_t::PROCESS_DYNAMICS || a.command != session_control_t::RESTORE)
+    return;
+  dcp_restore_answers_.push_back(a);
+  if (dcp_restore_answers_.size() > kMaxRestoresWaiting) dcp_restore_answers_.pop_front();
+}
+
+// Each waiting RESTORE taken as dynamics_proc answered it: done, the
+// checkpoint's inputs taken and one frame run, then frozen; refused,
+// nothing changed; no answer within kRestoreWaitUs, refused and frozen
+// (the DCP may have restored unheard: Run resumes).
+void OperatorStation::SettleRestores() {
+  while (!restores_waiting_.empty()) {
+    const WaitingRestore w = restores_waiting_.front();
+    const auto a = std::find_if(dcp_restore_answers_.begin(), dcp_restore_answers_.end(),
+                                [&](const control_answer_t& x) { return Answers(x, w.command); });
+    if (a == dcp_restore_answers_.end()) {
+      if (lcm_.NowUs() - w.since_us < kRestoreWaitUs) return;
+      restores_waiting_.pop_front();
+      counters_.Add(Counter::kControlRefused);
+      frozen_ = true;
+      const std::string why = fmt::format(
+          "no answer from dynamics_proc within {:.1f} s: the inputs not taken; frozen (run "
+          "resumes)",
+          kRestoreWaitUs / 1e6);
+      spdlog::error("restore {}: {}", w.command.name, why);
+      Answer(w.command, control_answer_t::REFUSED, why);
+      continue;
+    }
+    const control_answer_t heard = *a;
+    dcp_restore_answers_.erase(a);
+    restores_waiting_.pop_front();
+    if (heard.outcome == control_answer_t::DONE) {
+      ApplyRestore(w.command);
+    } else {
+      counters_.Add(Counter::kControlRefused);
+      spdlog::error("restore {} refused by dynamics_proc: {} (nothing changed)", w.command.name,
+                    heard.text);
+      Answer(w.command, control_answer_t::REFUSED,
+             "dynamics_proc refused it (" + heard.text + "): nothing changed");
+    }
+  }
+}
+
+void OperatorStation::ApplyRestore(const session_control_t& m) {
   // Carry on from the checkpoint's inputs, so the first frame after it
   // commands the arm where the DCP now has it.
-  const session_control_t m = *restore_command_;
-  restore_command_.reset();
   try {
     const wire::Checkpoint c = checkpoints_.Read(m.name);
     source_->Resume(c.inputs, true);
@@ -371,9 +437,13 @@ void OperatorStation::ApplyRestore() {
            "frozen after one frame from the inputs of " + m.name +
                " (every display shows the restored pose): run resumes");
   } catch (const InputError& e) {
+    // The DCP read it and restored: the checkpoint changed under us.
     counters_.Add(Counter::kControlRefused);
-    spdlog::error("{}", e.what());
-    Answer(m, control_answer_t::REFUSED, std::string(e.what()) + " (nothing changed)");
+    frozen_ = true;
+    spdlog::error("{}: the DCP restored it, its inputs not taken here; FROZEN", e.what());
+    Answer(m, control_answer_t::REFUSED,
+           std::string(e.what()) + " (the DCP restored it but its inputs could not be taken: " +
+               "frozen, run resumes)");
   }
 }
 
@@ -730,9 +800,9 @@ int OperatorStation::Run(const std::string& stats_path, const std::string& ready
     if (options_.max_frames >= 0 && frames_ >= options_.max_frames) break;
     if (lcm_.HandleSubscriptions(0) < 0) counters_.Add(Counter::kTransportErrors);
     transport::NoteTransportCounters(lcm_, &counters_);
-    if (restore_command_) ApplyRestore();
+    SettleRestores();
     WriteClockFileOnChange();
-    if (frozen_ && steps_pending_ == 0) {
+    if (Holding() && steps_pending_ == 0) {
       if (!RunFrozen()) break;
       status.Tick(builder_.next_frame() - 1, counters_);
       SleepUntilNs(MonotonicNs() + period_ns_);

@@ -283,6 +283,22 @@ TEST(InstructorStation, ARestartedStationRecoversItsHistoryAndADebriefScrubsAndM
             std::string::npos)
       << restored.out;
   EXPECT_EQ(state(), "FROZEN");
+  // A checkpoint the operator station can read but the DCP refuses (docked
+  // in Mode 1), its finger closed: refused by both, nothing taken.
+  auto bad = nlohmann::json::parse(ReadFile(out + "/checkpoints/here.json"));
+  bad["dcp"]["docked"] = true;
+  bad["operator_inputs"]["finger"] = 1.0;
+  std::ofstream(out + "/checkpoints/bad.json") << bad.dump();
+  const double finger_before = status()["dcp"].value("master_finger", -1.0);
+  const auto refused_restore = control({"restore", "bad"});
+  EXPECT_EQ(refused_restore.rc, 1) << refused_restore.out;
+  for (const char* said :
+       {"refused by dynamics_proc: checkpoint '", "bad.json': checkpoint: 'docked' needs Mode 3",
+        "refused by operator_station: dynamics_proc refused it"})
+    EXPECT_NE(refused_restore.out.find(said), std::string::npos) << said << refused_restore.out;
+  EXPECT_EQ(control({"step", "3"}).rc, 0);
+  EXPECT_TRUE(until([&] { return state() == "FROZEN"; }, 10)) << status().dump();
+  EXPECT_EQ(status()["dcp"].value("master_finger", -2.0), finger_before) << "inputs taken";
   const auto run = control({"run"});
   EXPECT_EQ(run.rc, 0) << run.out;
   EXPECT_TRUE(until([&] { return state() == "RUNNING"; }, 10)) << status().dump();
@@ -332,7 +348,8 @@ TEST(InstructorStation, ARestartedStationRecoversItsHistoryAndADebriefScrubsAndM
     EXPECT_FALSE(c["answers"].empty()) << c.dump();
     for (const auto& a : c["answers"]) refused += a["outcome"] == "refused";
   }
-  EXPECT_EQ(refused, 3) << summary["control"].dump();  // the missing checkpoint by both, a step
+  // The missing and the bad checkpoint by both, a step.
+  EXPECT_EQ(refused, 5) << summary["control"].dump();
   EXPECT_EQ(summary["control_answers_unmatched"], 0);
 
   // The debrief, in a browser.

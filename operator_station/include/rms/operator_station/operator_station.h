@@ -8,12 +8,14 @@
 // rates and latency), RMS_CONTROL (freeze, step, restore) and the live
 // window's keys. docs/operator.md.
 #include <cstdint>
+#include <deque>
 #include <memory>
 #include <optional>
 #include <string>
 
 #include "rms/base/config.h"
 #include "rms/base/counters.h"
+#include "rms/control_answer_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/lesson/lesson.h"
 #include "rms/operator_input_t.hpp"
@@ -114,7 +116,12 @@ class OperatorStation {
   void Answer(const session_control_t& m, std::int8_t outcome, const std::string& text);
   // The lesson's events due this frame, sent (docs/lessons.md).
   void FireLessonEvents();
-  void ApplyRestore();
+  // RESTORE (docs/sessions.md "Freeze, run, step, checkpoint"): taken only
+  // once dynamics_proc has answered it done, refused when it refused.
+  void OnControlAnswer(const void* data, int size, std::int64_t recv_us);
+  void SettleRestores();
+  void ApplyRestore(const session_control_t& m);
+  bool Holding() const { return frozen_ || !restores_waiting_.empty(); }
   // Drops the telemetry heard so far: after a reset or a restore nothing of
   // the frames before it is shown or flown on.
   void ForgetTelemetry(std::int64_t fresh_from_input_frame);
@@ -164,9 +171,15 @@ class OperatorStation {
   bool clock_written_frozen_ = false;  // what the clock file says (none: running)
   std::int64_t clock_written_frame_ = -1;
   bool reset_pending_ = false;  // RMS_CONTROL RESET: the next frame's reset button
-  std::optional<session_control_t> restore_command_;  // RESTORE: its name a checkpoint's
+  // RESTOREs waiting for dynamics_proc's answer (the station holds its frame
+  // meanwhile), and the DCP's answers heard before their command.
+  struct WaitingRestore {
+    session_control_t command;
+    std::int64_t since_us = 0;
+  };
+  std::deque<WaitingRestore> restores_waiting_;
+  std::deque<control_answer_t> dcp_restore_answers_;
   wire::CheckpointFolder checkpoints_;
-  wire::CheckpointRateLimit checkpoint_rate_;
   std::int64_t control_sequence_ = 0;
   std::int64_t frames_ = 0;
   wire::OperatorInputs last_;  // the last inputs published
