@@ -33,8 +33,14 @@ bool InstructorLesson::Restore() {
     fired_at[i] = fired[i].get<double>();
     l.MarkFired(i);
   }
+  std::vector<std::int64_t> ids(fired_at.size(), -1);
+  const nlohmann::json saved_ids = j.value("command_ids", nlohmann::json::array());
+  for (std::size_t i = 0; saved_ids.is_array() && i < saved_ids.size() && i < ids.size(); ++i) {
+    if (saved_ids[i].is_number_integer()) ids[i] = saved_ids[i].get<std::int64_t>();
+  }
   std::lock_guard<std::mutex> lock(mu_);
   fired_at_s_ = std::move(fired_at);
+  command_id_ = std::move(ids);
   text_ = j["text"].get<std::string>();
   source_ = j.value("source", "");
   loaded_ = j.value("loaded", nlohmann::json::array());
@@ -46,6 +52,7 @@ void InstructorLesson::Load(std::string_view toml, const std::string& source, do
   lesson::Lesson l = lesson::Lesson::Parse(toml, source);  // InputError: nothing changes
   std::lock_guard<std::mutex> lock(mu_);
   fired_at_s_.assign(l.events().size(), -1.0);
+  command_id_.assign(l.events().size(), -1);
   lesson_ = std::move(l);
   source_ = source;
   text_ = std::string(toml);
@@ -62,8 +69,11 @@ void InstructorLesson::Save() {
   if (state_path_.empty() || !lesson_) return;
   nlohmann::json fired = nlohmann::json::array();
   for (const double t : fired_at_s_) fired.push_back(t >= 0 ? nlohmann::json(t) : nullptr);
-  const nlohmann::json j = {
-      {"source", source_}, {"text", text_}, {"fired_at_s", fired}, {"loaded", loaded_}};
+  const nlohmann::json j = {{"source", source_},
+                            {"text", text_},
+                            {"fired_at_s", fired},
+                            {"command_ids", command_id_},
+                            {"loaded", loaded_}};
   try {
     WriteWholeFile(state_path_, j.dump(1) + "\n");
   } catch (
@@ -80,7 +90,7 @@ std::vector<LessonCommand> InstructorLesson::Due(const dcp_telemetry_t* telemetr
   const auto due_run = std::remove_if(run_at_us_.begin(), run_at_us_.end(),
                                       [&](std::int64_t at) { return at <= now_us; });
   for (auto it = due_run; it != run_at_us_.end(); ++it)
-    out.push_back({session_control_t::RUN, "", ""});
+    out.push_back({session_control_t::RUN, "", "", -1});
   run_at_us_.erase(due_run, run_at_us_.end());
   if (!lesson_ || !telemetry) return out;
   // Session time as the operator station counts it: the frames published,
@@ -93,12 +103,20 @@ std::vector<LessonCommand> InstructorLesson::Due(const dcp_telemetry_t* telemetr
     fired = true;
     out.push_back({e.command, e.name,
                    Sprintf("lesson %s: event %zu (%s), at %.3f s of session time", source_.c_str(),
-                           i + 1, e.text.c_str(), t_s)});
+                           i + 1, e.text.c_str(), t_s),
+                   static_cast<int>(i)});
     if (e.command == session_control_t::FREEZE && e.for_s > 0)
       run_at_us_.push_back(now_us + static_cast<std::int64_t>(e.for_s * 1e6));
   }
   if (fired) Save();
   return out;
+}
+
+void InstructorLesson::NoteCommandId(int event, std::int64_t id) {
+  std::lock_guard<std::mutex> lock(mu_);
+  if (event < 0 || static_cast<std::size_t>(event) >= command_id_.size()) return;
+  command_id_[static_cast<std::size_t>(event)] = id;
+  Save();
 }
 
 nlohmann::json InstructorLesson::Json() const {
@@ -110,7 +128,9 @@ nlohmann::json InstructorLesson::Json() const {
     const bool fired = fired_at_s_[i] >= 0;
     j["events"].push_back({{"text", lesson_->events()[i].text},
                            {"fired", fired},
-                           {"fired_at_s", fired ? nlohmann::json(fired_at_s_[i]) : nullptr}});
+                           {"fired_at_s", fired ? nlohmann::json(fired_at_s_[i]) : nullptr},
+                           {"command_id", command_id_[i] >= 0 ? nlohmann::json(command_id_[i])
+                                                              : nlohmann::json(nullptr)}});
   }
   return j;
 }

@@ -62,8 +62,9 @@ void FireLesson(InstructorLesson* lesson, SessionWatch& watch, double frame_rate
                 std::int64_t now_us, ControlQueue* controls, Counters* counters) {
   const std::optional<dcp_telemetry_t> t = watch.LatestTelemetry();
   for (const LessonCommand& c : lesson->Due(t ? &*t : nullptr, frame_rate_hz, now_us)) {
-    controls->Push({c.command, c.name});
+    const std::int64_t id = controls->Push({c.command, c.name});
     if (c.said.empty()) continue;  // a timed freeze's RUN
+    lesson->NoteCommandId(c.event, id);
     spdlog::warn("{}", c.said);
     watch.NoteLocal("lesson", c.said);
     counters->Add(Counter::kLessonEvents);
@@ -138,11 +139,21 @@ int RunInstructorStation(const LabConfig& config, transport::LcmInterface& lcm,
   StationViews views(config, options.view_width, options.view_height, options.view_rate_hz,
                      &counters);
   ControlQueue controls;
+  controls.set_next_id(watch.NextCommandId());  // ids go on through restarts
   // docs/lessons.md "From the instructor's station": a station restarted
   // after a crash carries on with the lesson in force, fired events fired.
   InstructorLesson lesson(options.lesson_state_path);
-  if (lesson.Restore()) {
-    spdlog::warn("lesson: carried on from {}", options.lesson_state_path);
+  bool restored = false;
+  try {
+    restored = lesson.Restore();
+  } catch (const InputError& e) {
+    if (!options.debrief) throw;
+    spdlog::warn("{}: the debrief shows no lesson", e.what());
+  }
+  if (restored) {
+    spdlog::warn("lesson: {} {}",
+                 options.debrief ? "as the session ran it, from" : "carried on from",
+                 options.lesson_state_path);
   } else if (!options.lesson_path.empty()) {
     lesson.Load(ReadRegularFile(options.lesson_path, "lesson", kMaxConfigBytes, Links::kFollow),
                 options.lesson_path, 0.0);

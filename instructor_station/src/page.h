@@ -114,7 +114,7 @@ details summary { cursor: pointer; color: #bbb; font-size: 12px; }
 <h2>Lesson</h2>
 <label for="lessonfile">A lesson file (docs/lessons.md): </label><input type="file" id="lessonfile" accept=".toml,text/plain">
 <div id="lessonsaid"></div><ol id="lesson"></ol></div>
-<div class="pane"><h2>Scorecard (live) <span class="nowtag">(now)</span></h2><table id="score"></table></div>
+<div class="pane"><h2><span id="scoretitle">Scorecard (live)</span> <span class="nowtag">(now)</span></h2><table id="score"></table></div>
 <div class="pane"><h2>Events</h2><div id="events" tabindex="0" aria-label="the session's events"></div></div>
 <div class="pane"><details><summary>Processes: rates, latency, losses</summary><div class="scroll-x"><table id="procs"></table></div></details></div>
 </div>
@@ -204,8 +204,12 @@ function showLesson(l) {
     list.innerHTML = "";
     for (const e of (l.events || [])) {
       const li = document.createElement("li");
-      li.textContent = e.text + (e.fired ? "  -- fired at " + fmt(e.fired_at_s, 1) + " s" : "  -- to come");
-      li.className = e.fired ? "ok" : "";
+      const o = e.outcome, refused = o && o.state === "refused";
+      const said = !e.fired ? "  -- to come" : "  -- fired at " + fmt(e.fired_at_s, 1) + " s" +
+        (!o ? "" : refused ? ": REFUSED, " + o.answers.filter((x) => !x.done).map((x) => x.text + " (" + x.process + ")").join("; ")
+                   : o.state === "done" ? ": done" : ": " + o.state);
+      li.textContent = e.text + said;
+      li.className = !e.fired ? "" : refused || (o && o.state === "unanswered") ? "bad" : "ok";
       list.appendChild(li);
     }
   }
@@ -264,20 +268,22 @@ function malfunctionMenu() {
 
 const repairOf = (t) => t.startsWith("joint") || t.startsWith("camera") ? t.split(" ").slice(0, 2).join(" ") : t.split(" ")[0];
 
-function showMalfunctions(list) {
+function showMalfunctions(list, off) {
   const div = $("mlist");
-  if (div.dataset.shown === JSON.stringify(list)) return;
-  div.dataset.shown = JSON.stringify(list);
+  const key = JSON.stringify([list, off]);
+  if (div.dataset.shown === key) return;
+  div.dataset.shown = key;
   div.innerHTML = list.length ? "" : "none in force";
   for (const t of list) {
     const row = document.createElement("div"), b = document.createElement("button");
     b.textContent = "Repair"; b.setAttribute("aria-label", "Repair " + t); b.onclick = () => control("repair", {name: repairOf(t)});
+    b.disabled = off;
     row.className = "bad"; row.appendChild(document.createTextNode(t + " ")); row.appendChild(b);
     div.appendChild(row);
   }
   if (list.length > 1) {
     const b = document.createElement("button"); b.id = "repairall"; b.textContent = "Repair all";
-    b.onclick = () => control("repair", {name: "all"}); div.appendChild(b);
+    b.onclick = () => control("repair", {name: "all"}); b.disabled = off; div.appendChild(b);
   }
 }
 
@@ -360,6 +366,8 @@ function showBanner(s) {
   $("note").textContent = st.restarted ? "STATION RESTARTED: its history recovered from the session's log" : "";
   for (const id of ["freeze", "run", "step", "reset", "checkpoint", "restore", "inject", "cpname", "cplist",
                     "mkind", "mtarget", "mvalue", "lessonfile"]) $(id).disabled = debrief || st.ended;
+  if (debrief) for (const n of document.querySelectorAll(".nowtag")) n.textContent = "(at the session's end, not the cursor)";
+  $("scoretitle").textContent = debrief ? "Scorecard (the session's)" : st.ended ? "Scorecard (at the end)" : "Scorecard (live)";
 }
 
 function showTrainee(s) {
@@ -454,7 +462,7 @@ function showStatus(s) {
   showAcquisition(d);
   showScore(s.scorecard);
   showProcesses(s);
-  showMalfunctions(s.malfunctions || []);
+  showMalfunctions(s.malfunctions || [], debrief || !!(s.session && s.session.ended));
   const h = s.history, sc = $("scrub");
   if (h) { sc.min = String(h.first_frame); sc.max = String(h.last_frame); if (cursorFrame === null) sc.value = sc.max; }
 }
@@ -484,7 +492,13 @@ function markCursorEvents() {
     l.classList.toggle("after", after);
     if (!after) last = l;
   }
-  if (last) last.scrollIntoView({block: "nearest"});
+  // Scroll the list only, never the page (on a phone the views stay in sight).
+  const box = $("events");
+  if (last) {
+    const lr = last.getBoundingClientRect(), br = box.getBoundingClientRect();
+    if (lr.bottom > br.bottom) box.scrollTop += lr.bottom - br.bottom;
+    else if (lr.top < br.top) box.scrollTop -= br.top - lr.top;
+  }
 }
 
 async function poll() {

@@ -296,6 +296,10 @@ void SessionWatch::OnControl(const void* data, int size) {
   if (command_texts_.size() >= kMaxEvents) command_texts_.erase(command_texts_.begin());
   command_texts_[id] = text;
   AddEvent("control", text + " (from " + wire::ProcessCodeName(m.sender.process) + ")");
+  // An earlier instance's command (read back from the log): the page's id
+  // for it still answers.
+  if (m.sender.process == sender_t::PROCESS_INSTRUCTOR && m.sender.pid != getpid())
+    RecordCommand(m.sequence, m.sender.pid, m.command, m.name.substr(0, 64), m.send_time_us);
 }
 
 // RMS_CONTROL_ANSWER (docs/protocol.md): each answer an event; the
@@ -339,9 +343,10 @@ void SessionWatch::OnAnswer(const void* data, int size) {
     ++score_.attempts;
     score_.acquired_s = score_.docked_s = -1;
   }
-  if (a.command_process != sender_t::PROCESS_INSTRUCTOR || a.command_pid != getpid()) return;
+  if (a.command_process != sender_t::PROCESS_INSTRUCTOR) return;
   for (CommandRecord& c : own_commands_) {
-    if (c.id == a.command_sequence) c.answers.push_back({by, done, a.text.substr(0, 400)});
+    if (c.id == a.command_sequence && c.pid == a.command_pid)
+      c.answers.push_back({by, done, a.text.substr(0, 400)});
   }
 }
 
@@ -680,6 +685,29 @@ nlohmann::json SessionWatch::OperatorJson() const {
   return j;
 }
 
+namespace {
+
+// A malfunction's text as the page says it: its value's unit and the
+// joint's name ("inputs delayed 300 ms", "joint 2 drift 0.5 deg/s
+// (shoulder pitch)"); a text that does not parse, as it came.
+std::string MalfunctionSaid(const std::string& text) {
+  wire::Malfunction m;
+  try {
+    m = wire::ParseMalfunction(text);
+  } catch (const InputError&) {
+    return text;
+  }
+  std::string said = text;
+  using K = wire::MalfunctionKind;
+  if (m.kind == K::kJointDrift || m.kind == K::kJointSlow) said += " deg/s";
+  if (m.kind == K::kInputsDelayed) said += " ms";
+  if (m.kind == K::kJointStuck || m.kind == K::kJointDrift || m.kind == K::kJointSlow)
+    said.append(" (").append(wire::JointName(m.target)).append(")");
+  return said;
+}
+
+}  // namespace
+
 // What the trainee is warned of, and what the instructor should see at a
 // glance: collisions, holds, joints at their limits, a singular pose,
 // parts not following, the malfunctions in force (an input delay named).
@@ -707,7 +735,8 @@ nlohmann::json SessionWatch::WarningsJson() const {
                       "the turn (margin {:.0f} ft)",
                       operator_->turn_clearance_ft, operator_state_t::CLEARANCE_MARGIN_FT));
   }
-  for (const std::string& t : malfunctions_) w.push_back("MALFUNCTION in force: " + t);
+  for (const std::string& t : malfunctions_)
+    w.push_back("MALFUNCTION in force: " + MalfunctionSaid(t));
   if (dcp_ && dcp_->control.no_video) w.push_back("NO VIDEO on the operator's monitor");
   return w;
 }
@@ -739,11 +768,17 @@ nlohmann::json SessionWatch::StateJson() const {
 
 void SessionWatch::NoteCommand(std::int64_t id, std::int8_t command, const std::string& name) {
   std::lock_guard<std::mutex> lock(mu_);
+  RecordCommand(id, getpid(), command, name, Now());
+}
+
+void SessionWatch::RecordCommand(std::int64_t id, std::int32_t pid, std::int8_t command,
+                                 const std::string& name, std::int64_t wall_us) {
   CommandRecord c;
   c.id = id;
+  c.pid = pid;
   c.command = command;
   c.name = name;
-  c.sent_wall_us = Now();
+  c.sent_wall_us = wall_us;
   switch (command) {
     case session_control_t::CHECKPOINT:
     case session_control_t::MALFUNCTION:
@@ -756,13 +791,21 @@ void SessionWatch::NoteCommand(std::int64_t id, std::int8_t command, const std::
     default:
       c.expected = {"operator_station"};
   }
+  next_command_id_ = std::max(next_command_id_, id + 1);
   own_commands_.push_back(std::move(c));
   if (own_commands_.size() > kMaxCommands) own_commands_.pop_front();
 }
 
+std::int64_t SessionWatch::NextCommandId() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return next_command_id_;
+}
+
 nlohmann::json SessionWatch::CommandJson(std::int64_t id) const {
   std::lock_guard<std::mutex> lock(mu_);
-  for (const CommandRecord& c : own_commands_) {
+  // The newest with the id (one command through restarts: NextCommandId).
+  for (auto it = own_commands_.rbegin(); it != own_commands_.rend(); ++it) {
+    const CommandRecord& c = *it;
     if (c.id != id) continue;
     nlohmann::json answers = nlohmann::json::array();
     bool refused = false;
@@ -1012,7 +1055,10 @@ nlohmann::json SessionWatch::AddMark(double session_s, const std::string& text) 
     throw InputError("form field 'text': a note, not only spaces");
   const double newest =
       dcp_ ? static_cast<double>(dcp_->frame) / config_.session.frame_rate_hz : 0.0;
-  if (session_s > newest + 1.0) {
+  // Live, the page's "now" may be a little ahead of the newest frame here;
+  // once the session has ended (or in a debrief), nothing is after its end.
+  const double ahead_s = state_.ended || debrief_ ? 0.5 / config_.session.frame_rate_hz : 1.0;
+  if (session_s > newest + ahead_s) {
     char why[160];
     std::snprintf(why, sizeof why, "parameter t=%.1f: beyond the session's newest frame (%.1f s)",
                   session_s, newest);

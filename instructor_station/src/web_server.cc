@@ -218,6 +218,7 @@ struct WebServer::Impl {
   Answer PastView(const Request& req, int view);
   Answer Mark(const Request& req);
   Answer LoadLesson(const Request& req);
+  nlohmann::json LessonJson() const;
   Answer Checkpoints() const;
   static MHD_Result OnRequest(void* cls, MHD_Connection* c, const char* url, const char* method,
                               const char* version, const char* upload, std::size_t* upload_size,
@@ -298,7 +299,7 @@ Answer WebServer::Impl::Route(const Request& req) {
   } else if (req.method == "POST" && req.path == "/api/mark") {
     return Mark(req);
   } else if (get && req.path == "/api/lesson") {
-    a.body = Json(lesson->Json());
+    a.body = Json(LessonJson());
   } else if (req.method == "POST" && req.path == "/api/lesson") {
     return LoadLesson(req);
   } else {
@@ -387,6 +388,38 @@ Answer WebServer::Impl::PastView(const Request& req, int v) {
 }
 
 // POST /api/mark: form fields `text` (1..500 bytes) and `t` (session time,
+
+namespace {
+
+// "12", "12.5": digits with at most one point (no sign, exponent, hex or
+// spaces, which strtod would take).
+bool PlainDecimal(const std::string& v) {
+  if (v.empty() || v.size() > 32 || v.front() == '.' || v.back() == '.') return false;
+  int points = 0;
+  for (char c : v) {
+    if (c == '.')
+      ++points;
+    else if (c < '0' || c > '9')
+      return false;
+  }
+  return points <= 1;
+}
+
+// A Unicode direction embedding, override or isolate (UTF-8 E2 80 AA..AE,
+// E2 81 A6..A9): shown, it reverses the text around it.
+bool HasBidiControl(const std::string& s) {
+  for (std::size_t i = 0; i + 2 < s.size(); ++i) {
+    const auto b = [&](std::size_t k) { return static_cast<unsigned char>(s[i + k]); };
+    if (b(0) != 0xE2) continue;
+    if ((b(1) == 0x80 && b(2) >= 0xAA && b(2) <= 0xAE) ||
+        (b(1) == 0x81 && b(2) >= 0xA6 && b(2) <= 0xA9))
+      return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 // s; default: the newest frame's).
 Answer WebServer::Impl::Mark(const Request& req) {
   std::string text = req.param("text");
@@ -395,12 +428,16 @@ Answer WebServer::Impl::Mark(const Request& req) {
                      std::to_string(SessionWatch::kMaxMarkTextBytes) + " bytes");
   for (char& c : text)
     if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = ' ';
+  if (HasBidiControl(text))
+    throw InputError(
+        "form field 'text': a direction control (U+202A..U+202E, U+2066..U+2069) would show "
+        "the note as other text: refused");
   double t_s = 0.0;
   if (req.has_param("t")) {
     const std::string v = req.param("t");
     char* end = nullptr;
     t_s = std::strtod(v.c_str(), &end);
-    if (v.empty() || !end || *end != '\0' || !std::isfinite(t_s) || t_s < 0 ||
+    if (!PlainDecimal(v) || !end || *end != '\0' || !std::isfinite(t_s) || t_s < 0 ||
         t_s > SessionWatch::kMaxMarkSessionS)
       throw InputError("parameter t='" + v.substr(0, 32) + "': a session time, s, 0..1e7");
   } else if (const auto d = watch->LatestDcpFrame()) {
@@ -436,12 +473,23 @@ Answer WebServer::Impl::LoadLesson(const Request& req) {
   spdlog::info("lesson loaded from the page: {}", source);
   watch->NoteLocal("lesson", "lesson loaded: " + source);
   Answer a;
-  a.body = Json(lesson->Json());
+  a.body = Json(LessonJson());
   return a;
 }
 
+// The lesson, each fired event with what became of its command
+// (/api/command's answer: done, refused with the reason, pending).
+nlohmann::json WebServer::Impl::LessonJson() const {
+  nlohmann::json j = lesson->Json();
+  for (nlohmann::json& e : j["events"]) {
+    if (e["command_id"].is_number_integer())
+      e["outcome"] = watch->CommandJson(e["command_id"].get<std::int64_t>());
+  }
+  return j;
+}
+
 Answer WebServer::Impl::Checkpoints() const {
-  nlohmann::json names = nlohmann::json::array();
+  std::vector<std::string> names;  // by name, for the page's list
   std::error_code ec;
   if (!options.checkpoint_dir.empty()) {
     for (const auto& e : std::filesystem::directory_iterator(options.checkpoint_dir, ec)) {
@@ -451,8 +499,9 @@ Answer WebServer::Impl::Checkpoints() const {
         names.push_back(n);
     }
   }
+  std::sort(names.begin(), names.end());
   Answer a;
-  a.body = Json(names);
+  a.body = Json(nlohmann::json(names));
   return a;
 }
 

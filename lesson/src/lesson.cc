@@ -137,6 +137,11 @@ LessonEvent ParseEvent(TomlReader& r) {
             : e.command == session_control_t::REPAIR    ? "repair "
                                                         : "freeze") +
            e.name;
+  if (e.for_s > 0) {
+    char for_s[48];
+    std::snprintf(for_s, sizeof for_s, " for %g s", e.for_s);
+    e.text += for_s;
+  }
   r.Finish();
   return e;
 }

@@ -222,6 +222,9 @@ def debrief(argv):
                 "--bind", a.bind, "--port", str(a.port), "--url-file", url_file,
                 "--marks-file", os.path.join(a.session, "instructor_marks.jsonl"),
                 "--checkpoint-dir", os.path.join(a.session, "checkpoints")]
+        lesson_state = os.path.join(a.session, "run", "instructor_lesson.json")
+        if os.path.isfile(lesson_state):  # the lesson the session ran, each event's outcome (read only)
+            argv += ["--lesson-state", lesson_state]
         proc = subprocess.Popen(argv, env=dict(os.environ, RMSLAB_INSTRUCTOR_TOKEN=token))
 
         def stop_on(signum, _frame):
@@ -319,7 +322,9 @@ def control(argv):
     if not argv or argv[0] in ("-h", "--help"):
         print(control.__doc__)
         return 0 if argv else 2
-    ensure("tools/rms_control")
+    no_build = "--no-build" in argv  # as every other subcommand takes it
+    argv = [a for a in argv if a != "--no-build"]
+    ensure("tools/rms_control", no_build)
     if not any(a in argv for a in ("--session", "--lcm-url", "--session-id")):
         live = running_sessions()
         if len(live) != 1:

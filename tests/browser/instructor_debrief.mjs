@@ -139,6 +139,16 @@ try {
   if (!mine || Math.abs(mine.session_s - early / 30) > 1) fail("the mark is not at the cursor's time: " + JSON.stringify(marks));
   result.mark = mine;
   console.log("ok a mark at " + mine.session_s.toFixed(1) + " s: " + note);
+  // ... but none after the session's end, nor at a time written otherwise than in decimals.
+  const beyond = await page.evaluate(async (t) => {
+    const token = new URLSearchParams(location.search).get("token");
+    const post = async (v) => (await fetch("/api/mark?token=" + token, {method: "POST",
+      headers: {"Content-Type": "application/x-www-form-urlencoded"}, body: "text=late&t=" + v})).status;
+    return [await post(String(t)), await post("0x10")];
+  }, range[1] / 30 + 0.2);
+  if (beyond[0] !== 400 || beyond[1] !== 400) fail("a mark after the end or at t=0x10 was taken: " + beyond);
+  const title = await page.$eval("#scoretitle", (e) => e.textContent);
+  if (!/session's/.test(title)) fail("the debrief's scorecard says '" + title + "'");
   // 6. A phone.
   await page.setViewport({width: 390, height: 844, isMobile: true, hasTouch: true});
   await sleep(800);
@@ -149,6 +159,15 @@ try {
   if (phone.smallestFontPx < 12) fail("text of " + phone.smallestFontPx + " px on a phone");
   if (!phone.freeze || phone.freeze.right > 390.5) fail("the controls are off-screen on a phone: " + JSON.stringify(phone.freeze));
   console.log("ok 390x844: nothing wider than the screen, the smallest text " + phone.smallestFontPx + " px");
+  // Scrubbing on a phone keeps the page where it is (only the events list scrolls).
+  await page.evaluate(() => window.scrollTo(0, 0));
+  await scrubTo(late);
+  await sleep(800);
+  await scrubTo(early);
+  await sleep(800);
+  const scrolled = await page.evaluate(() => window.scrollY);
+  if (scrolled > 5) fail("scrubbing on a phone scrolled the page " + scrolled + " px away from the views");
+  console.log("ok scrubbing on a phone leaves the page where it was");
   if (errors.length) fail("the page's scripts failed: " + errors.join("; "));
   result.ok = true;
   console.log(JSON.stringify(result));

@@ -214,6 +214,16 @@ std::pair<int, int> PngSize(const std::string& path) {
   return {static_cast<int>(be32(16)), static_cast<int>(be32(20))};
 }
 
+// Whether `ok` holds within `seconds` (asked every 0.2 s).
+bool Until(const std::function<bool()>& ok, double seconds) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (std::chrono::steady_clock::now() < end) {
+    if (ok()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  }
+  return ok();
+}
+
 // docs/instructor.md "The banner", "Commands and their answers", "A
 // restarted station", "Debrief": `scripts/lab control` freezes, restores
 // and resets the session, each confirmed by the process that acted (a
@@ -243,19 +253,11 @@ TEST(InstructorStation, ARestartedStationRecoversItsHistoryAndADebriefScrubsAndM
     const auto r = web.Get("/api/status?token=" + token);
     return r && r->status == 200 ? nlohmann::json::parse(r->body) : nlohmann::json::object();
   };
-  auto until = [](const std::function<bool()>& ok, double seconds) {
-    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-    while (std::chrono::steady_clock::now() < end) {
-      if (ok()) return true;
-      std::this_thread::sleep_for(std::chrono::milliseconds(200));
-    }
-    return ok();
-  };
   auto state = [&] {
     const auto s = status();
     return s.contains("session") ? s["session"].value("state", "") : std::string();
   };
-  ASSERT_TRUE(until([&] { return state() == "RUNNING"; }, 30)) << status().dump();
+  ASSERT_TRUE(Until([&] { return state() == "RUNNING"; }, 30)) << status().dump();
   auto control = [&](std::vector<std::string> words) {
     std::vector<std::string> argv = {SourcePath("scripts/lab"), "control", "--session", out};
     argv.insert(argv.end(), words.begin(), words.end());
@@ -265,7 +267,7 @@ TEST(InstructorStation, ARestartedStationRecoversItsHistoryAndADebriefScrubsAndM
   const auto freeze = control({"freeze"});
   EXPECT_EQ(freeze.rc, 0) << freeze.out;
   EXPECT_NE(freeze.out.find("freeze: frozen at operator frame"), std::string::npos) << freeze.out;
-  EXPECT_TRUE(until([&] { return state() == "FROZEN"; }, 10)) << status().dump();
+  EXPECT_TRUE(Until([&] { return state() == "FROZEN"; }, 10)) << status().dump();
   // Steps: one command and one answer however many frames.
   const auto steps = control({"step", "30"});
   EXPECT_EQ(steps.rc, 0) << steps.out;
@@ -297,11 +299,11 @@ TEST(InstructorStation, ARestartedStationRecoversItsHistoryAndADebriefScrubsAndM
         "refused by operator_station: dynamics_proc refused it"})
     EXPECT_NE(refused_restore.out.find(said), std::string::npos) << said << refused_restore.out;
   EXPECT_EQ(control({"step", "3"}).rc, 0);
-  EXPECT_TRUE(until([&] { return state() == "FROZEN"; }, 10)) << status().dump();
+  EXPECT_TRUE(Until([&] { return state() == "FROZEN"; }, 10)) << status().dump();
   EXPECT_EQ(status()["dcp"].value("master_finger", -2.0), finger_before) << "inputs taken";
   const auto run = control({"run"});
   EXPECT_EQ(run.rc, 0) << run.out;
-  EXPECT_TRUE(until([&] { return state() == "RUNNING"; }, 10)) << status().dump();
+  EXPECT_TRUE(Until([&] { return state() == "RUNNING"; }, 10)) << status().dump();
   const auto running_step = control({"step"});
   EXPECT_EQ(running_step.rc, 1) << running_step.out;
   EXPECT_NE(running_step.out.find("refused by operator_station: not frozen"), std::string::npos)
@@ -311,12 +313,26 @@ TEST(InstructorStation, ARestartedStationRecoversItsHistoryAndADebriefScrubsAndM
   EXPECT_NE(reset.out.find("reset: the reset button pressed for one frame"), std::string::npos)
       << reset.out;
 
+  // A command from the page: its id still means it after the restart below.
+  auto page_command = [&](const std::string& form) {
+    const auto r =
+        web.Post("/api/control?token=" + token, form, "application/x-www-form-urlencoded");
+    return r && r->status == 200 ? nlohmann::json::parse(r->body).value("id", -1) : -1;
+  };
+  auto command_state = [&](long id) {
+    const auto r = web.Get("/api/command?token=" + token + "&id=" + std::to_string(id));
+    const auto j = r && r->status == 200 ? nlohmann::json::parse(r->body) : nlohmann::json();
+    return j.is_object() ? j : nlohmann::json::object();  // null: not yet sent
+  };
+  const long early_id = page_command("command=checkpoint&name=early");
+  ASSERT_GE(early_id, 0);
+  EXPECT_TRUE(Until([&] { return command_state(early_id).value("state", "") == "done"; }, 10));
   // The station killed: the launcher restarts it, and it reads its history
   // back from the session's log.
   const std::string before = status().value("instance", "");
   const int pid = std::stoi(ReadFile(out + "/run/instructor_station.pid"));
   ASSERT_EQ(kill(pid, SIGKILL), 0);
-  ASSERT_TRUE(until(
+  ASSERT_TRUE(Until(
       [&] {
         const auto s = status();
         return s.contains("instance") && s["instance"] != before;
@@ -325,6 +341,10 @@ TEST(InstructorStation, ARestartedStationRecoversItsHistoryAndADebriefScrubsAndM
       << ReadFile(tmp + "/lab.log");
   const auto s = status();
   EXPECT_TRUE(s["session"]["restarted"].get<bool>()) << s.dump();
+  const nlohmann::json early = command_state(early_id);
+  EXPECT_EQ(early.value("name", ""), "early.json") << early.dump();
+  EXPECT_EQ(early.value("state", ""), "done") << early.dump();
+  EXPECT_GT(page_command("command=checkpoint&name=later"), early_id) << "an id used again";
   // ... and the page, in a browser, says so.
   std::string page_url = ReadFile(out + "/run/instructor.url");
   while (!page_url.empty() && std::isspace(static_cast<unsigned char>(page_url.back())))
@@ -357,7 +377,7 @@ TEST(InstructorStation, ARestartedStationRecoversItsHistoryAndADebriefScrubsAndM
       {SourcePath("scripts/lab"), "debrief", out, "--no-build", "--port", "0", "--for", "200"},
       tmp + "/debrief.log");
   std::string url;
-  ASSERT_TRUE(until(
+  ASSERT_TRUE(Until(
       [&] {
         const std::string log = ReadFile(tmp + "/debrief.log");
         const auto at = log.find("debrief of ");
@@ -457,6 +477,19 @@ TEST(InstructorStation, ALessonAtStartAndOneLoadedOnThePageFireAndReSimulate) {
   }
   ASSERT_TRUE(lesson["loaded"].get<bool>()) << lesson.dump();
   ASSERT_TRUE(lesson["events"][1]["fired"].get<bool>()) << lesson.dump();
+  for (const auto& e : lesson["events"])  // what became of each event's command, as it was answered
+    EXPECT_TRUE(Until(
+        [&] {
+          const auto r = web.Get("/api/lesson" + auth);
+          if (!r) return false;
+          const auto l = nlohmann::json::parse(r->body);
+          for (const auto& x : l["events"])
+            if (x["text"] == e["text"])
+              return x.contains("outcome") && x["outcome"]["state"] == "done";
+          return false;
+        },
+        10))
+        << e.dump();
   EXPECT_GE(lesson["events"][0]["fired_at_s"].get<double>(), 3.0);
   // The station killed: restarted, it carries on with the lesson in force
   // (run/instructor_lesson.json), and fires none of its events again.
@@ -477,7 +510,10 @@ TEST(InstructorStation, ALessonAtStartAndOneLoadedOnThePageFireAndReSimulate) {
       break;
     }
     ASSERT_TRUE(again.is_object()) << "the station did not come back";
-    EXPECT_EQ(again["events"], lesson["events"]) << again.dump();
+    ASSERT_EQ(again["events"].size(), lesson["events"].size()) << again.dump();
+    for (std::size_t i = 0; i < lesson["events"].size(); ++i)
+      for (const char* key : {"text", "fired", "fired_at_s", "command_id"})
+        EXPECT_EQ(again["events"][i][key], lesson["events"][i][key]) << key << again.dump();
   }
   // On the page: a bad lesson refused naming its key, the one in force kept...
   const auto refused =
@@ -513,6 +549,33 @@ TEST(InstructorStation, ALessonAtStartAndOneLoadedOnThePageFireAndReSimulate) {
   // (the restarted station's own run: the page's lesson's one event)
   EXPECT_EQ(stats["counters"].value("lesson.events", 0), 1);
   EXPECT_TRUE(summary["resimulation"]["exact"].get<bool>()) << summary["resimulation"].dump();
+  // The debrief shows the lesson the session ended with, its event's outcome.
+  Subprocess debrief(
+      {SourcePath("scripts/lab"), "debrief", out, "--no-build", "--port", "0", "--for", "60"},
+      tmp + "/debrief.log");
+  nlohmann::json shown;
+  EXPECT_TRUE(Until(
+      [&] {
+        const std::string log = ReadFile(tmp + "/debrief.log");
+        const auto said = log.find("debrief of ");  // the launcher's line, with the token
+        const auto at = log.find("http://", said == std::string::npos ? log.size() : said);
+        if (at == std::string::npos || log.find('\n', at) == std::string::npos) return false;
+        int debrief_port = 0;
+        std::string debrief_token;
+        SplitUrl(log.substr(at, log.find('\n', at) - at), &debrief_port, &debrief_token);
+        httplib::Client page("127.0.0.1", debrief_port);
+        const auto r = page.Get("/api/lesson?token=" + debrief_token);
+        if (!r || r->status != 200) return false;
+        shown = nlohmann::json::parse(r->body);
+        return true;
+      },
+      60))
+      << ReadFile(tmp + "/debrief.log");
+  EXPECT_NE(shown.value("source", "").find("near.toml"), std::string::npos) << shown.dump();
+  ASSERT_EQ(shown["events"].size(), 1u) << shown.dump();
+  EXPECT_EQ(shown["events"][0]["outcome"]["state"], "done") << shown.dump();
+  debrief.Signal(SIGINT);
+  EXPECT_EQ(debrief.Wait(30), 0) << ReadFile(tmp + "/debrief.log");
   fs::remove_all(tmp);
 }
 

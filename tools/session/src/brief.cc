@@ -216,6 +216,8 @@ void SessionLines(const Json& j, std::ostream& os) {
     os << "\n";
     for (std::size_t i = 0; i < refused.size() && i < 5; ++i)
       os << "  refused: " << refused[i] << "\n";
+    if (refused.size() > 5)
+      os << "  ... and " << refused.size() - 5 << " more refused (summary.json \"control\")\n";
   }
   if (j.contains("malfunctions") && !j["malfunctions"].empty()) {
     // docs/sessions.md "Malfunctions": as the DCP took them, at session time.

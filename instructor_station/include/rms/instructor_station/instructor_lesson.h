@@ -25,6 +25,7 @@ struct LessonCommand {
   std::int8_t command = 0;
   std::string name;
   std::string said;  // for the events list and the log ("" for a timed RUN)
+  int event = -1;    // the lesson's event it fires (-1: a timed freeze's RUN)
 };
 
 class InstructorLesson {
@@ -51,7 +52,11 @@ class InstructorLesson {
   // rate), and the RUN of a timed freeze whose wall time (now_us) came.
   std::vector<LessonCommand> Due(const dcp_telemetry_t* telemetry, double frame_rate_hz,
                                  std::int64_t now_us);
-  // {"loaded", "source", "events": [{"text", "fired", "fired_at_s"}]}.
+  // The page's id of the command event `event` fired (ControlQueue), so
+  // the page shows what became of it (done or refused, never "sent").
+  void NoteCommandId(int event, std::int64_t id);
+  // {"loaded", "source", "events": [{"text", "fired", "fired_at_s",
+  // "command_id" (null before it fired)}]}.
   nlohmann::json Json() const;
 
  private:
@@ -63,6 +68,7 @@ class InstructorLesson {
   std::string source_, text_;
   nlohmann::json loaded_ = nlohmann::json::array();  // every lesson loaded: when, source, text
   std::vector<double> fired_at_s_;                   // -1: not yet
+  std::vector<std::int64_t> command_id_;             // -1: none (yet)
   std::vector<std::int64_t> run_at_us_;              // timed freezes' RUNs still due
 };
 

@@ -63,7 +63,11 @@ struct SessionState {
 // One of this station's own commands and the answers it has had
 // (RMS_CONTROL_ANSWER): the page shows each outcome, never "sent".
 struct CommandRecord {
-  std::int64_t id = 0;  // its sequence (with this station's pid, its id on the wire)
+  // Its sequence: with `pid`, its id on the wire. A restarted station goes
+  // on from the last sequence its earlier instances sent (NextCommandId), so
+  // a page's id means one command through restarts.
+  std::int64_t id = 0;
+  std::int32_t pid = 0;  // the station that sent it (this one, or an earlier instance)
   std::int8_t command = 0;
   std::string name;
   std::int64_t sent_wall_us = 0;
@@ -142,6 +146,9 @@ class SessionWatch {
   // A command of this station's about to be sent: its answers are kept
   // (CommandJson).
   void NoteCommand(std::int64_t id, std::int8_t command, const std::string& name);
+  // The id this station's next command takes: after every one an earlier
+  // instance of it sent (read back from the log), so ids never repeat.
+  std::int64_t NextCommandId() const;
   // {id, command, name, state: pending|done|refused|unanswered, answers}.
   nlohmann::json CommandJson(std::int64_t id) const;
 
@@ -232,6 +239,10 @@ class SessionWatch {
   std::set<std::tuple<int, std::int32_t, std::int64_t>> commands_seen_;
   std::set<std::tuple<int, std::int32_t, std::int64_t, int>> answers_seen_;
   std::map<std::tuple<int, std::int32_t, std::int64_t>, std::string> command_texts_;
+  // With mu_ held: one of this station's commands, or an earlier instance's.
+  void RecordCommand(std::int64_t id, std::int32_t pid, std::int8_t command,
+                     const std::string& name, std::int64_t wall_us);
+  std::int64_t next_command_id_ = 0;
   std::deque<CommandRecord> own_commands_;  // the last kMaxCommands of this station's
   SessionState state_;
   std::optional<operator_state_t> operator_;

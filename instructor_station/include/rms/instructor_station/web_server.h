@@ -37,6 +37,8 @@ class ControlQueue {
   std::int64_t Push(ControlRequest r);
   // The requests due by `now_us`, in order.
   std::vector<ControlRequest> Drain(std::int64_t now_us);
+  // The first id (a restarted station's: SessionWatch::NextCommandId).
+  void set_next_id(std::int64_t id) { next_id_ = id; }
 
  private:
   std::mutex mu_;
