@@ -23,9 +23,9 @@
 #include <vector>
 
 #include "rms/base/config.h"
-#include "rms/dynamics_proc/collision.h"
-#include "rms/dynamics_proc/dcp_models.h"
-#include "rms/dynamics_proc/dynamic_collision_program.h"
+#include "rms/dcp_model/collision.h"
+#include "rms/dcp_model/dcp_models.h"
+#include "rms/dcp_model/dynamic_collision_program.h"
 #include "rms/reference/exact_hull.h"
 #include "rms/reference/generators.h"
 #include "rms/sim/closed_loop.h"
@@ -47,25 +47,25 @@ rms::bench::BoxShape Shape(const rms::reference::Solid& s) {
   return b;
 }
 
-rms::dynamics_proc::CollideOptions VerdictOnly() {
-  rms::dynamics_proc::CollideOptions o;
+rms::dcp_model::CollideOptions VerdictOnly() {
+  rms::dcp_model::CollideOptions o;
   o.want_plane = false;
   return o;
 }
 
 struct Sets {
-  std::vector<std::pair<rms::dynamics_proc::Hexahedron, rms::dynamics_proc::Hexahedron>> hex_boxes,
+  std::vector<std::pair<rms::dcp_model::Hexahedron, rms::dcp_model::Hexahedron>> hex_boxes,
       hex_general;
   std::vector<std::pair<rms::bench::BoxShape, rms::bench::BoxShape>> boxes;
   std::vector<std::pair<Hull, Hull>> hulls_boxes, hulls_general;
   std::vector<std::unique_ptr<rms::bench::FclPair>> fcl_boxes, fcl_general;
   // Dense: pairs whose bounding spheres overlap (what Mode 1 sees with the
   // end effector at the receptacle), half of them colliding.
-  std::vector<std::pair<rms::dynamics_proc::Hexahedron, rms::dynamics_proc::Hexahedron>>
-      hex_dense_boxes, hex_dense_general;
+  std::vector<std::pair<rms::dcp_model::Hexahedron, rms::dcp_model::Hexahedron>> hex_dense_boxes,
+      hex_dense_general;
   // Those of the dense boxes no face separates and no edge pierces (the
   // report's step 4: separate, the plane from the edges).
-  std::vector<std::pair<rms::dynamics_proc::Hexahedron, rms::dynamics_proc::Hexahedron>>
+  std::vector<std::pair<rms::dcp_model::Hexahedron, rms::dcp_model::Hexahedron>>
       hex_dense_boxes_no_edge_pierces;
   std::vector<std::pair<rms::bench::BoxShape, rms::bench::BoxShape>> dense_boxes;
   std::vector<std::unique_ptr<rms::bench::FclPair>> fcl_dense_boxes, fcl_dense_general;
@@ -73,8 +73,8 @@ struct Sets {
   // The pairs the DCP tests in the Mode 1 frames of an autopilot mission
   // (EFF HEX 1-3 against the BAR and its posts: boxes; against the payload's
   // strips: general hexahedra), 4096 of each taken evenly in flight order.
-  std::vector<std::pair<rms::dynamics_proc::Hexahedron, rms::dynamics_proc::Hexahedron>>
-      hex_mission_boxes, hex_mission_general;
+  std::vector<std::pair<rms::dcp_model::Hexahedron, rms::dcp_model::Hexahedron>> hex_mission_boxes,
+      hex_mission_general;
   std::vector<std::pair<rms::bench::BoxShape, rms::bench::BoxShape>> mission_boxes;
   std::vector<std::unique_ptr<rms::bench::FclPair>> fcl_mission_boxes, fcl_mission_general;
   int mission_frames = 0, mission_boxes_colliding = 0, mission_general_colliding = 0;
@@ -116,14 +116,14 @@ int MakeDenseSet(rms::reference::PairGenerator& gen, bool boxes, Take take) {
   return colliding;
 }
 
-Hull HullOf(const rms::dynamics_proc::Hexahedron& h) {
+Hull HullOf(const rms::dcp_model::Hexahedron& h) {
   Hull v;
   for (int i = 0; i < 8; ++i) v[i] = h.vertex(i);
   return v;
 }
 
 // A box hexahedron (MakeBox's numbering) as centre, axes and half extents.
-rms::bench::BoxShape BoxOf(const rms::dynamics_proc::Hexahedron& h) {
+rms::bench::BoxShape BoxOf(const rms::dcp_model::Hexahedron& h) {
   rms::bench::BoxShape b;
   b.centre = Eigen::Vector3d::Zero();
   for (int i = 0; i < 8; ++i) b.centre += h.vertex(i) / 8.0;
@@ -139,7 +139,7 @@ rms::bench::BoxShape BoxOf(const rms::dynamics_proc::Hexahedron& h) {
 // The mission's Mode 1 pairs: the planned autopilot's flight replayed
 // through the DCP, each Mode 1 frame's models rebuilt from its status.
 void MakeMissionSets(Sets* s) {
-  using namespace rms::dynamics_proc;
+  using namespace rms::dcp_model;
   const rms::LabConfig config = rms::LoadConfig(rms::DefaultConfigPath());
   std::vector<rms::wire::OperatorInputs> inputs;
   rms::sim::FlyAutopilot(config, {}, 20000, 1, &inputs);
@@ -200,8 +200,8 @@ Sets MakeSets() {
   rms::reference::PairGenerator dense(271828);
   s.dense_boxes_colliding = MakeDenseSet(dense, true, [&s](const Pair& p) {
     s.hex_dense_boxes.emplace_back(p.a.hex, p.b.hex);
-    if (rms::dynamics_proc::Collide(p.a.hex, p.b.hex, VerdictOnly()).decider ==
-        rms::dynamics_proc::Decider::kNoEdgePierces)
+    if (rms::dcp_model::Collide(p.a.hex, p.b.hex, VerdictOnly()).decider ==
+        rms::dcp_model::Decider::kNoEdgePierces)
       s.hex_dense_boxes_no_edge_pierces.emplace_back(p.a.hex, p.b.hex);
     s.dense_boxes.emplace_back(Shape(p.a), Shape(p.b));
     s.fcl_dense_boxes.push_back(rms::bench::FclPair::Boxes(Shape(p.a), Shape(p.b)));
@@ -257,8 +257,8 @@ void Tally(const Pair& p, bool exact, const Verdicts& says, Agreement* ag) {
 }
 
 bool DcpSaysCollide(const Pair& p) {
-  return rms::dynamics_proc::Collide(p.a.hex, p.b.hex, VerdictOnly()).verdict ==
-         rms::dynamics_proc::Verdict::kCollide;
+  return rms::dcp_model::Collide(p.a.hex, p.b.hex, VerdictOnly()).verdict ==
+         rms::dcp_model::Verdict::kCollide;
 }
 
 // Every method's verdict against the exact reference on the generator's box
@@ -303,21 +303,21 @@ void Cycle(benchmark::State& st, F&& f) {
 
 // The DCP's Collide on a set's pairs with these options.
 template <class Pairs>
-void RegisterDcp(const char* name, const Pairs& pairs, rms::dynamics_proc::CollideOptions o) {
+void RegisterDcp(const char* name, const Pairs& pairs, rms::dcp_model::CollideOptions o) {
   benchmark::RegisterBenchmark(name, [&pairs, o](benchmark::State& st) {
     Cycle(st, [&](std::size_t i) {
-      return rms::dynamics_proc::Collide(pairs[i].first, pairs[i].second, o).verdict;
+      return rms::dcp_model::Collide(pairs[i].first, pairs[i].second, o).verdict;
     });
   });
 }
 
 // Boxes: the DCP with and without its rejections, and every peer.
 void RegisterBoxTimings(const Sets& sets) {
-  const rms::dynamics_proc::CollideOptions verdict_only = VerdictOnly();
-  rms::dynamics_proc::CollideOptions report_only = verdict_only;
+  const rms::dcp_model::CollideOptions verdict_only = VerdictOnly();
+  rms::dcp_model::CollideOptions report_only = verdict_only;
   report_only.sphere_reject = false;
   report_only.aabb_reject = false;
-  rms::dynamics_proc::CollideOptions spheres_only = verdict_only;
+  rms::dcp_model::CollideOptions spheres_only = verdict_only;
   spheres_only.aabb_reject = false;
   RegisterDcp("boxes/DCP, verdict", sets.hex_boxes, verdict_only);
   RegisterDcp("boxes/DCP, verdict, no bounding-volume rejection", sets.hex_boxes, report_only);
@@ -353,7 +353,7 @@ void RegisterBoxTimings(const Sets& sets) {
 // Dense pairs: bounding spheres overlapping, half colliding; the widest
 // edge axis; the mission's own pairs.
 void RegisterDenseTimings(const Sets& sets) {
-  const rms::dynamics_proc::CollideOptions verdict_only = VerdictOnly();
+  const rms::dcp_model::CollideOptions verdict_only = VerdictOnly();
   RegisterDcp("dense boxes/DCP, verdict", sets.hex_dense_boxes, verdict_only);
   RegisterDcp("dense boxes/DCP, verdict and separating plane", sets.hex_dense_boxes, {});
   benchmark::RegisterBenchmark("dense boxes/separating axes, 15 (double)",
@@ -374,8 +374,8 @@ void RegisterDenseTimings(const Sets& sets) {
     benchmark::RegisterBenchmark(
         all ? "widest edge axis/all 144 axes" : "widest edge axis/skipping axes",
         [&sets, all](benchmark::State& st) {
-          const auto search = all ? rms::dynamics_proc::internal::WidestEdgeAxisExhaustive
-                                  : rms::dynamics_proc::internal::WidestEdgeAxis;
+          const auto search = all ? rms::dcp_model::internal::WidestEdgeAxisExhaustive
+                                  : rms::dcp_model::internal::WidestEdgeAxis;
           const auto& pairs = sets.hex_dense_boxes_no_edge_pierces;
           std::size_t i = 0;
           for (auto _ : st) {
@@ -416,7 +416,7 @@ void RegisterDenseTimings(const Sets& sets) {
 
 // General hexahedra.
 void RegisterGeneralTimings(const Sets& sets) {
-  const rms::dynamics_proc::CollideOptions verdict_only = VerdictOnly();
+  const rms::dcp_model::CollideOptions verdict_only = VerdictOnly();
   RegisterDcp("general/DCP, verdict", sets.hex_general, verdict_only);
   RegisterDcp("general/DCP, verdict and separating plane", sets.hex_general, {});
   benchmark::RegisterBenchmark("general/libccd MPR", [&sets](benchmark::State& st) {
@@ -490,7 +490,7 @@ void WidestEdgeAxisTable(const Collector& collector, const Sets& sets, std::ostr
   if (skip <= 0 || all <= 0 || pairs.empty()) return;
   long axes = 0;
   for (const auto& [a, b] : pairs)
-    axes += rms::dynamics_proc::internal::WidestEdgeAxis(a, b).axes_computed;
+    axes += rms::dcp_model::internal::WidestEdgeAxis(a, b).axes_computed;
   char line[400];
   std::snprintf(
       line, sizeof line,

@@ -27,7 +27,7 @@
 
 #include "rms/base/command_line.h"
 #include "rms/base/text.h"
-#include "rms/dynamics_proc/dynamic_collision_program.h"
+#include "rms/dcp_model/dynamic_collision_program.h"
 #include "rms/sim/closed_loop.h"
 #include "rms/sim/random_operator.h"
 #include "rms/wire/word_codec.h"
@@ -39,7 +39,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using rms::Sprintf;
 using rms::bench::Percentile;
-using namespace rms::dynamics_proc;
+using namespace rms::dcp_model;
 
 // ---------------------------------------------------------------- 1. frame
 

@@ -37,8 +37,8 @@
 
 #include "rms/base/command_line.h"
 #include "rms/base/text.h"
-#include "rms/dynamics_proc/dynamic_collision_program.h"
-#include "rms/dynamics_proc/dynamics_proc.h"
+#include "rms/dcp_model/dcp_telemetry.h"
+#include "rms/dcp_model/dynamic_collision_program.h"
 #include "rms/reference/exact_hull.h"
 #include "rms/reference/generators.h"
 #include "rms/sim/closed_loop.h"
@@ -47,7 +47,7 @@
 namespace {
 
 using namespace rms;
-using namespace rms::dynamics_proc;
+using namespace rms::dcp_model;
 using rms::reference::Pair;
 
 constexpr double kBand = 1e-9;
@@ -222,7 +222,7 @@ void StressPoses(const LabConfig& config, long n, std::uint64_t seed, Failures* 
     if (k == 4) in.value[4] = (u(rng) > 0 ? 90 : -90) + 1e-9 * u(rng);
     const wire::OperatorInputs dec =
         wire::DecodeInputs(wire::EncodeInputs(in, cal, &counters), cal, &counters);
-    arm::ArmSinCos sc = dynamics_proc::TransmittedArmWords(
+    arm::ArmSinCos sc = dcp_model::TransmittedArmWords(
         {dec.value[0], dec.value[1], dec.value[2], dec.value[3], dec.value[4], dec.value[5]});
     const arm::ArmPose pose = arm::ComputeArmPose(config.arm, sc, dec.value[kShoulderHeight]);
     const std::string what = Sprintf("pose %ld (kind %d)", i, k);

@@ -6,7 +6,7 @@
 #include <string_view>
 
 #include "rms/base/check.h"
-#include "rms/dynamics_proc/dynamic_collision_program.h"
+#include "rms/dcp_model/dynamic_collision_program.h"
 #include "rms/operator_station/timeline.h"
 #include "rms/session/lab_file.h"
 #include "rms/wire/checkpoint.h"
@@ -30,7 +30,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         break;
       default: {
         const rms::wire::Checkpoint c = rms::wire::ParseCheckpoint(text, "fuzz.json");
-        rms::dynamics_proc::DynamicCollisionProgram dcp(config);
+        rms::dcp_model::DynamicCollisionProgram dcp(config);
         dcp.RestoreState(c.dcp);
         dcp.Step(c.inputs);
         break;

@@ -5,36 +5,36 @@
 #include <cstdio>
 #include <sstream>
 
-#include "rms/dynamics_proc/collision.h"
+#include "rms/dcp_model/collision.h"
 #include "rms/reference/exact_hull.h"
 #include "rms/reference/generators.h"
 
 namespace rms::reference {
 
 namespace {
-const char* DeciderName(dynamics_proc::Decider d) {
+const char* DeciderName(dcp_model::Decider d) {
   switch (d) {
-    case dynamics_proc::Decider::kVertexOfAInB:
+    case dcp_model::Decider::kVertexOfAInB:
       return "vertex of A in B";
-    case dynamics_proc::Decider::kVertexOfBInA:
+    case dcp_model::Decider::kVertexOfBInA:
       return "vertex of B in A";
-    case dynamics_proc::Decider::kFaceOfBSeparates:
+    case dcp_model::Decider::kFaceOfBSeparates:
       return "face of B separates";
-    case dynamics_proc::Decider::kFaceOfASeparates:
+    case dcp_model::Decider::kFaceOfASeparates:
       return "face of A separates";
-    case dynamics_proc::Decider::kEdgeOfAPiercesB:
+    case dcp_model::Decider::kEdgeOfAPiercesB:
       return "edge of A pierces B";
-    case dynamics_proc::Decider::kEdgeOfBPiercesA:
+    case dcp_model::Decider::kEdgeOfBPiercesA:
       return "edge of B pierces A";
-    case dynamics_proc::Decider::kNoEdgePierces:
+    case dcp_model::Decider::kNoEdgePierces:
       return "no edge pierces";
-    case dynamics_proc::Decider::kNonFinite:
+    case dcp_model::Decider::kNonFinite:
       return "invalid";
-    case dynamics_proc::Decider::kSpheresApart:
+    case dcp_model::Decider::kSpheresApart:
       return "bounding spheres apart";
-    case dynamics_proc::Decider::kHintPlane:
+    case dcp_model::Decider::kHintPlane:
       return "previous plane separates";
-    case dynamics_proc::Decider::kBoxesApart:
+    case dcp_model::Decider::kBoxesApart:
       return "bounding boxes apart";
   }
   return "?";
@@ -86,21 +86,21 @@ bool ReferenceHit(const Pair& p, long n, int exact_every, CompareStats* st) {
 
 // The DCP's verdict and plane against the reference's, within the band
 // (docs/collision.md "Tolerance rule": 1000 x tau).
-void Judge(const Pair& p, const dynamics_proc::CollisionResult& r, bool ref_hit, long n,
-           double scale, double band_rel, const Topology& topo, CompareStats* st) {
-  const double band = 1000.0 * dynamics_proc::ToleranceFt(p.a.hex, p.b.hex, band_rel / 1000.0);
+void Judge(const Pair& p, const dcp_model::CollisionResult& r, bool ref_hit, long n, double scale,
+           double band_rel, const Topology& topo, CompareStats* st) {
+  const double band = 1000.0 * dcp_model::ToleranceFt(p.a.hex, p.b.hex, band_rel / 1000.0);
   const double s = std::max(p.a.hex.scale, p.b.hex.scale);
-  if (r.verdict == dynamics_proc::Verdict::kInvalid) {
+  if (r.verdict == dcp_model::Verdict::kInvalid) {
     ++st->invalid;
     if (st->examples.size() < 10) {
       st->examples.push_back(
           "pair " + std::to_string(n) + " (" + p.kind + ", scale " + std::to_string(scale) +
           "): invalid: " +
-          dynamics_proc::HexProblemName(p.a.hex.valid ? p.b.hex.problem : p.a.hex.problem));
+          dcp_model::HexProblemName(p.a.hex.valid ? p.b.hex.problem : p.a.hex.problem));
     }
     return;
   }
-  const bool dcp_hit = r.verdict == dynamics_proc::Verdict::kCollide;
+  const bool dcp_hit = r.verdict == dcp_model::Verdict::kCollide;
   // The pair's separation, only when needed: distance if disjoint, minus
   // the penetration depth if overlapping.
   auto separation = [&] {
@@ -128,7 +128,7 @@ void Judge(const Pair& p, const dynamics_proc::CollisionResult& r, bool ref_hit,
     // Separate: the plane must separate the solids (within the band).
     if (!r.plane_valid) {
       if (separation() > band) ++st->plane_missing;
-    } else if (!dynamics_proc::PlaneSeparates(p.a.hex, p.b.hex, r.plane.n_R, r.plane.d_ft, band)) {
+    } else if (!dcp_model::PlaneSeparates(p.a.hex, p.b.hex, r.plane.n_R, r.plane.d_ft, band)) {
       ++st->plane_wrong;
     }
   }
@@ -148,7 +148,7 @@ CompareStats Compare(std::uint64_t seed, long count, double band_rel, int exact_
     ++st.pairs;
     ++st.pairs_by_kind[p.kind];
     const auto t0 = Clock::now();
-    const dynamics_proc::CollisionResult r = dynamics_proc::Collide(p.a.hex, p.b.hex);
+    const dcp_model::CollisionResult r = dcp_model::Collide(p.a.hex, p.b.hex);
     const auto t1 = Clock::now();
     const bool ref_hit = ReferenceHit(p, n, exact_every, &st);
     const auto t2 = Clock::now();

@@ -7,8 +7,8 @@
 #include <optional>
 #include <random>
 
-#include "rms/dynamics_proc/dynamic_collision_program.h"
-#include "rms/dynamics_proc/dynamics_proc.h"
+#include "rms/dcp_model/dcp_telemetry.h"
+#include "rms/dcp_model/dynamic_collision_program.h"
 #include "rms/wire/input_block.h"
 
 #include "flight_log.h"
@@ -64,7 +64,7 @@ ClosedLoopResult Fly(const LabConfig& config, const VirtualSubject& subject, int
   const double kick = subject.tremor_deg * std::sqrt(1.0 - a * a);
   std::array<double, 6> wander{};
   bool colliding = false;
-  dynamics_proc::DynamicCollisionProgram program(config);
+  dcp_model::DynamicCollisionProgram program(config);
   std::deque<dcp_telemetry_t> in_flight;
   std::optional<dcp_telemetry_t> seen;
   for (int f = 0; f < max_frames; ++f) {
@@ -81,7 +81,7 @@ ClosedLoopResult Fly(const LabConfig& config, const VirtualSubject& subject, int
     wire::DcpFrameData out = program.Step(decoded);
     out.frame = f;
     out.input_frame = f;
-    dcp_telemetry_t tm = dynamics_proc::MakeTelemetry(program.status(), out);
+    dcp_telemetry_t tm = dcp_model::MakeTelemetry(program.status(), out);
     ObserveFrame(tm, f, &colliding, &r);
     in_flight.push_back(tm);
     while (static_cast<int>(in_flight.size()) > latency_frames) {

@@ -4,7 +4,7 @@
 #include <memory>
 
 #include "rms/base/check.h"
-#include "rms/dynamics_proc/dynamics_proc.h"
+#include "rms/dcp_model/dcp_telemetry.h"
 #include "rms/operator_station/devices.h"
 #include "rms/operator_station/input_sources.h"
 #include "rms/operator_station/status_screen.h"
@@ -102,7 +102,7 @@ void OfflineStation::StepFrame() {
   const int f = static_cast<int>(frames_);
   out.frame = f;
   out.input_frame = f;
-  const dcp_telemetry_t tm = dynamics_proc::MakeTelemetry(program_.status(), out);
+  const dcp_telemetry_t tm = dcp_model::MakeTelemetry(program_.status(), out);
   ObserveFrame(tm, f, &colliding_, &result_);
   inputs_ = in;
   telemetry_ = tm;  // read by the next frame, as over LCM

@@ -5,7 +5,7 @@
 #include <cstring>
 
 #include "rms/base/check.h"
-#include "rms/dynamics_proc/dynamics_proc.h"
+#include "rms/dcp_model/dcp_telemetry.h"
 #include "rms/esg_renderer/gl_context.h"
 #include "rms/esg_renderer/overlay.h"
 #include "rms/esg_renderer/png_io.h"
@@ -20,7 +20,7 @@ namespace {
 // from this frame's telemetry (a by-hand session in manual augmented control).
 operator_state_t StateOf(const LabConfig& config, const OfflineSession& s,
                          operator_station::CommandFrame frame) {
-  const dcp_telemetry_t t = dynamics_proc::MakeTelemetry(s.status(), s.dcp());
+  const dcp_telemetry_t t = dcp_model::MakeTelemetry(s.status(), s.dcp());
   const operator_station::ArmState arm = operator_station::ArmStateFrom(t);
   if (frame == operator_station::CommandFrame::kPayload && arm.mode == 1)
     frame = operator_station::CommandFrame::kEndEffector;

@@ -10,7 +10,7 @@
 #include "rms/mission/mission_plan.h"
 #include "rms/wire/input_block.h"
 
-namespace rms::dynamics_proc::testing {
+namespace rms::dcp_model::testing {
 
 class DcpFixture : public ::testing::Test {
  protected:
@@ -40,4 +40,4 @@ class DcpFixture : public ::testing::Test {
   }
 };
 
-}  // namespace rms::dynamics_proc::testing
+}  // namespace rms::dcp_model::testing

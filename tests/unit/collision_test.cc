@@ -1,6 +1,6 @@
 // The DCP's collision algorithm (report IV.A.1): hand-made cases, then
 // agreement with the independent references on generated pairs.
-#include "rms/dynamics_proc/collision.h"
+#include "rms/dcp_model/collision.h"
 
 #include <bit>
 #include <cmath>
@@ -12,7 +12,7 @@
 #include "rms/reference/compare.h"
 #include "rms/reference/generators.h"
 
-namespace rms::dynamics_proc {
+namespace rms::dcp_model {
 namespace {
 
 using Eigen::Matrix3d;
@@ -450,4 +450,4 @@ TEST(WidestEdgeAxis, SkippingAxesGivesTheExhaustiveSearchsAnswerBitForBit) {
 }
 
 }  // namespace
-}  // namespace rms::dynamics_proc
+}  // namespace rms::dcp_model

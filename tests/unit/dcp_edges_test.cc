@@ -10,15 +10,15 @@
 
 #include "rms/base/check.h"
 #include "rms/base/config.h"
-#include "rms/dynamics_proc/dcp_models.h"
-#include "rms/dynamics_proc/dynamic_collision_program.h"
+#include "rms/dcp_model/dcp_models.h"
+#include "rms/dcp_model/dynamic_collision_program.h"
 #include "rms/mission/arm_ik.h"
 #include "rms/mission/mission_plan.h"
 #include "rms/scene_model/scene_model.h"
 
 #include "dcp_fixture.h"
 
-namespace rms::dynamics_proc {
+namespace rms::dcp_model {
 namespace {
 
 using Eigen::Isometry3d;
@@ -326,9 +326,9 @@ TEST_F(DcpEdges, ACheckpointMissingItsLastKeyLeavesTheStateUnchanged) {
 }
 
 }  // namespace
-}  // namespace rms::dynamics_proc
+}  // namespace rms::dcp_model
 
-namespace rms::dynamics_proc {
+namespace rms::dcp_model {
 namespace {
 
 // The distance of p from a convex hexahedron's surface, ft, signed (> 0
@@ -377,4 +377,4 @@ TEST(DcpModels, WhatIsTestedIsWhatIsDrawn) {
 }
 
 }  // namespace
-}  // namespace rms::dynamics_proc
+}  // namespace rms::dcp_model

@@ -15,8 +15,8 @@
 #include "rms/base/check.h"
 #include "rms/base/config.h"
 #include "rms/dcp_frame_t.hpp"
-#include "rms/dynamics_proc/dcp_models.h"
-#include "rms/dynamics_proc/dynamic_collision_program.h"
+#include "rms/dcp_model/dcp_models.h"
+#include "rms/dcp_model/dynamic_collision_program.h"
 #include "rms/dynamics_proc/dynamics_proc.h"
 #include "rms/mission/arm_ik.h"
 #include "rms/mission/mission_plan.h"
@@ -28,7 +28,7 @@
 
 #include "dcp_fixture.h"
 
-namespace rms::dynamics_proc {
+namespace rms::dcp_model {
 namespace {
 
 using Eigen::Isometry3d;
@@ -440,7 +440,7 @@ TEST_F(Dcp, ACheckpointsTextHoldsItsStateAndIsReadAsParseCheckpointReadsIt) {
 }
 
 }  // namespace
-}  // namespace rms::dynamics_proc
+}  // namespace rms::dcp_model
 
 namespace rms {
 namespace {
@@ -456,7 +456,7 @@ TEST(CheckpointFolderTest, NamesOnlyNewFilesNoLinksAndASizeCap) {
   fs::create_directories(root / "elsewhere");
   const wire::CheckpointFolder folder((root / "checkpoints").string());
   wire::Checkpoint c;
-  c.dcp = dynamics_proc::DynamicCollisionProgram(
+  c.dcp = dcp_model::DynamicCollisionProgram(
               LoadConfig(std::string(RMSLAB_SOURCE_DIR) + "/config/rmslab.toml"))
               .SaveState();
   folder.Write("good.json", c);

@@ -10,10 +10,10 @@
 
 #include "rms/base/check.h"
 #include "rms/dcp_frame_t.hpp"
+#include "rms/dcp_model/dynamic_collision_program.h"
+#include "rms/dcp_model/malfunctions.h"
 #include "rms/dcp_state_t.hpp"
-#include "rms/dynamics_proc/dynamic_collision_program.h"
 #include "rms/dynamics_proc/dynamics_proc.h"
-#include "rms/dynamics_proc/malfunctions.h"
 #include "rms/mission/mission_plan.h"
 #include "rms/operator_station/follow_watch.h"
 #include "rms/operator_station/timeline.h"
@@ -128,7 +128,7 @@ TEST(MalfunctionText, ARepairClearsOnlyItsOwn) {
 // The Malfunctions object alone, at 10 Hz: every number exact.
 class MalfunctionsAlone : public ::testing::Test {
  protected:
-  dynamics_proc::Malfunctions m{
+  dcp_model::Malfunctions m{
       10.0, {-180, -180, -180, -180, -180, -180}, {180, 180, 180, 180, 180, 180}};
   std::array<double, 6> slave{10, 20, 30, 40, 50, 60};
 };
@@ -155,7 +155,7 @@ TEST_F(MalfunctionsAlone, ADriftingJointTurnsAtItsRateFromWhereItIs) {
   m.Apply(slave, &cmd, &finger);
   EXPECT_DOUBLE_EQ(cmd[0], 10.0 - 0.2);  // 2 deg/s at 10 Hz
   // Within the joint's range.
-  dynamics_proc::Malfunctions edge(10.0, {9.9, 0, 0, 0, 0, 0}, {180, 180, 180, 180, 180, 180});
+  dcp_model::Malfunctions edge(10.0, {9.9, 0, 0, 0, 0, 0}, {180, 180, 180, 180, 180, 180});
   edge.Inject(wire::ParseMalfunction("joint 1 drift -20"), slave, 0.3);
   edge.Apply(slave, &cmd, &finger);
   EXPECT_EQ(cmd[0], 9.9);
@@ -204,8 +204,8 @@ TEST_F(MalfunctionsAlone, DelayedInputsAreAnsweredExactlyThatManyFramesLate) {
   for (int k = 5; k < 12; ++k) got.push_back(m.Delay(block(k)).value[0]);
   EXPECT_EQ(got, (std::vector<double>{4, 4, 4, 5, 6, 7, 8}));
   // Through the checkpoint: the line goes on the same.
-  dynamics_proc::Malfunctions copy(10.0, {-180, -180, -180, -180, -180, -180},
-                                   {180, 180, 180, 180, 180, 180});
+  dcp_model::Malfunctions copy(10.0, {-180, -180, -180, -180, -180, -180},
+                               {180, 180, 180, 180, 180, 180});
   copy.FromJson(nlohmann::json::parse(m.ToJson().dump()));
   for (int k = 12; k < 20; ++k)
     EXPECT_EQ(copy.Delay(block(k)).value[0], m.Delay(block(k)).value[0]);
@@ -228,7 +228,7 @@ TEST_F(MalfunctionsAlone, ABadStateIsRefusedAndChangesNothing) {
 
 }  // namespace
 
-namespace dynamics_proc {
+namespace dcp_model {
 namespace {
 
 class DcpMalfunction : public testing::DcpFixture {
@@ -314,7 +314,7 @@ TEST_F(DcpMalfunction, AnotherDesignTakesTheRecordedMalfunctionsFromAState) {
   // Re-simulation with another design (docs/sessions.md "Re-simulation"):
   // a logged MALFUNCTION state brings its malfunctions, not its state.
   transport::LogLcm lcm("", "");
-  DynamicsProc node(config, &lcm);
+  dynamics_proc::DynamicsProc node(config, &lcm);
   DynamicCollisionProgram recorded(config);
   recorded.Inject(wire::ParseMalfunction("joint 1 stuck"));
   recorded.Inject(wire::ParseMalfunction("camera 2 lost"));
@@ -343,7 +343,7 @@ TEST_F(DcpMalfunction, AnotherDesignTakesTheRecordedMalfunctionsFromAState) {
 }
 
 }  // namespace
-}  // namespace dynamics_proc
+}  // namespace dcp_model
 
 namespace operator_station {
 namespace {

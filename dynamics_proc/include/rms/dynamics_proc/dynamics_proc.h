@@ -7,9 +7,10 @@
 #include <vector>
 
 #include "rms/base/counters.h"
+#include "rms/dcp_model/dcp_telemetry.h"
+#include "rms/dcp_model/dynamic_collision_program.h"
 #include "rms/dcp_state_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
-#include "rms/dynamics_proc/dynamic_collision_program.h"
 #include "rms/session_control_t.hpp"
 #include "rms/transport/lcm_interface.h"
 #include "rms/transport/process.h"
@@ -17,6 +18,11 @@
 #include "rms/wire/frame_receiver.h"
 
 namespace rms::dynamics_proc {
+
+// The model this process runs (rms::dcp_model, docs/architecture.md).
+using dcp_model::DcpStatus;
+using dcp_model::DynamicCollisionProgram;
+using dcp_model::MakeTelemetry;
 
 class DynamicsProc {
  public:
@@ -122,9 +128,6 @@ class DynamicsProc {
   bool made_a_frame_ = false;
   std::uint32_t state_key_ = 0;  // mode, acquired, docked, released: a change writes at once
 };
-
-// The telemetry message for a frame (docs/protocol.md "RMS_DCP_TELEMETRY").
-dcp_telemetry_t MakeTelemetry(const DcpStatus& status, const wire::DcpFrameData& frame);
 
 // Main loop until SIGINT / SIGTERM. Returns the exit code.
 // restore_path: a checkpoint to start from ("" for the initial state).

@@ -9,14 +9,14 @@
 #include <random>
 #include <string>
 
-#include "rms/dynamics_proc/hexahedron.h"
+#include "rms/dcp_model/hexahedron.h"
 #include "rms/reference/box_sat.h"
 #include "rms/reference/hull_distance.h"
 
 namespace rms::reference {
 
 struct Solid {
-  dynamics_proc::Hexahedron hex;
+  dcp_model::Hexahedron hex;
   std::array<Eigen::Vector3d, 8> v;
   bool is_box = false;
   RefBox box;  // when is_box
@@ -30,9 +30,8 @@ struct Pair {
 inline Topology StandardTopology() {
   Topology t;
   for (int f = 0; f < 6; ++f)
-    for (int j = 0; j < 4; ++j) t.faces[f][j] = dynamics_proc::kFaceVertices[f][j];
-  for (int e = 0; e < 12; ++e)
-    t.edges[e] = {dynamics_proc::kEdges[e][0], dynamics_proc::kEdges[e][1]};
+    for (int j = 0; j < 4; ++j) t.faces[f][j] = dcp_model::kFaceVertices[f][j];
+  for (int e = 0; e < 12; ++e) t.edges[e] = {dcp_model::kEdges[e][0], dcp_model::kEdges[e][1]};
   return t;
 }
 
@@ -60,7 +59,7 @@ inline Solid Box(const Eigen::Vector3d& centre, const Eigen::Matrix3d& R,
                  const Eigen::Vector3d& half) {
   Solid s;
   const Eigen::Vector3d U = R.col(0), V = R.col(1), W = R.col(2);
-  s.hex = dynamics_proc::MakeBox(centre - half.x() * U, U, V, W, 2 * half.x(), half.y(), half.z());
+  s.hex = dcp_model::MakeBox(centre - half.x() * U, U, V, W, 2 * half.x(), half.y(), half.z());
   for (int i = 0; i < 8; ++i) s.v[i] = s.hex.vertex(i);
   s.is_box = true;
   s.box.centre = centre.cast<long double>();
@@ -86,7 +85,7 @@ inline Solid General(const Eigen::Vector3d& centre, const Eigen::Matrix3d& M,
     }
     s.v[i] = centre + M * p;
   }
-  s.hex = dynamics_proc::FromVertices(s.v);
+  s.hex = dcp_model::FromVertices(s.v);
   return s;
 }
 
@@ -116,7 +115,7 @@ inline Pair Translated(const Pair& p, const Eigen::Vector3d& offset) {
     }
     Solid t = s;
     for (auto& v : t.v) v += offset;
-    t.hex = dynamics_proc::FromVertices(t.v);
+    t.hex = dcp_model::FromVertices(t.v);
     return t;
   };
   return {move(p.a), move(p.b), p.kind + ", far out"};

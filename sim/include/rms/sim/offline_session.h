@@ -9,7 +9,7 @@
 
 #include "rms/base/config.h"
 #include "rms/base/counters.h"
-#include "rms/dynamics_proc/dynamic_collision_program.h"
+#include "rms/dcp_model/dynamic_collision_program.h"
 #include "rms/operator_station/timeline.h"
 #include "rms/scene_proc/visual_scene_program.h"
 #include "rms/wire/word_blocks.h"
@@ -25,7 +25,7 @@ class OfflineSession {
   std::int64_t frame() const { return frame_ - 1; }
   const wire::OperatorInputs& inputs() const { return inputs_; }
   const wire::DcpFrameData& dcp() const { return dcp_; }
-  const dynamics_proc::DcpStatus& status() const { return program_.status(); }
+  const dcp_model::DcpStatus& status() const { return program_.status(); }
   // This frame's ESG frame from camera station s (1..8), as the ESG reads it.
   const wire::EsgFrameData& esg(int station) const { return esg_[station - 1]; }
   // ... from the station the timeline selected.
@@ -39,7 +39,7 @@ class OfflineSession {
  private:
   const LabConfig& config_;
   operator_station::Timeline timeline_;
-  dynamics_proc::DynamicCollisionProgram program_;
+  dcp_model::DynamicCollisionProgram program_;
   std::vector<std::unique_ptr<scene_proc::VisualSceneProgram>> scenes_;
   std::int64_t frame_ = 0;
   double t_ = 0, prev_t_ = -1;

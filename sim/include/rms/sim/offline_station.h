@@ -15,8 +15,8 @@
 #include <vector>
 
 #include "rms/base/config.h"
+#include "rms/dcp_model/dynamic_collision_program.h"
 #include "rms/dcp_telemetry_t.hpp"
-#include "rms/dynamics_proc/dynamic_collision_program.h"
 #include "rms/operator_station/bindings.h"
 #include "rms/operator_station/guidance.h"
 #include "rms/operator_station/hand_controllers.h"
@@ -59,7 +59,7 @@ class OfflineStation : public OperatorTerminal {
   const operator_station::Bindings bindings_;  // before hands_, which holds a reference
   operator_station::HandControllers hands_;
   operator_station::GuidanceGeometry geometry_;
-  dynamics_proc::DynamicCollisionProgram program_;
+  dcp_model::DynamicCollisionProgram program_;
   double rate_hz_, max_s_;
   int width_, height_;
   std::vector<int> pending_keys_;  // typed, for the keyboard's next poll

@@ -30,15 +30,15 @@
 
 #include "rms/arm/kinematics.h"
 #include "rms/base/config.h"
-#include "rms/dynamics_proc/collision.h"
-#include "rms/dynamics_proc/dcp_models.h"
-#include "rms/dynamics_proc/malfunctions.h"
+#include "rms/dcp_model/collision.h"
+#include "rms/dcp_model/dcp_models.h"
+#include "rms/dcp_model/malfunctions.h"
 #include "rms/wire/acquisition_conditions.h"
 #include "rms/wire/collision_bits.h"
 #include "rms/wire/input_block.h"
 #include "rms/wire/word_blocks.h"
 
-namespace rms::dynamics_proc {
+namespace rms::dcp_model {
 
 // The finger stops this far short of touching the bar once acquired (above
 // the finger gap word's resolution, so the bar and finger never overlap).
@@ -387,4 +387,4 @@ class DynamicCollisionProgram {
 // and read back. The DCP, the scene and the ESG all use these values.
 arm::ArmSinCos TransmittedArmWords(const std::array<double, 6>& angles_deg);
 
-}  // namespace rms::dynamics_proc
+}  // namespace rms::dcp_model

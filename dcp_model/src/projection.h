@@ -7,9 +7,9 @@
 #include <algorithm>
 #include <limits>
 
-#include "rms/dynamics_proc/hexahedron.h"
+#include "rms/dcp_model/hexahedron.h"
 
-namespace rms::dynamics_proc::internal {
+namespace rms::dcp_model::internal {
 
 // The least and greatest of n . v over h's vertices v, each projection
 // (n.x x + n.y y) + n.z z, the extremes taken vertex by vertex in order.
@@ -23,4 +23,4 @@ inline void ProjectionRange(const Hexahedron& h, const Eigen::Vector3d& n, doubl
   }
 }
 
-}  // namespace rms::dynamics_proc::internal
+}  // namespace rms::dcp_model::internal

@@ -7,12 +7,12 @@
 #include <cstdint>
 #include <limits>
 
-#include "rms/dynamics_proc/collision.h"
+#include "rms/dcp_model/collision.h"
 
 #include "projection.h"
 #include "simd.h"
 
-namespace rms::dynamics_proc::internal {
+namespace rms::dcp_model::internal {
 
 namespace {
 
@@ -285,4 +285,4 @@ EdgeAxisPlane WidestEdgeAxis(const Hexahedron& a, const Hexahedron& b) {
   return best;
 }
 
-}  // namespace rms::dynamics_proc::internal
+}  // namespace rms::dcp_model::internal

@@ -32,10 +32,10 @@
 #include <cstdint>
 #include <limits>
 
-#include "rms/dynamics_proc/hexahedron.h"
+#include "rms/dcp_model/hexahedron.h"
 #include "rms/scene_model/separating_plane.h"
 
-namespace rms::dynamics_proc {
+namespace rms::dcp_model {
 
 enum class Verdict : std::uint8_t { kSeparate, kCollide, kInvalid };
 
@@ -146,4 +146,4 @@ EdgeAxisPlane WidestEdgeAxisExhaustive(const Hexahedron& a, const Hexahedron& b)
 
 }  // namespace internal
 
-}  // namespace rms::dynamics_proc
+}  // namespace rms::dcp_model

@@ -1,11 +1,11 @@
-#include "rms/dynamics_proc/malfunctions.h"
+#include "rms/dcp_model/malfunctions.h"
 
 #include <algorithm>
 #include <cmath>
 
 #include "rms/base/check.h"
 
-namespace rms::dynamics_proc {
+namespace rms::dcp_model {
 
 using wire::MalfunctionKind;
 
@@ -201,4 +201,4 @@ void Malfunctions::FromJson(const nlohmann::json& j) {
   *this = std::move(next);
 }
 
-}  // namespace rms::dynamics_proc
+}  // namespace rms::dcp_model

@@ -21,7 +21,7 @@
 #include <array>
 #include <cstdint>
 
-namespace rms::dynamics_proc {
+namespace rms::dcp_model {
 
 enum Face : int { kFaceA = 0, kFaceB, kFaceC, kFaceD, kFaceE, kFaceF };
 inline constexpr int kNumFaces = 6;
@@ -172,4 +172,4 @@ Hexahedron MakeBox(const Eigen::Vector3d& p_A, const Eigen::Vector3d& U, const E
 // far from the origin is answered like the same solid at the origin.
 Hexahedron FromVertices(const std::array<Eigen::Vector3d, 8>& v);
 
-}  // namespace rms::dynamics_proc
+}  // namespace rms::dcp_model

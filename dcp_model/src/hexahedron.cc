@@ -1,11 +1,11 @@
-#include "rms/dynamics_proc/hexahedron.h"
+#include "rms/dcp_model/hexahedron.h"
 
 #include <algorithm>
 #include <cmath>
 
 #include "simd.h"
 
-namespace rms::dynamics_proc {
+namespace rms::dcp_model {
 
 char FaceLetter(int f) { return static_cast<char>('a' + f); }
 
@@ -372,4 +372,4 @@ Hexahedron FromVertices(const std::array<Eigen::Vector3d, 8>& v) {
   return h;
 }
 
-}  // namespace rms::dynamics_proc
+}  // namespace rms::dcp_model

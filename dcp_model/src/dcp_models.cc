@@ -1,11 +1,11 @@
-#include "rms/dynamics_proc/dcp_models.h"
+#include "rms/dcp_model/dcp_models.h"
 
 #include <cmath>
 #include <cstdio>
 
 #include "rms/scene_model/scene_model.h"
 
-namespace rms::dynamics_proc {
+namespace rms::dcp_model {
 
 EndEffectorModel MakeEndEffector(const EndEffectorConfig& ee, const Eigen::Isometry3d& X_RS2,
                                  double gap) {
@@ -148,4 +148,4 @@ Hexahedron MakeCaeFrontHalf(const CaeConfig& c) {
   return FromVertices(v);
 }
 
-}  // namespace rms::dynamics_proc
+}  // namespace rms::dcp_model

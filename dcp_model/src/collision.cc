@@ -1,4 +1,4 @@
-#include "rms/dynamics_proc/collision.h"
+#include "rms/dcp_model/collision.h"
 
 #include <algorithm>
 #include <bit>
@@ -8,7 +8,7 @@
 #include "projection.h"
 #include "simd.h"
 
-namespace rms::dynamics_proc {
+namespace rms::dcp_model {
 
 using internal::ProjectionRange;
 
@@ -412,4 +412,4 @@ CollisionResult Collide(const Hexahedron& a, const Hexahedron& b, const CollideO
   return r;
 }
 
-}  // namespace rms::dynamics_proc
+}  // namespace rms::dcp_model

@@ -28,7 +28,7 @@
 #include "rms/wire/input_block.h"
 #include "rms/wire/malfunction.h"
 
-namespace rms::dynamics_proc {
+namespace rms::dcp_model {
 
 class Malfunctions {
  public:
@@ -89,4 +89,4 @@ class Malfunctions {
   bool have_last_ = false;
 };
 
-}  // namespace rms::dynamics_proc
+}  // namespace rms::dcp_model

@@ -8,9 +8,9 @@
 #include <string>
 
 #include "rms/base/config.h"
-#include "rms/dynamics_proc/hexahedron.h"
+#include "rms/dcp_model/hexahedron.h"
 
-namespace rms::dynamics_proc {
+namespace rms::dcp_model {
 
 // EFF HEX 1 (palm), EFF HEX 2 (fixed finger), EFF HEX 3 (movable finger).
 // System Two: X2 = UX2 along the approach (a -> d: face d is the palm's
@@ -86,4 +86,4 @@ Hexahedron MakeCargoBay(const ShuttleConfig& s);
 // the docking envelope.
 Hexahedron MakeCaeFrontHalf(const CaeConfig& c);
 
-}  // namespace rms::dynamics_proc
+}  // namespace rms::dcp_model

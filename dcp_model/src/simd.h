@@ -10,7 +10,7 @@
 #define RMS_DCP_X86 1
 #endif
 
-namespace rms::dynamics_proc {
+namespace rms::dcp_model {
 
 #if defined(RMS_DCP_X86)
 // Use the AVX paths: checked once, at start; UseAvx (hexahedron.h) turns
@@ -19,4 +19,4 @@ namespace rms::dynamics_proc {
 inline bool avx_enabled = __builtin_cpu_supports("avx");
 #endif
 
-}  // namespace rms::dynamics_proc
+}  // namespace rms::dcp_model
