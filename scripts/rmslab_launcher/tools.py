@@ -225,7 +225,10 @@ def debrief(argv):
         lesson_state = os.path.join(a.session, "run", "instructor_lesson.json")
         if os.path.isfile(lesson_state):  # the lesson the session ran, each event's outcome (read only)
             argv += ["--lesson-state", lesson_state]
-        proc = subprocess.Popen(argv, env=dict(os.environ, RMSLAB_INSTRUCTOR_TOKEN=token))
+        # Its lifeline (standard input, closed when this launcher dies, even
+        # by SIGKILL): the station never outlives the debrief's launcher.
+        proc = subprocess.Popen(argv, stdin=subprocess.PIPE,
+                                env=dict(os.environ, RMSLAB_INSTRUCTOR_TOKEN=token, RMSLAB_LIFELINE="stdin"))
 
         def stop_on(signum, _frame):
             raise KeyboardInterrupt  # SIGTERM, SIGHUP: stopped as by Ctrl-C, the station with it
