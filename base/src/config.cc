@@ -215,7 +215,8 @@ void ReadCameras(TableReader& top, LabConfig* config) {
   LabConfig& c = *config;
   const toml::array* cams = top.Array("cameras");
   if (cams->size() != kNumCameraStations) {
-    top.Fail("cameras", "must list exactly 8 camera stations ([[cameras]] tables), got " +
+    top.Fail("cameras", "must list exactly " + std::to_string(kNumCameraStations) +
+                            " camera stations ([[cameras]] tables), got " +
                             std::to_string(cams->size()));
   }
   int i = 0;

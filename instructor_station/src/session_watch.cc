@@ -20,6 +20,7 @@
 #include "rms/wire/channels.h"
 #include "rms/wire/checkpoint.h"
 #include "rms/wire/collision_bits.h"
+#include "rms/wire/dcp_mode.h"
 #include "rms/wire/frame_receiver.h"
 #include "rms/wire/malfunction.h"
 #include "rms/wire/message_io.h"
@@ -33,17 +34,9 @@ constexpr std::int64_t kPathEveryFrames = 5;
 // A process whose reports stop this long is shown as silent.
 constexpr std::int64_t kSilentUs = 3'000'000;
 
-const char* ModeText(int mode) {
-  switch (mode) {
-    case 1:
-      return "Mode 1 (acquisition)";
-    case 2:
-      return "Mode 2 (extraction)";
-    case 3:
-      return "Mode 3 (manoeuvring and docking)";
-    default:
-      return "no mode";
-  }
+std::string ModeText(int mode) {
+  const wire::DcpModeInfo* m = wire::DcpModeOf(mode);
+  return m ? "Mode " + std::to_string(mode) + " (" + m->name + ")" : "no mode";
 }
 
 // The collision bits less the essential contact (the finger closing onto

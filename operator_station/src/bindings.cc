@@ -59,7 +59,8 @@ Action ParseAction(std::string_view t) {
       return a;
     }
   }
-  if (t.size() == 8 && t.substr(0, 7) == "camera_" && t[7] >= '1' && t[7] <= '8') {
+  if (t.size() == 8 && t.substr(0, 7) == "camera_" && t[7] >= '1' &&
+      t[7] < '1' + kNumCameraStations) {
     a.kind = ActionKind::kCamera;
     a.camera = t[7] - '0';
     return a;

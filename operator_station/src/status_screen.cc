@@ -15,23 +15,16 @@
 #include "rms/operator_station/follow_watch.h"
 #include "rms/wire/acquisition_conditions.h"
 #include "rms/wire/collision_bits.h"
+#include "rms/wire/dcp_mode.h"
 #include "rms/wire/malfunction.h"
 
 namespace rms::operator_station {
 
 namespace {
 
-const char* ModeName(int m) {
-  switch (m) {
-    case 1:
-      return "1 ACQUISITION";
-    case 2:
-      return "2 EXTRACTION";
-    case 3:
-      return "3 MANOEUVRING AND DOCKING";
-    default:
-      return "?";
-  }
+std::string ModeName(int m) {
+  const wire::DcpModeInfo* info = wire::DcpModeOf(m);
+  return info ? std::to_string(m) + " " + info->upper : "?";
 }
 
 // Fields packed into lines of at most `width` characters: a field that does
@@ -243,7 +236,7 @@ void ControlLines(const StatusSnapshot& s, Flow& flow) {
 
 void ModeLines(const StatusSnapshot& s, Flow& flow) {
   const dcp_telemetry_t& t = *s.telemetry;
-  flow.Line(Sprintf("MODE %s", ModeName(t.mode)))
+  flow.Line(Sprintf("MODE %s", ModeName(t.mode).c_str()))
       .Field(Sprintf("acquired %s", t.acquired ? "YES" : "no"))
       .Field(Sprintf("docked %s", t.docked ? "YES" : "no"))
       .Field(std::string("arm ") + (t.held          ? "HELD: the command collides"

@@ -19,8 +19,11 @@ import tomllib
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BUILD = os.environ.get("RMSLAB_BUILD", os.path.join(ROOT, "build"))
+# transport/include/rms/transport/lcm_interface.h kDefaultLcmUrl (held to it
+# by tests/python/test_cpp_constants.py), and its multicast group.
 DEFAULT_URL = "udpm://239.255.76.67:7667?ttl=0"
-DEFAULT_REPLAY_URL = "udpm://239.255.76.67:7669?ttl=0"
+DEFAULT_GROUP = DEFAULT_URL[len("udpm://"):].split(":")[0]
+DEFAULT_REPLAY_URL = f"udpm://{DEFAULT_GROUP}:7669?ttl=0"
 MAX_SPEED = 100.0  # transport/include/rms/transport/process.h kMaxSessionSpeed: the frame checks allow no faster
 
 
@@ -213,7 +216,7 @@ def require_built(*rels):
 
 def ensure_multicast_route():
     """LCM's UDP multicast needs a route to 224.0.0.0/4: added on loopback when missing."""
-    if subprocess.run(["ip", "route", "get", "239.255.76.67"], stdout=subprocess.DEVNULL,
+    if subprocess.run(["ip", "route", "get", DEFAULT_GROUP], stdout=subprocess.DEVNULL,
                       stderr=subprocess.DEVNULL).returncode == 0:
         return
     say("this machine has no route for multicast (224.0.0.0/4); adding one on loopback:")

@@ -5,7 +5,7 @@ import os
 import shlex
 import subprocess
 
-from .common import LabError, say, sudo_prefix
+from .common import DEFAULT_GROUP, LabError, say, sudo_prefix
 
 SSH = ["ssh", "-o", "BatchMode=yes", "-o", "ConnectTimeout=5"]
 
@@ -103,7 +103,7 @@ def check_hosts(url, remote_build, hosts):
             if h.name not in names:
                 problems.append(f"host {h}: no such network namespace (ip netns list)")
                 continue
-            if h.run(["ip", "route", "get", "239.255.76.67"], stdout=subprocess.DEVNULL,
+            if h.run(["ip", "route", "get", DEFAULT_GROUP], stdout=subprocess.DEVNULL,
                      stderr=subprocess.DEVNULL).returncode:
                 problems.append(f"host {h}: no route for multicast in the namespace "
                                 "(ip route add 224.0.0.0/4 dev IFACE)")
@@ -114,7 +114,7 @@ def check_hosts(url, remote_build, hosts):
             if subprocess.run(SSH + [h.name, f"test -x {shlex.quote(remote_build)}/dynamics_proc/dynamics_proc"],
                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).returncode:
                 problems.append(f"host {h}: rmslab is not built at {remote_build} (the lab file's [remote] build)")
-            if subprocess.run(SSH + [h.name, "ip route get 239.255.76.67"], stdout=subprocess.DEVNULL,
+            if subprocess.run(SSH + [h.name, "ip route get " + DEFAULT_GROUP], stdout=subprocess.DEVNULL,
                               stderr=subprocess.DEVNULL).returncode:
                 problems.append(f"host {h}: no route for multicast")
     if problems:

@@ -7,8 +7,8 @@ namespace rms::wire {
 using namespace control_bits;
 
 wire::Word PackControlWord(const ControlWord& cw) {
-  RMS_CHECK(cw.camera_station >= 1 && cw.camera_station <= 8);
-  RMS_CHECK(cw.mode >= 1 && cw.mode <= 3);
+  RMS_CHECK(cw.camera_station >= 1 && cw.camera_station <= kNumCameraStations);
+  RMS_CHECK(DcpModeOf(cw.mode) != nullptr);
   RMS_CHECK(cw.priority_dynamic <= kPriorityDynamicMask);
   RMS_CHECK(cw.priority_fixed <= kPriorityFixedMask);
   std::uint32_t w = static_cast<std::uint32_t>(cw.camera_station - 1) << kCameraShift;

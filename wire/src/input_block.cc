@@ -4,9 +4,16 @@
 #include <cmath>
 
 #include "rms/base/check.h"
+#include "rms/base/config.h"
 #include "rms/wire/word_codec.h"
 
 namespace rms::wire {
+
+// The input block's camera field (bits 0-2 of the discrete word) carries
+// station - 1: the stations' one count must fit it (docs/architecture.md
+// "Adding a camera station").
+static_assert(kNumCameraStations <= static_cast<int>(kDiscreteCameraMask) + 1,
+              "the input block's camera field is 3 bits");
 
 OperatorInputs InitialInputs(const InputCalibrations& cal) {
   OperatorInputs in;
@@ -41,9 +48,9 @@ std::array<std::int32_t, kInputWords> EncodeInputs(const OperatorInputs& in,
     words[i] = static_cast<std::int32_t>(e.word);
   }
   int station = in.camera_station;
-  if (station < 1 || station > 8) {
+  if (station < 1 || station > kNumCameraStations) {
     if (counters) counters->Add(Counter::kClampedCameraStation);
-    station = std::clamp(station, 1, 8);
+    station = std::clamp(station, 1, kNumCameraStations);
   }
   std::uint32_t d = static_cast<std::uint32_t>(station - 1) & kDiscreteCameraMask;
   if (in.reset) d |= kDiscreteReset;
@@ -117,8 +124,9 @@ OperatorInputs InputsFromJson(const nlohmann::json& j) {
       why = why.substr(why.find("] ") + 2);
     throw InputError("operator inputs: " + why);
   }
-  if (in.camera_station < 1 || in.camera_station > 8)
-    throw InputError("operator inputs: camera_station must be 1..8");
+  if (in.camera_station < 1 || in.camera_station > kNumCameraStations)
+    throw InputError("operator inputs: camera_station must be 1.." +
+                     std::to_string(kNumCameraStations));
   return in;
 }
 

@@ -94,9 +94,8 @@ const MalfunctionKindInfo& KindInfo(MalfunctionKind kind) {
 }
 
 const char* JointName(int joint) {
-  static constexpr const char* kNames[] = {"shoulder yaw", "shoulder pitch", "elbow pitch",
-                                           "wrist pitch",  "wrist yaw",      "wrist roll"};
-  return joint >= 1 && joint <= kNumJoints ? kNames[joint - 1] : "?";
+  // (kJointNames' literals end in a NUL: .data() is a C string.)
+  return joint >= 1 && joint <= kNumJoints ? kJointNames[joint - 1].data() : "?";
 }
 
 Malfunction ParseMalfunction(std::string_view text) {

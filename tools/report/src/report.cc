@@ -12,6 +12,7 @@
 #include <set>
 #include <sstream>
 
+#include "rms/base/analog_inputs.h"
 #include "rms/base/check.h"
 #include "rms/base/config.h"
 #include "rms/base/text.h"
@@ -804,18 +805,16 @@ std::string MakeReport(const std::string& session_dir, const std::string& chart_
 
   nlohmann::json data;
   data["title"] = s.value("session", root.filename().string());
-  data["series"] = {
-      {"t_s", t.t_s},
-      {"mode", t.mode},
-      {"attempt", t.attempt},
-      {"p_ft", t.p_ft},
-      {"payload_ft", t.payload_ft},
-      {"joints_deg", t.joints_deg},
-      {"joint_names",
-       {"shoulder yaw", "shoulder pitch", "elbow pitch", "wrist pitch", "wrist yaw", "wrist roll"}},
-      {"finger", t.finger},
-      {"distance_to_goal_ft", t.goal_ft},
-      {"dock_angle_deg", t.dock_angle_deg}};
+  data["series"] = {{"t_s", t.t_s},
+                    {"mode", t.mode},
+                    {"attempt", t.attempt},
+                    {"p_ft", t.p_ft},
+                    {"payload_ft", t.payload_ft},
+                    {"joints_deg", t.joints_deg},
+                    {"joint_names", kJointNames},
+                    {"finger", t.finger},
+                    {"distance_to_goal_ft", t.goal_ft},
+                    {"dock_angle_deg", t.dock_angle_deg}};
   data["series"]["inputs"] =
       t.by_hand
           ? nlohmann::json{{"names", {"x", "y", "z", "roll", "pitch", "yaw", "single joint"}},

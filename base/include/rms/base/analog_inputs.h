@@ -29,6 +29,25 @@ inline constexpr std::array<std::string_view, kNumAnalogInputs> kAnalogInputName
     "shoulder_yaw", "shoulder_pitch",  "elbow_pitch", "wrist_pitch", "wrist_yaw",  "wrist_roll",
     "finger",       "shoulder_height", "camera_pan",  "camera_tilt", "camera_zoom"};
 
+// The arm's joints: the first six inputs, in the report's order (theta1 ..
+// theta6). Their count and names live here once; the wire's malfunctions,
+// the report and the pages use these.
+inline constexpr int kNumJoints = kWristRoll + 1;
+inline constexpr std::array<std::string_view, kNumJoints> kJointNames = {
+    "shoulder yaw", "shoulder pitch", "elbow pitch", "wrist pitch", "wrist yaw", "wrist roll"};
+
+// Whether each joint's name is its input's with a space for the '_'.
+constexpr bool JointNamesMatchInputs() {
+  for (int j = 0; j < kNumJoints; ++j) {
+    const std::string_view a = kJointNames[j], b = kAnalogInputNames[j];
+    if (a.size() != b.size()) return false;
+    for (std::size_t i = 0; i < a.size(); ++i)
+      if (a[i] != (b[i] == '_' ? ' ' : b[i])) return false;
+  }
+  return true;
+}
+static_assert(JointNamesMatchInputs(), "kJointNames must follow kAnalogInputNames");
+
 // Returns the index of the named input, or -1.
 int AnalogInputIndex(std::string_view name);
 

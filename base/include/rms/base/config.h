@@ -125,6 +125,9 @@ struct LabConfig {
   std::vector<CameraStationConfig> cameras;  // exactly kNumCameraStations
 };
 
+// The camera stations (docs/scene.md): their one count. The control word
+// carries the station in 3 bits (rms/wire/control_word.h), which
+// static_asserts that the count fits.
 inline constexpr int kNumCameraStations = 8;
 
 // Every key of the file is required: config/rmslab.toml is the one place

@@ -17,9 +17,20 @@
 //  bits 17-23 PRIORITY_FIXED    viewpoint side of fixed planes 1-7   (scene_proc)
 #include <cstdint>
 
+#include "rms/base/config.h"
+#include "rms/wire/dcp_mode.h"
 #include "rms/wire/word_codec.h"
 
 namespace rms::wire {
+
+// The fields' widths, tied to the quantities they carry: a ninth camera
+// station or a fourth mode does not fit the word as the report drew it
+// (docs/architecture.md "Adding a camera station").
+inline constexpr int kCameraStationBits = 3;
+inline constexpr int kModeBits = 2;
+static_assert(kNumCameraStations <= (1 << kCameraStationBits),
+              "the control word's CAMERA field (bits 0-2) carries station - 1");
+static_assert(kNumDcpModes < (1 << kModeBits), "the MODE field (bits 8-9) carries 1..3");
 
 struct ControlWord {
   int camera_station = 1;  // 1..8
@@ -39,13 +50,13 @@ struct ControlWord {
 };
 
 namespace control_bits {
-inline constexpr std::uint32_t kCameraShift = 0, kCameraMask = 0x7;
+inline constexpr std::uint32_t kCameraShift = 0, kCameraMask = (1u << kCameraStationBits) - 1;
 inline constexpr std::uint32_t kReset = 1u << 3;
 inline constexpr std::uint32_t kOverlay = 1u << 4;
 inline constexpr std::uint32_t kCrosshairs = 1u << 5;
 inline constexpr std::uint32_t kNoVideo = 1u << 6;
 inline constexpr std::uint32_t kReservedMask = 0x1u << 7;
-inline constexpr std::uint32_t kModeShift = 8, kModeMask = 0x3;
+inline constexpr std::uint32_t kModeShift = 8, kModeMask = (1u << kModeBits) - 1;
 inline constexpr std::uint32_t kCollision = 1u << 10;
 inline constexpr std::uint32_t kReceptacle = 1u << 11;
 inline constexpr std::uint32_t kAcquired = 1u << 12;

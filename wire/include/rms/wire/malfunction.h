@@ -22,6 +22,9 @@
 #include <string_view>
 #include <vector>
 
+#include "rms/base/analog_inputs.h"
+#include "rms/base/config.h"
+
 namespace rms::wire {
 
 enum class MalfunctionKind : int {
@@ -60,8 +63,10 @@ inline constexpr std::array<MalfunctionKindInfo, static_cast<int>(MalfunctionKin
     }};
 const MalfunctionKindInfo& KindInfo(MalfunctionKind kind);
 
-inline constexpr int kNumJoints = 6;
-inline constexpr int kNumCameraStations = 8;
+// The joints and camera stations a malfunction names (their one home:
+// rms/base/analog_inputs.h, rms/base/config.h).
+using ::rms::kNumCameraStations;
+using ::rms::kNumJoints;
 
 struct Malfunction {
   MalfunctionKind kind = MalfunctionKind::kJointStuck;
