@@ -2,8 +2,10 @@
 // Malfunctions an instructor injects (docs/sessions.md "Malfunctions"): what
 // RMS_CONTROL's MALFUNCTION and REPAIR commands carry in their `name`, as
 // text, so the control message's type (and every log recorded before
-// malfunctions existed) stays as it was. One grammar, read and written here
-// only:
+// malfunctions existed) stays as it was. One grammar, parsed and printed
+// here only (the page's menu is built from kMalfunctionKinds through
+// /api/map; the launcher's `scripts/lab control --help` and docs/sessions.md
+// still write it out by hand):
 //
 //   MALFUNCTION  joint N stuck            joint N (1..6) stays where it is
 //                joint N drift RATE       joint N turns at RATE deg/s whatever is commanded
