@@ -48,8 +48,36 @@ void DynamicsProc::RestoreCheckpoint(const std::string& path) {
   Restore(wire::ReadCheckpoint(path), path);
 }
 
+namespace {
+
+// A checkpoint whose arm (the command or the slave) is beyond a joint's
+// limits (config [arm]) is a pose the arm cannot reach: refused
+// (docs/sessions.md "Freeze, run, step, checkpoint"). Malformed angles are
+// left to RestoreState, which names them.
+void CheckJointLimits(const nlohmann::json& dcp, const LabConfig& config) {
+  for (const char* who : {"master", "slave"}) {
+    if (!dcp.is_object() || !dcp.contains(who) || !dcp[who].is_object()) continue;
+    const nlohmann::json& a = dcp[who].value("angles_deg", nlohmann::json());
+    if (!a.is_array() || a.size() != static_cast<std::size_t>(kNumJoints)) continue;
+    for (int i = 0; i < kNumJoints; ++i) {
+      if (!a[i].is_number()) continue;
+      const double v = a[i].get<double>(), lo = config.arm.joint_min_deg[i],
+                   hi = config.arm.joint_max_deg[i];
+      if (v < lo - 1e-9 || v > hi + 1e-9)
+        throw InputError(fmt::format(
+            "checkpoint: the {} arm's joint {} ({}) at {:.3f} deg, beyond its limits {:.1f} .. "
+            "{:.1f} deg (config [arm]): a pose the arm cannot reach",
+            std::string(who) == "master" ? "commanded" : "slave", i + 1, kJointNames[i], v, lo,
+            hi));
+    }
+  }
+}
+
+}  // namespace
+
 void DynamicsProc::Restore(const wire::Checkpoint& c, const std::string& what) {
   try {
+    CheckJointLimits(c.dcp, config_);
     dcp_.RestoreState(c.dcp);
   } catch (const std::exception& e) {
     throw InputError("checkpoint '" + what + "': " + e.what());

@@ -370,6 +370,8 @@ function showBanner(s) {
   $("scoretitle").textContent = debrief ? "Scorecard (the session's)" : st.ended ? "Scorecard (at the end)" : "Scorecard (live)";
 }
 
+const rateScale = {};  // the largest rate of each kind commanded so far (the bars' full length)
+
 function showTrainee(s) {
   const o = s.operator;
   if (!o) { $("trainee").textContent = "no operator state yet"; }
@@ -378,11 +380,18 @@ function showTrainee(s) {
       (o.control_mode === "manual augmented" ? ", frame " + esc(o.command_frame) : "") +
       (o.joint ? ", joint " + esc(o.joint) : "") + ", " + esc(o.scale) +
       ", " + o.key_actions + " key presses");
-    const names = ["x", "roll", "y", "pitch", "z", "yaw"], order = [0, 3, 1, 4, 2, 5];
+    // The commanded rates (ft/s; deg/s; single joint: the joint's, deg/s), each
+    // bar against the largest of its kind commanded so far this session.
+    const single = o.control_mode === "single joint";
+    const names = single ? ["joint " + (o.joint || ""), "", "", "", "", ""] : ["x", "roll", "y", "pitch", "z", "yaw"];
+    const order = [0, 3, 1, 4, 2, 5], units = single ? ["deg/s", "", "", "", "", ""] : ["ft/s", "deg/s", "ft/s", "deg/s", "ft/s", "deg/s"];
     let h = "";
-    order.map((k) => o.hand_rate[k]).forEach((v, i) => {
-      const f = Math.max(-1, Math.min(1, v || 0));
-      h += "<span>" + names[i] + "</span><div class=bar><i style='left:" + (50 + Math.min(0, f) * 50) + "%;width:" + Math.abs(f) * 50 + "%'></i></div><span>" + fmt(v, 2) + "</span>";
+    order.map((k) => o.hand_rate[k] || 0).forEach((v, i) => {
+      const kind = single ? "joint" : i % 2 ? "deg" : "ft";
+      rateScale[kind] = Math.max(rateScale[kind] || 0, Math.abs(v));
+      const f = rateScale[kind] > 0 ? v / rateScale[kind] : 0;
+      if (!names[i]) return;
+      h += "<span>" + esc(names[i]) + "</span><div class=bar><i style='left:" + (50 + Math.min(0, f) * 50) + "%;width:" + Math.abs(f) * 50 + "%'></i></div><span>" + fmt(v, 2) + " " + units[i] + "</span>";
     });
     $("hands").innerHTML = h;
     const gd = o.guidance;

@@ -1053,7 +1053,7 @@ nlohmann::json SessionWatch::AddMark(double session_s, const std::string& text) 
   const double ahead_s = state_.ended || debrief_ ? 0.5 / config_.session.frame_rate_hz : 1.0;
   if (session_s > newest + ahead_s) {
     char why[160];
-    std::snprintf(why, sizeof why, "parameter t=%.1f: beyond the session's newest frame (%.1f s)",
+    std::snprintf(why, sizeof why, "parameter t=%.3f: beyond the session's newest frame (%.3f s)",
                   session_s, newest);
     throw InputError(why);
   }

@@ -298,6 +298,16 @@ TEST(InstructorStation, ARestartedStationRecoversItsHistoryAndADebriefScrubsAndM
        {"refused by dynamics_proc: checkpoint '", "bad.json': checkpoint: 'docked' needs Mode 3",
         "refused by operator_station: dynamics_proc refused it"})
     EXPECT_NE(refused_restore.out.find(said), std::string::npos) << said << refused_restore.out;
+  // ... and one whose arm is beyond a joint's limits (shoulder pitch -40 deg, its limit -2).
+  auto far = nlohmann::json::parse(ReadFile(out + "/checkpoints/here.json"));
+  far["dcp"]["master"]["angles_deg"][1] = -40.0;
+  far["dcp"]["slave"]["angles_deg"][1] = -40.0;
+  std::ofstream(out + "/checkpoints/far.json") << far.dump();
+  const auto unreachable = control({"restore", "far"});
+  EXPECT_EQ(unreachable.rc, 1) << unreachable.out;
+  EXPECT_NE(unreachable.out.find("joint 2 (shoulder pitch) at -40.000 deg, beyond its limits"),
+            std::string::npos)
+      << unreachable.out;
   EXPECT_EQ(control({"step", "3"}).rc, 0);
   EXPECT_TRUE(Until([&] { return state() == "FROZEN"; }, 10)) << status().dump();
   EXPECT_EQ(status()["dcp"].value("master_finger", -2.0), finger_before) << "inputs taken";
@@ -368,8 +378,8 @@ TEST(InstructorStation, ARestartedStationRecoversItsHistoryAndADebriefScrubsAndM
     EXPECT_FALSE(c["answers"].empty()) << c.dump();
     for (const auto& a : c["answers"]) refused += a["outcome"] == "refused";
   }
-  // The missing and the bad checkpoint by both, a step.
-  EXPECT_EQ(refused, 5) << summary["control"].dump();
+  // The missing, the bad and the unreachable checkpoint by both, a step.
+  EXPECT_EQ(refused, 7) << summary["control"].dump();
   EXPECT_EQ(summary["control_answers_unmatched"], 0);
 
   // The debrief, in a browser.
