@@ -216,12 +216,7 @@ std::pair<int, int> PngSize(const std::string& path) {
 
 // Whether `ok` holds within `seconds` (asked every 0.2 s).
 bool Until(const std::function<bool()>& ok, double seconds) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  while (std::chrono::steady_clock::now() < end) {
-    if (ok()) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(200));
-  }
-  return ok();
+  return testing::WaitUntil(ok, seconds, 200);
 }
 
 // docs/instructor.md "The banner", "Commands and their answers", "A

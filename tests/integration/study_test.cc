@@ -215,14 +215,7 @@ int Starts(const std::string& folder, int trial) {
   return n;
 }
 
-bool WaitUntil(const std::function<bool()>& done, double limit_s) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(limit_s);
-  while (std::chrono::steady_clock::now() < end) {
-    if (done()) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  return done();
-}
+using testing::WaitUntil;
 
 // A dry run (the autopilot as a virtual subject): four trials one after
 // another, the run killed (SIGKILL) as its second begins and resumed, and

@@ -89,6 +89,15 @@ bool WaitForFile(const std::string& path, double timeout_s) {
   return true;
 }
 
+bool WaitUntil(const std::function<bool()>& done, double limit_s, int poll_ms) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(limit_s);
+  while (std::chrono::steady_clock::now() < end) {
+    if (done()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(poll_ms));
+  }
+  return done();
+}
+
 std::string ReadFile(const std::string& path) {
   std::ifstream f(path);
   std::stringstream ss;

@@ -2,6 +2,7 @@
 // Runs a real executable for integration tests: stdout and stderr to a log
 // file, signals, waits with a timeout, and SIGKILL on destruction so a failed
 // test leaves no orphans.
+#include <functional>
 #include <string>
 #include <sys/types.h>
 #include <vector>
@@ -37,6 +38,9 @@ ScriptRun Script(const std::vector<std::string>& argv, const std::string& log,
                  double timeout_s = 300);
 
 bool WaitForFile(const std::string& path, double timeout_s);
+// Whether `done` holds within limit_s, asked every poll_ms (and once more
+// at the end).
+bool WaitUntil(const std::function<bool()>& done, double limit_s, int poll_ms = 50);
 std::string ReadFile(const std::string& path);
 // A fresh directory under the temp directory.
 std::string MakeTempDir(const std::string& tag);
