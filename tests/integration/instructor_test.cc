@@ -214,6 +214,16 @@ std::pair<int, int> PngSize(const std::string& path) {
   return {static_cast<int>(be32(16)), static_cast<int>(be32(20))};
 }
 
+// The page's URL `scripts/lab debrief` printed to its log ("debrief of
+// SESSION: URL"), once the line is whole; "" before.
+std::string DebriefUrl(const std::string& log_path) {
+  const std::string log = ReadFile(log_path);
+  const auto at = log.find("debrief of ");
+  const auto http = log.find("http://", at == std::string::npos ? log.size() : at);
+  const auto end = http == std::string::npos ? http : log.find('\n', http);
+  return end == std::string::npos ? "" : log.substr(http, end - http);
+}
+
 // Whether `ok` holds within `seconds` (asked every 0.2 s).
 bool Until(const std::function<bool()>& ok, double seconds) {
   return testing::WaitUntil(ok, seconds, 200);
@@ -384,14 +394,8 @@ TEST(InstructorStation, ARestartedStationRecoversItsHistoryAndADebriefScrubsAndM
   std::string url;
   ASSERT_TRUE(Until(
       [&] {
-        const std::string log = ReadFile(tmp + "/debrief.log");
-        const auto at = log.find("debrief of ");
-        if (at == std::string::npos) return false;
-        const auto http = log.find("http://", at);
-        const auto end = log.find('\n', http);
-        if (http == std::string::npos || end == std::string::npos) return false;
-        url = log.substr(http, end - http);
-        return true;
+        url = DebriefUrl(tmp + "/debrief.log");
+        return !url.empty();
       },
       60))
       << ReadFile(tmp + "/debrief.log");
@@ -561,13 +565,11 @@ TEST(InstructorStation, ALessonAtStartAndOneLoadedOnThePageFireAndReSimulate) {
   nlohmann::json shown;
   EXPECT_TRUE(Until(
       [&] {
-        const std::string log = ReadFile(tmp + "/debrief.log");
-        const auto said = log.find("debrief of ");  // the launcher's line, with the token
-        const auto at = log.find("http://", said == std::string::npos ? log.size() : said);
-        if (at == std::string::npos || log.find('\n', at) == std::string::npos) return false;
+        const std::string url = DebriefUrl(tmp + "/debrief.log");
+        if (url.empty()) return false;
         int debrief_port = 0;
         std::string debrief_token;
-        SplitUrl(log.substr(at, log.find('\n', at) - at), &debrief_port, &debrief_token);
+        SplitUrl(url, &debrief_port, &debrief_token);
         httplib::Client page("127.0.0.1", debrief_port);
         const auto r = page.Get("/api/lesson?token=" + debrief_token);
         if (!r || r->status != 200) return false;
