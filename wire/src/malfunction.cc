@@ -150,7 +150,6 @@ Repair ParseRepair(std::string_view text) {
     Refuse(text, "longer than " + std::to_string(kMaxMalfunctionTextBytes) + " bytes",
            kRepairGrammar);
   const std::vector<std::string> w = Words(text);
-  Repair r;
   if (w.size() == 1 && w[0] == "all") return {RepairWhat::kAll, 0};
   if (w.size() == 1 && w[0] == "finger") return {RepairWhat::kFinger, 0};
   if (w.size() == 1 && w[0] == "inputs") return {RepairWhat::kInputs, 0};
