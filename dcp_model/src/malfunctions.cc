@@ -8,31 +8,31 @@
 namespace rms::dcp_model {
 
 using wire::MalfunctionKind;
+using wire::MalfunctionPart;
 
-Malfunctions::Malfunctions(double frame_rate_hz, const std::array<double, 6>& joint_min_deg,
-                           const std::array<double, 6>& joint_max_deg)
+Malfunctions::Malfunctions(double frame_rate_hz,
+                           const std::array<double, kNumJoints>& joint_min_deg,
+                           const std::array<double, kNumJoints>& joint_max_deg)
     : frame_rate_hz_(frame_rate_hz), joint_min_deg_(joint_min_deg), joint_max_deg_(joint_max_deg) {
   RMS_CHECK(frame_rate_hz > 0.0);
 }
 
-void Malfunctions::Inject(const wire::Malfunction& m, const std::array<double, 6>& slave_angles_deg,
+void Malfunctions::Inject(const wire::Malfunction& m,
+                          const std::array<double, kNumJoints>& slave_angles_deg,
                           double slave_finger) {
-  switch (m.kind) {
-    case MalfunctionKind::kJointStuck:
-    case MalfunctionKind::kJointDrift:
-    case MalfunctionKind::kJointSlow:
-      RMS_CHECK(m.target >= 1 && m.target <= 6);
+  const wire::MalfunctionPart part = wire::KindInfo(m.kind).part;
+  RMS_CHECK(m.target >= 0 && m.target <= wire::PartInfo(part).count);
+  switch (part) {
+    case MalfunctionPart::kJoint:
       joints_[m.target - 1] = JointFault{m.kind, m.value, slave_angles_deg[m.target - 1]};
       break;
-    case MalfunctionKind::kFingerJammedOpen:
-    case MalfunctionKind::kFingerJammedClosed:
+    case MalfunctionPart::kFinger:
       finger_ = FingerFault{m.kind == MalfunctionKind::kFingerJammedOpen, slave_finger};
       break;
-    case MalfunctionKind::kCameraLost:
-      RMS_CHECK(m.target >= 1 && m.target <= 8);
+    case MalfunctionPart::kCamera:
       cameras_lost_ |= 1u << (m.target - 1);
       break;
-    case MalfunctionKind::kInputsDelayed: {
+    case MalfunctionPart::kInputs: {
       delay_ms_ = m.value;
       delay_frames_ = std::max(1, static_cast<int>(std::lround(m.value * frame_rate_hz_ / 1000.0)));
       // A longer delay holds the oldest block due for the extra frames; a
@@ -44,7 +44,7 @@ void Malfunctions::Inject(const wire::Malfunction& m, const std::array<double, 6
       while (static_cast<int>(line_.size()) > delay_frames_) line_.pop_front();
       break;
     }
-    case MalfunctionKind::kCount:
+    case MalfunctionPart::kCount:
       RMS_CHECK(false);
   }
 }
@@ -52,25 +52,22 @@ void Malfunctions::Inject(const wire::Malfunction& m, const std::array<double, 6
 void Malfunctions::Repair(const wire::Repair& r) {
   for (const wire::Malfunction& m : active()) {
     if (!wire::Clears(r, m)) continue;
-    switch (m.kind) {
-      case MalfunctionKind::kJointStuck:
-      case MalfunctionKind::kJointDrift:
-      case MalfunctionKind::kJointSlow:
+    switch (wire::KindInfo(m.kind).part) {
+      case MalfunctionPart::kJoint:
         joints_[m.target - 1].reset();
         break;
-      case MalfunctionKind::kFingerJammedOpen:
-      case MalfunctionKind::kFingerJammedClosed:
+      case MalfunctionPart::kFinger:
         finger_.reset();
         break;
-      case MalfunctionKind::kCameraLost:
+      case MalfunctionPart::kCamera:
         cameras_lost_ &= ~(1u << (m.target - 1));
         break;
-      case MalfunctionKind::kInputsDelayed:
+      case MalfunctionPart::kInputs:
         delay_ms_ = 0.0;
         delay_frames_ = 0;
         line_.clear();  // the next frame answers its own block
         break;
-      case MalfunctionKind::kCount:
+      case MalfunctionPart::kCount:
         break;
     }
   }
@@ -92,8 +89,8 @@ const wire::OperatorInputs& Malfunctions::Delay(const wire::OperatorInputs& in) 
   return last_;
 }
 
-void Malfunctions::Apply(const std::array<double, 6>& slave_angles_deg,
-                         std::array<double, 6>* angles_deg, double* finger) {
+void Malfunctions::Apply(const std::array<double, kNumJoints>& slave_angles_deg,
+                         std::array<double, kNumJoints>* angles_deg, double* finger) {
   const double dt_s = 1.0 / frame_rate_hz_;
   for (int i = 0; i < 6; ++i) {
     if (!joints_[i]) continue;
@@ -153,11 +150,10 @@ nlohmann::ordered_json Malfunctions::ToJson() const {
   for (const wire::Malfunction& m : active()) {
     nlohmann::ordered_json a;
     a["text"] = wire::MalfunctionText(m);
-    if (m.kind == MalfunctionKind::kJointStuck || m.kind == MalfunctionKind::kJointDrift ||
-        m.kind == MalfunctionKind::kJointSlow) {
+    const wire::MalfunctionPart part = wire::KindInfo(m.kind).part;
+    if (part == MalfunctionPart::kJoint) {
       a["anchor"] = joints_[m.target - 1]->anchor_deg;
-    } else if (m.kind == MalfunctionKind::kFingerJammedOpen ||
-               m.kind == MalfunctionKind::kFingerJammedClosed) {
+    } else if (part == MalfunctionPart::kFinger) {
       a["anchor"] = finger_->anchor_lever;
     }
     list.push_back(a);
@@ -181,11 +177,11 @@ void Malfunctions::FromJson(const nlohmann::json& j) {
     }
     for (const auto& a : j.at("active")) {
       const wire::Malfunction m = wire::ParseMalfunction(a.at("text").get<std::string>());
-      const bool anchored =
-          m.kind != MalfunctionKind::kCameraLost && m.kind != MalfunctionKind::kInputsDelayed;
+      const wire::MalfunctionPart part = wire::KindInfo(m.kind).part;
+      const bool anchored = part == MalfunctionPart::kJoint || part == MalfunctionPart::kFinger;
       const double anchor = anchored ? a.at("anchor").get<double>() : 0.0;
       if (!std::isfinite(anchor)) throw InputError("an anchor is not finite");
-      std::array<double, 6> q{};
+      std::array<double, kNumJoints> q{};
       q.fill(anchor);
       next.Inject(m, q, anchor);
     }

@@ -250,12 +250,12 @@ function malfunctionMenu() {
   const update = () => {
     const k = chosen(), was = target.value;
     target.innerHTML = "";
-    const names = k.pattern.startsWith("joint") ? map.joints : k.pattern.startsWith("camera") ? map.stations : [];
+    const names = map.parts[k.part];
     names.forEach((n, i) => { const o = document.createElement("option"); o.value = String(i + 1); o.textContent = (i + 1) + " " + n; target.appendChild(o); });
     if ([...target.options].some((o) => o.value === was)) target.value = was;
     target.style.display = names.length ? "" : "none";
     $("mvalue").style.display = k.value ? "" : "none";
-    $("mvalue").value = k.pattern.includes("delayed") ? "500" : "1";
+    $("mvalue").value = String(k.typical);
     $("munit").textContent = k.value ? k.value + " " : "";
   };
   kind.onchange = update;
@@ -266,7 +266,8 @@ function malfunctionMenu() {
   };
 }
 
-const repairOf = (t) => t.startsWith("joint") || t.startsWith("camera") ? t.split(" ").slice(0, 2).join(" ") : t.split(" ")[0];
+// A malfunction's repair: its part's word, and its number when the part has one.
+const repairOf = (t) => { const w = t.split(" "); return (map.parts[w[0]] || []).length ? w[0] + " " + w[1] : w[0]; };
 
 function showMalfunctions(list, off) {
   const div = $("mlist");

@@ -691,10 +691,9 @@ std::string MalfunctionSaid(const std::string& text) {
     return text;
   }
   std::string said = text;
-  using K = wire::MalfunctionKind;
-  if (m.kind == K::kJointDrift || m.kind == K::kJointSlow) said += " deg/s";
-  if (m.kind == K::kInputsDelayed) said += " ms";
-  if (m.kind == K::kJointStuck || m.kind == K::kJointDrift || m.kind == K::kJointSlow)
+  const wire::MalfunctionKindInfo& kind = wire::KindInfo(m.kind);
+  if (kind.value[0] != '\0') said.append(" ").append(kind.unit);
+  if (kind.part == wire::MalfunctionPart::kJoint)
     said.append(" (").append(wire::JointName(m.target)).append(")");
   return said;
 }

@@ -67,20 +67,31 @@ nlohmann::json MapJson(const LabConfig& config) {
   nlohmann::json stations = nlohmann::json::array();
   for (const auto& cam : config.cameras) stations.push_back(cam.name);
   // The page's malfunction menu, from the one table (rms/wire/malfunction.h).
+  nlohmann::json joints = nlohmann::json::array();
+  for (int j = 1; j <= wire::kNumJoints; ++j) joints.push_back(wire::JointName(j));
+  // Each part's word and the names of its numbers (none: it has no number).
+  nlohmann::json parts = nlohmann::json::object();
+  for (const wire::MalfunctionPartInfo& p : wire::kMalfunctionParts) {
+    parts[p.word] = p.part == wire::MalfunctionPart::kJoint    ? joints
+                    : p.part == wire::MalfunctionPart::kCamera ? stations
+                                                               : nlohmann::json::array();
+    RMS_CHECK(static_cast<int>(parts[p.word].size()) == p.count);
+  }
   nlohmann::json kinds = nlohmann::json::array();
   for (const wire::MalfunctionKindInfo& k : wire::kMalfunctionKinds) {
     kinds.push_back({{"name", k.name},
+                     {"part", wire::PartInfo(k.part).word},
                      {"pattern", k.pattern},
                      {"value", k.value},
                      {"min", k.min_value},
-                     {"max", k.max_value}});
+                     {"max", k.max_value},
+                     {"typical", k.typical_value}});
   }
-  nlohmann::json joints = nlohmann::json::array();
-  for (int j = 1; j <= wire::kNumJoints; ++j) joints.push_back(wire::JointName(j));
   return {{"outlines", outlines},
           {"payload_ft", {config.payload.p_RoPo_R_ft.x(), config.payload.p_RoPo_R_ft.y()}},
           {"stations", stations},
           {"malfunctions", kinds},
+          {"parts", parts},
           {"joints", joints}};
 }
 

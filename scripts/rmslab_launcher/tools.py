@@ -317,18 +317,19 @@ def control(argv):
     """scripts/lab control [--session DIR] freeze | run | step [N] | reset | checkpoint NAME | restore NAME|FILE [--run]
                     | malfunction WHAT... | repair WHAT...:
     commands to a running session (docs/sessions.md "Freeze, run, step,
-    checkpoint" and "Malfunctions"). WHAT is 'joint N stuck', 'joint N drift
-    DEG_S', 'joint N slow DEG_S', 'finger jammed open|closed', 'camera N lost'
-    or 'inputs delayed MS'; a repair names 'joint N', 'finger', 'camera N',
-    'inputs' or 'all'. Without --session (or --lcm-url and --session-id): the
-    one session of this checkout that is running now."""
+    checkpoint" and "Malfunctions"). WHAT is a malfunction or a repair in
+    the grammar that `scripts/lab control malfunction --help` and `scripts/lab
+    control repair --help` print (made from the malfunction table in
+    wire/include/rms/wire/malfunction.h). Without --session (or --lcm-url and
+    --session-id): the one session of this checkout that is running now."""
     if not argv or argv[0] in ("-h", "--help"):
         print(control.__doc__)
         return 0 if argv else 2
     no_build = "--no-build" in argv  # as every other subcommand takes it
     argv = [a for a in argv if a != "--no-build"]
     ensure("tools/rms_control", no_build)
-    if not any(a in argv for a in ("--session", "--lcm-url", "--session-id")):
+    helping = any(a in argv for a in ("-h", "--help"))
+    if not helping and not any(a in argv for a in ("--session", "--lcm-url", "--session-id")):
         live = running_sessions()
         if len(live) != 1:
             raise LabError("no session of this checkout is running: give --session DIR" if not live else

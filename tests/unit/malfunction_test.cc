@@ -4,7 +4,9 @@
 #include "rms/wire/malfunction.h"
 
 #include <cstring>
+#include <fstream>
 #include <gtest/gtest.h>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -58,7 +60,7 @@ TEST(MalfunctionText, BadTextIsRefusedNamingWhatIsWrong) {
            {"joint 7 stuck", "joint '7' is not 1..6"},
            {"joint 0 stuck", "joint '0' is not 1..6"},
            {"joint two stuck", "joint 'two'"},
-           {"joint 2 broken", "'stuck', 'drift' or 'slow'"},
+           {"joint 2 broken", "'joint N stuck', 'joint N drift DEG_S' or 'joint N slow DEG_S'"},
            {"joint 2 drift", "expected 4 words"},
            {"joint 2 drift 50", "outside"},
            {"joint 2 slow 0", "outside"},
@@ -67,7 +69,7 @@ TEST(MalfunctionText, BadTextIsRefusedNamingWhatIsWrong) {
            {"joint 2 drift 1e400", "not a number"},
            {"joint 2 stuck now", "expected 3 words"},
            {"finger jammed", "expected 3 words"},
-           {"finger jammed sideways", "'jammed open' or 'jammed closed'"},
+           {"finger jammed sideways", "'finger jammed open' or 'finger jammed closed'"},
            {"camera 9 lost", "camera station '9' is not 1..8"},
            {"inputs delayed 0", "outside"},
            {"inputs delayed 99999", "outside"},
@@ -123,6 +125,32 @@ TEST(MalfunctionText, ARepairClearsOnlyItsOwn) {
     EXPECT_TRUE(wire::Clears(wire::RepairFor(m), m)) << t;
   }
   EXPECT_EQ(wire::RepairText(wire::RepairFor(wire::ParseMalfunction("joint 4 slow 1"))), "joint 4");
+}
+
+// The one table: each pattern starts with its part's word and has N exactly
+// when the part is numbered; the grammar, help and docs are made from it.
+TEST(MalfunctionText, TheTableMakesTheGrammarAndTheDocs) {
+  for (const wire::MalfunctionKindInfo& k : wire::kMalfunctionKinds) {
+    const wire::MalfunctionPartInfo& part = wire::PartInfo(k.part);
+    const std::string pattern = k.pattern;
+    EXPECT_EQ(pattern.rfind(std::string(part.word) + " ", 0), 0u) << pattern;
+    EXPECT_EQ(pattern.find(" N ") != std::string::npos, part.count > 0) << pattern;
+    EXPECT_EQ(pattern.find(" V") != std::string::npos, k.value[0] != '\0') << pattern;
+    EXPECT_EQ(k.value_word[0] != '\0', k.value[0] != '\0') << pattern;
+    EXPECT_NE(wire::MalfunctionGrammar().find(pattern.substr(0, pattern.find(" V"))),
+              std::string::npos)
+        << pattern;
+  }
+  EXPECT_NE(wire::MalfunctionGrammar().find("(joints 1..6, camera stations 1..8)"),
+            std::string::npos);
+  EXPECT_EQ(wire::RepairGrammar().rfind("'joint N', 'finger', 'camera N', 'inputs' or 'all'", 0),
+            0u);
+  std::ifstream f(std::string(RMSLAB_SOURCE_DIR) + "/docs/sessions.md");
+  std::stringstream docs;
+  docs << f.rdbuf();
+  EXPECT_NE(docs.str().find(wire::MalfunctionTableMarkdown()), std::string::npos)
+      << "docs/sessions.md \"Malfunctions\" is not the table: build/tools/rms_session "
+         "malfunctions prints it";
 }
 
 // The Malfunctions object alone, at 10 Hz: every number exact.

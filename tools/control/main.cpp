@@ -337,14 +337,13 @@ int main(int argc, char** argv) {
       ->required();
   restore->add_flag("--run", then_run, "Run again after restoring");
   std::vector<std::string> words;
-  auto* malfunction = app.add_subcommand(
-      "malfunction",
-      "Inject a malfunction: 'joint N stuck', 'joint N drift DEG_S', 'joint N slow DEG_S', "
-      "'finger jammed open|closed', 'camera N lost', 'inputs delayed MS' (docs/sessions.md "
-      "\"Malfunctions\")");
+  // (The grammars are made from the malfunction table, rms/wire/malfunction.h.)
+  auto* malfunction =
+      app.add_subcommand("malfunction", "Inject a malfunction: " + rms::wire::MalfunctionGrammar() +
+                                            " (docs/sessions.md \"Malfunctions\")");
   malfunction->add_option("what", words, "The malfunction, e.g. joint 2 stuck")->required();
-  auto* repair = app.add_subcommand(
-      "repair", "Repair a malfunction: 'joint N', 'finger', 'camera N', 'inputs' or 'all'");
+  auto* repair =
+      app.add_subcommand("repair", "Repair a malfunction: " + rms::wire::RepairGrammar());
   repair->add_option("what", words, "What to repair, e.g. joint 2")->required();
   if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   try {

@@ -22,6 +22,7 @@
 #include "rms/session/record.h"
 #include "rms/session/session_folder.h"
 #include "rms/session/session_summary.h"
+#include "rms/wire/malfunction.h"
 
 namespace {
 
@@ -296,14 +297,25 @@ Command Counters(CLI::App& app) {
           }};
 }
 
+// malfunctions: the malfunction table, as docs/sessions.md shows it.
+Command Malfunctions(CLI::App& app) {
+  CLI::App* c = app.add_subcommand(
+      "malfunctions",
+      "Print the malfunctions an instructor injects, with their grammar (markdown)");
+  return {c, [] {
+            std::cout << rms::wire::MalfunctionTableMarkdown();
+            return 0;
+          }};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"rmslab session tools"};
   app.require_subcommand(1);
-  const std::vector<Command> commands = {Summary(app),  Record(app), Manifest(app), CompareEsg(app),
-                                         Export(app),   Folder(app), LabFile(app),  Probe(app),
-                                         Counters(app), Design(app)};
+  const std::vector<Command> commands = {
+      Summary(app), Record(app), Manifest(app), CompareEsg(app),   Export(app), Folder(app),
+      LabFile(app), Probe(app),  Counters(app), Malfunctions(app), Design(app)};
   if (const auto rc = rms::ParseCommandLine(app, argc, argv)) return *rc;
   try {
     for (const Command& c : commands) {

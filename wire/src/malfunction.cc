@@ -12,11 +12,8 @@ namespace rms::wire {
 
 namespace {
 
-constexpr const char* kMalfunctionGrammar =
-    "'joint N stuck', 'joint N drift DEG_S', 'joint N slow DEG_S', 'finger jammed open', "
-    "'finger jammed closed', 'camera N lost' or 'inputs delayed MS' (joints 1..6, cameras 1..8)";
-constexpr const char* kRepairGrammar =
-    "'joint N', 'finger', 'camera N', 'inputs' or 'all' (joints 1..6, cameras 1..8)";
+// Which grammar an error shows.
+enum class Grammar { kMalfunction, kRepair };
 
 std::vector<std::string> Words(std::string_view text) {
   std::vector<std::string> words;
@@ -44,18 +41,21 @@ std::string Quoted(std::string_view text) {
   return Printable(std::string(text.substr(0, n)));
 }
 
-[[noreturn]] void Refuse(std::string_view text, const std::string& why, const char* grammar) {
-  const char* what = grammar == kRepairGrammar ? "repair" : "malfunction";
-  throw InputError(std::string(what) + " '" + Quoted(text) + "': " + Printable(why) +
-                   "; expected " + grammar);
+[[noreturn]] void Refuse(std::string_view text, const std::string& why, Grammar grammar) {
+  const bool repair = grammar == Grammar::kRepair;
+  throw InputError(std::string(repair ? "repair" : "malfunction") + " '" + Quoted(text) +
+                   "': " + Printable(why) + "; expected " +
+                   (repair ? RepairGrammar() : MalfunctionGrammar()));
 }
 
-int Target(std::string_view text, const std::string& word, int max, const char* what,
-           const char* grammar) {
+int Target(std::string_view text, const std::string& word, const MalfunctionPartInfo& part,
+           Grammar grammar) {
   int n = 0;
   const auto [p, ec] = std::from_chars(word.data(), word.data() + word.size(), n);
-  if (ec != std::errc() || p != word.data() + word.size() || n < 1 || n > max) {
-    Refuse(text, std::string(what) + " '" + word + "' is not 1.." + std::to_string(max), grammar);
+  if (ec != std::errc() || p != word.data() + word.size() || n < 1 || n > part.count) {
+    Refuse(text,
+           std::string(part.target) + " '" + word + "' is not 1.." + std::to_string(part.count),
+           grammar);
   }
   return n;
 }
@@ -65,16 +65,16 @@ double Value(std::string_view text, std::string word, const MalfunctionKindInfo&
   double v = 0.0;
   const auto [p, ec] = std::from_chars(word.data(), word.data() + word.size(), v);
   if (ec != std::errc() || p != word.data() + word.size() || !std::isfinite(v)) {
-    Refuse(text, "'" + word + "' is not a number (" + info.value + ")", kMalfunctionGrammar);
+    Refuse(text, "'" + word + "' is not a number (" + info.value + ")", Grammar::kMalfunction);
   }
   if (v < info.min_value || v > info.max_value) {
     std::ostringstream range;
     range << info.min_value << " .. " << info.max_value;
     Refuse(text, std::string(info.value) + " " + word + " is outside " + range.str(),
-           kMalfunctionGrammar);
+           Grammar::kMalfunction);
   }
   if (v == 0.0 && info.kind == MalfunctionKind::kJointDrift)
-    Refuse(text, "a drift of 0 is no drift (a joint that stays is 'stuck')", kMalfunctionGrammar);
+    Refuse(text, "a drift of 0 is no drift (a joint that stays is 'stuck')", Grammar::kMalfunction);
   if (v == 0.0) v = 0.0;  // no -0: the text reads back the same
   return v;
 }
@@ -85,6 +85,80 @@ std::string Number(double v) {
   return ec == std::errc() ? std::string(buf, p) : "nan";
 }
 
+// A pattern's words as written (N and V upper case).
+std::vector<std::string> Split(std::string_view text) {
+  std::vector<std::string> words;
+  std::istringstream in{std::string(text)};
+  for (std::string w; in >> w;) words.push_back(w);
+  return words;
+}
+
+bool IsSlot(const std::string& word) { return word == "N" || word == "V"; }
+
+// Whether the words given so far are the pattern's, slots aside.
+bool Fits(const std::vector<std::string>& pattern, const std::vector<std::string>& words) {
+  for (std::size_t i = 0; i < std::min(pattern.size(), words.size()); ++i) {
+    if (!IsSlot(pattern[i]) && pattern[i] != words[i]) return false;
+  }
+  return true;
+}
+
+// The pattern as the grammar shows it, V as its value word.
+std::string Shown(const MalfunctionKindInfo& kind) {
+  std::string out;
+  for (const std::string& word : Split(kind.pattern)) {
+    if (!out.empty()) out += ' ';
+    out += word == "V" ? kind.value_word : word;
+  }
+  return out;
+}
+
+// 'a', 'b' or 'c'.
+std::string OneOf(const std::vector<std::string>& items) {
+  std::string out;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    if (i > 0) out += i + 1 == items.size() ? " or " : ", ";
+    out.append("'").append(items[i]).append("'");
+  }
+  return out;
+}
+
+// "(joints 1..6, camera stations 1..8)": the parts' numbers.
+std::string Ranges() {
+  std::string out;
+  for (const MalfunctionPartInfo& part : kMalfunctionParts) {
+    if (part.count == 0) continue;
+    out.append(out.empty() ? "(" : ", ").append(part.target).append("s 1..");
+    out += std::to_string(part.count);
+  }
+  return out + ")";
+}
+
+const MalfunctionPartInfo* PartNamed(const std::string& word) {
+  for (const MalfunctionPartInfo& part : kMalfunctionParts) {
+    if (word == part.word) return &part;
+  }
+  return nullptr;
+}
+
+void CheckLength(std::string_view text, Grammar grammar) {
+  if (text.size() > kMaxMalfunctionTextBytes)
+    Refuse(text, "longer than " + std::to_string(kMaxMalfunctionTextBytes) + " bytes", grammar);
+}
+
+// The words read as the kind's pattern (which they fit, word for word).
+Malfunction Read(std::string_view text, const MalfunctionKindInfo& kind,
+                 const std::vector<std::string>& pattern, const std::vector<std::string>& words) {
+  Malfunction m;
+  m.kind = kind.kind;
+  for (std::size_t i = 0; i < pattern.size(); ++i) {
+    if (pattern[i] == "N")
+      m.target = Target(text, words[i], PartInfo(kind.part), Grammar::kMalfunction);
+    if (pattern[i] == "V") m.value = Value(text, words[i], kind);
+  }
+  return m;
+}
+
 }  // namespace
 
 const MalfunctionKindInfo& KindInfo(MalfunctionKind kind) {
@@ -93,151 +167,107 @@ const MalfunctionKindInfo& KindInfo(MalfunctionKind kind) {
   return kMalfunctionKinds[k];
 }
 
+const MalfunctionPartInfo& PartInfo(MalfunctionPart part) {
+  const int p = static_cast<int>(part);
+  RMS_CHECK(p >= 0 && p < static_cast<int>(MalfunctionPart::kCount));
+  return kMalfunctionParts[p];
+}
+
 const char* JointName(int joint) {
   // (kJointNames' literals end in a NUL: .data() is a C string.)
   return joint >= 1 && joint <= kNumJoints ? kJointNames[joint - 1].data() : "?";
 }
 
+std::string MalfunctionGrammar() {
+  std::vector<std::string> forms;
+  for (const MalfunctionKindInfo& kind : kMalfunctionKinds) forms.push_back(Shown(kind));
+  return OneOf(forms) + " " + Ranges();
+}
+
+std::string RepairGrammar() {
+  std::vector<std::string> forms;
+  for (const MalfunctionPartInfo& part : kMalfunctionParts)
+    forms.push_back(std::string(part.word) + (part.count > 0 ? " N" : ""));
+  forms.push_back("all");
+  return OneOf(forms) + " " + Ranges();
+}
+
 Malfunction ParseMalfunction(std::string_view text) {
-  if (text.size() > kMaxMalfunctionTextBytes)
-    Refuse(text, "longer than " + std::to_string(kMaxMalfunctionTextBytes) + " bytes",
-           kMalfunctionGrammar);
+  CheckLength(text, Grammar::kMalfunction);
   const std::vector<std::string> w = Words(text);
-  if (w.empty()) Refuse(text, "empty", kMalfunctionGrammar);
-  Malfunction m;
-  const auto want = [&](std::size_t n) {
-    if (w.size() != n)
-      Refuse(text, "expected " + std::to_string(n) + " words", kMalfunctionGrammar);
-  };
-  if (w[0] == "joint") {
-    if (w.size() < 3) Refuse(text, "a joint needs its number and what fails", kMalfunctionGrammar);
-    m.target = Target(text, w[1], kNumJoints, "joint", kMalfunctionGrammar);
-    if (w[2] == "stuck") {
-      want(3);
-      m.kind = MalfunctionKind::kJointStuck;
-    } else if (w[2] == "drift" || w[2] == "slow") {
-      want(4);
-      m.kind = w[2] == "drift" ? MalfunctionKind::kJointDrift : MalfunctionKind::kJointSlow;
-      m.value = Value(text, w[3], KindInfo(m.kind));
-    } else {
-      Refuse(text, "a joint is 'stuck', 'drift' or 'slow', not '" + w[2] + "'",
-             kMalfunctionGrammar);
-    }
-  } else if (w[0] == "finger") {
-    want(3);
-    if (w[1] != "jammed" || (w[2] != "open" && w[2] != "closed"))
-      Refuse(text, "the finger is 'jammed open' or 'jammed closed'", kMalfunctionGrammar);
-    m.kind =
-        w[2] == "open" ? MalfunctionKind::kFingerJammedOpen : MalfunctionKind::kFingerJammedClosed;
-  } else if (w[0] == "camera") {
-    want(3);
-    m.target = Target(text, w[1], kNumCameraStations, "camera station", kMalfunctionGrammar);
-    if (w[2] != "lost") Refuse(text, "a camera station is 'lost'", kMalfunctionGrammar);
-    m.kind = MalfunctionKind::kCameraLost;
-  } else if (w[0] == "inputs") {
-    want(3);
-    if (w[1] != "delayed") Refuse(text, "the inputs are 'delayed MS'", kMalfunctionGrammar);
-    m.kind = MalfunctionKind::kInputsDelayed;
-    m.value = Value(text, w[2], KindInfo(m.kind));
-  } else {
-    Refuse(text, "unknown part '" + w[0] + "'", kMalfunctionGrammar);
+  if (w.empty()) Refuse(text, "empty", Grammar::kMalfunction);
+  const MalfunctionPartInfo* part = PartNamed(w[0]);
+  if (part == nullptr) Refuse(text, "unknown part '" + w[0] + "'", Grammar::kMalfunction);
+  std::vector<std::string> forms;
+  std::size_t words_wanted = 0;  // of the first pattern the words fit but for their count
+  for (const MalfunctionKindInfo& kind : kMalfunctionKinds) {
+    if (kind.part != part->part) continue;
+    forms.push_back(Shown(kind));
+    const std::vector<std::string> pattern = Split(kind.pattern);
+    if (!Fits(pattern, w)) continue;
+    if (pattern.size() == w.size()) return Read(text, kind, pattern, w);
+    if (words_wanted == 0) words_wanted = pattern.size();
   }
-  return m;
+  if (words_wanted > 0)
+    Refuse(text, "expected " + std::to_string(words_wanted) + " words", Grammar::kMalfunction);
+  Refuse(text, "a malfunction of the " + std::string(part->word) + " is " + OneOf(forms),
+         Grammar::kMalfunction);
 }
 
 Repair ParseRepair(std::string_view text) {
-  if (text.size() > kMaxMalfunctionTextBytes)
-    Refuse(text, "longer than " + std::to_string(kMaxMalfunctionTextBytes) + " bytes",
-           kRepairGrammar);
+  CheckLength(text, Grammar::kRepair);
   const std::vector<std::string> w = Words(text);
-  if (w.size() == 1 && w[0] == "all") return {RepairWhat::kAll, 0};
-  if (w.size() == 1 && w[0] == "finger") return {RepairWhat::kFinger, 0};
-  if (w.size() == 1 && w[0] == "inputs") return {RepairWhat::kInputs, 0};
-  if (w.size() == 2 && w[0] == "joint")
-    return {RepairWhat::kJoint, Target(text, w[1], kNumJoints, "joint", kRepairGrammar)};
-  if (w.size() == 2 && w[0] == "camera") {
-    return {RepairWhat::kCamera,
-            Target(text, w[1], kNumCameraStations, "camera station", kRepairGrammar)};
-  }
-  Refuse(text, "not a repair", kRepairGrammar);
+  if (w.size() == 1 && w[0] == "all") return Repair{};
+  const MalfunctionPartInfo* part = w.empty() ? nullptr : PartNamed(w[0]);
+  if (part != nullptr && part->count == 0 && w.size() == 1) return {false, part->part, 0};
+  if (part != nullptr && part->count > 0 && w.size() == 2)
+    return {false, part->part, Target(text, w[1], *part, Grammar::kRepair)};
+  Refuse(text, "not a repair", Grammar::kRepair);
 }
 
 std::string MalfunctionText(const Malfunction& m) {
-  const std::string n = std::to_string(m.target);
-  switch (m.kind) {
-    case MalfunctionKind::kJointStuck:
-      return "joint " + n + " stuck";
-    case MalfunctionKind::kJointDrift:
-      return "joint " + n + " drift " + Number(m.value);
-    case MalfunctionKind::kJointSlow:
-      return "joint " + n + " slow " + Number(m.value);
-    case MalfunctionKind::kFingerJammedOpen:
-      return "finger jammed open";
-    case MalfunctionKind::kFingerJammedClosed:
-      return "finger jammed closed";
-    case MalfunctionKind::kCameraLost:
-      return "camera " + n + " lost";
-    case MalfunctionKind::kInputsDelayed:
-      return "inputs delayed " + Number(m.value);
-    case MalfunctionKind::kCount:
-      break;
+  std::string out;
+  for (const std::string& word : Split(KindInfo(m.kind).pattern)) {
+    if (!out.empty()) out += ' ';
+    out += word == "N" ? std::to_string(m.target) : word == "V" ? Number(m.value) : word;
   }
-  RMS_CHECK(false);
-  return "";
+  return out;
 }
 
 std::string RepairText(const Repair& r) {
-  switch (r.what) {
-    case RepairWhat::kJoint:
-      return "joint " + std::to_string(r.target);
-    case RepairWhat::kFinger:
-      return "finger";
-    case RepairWhat::kCamera:
-      return "camera " + std::to_string(r.target);
-    case RepairWhat::kInputs:
-      return "inputs";
-    case RepairWhat::kAll:
-      return "all";
-  }
-  RMS_CHECK(false);
-  return "";
+  if (r.all) return "all";
+  const MalfunctionPartInfo& part = PartInfo(r.part);
+  return part.count > 0 ? std::string(part.word) + " " + std::to_string(r.target) : part.word;
 }
 
 bool Clears(const Repair& r, const Malfunction& m) {
-  switch (r.what) {
-    case RepairWhat::kAll:
-      return true;
-    case RepairWhat::kJoint:
-      return (m.kind == MalfunctionKind::kJointStuck || m.kind == MalfunctionKind::kJointDrift ||
-              m.kind == MalfunctionKind::kJointSlow) &&
-             m.target == r.target;
-    case RepairWhat::kFinger:
-      return m.kind == MalfunctionKind::kFingerJammedOpen ||
-             m.kind == MalfunctionKind::kFingerJammedClosed;
-    case RepairWhat::kCamera:
-      return m.kind == MalfunctionKind::kCameraLost && m.target == r.target;
-    case RepairWhat::kInputs:
-      return m.kind == MalfunctionKind::kInputsDelayed;
-  }
-  return false;
+  return r.all || (KindInfo(m.kind).part == r.part && m.target == r.target);
 }
 
-Repair RepairFor(const Malfunction& m) {
-  switch (m.kind) {
-    case MalfunctionKind::kJointStuck:
-    case MalfunctionKind::kJointDrift:
-    case MalfunctionKind::kJointSlow:
-      return {RepairWhat::kJoint, m.target};
-    case MalfunctionKind::kFingerJammedOpen:
-    case MalfunctionKind::kFingerJammedClosed:
-      return {RepairWhat::kFinger, 0};
-    case MalfunctionKind::kCameraLost:
-      return {RepairWhat::kCamera, m.target};
-    case MalfunctionKind::kInputsDelayed:
-    case MalfunctionKind::kCount:
-      break;
+Repair RepairFor(const Malfunction& m) { return {false, KindInfo(m.kind).part, m.target}; }
+
+std::string MalfunctionTableMarkdown() {
+  std::string out = "| Text | What fails | Value |\n|---|---|---|\n";
+  for (const MalfunctionKindInfo& kind : kMalfunctionKinds) {
+    std::string value = kind.unit;
+    if (kind.value[0] != '\0')
+      value += ", " + Number(kind.min_value) + ".." + Number(kind.max_value);
+    out.append("| `").append(kind.pattern).append("` | ").append(kind.meaning);
+    out.append(" | ").append(value).append(" |\n");
   }
-  return {RepairWhat::kInputs, 0};
+  out += "\nN is ";
+  for (const MalfunctionPartInfo& part : kMalfunctionParts) {
+    if (part.count == 0) continue;
+    if (out.back() != ' ') out += ", or ";
+    out.append("a ").append(part.target).append(" 1..").append(std::to_string(part.count));
+    if (part.part != MalfunctionPart::kJoint) continue;
+    out += " (";
+    for (int j = 1; j <= kNumJoints; ++j)
+      out.append(j > 1 ? ", " : "").append(std::to_string(j)).append(" ").append(JointName(j));
+    out += ")";
+  }
+  out += ". A repair is " + RepairGrammar() + ".\n";
+  return out;
 }
 
 std::vector<std::string> MalfunctionTexts(const nlohmann::json& dcp_state) {

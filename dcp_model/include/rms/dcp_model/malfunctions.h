@@ -35,13 +35,13 @@ class Malfunctions {
   // frame_rate_hz: the session's; joint_min/max_deg: each joint's travel
   // (config [arm] joint limits within [inputs.*]), which a drifting joint
   // stays within.
-  Malfunctions(double frame_rate_hz, const std::array<double, 6>& joint_min_deg,
-               const std::array<double, 6>& joint_max_deg);
+  Malfunctions(double frame_rate_hz, const std::array<double, kNumJoints>& joint_min_deg,
+               const std::array<double, kNumJoints>& joint_max_deg);
 
   // A malfunction from now on (one per joint, one for the finger: a new one
   // replaces the old), anchored at the slave's joint angles and finger lever
   // now.
-  void Inject(const wire::Malfunction& m, const std::array<double, 6>& slave_angles_deg,
+  void Inject(const wire::Malfunction& m, const std::array<double, kNumJoints>& slave_angles_deg,
               double slave_finger);
   void Repair(const wire::Repair& r);
 
@@ -50,8 +50,8 @@ class Malfunctions {
   const wire::OperatorInputs& Delay(const wire::OperatorInputs& in);
   // The command the failed joints and the finger let through, from the
   // slave's pose (*angles_deg and *finger: the command, changed in place).
-  void Apply(const std::array<double, 6>& slave_angles_deg, std::array<double, 6>* angles_deg,
-             double* finger);
+  void Apply(const std::array<double, kNumJoints>& slave_angles_deg,
+             std::array<double, kNumJoints>* angles_deg, double* finger);
   bool CameraLost(int station) const { return (cameras_lost_ >> (station - 1)) & 1u; }
 
   // Whether any is in force (what active() lists), without building the list.
@@ -78,8 +78,8 @@ class Malfunctions {
     double anchor_lever;  // where it jammed
   };
   double frame_rate_hz_;
-  std::array<double, 6> joint_min_deg_, joint_max_deg_;
-  std::array<std::optional<JointFault>, 6> joints_{};
+  std::array<double, kNumJoints> joint_min_deg_, joint_max_deg_;
+  std::array<std::optional<JointFault>, kNumJoints> joints_{};
   std::optional<FingerFault> finger_;
   std::uint32_t cameras_lost_ = 0;  // bit k-1: station k
   double delay_ms_ = 0.0;

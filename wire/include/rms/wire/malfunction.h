@@ -2,18 +2,16 @@
 // Malfunctions an instructor injects (docs/sessions.md "Malfunctions"): what
 // RMS_CONTROL's MALFUNCTION and REPAIR commands carry in their `name`, as
 // text, so the control message's type (and every log recorded before
-// malfunctions existed) stays as it was. One grammar, parsed and printed
-// here only (the page's menu is built from kMalfunctionKinds through
-// /api/map; the launcher's `scripts/lab control --help` and docs/sessions.md
-// still write it out by hand):
+// malfunctions existed) stays as it was. One grammar, in the two tables
+// below (kMalfunctionParts, kMalfunctionKinds): the parser, the printer, the
+// error messages, the page's menu (/api/map), `rms_control --help` and the
+// table in docs/sessions.md (`rms_session malfunctions`, held to it by a
+// test) are all made from them. A new kind is a row of kMalfunctionKinds
+// and what the DCP does with it (rms/dcp_model/malfunctions.h):
 //
-//   MALFUNCTION  joint N stuck            joint N (1..6) stays where it is
-//                joint N drift RATE       joint N turns at RATE deg/s whatever is commanded
-//                joint N slow RATE        joint N follows at most RATE deg/s
-//                finger jammed open       the finger can no longer close past where it is
-//                finger jammed closed     the finger can no longer open past where it is
-//                camera N lost            camera station N (1..8) sends no picture
-//                inputs delayed MS        the operator's inputs reach the DCP MS ms late
+//   MALFUNCTION  joint N stuck | joint N drift DEG_S | joint N slow DEG_S
+//                | finger jammed open | finger jammed closed
+//                | camera N lost | inputs delayed MS
 //   REPAIR       joint N | finger | camera N | inputs | all
 //
 // Joints are numbered as the report's angles: 1 shoulder yaw, 2 shoulder
@@ -40,28 +38,70 @@ enum class MalfunctionKind : int {
   kCount
 };
 
-// What a kind's text looks like and what its number means (the one table:
-// the parser, the page's menu and docs/sessions.md follow it).
+// The part a malfunction acts on, and the part a repair names (all but
+// REPAIR all).
+enum class MalfunctionPart : int { kJoint = 0, kFinger, kCamera, kInputs, kCount };
+struct MalfunctionPartInfo {
+  MalfunctionPart part;
+  const char* word;    // the first word of its malfunctions and of its repair
+  const char* target;  // what its number N names ("" when it has none)
+  int count;           // N is 1..count; 0 when it has no number
+};
+inline constexpr std::array<MalfunctionPartInfo, static_cast<int>(MalfunctionPart::kCount)>
+    kMalfunctionParts = {{
+        {MalfunctionPart::kJoint, "joint", "joint", ::rms::kNumJoints},
+        {MalfunctionPart::kFinger, "finger", "", 0},
+        {MalfunctionPart::kCamera, "camera", "camera station", ::rms::kNumCameraStations},
+        {MalfunctionPart::kInputs, "inputs", "", 0},
+    }};
+const MalfunctionPartInfo& PartInfo(MalfunctionPart part);
+
+// What a kind's text looks like, the part it acts on and what its number
+// means (the one table: the parser, the printer, the page's menu and
+// docs/sessions.md follow it). The pattern's first word is its part's word;
+// N stands for the part's number (when it has one) and V for the value.
 struct MalfunctionKindInfo {
   MalfunctionKind kind;
+  MalfunctionPart part;
   const char* name;             // identifier, e.g. "joint_stuck" (the page's menu, summary.json)
   const char* pattern;          // the text, with N the target and V the value
+  const char* value_word;       // V as the grammar shows it ("DEG_S", "MS"; "" when none)
   const char* value;            // the value's meaning and unit ("" when none)
   double min_value, max_value;  // the value's accepted range (inclusive)
+  double typical_value;         // the value the page offers first (0 when none)
+  const char* unit;             // the value's unit in docs ("-" when none)
+  const char* meaning;          // what fails (docs/sessions.md's table)
 };
 inline constexpr std::array<MalfunctionKindInfo, static_cast<int>(MalfunctionKind::kCount)>
     kMalfunctionKinds = {{
-        {MalfunctionKind::kJointStuck, "joint_stuck", "joint N stuck", "", 0, 0},
-        {MalfunctionKind::kJointDrift, "joint_drift", "joint N drift V",
-         "drift rate, deg/s (signed, not 0)", -20.0, 20.0},
-        {MalfunctionKind::kJointSlow, "joint_slow", "joint N slow V",
-         "the joint's rate at most, deg/s", 0.01, 100.0},
-        {MalfunctionKind::kFingerJammedOpen, "finger_jammed_open", "finger jammed open", "", 0, 0},
-        {MalfunctionKind::kFingerJammedClosed, "finger_jammed_closed", "finger jammed closed", "",
-         0, 0},
-        {MalfunctionKind::kCameraLost, "camera_lost", "camera N lost", "", 0, 0},
-        {MalfunctionKind::kInputsDelayed, "inputs_delayed", "inputs delayed V", "the delay, ms",
-         1.0, 3000.0},
+        {MalfunctionKind::kJointStuck, MalfunctionPart::kJoint, "joint_stuck", "joint N stuck", "",
+         "", 0, 0, 0, "-", "joint N stays where it was when it failed, whatever is commanded"},
+        {MalfunctionKind::kJointDrift, MalfunctionPart::kJoint, "joint_drift", "joint N drift V",
+         "DEG_S", "drift rate, deg/s (signed, not 0)", -20.0, 20.0, 1.0, "deg/s",
+         "joint N turns at V deg/s (signed, not 0) whatever is commanded, from where it is each "
+         "frame (held by a collision, it does not wind up), within the joint's travel (config "
+         "`[arm]` joint limits, within `[inputs.*]`)"},
+        {MalfunctionKind::kJointSlow, MalfunctionPart::kJoint, "joint_slow", "joint N slow V",
+         "DEG_S", "the joint's rate at most, deg/s", 0.01, 100.0, 1.0, "deg/s",
+         "joint N moves toward its command at most V deg/s"},
+        {MalfunctionKind::kFingerJammedOpen, MalfunctionPart::kFinger, "finger_jammed_open",
+         "finger jammed open", "", "", 0, 0, 0, "-",
+         "the finger cannot close past where it was when it jammed (it may still open): it cannot "
+         "acquire"},
+        {MalfunctionKind::kFingerJammedClosed, MalfunctionPart::kFinger, "finger_jammed_closed",
+         "finger jammed closed", "", "", 0, 0, 0, "-",
+         "the finger cannot open past where it was: a held payload cannot be released"},
+        {MalfunctionKind::kCameraLost, MalfunctionPart::kCamera, "camera_lost", "camera N lost", "",
+         "", 0, 0, 0, "-",
+         "camera station N sends no picture: when the operator selects it, the DCP sets the "
+         "control word's NO VIDEO bit (bit 6) and the ESG draws black with \"NO VIDEO\"; the "
+         "instructor's view of the station goes black too"},
+        {MalfunctionKind::kInputsDelayed, MalfunctionPart::kInputs, "inputs_delayed",
+         "inputs delayed V", "MS", "the delay, ms", 1.0, 3000.0, 500.0, "ms",
+         "the operator's inputs reach the DCP V ms late: every input block is answered round(V x "
+         "frame rate / 1000) frames late, at least one. When the delay starts, the last block "
+         "answered is held until the first delayed one is due; a longer delay holds, a shorter "
+         "one drops the oldest blocks; repaired, the next frame answers its own block"},
     }};
 const MalfunctionKindInfo& KindInfo(MalfunctionKind kind);
 
@@ -77,11 +117,12 @@ struct Malfunction {
   bool operator==(const Malfunction&) const = default;
 };
 
-// What a REPAIR clears.
-enum class RepairWhat : int { kJoint = 0, kFinger, kCamera, kInputs, kAll };
+// What a REPAIR clears: every malfunction, or those of one part (and of its
+// number N, for a part that has one).
 struct Repair {
-  RepairWhat what = RepairWhat::kAll;
-  int target = 0;  // the joint or camera station; 0 otherwise
+  bool all = true;
+  MalfunctionPart part = MalfunctionPart::kJoint;  // when not all
+  int target = 0;                                  // the joint or camera station; 0 otherwise
   bool operator==(const Repair&) const = default;
 };
 
@@ -101,6 +142,12 @@ bool Clears(const Repair& r, const Malfunction& m);
 Repair RepairFor(const Malfunction& m);
 // The joint's name, 1 "shoulder yaw" .. 6 "wrist roll".
 const char* JointName(int joint);
+// The grammars as error messages and help show them, made from the tables:
+// "'joint N stuck', ..., or 'inputs delayed MS' (joints 1..6, cameras 1..8)".
+std::string MalfunctionGrammar();
+std::string RepairGrammar();
+// docs/sessions.md's table of malfunctions (markdown), made from the tables.
+std::string MalfunctionTableMarkdown();
 // The longest malfunction or repair text a command may carry, bytes.
 inline constexpr std::size_t kMaxMalfunctionTextBytes = 64;
 
