@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "rms/arm/kinematics.h"
+#include "rms/base/camera_view.h"
 #include "rms/base/check.h"
 #include "rms/mission/arm_ik.h"
 #include "rms/mission/mission_geometry.h"
@@ -19,6 +20,11 @@ std::vector<Keyframe> PlanMission(const LabConfig& c) {
   std::vector<Keyframe> keys;
   const scene_model::SceneModel model = scene_model::BuildSceneModel(c);
   const Eigen::Isometry3d X_RP_bay = arm::MakeIsometry(c.payload.R_RP, c.payload.p_RoPo_R_ft);
+  // Each view's camera station, by its mount (0: the configuration has none;
+  // the keyframe then keeps the station it has).
+  const CameraStations stations = FindCameraStations(c.cameras);
+  const auto station = [&](CameraView v) { return stations[static_cast<int>(v)]; };
+  using V = CameraView;
   // Elbow up (one branch all along, so joint interpolation between close
   // waypoints stays smooth); a waypoint that puts the arm or the payload
   // into the orbiter or the CAE is refused.
@@ -39,7 +45,7 @@ std::vector<Keyframe> PlanMission(const LabConfig& c) {
   };
   Keyframe stowed;
   stowed.shoulder_height_ft = h;
-  stowed.camera = 8;
+  stowed.camera = station(V::kExternal);
   stowed.note = "stowed, external camera";
   stowed.extra = "overlay=on";
   keys.push_back(stowed);
@@ -50,12 +56,12 @@ std::vector<Keyframe> PlanMission(const LabConfig& c) {
     return X;
   };
   // Mode 1: over the receptacle, down, close the finger.
-  add(5.0, shifted(g.X_RS2_grasp, 8 * up), 0, 1, "over the receptacle, aft flight deck camera",
+  add(5.0, shifted(g.X_RS2_grasp, 8 * up), 0, station(V::kOverTheBay), "over the receptacle, aft flight deck camera",
       "camera_zoom=0 camera_pan=0 camera_tilt=0");
-  add(8.0, shifted(g.X_RS2_grasp, 2 * up), 0, 4, "just above it, wrist camera", "camera_zoom=0.3");
+  add(8.0, shifted(g.X_RS2_grasp, 2 * up), 0, station(V::kWrist), "just above it, wrist camera", "camera_zoom=0.3");
   add(11.0, g.X_RS2_grasp, 0, 0, "grasp position", "camera_zoom=0.3");
   add(12.0, g.X_RS2_grasp, 0, 0, "finger open", "camera_zoom=0");
-  add(15.0, g.X_RS2_grasp, 1, 5, "finger closed on the bar: acquisition; forward bulkhead camera");
+  add(15.0, g.X_RS2_grasp, 1, station(V::kForwardBulkhead), "finger closed on the bar: acquisition; forward bulkhead camera");
   // Mode 2: straight up out of the bay in small steps (joint interpolation
   // between close waypoints keeps the path straight).
   const double r = 0.5 * c.payload.diameter_ft + c.payload.probe_diameter_ft;
@@ -63,8 +69,8 @@ std::vector<Keyframe> PlanMission(const LabConfig& c) {
   const int steps = 6;
   for (int i = 1; i <= steps; ++i) {
     add(15.0 + 1.5 * i, shifted(g.X_RS2_grasp, (lift * i / steps) * up), 1,
-        i == 1   ? 6
-        : i == 4 ? 3
+        i == 1   ? station(V::kAftBulkhead)
+        : i == 4 ? station(V::kElbow)
                  : 0,
         i == steps ? "clear of the bay"
         : i == 1   ? "lifting, aft bulkhead camera"
@@ -77,7 +83,7 @@ std::vector<Keyframe> PlanMission(const LabConfig& c) {
   const Eigen::Vector3d yC = c.cae.R_RC.col(1);
   const Eigen::Isometry3d X_RS2_predock = shifted(X_RS2_dock, -3.0 * yC);
   const Eigen::Isometry3d X_high = shifted(g.X_RS2_grasp, (lift + 6.0) * up);
-  add(t += 3.0, X_high, 1, 2, "high above the bay, port aft window: pan and tilt up",
+  add(t += 3.0, X_high, 1, station(V::kPortAftWindow), "high above the bay, port aft window: pan and tilt up",
       "camera_pan=0 camera_tilt=0 camera_zoom=0");
   // Turn in steps: interpolate the payload's pose from high to pre-dock.
   const Eigen::Isometry3d X_RP_high = X_high * g.X_S2P, X_RP_pre = X_RS2_predock * g.X_S2P;
@@ -89,8 +95,8 @@ std::vector<Keyframe> PlanMission(const LabConfig& c) {
     X_RP.linear() = q0.slerp(u, q1).toRotationMatrix();
     X_RP.translation() = (1 - u) * X_RP_high.translation() + u * X_RP_pre.translation();
     add(t += 1.5, X_RP * g.X_S2P.inverse(), 1,
-        i == turn ? 7
-        : i == 3  ? 8
+        i == turn ? station(V::kCaeDockingPort)
+        : i == 3  ? station(V::kExternal)
                   : 0,
         i == turn ? "under the port, CAE camera"
         : i == 3  ? "turning toward the port, external camera"
@@ -104,7 +110,7 @@ std::vector<Keyframe> PlanMission(const LabConfig& c) {
     add(t += 1.0, shifted(X_RS2_predock, (3.0 * i / rise) * yC), 1, 0,
         i == rise ? "docked" : "rising to the port", i == rise ? "camera_zoom=0.5" : "");
   }
-  add(t += 2.0, X_RS2_dock, 1, 8, "hold, external camera", "camera_zoom=0");
+  add(t += 2.0, X_RS2_dock, 1, station(V::kExternal), "hold, external camera", "camera_zoom=0");
   return keys;
 }
 

@@ -63,9 +63,10 @@ Autopilot::Autopilot(const LabConfig& config, AutopilotOptions options)
       limits_(LimitsFromConfig(config, options.joint_rate_deg_s)),
       model_(scene_model::BuildSceneModel(config)),
       dt_s_(1.0 / config.session.frame_rate_hz),
-      follow_(config.session.frame_rate_hz) {
+      follow_(config.session.frame_rate_hz),
+      stations_(FindCameraStations(config.cameras)) {
   cmd_ = wire::InitialInputs(config.inputs);
-  cmd_.camera_station = 8;
+  if (const int s = stations_[static_cast<int>(CameraView::kExternal)]) cmd_.camera_station = s;
   cmd_.overlay = true;
   // System Two at the grasp, in the payload's frame (body-fixed; the payload
   // itself is wherever the telemetry says it is).
@@ -85,8 +86,9 @@ void Autopilot::Fail(const std::string& why) {
   phase_ = AutopilotPhase::kFailed;
 }
 
-void Autopilot::Camera(int station, double zoom) {
-  if (!opt_.cameras) return;
+void Autopilot::Camera(CameraView view, double zoom) {
+  const int station = stations_[static_cast<int>(view)];
+  if (!opt_.cameras || station == 0) return;  // none in the configuration: as it is
   cmd_.camera_station = station;
   cmd_.value[kCameraPan] = 0.0;
   cmd_.value[kCameraTilt] = 0.0;
@@ -294,33 +296,33 @@ void Autopilot::StartPhase(AutopilotPhase p, const dcp_telemetry_t& tm) {
   plan_.clear();
   switch (p) {
     case AutopilotPhase::kApproach:
-      Camera(1);
+      Camera(CameraView::kOverTheBay);
       PlanApproach(tm);
       break;
     case AutopilotPhase::kDescend:
-      Camera(4, 0.3);
+      Camera(CameraView::kWrist, 0.3);
       PlanLine(TelemetryPose(tm.p_RoPo_R_ft, tm.R_RP) * X_PS2_grasp_, opt_.descend_speed_ft_s);
       break;
     case AutopilotPhase::kClose:
-      Camera(5);
+      Camera(CameraView::kForwardBulkhead);
       finger_full_frames_ = 0;
       break;
     case AutopilotPhase::kLift:
-      Camera(6);
+      Camera(CameraView::kAftBulkhead);
       seen_mode3_ = tm.mode == 3;
       mode3_height_ft_ = CommandedPose().translation().z();
       PlanLine(Shifted(CommandedPose(), Eigen::Vector3d(0, 0, 40.0)), opt_.lift_speed_ft_s);
       break;
     case AutopilotPhase::kTransfer:
-      Camera(2);
+      Camera(CameraView::kPortAftWindow);
       PlanTransfer(tm);
       break;
     case AutopilotPhase::kDock:
-      Camera(7);
+      Camera(CameraView::kCaeDockingPort);
       PlanLine(X_RP_dock_ * X_S2P_.inverse(), opt_.dock_speed_ft_s);
       break;
     case AutopilotPhase::kDocked:
-      Camera(8);
+      Camera(CameraView::kExternal);
       docked_at_s_ = t_s_;
       break;
     default:
@@ -485,7 +487,7 @@ void Autopilot::StepWaitTelemetry(const dcp_telemetry_t& tm) {
   for (int i = 0; i < 6; ++i) cmd_.value[i] = tm.slave_angles_deg[i];
   cmd_.value[kShoulderHeight] = tm.slave_shoulder_height_ft;
   cmd_.value[kFinger] = tm.slave_finger;
-  Camera(8);
+  Camera(CameraView::kExternal);
   if (tm.mode != 1 || tm.acquired || tm.docked) {
     Enter(AutopilotPhase::kReset);
     reset_frames_ = 0;
@@ -561,7 +563,7 @@ void Autopilot::StepLift(const dcp_telemetry_t& tm) {
   if (tm.mode == 3 && !seen_mode3_) {
     seen_mode3_ = true;
     mode3_height_ft_ = CommandedPose().translation().z();
-    Camera(3);
+    Camera(CameraView::kElbow);
   }
   if (seen_mode3_ && CommandedPose().translation().z() >= mode3_height_ft_ + opt_.lift_margin_ft)
     plan_.clear();
@@ -575,7 +577,8 @@ void Autopilot::StepLift(const dcp_telemetry_t& tm) {
 void Autopilot::StepTransfer(const dcp_telemetry_t& tm) {
   const PlanState ps = StepPlan();
   if (ps == PlanState::kUnreachable) return Fail("the transfer path left the arm's reach");
-  if (t_s_ - phase_t0_s_ > 6.0 && cmd_.camera_station == 2) Camera(8);
+  if (t_s_ - phase_t0_s_ > 6.0 && cmd_.camera_station == stations_[static_cast<int>(CameraView::kPortAftWindow)])
+    Camera(CameraView::kExternal);
   if (ps == PlanState::kDone && Settled(tm)) StartPhase(AutopilotPhase::kDock, tm);
 }
 

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "rms/base/camera_view.h"
 #include "rms/base/config.h"
 #include "rms/base/counters.h"
 #include "rms/dcp_telemetry_t.hpp"
@@ -138,7 +139,7 @@ class Autopilot {
   void StepResync(const dcp_telemetry_t& tm);
   void Fail(const std::string& why);
   void Relieve(const dcp_telemetry_t& tm);
-  void Camera(int station, double zoom = 0.0);
+  void Camera(CameraView view, double zoom = 0.0);
   void PlanApproach(const dcp_telemetry_t& tm);
   void PlanTransfer(const dcp_telemetry_t& tm);
   void StartPhase(AutopilotPhase p, const dcp_telemetry_t& tm);
@@ -151,6 +152,7 @@ class Autopilot {
   // A joint or the finger not following (a failure, docs/operator.md "The
   // autopilot"): the autopilot says so and holds its command until it follows.
   FollowWatch follow_;
+  CameraStations stations_;  // each view's camera station, by its mount (0: none)
   double holding_since_s_ = 0.0;  // when it last said it holds for a failure
   // The telemetry's master command is where the slave arm is (every joint
   // within FollowWatch's recovery tolerance, the same shoulder height).
