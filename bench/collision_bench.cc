@@ -29,6 +29,7 @@
 #include "rms/reference/exact_hull.h"
 #include "rms/reference/generators.h"
 #include "rms/sim/closed_loop.h"
+#include "rms/wire/dcp_mode.h"
 
 #include "peers.h"
 
@@ -146,9 +147,9 @@ void MakeMissionSets(Sets* s) {
   DynamicCollisionProgram dcp(config);
   std::vector<std::pair<Hexahedron, Hexahedron>> boxes, general;
   for (const auto& in : inputs) {
-    const bool mode1 = dcp.mode() == 1;
+    const bool mode1 = dcp.mode() == rms::wire::DcpMode::kAcquisition;
     dcp.Step(in);
-    if (!mode1 || dcp.mode() != 1) continue;
+    if (!mode1 || dcp.mode() != rms::wire::DcpMode::kAcquisition) continue;
     ++s->mission_frames;
     const DcpStatus& st = dcp.status();
     const EndEffectorModel ee = MakeEndEffector(config.end_effector, st.X_RS2, st.finger_gap_ft);

@@ -30,6 +30,7 @@
 #include "rms/dcp_model/dynamic_collision_program.h"
 #include "rms/sim/closed_loop.h"
 #include "rms/sim/random_operator.h"
+#include "rms/wire/dcp_mode.h"
 #include "rms/wire/word_codec.h"
 
 #include "bench_stats.h"
@@ -63,7 +64,7 @@ struct FrameVariant {
 // bits, mode, acquired, docked, the slave's pose.
 struct Decision {
   std::uint32_t control = 0, collisions = 0;
-  int mode = 0;
+  rms::wire::DcpMode mode = rms::wire::DcpMode::kAcquisition;
   Eigen::Vector3d p;
   bool operator==(const Decision& o) const {
     return control == o.control && collisions == o.collisions && mode == o.mode && p == o.p;
@@ -81,14 +82,14 @@ void RunFrames(const rms::LabConfig& config, const std::vector<Flight>& flights,
         DynamicCollisionProgram dcp(config, v.options);
         std::vector<Decision> decisions;
         for (const rms::wire::OperatorInputs& in : flights[fi].inputs) {
-          const int mode = dcp.mode();
+          const rms::wire::DcpMode mode = dcp.mode();
           const auto master_before = dcp.status().master, slave_before = dcp.status().slave;
           const auto t0 = Clock::now();
           rms::wire::DcpFrameData out = dcp.Step(in);
           benchmark::DoNotOptimize(out);
           const double ns = std::chrono::duration<double, std::nano>(Clock::now() - t0).count();
           v.ns.push_back(ns);
-          v.ns_mode[mode].push_back(ns);
+          v.ns_mode[rms::wire::ModeNumber(mode)].push_back(ns);
           auto changed = [](const ArmCommand& a, const ArmCommand& b) {
             return a.angles_deg != b.angles_deg || a.shoulder_height_ft != b.shoulder_height_ft ||
                    a.finger != b.finger;
@@ -427,7 +428,7 @@ void DrawSamples(Bench* b) {
   for (const Flight& f : b->flights) {
     for (const auto& in : f.inputs) {
       dcp.Step(in);
-      if (dcp.mode() != 1) continue;
+      if (dcp.mode() != rms::wire::DcpMode::kAcquisition) continue;
       for (int k = 0; k < 8; ++k) {
         ArmSample s;
         for (int j = 0; j < 6; ++j) s.deg[j] = dcp.status().slave.angles_deg[j] + jitter(b->rng);

@@ -43,6 +43,7 @@
 #include "rms/reference/generators.h"
 #include "rms/sim/closed_loop.h"
 #include "rms/sim/random_operator.h"
+#include "rms/wire/dcp_mode.h"
 
 namespace {
 
@@ -253,10 +254,10 @@ std::vector<nlohmann::json> MissionCheckpoints(const LabConfig& config, Failures
   rms::sim::FlyAutopilot(config, {}, 20000, 1, &inputs);
   std::vector<nlohmann::json> checkpoints;
   DynamicCollisionProgram d(config);
-  int last_mode = 1;
+  wire::DcpMode last_mode = wire::DcpMode::kAcquisition;
   for (std::size_t f = 0; f < inputs.size(); ++f) {
     d.Step(inputs[f]);
-    if (d.mode() != last_mode && d.mode() >= 2 && !d.status().docked) {
+    if (d.mode() != last_mode && d.mode() >= wire::DcpMode::kExtraction && !d.status().docked) {
       for (int k = 0; k < 30 && f + 1 < inputs.size(); ++k) d.Step(inputs[++f]);
       checkpoints.push_back(d.SaveState());
     }
@@ -297,7 +298,7 @@ bool CheckSoakFrame(const LabConfig& config, const DynamicCollisionProgram& dcp,
   st->worst_orthonormal = std::max({st->worst_orthonormal, orth, orth_p});
   if (orth > 1e-12 || orth_p > 1e-12)
     fail->Add("a rotation drifted from orthonormal (1e-12)", what);
-  if (s.mode >= 2) {
+  if (s.mode >= wire::DcpMode::kExtraction) {
     const Eigen::Isometry3d X_RP_bay =
         arm::MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft);
     const auto l0 = EdgeLengths(MakePayload(config.payload, X_RP_bay).body[0]);
@@ -344,7 +345,7 @@ void Soak(const LabConfig& config, long frames, std::uint64_t seed, SoakStats* s
     const wire::DcpFrameData out = dcp.Step(dec);
     ++st->frames;
     const DcpStatus& s = dcp.status();
-    ++st->frames_in_mode[s.mode];
+    ++st->frames_in_mode[wire::ModeNumber(s.mode)];
     st->held += s.held;
     (void)MakeTelemetry(s, out);  // the telemetry is made from every state
     if (!CheckSoakFrame(config, dcp, out, fresh, dec.reset,

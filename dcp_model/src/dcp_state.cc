@@ -8,6 +8,7 @@
 
 #include "rms/base/check.h"
 #include "rms/dcp_model/dynamic_collision_program.h"
+#include "rms/wire/dcp_mode.h"
 
 #include "program_internal.h"
 
@@ -125,7 +126,8 @@ std::unique_ptr<DynamicCollisionProgram::RestoredState> DynamicCollisionProgram:
                        "', expected '" + kCheckpointFormat + "'");
     }
     p->mode = j.at("mode").get<int>();
-    if (p->mode < 1 || p->mode > 3) throw InputError("checkpoint: mode must be 1, 2 or 3");
+    if (p->mode < wire::DcpMode::kAcquisition || p->mode > wire::DcpMode::kManoeuvring)
+      throw InputError("checkpoint: mode must be 1, 2 or 3");
     p->acquired = j.at("acquired").get<bool>();
     p->docked = j.at("docked").get<bool>();
     p->released = j.at("released").get<bool>();
@@ -196,7 +198,7 @@ void DynamicCollisionProgram::RestoreState(const nlohmann::json& j) {
   // The slave must be free where the checkpoint puts it: tried on the state
   // it describes, and the old state put back if not.
   const nlohmann::ordered_json before = SaveState();
-  status_.mode = p->mode;
+  status_.mode = static_cast<wire::DcpMode>(p->mode);  // 1..3: CheckRestoredState
   status_.acquired = p->acquired;
   status_.docked = p->docked;
   released_ = status_.released = p->released;
@@ -232,9 +234,10 @@ void DynamicCollisionProgram::CheckRestored(int mode, bool acquired, bool docked
                                             double contact_gap_ft,
                                             double acquisition_gap_ft) const {
   // A state the program could have reached (docs/sessions.md "checkpoint").
-  if (acquired != (mode >= 2))
+  if (acquired != (mode >= wire::DcpMode::kExtraction))
     throw InputError("checkpoint: 'acquired' must be true exactly in Modes 2 and 3");
-  if (docked && mode != 3) throw InputError("checkpoint: 'docked' needs Mode 3");
+  if (docked && mode != wire::DcpMode::kManoeuvring)
+    throw InputError("checkpoint: 'docked' needs Mode 3");
   if (released && !docked) throw InputError("checkpoint: 'released' needs 'docked'");
   if (!std::isfinite(contact_gap_ft) || !std::isfinite(acquisition_gap_ft)) {
     throw InputError("checkpoint: a finger gap is not finite");

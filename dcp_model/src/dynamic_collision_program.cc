@@ -10,6 +10,7 @@
 
 #include "rms/base/check.h"
 #include "rms/scene_model/scene_model.h"
+#include "rms/wire/dcp_mode.h"
 #include "rms/wire/word_codec.h"
 
 #include "program_internal.h"
@@ -110,11 +111,11 @@ bool DynamicCollisionProgram::Reset() {
   // The reset scene: Mode 1, the payload in the bay. The arm stays; where it
   // is must be free there, or the reset is refused.
   const Eigen::Isometry3d X_RP_free = X_RP_free_;
-  const int mode = status_.mode;
+  const wire::DcpMode mode = status_.mode;
   const bool acquired = status_.acquired, docked = status_.docked, released = released_;
   const double reach = payload_reach_ft_;
   PlacePayload(X_RP_bay_);
-  status_.mode = 1;
+  status_.mode = wire::DcpMode::kAcquisition;
   status_.acquired = status_.docked = false;
   released_ = false;
   payload_reach_ft_ = 0.0;
@@ -350,19 +351,19 @@ void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* 
   e.words = TransmittedArmWords(cmd.angles_deg);
   e.pose = arm::ComputeArmPose(config_.arm, e.words, cmd.shoulder_height_ft);
   e.finger_gap_ft = FingerGapFt(cmd.finger);
-  if (status_.mode >= 2 && !(status_.docked && released_)) {
+  if (status_.mode >= wire::DcpMode::kExtraction && !(status_.docked && released_)) {
     const double widest =
         status_.docked ? config_.end_effector.finger_gap_open_ft : acquisition_gap_ft_;
     e.finger_gap_ft = std::clamp(e.finger_gap_ft, contact_gap_ft_, widest);
   }
   switch (status_.mode) {
-    case 1:
+    case wire::DcpMode::kAcquisition:
       EvaluateMode1(prev, &e);
       break;
-    case 2:
+    case wire::DcpMode::kExtraction:
       EvaluateMode2(&e);
       break;
-    default:
+    case wire::DcpMode::kManoeuvring:
       EvaluateMode3(prev, &e);
       break;
   }
@@ -372,7 +373,8 @@ void DynamicCollisionProgram::Evaluate(const ArmCommand& cmd, const Evaluation* 
     e.collisions |= wire::collision_bits::kNonFinite;
   if (e.collisions) e.clearance_ft = 0.0;
   e.mode = status_.mode;
-  if (!options_.mode_pairs_only && status_.mode >= 2) EvaluateExtraPairs(&e);
+  if (!options_.mode_pairs_only && status_.mode >= wire::DcpMode::kExtraction)
+    EvaluateExtraPairs(&e);
 }
 
 void DynamicCollisionProgram::AcceptSpare() { std::swap(slave_, spare_); }
@@ -579,7 +581,7 @@ void DynamicCollisionProgram::Respond(const ArmCommand& command) {
     status_.held = true;
     return;
   }
-  if (status_.mode == 1 && command.finger != slave_->cmd.finger) {
+  if (status_.mode == wire::DcpMode::kAcquisition && command.finger != slave_->cmd.finger) {
     // The finger is what collides: let the arm follow, and move the finger
     // as far as it goes (onto the bar: the essential contact).
     ArmCommand arm_only = command;
@@ -607,7 +609,7 @@ void DynamicCollisionProgram::LetGo() {
   // The payload where it is, Mode 1; the arm where it is must be free of it
   // (it is, but for rounding through X_S2P), else the grasp is kept.
   const Eigen::Isometry3d X_RP_free = X_RP_free_;
-  status_.mode = 1;
+  status_.mode = wire::DcpMode::kAcquisition;
   status_.acquired = false;
   const double reach = payload_reach_ft_;
   payload_reach_ft_ = 0.0;
@@ -674,7 +676,7 @@ ArmCommand DynamicCollisionProgram::SlaveCommand(const ArmCommand& master) {
       command.angles_deg = slave_->cmd.angles_deg;
       command.shoulder_height_ft = slave_->cmd.shoulder_height_ft;
     }
-  } else if (status_.mode >= 2 && !status_.docked &&
+  } else if (status_.mode >= wire::DcpMode::kExtraction && !status_.docked &&
              FingerGapFt(master.finger) >= acquisition_gap_ft_ + kReleaseOpeningFt) {
     LetGo();
   }
@@ -708,7 +710,7 @@ wire::DcpFrameData DynamicCollisionProgram::FrameOut(const wire::OperatorInputs&
   out.control.overlay = in.overlay;
   out.control.crosshairs = in.crosshairs;
   out.control.no_video = malfunctions_.CameraLost(in.camera_station);
-  out.control.mode = status_.mode;
+  out.control.mode = wire::ModeNumber(status_.mode);
   // COLLISION: a detrimental collision; RECPT: the essential contact.
   const std::uint32_t essential =
       status_.essential_contact ? wire::collision_bits::kEffHexRecpt << 2 : 0u;
@@ -752,11 +754,11 @@ wire::DcpFrameData DynamicCollisionProgram::Step(const wire::OperatorInputs& raw
   status_.X_RP = slave_->X_RP;
   status_.finger_gap_ft = slave_->finger_gap_ft;
   UpdatePlanes();
-  const int mode_before = status_.mode;
+  const wire::DcpMode mode_before = status_.mode;
   UpdateDocking();  // distance and angle every frame; docking in Mode 3
-  if (mode_before == 1)
+  if (mode_before == wire::DcpMode::kAcquisition)
     UpdateAcquisition();
-  else if (mode_before == 2)
+  else if (mode_before == wire::DcpMode::kExtraction)
     UpdateExtraction();
   else
     status_.bay_clearance_ft = BayClearance(slave_->payload);
@@ -770,7 +772,7 @@ void DynamicCollisionProgram::UpdatePlanes() {
   // frame coherence; the checkpoint keeps the planes).
   status_.plane_valid = 0;
   status_.planes = {};
-  if (status_.mode != 1) return;
+  if (status_.mode != wire::DcpMode::kAcquisition) return;
   for (int k = 0; k < 3; ++k) {
     const CollisionResult& r = slave_->ee_bar[k];
     if (r.verdict == Verdict::kSeparate && r.plane_valid) {
@@ -793,7 +795,7 @@ void DynamicCollisionProgram::RefreshMeasures() {
   status_.acquisition_margin_ft = {};
   status_.palm_to_bar_ft = 0.0;
   status_.finger_contact = false;
-  if (status_.mode == 1) {
+  if (status_.mode == wire::DcpMode::kAcquisition) {
     const AcquisitionCheck c =
         CheckAcquisition(config_.dcp, slave_->ee, bar_, slave_->finger_gap_ft, tau_rel_);
     status_.acquisition = c.holds;
@@ -904,7 +906,7 @@ void DynamicCollisionProgram::UpdateAcquisition() {
   status_.bay_clearance_ft = BayClearance(slave_->payload);
   status_.finger_contact = c.margin_ft[wire::kBarBeyondFingerFaceE] <= kFingerContactToleranceFt;
   if (!(c.all() && status_.finger_contact)) return;
-  status_.mode = 2;
+  status_.mode = wire::DcpMode::kExtraction;
   status_.acquired = true;
   X_S2P_ = slave_->pose.X_RS2.inverse() * X_RP_free_;
   // The gap at which face e of EFF HEX 3 would touch the bar: from face b
@@ -920,7 +922,7 @@ void DynamicCollisionProgram::UpdateAcquisition() {
                  0.0, acquisition_gap_ft_);
   payload_reach_ft_ = PayloadReachFt(X_S2P_);  // bounds the held payload's travel
   if (!ReevaluateSlave()) {
-    status_.mode = 1;
+    status_.mode = wire::DcpMode::kAcquisition;
     status_.acquired = false;
     payload_reach_ft_ = 0.0;
     return;
@@ -934,7 +936,8 @@ bool DynamicCollisionProgram::ReevaluateSlave() {
   // collides there keeps the mode it was in (reported, never shown).
   Evaluate(slave_->cmd, slave_, spare_);
   if (spare_->collisions) {
-    spdlog::warn("Mode {} not entered: the arm where it is would collide there ({})", status_.mode,
+    spdlog::warn("Mode {} not entered: the arm where it is would collide there ({})",
+                 wire::ModeNumber(status_.mode),
                  wire::CollisionNames(spare_->collisions, ", ", "none"));
     return false;
   }
@@ -953,9 +956,9 @@ void DynamicCollisionProgram::UpdateExtraction() {
   for (const Eigen::Vector3d& v : slave_->payload.v) {
     if (!(bay_.Word(v, tau) & FaceBit(kFaceC))) return;
   }
-  status_.mode = 3;
+  status_.mode = wire::DcpMode::kManoeuvring;
   if (!ReevaluateSlave()) {
-    status_.mode = 2;
+    status_.mode = wire::DcpMode::kExtraction;
     return;
   }
   spdlog::info("clear of the cargo bay: Mode 2 -> Mode 3");
@@ -967,7 +970,7 @@ void DynamicCollisionProgram::UpdateDocking() {
   status_.envelope_margin_ft = d.envelope_margin_ft;
   status_.dock_distance_ft = d.distance_ft;
   status_.dock_angle_deg = d.angle_deg;
-  if (status_.mode == 3 && !status_.docked && d.docked) {
+  if (status_.mode == wire::DcpMode::kManoeuvring && !status_.docked && d.docked) {
     status_.docked = true;
     X_RP_docked_ = slave_->X_RP;
     PlacePayload(X_RP_docked_);

@@ -13,6 +13,7 @@
 #include "rms/wire/acquisition_conditions.h"
 #include "rms/wire/channels.h"
 #include "rms/wire/checkpoint.h"
+#include "rms/wire/dcp_mode.h"
 #include "rms/wire/frame_receiver.h"
 #include "rms/wire/malfunction.h"
 #include "rms/wire/message_io.h"
@@ -83,8 +84,8 @@ void DynamicsProc::Restore(const wire::Checkpoint& c, const std::string& what) {
     throw InputError("checkpoint '" + what + "': " + e.what());
   }
   spdlog::info("restored the DCP's state from {} (saved at DCP frame {}): Mode {}{}{}", what,
-               c.dcp_frame, dcp_.status().mode, dcp_.status().acquired ? ", acquired" : "",
-               dcp_.status().docked ? ", docked" : "");
+               c.dcp_frame, wire::ModeNumber(dcp_.status().mode),
+               dcp_.status().acquired ? ", acquired" : "", dcp_.status().docked ? ", docked" : "");
 }
 
 void DynamicsProc::PublishState(std::int8_t reason) {
@@ -169,7 +170,8 @@ bool DynamicsProc::ResumeFromStateFile() {
   last_inputs_ = c.inputs;
   counters_.Add(Counter::kResumed);
   spdlog::warn("resumed from the last state written ({}, DCP frame {}): Mode {}{}{}", state_file_,
-               c.dcp_frame, dcp_.status().mode, dcp_.status().acquired ? ", payload attached" : "",
+               c.dcp_frame, wire::ModeNumber(dcp_.status().mode),
+               dcp_.status().acquired ? ", payload attached" : "",
                dcp_.status().docked ? ", docked" : "");
   return true;
 }
@@ -237,7 +239,8 @@ void DynamicsProc::OnControl(const void* data, int size) {
       counters_.Add(Counter::kControlRestores);
       PublishState(dcp_state_t::RESTORE);
       Answer(m, control_answer_t::DONE,
-             "restored " + m.name + ": Mode " + std::to_string(dcp_.status().mode) +
+             "restored " + m.name + ": Mode " +
+                 std::to_string(wire::ModeNumber(dcp_.status().mode)) +
                  (dcp_.status().acquired ? ", acquired" : "") +
                  (dcp_.status().docked ? ", docked" : ""));
     }
@@ -366,7 +369,7 @@ void DynamicsProc::OnInput(const void* data, int size, std::int64_t recv_time_us
 }
 
 void DynamicsProc::Report(const DcpStatus& st, std::int64_t frame) {
-  counters_.Set(Counter::kMode, st.mode);
+  counters_.Set(Counter::kMode, wire::ModeNumber(st.mode));
   if (st.held) counters_.Add(Counter::kFramesHeld);
   if (st.finger_held) counters_.Add(Counter::kFramesFingerHeld);
   // docs/collision.md "Collision response": what the DCP refused.
@@ -381,7 +384,7 @@ void DynamicsProc::Report(const DcpStatus& st, std::int64_t frame) {
   }
   if (st.mode != last_mode_) {
     if (last_mode_ != 0) counters_.Add(Counter::kModeChanges);
-    last_mode_ = st.mode;
+    last_mode_ = wire::ModeNumber(st.mode);
   }
   // Each collision as it starts and ends.
   const std::uint32_t started = st.collisions & ~last_collisions_;
@@ -431,11 +434,11 @@ int RunDynamicsProc(const LabConfig& config, transport::LcmInterface& lcm,
       lcm, "dynamics_proc", node.counters(), node.latencies(), [&] { return node.last_frame(); },
       until_first_frame, stats_path);
   node.WriteStateFile();
-  spdlog::info("published {} DCP frames; inputs missing {}, late {}, dropped {}; final mode {}",
-               node.counters().Get(Counter::kPublished),
-               node.counters().Get(Counter::kInputMissing),
-               node.counters().Get(Counter::kFramesLate),
-               node.counters().Sum(kDroppedFirst, kDroppedLast), node.program().mode());
+  spdlog::info(
+      "published {} DCP frames; inputs missing {}, late {}, dropped {}; final mode {}",
+      node.counters().Get(Counter::kPublished), node.counters().Get(Counter::kInputMissing),
+      node.counters().Get(Counter::kFramesLate), node.counters().Sum(kDroppedFirst, kDroppedLast),
+      wire::ModeNumber(node.program().mode()));
   return 0;
 }
 

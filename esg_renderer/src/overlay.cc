@@ -10,6 +10,7 @@
 #include "rms/base/check.h"
 #include "rms/mission/mission_geometry.h"
 #include "rms/scene_model/scene_model.h"
+#include "rms/wire/dcp_mode.h"
 
 namespace rms::esg_renderer {
 
@@ -324,9 +325,10 @@ void DrawGuidance(std::uint8_t* rgba, int w, int h, const operator_state_t& st) 
   if (st.automatic & operator_state_t::AUTO_UNWIND) L.push_back("UNWINDING THE WRIST");
   if (st.automatic & operator_state_t::AUTO_STOW) L.push_back("STOWING THE ARM");
   if (st.joints_near_limit)
-    L.push_back(st.mode == 1 ? "WARNING: WRIST NEAR ITS LIMIT: UNWIND IT OR STOW THE ARM"
-                             : "WARNING: WRIST NEAR ITS LIMIT: UNWIND IT");
-  if (st.mode == 1) {
+    L.push_back(st.mode == wire::DcpMode::kAcquisition
+                    ? "WARNING: WRIST NEAR ITS LIMIT: UNWIND IT OR STOW THE ARM"
+                    : "WARNING: WRIST NEAR ITS LIMIT: UNWIND IT");
+  if (st.mode == wire::DcpMode::kAcquisition) {
     std::string c = "ACQ";
     for (int i = 0; i < 6; ++i) {
       std::snprintf(b, sizeof b, "  %d %s %.2f", i + 1, st.margin_ft[i] >= 0 ? "OK" : "NO",
@@ -344,7 +346,7 @@ void DrawGuidance(std::uint8_t* rgba, int w, int h, const operator_state_t& st) 
                                 : "NOT BELOW D3Y");
       L.push_back(b);
     }
-  } else if (st.mode == 2) {
+  } else if (st.mode == wire::DcpMode::kExtraction) {
     std::snprintf(b, sizeof b, "BAY: %.2f FT TO CLEAR", std::max(0.0, -st.bay_clearance_ft));
     L.push_back(b);
   } else {

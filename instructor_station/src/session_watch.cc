@@ -578,7 +578,8 @@ void SessionWatch::Score(const dcp_telemetry_t& t) {
   const dcp_telemetry_t* p = telemetry_ ? &*telemetry_ : nullptr;
   const double t_s = t.frame / config_.session.frame_rate_hz;
   ++score_.frames;
-  if (t.mode >= 0 && t.mode <= 3) ++score_.mode_frames[static_cast<std::size_t>(t.mode)];
+  if (t.mode >= 0 && t.mode <= wire::DcpMode::kManoeuvring)
+    ++score_.mode_frames[static_cast<std::size_t>(t.mode)];
   const std::uint32_t now = Detrimental(t), before = p ? Detrimental(*p) : 0;
   if (now & ~before) ++score_.collisions;
   if (now) ++score_.collision_frames;
@@ -593,7 +594,7 @@ void SessionWatch::TelemetryPlot(const dcp_telemetry_t& t) {
   q.frame = t.frame;
   q.mode = t.mode;
   q.goal_ft = std::numeric_limits<double>::quiet_NaN();
-  if (t.mode >= 2)
+  if (t.mode >= wire::DcpMode::kExtraction)
     q.goal_ft = t.dock_distance_ft;
   else if (operator_ && operator_->guidance_valid && operator_->mode == t.mode)
     q.goal_ft = operator_->distance_ft;
@@ -601,7 +602,7 @@ void SessionWatch::TelemetryPlot(const dcp_telemetry_t& t) {
     q.margin_ft[static_cast<std::size_t>(i)] = t.acquisition_margin_ft[i];
   q.dock_angle_deg = t.dock_angle_deg;
   if (std::isfinite(q.goal_ft) && (score_.min_goal_ft < 0 || q.goal_ft < score_.min_goal_ft) &&
-      t.mode >= 2)
+      t.mode >= wire::DcpMode::kExtraction)
     score_.min_goal_ft = q.goal_ft;
   plot_.push_back(q);
   if (plot_.size() > kMaxPlotPoints) {

@@ -8,6 +8,7 @@
 #include "rms/operator_station/guidance.h"
 #include "rms/wire/acquisition_conditions.h"
 #include "rms/wire/collision_bits.h"
+#include "rms/wire/dcp_mode.h"
 
 namespace rms::operator_station {
 
@@ -309,7 +310,7 @@ void Autopilot::StartPhase(AutopilotPhase p, const dcp_telemetry_t& tm) {
       break;
     case AutopilotPhase::kLift:
       Camera(CameraView::kAftBulkhead);
-      seen_mode3_ = tm.mode == 3;
+      seen_mode3_ = tm.mode == wire::DcpMode::kManoeuvring;
       mode3_height_ft_ = CommandedPose().translation().z();
       PlanLine(Shifted(CommandedPose(), Eigen::Vector3d(0, 0, 40.0)), opt_.lift_speed_ft_s);
       break;
@@ -350,7 +351,7 @@ void Autopilot::Relieve(const dcp_telemetry_t& tm) {
   relieved_at_frame_ = tm.frame;
   const Eigen::Isometry3d X = CommandedPose();
   plan_.clear();
-  if (tm.mode == 1) {
+  if (tm.mode == wire::DcpMode::kAcquisition) {
     // Up and away from the payload's axis, horizontally.
     const Eigen::Isometry3d X_RP = TelemetryPose(tm.p_RoPo_R_ft, tm.R_RP);
     const Eigen::Vector3d axis = X_RP.linear().col(1);
@@ -360,7 +361,7 @@ void Autopilot::Relieve(const dcp_telemetry_t& tm) {
     away = away.norm() > 1e-6 ? away.normalized() : Eigen::Vector3d::UnitY();
     PlanLine(Shifted(X, 1.5 * away + Eigen::Vector3d(0, 0, 1.5)), 0.5);
     resume_ = AutopilotPhase::kApproach;
-  } else if (tm.mode == 2) {
+  } else if (tm.mode == wire::DcpMode::kExtraction) {
     const Eigen::Vector3d to_centre(0, -0.3 * std::copysign(1.0, tm.p_RoPo_R_ft[1]), 0.5);
     PlanLine(Shifted(X, to_centre), 0.5);  // up and toward the bay's centre line
     resume_ = AutopilotPhase::kLift;
@@ -488,7 +489,7 @@ void Autopilot::StepWaitTelemetry(const dcp_telemetry_t& tm) {
   cmd_.value[kShoulderHeight] = tm.slave_shoulder_height_ft;
   cmd_.value[kFinger] = tm.slave_finger;
   Camera(CameraView::kExternal);
-  if (tm.mode != 1 || tm.acquired || tm.docked) {
+  if (tm.mode != wire::DcpMode::kAcquisition || tm.acquired || tm.docked) {
     Enter(AutopilotPhase::kReset);
     reset_frames_ = 0;
   } else {
@@ -500,7 +501,8 @@ void Autopilot::StepReset(const dcp_telemetry_t& tm) {
   // The reset button, one frame; then wait for Mode 1.
   if (reset_frames_++ == 0)
     cmd_.reset = true;
-  else if (reset_frames_ > 3 && tm.mode == 1 && !tm.acquired && !tm.docked)
+  else if (reset_frames_ > 3 && tm.mode == wire::DcpMode::kAcquisition && !tm.acquired &&
+           !tm.docked)
     Enter(AutopilotPhase::kOpenFinger);
   else if (reset_frames_ > 60)
     Fail("the DCP did not return to Mode 1 after a reset");
@@ -537,7 +539,7 @@ void Autopilot::StepDescend(const dcp_telemetry_t& tm) {
 }
 
 void Autopilot::StepClose(const dcp_telemetry_t& tm) {
-  if (tm.acquired && tm.mode == 2) {
+  if (tm.acquired && tm.mode == wire::DcpMode::kExtraction) {
     StartPhase(AutopilotPhase::kLift, tm);
     return;
   }
@@ -560,7 +562,7 @@ void Autopilot::StepClose(const dcp_telemetry_t& tm) {
 }
 
 void Autopilot::StepLift(const dcp_telemetry_t& tm) {
-  if (tm.mode == 3 && !seen_mode3_) {
+  if (tm.mode == wire::DcpMode::kManoeuvring && !seen_mode3_) {
     seen_mode3_ = true;
     mode3_height_ft_ = CommandedPose().translation().z();
     Camera(CameraView::kElbow);
@@ -577,7 +579,8 @@ void Autopilot::StepLift(const dcp_telemetry_t& tm) {
 void Autopilot::StepTransfer(const dcp_telemetry_t& tm) {
   const PlanState ps = StepPlan();
   if (ps == PlanState::kUnreachable) return Fail("the transfer path left the arm's reach");
-  if (t_s_ - phase_t0_s_ > 6.0 && cmd_.camera_station == stations_[static_cast<int>(CameraView::kPortAftWindow)])
+  if (t_s_ - phase_t0_s_ > 6.0 &&
+      cmd_.camera_station == stations_[static_cast<int>(CameraView::kPortAftWindow)])
     Camera(CameraView::kExternal);
   if (ps == PlanState::kDone && Settled(tm)) StartPhase(AutopilotPhase::kDock, tm);
 }
@@ -624,9 +627,9 @@ void Autopilot::StepResync(const dcp_telemetry_t& tm) {
   if (!Settled(tm)) return;
   if (tm.docked) {
     StartPhase(AutopilotPhase::kDocked, tm);
-  } else if (tm.mode == 3) {
+  } else if (tm.mode == wire::DcpMode::kManoeuvring) {
     StartPhase(AutopilotPhase::kTransfer, tm);
-  } else if (tm.mode == 2) {
+  } else if (tm.mode == wire::DcpMode::kExtraction) {
     StartPhase(AutopilotPhase::kLift, tm);
   } else {
     Enter(AutopilotPhase::kOpenFinger);

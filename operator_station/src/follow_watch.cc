@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fmt/format.h>
 
+#include "rms/wire/dcp_mode.h"
 #include "rms/wire/malfunction.h"
 
 namespace rms::operator_station {
@@ -63,7 +64,8 @@ std::vector<FollowWatch::Change> FollowWatch::Observe(const dcp_telemetry_t& t, 
       back = arm_judged && d <= kRecoverToleranceDeg;
     } else {
       const double d = t.master_finger - t.slave_finger;  // > 0: commanded more closed
-      const bool free_to_close = t.mode == 1 && !t.finger_held && t.collisions == 0;
+      const bool free_to_close =
+          t.mode == wire::DcpMode::kAcquisition && !t.finger_held && t.collisions == 0;
       off = !t.held && (d < -kFingerTolerance || (free_to_close && d > kFingerTolerance));
       back = !off;
     }

@@ -5,6 +5,7 @@
 #include "rms/arm/kinematics.h"
 #include "rms/mission/mission_geometry.h"
 #include "rms/operator_station/arm_motion.h"
+#include "rms/wire/dcp_mode.h"
 
 namespace rms::operator_station {
 
@@ -86,7 +87,7 @@ Eigen::Matrix3d CommandAxes(const GuidanceGeometry& g, CommandFrame f, const Arm
       return R;
     }
     case CommandFrame::kPayload:
-      if (s.mode >= 2) return s.X_RP.linear();
+      if (s.mode >= wire::DcpMode::kExtraction) return s.X_RP.linear();
       [[fallthrough]];
     case CommandFrame::kEndEffector:
       break;
@@ -95,7 +96,7 @@ Eigen::Matrix3d CommandAxes(const GuidanceGeometry& g, CommandFrame f, const Arm
 }
 
 Eigen::Vector3d PointOfResolution(const GuidanceGeometry& g, const ArmState& s) {
-  if (s.mode == 1) return g.p_S2oG_S2;
+  if (s.mode == wire::DcpMode::kAcquisition) return g.p_S2oG_S2;
   return s.X_RS2.inverse() * (s.X_RP * g.p_PoT_P);
 }
 
@@ -155,7 +156,8 @@ double TurnClearance(const GuidanceGeometry& g, const Eigen::Isometry3d& X_RP,
 }
 
 bool WouldAcquire(const dcp_telemetry_t& t, const Guidance& g, double d3y_ft) {
-  if (t.mode != 1 || g.close_gap_ft <= 0 || g.close_gap_ft >= d3y_ft) return false;
+  if (t.mode != wire::DcpMode::kAcquisition || g.close_gap_ft <= 0 || g.close_gap_ft >= d3y_ft)
+    return false;
   for (int i : {0, 1, 2, 4, 5})  // all but 4, the finger's own (docs/collision.md)
     if (!t.acquisition_conditions[i]) return false;
   return true;
@@ -167,7 +169,7 @@ Guidance ComputeGuidance(const GuidanceGeometry& g, const ArmState& s, CommandFr
   out.frame = f;
   const Eigen::Matrix3d R_RF = CommandAxes(g, f, s);
   Eigen::Vector3d d_R, phi_R;
-  if (s.mode == 1) {
+  if (s.mode == wire::DcpMode::kAcquisition) {
     out.target = GuidanceTarget::kGrasp;
     const Eigen::Vector3d Q = s.X_RS2 * g.p_S2oG_S2;
     phi_R = RotationVector(g.X_RS2_grasp.linear() * s.X_RS2.linear().transpose());
@@ -193,7 +195,7 @@ Guidance ComputeGuidance(const GuidanceGeometry& g, const ArmState& s, CommandFr
     else
       phi_R.setZero();
   }
-  if (s.mode == 2) {
+  if (s.mode == wire::DcpMode::kExtraction) {
     out.leave_bay = true;
     const double up = std::max(0.0, kLeaveBayMarginFt - s.bay_clearance_ft);
     out.leave_bay_ft = R_RF.transpose() * Eigen::Vector3d(0, 0, up);
@@ -202,14 +204,16 @@ Guidance ComputeGuidance(const GuidanceGeometry& g, const ArmState& s, CommandFr
   out.rotation_deg = R_RF.transpose() * phi_R * (180.0 / M_PI);
   out.distance_ft = d_R.norm();
   out.angle_deg = phi_R.norm() * 180.0 / M_PI;
-  if (s.mode >= 2) {
+  if (s.mode >= wire::DcpMode::kExtraction) {
     const Eigen::Vector3d turn_R =
         turn_F_deg ? Eigen::Vector3d(R_RF * *turn_F_deg * (M_PI / 180.0)) : phi_R;
     out.turn_clearance_ft = TurnClearance(g, s.X_RP, s.X_RP * g.p_PoT_P, turn_R);
-    out.clearance_warning = s.mode == 3 && out.turn_clearance_ft < kClearanceMarginFt;
+    out.clearance_warning =
+        s.mode == wire::DcpMode::kManoeuvring && out.turn_clearance_ft < kClearanceMarginFt;
   }
-  const Eigen::Vector3d approach_R =
-      s.mode == 1 ? Eigen::Vector3d(g.X_RS2_grasp.linear().col(0)) : g.y_port_R;
+  const Eigen::Vector3d approach_R = s.mode == wire::DcpMode::kAcquisition
+                                         ? Eigen::Vector3d(g.X_RS2_grasp.linear().col(0))
+                                         : g.y_port_R;
   out.next_axis = NextAxis(out, R_RF.transpose() * approach_R);
   if (out.leave_bay && out.leave_bay_ft.norm() > 1e-9) {
     int up = 0;

@@ -5,6 +5,7 @@
 #include <spdlog/spdlog.h>
 
 #include "rms/arm/kinematics.h"
+#include "rms/wire/dcp_mode.h"
 
 namespace rms::operator_station {
 
@@ -214,7 +215,7 @@ double HandControllers::FullRate(int axis) const {
 }
 
 void HandControllers::HandleEvents(const DeviceCommands& cmd, const dcp_telemetry_t* tm) {
-  const bool held = tm && tm->mode >= 2;
+  const bool held = tm && tm->mode >= wire::DcpMode::kExtraction;
   for (const Action& a : cmd.events) {
     switch (a.kind) {
       case ActionKind::kCamera:
@@ -296,7 +297,7 @@ void HandControllers::HandleEvents(const DeviceCommands& cmd, const dcp_telemetr
 }
 
 void HandControllers::StartAutomatic(const Action& a) {
-  if (a.kind == ActionKind::kStow && (dcp_mode_ != 1 || X_S2P_)) {
+  if (a.kind == ActionKind::kStow && (dcp_mode_ != wire::DcpMode::kAcquisition || X_S2P_)) {
     // With the payload held the arm's way back would carry it through the
     // bay's sill and the orbiter (docs/operator.md "Stowing the arm").
     counters_.Add(Counter::kIncrementsBlocked);
@@ -361,7 +362,7 @@ ArmState HandControllers::CommandedArmState() const {
     s.X_RP = s.X_RS2 * *X_S2P_;
     s.bay_clearance_ft = PayloadLowestZ(geometry_, s.X_RP);  // as commanded, for the way out
   } else {
-    s.mode = 1;
+    s.mode = wire::ModeNumber(wire::DcpMode::kAcquisition);
     s.X_RP = X_RP_;
   }
   return s;
@@ -785,13 +786,14 @@ wire::OperatorInputs HandControllers::Apply(const DeviceCommands& cmd, double dt
   frozen_noted_ = false;
   key_actions_ += cmd.key_actions;
   if (tm) {
-    if (tm->mode == 1 && dcp_mode_ != 1 && status_.frame == CommandFrame::kPayload) {
+    if (tm->mode == wire::DcpMode::kAcquisition && dcp_mode_ != wire::DcpMode::kAcquisition &&
+        status_.frame == CommandFrame::kPayload) {
       status_.frame = CommandFrame::kEndEffector;  // reset: no payload held any more
       Announce("command frame");
     }
     dcp_mode_ = tm->mode;
     X_RP_ = TelemetryPose(tm->p_RoPo_R_ft, tm->R_RP);
-    if (tm->mode >= 2)
+    if (tm->mode >= wire::DcpMode::kExtraction)
       X_S2P_ = TelemetryPose(tm->p_RoA_R_ft, tm->R_RS2).inverse() * X_RP_;
     else
       X_S2P_.reset();

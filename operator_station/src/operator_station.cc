@@ -20,6 +20,7 @@
 #include "rms/window_keys_t.hpp"
 #include "rms/wire/channels.h"
 #include "rms/wire/checkpoint.h"
+#include "rms/wire/dcp_mode.h"
 #include "rms/wire/message_io.h"
 
 namespace rms::operator_station {
@@ -452,9 +453,10 @@ std::optional<Guidance> OperatorStation::CurrentGuidance() const {
   const ArmState s = ArmStateFrom(*telemetry_);
   const HandControllers* hand = source_->hand();
   CommandFrame f = hand ? hand->status().frame : CommandFrame::kEndEffector;
-  if (f == CommandFrame::kPayload && s.mode == 1) f = CommandFrame::kEndEffector;
+  if (f == CommandFrame::kPayload && s.mode == wire::DcpMode::kAcquisition)
+    f = CommandFrame::kEndEffector;
   const Guidance g = ComputeGuidance(geometry_, s, f);
-  if (!hand || s.mode == 1) return g;
+  if (!hand || s.mode == wire::DcpMode::kAcquisition) return g;
   // The clearance over the turn in flight, where one is (else the whole turn's).
   const auto turn = TurnInFlight(hand->status(), g);
   return turn ? ComputeGuidance(geometry_, s, f, &*turn) : g;

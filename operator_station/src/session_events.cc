@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include "rms/wire/collision_bits.h"
+#include "rms/wire/dcp_mode.h"
 
 namespace rms::operator_station {
 
@@ -20,11 +21,11 @@ void TelemetryEvents::Observe(const dcp_telemetry_t& t) {
     spdlog::info("{}", what);
   };
   if (t.mode != p.mode) {
-    if (t.mode == 2 && p.mode == 1) {
+    if (t.mode == wire::DcpMode::kExtraction && p.mode == wire::DcpMode::kAcquisition) {
       event("ACQUIRED: the payload is held (Mode 2, extraction): lift it clear of the bay");
-    } else if (t.mode == 3 && p.mode == 2) {
+    } else if (t.mode == wire::DcpMode::kManoeuvring && p.mode == wire::DcpMode::kExtraction) {
       event("CLEAR of the cargo bay (Mode 3): bring the probe to the CAE's port");
-    } else if (t.mode == 1) {
+    } else if (t.mode == wire::DcpMode::kAcquisition) {
       event("RESET: Mode 1, the payload back in the cargo bay");
     } else {
       event(fmt::format("Mode {} -> {}", static_cast<int>(p.mode), static_cast<int>(t.mode)));

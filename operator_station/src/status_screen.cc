@@ -212,7 +212,7 @@ void ControlLines(const StatusSnapshot& s, Flow& flow) {
     // KeyHint, which names no hand-controller key in single joint).
     const std::string unwind = KeysOf(s, "unwind"), stow = KeysOf(s, "stow");
     std::string out = unwind.empty() ? "" : "; " + unwind + " unwinds it";
-    if (!stow.empty() && s.telemetry && s.telemetry->mode == 1)
+    if (!stow.empty() && s.telemetry && s.telemetry->mode == wire::DcpMode::kAcquisition)
       out += (out.empty() ? "; " : ", ") + stow + " stows the arm";
     flow.Field(Sprintf("WRIST NEAR ITS LIMIT (within %.0f deg): ", kNearLimitDeg) + j + out);
   }
@@ -265,7 +265,7 @@ void CollisionLines(const StatusSnapshot& s, Flow& flow) {
 
 void ConditionLines(const StatusSnapshot& s, const LabConfig& config, int width, Flow& flow) {
   const dcp_telemetry_t& t = *s.telemetry;
-  if (t.mode == 1) {
+  if (t.mode == wire::DcpMode::kAcquisition) {
     flow.Line("ACQUISITION (each condition's margin):");
     // Two a line, named in full on a wide screen; three, by tag, on a narrow one.
     const bool wide = width >= 110;
@@ -297,7 +297,7 @@ void ConditionLines(const StatusSnapshot& s, const LabConfig& config, int width,
       flow.Line("  closing now would not acquire" +
                 (short_of.empty() ? std::string(": the finger would not stop below D3Y")
                                   : ": conditions " + short_of + " short"));
-  } else if (t.mode == 2) {
+  } else if (t.mode == wire::DcpMode::kExtraction) {
     flow.Line("ACQUISITION: acquired; the payload is held")
         .Field(t.bay_clearance_ft > 0
                    ? Sprintf("clear of the bay by %.2f ft", t.bay_clearance_ft)

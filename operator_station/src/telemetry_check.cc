@@ -4,6 +4,7 @@
 #include <initializer_list>
 
 #include "rms/wire/collision_bits.h"
+#include "rms/wire/dcp_mode.h"
 #include "rms/wire/frame_numbers.h"
 
 namespace rms::operator_station {
@@ -16,7 +17,8 @@ std::optional<Counter> TelemetryProblem(const dcp_telemetry_t& m) {
   if (m.send_time_us < 0 || m.send_time_us >= kMaxSendTimeUs || m.input_send_time_us < 0 ||
       m.input_send_time_us >= kMaxSendTimeUs)
     return Counter::kDroppedTelemetryTime;
-  if (m.mode < 1 || m.mode > 3) return Counter::kDroppedTelemetryMode;
+  if (m.mode < wire::DcpMode::kAcquisition || m.mode > wire::DcpMode::kManoeuvring)
+    return Counter::kDroppedTelemetryMode;
   const std::uint32_t defined = (1u << wire::collision_bits::kCount) - 1;
   if ((static_cast<std::uint32_t>(m.collisions) & ~defined) ||
       (static_cast<std::uint32_t>(m.slave_collisions) & ~defined))

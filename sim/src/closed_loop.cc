@@ -9,6 +9,7 @@
 
 #include "rms/dcp_model/dcp_telemetry.h"
 #include "rms/dcp_model/dynamic_collision_program.h"
+#include "rms/wire/dcp_mode.h"
 #include "rms/wire/input_block.h"
 
 #include "flight_log.h"
@@ -16,7 +17,8 @@
 namespace rms::sim {
 
 void ObserveFrame(const dcp_telemetry_t& tm, int frame, bool* colliding, ClosedLoopResult* r) {
-  if (tm.mode >= 1 && tm.mode <= 3 && r->modes_entered[tm.mode] == 0 && frame > 0)
+  if (tm.mode >= wire::DcpMode::kAcquisition && tm.mode <= wire::DcpMode::kManoeuvring &&
+      r->modes_entered[tm.mode] == 0 && frame > 0)
     r->modes_entered[tm.mode] = frame;
   if (tm.collisions != 0 && !*colliding) ++r->collision_events;
   *colliding = tm.collisions != 0;

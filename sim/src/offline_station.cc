@@ -8,6 +8,7 @@
 #include "rms/operator_station/devices.h"
 #include "rms/operator_station/input_sources.h"
 #include "rms/operator_station/status_screen.h"
+#include "rms/wire/dcp_mode.h"
 #include "rms/wire/input_block.h"
 #include "rms/wire/key_codes.h"
 
@@ -121,7 +122,7 @@ std::string OfflineStation::Capture() {
   if (telemetry_) {
     const operator_station::ArmState arm = operator_station::ArmStateFrom(*telemetry_);
     operator_station::CommandFrame f = hands_.status().frame;
-    if (f == operator_station::CommandFrame::kPayload && arm.mode == 1)
+    if (f == operator_station::CommandFrame::kPayload && arm.mode == wire::DcpMode::kAcquisition)
       f = operator_station::CommandFrame::kEndEffector;
     s.guidance = operator_station::ComputeGuidance(geometry_, arm, f);
   }

@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <regex>
 
+#include "rms/wire/dcp_mode.h"
+
 namespace rms::sim {
 
 namespace {
@@ -219,7 +221,7 @@ bool ScriptedOperator::FlyAutomatic(const std::vector<std::string>& keys, const 
     const Screen s = Look();
     if (s.t_s > limit_s) return false;
     if (s.held || s.docked) return true;
-    if (s.mode == 1 && s.near_limit && !s.unwinding && !s.stowing &&
+    if (s.mode == wire::DcpMode::kAcquisition && s.near_limit && !s.unwinding && !s.stowing &&
         (s.squaring || s.angle > 1.0)) {
       // The ways out the screen names: unwind, then square up again; where
       // the wrist comes back to its limit after that, stow the arm and
@@ -356,7 +358,7 @@ bool ScriptedOperator::Acquire(double limit_s) {
     }
     if (s.t_s > limit_s)
       return report_.failure = "no acquisition by " + Fmt("%.0f s", limit_s), false;
-    if (s.mode >= 2) {
+    if (s.mode >= wire::DcpMode::kExtraction) {
       Note("acquired");
       return true;
     }
@@ -399,8 +401,9 @@ bool ScriptedOperator::Acquire(double limit_s) {
     }
     Press({"c"}, "the screen says closing the finger now acquires: close it");
     const double closed_at = Look().t_s;
-    while (Look().mode < 2 && last_.t_s - closed_at < 4.0) terminal_->Wait(0.1);
-    if (last_.mode < 2)
+    while (Look().mode < wire::DcpMode::kExtraction && last_.t_s - closed_at < 4.0)
+      terminal_->Wait(0.1);
+    if (last_.mode < wire::DcpMode::kExtraction)
       Press({"x"}, "closed and not acquired (conditions " + Conditions(last_) + "): open it");
   }
 }
@@ -412,7 +415,7 @@ bool ScriptedOperator::Extract(double limit_s) {
     const Screen s = Look();
     if (s.t_s > limit_s)
       return report_.failure = "not out of the bay by " + Fmt("%.0f s", limit_s), false;
-    if (s.mode == 3 && s.bay_clearance > 2.0) {
+    if (s.mode == wire::DcpMode::kManoeuvring && s.bay_clearance > 2.0) {
       Note("clear of the bay");
       return true;
     }
@@ -494,7 +497,7 @@ FlightReport ScriptedOperator::FlyAgainAfterReset(double limit_s) {
   Press({"BSpace"}, "reset: a new attempt from where the arm is");
   for (int i = 0; i < 100; ++i) {
     const Screen s = Look();
-    if (s.mode == 1 && !s.docked && !s.acquired) break;
+    if (s.mode == wire::DcpMode::kAcquisition && !s.docked && !s.acquired) break;
     terminal_->Wait(0.1);
   }
   // The finger is still closed from the docking: open it for the new grasp.
@@ -513,7 +516,7 @@ FlightReport ScriptedOperator::Fly(bool acquire_only, double limit_s) {
   // The screen up, with guidance.
   for (int i = 0; i < 200; ++i) {
     const Screen s = Look();
-    if (s.valid && s.guidance && s.mode == 1) break;
+    if (s.valid && s.guidance && s.mode == wire::DcpMode::kAcquisition) break;
     terminal_->Wait(0.1);
   }
   Note("start");

@@ -11,6 +11,7 @@
 #include "rms/esg_renderer/png_io.h"
 #include "rms/esg_renderer/renderer.h"
 #include "rms/sim/offline_session.h"
+#include "rms/wire/dcp_mode.h"
 
 namespace rms::sim {
 
@@ -22,7 +23,7 @@ operator_state_t StateOf(const LabConfig& config, const OfflineSession& s,
                          operator_station::CommandFrame frame) {
   const dcp_telemetry_t t = dcp_model::MakeTelemetry(s.status(), s.dcp());
   const operator_station::ArmState arm = operator_station::ArmStateFrom(t);
-  if (frame == operator_station::CommandFrame::kPayload && arm.mode == 1)
+  if (frame == operator_station::CommandFrame::kPayload && arm.mode == wire::DcpMode::kAcquisition)
     frame = operator_station::CommandFrame::kEndEffector;
   const operator_station::Guidance g =
       operator_station::ComputeGuidance(operator_station::MakeGuidanceGeometry(config), arm, frame);

@@ -18,6 +18,7 @@
 #include "rms/scene_model/scene_model.h"
 #include "rms/wire/channels.h"
 #include "rms/wire/control_word.h"
+#include "rms/wire/dcp_mode.h"
 #include "rms/wire/message_io.h"
 
 #include "session_files.h"
@@ -104,7 +105,7 @@ TEST(DcpSession, TheMissionAcquiresExtractsAndDocks) {
   // The ESG's control words carry it too: the last DCP frames say Mode 3, docked.
   ASSERT_FALSE(s.dcp_frames.empty());
   const wire::ControlWord last = wire::UnpackControlWord(s.dcp_frames.back().control_word);
-  EXPECT_EQ(last.mode, 3);
+  EXPECT_EQ(last.mode, wire::DcpMode::kManoeuvring);
   EXPECT_TRUE(last.docked);
   EXPECT_TRUE(last.acquired);
   // Telemetry and DCP frames pair up one to one, in order.

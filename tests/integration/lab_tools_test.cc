@@ -35,6 +35,7 @@
 #include "rms/sender_t.hpp"
 #include "rms/transport/lcm_interface.h"
 #include "rms/wire/channels.h"
+#include "rms/wire/dcp_mode.h"
 #include "rms/wire/message_auth.h"
 #include "rms/wire/message_io.h"
 
@@ -1216,8 +1217,11 @@ TEST(SessionControl, ACheckpointRestoresTheDcpAndASessionStartsFromOne) {
       EXPECT_EQ(c.Wait(10), 0) << ReadFile(dir + "/control.log");
     };
     // In Mode 3, under way to the port: a checkpoint.
-    for (int i = 0; i < 600 && !(l.telemetry && l.telemetry->mode == 3); ++i) l.Pump(0.05);
-    ASSERT_TRUE(l.telemetry && l.telemetry->mode == 3) << ReadFile(dir + "/op.log");
+    for (int i = 0; i < 600 && !(l.telemetry && l.telemetry->mode == wire::DcpMode::kManoeuvring);
+         ++i)
+      l.Pump(0.05);
+    ASSERT_TRUE(l.telemetry && l.telemetry->mode == wire::DcpMode::kManoeuvring)
+        << ReadFile(dir + "/op.log");
     control({"checkpoint", "before_docking"});  // a name: saved in the session's checkpoints folder
     l.Pump(0.5);
     ASSERT_TRUE(fs::exists(cp)) << ReadFile(dir + "/dynamics_proc.log");
@@ -1232,7 +1236,8 @@ TEST(SessionControl, ACheckpointRestoresTheDcpAndASessionStartsFromOne) {
     bool undocked = false;
     for (int i = 0; i < 100 && !undocked; ++i) {
       l.Pump(0.05);
-      undocked = l.telemetry && !l.telemetry->docked && l.telemetry->mode == 3;
+      undocked =
+          l.telemetry && !l.telemetry->docked && l.telemetry->mode == wire::DcpMode::kManoeuvring;
     }
     EXPECT_TRUE(undocked) << "the restore did not take the DCP back to before docking";
     for (int i = 0; i < 600 && !l.telemetry->docked; ++i) l.Pump(0.05);

@@ -15,6 +15,7 @@
 #include "rms/mission/arm_ik.h"
 #include "rms/mission/mission_plan.h"
 #include "rms/scene_model/scene_model.h"
+#include "rms/wire/dcp_mode.h"
 
 #include "dcp_fixture.h"
 
@@ -34,7 +35,7 @@ class DcpEdges : public testing::DcpFixture {
   // `d` in steps of at most 0.1 ft.
   void AcquireAndMove(DynamicCollisionProgram* dcp, const Vector3d& d) const {
     for (int f = 0; f <= 30; ++f) dcp->Step(Inputs(geo.X_RS2_grasp, f / 30.0));
-    ASSERT_EQ(dcp->mode(), 2);
+    ASSERT_EQ(dcp->mode(), wire::DcpMode::kExtraction);
     const int n = static_cast<int>(std::ceil(d.norm() / 0.1));
     for (int f = 1; f <= n; ++f) dcp->Step(Inputs(Shifted(geo.X_RS2_grasp, d * f / n), 1.0));
     ASSERT_FALSE(dcp->status().held);
@@ -111,12 +112,12 @@ TEST_F(DcpEdges, AFastCommandThroughABayWallBetweenTwoFramesIsHeld) {
   const double lift = -(config.payload.p_RoPo_R_ft.z() + z_side) - 0.5;
   const double out_y = 0.5 * config.shuttle.bay_width_ft - x_side - 0.3;
   AcquireAndMove(&dcp, Vector3d(0, out_y, lift));
-  ASSERT_EQ(dcp.mode(), 2);
+  ASSERT_EQ(dcp.mode(), wire::DcpMode::kExtraction);
   dcp.Step(Inputs(Shifted(geo.X_RS2_grasp, Vector3d(0, out_y + 1.0, lift + 1.0)), 1.0));
   EXPECT_TRUE(dcp.status().held);
   EXPECT_TRUE(dcp.status().motion_collision);
   EXPECT_TRUE(dcp.status().collisions & (wire::collision_bits::kBayFace << kFaceB));
-  EXPECT_EQ(dcp.mode(), 2);
+  EXPECT_EQ(dcp.mode(), wire::DcpMode::kExtraction);
 }
 
 TEST_F(DcpEdges, InMode3ThePayloadCannotBeLoweredBackThroughTheBayWalls) {
@@ -127,7 +128,7 @@ TEST_F(DcpEdges, InMode3ThePayloadCannotBeLoweredBackThroughTheBayWalls) {
       scene_model::PayloadTopFlat_P(config.payload);  // the 16-gon's flats from its axis
   const double lift = -(config.payload.p_RoPo_R_ft.z() - r) + 0.5;
   AcquireAndMove(&dcp, Vector3d(0, 0, lift));
-  ASSERT_EQ(dcp.mode(), 3);
+  ASSERT_EQ(dcp.mode(), wire::DcpMode::kManoeuvring);
   const Vector3d over_wall(0, 0.5 * config.shuttle.bay_width_ft - r + 2.0, lift);
   for (int f = 1; f <= 40; ++f)
     dcp.Step(Inputs(
@@ -140,7 +141,7 @@ TEST_F(DcpEdges, InMode3ThePayloadCannotBeLoweredBackThroughTheBayWalls) {
   }
   EXPECT_GT(held, 15);
   EXPECT_TRUE(dcp.status().collisions & (wire::collision_bits::kBayFace << kFaceB));
-  EXPECT_EQ(dcp.mode(), 3);
+  EXPECT_EQ(dcp.mode(), wire::DcpMode::kManoeuvring);
   // No payload vertex beyond the wall is below the sill.
   const PayloadModel p = MakePayload(config.payload, dcp.X_RP());
   for (const Vector3d& v : p.v) {
@@ -176,7 +177,7 @@ TEST_F(DcpEdges, AResetWhoseArmPoseWouldCollideIsRefused) {
   in.reset = true;
   dcp.Step(in);
   EXPECT_TRUE(dcp.status().reset_refused);
-  EXPECT_EQ(dcp.mode(), 2);
+  EXPECT_EQ(dcp.mode(), wire::DcpMode::kExtraction);
   EXPECT_TRUE(dcp.status().acquired);
   // Up 1 ft first: the reset is taken.
   for (int f = 1; f <= 14; ++f)
@@ -185,7 +186,7 @@ TEST_F(DcpEdges, AResetWhoseArmPoseWouldCollideIsRefused) {
   in.reset = true;
   dcp.Step(in);
   EXPECT_FALSE(dcp.status().reset_refused);
-  EXPECT_EQ(dcp.mode(), 1);
+  EXPECT_EQ(dcp.mode(), wire::DcpMode::kAcquisition);
   EXPECT_NE(dcp.SaveState().dump(), before);
 }
 
@@ -193,14 +194,14 @@ TEST_F(DcpEdges, TheFingerStopsAtTheBarAndAcquisitionNeedsItThere) {
   // Below D3Y but 0.07 ft short of the bar: the six conditions hold, no contact, no acquisition.
   DynamicCollisionProgram dcp(config);
   dcp.Step(Inputs(geo.X_RS2_grasp, Lever(0.55)));
-  EXPECT_EQ(dcp.mode(), 1);
+  EXPECT_EQ(dcp.mode(), wire::DcpMode::kAcquisition);
   EXPECT_FALSE(dcp.status().finger_contact);
   for (int i = 0; i < 6; ++i) EXPECT_TRUE(dcp.status().acquisition[i]) << i;
   // Closing on: acquisition when the finger reaches the bar, and the finger
   // never closes into it.
-  for (int f = 1; f <= 30 && dcp.mode() == 1; ++f)
+  for (int f = 1; f <= 30 && dcp.mode() == wire::DcpMode::kAcquisition; ++f)
     dcp.Step(Inputs(geo.X_RS2_grasp, Lever(0.55) + f * 0.01));
-  ASSERT_EQ(dcp.mode(), 2);
+  ASSERT_EQ(dcp.mode(), wire::DcpMode::kExtraction);
   const Hexahedron bar = MakeBar(config.payload, X_RP_bay());
   const EndEffectorModel ee =
       MakeEndEffector(config.end_effector, dcp.status().X_RS2, dcp.status().finger_gap_ft);
@@ -227,7 +228,7 @@ TEST_F(DcpEdges, TheFingerClosingOnTheBarIsEssentialAndThePalmStrikingItIsDetrim
     }
   }
   ASSERT_TRUE(essential);
-  EXPECT_EQ(dcp.mode(), 1);
+  EXPECT_EQ(dcp.mode(), wire::DcpMode::kAcquisition);
   EXPECT_NEAR(dcp.status().acquisition_margin_ft[2], 0.0, 1e-4);
   // The palm pushed down onto the bar: detrimental.
   DynamicCollisionProgram palm(config);
@@ -251,7 +252,7 @@ TEST_F(DcpEdges, OpeningTheFingerBeforeDockingLetsThePayloadGoWhereItIs) {
   const Vector3d held_at = dcp.X_RP().translation();
   dcp.Step(Inputs(Shifted(geo.X_RS2_grasp, Vector3d(0, 0, 1.0)), 0.0));
   EXPECT_TRUE(dcp.status().let_go);
-  EXPECT_EQ(dcp.mode(), 1);
+  EXPECT_EQ(dcp.mode(), wire::DcpMode::kAcquisition);
   EXPECT_FALSE(dcp.status().acquired);
   // The arm moves away; the payload stays.
   for (int f = 1; f <= 20; ++f)
@@ -286,7 +287,7 @@ TEST_F(DcpEdges, ACheckpointMissingItsLastKeyLeavesTheStateUnchanged) {
   for (int f = 0; f <= 10; ++f)
     other.Step(Inputs(Shifted(geo.X_RS2_grasp, Vector3d(-3, 0, 3)), 0.2));
   const std::string before = other.SaveState().dump();
-  const int mode = other.mode();
+  const wire::DcpMode mode = other.mode();
   EXPECT_THROW(other.RestoreState(cp), InputError);
   EXPECT_EQ(other.SaveState().dump(), before);
   EXPECT_EQ(other.mode(), mode);
@@ -322,7 +323,7 @@ TEST_F(DcpEdges, ACheckpointMissingItsLastKeyLeavesTheStateUnchanged) {
   }
   // The good one restores.
   other.RestoreState(good);
-  EXPECT_EQ(other.mode(), 2);
+  EXPECT_EQ(other.mode(), wire::DcpMode::kExtraction);
 }
 
 }  // namespace

@@ -24,6 +24,7 @@
 #include "rms/scene_model/scene_model.h"
 #include "rms/sim/random_operator.h"
 #include "rms/wire/checkpoint.h"
+#include "rms/wire/dcp_mode.h"
 #include "rms/wire/word_blocks.h"
 
 #include "dcp_fixture.h"
@@ -298,7 +299,7 @@ TEST_F(Dcp, TheFingerStopsOnTheBarWhileTheArmFollows) {
     }
   }
   EXPECT_TRUE(finger_held);
-  EXPECT_EQ(dcp.mode(), 1);
+  EXPECT_EQ(dcp.mode(), wire::DcpMode::kAcquisition);
   EXPECT_GT(dcp.status().finger_gap_ft, config.dcp.d3y_ft);  // stopped on the bar, above D3Y
   // The arm moves up 0.5 ft with the finger still commanded closed: it follows.
   const double z0 = dcp.status().X_RS2.translation().z();
@@ -309,7 +310,7 @@ TEST_F(Dcp, TheFingerStopsOnTheBarWhileTheArmFollows) {
 TEST_F(Dcp, InMode2APayloadVertexBeyondABayWallHoldsTheArm) {
   DynamicCollisionProgram dcp(config);
   for (int f = 0; f <= 30; ++f) dcp.Step(Inputs(geo.X_RS2_grasp, f / 30.0));
-  ASSERT_EQ(dcp.mode(), 2);
+  ASSERT_EQ(dcp.mode(), wire::DcpMode::kExtraction);
   // Push sideways toward the starboard wall (+Y_R): the payload's side is 2.5 ft from it.
   int held = 0;
   for (int f = 1; f <= 60; ++f) {
@@ -324,21 +325,21 @@ TEST_F(Dcp, InMode2APayloadVertexBeyondABayWallHoldsTheArm) {
   EXPECT_LT(dcp.status().X_RP.translation().y() +
                 scene_model::PayloadTopFlat_P(config.payload),  // the 16-gon's side flat
             0.5 * config.shuttle.bay_width_ft + 1e-9);
-  EXPECT_EQ(dcp.mode(), 2);
+  EXPECT_EQ(dcp.mode(), wire::DcpMode::kExtraction);
 }
 
 TEST_F(Dcp, ResetReturnsToMode1AndTheInitialState) {
   DynamicCollisionProgram dcp(config);
   for (int f = 0; f <= 30; ++f) dcp.Step(Inputs(geo.X_RS2_grasp, f / 30.0));
-  ASSERT_EQ(dcp.mode(), 2);
+  ASSERT_EQ(dcp.mode(), wire::DcpMode::kExtraction);
   for (int f = 1; f <= 30; ++f)
     dcp.Step(Inputs(Shifted(geo.X_RS2_grasp, Vector3d(0, 0, 0.2 * f)), 1.0));
   ASSERT_GT(dcp.X_RP().translation().z(), config.payload.p_RoPo_R_ft.z() + 5.0);
   wire::OperatorInputs in = Inputs(Shifted(geo.X_RS2_grasp, Vector3d(0, 0, 6)), 0.0);
   in.reset = true;
   const wire::DcpFrameData out = dcp.Step(in);
-  EXPECT_EQ(dcp.mode(), 1);
-  EXPECT_EQ(out.control.mode, 1);
+  EXPECT_EQ(dcp.mode(), wire::DcpMode::kAcquisition);
+  EXPECT_EQ(out.control.mode, wire::DcpMode::kAcquisition);
   EXPECT_TRUE(out.control.reset);
   EXPECT_FALSE(out.control.acquired);
   EXPECT_LT((dcp.X_RP().translation() - config.payload.p_RoPo_R_ft).norm(), 1e-12);
@@ -372,7 +373,7 @@ TEST_F(Dcp, ACheckpointRestoresTheStateExactly) {
     }
     EXPECT_DOUBLE_EQ(restored.status().dock_distance_ft, live.status().dock_distance_ft) << at;
     EXPECT_DOUBLE_EQ(restored.status().bay_clearance_ft, live.status().bay_clearance_ft) << at;
-    if (live.mode() >= 2) {
+    if (live.mode() >= wire::DcpMode::kExtraction) {
       for (int i = 0; i < 6; ++i)
         EXPECT_FALSE(live.status().acquisition[i]) << "not evaluated after acquisition";
     }
@@ -408,7 +409,7 @@ TEST_F(Dcp, ABadCheckpointIsRefusedNamingWhatIsWrong) {
   j = dcp.SaveState();
   j.erase("X_S2P");
   EXPECT_THROW(dcp.RestoreState(j), InputError);
-  EXPECT_EQ(dcp.mode(), 1);
+  EXPECT_EQ(dcp.mode(), wire::DcpMode::kAcquisition);
 }
 
 // wire::TextHoldsDcp (the re-simulation's check of a logged state): a

@@ -29,6 +29,7 @@
 #include "rms/operator_station/guidance.h"
 #include "rms/operator_station/hand_controllers.h"
 #include "rms/operator_station/status_screen.h"
+#include "rms/wire/dcp_mode.h"
 
 namespace rms::operator_station {
 namespace {
@@ -64,8 +65,9 @@ class Devices : public ::testing::Test {
     t.mode = static_cast<std::int8_t>(mode);
     const Eigen::Isometry3d X = X_RS2(in);
     const Eigen::Isometry3d P =
-        mode == 1 ? arm::MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft)
-                  : X * mission::PlanGeometry(config).X_S2P;
+        mode == wire::DcpMode::kAcquisition
+            ? arm::MakeIsometry(config.payload.R_RP, config.payload.p_RoPo_R_ft)
+            : X * mission::PlanGeometry(config).X_S2P;
     for (int i = 0; i < 3; ++i) {
       t.p_RoA_R_ft[i] = X.translation()[i];
       t.p_RoPo_R_ft[i] = P.translation()[i];

@@ -17,6 +17,7 @@
 #include "rms/scene_proc/camera_stations.h"
 #include "rms/scene_proc/scene_proc.h"
 #include "rms/wire/channels.h"
+#include "rms/wire/dcp_mode.h"
 #include "rms/wire/message_io.h"
 
 namespace rms {
@@ -67,7 +68,7 @@ TEST_F(Pipeline, OneEsgFramePerInputBlockCarryingTheKinematics) {
     ASSERT_LE(esg[f].num_words, 64);
     const wire::EsgFrameData d = wire::UnpackEsgWords(esg[f].words);
     EXPECT_EQ(d.control.camera_station, 1 + f % 8);
-    EXPECT_EQ(d.control.mode, 1);
+    EXPECT_EQ(d.control.mode, wire::DcpMode::kAcquisition);
     EXPECT_NEAR(std::atan2(d.arm[0].s, d.arm[0].c) * 180 / M_PI, f, 0.006);
     EXPECT_NEAR(std::atan2(d.arm[1].s, d.arm[1].c) * 180 / M_PI, 2.0 * f, 0.006);
     EXPECT_NEAR(d.shoulder_height_ft, 3.0 + 0.1 * f, 1e-3);
@@ -120,7 +121,7 @@ TEST_F(Pipeline, ResetReturnsToMode1AndSetsTheResetBit) {
   ASSERT_EQ(esg.size(), 1u);
   const wire::EsgFrameData d = wire::UnpackEsgWords(esg[0].words);
   EXPECT_TRUE(d.control.reset);
-  EXPECT_EQ(d.control.mode, 1);
+  EXPECT_EQ(d.control.mode, wire::DcpMode::kAcquisition);
 }
 
 TEST_F(Pipeline, TheVideoHasOneFramePerFrameNumberThoughTheFirstFramesWereSuperseded) {

@@ -28,6 +28,7 @@
 #include "rms/session_control_t.hpp"
 #include "rms/wire/channels.h"
 #include "rms/wire/collision_bits.h"
+#include "rms/wire/dcp_mode.h"
 #include "rms/wire/message_io.h"
 
 namespace fs = std::filesystem;
@@ -105,7 +106,7 @@ struct TraceReader {
   // The unsigned distance to the mode's goal: Mode 1 point A to the BAR's
   // centre (where the grasp is), Modes 2-3 the probe's tip to the port.
   double Goal(const dcp_telemetry_t& m) const {
-    if (m.mode != 1) return std::abs(m.dock_distance_ft);
+    if (m.mode != wire::DcpMode::kAcquisition) return std::abs(m.dock_distance_ft);
     Eigen::Matrix3d R_RP;
     for (int i = 0; i < 9; ++i) R_RP(i / 3, i % 3) = m.R_RP[i];
     const Eigen::Vector3d bar =
@@ -134,8 +135,9 @@ struct TraceReader {
     t.joints_deg.push_back(std::vector<double>(m.slave_angles_deg, m.slave_angles_deg + 6));
     t.finger.push_back(m.slave_finger);
     t.goal_ft.push_back(Goal(m));
-    t.dock_angle_deg.push_back(m.mode == 1 ? nlohmann::json(nullptr)
-                                           : nlohmann::json(m.dock_angle_deg));
+    t.dock_angle_deg.push_back(m.mode == wire::DcpMode::kAcquisition
+                                   ? nlohmann::json(nullptr)
+                                   : nlohmann::json(m.dock_angle_deg));
     t.inputs.push_back(std::vector<double>(hand.begin(), hand.end()));
   }
   void Finish(double t_s, const nlohmann::ordered_json& collisions) {

@@ -8,6 +8,7 @@
 #include "rms/base/check.h"
 #include "rms/wire/acquisition_conditions.h"
 #include "rms/wire/collision_bits.h"
+#include "rms/wire/dcp_mode.h"
 
 #include "recording.h"
 
@@ -29,8 +30,8 @@ Outcome OutcomeOf(const Telemetry& tm) {
   Outcome o;
   for (const dcp_telemetry_t& t : tm) {
     const std::int64_t f = t.frame;
-    if (t.mode == 2 && o.acquired < 0) o.acquired = f;
-    if (t.mode == 3 && o.clear < 0) o.clear = f;
+    if (t.mode == wire::DcpMode::kExtraction && o.acquired < 0) o.acquired = f;
+    if (t.mode == wire::DcpMode::kManoeuvring && o.clear < 0) o.clear = f;
     if (t.docked && o.docked < 0) o.docked = f;
     if (t.held) {
       ++o.held;

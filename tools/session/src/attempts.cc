@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "rms/wire/collision_bits.h"
+#include "rms/wire/dcp_mode.h"
 
 namespace rms::session {
 
@@ -56,13 +57,13 @@ void AttemptLog::Clearances(const dcp_telemetry_t& m, Attempt* a) const {
     d = std::max(0.0, d);
     if (*best < 0 || d < *best) *best = d;
   };
-  if (m.mode == 1) {
+  if (m.mode == wire::DcpMode::kAcquisition) {
     // Point A to the payload's surface.
     const Eigen::Vector3d q = V(m.p_RoA_R_ft) - c;
     const double along = std::abs(q.dot(axis)) - hl;
     const double radial = (q - q.dot(axis) * axis).norm() - r;
     least(&a->least_ee_payload_ft, std::hypot(std::max(along, 0.0), std::max(radial, 0.0)));
-  } else if (m.mode == 2) {
+  } else if (m.mode == wire::DcpMode::kExtraction) {
     // The payload to the bay's floor, walls and bulkheads (x 0..L, y +-w/2, z -D..0 in R).
     const ShuttleConfig& s = config_.shuttle;
     const struct {
@@ -76,7 +77,7 @@ void AttemptLog::Clearances(const dcp_telemetry_t& m, Attempt* a) const {
       for (const auto& pl : planes)
         least(&a->least_payload_bay_ft, pl.n.dot(c - pl.p0) - Extent(pl.n, axis, r, hl));
     }
-  } else if (m.mode == 3) {
+  } else if (m.mode == wire::DcpMode::kManoeuvring) {
     // The payload's body to the CAE's port face (face c, y_C = 0, facing -y_C).
     const Eigen::Vector3d n = -config_.cae.R_RC.col(1);
     least(&a->least_payload_cae_ft, n.dot(c - config_.cae.p_RoCo_R_ft) - Extent(n, axis, r, hl));
@@ -98,9 +99,14 @@ void AttemptLog::ObserveFrame(const dcp_telemetry_t& m, bool reset, double t_s) 
   a.last_s = t_s;
   a.last_frame = m.frame;
   ++a.frames;
-  if (m.mode == 2 && a.t_acquired < 0 && a.start_mode == 1) a.t_acquired = t_s;
-  if (m.mode == 3 && a.t_clear < 0 && a.start_mode <= 2) a.t_clear = t_s;
-  if (m.mode == 3 && m.probe_in_envelope && a.t_envelope < 0) a.t_envelope = t_s;
+  if (m.mode == wire::DcpMode::kExtraction && a.t_acquired < 0 &&
+      a.start_mode == wire::DcpMode::kAcquisition)
+    a.t_acquired = t_s;
+  if (m.mode == wire::DcpMode::kManoeuvring && a.t_clear < 0 &&
+      a.start_mode <= wire::DcpMode::kExtraction)
+    a.t_clear = t_s;
+  if (m.mode == wire::DcpMode::kManoeuvring && m.probe_in_envelope && a.t_envelope < 0)
+    a.t_envelope = t_s;
   if (m.docked && a.t_docked < 0) {
     a.t_docked = t_s;
     if (a.t_envelope < 0) a.t_envelope = t_s;
@@ -111,7 +117,7 @@ void AttemptLog::ObserveFrame(const dcp_telemetry_t& m, bool reset, double t_s) 
                  {"within_tolerance", m.dock_distance_ft <= config_.dcp.dock_distance_ft &&
                                           m.dock_angle_deg <= config_.dcp.dock_angle_deg}};
   }
-  if (m.mode == 3 &&
+  if (m.mode == wire::DcpMode::kManoeuvring &&
       (a.best_dock_distance_ft < 0 || m.dock_distance_ft < a.best_dock_distance_ft)) {
     a.best_dock_distance_ft = m.dock_distance_ft;
     a.best_dock_angle_deg = m.dock_angle_deg;
@@ -131,19 +137,19 @@ void AttemptLog::ObserveFrame(const dcp_telemetry_t& m, bool reset, double t_s) 
   a.last_held = m.held;
   a.last_finger_held = m.finger_held;
   Clearances(m, &a);
-  if (m.mode == 1) {
+  if (m.mode == wire::DcpMode::kAcquisition) {
     a.near_d3y += Near(m.finger_gap_ft, config_.dcp.d3y_ft);
     a.near_tpob += Near(std::abs(m.palm_to_bar_ft), config_.dcp.tpob_ft);
-  } else if (m.mode == 3 && !m.docked) {
+  } else if (m.mode == wire::DcpMode::kManoeuvring && !m.docked) {
     a.near_dock_distance += Near(m.dock_distance_ft, config_.dcp.dock_distance_ft);
     a.near_dock_angle += Near(m.dock_angle_deg, config_.dcp.dock_angle_deg);
   }
   // A finger closure (the lever past half way) in Mode 1, and whether it
   // acquired before the finger opened again.
-  if (m.mode == 1 && !a.finger_closing && m.master_finger >= 0.5) {
+  if (m.mode == wire::DcpMode::kAcquisition && !a.finger_closing && m.master_finger >= 0.5) {
     a.finger_closing = true;
     ++a.closures;
-  } else if (a.finger_closing && m.mode == 2) {
+  } else if (a.finger_closing && m.mode == wire::DcpMode::kExtraction) {
     ++a.closures_acquired;
     a.finger_closing = false;
   } else if (a.finger_closing && m.master_finger < 0.5) {
@@ -178,9 +184,9 @@ nlohmann::ordered_json AttemptLog::AttemptJson(const Attempt& a) const {
   auto span = [](double from, double to) {
     return from < 0 || to < 0 ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(to - from);
   };
-  const double acq_from = a.start_mode == 1 ? a.start_s : -1;
-  const double ext_from = a.start_mode == 2 ? a.start_s : a.t_acquired;
-  const double man_from = a.start_mode == 3 ? a.start_s : a.t_clear;
+  const double acq_from = a.start_mode == wire::DcpMode::kAcquisition ? a.start_s : -1;
+  const double ext_from = a.start_mode == wire::DcpMode::kExtraction ? a.start_s : a.t_acquired;
+  const double man_from = a.start_mode == wire::DcpMode::kManoeuvring ? a.start_s : a.t_clear;
   nlohmann::ordered_json j;
   j["index"] = a.index;
   j["started_by"] = a.started_by;
@@ -192,11 +198,11 @@ nlohmann::ordered_json AttemptLog::AttemptJson(const Attempt& a) const {
   j["frames"] = a.frames;
   j["first_frame"] = a.start_frame;
   j["last_frame"] = a.last_frame;
-  j["outcome"] = a.t_docked >= 0     ? "docked"
-                 : a.t_clear >= 0    ? "cleared the bay"
-                 : a.t_acquired >= 0 ? "acquired"
-                 : a.start_mode > 1  ? "not docked"
-                                     : "not acquired";
+  j["outcome"] = a.t_docked >= 0                              ? "docked"
+                 : a.t_clear >= 0                             ? "cleared the bay"
+                 : a.t_acquired >= 0                          ? "acquired"
+                 : a.start_mode > wire::DcpMode::kAcquisition ? "not docked"
+                                                              : "not acquired";
   j["reached_s"] = {{"acquired", OrNull(a.t_acquired)},
                     {"clear_of_bay", OrNull(a.t_clear)},
                     {"in_envelope", OrNull(a.t_envelope)},

@@ -35,6 +35,7 @@
 #include "rms/dcp_model/malfunctions.h"
 #include "rms/wire/acquisition_conditions.h"
 #include "rms/wire/collision_bits.h"
+#include "rms/wire/dcp_mode.h"
 #include "rms/wire/input_block.h"
 #include "rms/wire/word_blocks.h"
 
@@ -113,7 +114,7 @@ struct ArmCommand {
 
 // What one frame decided, for telemetry.
 struct DcpStatus {
-  int mode = 1;
+  wire::DcpMode mode = wire::DcpMode::kAcquisition;
   bool acquired = false;
   bool docked = false;
   bool released = false;  // docked and let go by the finger: the arm is free
@@ -210,7 +211,7 @@ class DynamicCollisionProgram {
   void Repair(const wire::Repair& r) { malfunctions_.Repair(r); }
   const Malfunctions& malfunctions() const { return malfunctions_; }
 
-  int mode() const { return status_.mode; }
+  wire::DcpMode mode() const { return status_.mode; }
   bool released() const { return released_; }
   const DcpStatus& status() const { return status_; }
   const arm::ArmPose& arm_pose() const { return slave_->pose; }
@@ -222,7 +223,7 @@ class DynamicCollisionProgram {
   // the finger's clamps in Modes 2 and 3, and where the payload is (free,
   // held, docked). Compared bit for bit.
   struct SceneKey {
-    int mode = 0;
+    wire::DcpMode mode = wire::DcpMode::kAcquisition;
     bool docked = false, released = false;
     double contact_gap_ft = 0.0, acquisition_gap_ft = 0.0;
     Eigen::Matrix4d X_RP_free{}, X_S2P{}, X_RP_docked{};
@@ -248,7 +249,7 @@ class DynamicCollisionProgram {
     // is tested): between two free poses whose clearances add up to more
     // than any vertex's travel, nothing can touch.
     double clearance_ft = 0.0;
-    int mode = 0;  // the mode it was evaluated in
+    wire::DcpMode mode = wire::DcpMode::kAcquisition;  // the mode it was evaluated in
   };
   // Into *e (not prev). prev: the last accepted evaluation, whose planes are
   // the hints (frame coherence); null: none. e->ee is left as it was outside

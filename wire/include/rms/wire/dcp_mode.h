@@ -6,6 +6,7 @@
 // sessions.md "Attempts": "maneuvering", a key kept as recorded sessions
 // have it).
 #include <array>
+#include <compare>
 
 namespace rms::wire {
 
@@ -30,6 +31,18 @@ inline constexpr std::array<DcpModeInfo, kNumDcpModes> kDcpModes = {{
 // Mode 1..3's entry; nullptr for any other number (a mode not yet known).
 constexpr const DcpModeInfo* DcpModeOf(int mode) {
   return mode >= 1 && mode <= kNumDcpModes ? &kDcpModes[mode - 1] : nullptr;
+}
+
+// The number the wire carries for a mode (0 on the wire: not yet known).
+constexpr int ModeNumber(DcpMode mode) { return static_cast<int>(mode); }
+
+// A mode as the wire carries it (its number) compared with the enumeration,
+// so readers of telemetry write the mode's name, never its number:
+// `tm.mode == DcpMode::kManoeuvring`, `tm.mode >= DcpMode::kExtraction`
+// (the payload held: Mode 2 or 3).
+constexpr bool operator==(int number, DcpMode mode) { return number == ModeNumber(mode); }
+constexpr std::strong_ordering operator<=>(int number, DcpMode mode) {
+  return number <=> ModeNumber(mode);
 }
 
 }  // namespace rms::wire
