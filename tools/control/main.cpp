@@ -29,7 +29,7 @@
 #include "rms/control_answer_t.hpp"
 #include "rms/process_status_t.hpp"
 #include "rms/sender_t.hpp"
-#include "rms/session/session_summary.h"
+#include "rms/session/manifest.h"
 #include "rms/session_control_t.hpp"
 #include "rms/transport/journal.h"
 #include "rms/transport/lcm_interface.h"

@@ -11,7 +11,7 @@
 #include "rms/base/command_line.h"
 #include "rms/monitor/monitor.h"
 #include "rms/sender_t.hpp"
-#include "rms/session/session_summary.h"
+#include "rms/session/manifest.h"
 #include "rms/transport/lcm_interface.h"
 #include "rms/transport/process.h"
 

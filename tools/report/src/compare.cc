@@ -10,6 +10,7 @@
 #include "rms/base/check.h"
 #include "rms/base/text.h"
 #include "rms/report/report.h"
+#include "rms/session/manifest.h"
 #include "rms/session/session_folder.h"
 #include "rms/session/session_summary.h"
 

@@ -22,6 +22,7 @@
 #include "rms/dcp_state_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
 #include "rms/dynamics_proc/dynamics_proc.h"
+#include "rms/session/manifest.h"
 #include "rms/session/session_folder.h"
 #include "rms/session/session_log.h"
 #include "rms/session/session_summary.h"

@@ -27,7 +27,6 @@
 #include "rms/process_status_t.hpp"
 #include "rms/session/session_folder.h"
 #include "rms/session/session_log.h"
-#include "rms/session/session_summary.h"
 #include "rms/session_control_t.hpp"
 #include "rms/window_keys_t.hpp"
 #include "rms/wire/acquisition_conditions.h"

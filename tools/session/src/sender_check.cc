@@ -7,8 +7,8 @@
 
 #include "rms/base/check.h"
 #include "rms/sender_t.hpp"
+#include "rms/session/manifest.h"
 #include "rms/session/session_folder.h"
-#include "rms/session/session_summary.h"
 #include "rms/wire/channels.h"
 #include "rms/wire/message_io.h"
 

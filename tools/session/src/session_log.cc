@@ -8,8 +8,8 @@
 #include "rms/base/check.h"
 #include "rms/base/config.h"
 #include "rms/base/other_core.h"
+#include "rms/session/manifest.h"
 #include "rms/session/session_folder.h"
-#include "rms/session/session_summary.h"
 #include "rms/wire/channels.h"
 
 #include "raw_log.h"
