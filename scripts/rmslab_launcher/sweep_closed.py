@@ -28,7 +28,7 @@ import shlex
 import subprocess
 import time
 
-from . import sweep, sweep_cache
+from . import sweep, sweep_cache, sweep_cells, sweep_parallel, sweep_slurm
 from .common import (ROOT, LabError, binary, file_sha256, install_and_build, replacing, require_built,
                      run_statistics, say)
 
@@ -83,8 +83,8 @@ def parse_args(argv):
         raise LabError(f"--runs-per-cell {a.runs_per_cell}: 1..100000")
     if not 0 <= a.seed < 2**64:
         raise LabError(f"--seed {a.seed}: 0..2^64-1")
-    if a.jobs < 0 or a.jobs > sweep.MAX_JOBS:
-        raise LabError(f"--jobs {a.jobs}: 0 (this machine's CPUs) .. {sweep.MAX_JOBS}")
+    if a.jobs < 0 or a.jobs > sweep_cells.MAX_JOBS:
+        raise LabError(f"--jobs {a.jobs}: 0 (this machine's CPUs) .. {sweep_cells.MAX_JOBS}")
     if a.retries < 0:
         raise LabError(f"--retries {a.retries}: must not be negative")
     if a.slurm and a.hosts:
@@ -236,12 +236,12 @@ def write_slurm(a, out, cells, cache_dir):
         rerun += ["--vary", f"{k}={','.join(vals)}"]
     rerun += ["--out", out, "--cache", cache_dir, "--cached-only", "--no-build"]
     command = " ".join(shlex.quote(x) for x in rerun)
-    return sweep.write_slurm(out, cells, cache_dir, command, cell_args="--fly"), command
+    return sweep_slurm.write_slurm(out, cells, cache_dir, command, cell_args="--fly"), command
 
 
 def fly_cells(a, cells, todo, out, cache, cached):
     """The missing cells flown (sweep.py's runners), each cached as it
-    arrives. Returns (tries again, errors) or raises sweep.Interrupted."""
+    arrives. Returns (tries again, errors) or raises sweep_cells.Interrupted."""
     with sweep.stopped_by_signals():
         return sweep.run_cells(a, cells, todo, out, cache, cached)
 
@@ -301,9 +301,9 @@ def run(argv):
     out = os.path.abspath(a.out or os.path.join(ROOT, "sessions", "sweep-closed-" + stamp))
     cells = make_cells(a, ds, software_id())
     check_out(a, out, cells)
-    sweep.timeout_override()
-    a.workers = sweep.lab_workers(a.hosts, a.jobs) if a.hosts else None
-    sweep.check_parallel_paths(a.workers)
+    sweep_cells.timeout_override()
+    a.workers = sweep_parallel.lab_workers(a.hosts, a.jobs) if a.hosts else None
+    sweep_parallel.check_parallel_paths(a.workers)
     for d in ds:  # every design and setting checked before any is flown (one short flight each)
         check_design(a, d)
     cache = sweep_cache.Cache(a.cache or os.path.join(ROOT, "sessions", "sweep-cache"), must_exist=a.cached_only)
@@ -314,7 +314,7 @@ def run(argv):
     os.makedirs(out, exist_ok=True)
     jobs = a.jobs or len(os.sched_getaffinity(0))
     if not a.cached_only:
-        sweep.write_manifest(os.path.join(out, "cells.tsv"), cells)
+        sweep_cells.write_manifest(os.path.join(out, "cells.tsv"), cells)
         write_tables(a, out, ds, [], jobs, 0.0, [])  # what the sweep is, before anything is flown
     results, todo = cached_results(a, cells, cache)
     cached = len(cells) - len(todo)
@@ -336,7 +336,7 @@ def run(argv):
     elif todo:
         try:
             _, errors = fly_cells(a, cells, todo, out, cache, cached)
-        except sweep.Interrupted as e:
+        except sweep_cells.Interrupted as e:
             done = sum(1 for c in todo if "error" not in c)
             say(f"sweep interrupted ({e.name}): the {done} cells finished in this run are in the cache; "
                 "the same command again flies only what is missing")
