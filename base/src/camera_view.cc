@@ -20,7 +20,8 @@ std::optional<int> CameraStationFor(const std::vector<CameraStationConfig>& came
                                     CameraView view) {
   const CameraViewInfo& info = kCameraViews[static_cast<int>(view)];
   const std::string word = Lower(info.name_word);
-  for (std::size_t i = 0; i < cameras.size() && i < static_cast<std::size_t>(kNumCameraStations); ++i) {
+  for (std::size_t i = 0; i < cameras.size() && i < static_cast<std::size_t>(kNumCameraStations);
+       ++i) {
     if (cameras[i].mount != info.mount) continue;
     if (Lower(cameras[i].name).find(word) != std::string::npos) return static_cast<int>(i) + 1;
   }

@@ -56,12 +56,14 @@ std::vector<Keyframe> PlanMission(const LabConfig& c) {
     return X;
   };
   // Mode 1: over the receptacle, down, close the finger.
-  add(5.0, shifted(g.X_RS2_grasp, 8 * up), 0, station(V::kOverTheBay), "over the receptacle, aft flight deck camera",
-      "camera_zoom=0 camera_pan=0 camera_tilt=0");
-  add(8.0, shifted(g.X_RS2_grasp, 2 * up), 0, station(V::kWrist), "just above it, wrist camera", "camera_zoom=0.3");
+  add(5.0, shifted(g.X_RS2_grasp, 8 * up), 0, station(V::kOverTheBay),
+      "over the receptacle, aft flight deck camera", "camera_zoom=0 camera_pan=0 camera_tilt=0");
+  add(8.0, shifted(g.X_RS2_grasp, 2 * up), 0, station(V::kWrist), "just above it, wrist camera",
+      "camera_zoom=0.3");
   add(11.0, g.X_RS2_grasp, 0, 0, "grasp position", "camera_zoom=0.3");
   add(12.0, g.X_RS2_grasp, 0, 0, "finger open", "camera_zoom=0");
-  add(15.0, g.X_RS2_grasp, 1, station(V::kForwardBulkhead), "finger closed on the bar: acquisition; forward bulkhead camera");
+  add(15.0, g.X_RS2_grasp, 1, station(V::kForwardBulkhead),
+      "finger closed on the bar: acquisition; forward bulkhead camera");
   // Mode 2: straight up out of the bay in small steps (joint interpolation
   // between close waypoints keeps the path straight).
   const double r = 0.5 * c.payload.diameter_ft + c.payload.probe_diameter_ft;
@@ -83,7 +85,8 @@ std::vector<Keyframe> PlanMission(const LabConfig& c) {
   const Eigen::Vector3d yC = c.cae.R_RC.col(1);
   const Eigen::Isometry3d X_RS2_predock = shifted(X_RS2_dock, -3.0 * yC);
   const Eigen::Isometry3d X_high = shifted(g.X_RS2_grasp, (lift + 6.0) * up);
-  add(t += 3.0, X_high, 1, station(V::kPortAftWindow), "high above the bay, port aft window: pan and tilt up",
+  add(t += 3.0, X_high, 1, station(V::kPortAftWindow),
+      "high above the bay, port aft window: pan and tilt up",
       "camera_pan=0 camera_tilt=0 camera_zoom=0");
   // Turn in steps: interpolate the payload's pose from high to pre-dock.
   const Eigen::Isometry3d X_RP_high = X_high * g.X_S2P, X_RP_pre = X_RS2_predock * g.X_S2P;

@@ -14,22 +14,22 @@
 namespace rms {
 
 enum class CameraView : int {
-  kOverTheBay = 0,    // aft flight deck, overhead window: over the receptacle
-  kPortAftWindow,     // aft flight deck, port aft window: up and over the bay
-  kElbow,             // on the elbow
-  kWrist,             // on the wrist: just above the receptacle
-  kForwardBulkhead,   // cargo bay, forward bulkhead: the finger on the bar
-  kAftBulkhead,       // cargo bay, aft bulkhead: lifting out of the bay
-  kCaeDockingPort,    // on the CAE: the probe under the port
-  kExternal,          // outside the orbiter: the whole arm
+  kOverTheBay = 0,   // aft flight deck, overhead window: over the receptacle
+  kPortAftWindow,    // aft flight deck, port aft window: up and over the bay
+  kElbow,            // on the elbow
+  kWrist,            // on the wrist: just above the receptacle
+  kForwardBulkhead,  // cargo bay, forward bulkhead: the finger on the bar
+  kAftBulkhead,      // cargo bay, aft bulkhead: lifting out of the bay
+  kCaeDockingPort,   // on the CAE: the probe under the port
+  kExternal,         // outside the orbiter: the whole arm
   kCount
 };
 
 struct CameraViewInfo {
   CameraView view;
-  const char* name;        // as logged and shown ("wrist")
-  CameraMount mount;       // the station's mount
-  const char* name_word;   // a word of the station's name ("" when the mount alone says)
+  const char* name;       // as logged and shown ("wrist")
+  CameraMount mount;      // the station's mount
+  const char* name_word;  // a word of the station's name ("" when the mount alone says)
 };
 inline constexpr std::array<CameraViewInfo, static_cast<int>(CameraView::kCount)> kCameraViews = {{
     {CameraView::kOverTheBay, "over the bay", CameraMount::kShuttle, "overhead"},

@@ -152,7 +152,7 @@ class Autopilot {
   // A joint or the finger not following (a failure, docs/operator.md "The
   // autopilot"): the autopilot says so and holds its command until it follows.
   FollowWatch follow_;
-  CameraStations stations_;  // each view's camera station, by its mount (0: none)
+  CameraStations stations_;       // each view's camera station, by its mount (0: none)
   double holding_since_s_ = 0.0;  // when it last said it holds for a failure
   // The telemetry's master command is where the slave arm is (every joint
   // within FollowWatch's recovery tolerance, the same shoulder height).
