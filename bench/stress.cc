@@ -349,7 +349,7 @@ void Soak(const LabConfig& config, long frames, std::uint64_t seed, SoakStats* s
     st->held += s.held;
     (void)MakeTelemetry(s, out);  // the telemetry is made from every state
     if (!CheckSoakFrame(config, dcp, out, fresh, dec.reset,
-                        Sprintf("frame %ld (mode %d)", f, s.mode), st, fail)) {
+                        Sprintf("frame %ld (mode %d)", f, wire::ModeNumber(s.mode)), st, fail)) {
       continue;
     }
     // Until the slave first takes a collision-free command it may start in collision.

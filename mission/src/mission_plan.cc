@@ -14,6 +14,21 @@
 
 namespace rms::mission {
 
+namespace {
+
+// The pose a fraction u of the way from X_RA to X_RB: the rotation by slerp,
+// the position in a straight line.
+Eigen::Isometry3d Between(const Eigen::Isometry3d& X_RA, const Eigen::Isometry3d& X_RB, double u) {
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = Eigen::Quaterniond(X_RA.linear())
+                   .slerp(u, Eigen::Quaterniond(X_RB.linear()))
+                   .toRotationMatrix();
+  X.translation() = (1 - u) * X_RA.translation() + u * X_RB.translation();
+  return X;
+}
+
+}  // namespace
+
 std::vector<Keyframe> PlanMission(const LabConfig& c) {
   const MissionGeometry g = PlanGeometry(c);
   const double h = g.shoulder_height_ft;
@@ -90,13 +105,9 @@ std::vector<Keyframe> PlanMission(const LabConfig& c) {
       "camera_pan=0 camera_tilt=0 camera_zoom=0");
   // Turn in steps: interpolate the payload's pose from high to pre-dock.
   const Eigen::Isometry3d X_RP_high = X_high * g.X_S2P, X_RP_pre = X_RS2_predock * g.X_S2P;
-  const Eigen::Quaterniond q0(X_RP_high.linear()), q1(X_RP_pre.linear());
   const int turn = 6;
   for (int i = 1; i <= turn; ++i) {
-    const double u = static_cast<double>(i) / turn;
-    Eigen::Isometry3d X_RP = Eigen::Isometry3d::Identity();
-    X_RP.linear() = q0.slerp(u, q1).toRotationMatrix();
-    X_RP.translation() = (1 - u) * X_RP_high.translation() + u * X_RP_pre.translation();
+    const Eigen::Isometry3d X_RP = Between(X_RP_high, X_RP_pre, static_cast<double>(i) / turn);
     add(t += 1.5, X_RP * g.X_S2P.inverse(), 1,
         i == turn ? station(V::kCaeDockingPort)
         : i == 3  ? station(V::kExternal)

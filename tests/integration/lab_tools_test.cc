@@ -1012,7 +1012,7 @@ TEST_F(RecordedSession, AnExportSaysWhatItCouldNotReadAndKeepsTheRecord) {
     EXPECT_NE(r.out.find("that is the session's own"), std::string::npos) << r.out;
   }
   EXPECT_EQ(ReadFile(*dir_ + "/lcmlog"), whole);
-  EXPECT_NO_THROW(nlohmann::json::parse(ReadFile(*dir_ + "/summary.json")));
+  EXPECT_TRUE(nlohmann::json::accept(ReadFile(*dir_ + "/summary.json")));
 }
 
 TEST_F(RecordedSession, ItsReportOpensInABrowserWithPlots) {
