@@ -8,7 +8,7 @@ namespace rms::arm {
 
 ArmSinCos SinCosFromDegrees(const std::array<double, 6>& angles_deg) {
   ArmSinCos sc;
-  for (int i = 0; i < 6; ++i) {
+  for (int i = 0; i < kNumJoints; ++i) {
     const double a = angles_deg[i] * (M_PI / 180.0);
     sc[i] = {std::sin(a), std::cos(a)};
   }
@@ -53,7 +53,7 @@ Eigen::Matrix3d RotPitch(const SinCos& a) {
 
 ArmPose ComputeArmPose(const ArmGeometry& arm, const ArmSinCos& raw, double shoulder_height_ft) {
   ArmSinCos sc;
-  for (int i = 0; i < 6; ++i) sc[i] = Normalized(raw[i]);
+  for (int i = 0; i < kNumJoints; ++i) sc[i] = Normalized(raw[i]);
   ArmPose p;
   p.p_RoB_R = arm.p_RoB_R_ft;
   p.p_RoS_R = arm.p_RoB_R_ft + Eigen::Vector3d(0, 0, shoulder_height_ft);

@@ -76,7 +76,7 @@ void ReadArm(TableReader& top, LabConfig* config) {
   c.arm.boom_diameter_ft = r.Positive("boom_diameter_ft", kMaxPartFt);
   const std::vector<double> lo = r.Numbers("joint_min_deg", 6, -180.0, 180.0);
   const std::vector<double> hi = r.Numbers("joint_max_deg", 6, -180.0, 180.0);
-  for (int i = 0; i < 6; ++i) {
+  for (int i = 0; i < kNumJoints; ++i) {
     if (!(lo[i] < hi[i])) {
       r.Fail("joint_max_deg", "joint " + std::to_string(i + 1) + " (" +
                                   std::string(kAnalogInputNames[i]) + "): max " +

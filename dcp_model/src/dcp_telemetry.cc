@@ -32,7 +32,7 @@ dcp_telemetry_t MakeTelemetry(const DcpStatus& st, const wire::DcpFrameData& out
     for (int j = 0; j < 3; ++j) t.plane_n[3 * k + j] = st.planes[k].n_R[j];
     t.plane_d_ft[k] = st.planes[k].d_ft;
   }
-  for (int i = 0; i < 6; ++i) {
+  for (int i = 0; i < kNumJoints; ++i) {
     t.master_angles_deg[i] = st.master.angles_deg[i];
     t.slave_angles_deg[i] = st.slave.angles_deg[i];
   }

@@ -46,7 +46,7 @@ namespace internal {
 // limits within the input's range (config [arm], [inputs.*]).
 Malfunctions MakeMalfunctions(const LabConfig& config) {
   std::array<double, 6> lo{}, hi{};
-  for (int i = 0; i < 6; ++i) {
+  for (int i = 0; i < kNumJoints; ++i) {
     lo[i] = std::max(config.arm.joint_min_deg[i], config.inputs[i].min);
     hi[i] = std::min(config.arm.joint_max_deg[i], config.inputs[i].max);
   }
@@ -74,7 +74,7 @@ DynamicCollisionProgram::DynamicCollisionProgram(const LabConfig& config, const 
   // The slave starts at the initial inputs' pose, which must be free.
   const wire::OperatorInputs initial = wire::InitialInputs(config.inputs);
   ArmCommand start;
-  for (int i = 0; i < 6; ++i) start.angles_deg[i] = initial.value[i];
+  for (int i = 0; i < kNumJoints; ++i) start.angles_deg[i] = initial.value[i];
   start.shoulder_height_ft = initial.value[kShoulderHeight];
   start.finger = initial.value[kFinger];
   Evaluate(start, nullptr, slave_);
@@ -165,7 +165,7 @@ constexpr std::uint32_t kTooFast = 1u << 31;
 
 ArmCommand Lerp(const ArmCommand& a, const ArmCommand& b, double t) {
   ArmCommand c;
-  for (int i = 0; i < 6; ++i)
+  for (int i = 0; i < kNumJoints; ++i)
     c.angles_deg[i] = a.angles_deg[i] + t * (b.angles_deg[i] - a.angles_deg[i]);
   c.shoulder_height_ft = a.shoulder_height_ft + t * (b.shoulder_height_ft - a.shoulder_height_ft);
   c.finger = a.finger + t * (b.finger - a.finger);
@@ -399,7 +399,7 @@ double DynamicCollisionProgram::TravelFt(const ArmCommand& from, const ArmComman
   // finger moves the movable finger alone.
   const std::array<double, 6> reach = JointReachFt();
   double travel = std::abs(to.shoulder_height_ft - from.shoulder_height_ft);
-  for (int i = 0; i < 6; ++i)
+  for (int i = 0; i < kNumJoints; ++i)
     travel += std::abs(to.angles_deg[i] - from.angles_deg[i]) * (M_PI / 180.0) * reach[i];
   return travel + std::abs(FingerGapFt(to.finger) - FingerGapFt(from.finger));
 }
@@ -639,7 +639,7 @@ void DynamicCollisionProgram::LetGo() {
 // are not finite), and the reset button acted on as it is pressed.
 ArmCommand DynamicCollisionProgram::TakeInputs(const wire::OperatorInputs& in) {
   ArmCommand master;
-  for (int i = 0; i < 6; ++i) master.angles_deg[i] = in.value[i];
+  for (int i = 0; i < kNumJoints; ++i) master.angles_deg[i] = in.value[i];
   master.shoulder_height_ft = in.value[kShoulderHeight];
   master.finger = in.value[kFinger];
   status_.input_refused = !Finite(master);

@@ -92,7 +92,7 @@ const wire::OperatorInputs& Malfunctions::Delay(const wire::OperatorInputs& in) 
 void Malfunctions::Apply(const std::array<double, kNumJoints>& slave_angles_deg,
                          std::array<double, kNumJoints>* angles_deg, double* finger) {
   const double dt_s = 1.0 / frame_rate_hz_;
-  for (int i = 0; i < 6; ++i) {
+  for (int i = 0; i < kNumJoints; ++i) {
     if (!joints_[i]) continue;
     JointFault& f = *joints_[i];
     double& q = (*angles_deg)[i];
@@ -109,8 +109,12 @@ void Malfunctions::Apply(const std::array<double, kNumJoints>& slave_angles_deg,
         q = slave_angles_deg[i] + std::clamp(q - slave_angles_deg[i], -step, step);
         break;
       }
-      default:
-        break;
+      case MalfunctionKind::kFingerJammedOpen:  // not a joint's: never in joints_
+      case MalfunctionKind::kFingerJammedClosed:
+      case MalfunctionKind::kCameraLost:
+      case MalfunctionKind::kInputsDelayed:
+      case MalfunctionKind::kCount:
+        RMS_CHECK(false);
     }
   }
   if (finger_) {
@@ -126,7 +130,7 @@ bool Malfunctions::any() const {
 
 std::vector<wire::Malfunction> Malfunctions::active() const {
   std::vector<wire::Malfunction> out;
-  for (int i = 0; i < 6; ++i) {
+  for (int i = 0; i < kNumJoints; ++i) {
     if (joints_[i]) out.push_back({joints_[i]->kind, i + 1, joints_[i]->value});
   }
   if (finger_) {
@@ -134,7 +138,7 @@ std::vector<wire::Malfunction> Malfunctions::active() const {
         {finger_->open ? MalfunctionKind::kFingerJammedOpen : MalfunctionKind::kFingerJammedClosed,
          0, 0.0});
   }
-  for (int k = 1; k <= 8; ++k) {
+  for (int k = 1; k <= kNumCameraStations; ++k) {
     if (CameraLost(k)) out.push_back({MalfunctionKind::kCameraLost, k, 0.0});
   }
   if (delay_frames_ > 0) out.push_back({MalfunctionKind::kInputsDelayed, 0, delay_ms_});

@@ -382,7 +382,7 @@ void DynamicsProc::Report(const DcpStatus& st, std::int64_t frame) {
   for (int b = 0; b < wire::collision_bits::kCount; ++b) {
     if (st.collisions & (1u << b)) counters_.Add(wire::CollisionFramesCounter(b));
   }
-  if (st.mode != last_mode_) {
+  if (last_mode_ != st.mode) {  // (last_mode_: the number, 0 before the first)
     if (last_mode_ != 0) counters_.Add(Counter::kModeChanges);
     last_mode_ = wire::ModeNumber(st.mode);
   }

@@ -9,6 +9,7 @@
 #include "rms/base/toml_reader.h"
 #include "rms/session_control_t.hpp"
 #include "rms/wire/collision_bits.h"
+#include "rms/wire/dcp_mode.h"
 #include "rms/wire/malfunction.h"
 
 namespace rms::lesson {
@@ -123,8 +124,11 @@ LessonEvent ParseEvent(TomlReader& r) {
     e.at_s = r.Number("at_s", 0.0, 86400.0);
     std::snprintf(trigger, sizeof trigger, "at %g s", *e.at_s);
   } else if (r.Has("on_mode")) {
-    e.on_mode = static_cast<int>(r.Number("on_mode", 1, 3));
-    if (e.on_mode != r.Number("on_mode", 1, 3)) r.Fail("on_mode", "must be 1, 2 or 3");
+    // A DCP mode's number, 1 .. wire::kNumDcpModes (rms/wire/dcp_mode.h).
+    const double mode = r.Number("on_mode", 1, wire::kNumDcpModes);
+    e.on_mode = static_cast<int>(mode);
+    if (e.on_mode != mode)
+      r.Fail("on_mode", "must be a mode's number, 1.." + std::to_string(wire::kNumDcpModes));
     std::snprintf(trigger, sizeof trigger, "on entering Mode %d", e.on_mode);
   } else {
     e.when_text = r.String("when");

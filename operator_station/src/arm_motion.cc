@@ -21,7 +21,7 @@ double WrapDeg(double d) {
 
 JointLimits LimitsFromConfig(const LabConfig& config, double rate_deg_s) {
   JointLimits l;
-  for (int i = 0; i < 6; ++i) {
+  for (int i = 0; i < kNumJoints; ++i) {
     l.min_deg[i] = std::max(config.arm.joint_min_deg[i], config.inputs[i].min);
     l.max_deg[i] = std::min(config.arm.joint_max_deg[i], config.inputs[i].max);
     l.rate_deg_s[i] = rate_deg_s;
@@ -46,7 +46,7 @@ Matrix6d ArmJacobian(const ArmGeometry& arm, const JointAngles& q, double h,
   const std::array<Eigen::Vector3d, 6> at = {pose.p_RoS_R, pose.p_RoS_R, pose.p_RoE_R,
                                              pose.p_RoW_R, pose.p_RoW_R, pose.p_RoW_R};
   Matrix6d J;
-  for (int i = 0; i < 6; ++i) {
+  for (int i = 0; i < kNumJoints; ++i) {
     J.block<3, 1>(0, i) = axis[i].cross(Q - at[i]);
     J.block<3, 1>(3, i) = axis[i];
   }
@@ -61,7 +61,7 @@ Matrix6d DampedPseudoInverse(const Matrix6d& J, double lambda) {
   const Eigen::JacobiSVD<Matrix6d> svd(J, Eigen::ComputeFullU | Eigen::ComputeFullV);
   const Vector6d& s = svd.singularValues();
   Vector6d g = Vector6d::Zero();
-  for (int i = 0; i < 6; ++i) {
+  for (int i = 0; i < kNumJoints; ++i) {
     if (s[i] > 1e-12) g[i] = s[i] / (s[i] * s[i] + lambda * lambda);
   }
   return svd.matrixV() * g.asDiagonal() * svd.matrixU().transpose();
@@ -109,16 +109,16 @@ Vector6d SolveWithLimits(const Matrix6d& Jw, const Vector6d& xw, const JointLimi
   Vector6d dq = Vector6d::Zero();
   for (int pass = 0; pass < 7; ++pass) {
     Matrix6d Jl = Jw;
-    for (int i = 0; i < 6; ++i) {
+    for (int i = 0; i < kNumJoints; ++i) {
       if (*locked & (1u << i)) Jl.col(i).setZero();
     }
     dq = DampedPseudoInverse(Jl, lambda) * xw;
     if (!(*locked & (1u << 2))) dq += ElbowBend(Jl, q, ratio, o);
-    for (int i = 0; i < 6; ++i) {
+    for (int i = 0; i < kNumJoints; ++i) {
       if (*locked & (1u << i)) dq[i] = 0.0;
     }
     std::uint32_t pushed = 0;
-    for (int i = 0; i < 6; ++i) {
+    for (int i = 0; i < kNumJoints; ++i) {
       const double next = q[i] + dq[i] / kDeg * dt_s;
       if ((dq[i] > 0 && next > limits.max_deg[i] && q[i] >= limits.max_deg[i] - 1e-9) ||
           (dq[i] < 0 && next < limits.min_deg[i] && q[i] <= limits.min_deg[i] + 1e-9)) {
@@ -136,13 +136,13 @@ Vector6d SolveWithLimits(const Matrix6d& Jw, const Vector6d& xw, const JointLimi
 void TakeRates(Vector6d dq, const JointLimits& limits, const JointAngles& q, double dt_s,
                RateResult* r) {
   double k = 1.0;
-  for (int i = 0; i < 6; ++i) {
+  for (int i = 0; i < kNumJoints; ++i) {
     const double rate = std::abs(dq[i]) / kDeg;
     if (rate > limits.rate_deg_s[i]) k = std::min(k, limits.rate_deg_s[i] / rate);
   }
   r->rate_limited = k < 1.0;
   dq *= k;
-  for (int i = 0; i < 6; ++i) {
+  for (int i = 0; i < kNumJoints; ++i) {
     double next = q[i] + dq[i] / kDeg * dt_s;
     if (next > limits.max_deg[i] && dq[i] > 0) {
       next = std::max(q[i], limits.max_deg[i]);
@@ -180,7 +180,7 @@ RateResult ResolveRate(const ArmGeometry& arm, const JointLimits& limits, const 
   r.at_limit = locked;
   TakeRates(dq, limits, q, dt_s, &r);
   Vector6d done;
-  for (int i = 0; i < 6; ++i) done[i] = r.rate_deg_s[i] * kDeg;
+  for (int i = 0; i < kNumJoints; ++i) done[i] = r.rate_deg_s[i] * kDeg;
   r.achieved = J * done;
   return r;
 }
@@ -189,12 +189,12 @@ bool StepJointsToward(JointAngles* q, const JointAngles& target, const JointAngl
                       double dt_s) {
   double k = 1.0;
   JointAngles d{};
-  for (int i = 0; i < 6; ++i) {
+  for (int i = 0; i < kNumJoints; ++i) {
     d[i] = WrapDeg(target[i] - (*q)[i]);
     const double lim = rate_deg_s[i] * dt_s;
     if (std::abs(d[i]) > lim) k = std::min(k, lim / std::abs(d[i]));
   }
-  for (int i = 0; i < 6; ++i) (*q)[i] = WrapDeg((*q)[i] + k * d[i]);
+  for (int i = 0; i < kNumJoints; ++i) (*q)[i] = WrapDeg((*q)[i] + k * d[i]);
   return k == 1.0;
 }
 
@@ -202,7 +202,7 @@ std::optional<JointAngles> SolveWithinLimits(const ArmGeometry& arm, const Joint
                                              const Eigen::Isometry3d& X_RS2, double h) {
   const auto s = mission::SolveArmIk(arm, X_RS2, h, mission::Elbow::kUp);
   if (!s) return std::nullopt;
-  for (int i = 0; i < 6; ++i) {
+  for (int i = 0; i < kNumJoints; ++i) {
     if (s->angles_deg[i] < limits.min_deg[i] || s->angles_deg[i] > limits.max_deg[i])
       return std::nullopt;
   }

@@ -98,7 +98,7 @@ void Autopilot::Camera(CameraView view, double zoom) {
 
 std::array<double, 6> Autopilot::CommandedAngles() const {
   std::array<double, 6> q{};
-  for (int i = 0; i < 6; ++i) q[i] = cmd_.value[i];
+  for (int i = 0; i < kNumJoints; ++i) q[i] = cmd_.value[i];
   return q;
 }
 
@@ -114,7 +114,7 @@ std::optional<std::array<double, 6>> Autopilot::Solve(const Eigen::Isometry3d& X
 bool Autopilot::StepJoints(const std::array<double, 6>& target) {
   JointAngles q = CommandedAngles();
   const bool there = StepJointsToward(&q, target, limits_.rate_deg_s, dt_s_);
-  for (int i = 0; i < 6; ++i) cmd_.value[i] = q[i];
+  for (int i = 0; i < kNumJoints; ++i) cmd_.value[i] = q[i];
   return there;
 }
 
@@ -162,7 +162,7 @@ Autopilot::PlanState Autopilot::StepPlan() {
 
 bool Autopilot::Settled(const dcp_telemetry_t& tm) const {
   if (tm.held) return false;
-  for (int i = 0; i < 6; ++i) {
+  for (int i = 0; i < kNumJoints; ++i) {
     if (std::abs(WrapDeg(tm.master_angles_deg[i] - cmd_.value[i])) > 0.02) return false;
     if (std::abs(WrapDeg(tm.slave_angles_deg[i] - tm.master_angles_deg[i])) > 0.02) return false;
   }
@@ -173,13 +173,13 @@ std::string Autopilot::JointPathHits(const std::array<double, 6>& q0,
                                      const std::array<double, 6>& q1, const dcp_telemetry_t& tm,
                                      mission::PayloadState payload) const {
   double m = 0.0;
-  for (int i = 0; i < 6; ++i) m = std::max(m, std::abs(WrapDeg(q1[i] - q0[i])));
+  for (int i = 0; i < kNumJoints; ++i) m = std::max(m, std::abs(WrapDeg(q1[i] - q0[i])));
   const int n = std::max(1, static_cast<int>(std::ceil(m / 1.0)));  // a sample a degree
   const Eigen::Isometry3d X_RP = TelemetryPose(tm.p_RoPo_R_ft, tm.R_RP);
   const double margin = payload == mission::PayloadState::kInBay ? margin_ft_ : opt_.clearance_ft;
   for (int k = 1; k <= n; ++k) {
     std::array<double, 6> q{};
-    for (int i = 0; i < 6; ++i) q[i] = q0[i] + WrapDeg(q1[i] - q0[i]) * k / n;
+    for (int i = 0; i < kNumJoints; ++i) q[i] = q0[i] + WrapDeg(q1[i] - q0[i]) * k / n;
     std::string hit = mission::Interpenetration(config_, model_, q, cmd_.value[kShoulderHeight],
                                                 tm.finger_gap_ft, X_RP, payload, margin);
     if (!hit.empty()) return hit;
@@ -345,7 +345,7 @@ void Autopilot::Relieve(const dcp_telemetry_t& tm) {
   // stopped, which ends the collision (unless the slave itself started in
   // one), then move away from the contact.
   if (tm.slave_collisions == 0) {
-    for (int i = 0; i < 6; ++i) cmd_.value[i] = tm.slave_angles_deg[i];
+    for (int i = 0; i < kNumJoints; ++i) cmd_.value[i] = tm.slave_angles_deg[i];
     cmd_.value[kFinger] = tm.slave_finger;
   }
   relieved_at_frame_ = tm.frame;
@@ -386,7 +386,7 @@ void Autopilot::Resync(const wire::OperatorInputs& restored) {
 }
 
 bool Autopilot::CommandedWhereItIs(const dcp_telemetry_t& tm) const {
-  for (int i = 0; i < 6; ++i) {
+  for (int i = 0; i < kNumJoints; ++i) {
     if (std::abs(tm.master_angles_deg[i] - tm.slave_angles_deg[i]) >
         FollowWatch::kRecoverToleranceDeg)
       return false;
@@ -485,7 +485,7 @@ wire::OperatorInputs Autopilot::Step(const dcp_telemetry_t* tm_ptr) {
 
 void Autopilot::StepWaitTelemetry(const dcp_telemetry_t& tm) {
   // Take the arm as it is, so the first command moves nothing.
-  for (int i = 0; i < 6; ++i) cmd_.value[i] = tm.slave_angles_deg[i];
+  for (int i = 0; i < kNumJoints; ++i) cmd_.value[i] = tm.slave_angles_deg[i];
   cmd_.value[kShoulderHeight] = tm.slave_shoulder_height_ft;
   cmd_.value[kFinger] = tm.slave_finger;
   Camera(CameraView::kExternal);

@@ -48,7 +48,7 @@ std::vector<FollowWatch::Change> FollowWatch::Observe(const dcp_telemetry_t& t, 
   const bool captured = t.docked && !t.released;
   const bool arm_judged = !t.held && !captured;
   bool at_command = true;  // every joint where it is commanded
-  for (int i = 0; i < 6; ++i) {
+  for (int i = 0; i < kNumJoints; ++i) {
     at_command = at_command &&
                  std::abs(t.master_angles_deg[i] - t.slave_angles_deg[i]) <= kRecoverToleranceDeg;
   }

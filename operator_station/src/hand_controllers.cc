@@ -60,7 +60,7 @@ HandControllers::HandControllers(const LabConfig& config, const Bindings& bindin
       limits_(LimitsFromConfig(config, 0.0)),
       target_(wire::InitialInputs(config.inputs)),
       out_(target_) {
-  for (int i = 0; i < 6; ++i) limits_.rate_deg_s[i] = bindings.max_rate[i];
+  for (int i = 0; i < kNumJoints; ++i) limits_.rate_deg_s[i] = bindings.max_rate[i];
   status_.mode = bindings.initial_mode;
   status_.frame = bindings.initial_frame;
   status_.scale = bindings.initial_scale;
@@ -163,7 +163,7 @@ void HandControllers::StopAndRelease(const DeviceCommands& cmd) {
 }
 
 void HandControllers::FollowHeldArm(const dcp_telemetry_t& tm) {
-  for (int i = 0; i < 6; ++i) target_.value[i] = tm.slave_angles_deg[i];
+  for (int i = 0; i < kNumJoints; ++i) target_.value[i] = tm.slave_angles_deg[i];
   X_ref_.reset();
 }
 
@@ -354,7 +354,7 @@ void HandControllers::TakeAxis(int i) {
 
 ArmState HandControllers::CommandedArmState() const {
   JointAngles q{};
-  for (int i = 0; i < 6; ++i) q[i] = target_.value[i];
+  for (int i = 0; i < kNumJoints; ++i) q[i] = target_.value[i];
   ArmState s;
   s.mode = dcp_mode_;
   s.X_RS2 = ForwardPose(config_.arm, q, target_.value[kShoulderHeight]);
@@ -428,7 +428,7 @@ void HandControllers::FlyJoints(std::uint32_t bit, double dt_s) {
   const bool stow = bit == kAutoStow;
   const char* what = stow ? "stow" : "unwind";
   JointAngles q{}, goal{}, rate{};
-  for (int i = 0; i < 6; ++i) {
+  for (int i = 0; i < kNumJoints; ++i) {
     q[i] = goal[i] = target_.value[i];
     rate[i] = b_.max_rate[i];
     if (stow) goal[i] = config_.inputs[i].initial;  // where the session started it
@@ -439,7 +439,7 @@ void HandControllers::FlyJoints(std::uint32_t bit, double dt_s) {
   // No headway (held by a contact: the hand controllers carry on from the
   // pose the DCP holds) for kBlockedS: given up, and said so.
   double left = 0.0;
-  for (int i = 0; i < 6; ++i) left += std::abs(goal[i] - q[i]);
+  for (int i = 0; i < kNumJoints; ++i) left += std::abs(goal[i] - q[i]);
   auto_stalled_s_[kNumHandAxes] =
       left < auto_best_[kNumHandAxes] - 1e-3 ? 0.0 : auto_stalled_s_[kNumHandAxes] + dt_s;
   auto_best_[kNumHandAxes] = std::min(auto_best_[kNumHandAxes], left);
@@ -450,7 +450,7 @@ void HandControllers::FlyJoints(std::uint32_t bit, double dt_s) {
                  kBlockedS);
     return;
   }
-  for (int i = 0; i < 6; ++i) target_.value[i] = q[i];
+  for (int i = 0; i < kNumJoints; ++i) target_.value[i] = q[i];
   X_ref_.reset();
   status_.achieved = {};
   status_.singular = false;
@@ -557,7 +557,7 @@ std::array<double, kNumHandAxes> HandControllers::CommandedRates(const DeviceCom
 void HandControllers::FlyManualAugmented(const std::array<double, kNumHandAxes>& rate,
                                          double dt_s) {
   JointAngles q{};
-  for (int i = 0; i < 6; ++i) q[i] = target_.value[i];
+  for (int i = 0; i < kNumJoints; ++i) q[i] = target_.value[i];
   const double h = target_.value[kShoulderHeight];
   const ArmState s = CommandedArmState();
   const Eigen::Matrix3d R_RF = CommandAxes(geometry_, FlownFrame(), s);
@@ -629,7 +629,7 @@ void HandControllers::FlyManualAugmented(const std::array<double, kNumHandAxes>&
     }
   }
   const RateResult r = ResolveRate(config_.arm, limits_, q, h, por, v_fly, w_fly, dt_s);
-  for (int i = 0; i < 6; ++i) target_.value[i] = r.q_deg[i];
+  for (int i = 0; i < kNumJoints; ++i) target_.value[i] = r.q_deg[i];
   const Eigen::Vector3d v_done = R_RF.transpose() * r.achieved.head<3>();
   const Eigen::Vector3d w_done = R_RF.transpose() * r.achieved.tail<3>() / kDeg;
   status_.achieved = {v_done.x(), v_done.y(), v_done.z(), w_done.x(), w_done.y(), w_done.z()};
@@ -726,7 +726,7 @@ void HandControllers::FlySingleJoint(double rate_deg_s, double dt_s) {
 
 void HandControllers::ReportLimits(std::uint32_t at_limit) {
   status_.at_limit = at_limit;
-  for (int i = 0; i < 6; ++i) {
+  for (int i = 0; i < kNumJoints; ++i) {
     const std::uint32_t bit = 1u << i;
     const double q = target_.value[i];
     const bool on_limit = q <= limits_.min_deg[i] + 1e-6 || q >= limits_.max_deg[i] - 1e-6;
@@ -826,7 +826,7 @@ wire::OperatorInputs HandControllers::Apply(const DeviceCommands& cmd, double dt
   }
   ReportNearLimits();
   DirectInputs(cmd, dt_s);
-  for (int i = 0; i < 6; ++i) out_.value[i] = target_.value[i];
+  for (int i = 0; i < kNumJoints; ++i) out_.value[i] = target_.value[i];
   out_.camera_station = target_.camera_station;
   out_.overlay = target_.overlay;
   out_.crosshairs = target_.crosshairs;

@@ -91,7 +91,7 @@ std::string KeyHelp(const Bindings& b) {
       by_action.erase(one);
     }
   }
-  s += "  1-8 camera";
+  s += "  1-" + std::to_string(kNumCameraStations) + " camera";
   return s;
 }
 
@@ -190,7 +190,7 @@ std::optional<wire::OperatorInputs> AutopilotSource::Next(const Frame& f) {
     // telemetry says it is (no reset).
     const dcp_telemetry_t& t = *f.telemetry;
     wire::OperatorInputs from = wire::InitialInputs(config_.inputs);
-    for (int i = 0; i < 6; ++i) from.value[i] = t.master_angles_deg[i];
+    for (int i = 0; i < kNumJoints; ++i) from.value[i] = t.master_angles_deg[i];
     from.value[kShoulderHeight] = t.master_shoulder_height_ft;
     from.value[kFinger] = t.master_finger;
     autopilot_.Resync(from);

@@ -500,11 +500,11 @@ void OperatorStation::PublishState(std::int64_t frame, const std::optional<Guida
                   kAutoStow == operator_state_t::AUTO_STOW);
     static_assert(kNearLimitDeg == operator_state_t::NEAR_LIMIT_DEG);
     m.scale = static_cast<std::int8_t>(s.scale);
-    for (int i = 0; i < 6; ++i) m.achieved_rate[i] = s.achieved[i];
+    for (int i = 0; i < kNumHandAxes; ++i) m.achieved_rate[i] = s.achieved[i];
     m.automatic = static_cast<std::int16_t>(s.automatic);
     m.joints_near_limit = static_cast<std::int8_t>(s.near_limit);
     m.joint = static_cast<std::int8_t>(s.joint);
-    for (int i = 0; i < 6; ++i) m.hand_rate[i] = s.rate[i];
+    for (int i = 0; i < kNumHandAxes; ++i) m.hand_rate[i] = s.rate[i];
     m.joint_limits = static_cast<std::int8_t>(s.at_limit);
     m.singular = s.singular;
     m.sigma_min_ft = s.sigma_min_ft;
@@ -625,7 +625,7 @@ bool OperatorStation::RunFrozen() {
 void OperatorStation::ResumeFromTelemetry() {
   const dcp_telemetry_t& t = *telemetry_;
   wire::OperatorInputs from = last_;
-  for (int i = 0; i < 6; ++i) from.value[i] = t.master_angles_deg[i];
+  for (int i = 0; i < kNumJoints; ++i) from.value[i] = t.master_angles_deg[i];
   from.value[kShoulderHeight] = t.master_shoulder_height_ft;
   from.value[kFinger] = t.master_finger;
   source_->Resume(from, false);

@@ -201,7 +201,7 @@ void ControlLines(const StatusSnapshot& s, Flow& flow) {
   if (!moving) flow.Field("still");
   if (h.near_limit) {
     std::string j;
-    for (int i = 0; i < 6; ++i) {
+    for (int i = 0; i < kNumJoints; ++i) {
       if (h.near_limit & (1u << i))
         j += std::string(j.empty() ? "" : ", ") + std::string(kAnalogInputNames[i]) +
              Sprintf(" %+.1f", s.inputs.value[i]);
@@ -218,7 +218,7 @@ void ControlLines(const StatusSnapshot& s, Flow& flow) {
   }
   if (h.at_limit) {
     std::string j;
-    for (int i = 0; i < 6; ++i) {
+    for (int i = 0; i < kNumJoints; ++i) {
       if (h.at_limit & (1u << i))
         j += std::string(j.empty() ? "" : ", ") + std::string(kAnalogInputNames[i]);
     }

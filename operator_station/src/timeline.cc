@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "rms/base/check.h"
+#include "rms/base/config.h"
 
 namespace rms::operator_station {
 
@@ -80,8 +81,9 @@ void Timeline::AddItem(double t, std::string_view item, const InputCalibrations&
   const std::string_view val = item.substr(eq + 1);
   if (key == "camera") {
     double v = 0;
-    if (!ParseDouble(val, &v) || v != std::floor(v) || v < 1 || v > 8) {
-      fail("camera must be a station number 1-8, got '" + std::string(val) + "'");
+    if (!ParseDouble(val, &v) || v != std::floor(v) || v < 1 || v > kNumCameraStations) {
+      fail("camera must be a station number 1-" + std::to_string(kNumCameraStations) + ", got '" +
+           std::string(val) + "'");
     }
     camera_.emplace_back(t, static_cast<int>(v));
     return;

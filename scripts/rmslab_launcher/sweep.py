@@ -13,9 +13,10 @@ what rms_resim SESSION --set KEY=VALUE... --discard --result-json gives.
 Results are cached by the log's hash, the configuration's hash and
 the software's version, so a rerun does only what is missing.
 
-Here: the grid, the cells, the cache and the table; each runner in a module
-of its own (sweep_here.py, sweep_parallel.py, sweep_slurm.py), what they
-share in sweep_cells.py.
+Here: the grid, its cells and the run of a sweep; the cache is
+sweep_cache.py, the table sweep_table.py; each runner a module of its own
+(sweep_here.py, sweep_parallel.py, sweep_slurm.py), what they share
+sweep_cells.py.
 """
 import argparse
 import collections
@@ -262,8 +263,9 @@ def parse_args(argv):
 
 
 def run_cells(a, cells, todo, sweep_dir, cache, cached):
-    """The missing cells through GNU parallel, tried again up to --retries
-    times; each result cached as it arrives. Returns (tries again, errors)."""
+    """The missing cells on this machine (sweep_here) or through GNU parallel
+    on a lab's hosts (sweep_parallel), tried again up to --retries times;
+    each result cached as it arrives. Returns (tries again, errors)."""
     errors, retried, pending = [], 0, todo
 
     def on_result(cell, res):

@@ -8,7 +8,7 @@ station (it reads only the status screen and types only keys), each run
 with a reaction time, a rate gain and a noise seed drawn from --seed
 (rms_fly), in closed loop with the real DCP and no network. The flights go
 out as cells (a design, a kind of subject, up to --runs-per-cell runs) the
-way a replay sweep's do (sweep.py): on this machine's cores, on a lab's
+way a replay sweep's do (sweep.py and its runners): on this machine's cores, on a lab's
 hosts through GNU parallel (--hosts LABFILE), or as a Slurm array job
 (--slurm; then --cached-only for the table); each cell's result is cached,
 so a sweep stopped part way runs only what is missing. One table a design
@@ -36,7 +36,7 @@ SUBJECTS = ("autopilot", "scripted")
 FLIGHT_COLUMNS = ["design", "subject", "run", "seed", "reaction_s", "latency_frames", "rate_gain", "docked",
                   "failure", "time_s", "acquired_s", "cleared_s", "docked_s", "dock_distance_ft", "dock_angle_deg",
                   "distance_margin_ft", "angle_margin_deg", "collision_events", "held_frames", "key_actions"]
-# A cell's time limit (a batch's, as sweep.py's): a flight of max_s session
+# A cell's time limit (a batch's, as sweep_cells.py's): a flight of max_s session
 # seconds takes well under a tenth of that here, loaded (the scripted
 # operator, the slower, about 1 s for 90 s); this is several times that.
 CELL_S_BASE, CELL_S_A_FLIGHT_S = 10.0, 0.1
@@ -108,7 +108,7 @@ def parse_args(argv):
     if any(c in a.config for c in "\t\n\r"):
         raise LabError(f"--config {a.config!r}: tabs and line breaks are not allowed in its path")
     a.grid = sweep.parse_vary(a.vary)
-    a.cell_mode = "--fly-cells"  # sweep.py's runners: scripts/sweep-cell --fly-cells
+    a.cell_mode = "--fly-cells"  # the runners (sweep_here, sweep_parallel): scripts/sweep-cell --fly-cells
     return a
 
 
@@ -240,7 +240,7 @@ def write_slurm(a, out, cells, cache_dir):
 
 
 def fly_cells(a, cells, todo, out, cache, cached):
-    """The missing cells flown (sweep.py's runners), each cached as it
+    """The missing cells flown (sweep.run_cells's runners), each cached as it
     arrives. Returns (tries again, errors) or raises sweep_cells.Interrupted."""
     with sweep.stopped_by_signals():
         return sweep.run_cells(a, cells, todo, out, cache, cached)

@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "rms/base/check.h"
+#include "rms/base/config.h"
 #include "rms/dcp_model/dcp_telemetry.h"
 #include "rms/esg_renderer/gl_context.h"
 #include "rms/esg_renderer/overlay.h"
@@ -60,7 +61,8 @@ std::vector<Shot> ParseShots(const std::vector<std::string>& specs) {
     char name[256] = {};
     if (std::sscanf(spec.c_str(), "%lf:%d:%255s", &sh.t, &sh.station, name) != 3 ||
         sh.station < 1 || sh.station > kNumCameraStations) {
-      throw InputError("--shot '" + spec + "': must be TIME:STATION:NAME, station 1..8");
+      throw InputError("--shot '" + spec + "': must be TIME:STATION:NAME, station 1.." +
+                       std::to_string(kNumCameraStations));
     }
     sh.name = name;
     list.push_back(sh);

@@ -44,7 +44,7 @@ std::string Quoted(std::string_view text) {
 [[noreturn]] void Refuse(std::string_view text, const std::string& why, Grammar grammar) {
   const bool repair = grammar == Grammar::kRepair;
   throw InputError(std::string(repair ? "repair" : "malfunction") + " '" + Quoted(text) +
-                   "': " + Printable(why) + "; expected " +
+                   "': " + Printable(why) + "; a " + (repair ? "repair" : "malfunction") + " is " +
                    (repair ? RepairGrammar() : MalfunctionGrammar()));
 }
 
@@ -60,29 +60,32 @@ int Target(std::string_view text, const std::string& word, const MalfunctionPart
   return n;
 }
 
+std::string Number(double v) {
+  char buf[32];
+  const auto [p, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  return ec == std::errc() ? std::string(buf, p) : "nan";
+}
+
 double Value(std::string_view text, std::string word, const MalfunctionKindInfo& info) {
   if (!word.empty() && word[0] == '+') word.erase(0, 1);
+  if (word.find_first_not_of("-.0123456789") != std::string::npos)
+    Refuse(text, "'" + word + "' is not a plain decimal number (" + info.value + ")",
+           Grammar::kMalfunction);
   double v = 0.0;
   const auto [p, ec] = std::from_chars(word.data(), word.data() + word.size(), v);
   if (ec != std::errc() || p != word.data() + word.size() || !std::isfinite(v)) {
     Refuse(text, "'" + word + "' is not a number (" + info.value + ")", Grammar::kMalfunction);
   }
   if (v < info.min_value || v > info.max_value) {
-    std::ostringstream range;
-    range << info.min_value << " .. " << info.max_value;
-    Refuse(text, std::string(info.value) + " " + word + " is outside " + range.str(),
+    Refuse(text,
+           word + " is outside " + Number(info.min_value) + ".." + Number(info.max_value) + " (" +
+               info.value + ")",
            Grammar::kMalfunction);
   }
   if (v == 0.0 && info.kind == MalfunctionKind::kJointDrift)
     Refuse(text, "a drift of 0 is no drift (a joint that stays is 'stuck')", Grammar::kMalfunction);
   if (v == 0.0) v = 0.0;  // no -0: the text reads back the same
   return v;
-}
-
-std::string Number(double v) {
-  char buf[32];
-  const auto [p, ec] = std::to_chars(buf, buf + sizeof buf, v);
-  return ec == std::errc() ? std::string(buf, p) : "nan";
 }
 
 // A pattern's words as written (N and V upper case).
@@ -208,8 +211,10 @@ Malfunction ParseMalfunction(std::string_view text) {
     if (pattern.size() == w.size()) return Read(text, kind, pattern, w);
     if (words_wanted == 0) words_wanted = pattern.size();
   }
-  if (words_wanted > 0)
-    Refuse(text, "expected " + std::to_string(words_wanted) + " words", Grammar::kMalfunction);
+  if (words_wanted > 0) {
+    Refuse(text, std::to_string(words_wanted) + " words wanted, as " + OneOf(forms),
+           Grammar::kMalfunction);
+  }
   Refuse(text, "a malfunction of the " + std::string(part->word) + " is " + OneOf(forms),
          Grammar::kMalfunction);
 }
@@ -222,7 +227,12 @@ Repair ParseRepair(std::string_view text) {
   if (part != nullptr && part->count == 0 && w.size() == 1) return {false, part->part, 0};
   if (part != nullptr && part->count > 0 && w.size() == 2)
     return {false, part->part, Target(text, w[1], *part, Grammar::kRepair)};
-  Refuse(text, "not a repair", Grammar::kRepair);
+  if (w.empty()) Refuse(text, "empty", Grammar::kRepair);
+  if (part == nullptr) Refuse(text, "unknown part '" + w[0] + "'", Grammar::kRepair);
+  Refuse(text,
+         part->count > 0 ? std::string("'") + part->word + "' takes its number N and no more"
+                         : std::string("'") + part->word + "' takes no number",
+         Grammar::kRepair);
 }
 
 std::string MalfunctionText(const Malfunction& m) {

@@ -29,7 +29,7 @@ void PutRot(It out, const Eigen::Matrix3d& r, Counter field, Counters* c) {
 
 template <class It>
 void PutArm(It out, const arm::ArmSinCos& arm, Counters* c) {
-  for (int i = 0; i < 6; ++i) {
+  for (int i = 0; i < kNumJoints; ++i) {
     out[2 * i] = Put(wire::kSC22, arm[i].s, Counter::kSaturatedArm, c);
     out[2 * i + 1] = Put(wire::kSC22, arm[i].c, Counter::kSaturatedArm, c);
   }
@@ -66,7 +66,7 @@ struct Reader {
   }
   arm::ArmSinCos Arm(int i) const {
     arm::ArmSinCos a;
-    for (int k = 0; k < 6; ++k) {
+    for (int k = 0; k < kNumJoints; ++k) {
       a[k].s = Get(wire::kSC22, i + 2 * k);
       a[k].c = Get(wire::kSC22, i + 2 * k + 1);
       if (!(std::abs(std::hypot(a[k].s, a[k].c) - 1.0) <= 1e-3)) {

@@ -207,7 +207,7 @@ struct TraceReader {
     if (m.control_mode == operator_state_t::CONTROL_SINGLE_JOINT)
       hand[6] = m.hand_rate[0];
     else
-      for (int i = 0; i < 6; ++i) hand[i] = m.hand_rate[i];
+      for (int i = 0; i < kNumJoints; ++i) hand[i] = m.hand_rate[i];
   }
 };
 

@@ -117,8 +117,13 @@ void ControlCells(std::vector<std::string>* v, const wire::ControlWord& c) {
   Add(v, {I(c.camera_station), B(c.reset), B(c.overlay), I(c.mode), B(c.collision),
           B(c.receptacle_collision), B(c.acquired), B(c.docked)});
 }
-const char* kAngle[6] = {"shoulder_yaw [deg]", "shoulder_pitch [deg]", "elbow_pitch [deg]",
-                         "wrist_pitch [deg]",  "wrist_yaw [deg]",      "wrist_roll [deg]"};
+// The joints' angle columns, "shoulder_yaw [deg]" ..., from the inputs' names.
+std::vector<std::string> AngleColumns(const std::string& prefix = "") {
+  std::vector<std::string> v;
+  for (int j = 0; j < kNumJoints; ++j)
+    v.push_back(prefix + std::string(kAnalogInputNames[j]) + " [deg]");
+  return v;
+}
 
 std::vector<std::string> Vec3Columns(const std::string& name, const std::string& unit) {
   return {name + "_x [" + unit + "]", name + "_y [" + unit + "]", name + "_z [" + unit + "]"};
@@ -156,7 +161,7 @@ void AddPoseColumns(std::vector<std::string>* cols, const std::string& p, const 
 std::vector<std::string> DcpColumns() {
   std::vector<std::string> cols = {"log_time [us]",  "session_time [s]", "frame",
                                    "send_time [us]", "input_frame",      "input_send_time [us]"};
-  cols.insert(cols.end(), kAngle, kAngle + 6);
+  for (const auto& c : AngleColumns()) cols.push_back(c);
   for (const auto& c : ControlColumns("")) cols.push_back(c);
   AddPlaneColumns(&cols);
   Add(&cols, {"shoulder_height [ft]", "finger_gap [ft]", "camera_pan [deg]", "camera_tilt [deg]",
@@ -171,7 +176,7 @@ std::vector<std::string> EsgColumns() {
                                    "input_send_time [us]", "num_words",        "frame_count"};
   for (const auto& c : ControlColumns("")) cols.push_back(c);
   Add(&cols, {"priority_dynamic", "priority_fixed"});
-  cols.insert(cols.end(), kAngle, kAngle + 6);
+  for (const auto& c : AngleColumns()) cols.push_back(c);
   Add(&cols, {"shoulder_height [ft]", "finger_gap [ft]"});
   AddPoseColumns(&cols, "p_RoEye_R", "R_RE");
   cols.push_back("fov [deg]");
@@ -201,7 +206,7 @@ std::vector<std::string> TelemetryColumns() {
               "dock_angle [deg]"});
   AddPlaneColumns(&cols);
   for (const char* w : {"master_", "slave_"}) {
-    for (const char* a : kAngle) cols.push_back(std::string(w) + a);
+    for (const auto& c : AngleColumns(w)) cols.push_back(c);
   }
   Add(&cols, {"master_shoulder_height [ft]", "slave_shoulder_height [ft]", "master_finger [1]",
               "slave_finger [1]"});
@@ -258,7 +263,7 @@ std::vector<std::string> DcpRow(const LogMessage& msg, const std::string& t, dou
                                   I(m.send_time_us),
                                   I(m.input_frame),
                                   I(m.input_send_time_us)};
-  for (int i = 0; i < 6; ++i) row.push_back(N(Deg(d.arm[i])));
+  for (int i = 0; i < kNumJoints; ++i) row.push_back(N(Deg(d.arm[i])));
   ControlCells(&row, d.control);
   for (int k = 0; k < 3; ++k) {
     Add(&row, {B((d.plane_valid >> k) & 1), N(d.planes[k].n_R.x()), N(d.planes[k].n_R.y()),
@@ -285,7 +290,7 @@ std::vector<std::string> EsgRow(const LogMessage& msg, const std::string& t, dou
                                   I(d.frame_count)};
   ControlCells(&row, d.control);
   Add(&row, {I(d.control.priority_dynamic), I(d.control.priority_fixed)});
-  for (int i = 0; i < 6; ++i) row.push_back(N(Deg(d.arm[i])));
+  for (int i = 0; i < kNumJoints; ++i) row.push_back(N(Deg(d.arm[i])));
   Add(&row, {N(d.shoulder_height_ft), N(d.finger_gap_ft)});
   AddVec3(&row, d.p_RoEye_R_ft);
   AddMat(&row, d.R_RE);
@@ -323,8 +328,8 @@ std::vector<std::string> TelemetryRow(const LogMessage& msg, const std::string& 
     Add(&row, {B(m.plane_valid[k]), N(m.plane_n[3 * k]), N(m.plane_n[3 * k + 1]),
                N(m.plane_n[3 * k + 2]), N(m.plane_d_ft[k])});
   }
-  for (int i = 0; i < 6; ++i) row.push_back(N(m.master_angles_deg[i]));
-  for (int i = 0; i < 6; ++i) row.push_back(N(m.slave_angles_deg[i]));
+  for (int i = 0; i < kNumJoints; ++i) row.push_back(N(m.master_angles_deg[i]));
+  for (int i = 0; i < kNumJoints; ++i) row.push_back(N(m.slave_angles_deg[i]));
   Add(&row, {N(m.master_shoulder_height_ft), N(m.slave_shoulder_height_ft), N(m.master_finger),
              N(m.slave_finger)});
   for (int i = 0; i < 3; ++i) row.push_back(N(m.p_RoA_R_ft[i]));

@@ -1,38 +1,27 @@
 #include "rms/session/session_summary.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <ctime>
 #include <filesystem>
-#include <fstream>
-#include <lcm/lcm-cpp.hpp>
 #include <map>
 #include <set>
 #include <sstream>
-#include <tuple>
 
 #include "rms/base/check.h"
 #include "rms/base/config.h"
 #include "rms/base/counters.h"
 #include "rms/base/text.h"
-#include "rms/base/version.h"
 #include "rms/control_answer_t.hpp"
 #include "rms/dcp_frame_t.hpp"
 #include "rms/dcp_state_t.hpp"
 #include "rms/dcp_telemetry_t.hpp"
-#include "rms/esg_frame_t.hpp"
-#include "rms/operator_input_t.hpp"
 #include "rms/operator_state_t.hpp"
 #include "rms/process_status_t.hpp"
-#include "rms/sender_t.hpp"
 #include "rms/session/sender_check.h"
 #include "rms/session/session_folder.h"
 #include "rms/session/session_log.h"
 #include "rms/session_control_t.hpp"
-#include "rms/transport/lcm_interface.h"
 #include "rms/transport/process.h"
 #include "rms/wire/channels.h"
 #include "rms/wire/checkpoint.h"

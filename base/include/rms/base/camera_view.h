@@ -42,6 +42,15 @@ inline constexpr std::array<CameraViewInfo, static_cast<int>(CameraView::kCount)
     {CameraView::kExternal, "external", CameraMount::kShuttle, "external"},
 }};
 
+static_assert(
+    [] {
+      for (std::size_t i = 0; i < kCameraViews.size(); ++i) {
+        if (static_cast<std::size_t>(kCameraViews[i].view) != i) return false;
+      }
+      return true;
+    }(),
+    "kCameraViews is in CameraView's order");
+
 // The camera station (1..kNumCameraStations) that gives the view: the first
 // on its mount whose name has its word (any case); none when the
 // configuration has no such station (the caller then keeps the station it

@@ -7,12 +7,9 @@
 // error messages, the page's menu (/api/map), `rms_control --help` and the
 // table in docs/sessions.md (`rms_session malfunctions`, held to it by a
 // test) are all made from them. A new kind is a row of kMalfunctionKinds
-// and what the DCP does with it (rms/dcp_model/malfunctions.h):
-//
-//   MALFUNCTION  joint N stuck | joint N drift DEG_S | joint N slow DEG_S
-//                | finger jammed open | finger jammed closed
-//                | camera N lost | inputs delayed MS
-//   REPAIR       joint N | finger | camera N | inputs | all
+// and what the DCP does with it (rms/dcp_model/malfunctions.h). The grammar
+// as users read it: `rms_session malfunctions`, `rms_control malfunction
+// --help`.
 //
 // Joints are numbered as the report's angles: 1 shoulder yaw, 2 shoulder
 // pitch, 3 elbow pitch, 4 wrist pitch, 5 wrist yaw, 6 wrist roll.
@@ -55,6 +52,14 @@ inline constexpr std::array<MalfunctionPartInfo, static_cast<int>(MalfunctionPar
         {MalfunctionPart::kInputs, "inputs", "", 0},
     }};
 const MalfunctionPartInfo& PartInfo(MalfunctionPart part);
+static_assert(
+    [] {
+      for (std::size_t i = 0; i < kMalfunctionParts.size(); ++i) {
+        if (static_cast<std::size_t>(kMalfunctionParts[i].part) != i) return false;
+      }
+      return true;
+    }(),
+    "kMalfunctionParts is in MalfunctionPart's order (PartInfo reads it so)");
 
 // What a kind's text looks like, the part it acts on and what its number
 // means (the one table: the parser, the printer, the page's menu and
@@ -104,6 +109,14 @@ inline constexpr std::array<MalfunctionKindInfo, static_cast<int>(MalfunctionKin
          "one drops the oldest blocks; repaired, the next frame answers its own block"},
     }};
 const MalfunctionKindInfo& KindInfo(MalfunctionKind kind);
+static_assert(
+    [] {
+      for (std::size_t i = 0; i < kMalfunctionKinds.size(); ++i) {
+        if (static_cast<std::size_t>(kMalfunctionKinds[i].kind) != i) return false;
+      }
+      return true;
+    }(),
+    "kMalfunctionKinds is in MalfunctionKind's order (KindInfo reads it so)");
 
 // The joints and camera stations a malfunction names (their one home:
 // rms/base/analog_inputs.h, rms/base/config.h).
